@@ -1,0 +1,137 @@
+/* luxel/bake.h - per-texel lightmaps: every node that carries meshes gets a
+ * lightmap over its lightmap UVs; texels are mapped to world space by
+ * rasterizing the triangles in UV space, lit by the scene's lights with
+ * hard, blurred or no shadows, plus ambient, and padded by dilation.
+ * The baker is also the seed's real-time path: texel map and ray structures
+ * are built once; dynamic lights are re-evaluated by lx_baker_update while
+ * static lights stay baked, and lx_baker_apply combines the two.
+ *
+ * CONVENTIONS  Lightmap UVs are TEXCOORD_1 when a mesh has them, else
+ *   TEXCOORD_0 (with a warning). Texel (x, y), row 0 at the top, has its
+ *   centre at UV ((x+0.5)/W, (y+0.5)/H). Outputs are irradiance in lux
+ *   (LX_QUANTITY_IRRADIANCE) or outgoing radiance of a Lambertian surface
+ *   in nits: irradiance * base colour / pi (LX_QUANTITY_RADIANCE). Lights
+ *   using the classic model add in their own units.
+ * ERRORS  lx_baker_create names the mesh and the problem (zero-area UV
+ *   triangles, no lightmap fits in memory...). Overlapping UVs, meshes
+ *   without UVs and UVs outside [0,1] are warnings through lx_log.
+ * MEMORY  lx_baker_create copies what it needs from the scene (the scene
+ *   may be destroyed afterwards). Info structs are borrowed until
+ *   lx_baker_destroy.
+ * THREADING  One baker is used from one thread at a time; it runs OpenMP
+ *   over texel tiles internally (desc.threads). Results are bit-identical
+ *   for any thread count.
+ *
+ * USAGE
+ *   lx_bake_desc d = {.resolution = 512};
+ *   lx_baker *b;
+ *   lx_baker_create(scene, &d, &b);
+ *   lx_baker_bake(b);                                    // static lights
+ *   lx_image img; lx_baker_apply_alloc(b, 0, &img);      // baked + real-time
+ *   lx_baker_destroy(b);
+ */
+#ifndef LUXEL_BAKE_H
+#define LUXEL_BAKE_H
+
+#include "luxel/core.h"
+#include "luxel/light.h"
+#include "luxel/math.h"
+#include "luxel/scene.h"
+
+#ifdef __cplusplus
+extern "C" {
+#endif
+
+typedef struct lx_baker lx_baker;
+
+typedef enum lx_quantity {
+    LX_QUANTITY_IRRADIANCE = 0, /* lux */
+    LX_QUANTITY_RADIANCE        /* nits, irradiance * base colour / pi */
+} lx_quantity;
+
+#define LX_PADDING_NONE (-1)
+#define LX_MAX_LIGHTMAP_SIZE 16384
+
+typedef struct lx_bake_desc {
+    int resolution;      /* texels per side for every lightmap, 0 = 256 */
+    float texel_density; /* texels per metre; > 0 sizes each lightmap from its
+                            world and UV areas, rounded to a multiple of 4 */
+    int max_resolution;  /* cap for texel_density sizes, 0 = 4096 */
+    lx_quantity quantity;
+    int padding;         /* texels of dilation, 0 = 2, LX_PADDING_NONE = none */
+    int threads;         /* 0 = all cores */
+    bool skip_degenerate; /* zero-UV-area triangles: warn and skip, not fail */
+    float shadow_bias;   /* ray origin offset in metres, 0 = scale-aware auto */
+    lx_progress_fn progress;
+    void *progress_user;
+} lx_bake_desc;
+
+/* A copy of desc (or of zeros when NULL) with every default filled in. */
+lx_bake_desc lx_bake_desc_defaults(const lx_bake_desc *desc);
+
+typedef struct lx_lightmap_info {
+    uint32_t node;          /* scene node index */
+    const char *name;       /* node name */
+    int width, height;
+    int uv_set;             /* 1 = TEXCOORD_1, 0 = TEXCOORD_0 */
+    uint32_t used_texels;   /* texels covered by triangles */
+    uint32_t overlap_texels; /* texels claimed by two triangles' interiors */
+} lx_lightmap_info;
+
+/* Builds the texel maps of every node with UVs and the ray structures.
+ * Lights are copied from scene->lights, ambient from scene->ambient. */
+lx_status lx_baker_create(const lx_scene *scene, const lx_bake_desc *desc, lx_baker **out);
+void lx_baker_destroy(lx_baker *baker);
+
+uint32_t lx_baker_lightmap_count(const lx_baker *baker);
+/* Borrowed until lx_baker_destroy. */
+const lx_lightmap_info *lx_baker_lightmap_info(const lx_baker *baker, uint32_t map);
+/* width*height bytes, 1 where a texel is covered. Borrowed. */
+const uint8_t *lx_baker_mask(const lx_baker *baker, uint32_t map);
+
+/* Bakes the static (non-dynamic) lights and ambient. LX_ERR_CANCELLED when
+ * the progress callback asks to stop. */
+lx_status lx_baker_bake(lx_baker *baker);
+
+/* Light access: index as in scene->lights. Changing a static light takes
+ * effect at the next lx_baker_bake, a dynamic one at the next update. */
+uint32_t lx_baker_light_count(const lx_baker *baker);
+const lx_light *lx_baker_light(const lx_baker *baker, uint32_t light);
+lx_status lx_baker_set_light(lx_baker *baker, uint32_t light, const lx_light *value);
+
+/* Moves a node (the seed's "moving meshes"): its texels and the ray
+ * structures follow at the next update. Baked light on it is not rebaked. */
+lx_status lx_baker_set_node_transform(lx_baker *baker, uint32_t node, const lx_mat4 *world);
+
+/* Re-evaluates the dynamic lights into the real-time buffers. */
+lx_status lx_baker_update(lx_baker *baker);
+
+/* baked + real-time for one lightmap, in the desc's quantity, padded.
+ * out must be a 3-channel image of the lightmap's size. */
+lx_status lx_baker_apply(const lx_baker *baker, uint32_t map, lx_image *out);
+/* Same into a newly allocated image (free with lx_image_free). */
+lx_status lx_baker_apply_alloc(const lx_baker *baker, uint32_t map, lx_image *out);
+/* The seed's apply: saturated 8-bit RGBA (exposure multiplier, then clamp;
+ * sRGB-encoded when srgb). out must hold width*height*4 bytes. */
+lx_status lx_baker_apply_rgba8(const lx_baker *baker, uint32_t map, float exposure, bool srgb,
+                               uint8_t *out);
+
+typedef struct lx_texel_sample {
+    lx_vec3 position;  /* world, on the triangle */
+    lx_vec3 normal;    /* world shading normal (normal map applied) */
+    lx_vec3 geometric_normal;
+    uint32_t mesh;     /* scene mesh index */
+    uint32_t triangle; /* triangle in that mesh */
+} lx_texel_sample;
+
+/* The world-space sample of texel (x, y); false when it is not covered. */
+bool lx_baker_texel(const lx_baker *baker, uint32_t map, int x, int y, lx_texel_sample *out);
+
+/* Fills unused texels (mask 0) from used neighbours, one ring per pass, so
+ * bilinear sampling and mips do not bleed black. mask is updated. */
+void lx_dilate(float *data, uint8_t *mask, int width, int height, int channels, int passes);
+
+#ifdef __cplusplus
+}
+#endif
+#endif

@@ -1,0 +1,142 @@
+/* luxel/light.h - the physical light model: light types, units and their
+ * conversions, distance and angular attenuation, illuminance at a point.
+ *
+ * CONVENTIONS  Positions in metres, directions are unit vectors pointing
+ *   where the light shines (a light node's local -Z, as KHR_lights_punctual).
+ *   Intensity inside an lx_light is always candela for point and spot
+ *   lights and lux for directional lights; other units are converted when a
+ *   light is made (lx_light_intensity_to_native). Angles in radians, spot
+ *   angles measured from the axis. Colour is linear Rec.709 RGB.
+ *   Evaluation follows Filament's physically based model (seed 001): inverse
+ *   square law with the smooth window (1 - (d/r)^4)^2, the spot's smooth
+ *   angular attenuation, N.L. The seed-000 "classic" model is
+ *   ((1 - d/range) * |N.L|)^2 * colour * intensity, in the light's own units.
+ * ERRORS  Validation functions return LX_ERR_INVALID naming the light.
+ * MEMORY  lx_light is plain data.
+ * THREADING  Pure functions.
+ *
+ * USAGE
+ *   lx_light l = lx_light_defaults(LX_LIGHT_POINT);
+ *   l.position = lx_v3(0, 2, 0);
+ *   l.intensity = 800.0f;                      // candela
+ *   lx_light_eval e;
+ *   if (lx_light_evaluate(&l, p, n, &e)) use(e.illuminance);   // lux
+ */
+#ifndef LUXEL_LIGHT_H
+#define LUXEL_LIGHT_H
+
+#include "luxel/core.h"
+#include "luxel/math.h"
+
+#ifdef __cplusplus
+extern "C" {
+#endif
+
+/* Lumens per watt used to convert radiometric input (photopic maximum). */
+#define LX_LUMENS_PER_WATT 683.0f
+
+typedef enum lx_light_type {
+    LX_LIGHT_POINT = 0,
+    LX_LIGHT_SPOT,
+    LX_LIGHT_DIRECTIONAL
+} lx_light_type;
+
+typedef enum lx_shadow_mode {
+    LX_SHADOW_HARD = 0, /* one occlusion ray per texel and light */
+    LX_SHADOW_NONE,     /* lit only: nothing blocks the light */
+    LX_SHADOW_BLUR      /* the seed's dynamic blur from the nearest occluder */
+} lx_shadow_mode;
+
+typedef enum lx_falloff_model {
+    LX_MODEL_PHYSICAL = 0, /* inverse square x smooth range window (lux) */
+    LX_MODEL_CLASSIC       /* ((1 - d/range) |N.L|)^2 colour intensity */
+} lx_falloff_model;
+
+typedef enum lx_light_unit {
+    LX_UNIT_DEFAULT = 0, /* cd for point/spot, lx for directional */
+    LX_UNIT_CANDELA,
+    LX_UNIT_LUMEN,
+    LX_UNIT_WATT,
+    LX_UNIT_LUX
+} lx_light_unit;
+
+/* How a spot light's luminous power becomes intensity. */
+typedef enum lx_spot_conversion {
+    LX_SPOT_POWER_PI = 0, /* I = P / pi: illuminance does not depend on the cone */
+    LX_SPOT_POWER_CONE    /* I = P / (2 pi (1 - cos outer)): power stays in the cone */
+} lx_spot_conversion;
+
+#define LX_LIGHT_NAME_MAX 64
+
+typedef struct lx_light {
+    char name[LX_LIGHT_NAME_MAX];
+    lx_light_type type;
+    lx_vec3 position;  /* metres (point, spot) */
+    lx_vec3 direction; /* unit, where the light shines (spot, directional) */
+    lx_vec3 color;     /* linear RGB, typically max component 1 */
+    float intensity;   /* candela (point, spot) or lux (directional) */
+    float range;       /* metres; 0 = unlimited (physical), required > 0 for classic */
+    float inner_angle; /* radians from the axis, 0 <= inner <= outer */
+    float outer_angle; /* radians from the axis, 0 < outer <= pi/2 */
+    lx_falloff_model model;
+    lx_shadow_mode shadow;
+    float blur_power;      /* seed's blur exponent, default 1 */
+    float blur_multiplier; /* seed's blur scale, default 1 */
+    lx_vec3 ambient;       /* lux added everywhere in range, falling off with range */
+    bool dynamic;          /* re-evaluated by lx_baker_update instead of baked */
+} lx_light;
+
+/* A light of the given type with every default filled in: white, intensity
+ * 1, unlimited range, cone 0..pi/4, hard shadows, blur power/multiplier 1,
+ * pointing down -Y. */
+lx_light lx_light_defaults(lx_light_type type);
+
+/* Checks every field (finite, in range, unit direction); fails with
+ * LX_ERR_INVALID and "light 'name': <problem>". */
+lx_status lx_light_validate(const lx_light *light);
+
+/* Converts value in unit to the light's native unit (cd or lx) given its
+ * type and cone. Fails with LX_ERR_INVALID when the unit does not fit the
+ * type (lux for a point light, candela for a directional one). */
+lx_status lx_light_intensity_to_native(const lx_light *light, float value, lx_light_unit unit,
+                                       lx_spot_conversion spot_conversion, float *native);
+
+/* Parses "cd", "lm", "W", "lx" (and long names); LX_UNIT_DEFAULT if unknown. */
+lx_light_unit lx_light_unit_from_string(const char *s);
+const char *lx_light_unit_symbol(lx_light_unit unit);
+const char *lx_light_type_name(lx_light_type type);
+const char *lx_shadow_mode_name(lx_shadow_mode mode);
+
+/* Smooth distance window (1 - (d^2/r^2)^2)^2, 1 when range is 0. */
+float lx_light_range_window(float distance_sq, float range);
+/* Spot angular attenuation for cos of the angle to the axis. */
+float lx_light_spot_attenuation(const lx_light *light, float cos_angle);
+
+typedef struct lx_light_eval {
+    lx_vec3 to_light;   /* unit vector from the point toward the light */
+    float distance;     /* to the light, INFINITY for directional */
+    lx_vec3 illuminance; /* unshadowed, N.L included: lux (physical model) */
+    lx_vec3 ambient;    /* the light's ambient contribution at the point */
+} lx_light_eval;
+
+/* Evaluates light at point p with unit normal n. Returns false when the
+ * light contributes nothing direct there (behind, out of range or cone);
+ * ambient is filled in either case. */
+bool lx_light_evaluate(const lx_light *light, lx_vec3 p, lx_vec3 n, lx_light_eval *out);
+
+/* The seed's blur shadow factor: clamp((occluder_dist / light_dist)^power *
+ * multiplier, 0, 1), where occluder_dist is measured from the texel. */
+float lx_light_blur_visibility(const lx_light *light, float occluder_distance,
+                               float light_distance);
+
+/* ---- exposure ------------------------------------------------------------ */
+
+/* Photometric exposure multiplier for an EV100: 1 / (1.2 * 2^ev100). */
+float lx_exposure_from_ev100(float ev100);
+/* EV100 that maps an average luminance (nits) to middle grey (K = 12.5). */
+float lx_ev100_from_luminance(double average_luminance);
+
+#ifdef __cplusplus
+}
+#endif
+#endif

@@ -1,0 +1,16 @@
+/* luxel/luxel.h - the whole public API of libluxel, a lighting toolkit:
+ * core (errors, images), scene import, the physical light model, ray
+ * queries, texture-space maps and the per-texel lightmap baker.
+ * Each header documents its units, errors, memory and threading rules. */
+#ifndef LUXEL_H
+#define LUXEL_H
+
+#include "luxel/core.h"
+#include "luxel/math.h"
+#include "luxel/light.h"
+#include "luxel/scene.h"
+#include "luxel/trace.h"
+#include "luxel/maps.h"
+#include "luxel/bake.h"
+
+#endif

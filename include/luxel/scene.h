@@ -1,0 +1,138 @@
+/* luxel/scene.h - triangle meshes, materials, nodes (instances) and lights:
+ * import from glTF 2.0 / OBJ / anything assimp reads, programmatic
+ * construction, and the lights JSON that adds to or overrides a scene.
+ *
+ * CONVENTIONS  Right-handed, +Y up, metres. Mesh data is in object space;
+ *   a node places one or more meshes with its world matrix. UV origin at the
+ *   top-left of the image (glTF); OBJ's bottom-left V is flipped on import.
+ *   uv[0] is TEXCOORD_0, uv[1] TEXCOORD_1. Tangents are xyz + w handedness:
+ *   bitangent = cross(normal, tangent.xyz) * w (glTF).
+ *   Lights are world-space lx_lights with native units (cd, lx); glTF
+ *   KHR_lights_punctual fields are read exactly from the file's JSON.
+ * ERRORS  Loaders fail with a message naming the file and the place:
+ *   "room.glb: mesh 'floor': vertex 12: position is not finite".
+ *   Problems that do not stop a load (a mesh with no UVs...) are reported
+ *   through lx_log as warnings.
+ * MEMORY  lx_scene_load / lx_scene_create allocate; lx_scene_destroy frees
+ *   the scene and everything it points to. Pointers into a scene are
+ *   borrowed until lx_scene_destroy.
+ * THREADING  A scene is read-only once loaded; reading it from several
+ *   threads is safe.
+ *
+ * USAGE
+ *   lx_scene *scene;
+ *   if (lx_scene_load("room.glb", NULL, &scene) != LX_OK) die(lx_last_error());
+ *   lx_lights_json_apply(scene, "lights.json");       // optional
+ *   printf("%u nodes, %u lights\n", scene->node_count, scene->light_count);
+ *   lx_scene_destroy(scene);
+ */
+#ifndef LUXEL_SCENE_H
+#define LUXEL_SCENE_H
+
+#include "luxel/core.h"
+#include "luxel/light.h"
+#include "luxel/math.h"
+
+#ifdef __cplusplus
+extern "C" {
+#endif
+
+#define LX_MAX_UV_SETS 2
+
+typedef struct lx_mesh {
+    char *name;
+    uint32_t vertex_count;
+    uint32_t triangle_count;
+    lx_vec3 *positions;               /* vertex_count */
+    lx_vec3 *normals;                 /* vertex_count, unit length */
+    lx_vec4 *tangents;                /* vertex_count or NULL */
+    lx_vec2 *uv[LX_MAX_UV_SETS];      /* vertex_count each, or NULL */
+    uint32_t *indices;                /* 3 * triangle_count */
+    uint32_t material;                /* index into scene->materials */
+} lx_mesh;
+
+typedef struct lx_material {
+    char *name;
+    lx_vec4 base_color;   /* linear RGBA factor */
+    lx_image base_color_map; /* linear RGBA (sRGB-decoded), width 0 if none */
+    int base_color_uv_set;
+    lx_image normal_map;  /* raw tangent-space normals in [0,1], width 0 if none */
+    float normal_scale;   /* glTF normalTexture.scale, 1 by default */
+    int normal_uv_set;    /* UV set the normal map uses */
+    char *normal_map_path; /* where it came from (for messages), or NULL */
+} lx_material;
+
+typedef struct lx_node {
+    char *name;           /* unique within the scene */
+    lx_mat4 world;        /* object to world */
+    uint32_t *meshes;     /* indices into scene->meshes */
+    uint32_t mesh_count;
+} lx_node;
+
+typedef struct lx_scene {
+    char *path;           /* file the scene came from, or a given name */
+    lx_mesh *meshes;
+    uint32_t mesh_count;
+    lx_material *materials;
+    uint32_t material_count;
+    lx_node *nodes;       /* only nodes that carry meshes */
+    uint32_t node_count;
+    lx_light *lights;
+    uint32_t light_count;
+    lx_vec3 ambient;      /* constant scene ambient (lux) */
+    /* internal bookkeeping for growth; do not touch */
+    uint32_t mesh_capacity, material_capacity, node_capacity, light_capacity;
+} lx_scene;
+
+typedef struct lx_scene_load_desc {
+    bool skip_degenerate; /* warn and drop zero-area triangles instead of failing */
+} lx_scene_load_desc;
+
+/* Imports a scene file through assimp (glTF 2.0, OBJ, FBX, ...), plus the
+ * KHR_lights_punctual lights of glTF files. desc may be NULL. Triangles of
+ * zero area in space, non-finite values and out-of-range indices fail the
+ * load with a message naming the mesh (see skip_degenerate). */
+lx_status lx_scene_load(const char *path, const lx_scene_load_desc *desc, lx_scene **out);
+
+/* An empty scene named name (used in messages). */
+lx_status lx_scene_create(const char *name, lx_scene **out);
+void lx_scene_destroy(lx_scene *scene);
+
+/* Adds a copy of mesh (all arrays are copied; normals computed from faces
+ * when NULL). Returns its index in *index (may be NULL). Validates it. */
+lx_status lx_scene_add_mesh(lx_scene *scene, const lx_mesh *mesh, uint32_t *index);
+/* Adds a copy of material (normal map image copied). */
+lx_status lx_scene_add_material(lx_scene *scene, const lx_material *material, uint32_t *index);
+/* Adds a node placing meshes with world; name must be unique. */
+lx_status lx_scene_add_node(lx_scene *scene, const char *name, const lx_mat4 *world,
+                            const uint32_t *meshes, uint32_t mesh_count, uint32_t *index);
+/* Adds a copy of light after validating it; a light whose name matches an
+ * existing light's replaces it. */
+lx_status lx_scene_add_light(lx_scene *scene, const lx_light *light);
+
+/* True when triangle abc has negligible area next to its edges (its normal
+ * cannot be trusted). */
+bool lx_triangle_degenerate(lx_vec3 a, lx_vec3 b, lx_vec3 c);
+
+/* World-space bounds of every node's meshes. false when empty. */
+bool lx_scene_bounds(const lx_scene *scene, lx_vec3 *lo, lx_vec3 *hi);
+
+/* Reads a lights JSON file (docs/lights-json.md) and applies it: its
+ * "ambient" sets scene->ambient, each light is added or replaces the scene
+ * light of the same name. Fails naming the file and the field. */
+lx_status lx_lights_json_apply(lx_scene *scene, const char *path);
+/* Same from text already in memory; name is used in messages. */
+lx_status lx_lights_json_apply_text(lx_scene *scene, const char *text, size_t size,
+                                    const char *name);
+
+/* Reads the KHR_lights_punctual lights of a .gltf or .glb file and adds
+ * them, placed by their nodes' world transforms. Files without the
+ * extension add nothing. */
+lx_status lx_gltf_lights_load(lx_scene *scene, const char *path);
+lx_status lx_gltf_lights_load_memory(lx_scene *scene, const void *bytes, size_t size,
+                                     const char *name);
+
+#ifdef __cplusplus
+}
+#endif
+#endif

@@ -1,0 +1,70 @@
+/* Private to src/bake: the baker's texel maps and lighting passes. */
+#ifndef LX_BAKE_INTERNAL_H
+#define LX_BAKE_INTERNAL_H
+
+#include "luxel/bake.h"
+#include "luxel/trace.h"
+
+/* Texels are stored in tiles of TILE x TILE for coherent rays; a tile is
+ * also the unit of parallel work, so results do not depend on threads. */
+#define LX_TILE 8
+
+/* One covered texel, in object space (what survives a node moving). */
+typedef struct lx_texel {
+    uint32_t pixel;    /* y * width + x */
+    uint32_t mesh;     /* scene mesh index */
+    uint32_t triangle; /* in that mesh */
+    lx_vec3 position;  /* object space */
+    lx_vec3 normal;    /* object space shading normal, normal map applied */
+    lx_vec3 geometric_normal;
+    lx_vec3 albedo;    /* base colour (factor x texture) */
+} lx_texel;
+
+typedef struct lx_lightmap {
+    lx_lightmap_info info;
+    char *name;
+    lx_texel *texels;    /* info.used_texels, grouped by tile */
+    uint32_t *tile_start; /* tile_count + 1 offsets into texels */
+    uint32_t tile_count;
+    lx_vec3 *world_position; /* per texel, for the node's current transform */
+    lx_vec3 *world_normal;
+    lx_vec3 *world_geometric_normal;
+    uint8_t *mask;     /* width * height */
+    float *baked;      /* width * height * 3 */
+    float *realtime;   /* width * height * 3 */
+} lx_lightmap;
+
+struct lx_baker {
+    lx_bake_desc desc;
+    lx_lightmap *maps;
+    uint32_t map_count;
+    uint32_t *node_map;  /* scene node -> map index or UINT32_MAX */
+    uint32_t node_count;
+    lx_mat4 *node_world;
+    lx_light *lights;
+    uint32_t light_count;
+    lx_vec3 ambient;
+    lx_tracer *tracer;
+    bool tracer_dirty;
+    float scene_diagonal;
+    float bias;          /* shadow ray origin offset, metres */
+};
+
+/* Builds the texel map of scene node `node` into map (texel_map.c).
+ * Returns LX_OK with map->info.used_texels == 0 and a warning when the
+ * node has no UVs to bake. */
+lx_status lx_texel_map_build(const lx_scene *scene, uint32_t node, const lx_bake_desc *desc,
+                             lx_lightmap *map);
+void lx_texel_map_free(lx_lightmap *map);
+/* Recomputes world positions and normals from a node transform. */
+void lx_texel_map_transform(lx_lightmap *map, const lx_mat4 *world);
+
+/* Adds the given lights (indices into baker->lights) into target
+ * (width*height*3 floats per map), plus `ambient` at every texel
+ * (direct.c). progress_base/progress_span place this pass in the whole
+ * operation's progress. */
+lx_status lx_bake_lights(lx_baker *baker, const uint32_t *lights, uint32_t light_count,
+                         lx_vec3 ambient, bool to_realtime, float progress_base,
+                         float progress_span);
+
+#endif

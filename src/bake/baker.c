@@ -1,0 +1,322 @@
+/* The baker: builds a texel map per node and the ray structures once, bakes
+ * static lights, re-evaluates dynamic lights per update and combines the
+ * two (seed 000's initial frame / update frame / Apply kernel). */
+#include "bake_internal.h"
+
+#include <stdio.h>
+#include <stdlib.h>
+#include <string.h>
+
+lx_bake_desc lx_bake_desc_defaults(const lx_bake_desc *desc)
+{
+    lx_bake_desc d = {0};
+    if (desc)
+        d = *desc;
+    if (d.resolution == 0)
+        d.resolution = 256;
+    if (d.max_resolution == 0)
+        d.max_resolution = 4096;
+    if (d.padding == 0)
+        d.padding = 2;
+    return d;
+}
+
+static lx_status validate_desc(const lx_bake_desc *d)
+{
+    if (d->resolution < 1 || d->resolution > LX_MAX_LIGHTMAP_SIZE)
+        return lx_fail(LX_ERR_INVALID, "resolution %d is outside 1..%d", d->resolution,
+                       LX_MAX_LIGHTMAP_SIZE);
+    if (d->max_resolution < 4 || d->max_resolution > LX_MAX_LIGHTMAP_SIZE)
+        return lx_fail(LX_ERR_INVALID, "max resolution %d is outside 4..%d", d->max_resolution,
+                       LX_MAX_LIGHTMAP_SIZE);
+    if (!(d->texel_density >= 0.0f) || !isfinite(d->texel_density))
+        return lx_fail(LX_ERR_INVALID, "texel density must be a finite positive number");
+    if (d->padding < LX_PADDING_NONE || d->padding > 64)
+        return lx_fail(LX_ERR_INVALID, "padding %d is outside 0..64", d->padding);
+    if (d->threads < 0 || d->threads > 1024)
+        return lx_fail(LX_ERR_INVALID, "thread count %d is outside 0..1024", d->threads);
+    if (!(d->shadow_bias >= 0.0f) || !isfinite(d->shadow_bias))
+        return lx_fail(LX_ERR_INVALID, "shadow bias must be finite and >= 0");
+    if (d->quantity != LX_QUANTITY_IRRADIANCE && d->quantity != LX_QUANTITY_RADIANCE)
+        return lx_fail(LX_ERR_INVALID, "unknown quantity %d", (int)d->quantity);
+    return LX_OK;
+}
+
+lx_status lx_baker_create(const lx_scene *scene, const lx_bake_desc *in, lx_baker **out)
+{
+    *out = NULL;
+    lx_bake_desc desc = lx_bake_desc_defaults(in);
+    lx_status st = validate_desc(&desc);
+    if (st != LX_OK)
+        return st;
+    for (uint32_t l = 0; l < scene->light_count; l++)
+        if ((st = lx_light_validate(&scene->lights[l])) != LX_OK)
+            return st;
+    if (!lx_vec3_finite(scene->ambient) || scene->ambient.x < 0 || scene->ambient.y < 0 ||
+        scene->ambient.z < 0)
+        return lx_fail(LX_ERR_INVALID, "%s: ambient must be finite and >= 0", scene->path);
+
+    lx_baker *b = calloc(1, sizeof *b);
+    if (!b)
+        return lx_fail(LX_ERR_NOMEM, "out of memory creating a baker");
+    b->desc = desc;
+    b->ambient = scene->ambient;
+    b->node_count = scene->node_count;
+    b->node_map = malloc(sizeof(uint32_t) * (scene->node_count + 1));
+    b->node_world = malloc(sizeof(lx_mat4) * (scene->node_count + 1));
+    b->maps = calloc(scene->node_count + 1, sizeof(lx_lightmap));
+    b->light_count = scene->light_count;
+    b->lights = malloc(sizeof(lx_light) * (scene->light_count + 1));
+    if (!b->node_map || !b->node_world || !b->maps || !b->lights) {
+        lx_baker_destroy(b);
+        return lx_fail(LX_ERR_NOMEM, "out of memory creating a baker");
+    }
+    if (scene->light_count)
+        memcpy(b->lights, scene->lights, sizeof(lx_light) * scene->light_count);
+
+    lx_vec3 lo, hi;
+    b->scene_diagonal = lx_scene_bounds(scene, &lo, &hi) ? lx_length(lx_sub(hi, lo)) : 1.0f;
+    if (!(b->scene_diagonal > 0.0f))
+        b->scene_diagonal = 1.0f;
+    b->bias = desc.shadow_bias > 0.0f ? desc.shadow_bias : 1e-5f * b->scene_diagonal;
+
+    /* memory for every lightmap together, before allocating any */
+    if (desc.texel_density == 0.0f) {
+        uint64_t px = (uint64_t)desc.resolution * (uint64_t)desc.resolution;
+        uint64_t bytes = px * (64 + sizeof(lx_texel)) * (uint64_t)scene->node_count;
+        char what[96];
+        snprintf(what, sizeof what, "%u lightmaps of %dx%d", scene->node_count,
+                 desc.resolution, desc.resolution);
+        if ((st = lx_check_memory(bytes, what)) != LX_OK) {
+            lx_baker_destroy(b);
+            return st;
+        }
+    }
+    for (uint32_t n = 0; n < scene->node_count; n++) {
+        b->node_world[n] = scene->nodes[n].world;
+        b->node_map[n] = UINT32_MAX;
+        lx_lightmap *map = &b->maps[b->map_count];
+        st = lx_texel_map_build(scene, n, &desc, map);
+        if (st != LX_OK) {
+            lx_texel_map_free(map);
+            lx_baker_destroy(b);
+            return st;
+        }
+        if (map->info.width == 0) {
+            lx_texel_map_free(map); /* no UVs: nothing to bake */
+            continue;
+        }
+        b->node_map[n] = b->map_count++;
+    }
+    st = lx_tracer_create(scene, &b->tracer);
+    if (st != LX_OK) {
+        lx_baker_destroy(b);
+        return st;
+    }
+    *out = b;
+    return LX_OK;
+}
+
+void lx_baker_destroy(lx_baker *b)
+{
+    if (!b)
+        return;
+    for (uint32_t m = 0; m < b->map_count; m++)
+        lx_texel_map_free(&b->maps[m]);
+    lx_tracer_destroy(b->tracer);
+    free(b->maps);
+    free(b->node_map);
+    free(b->node_world);
+    free(b->lights);
+    free(b);
+}
+
+uint32_t lx_baker_lightmap_count(const lx_baker *b) { return b->map_count; }
+
+const lx_lightmap_info *lx_baker_lightmap_info(const lx_baker *b, uint32_t map)
+{
+    return map < b->map_count ? &b->maps[map].info : NULL;
+}
+
+const uint8_t *lx_baker_mask(const lx_baker *b, uint32_t map)
+{
+    return map < b->map_count ? b->maps[map].mask : NULL;
+}
+
+uint32_t lx_baker_light_count(const lx_baker *b) { return b->light_count; }
+
+const lx_light *lx_baker_light(const lx_baker *b, uint32_t light)
+{
+    return light < b->light_count ? &b->lights[light] : NULL;
+}
+
+lx_status lx_baker_set_light(lx_baker *b, uint32_t light, const lx_light *value)
+{
+    if (light >= b->light_count)
+        return lx_fail(LX_ERR_INVALID, "light %u out of range (count %u)", light,
+                       b->light_count);
+    lx_status st = lx_light_validate(value);
+    if (st != LX_OK)
+        return st;
+    b->lights[light] = *value;
+    return LX_OK;
+}
+
+lx_status lx_baker_set_node_transform(lx_baker *b, uint32_t node, const lx_mat4 *world)
+{
+    if (node >= b->node_count)
+        return lx_fail(LX_ERR_INVALID, "node %u out of range (count %u)", node, b->node_count);
+    lx_status st = lx_tracer_set_node_transform(b->tracer, node, world);
+    if (st != LX_OK)
+        return st;
+    b->node_world[node] = *world;
+    b->tracer_dirty = true;
+    if (b->node_map[node] != UINT32_MAX)
+        lx_texel_map_transform(&b->maps[b->node_map[node]], world);
+    return LX_OK;
+}
+
+/* Indices of the lights with dynamic == want. */
+static uint32_t select_lights(const lx_baker *b, bool want, uint32_t *out)
+{
+    uint32_t n = 0;
+    for (uint32_t l = 0; l < b->light_count; l++)
+        if (b->lights[l].dynamic == want)
+            out[n++] = l;
+    return n;
+}
+
+static void clear_buffers(lx_baker *b, bool realtime)
+{
+    for (uint32_t m = 0; m < b->map_count; m++) {
+        lx_lightmap *map = &b->maps[m];
+        size_t n = (size_t)map->info.width * map->info.height * 3;
+        memset(realtime ? map->realtime : map->baked, 0, n * sizeof(float));
+    }
+}
+
+lx_status lx_baker_bake(lx_baker *b)
+{
+    uint32_t *idx = malloc(sizeof(uint32_t) * (b->light_count + 1));
+    if (!idx)
+        return lx_fail(LX_ERR_NOMEM, "out of memory");
+    uint32_t n = select_lights(b, false, idx);
+    clear_buffers(b, false);
+    lx_status st = lx_bake_lights(b, idx, n, b->ambient, false, 0.0f, 1.0f);
+    if (st != LX_OK)
+        clear_buffers(b, false);
+    free(idx);
+    return st;
+}
+
+lx_status lx_baker_update(lx_baker *b)
+{
+    uint32_t idx_buf[64];
+    uint32_t *idx = b->light_count <= 64 ? idx_buf : malloc(sizeof(uint32_t) * b->light_count);
+    if (!idx)
+        return lx_fail(LX_ERR_NOMEM, "out of memory");
+    uint32_t n = select_lights(b, true, idx);
+    clear_buffers(b, true);
+    lx_bake_desc saved = b->desc;
+    b->desc.progress = NULL; /* per-frame work reports no progress */
+    lx_status st = lx_bake_lights(b, idx, n, lx_v3(0, 0, 0), true, 0.0f, 1.0f);
+    b->desc = saved;
+    if (idx != idx_buf)
+        free(idx);
+    return st;
+}
+
+lx_status lx_baker_apply(const lx_baker *b, uint32_t map_index, lx_image *out)
+{
+    if (map_index >= b->map_count)
+        return lx_fail(LX_ERR_INVALID, "lightmap %u out of range (count %u)", map_index,
+                       b->map_count);
+    const lx_lightmap *map = &b->maps[map_index];
+    int w = map->info.width, h = map->info.height;
+    if (!out || out->width != w || out->height != h || out->channels != 3 || !out->data)
+        return lx_fail(LX_ERR_INVALID, "lightmap '%s': output must be a %dx%d RGB image",
+                       map->name, w, h);
+    size_t pixels = (size_t)w * h;
+    memset(out->data, 0, pixels * 3 * sizeof(float));
+    for (uint32_t i = 0; i < map->info.used_texels; i++) {
+        const lx_texel *t = &map->texels[i];
+        size_t p = t->pixel;
+        lx_vec3 e = lx_v3(map->baked[3 * p] + map->realtime[3 * p],
+                          map->baked[3 * p + 1] + map->realtime[3 * p + 1],
+                          map->baked[3 * p + 2] + map->realtime[3 * p + 2]);
+        if (b->desc.quantity == LX_QUANTITY_RADIANCE)
+            e = lx_scale(lx_mul(e, t->albedo), 1.0f / LX_PI);
+        out->data[3 * p] = e.x;
+        out->data[3 * p + 1] = e.y;
+        out->data[3 * p + 2] = e.z;
+    }
+    if (b->desc.padding > 0) {
+        uint8_t *mask = malloc(pixels);
+        if (!mask)
+            return lx_fail(LX_ERR_NOMEM, "out of memory");
+        memcpy(mask, map->mask, pixels);
+        lx_dilate(out->data, mask, w, h, 3, b->desc.padding);
+        free(mask);
+    }
+    return LX_OK;
+}
+
+lx_status lx_baker_apply_alloc(const lx_baker *b, uint32_t map, lx_image *out)
+{
+    memset(out, 0, sizeof *out);
+    if (map >= b->map_count)
+        return lx_fail(LX_ERR_INVALID, "lightmap %u out of range (count %u)", map, b->map_count);
+    lx_status st = lx_image_alloc(out, b->maps[map].info.width, b->maps[map].info.height, 3);
+    if (st != LX_OK)
+        return st;
+    st = lx_baker_apply(b, map, out);
+    if (st != LX_OK)
+        lx_image_free(out);
+    return st;
+}
+
+lx_status lx_baker_apply_rgba8(const lx_baker *b, uint32_t map, float exposure, bool srgb,
+                               uint8_t *out)
+{
+    lx_image img;
+    lx_status st = lx_baker_apply_alloc(b, map, &img);
+    if (st != LX_OK)
+        return st;
+    size_t pixels = (size_t)img.width * img.height;
+    for (size_t p = 0; p < pixels; p++) {
+        for (int c = 0; c < 3; c++) {
+            float v = lx_saturate(img.data[3 * p + c] * exposure);
+            if (srgb)
+                v = lx_linear_to_srgb(v);
+            out[4 * p + c] = (uint8_t)(v * 255.0f + 0.5f);
+        }
+        out[4 * p + 3] = b->maps[map].mask[p] ? 255 : 0;
+    }
+    lx_image_free(&img);
+    return LX_OK;
+}
+
+bool lx_baker_texel(const lx_baker *b, uint32_t map_index, int x, int y, lx_texel_sample *out)
+{
+    if (map_index >= b->map_count)
+        return false;
+    const lx_lightmap *map = &b->maps[map_index];
+    if (x < 0 || y < 0 || x >= map->info.width || y >= map->info.height)
+        return false;
+    uint32_t pixel = (uint32_t)y * (uint32_t)map->info.width + (uint32_t)x;
+    if (!map->mask[pixel])
+        return false;
+    /* texels are stored by tile; find the tile, then scan its few texels */
+    int tiles_x = (map->info.width + LX_TILE - 1) / LX_TILE;
+    uint32_t tile = (uint32_t)(y / LX_TILE) * (uint32_t)tiles_x + (uint32_t)(x / LX_TILE);
+    for (uint32_t i = map->tile_start[tile]; i < map->tile_start[tile + 1]; i++)
+        if (map->texels[i].pixel == pixel) {
+            out->position = map->world_position[i];
+            out->normal = map->world_normal[i];
+            out->geometric_normal = map->world_geometric_normal[i];
+            out->mesh = map->texels[i].mesh;
+            out->triangle = map->texels[i].triangle;
+            return true;
+        }
+    return false;
+}

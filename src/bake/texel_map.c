@@ -1,0 +1,539 @@
+/* Texel map: lightmap texels mapped to world space. Seed 000 searches every
+ * triangle for every texel; here each triangle is rasterized in UV space
+ * instead, O(texels + triangles). Pass 1 gives each texel whose centre lies
+ * in a triangle that triangle's barycentric point; pass 2 gives texels a
+ * triangle only partly covers (chart borders) the triangle's closest point
+ * to the texel centre, so chart edges get real samples and do not go dark. */
+#include "bake_internal.h"
+
+#include "luxel/maps.h"
+
+#include <stdio.h>
+#include <stdlib.h>
+#include <string.h>
+
+typedef struct raster_ctx {
+    int width, height;
+    uint32_t *owner;    /* per pixel: node-local triangle id, UINT32_MAX = none */
+    float *b1, *b2;     /* barycentrics of vertices 1 and 2 */
+    float *distance;    /* 0 for centre coverage, else texel-space distance */
+    uint8_t *strict;    /* centre strictly inside the owner */
+    uint32_t overlap;
+} raster_ctx;
+
+typedef struct slot {
+    const lx_mesh *mesh;
+    uint32_t mesh_index;
+    uint32_t first_triangle; /* node-local id of the mesh's triangle 0 */
+    const lx_vec2 *uv;
+} slot;
+
+/* Barycentrics (w0, w1, w2) of point p in triangle abc, in double so edge
+ * decisions do not depend on evaluation order. false if degenerate. */
+static bool barycentric(const double a[2], const double b[2], const double c[2], double px,
+                        double py, double w[3])
+{
+    double d = (b[0] - a[0]) * (c[1] - a[1]) - (c[0] - a[0]) * (b[1] - a[1]);
+    if (d == 0.0)
+        return false;
+    w[1] = ((px - a[0]) * (c[1] - a[1]) - (c[0] - a[0]) * (py - a[1])) / d;
+    w[2] = ((b[0] - a[0]) * (py - a[1]) - (px - a[0]) * (b[1] - a[1])) / d;
+    w[0] = 1.0 - w[1] - w[2];
+    return true;
+}
+
+/* Closest point of triangle abc to p (Ericson, Real-Time Collision
+ * Detection 5.1.5), as barycentrics. */
+static void closest_on_triangle(const double a[2], const double b[2], const double c[2],
+                                const double p[2], double w[3])
+{
+    double ab[2] = {b[0] - a[0], b[1] - a[1]}, ac[2] = {c[0] - a[0], c[1] - a[1]};
+    double ap[2] = {p[0] - a[0], p[1] - a[1]};
+    double d1 = ab[0] * ap[0] + ab[1] * ap[1], d2 = ac[0] * ap[0] + ac[1] * ap[1];
+    if (d1 <= 0 && d2 <= 0) {
+        w[0] = 1, w[1] = 0, w[2] = 0;
+        return;
+    }
+    double bp[2] = {p[0] - b[0], p[1] - b[1]};
+    double d3 = ab[0] * bp[0] + ab[1] * bp[1], d4 = ac[0] * bp[0] + ac[1] * bp[1];
+    if (d3 >= 0 && d4 <= d3) {
+        w[0] = 0, w[1] = 1, w[2] = 0;
+        return;
+    }
+    double vc = d1 * d4 - d3 * d2;
+    if (vc <= 0 && d1 >= 0 && d3 <= 0) {
+        double v = d1 / (d1 - d3);
+        w[0] = 1 - v, w[1] = v, w[2] = 0;
+        return;
+    }
+    double cp[2] = {p[0] - c[0], p[1] - c[1]};
+    double d5 = ab[0] * cp[0] + ab[1] * cp[1], d6 = ac[0] * cp[0] + ac[1] * cp[1];
+    if (d6 >= 0 && d5 <= d6) {
+        w[0] = 0, w[1] = 0, w[2] = 1;
+        return;
+    }
+    double vb = d5 * d2 - d1 * d6;
+    if (vb <= 0 && d2 >= 0 && d6 <= 0) {
+        double t = d2 / (d2 - d6);
+        w[0] = 1 - t, w[1] = 0, w[2] = t;
+        return;
+    }
+    double va = d3 * d6 - d5 * d4;
+    if (va <= 0 && (d4 - d3) >= 0 && (d5 - d6) >= 0) {
+        double t = (d4 - d3) / ((d4 - d3) + (d5 - d6));
+        w[0] = 0, w[1] = 1 - t, w[2] = t;
+        return;
+    }
+    double denom = 1.0 / (va + vb + vc);
+    w[1] = vb * denom;
+    w[2] = vc * denom;
+    w[0] = 1 - w[1] - w[2];
+}
+
+/* Does triangle abc overlap the axis-aligned square [x0,x0+1]x[y0,y0+1]?
+ * Separating axes: the square's two axes and the triangle's edge normals. */
+static bool triangle_overlaps_texel(const double *v[3], double x0, double y0)
+{
+    double minx = fmin(v[0][0], fmin(v[1][0], v[2][0]));
+    double maxx = fmax(v[0][0], fmax(v[1][0], v[2][0]));
+    double miny = fmin(v[0][1], fmin(v[1][1], v[2][1]));
+    double maxy = fmax(v[0][1], fmax(v[1][1], v[2][1]));
+    if (maxx < x0 || minx > x0 + 1 || maxy < y0 || miny > y0 + 1)
+        return false;
+    double corners[4][2] = {{x0, y0}, {x0 + 1, y0}, {x0, y0 + 1}, {x0 + 1, y0 + 1}};
+    for (int e = 0; e < 3; e++) {
+        const double *p = v[e], *q = v[(e + 1) % 3], *r = v[(e + 2) % 3];
+        double nx = q[1] - p[1], ny = p[0] - q[0];
+        double side = nx * (r[0] - p[0]) + ny * (r[1] - p[1]);
+        bool all_out = true;
+        for (int k = 0; k < 4 && all_out; k++) {
+            double s = nx * (corners[k][0] - p[0]) + ny * (corners[k][1] - p[1]);
+            all_out = side > 0 ? s < 0 : s > 0;
+        }
+        if (all_out)
+            return false;
+    }
+    return true;
+}
+
+static void uv_to_texel(const raster_ctx *r, lx_vec2 uv, double out[2])
+{
+    out[0] = (double)uv.x * r->width;
+    out[1] = (double)uv.y * r->height;
+}
+
+static void bbox(const double *v[3], int pad, const raster_ctx *r, int *x0, int *y0, int *x1,
+                 int *y1)
+{
+    double minx = fmin(v[0][0], fmin(v[1][0], v[2][0]));
+    double maxx = fmax(v[0][0], fmax(v[1][0], v[2][0]));
+    double miny = fmin(v[0][1], fmin(v[1][1], v[2][1]));
+    double maxy = fmax(v[0][1], fmax(v[1][1], v[2][1]));
+    /* clamp in double before converting: UVs far outside [0,1] stay cheap */
+    *x0 = (int)fmax(floor(minx) - pad, 0.0);
+    *y0 = (int)fmax(floor(miny) - pad, 0.0);
+    *x1 = (int)fmin(floor(maxx) + pad, r->width - 1.0);
+    *y1 = (int)fmin(floor(maxy) + pad, r->height - 1.0);
+}
+
+static void raster_centres(raster_ctx *r, const double *v[3], uint32_t id)
+{
+    int x0, y0, x1, y1;
+    bbox(v, 0, r, &x0, &y0, &x1, &y1);
+    const double strict_eps = 1e-6;
+    for (int y = y0; y <= y1; y++)
+        for (int x = x0; x <= x1; x++) {
+            double w[3];
+            if (!barycentric(v[0], v[1], v[2], x + 0.5, y + 0.5, w))
+                return;
+            if (w[0] < 0 || w[1] < 0 || w[2] < 0)
+                continue;
+            size_t p = (size_t)y * r->width + x;
+            bool strict = w[0] > strict_eps && w[1] > strict_eps && w[2] > strict_eps;
+            if (r->owner[p] != UINT32_MAX) {
+                /* an edge shared by neighbours is not an overlap */
+                if (strict && r->strict[p])
+                    r->overlap++;
+                continue;
+            }
+            r->owner[p] = id;
+            r->b1[p] = (float)w[1];
+            r->b2[p] = (float)w[2];
+            r->distance[p] = 0.0f;
+            r->strict[p] = strict;
+        }
+}
+
+static void raster_borders(raster_ctx *r, const double *v[3], uint32_t id)
+{
+    int x0, y0, x1, y1;
+    bbox(v, 1, r, &x0, &y0, &x1, &y1);
+    for (int y = y0; y <= y1; y++)
+        for (int x = x0; x <= x1; x++) {
+            size_t p = (size_t)y * r->width + x;
+            if (r->owner[p] != UINT32_MAX && r->distance[p] == 0.0f)
+                continue; /* centre already covered */
+            if (!triangle_overlaps_texel(v, x, y))
+                continue;
+            double c[2] = {x + 0.5, y + 0.5}, w[3];
+            closest_on_triangle(v[0], v[1], v[2], c, w);
+            /* nudge the sample off the edge, into the triangle */
+            const double nudge = 1e-3;
+            for (int k = 0; k < 3; k++)
+                w[k] = w[k] * (1 - nudge) + nudge / 3;
+            double px = w[0] * v[0][0] + w[1] * v[1][0] + w[2] * v[2][0];
+            double py = w[0] * v[0][1] + w[1] * v[1][1] + w[2] * v[2][1];
+            float d = (float)hypot(px - c[0], py - c[1]);
+            if (d <= 0.0f)
+                d = 1e-9f;
+            if (r->owner[p] != UINT32_MAX && r->distance[p] <= d)
+                continue;
+            r->owner[p] = id;
+            r->b1[p] = (float)w[1];
+            r->b2[p] = (float)w[2];
+            r->distance[p] = d;
+        }
+}
+
+/* Lightmap size for texel density: R^2 * uv_area = T^2 * world_area. */
+static int size_from_density(const lx_scene *scene, const lx_node *node, const slot *slots,
+                             uint32_t slot_count, const lx_bake_desc *desc)
+{
+    double world_area = 0, uv_area = 0;
+    for (uint32_t s = 0; s < slot_count; s++) {
+        const lx_mesh *m = slots[s].mesh;
+        for (uint32_t t = 0; t < m->triangle_count; t++) {
+            const uint32_t *i = &m->indices[3 * t];
+            lx_vec3 a = lx_mat4_point(&node->world, m->positions[i[0]]);
+            lx_vec3 b = lx_mat4_point(&node->world, m->positions[i[1]]);
+            lx_vec3 c = lx_mat4_point(&node->world, m->positions[i[2]]);
+            world_area += 0.5 * lx_length(lx_cross(lx_sub(b, a), lx_sub(c, a)));
+            lx_vec2 ua = slots[s].uv[i[0]], ub = slots[s].uv[i[1]], uc = slots[s].uv[i[2]];
+            uv_area += 0.5 * fabs((double)(ub.x - ua.x) * (uc.y - ua.y) -
+                                  (double)(uc.x - ua.x) * (ub.y - ua.y));
+        }
+    }
+    (void)scene;
+    if (!(uv_area > 0))
+        return 4;
+    double r = desc->texel_density * sqrt(world_area / uv_area);
+    int size = (int)(ceil(r / 4.0) * 4.0);
+    if (size < 4)
+        size = 4;
+    if (size > desc->max_resolution) {
+        lx_log(LX_LOG_WARN,
+               "node '%s': %.0f texels per side needed for %.3g texels/m; capped at %d",
+               node->name, r, desc->texel_density, desc->max_resolution);
+        size = desc->max_resolution;
+    }
+    return size;
+}
+
+static lx_status check_uv_triangles(const lx_scene *scene, const slot *s, const lx_node *node,
+                                    const lx_bake_desc *desc, int uv_set, uint8_t *skip)
+{
+    uint32_t degenerate = 0, outside = 0;
+    const lx_mesh *m = s->mesh;
+    for (uint32_t t = 0; t < m->triangle_count; t++) {
+        const uint32_t *i = &m->indices[3 * t];
+        lx_vec2 a = s->uv[i[0]], b = s->uv[i[1]], c = s->uv[i[2]];
+        double e1x = b.x - a.x, e1y = b.y - a.y, e2x = c.x - a.x, e2y = c.y - a.y;
+        double cross = e1x * e2y - e2x * e1y;
+        double longest = fmax(e1x * e1x + e1y * e1y,
+                              fmax(e2x * e2x + e2y * e2y,
+                                   (c.x - b.x) * (double)(c.x - b.x) +
+                                       (c.y - b.y) * (double)(c.y - b.y)));
+        skip[t] = 0;
+        if (!(fabs(cross) > 1e-7 * longest) || longest == 0.0) {
+            if (!desc->skip_degenerate)
+                return lx_fail(LX_ERR_FORMAT,
+                               "%s: mesh '%s': triangle %u has zero area in TEXCOORD_%d "
+                               "(--skip-degenerate skips such triangles)",
+                               scene->path, m->name, t, uv_set);
+            skip[t] = 1;
+            degenerate++;
+            continue;
+        }
+        float lo = fminf(a.x, fminf(b.x, fminf(c.x, fminf(a.y, fminf(b.y, c.y)))));
+        float hi = fmaxf(a.x, fmaxf(b.x, fmaxf(c.x, fmaxf(a.y, fmaxf(b.y, c.y)))));
+        if (lo < 0.0f || hi > 1.0f)
+            outside++;
+    }
+    if (degenerate)
+        lx_log(LX_LOG_WARN, "%s: node '%s': mesh '%s': %u triangles with zero UV area skipped",
+               scene->path, node->name, m->name, degenerate);
+    if (outside)
+        lx_log(LX_LOG_WARN,
+               "%s: node '%s': mesh '%s': %u triangles reach outside the [0,1] lightmap; "
+               "the parts outside get no texels",
+               scene->path, node->name, m->name, outside);
+    return LX_OK;
+}
+
+static void sample_normal_map(const lx_material *mat, const lx_mesh *m, const lx_vec4 *tangents,
+                              const uint32_t *i, float w0, float w1, float w2, lx_vec3 *normal)
+{
+    const lx_vec2 *uv = m->uv[mat->normal_uv_set];
+    float u = uv[i[0]].x * w0 + uv[i[1]].x * w1 + uv[i[2]].x * w2;
+    float v = uv[i[0]].y * w0 + uv[i[1]].y * w1 + uv[i[2]].y * w2;
+    float c[4];
+    lx_image_sample_bilinear(&mat->normal_map, u, v, c);
+    lx_vec3 t = lx_v3(0, 0, 0);
+    for (int k = 0; k < 3; k++) {
+        float wk = k == 0 ? w0 : (k == 1 ? w1 : w2);
+        t = lx_madd(t, lx_v3(tangents[i[k]].x, tangents[i[k]].y, tangents[i[k]].z), wk);
+    }
+    lx_vec3 mn = lx_v3((2.0f * c[0] - 1.0f) * mat->normal_scale,
+                       (2.0f * c[1] - 1.0f) * mat->normal_scale, 2.0f * c[2] - 1.0f);
+    *normal = lx_tangent_to_world(mn, *normal, lx_v4(t.x, t.y, t.z, tangents[i[0]].w));
+}
+
+static lx_vec3 sample_albedo(const lx_material *mat, const lx_mesh *m, const uint32_t *i, float w0,
+                             float w1, float w2)
+{
+    lx_vec3 a = lx_v3(mat->base_color.x, mat->base_color.y, mat->base_color.z);
+    const lx_vec2 *uv = m->uv[mat->base_color_uv_set];
+    if (mat->base_color_map.width > 0 && uv) {
+        float u = uv[i[0]].x * w0 + uv[i[1]].x * w1 + uv[i[2]].x * w2;
+        float v = uv[i[0]].y * w0 + uv[i[1]].y * w1 + uv[i[2]].y * w2;
+        float c[4] = {1, 1, 1, 1};
+        lx_image_sample_bilinear(&mat->base_color_map, u, v, c);
+        a = lx_mul(a, lx_v3(c[0], c[1], c[2]));
+    }
+    return a;
+}
+
+/* Choose the node's lightmap UV set and its meshes with UVs. */
+static uint32_t collect_slots(const lx_scene *scene, const lx_node *node, slot *slots,
+                              int *uv_set)
+{
+    bool all_have_uv1 = true;
+    for (uint32_t k = 0; k < node->mesh_count; k++) {
+        const lx_mesh *m = &scene->meshes[node->meshes[k]];
+        if ((m->uv[0] || m->uv[1]) && !m->uv[1])
+            all_have_uv1 = false;
+    }
+    *uv_set = all_have_uv1 ? 1 : 0;
+    uint32_t n = 0, first = 0;
+    for (uint32_t k = 0; k < node->mesh_count; k++) {
+        const lx_mesh *m = &scene->meshes[node->meshes[k]];
+        const lx_vec2 *uv = m->uv[*uv_set];
+        if (!uv) {
+            lx_log(LX_LOG_WARN, "%s: node '%s': mesh '%s' has no UVs; it gets no lightmap "
+                   "texels (it still casts shadows)", scene->path, node->name, m->name);
+            continue;
+        }
+        if (*uv_set == 0)
+            lx_log(LX_LOG_WARN, "%s: node '%s': mesh '%s' has no TEXCOORD_1; its lightmap "
+                   "uses TEXCOORD_0", scene->path, node->name, m->name);
+        slots[n++] = (slot){m, node->meshes[k], first, uv};
+        first += m->triangle_count;
+    }
+    return n;
+}
+
+lx_status lx_texel_map_build(const lx_scene *scene, uint32_t node_index,
+                             const lx_bake_desc *desc, lx_lightmap *map)
+{
+    const lx_node *node = &scene->nodes[node_index];
+    memset(map, 0, sizeof *map);
+    map->info.node = node_index;
+    map->name = lx_strdup(node->name);
+    map->info.name = map->name;
+    slot *slots = calloc(node->mesh_count ? node->mesh_count : 1, sizeof *slots);
+    if (!slots || !map->name) {
+        free(slots);
+        return lx_fail(LX_ERR_NOMEM, "out of memory");
+    }
+    int uv_set;
+    uint32_t slot_count = collect_slots(scene, node, slots, &uv_set);
+    map->info.uv_set = uv_set;
+    if (slot_count == 0) {
+        free(slots);
+        return LX_OK;
+    }
+    int size = desc->texel_density > 0 ? size_from_density(scene, node, slots, slot_count, desc)
+                                       : desc->resolution;
+    int w = size, h = size;
+    map->info.width = w;
+    map->info.height = h;
+    /* raster scratch + mask + two RGB buffers + worst-case texel records */
+    uint64_t pixels = (uint64_t)w * (uint64_t)h;
+    uint64_t per_pixel = 4 + 4 + 4 + 4 + 1 + 1 + 12 + 12 + sizeof(lx_texel) + 3 * 12;
+    char what[160];
+    snprintf(what, sizeof what, "lightmap '%s' (%dx%d)", node->name, w, h);
+    lx_status st = lx_check_memory(pixels * per_pixel, what);
+    if (st != LX_OK) {
+        free(slots);
+        return st;
+    }
+
+    raster_ctx r = {.width = w, .height = h};
+    r.owner = malloc(sizeof(uint32_t) * pixels);
+    r.b1 = malloc(sizeof(float) * pixels);
+    r.b2 = malloc(sizeof(float) * pixels);
+    r.distance = malloc(sizeof(float) * pixels);
+    r.strict = calloc(pixels, 1);
+    uint32_t total_triangles = 0;
+    for (uint32_t s = 0; s < slot_count; s++)
+        total_triangles += slots[s].mesh->triangle_count;
+    uint8_t *skip = malloc(total_triangles ? total_triangles : 1);
+    if (!r.owner || !r.b1 || !r.b2 || !r.distance || !r.strict || !skip) {
+        st = lx_fail(LX_ERR_NOMEM, "%s: out of memory", what);
+        goto done;
+    }
+    memset(r.owner, 0xFF, sizeof(uint32_t) * pixels);
+    for (uint32_t s = 0; s < slot_count && st == LX_OK; s++)
+        st = check_uv_triangles(scene, &slots[s], node, desc, uv_set,
+                                skip + slots[s].first_triangle);
+    if (st != LX_OK)
+        goto done;
+
+    for (int pass = 0; pass < 2; pass++)
+        for (uint32_t s = 0; s < slot_count; s++) {
+            const lx_mesh *m = slots[s].mesh;
+            for (uint32_t t = 0; t < m->triangle_count; t++) {
+                if (skip[slots[s].first_triangle + t])
+                    continue;
+                const uint32_t *i = &m->indices[3 * t];
+                double a[2], b[2], c[2];
+                uv_to_texel(&r, slots[s].uv[i[0]], a);
+                uv_to_texel(&r, slots[s].uv[i[1]], b);
+                uv_to_texel(&r, slots[s].uv[i[2]], c);
+                const double *v[3] = {a, b, c};
+                if (pass == 0)
+                    raster_centres(&r, v, slots[s].first_triangle + t);
+                else
+                    raster_borders(&r, v, slots[s].first_triangle + t);
+            }
+        }
+    map->info.overlap_texels = r.overlap;
+    if (r.overlap)
+        lx_log(LX_LOG_WARN, "%s: node '%s': %u texels are covered by overlapping lightmap UVs",
+               scene->path, node->name, r.overlap);
+
+    /* gather covered texels tile by tile */
+    uint32_t used = 0;
+    for (uint64_t p = 0; p < pixels; p++)
+        used += r.owner[p] != UINT32_MAX;
+    int tiles_x = (w + LX_TILE - 1) / LX_TILE, tiles_y = (h + LX_TILE - 1) / LX_TILE;
+    map->tile_count = (uint32_t)tiles_x * (uint32_t)tiles_y;
+    map->texels = malloc(sizeof(lx_texel) * (used ? used : 1));
+    map->tile_start = malloc(sizeof(uint32_t) * (map->tile_count + 1));
+    map->mask = calloc(pixels, 1);
+    map->baked = calloc(pixels * 3, sizeof(float));
+    map->realtime = calloc(pixels * 3, sizeof(float));
+    map->world_position = malloc(sizeof(lx_vec3) * (used ? used : 1));
+    map->world_normal = malloc(sizeof(lx_vec3) * (used ? used : 1));
+    map->world_geometric_normal = malloc(sizeof(lx_vec3) * (used ? used : 1));
+    if (!map->texels || !map->tile_start || !map->mask || !map->baked || !map->realtime ||
+        !map->world_position || !map->world_normal || !map->world_geometric_normal) {
+        st = lx_fail(LX_ERR_NOMEM, "%s: out of memory", what);
+        goto done;
+    }
+    /* tangents for normal-mapped meshes: from the file, else computed */
+    lx_vec4 **tangents = calloc(slot_count, sizeof(lx_vec4 *));
+    bool *own_tangents = calloc(slot_count, sizeof(bool));
+    if (!tangents || !own_tangents) {
+        free(tangents);
+        free(own_tangents);
+        st = lx_fail(LX_ERR_NOMEM, "%s: out of memory", what);
+        goto done;
+    }
+    for (uint32_t s = 0; s < slot_count && st == LX_OK; s++) {
+        const lx_mesh *m = slots[s].mesh;
+        const lx_material *mat = &scene->materials[m->material];
+        if (mat->normal_map.width <= 0 || !m->uv[mat->normal_uv_set])
+            continue;
+        if (m->tangents) {
+            tangents[s] = m->tangents;
+            continue;
+        }
+        tangents[s] = malloc(sizeof(lx_vec4) * m->vertex_count);
+        own_tangents[s] = true;
+        st = tangents[s] ? lx_compute_tangents(m, mat->normal_uv_set, tangents[s])
+                         : lx_fail(LX_ERR_NOMEM, "%s: out of memory", what);
+    }
+    uint32_t n = 0;
+    for (int ty = 0; ty < tiles_y && st == LX_OK; ty++)
+        for (int tx = 0; tx < tiles_x; tx++) {
+            map->tile_start[ty * tiles_x + tx] = n;
+            for (int y = ty * LX_TILE; y < (ty + 1) * LX_TILE && y < h; y++)
+                for (int x = tx * LX_TILE; x < (tx + 1) * LX_TILE && x < w; x++) {
+                    size_t p = (size_t)y * w + x;
+                    if (r.owner[p] == UINT32_MAX)
+                        continue;
+                    uint32_t s = 0;
+                    while (s + 1 < slot_count && slots[s + 1].first_triangle <= r.owner[p])
+                        s++;
+                    const lx_mesh *m = slots[s].mesh;
+                    uint32_t t = r.owner[p] - slots[s].first_triangle;
+                    const uint32_t *i = &m->indices[3 * t];
+                    float w1 = r.b1[p], w2 = r.b2[p], w0 = 1.0f - w1 - w2;
+                    lx_texel *tx_ = &map->texels[n++];
+                    tx_->pixel = (uint32_t)p;
+                    tx_->mesh = slots[s].mesh_index;
+                    tx_->triangle = t;
+                    lx_vec3 pa = m->positions[i[0]], pb = m->positions[i[1]],
+                            pc = m->positions[i[2]];
+                    tx_->position =
+                        lx_add(lx_add(lx_scale(pa, w0), lx_scale(pb, w1)), lx_scale(pc, w2));
+                    tx_->geometric_normal = lx_normalize(lx_cross(lx_sub(pb, pa), lx_sub(pc, pa)));
+                    lx_vec3 nrm = lx_add(lx_add(lx_scale(m->normals[i[0]], w0),
+                                                lx_scale(m->normals[i[1]], w1)),
+                                         lx_scale(m->normals[i[2]], w2));
+                    nrm = lx_length(nrm) > 1e-12f ? lx_normalize(nrm) : tx_->geometric_normal;
+                    const lx_material *mat = &scene->materials[m->material];
+                    if (tangents[s])
+                        sample_normal_map(mat, m, tangents[s], i, w0, w1, w2, &nrm);
+                    tx_->normal = nrm;
+                    tx_->albedo = sample_albedo(mat, m, i, w0, w1, w2);
+                    map->mask[p] = 1;
+                }
+        }
+    map->tile_start[map->tile_count] = n;
+    map->info.used_texels = n;
+    for (uint32_t s = 0; s < slot_count; s++)
+        if (own_tangents[s])
+            free(tangents[s]);
+    free(tangents);
+    free(own_tangents);
+    if (st == LX_OK)
+        lx_texel_map_transform(map, &node->world);
+done:
+    free(r.owner);
+    free(r.b1);
+    free(r.b2);
+    free(r.distance);
+    free(r.strict);
+    free(skip);
+    free(slots);
+    return st;
+}
+
+void lx_texel_map_transform(lx_lightmap *map, const lx_mat4 *world)
+{
+    lx_mat4 nm;
+    if (!lx_mat4_normal_matrix(world, &nm))
+        nm = *world;
+    for (uint32_t i = 0; i < map->info.used_texels; i++) {
+        const lx_texel *t = &map->texels[i];
+        map->world_position[i] = lx_mat4_point(world, t->position);
+        map->world_normal[i] = lx_normalize(lx_mat4_vector(&nm, t->normal));
+        map->world_geometric_normal[i] = lx_normalize(lx_mat4_vector(&nm, t->geometric_normal));
+    }
+}
+
+void lx_texel_map_free(lx_lightmap *map)
+{
+    free(map->name);
+    free(map->texels);
+    free(map->tile_start);
+    free(map->world_position);
+    free(map->world_normal);
+    free(map->world_geometric_normal);
+    free(map->mask);
+    free(map->baked);
+    free(map->realtime);
+    memset(map, 0, sizeof *map);
+}

@@ -1,0 +1,67 @@
+/* Thread-local error messages and the process-wide log callback. */
+#include "luxel/core.h"
+
+#include <stdarg.h>
+#include <stdio.h>
+#include <string.h>
+
+#define LX_ERROR_MAX 1024
+
+static _Thread_local char error_message[LX_ERROR_MAX];
+
+static lx_log_fn log_fn;
+static void *log_user;
+
+const char *lx_version(void) { return LX_VERSION; }
+
+const char *lx_last_error(void) { return error_message; }
+
+void lx_clear_error(void) { error_message[0] = '\0'; }
+
+const char *lx_status_name(lx_status status)
+{
+    switch (status) {
+    case LX_OK: return "LX_OK";
+    case LX_ERR_IO: return "LX_ERR_IO";
+    case LX_ERR_FORMAT: return "LX_ERR_FORMAT";
+    case LX_ERR_INVALID: return "LX_ERR_INVALID";
+    case LX_ERR_NOMEM: return "LX_ERR_NOMEM";
+    case LX_ERR_UNSUPPORTED: return "LX_ERR_UNSUPPORTED";
+    case LX_ERR_CANCELLED: return "LX_ERR_CANCELLED";
+    }
+    return "LX_ERR_UNKNOWN";
+}
+
+lx_status lx_fail(lx_status status, const char *fmt, ...)
+{
+    va_list ap;
+    va_start(ap, fmt);
+    vsnprintf(error_message, sizeof error_message, fmt, ap);
+    va_end(ap);
+    return status;
+}
+
+void lx_error_prefix(const char *prefix)
+{
+    char old[LX_ERROR_MAX];
+    memcpy(old, error_message, sizeof old);
+    snprintf(error_message, sizeof error_message, "%s: %s", prefix, old);
+}
+
+void lx_set_log_callback(lx_log_fn fn, void *user)
+{
+    log_fn = fn;
+    log_user = user;
+}
+
+void lx_log(lx_log_level level, const char *fmt, ...)
+{
+    if (!log_fn)
+        return;
+    char line[LX_ERROR_MAX];
+    va_list ap;
+    va_start(ap, fmt);
+    vsnprintf(line, sizeof line, fmt, ap);
+    va_end(ap);
+    log_fn(log_user, level, line);
+}

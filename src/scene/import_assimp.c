@@ -1,0 +1,397 @@
+/* Scene import through assimp's C API (glTF 2.0, OBJ, FBX, ...): meshes,
+ * materials with their normal and base-colour textures, and the node
+ * hierarchy flattened into world-space instances. glTF's KHR_lights_punctual
+ * lights are read from the file's own JSON (gltf_lights.c) because assimp
+ * drops their units and range. */
+#include "luxel/scene.h"
+
+#include <assimp/cimport.h>
+#include <assimp/config.h>
+#include <assimp/material.h>
+#include <assimp/postprocess.h>
+#include <assimp/scene.h>
+#include <stdio.h>
+#include <stdlib.h>
+#include <string.h>
+#include <strings.h>
+#include <sys/stat.h>
+
+#define LX_NAME_MAX 256
+
+typedef struct import_ctx {
+    const char *path;
+    const struct aiScene *ai;
+    lx_scene *scene;
+    const lx_scene_load_desc *desc;
+    uint32_t *mesh_map; /* assimp mesh -> lx mesh index, UINT32_MAX if skipped */
+    char *folder;
+} import_ctx;
+
+static lx_mat4 mat4_from_ai(const struct aiMatrix4x4 *a)
+{
+    /* aiMatrix4x4 is row-major (a1..a4 the first row); lx_mat4 column-major */
+    lx_mat4 m = {{a->a1, a->b1, a->c1, a->d1, a->a2, a->b2, a->c2, a->d2, a->a3, a->b3, a->c3,
+                  a->d3, a->a4, a->b4, a->c4, a->d4}};
+    return m;
+}
+
+static bool has_extension(const char *path, const char *ext)
+{
+    size_t n = strlen(path), e = strlen(ext);
+    return n >= e && strcasecmp(path + n - e, ext) == 0;
+}
+
+/* Loads a texture named by a material: "*N" is embedded in the file, other
+ * paths are relative to the scene's folder. Failures are warnings: the
+ * material then goes without the map. */
+static void load_texture(import_ctx *c, const struct aiString *tex_path, bool raw,
+                         const char *what, const char *material, lx_image *out,
+                         char **out_path)
+{
+    const char *p = tex_path->data;
+    lx_image_load_desc ld = {.raw_8bit = raw, .channels = raw ? 3 : 4};
+    lx_status st;
+    char *full = NULL;
+    if (p[0] == '*') {
+        char *end = NULL;
+        long idx = strtol(p + 1, &end, 10);
+        if (!end || *end || idx < 0 || (unsigned long)idx >= c->ai->mNumTextures) {
+            lx_log(LX_LOG_WARN, "%s: material '%s': %s texture '%s' does not exist; ignored",
+                   c->path, material, what, p);
+            return;
+        }
+        const struct aiTexture *t = c->ai->mTextures[idx];
+        if (t->mHeight != 0) {
+            lx_log(LX_LOG_WARN,
+                   "%s: material '%s': uncompressed embedded %s texture is not supported; "
+                   "ignored",
+                   c->path, material, what);
+            return;
+        }
+        char name[LX_NAME_MAX];
+        snprintf(name, sizeof name, "%s: embedded texture %ld", c->path, idx);
+        st = lx_image_load_memory(t->pcData, t->mWidth, name, &ld, out);
+    } else {
+        full = lx_path_join(c->folder, p);
+        if (!full)
+            return;
+        st = lx_image_load(full, &ld, out);
+    }
+    if (st != LX_OK) {
+        lx_log(LX_LOG_WARN, "%s: material '%s': %s texture not loaded (%s); ignored", c->path,
+               material, what, lx_last_error());
+        memset(out, 0, sizeof *out);
+        free(full);
+        return;
+    }
+    if (out_path)
+        *out_path = full ? full : lx_strdup(p);
+    else
+        free(full);
+}
+
+static lx_status import_materials(import_ctx *c)
+{
+    for (unsigned i = 0; i < c->ai->mNumMaterials; i++) {
+        const struct aiMaterial *am = c->ai->mMaterials[i];
+        lx_material m = {0};
+        struct aiString name;
+        char name_buf[LX_NAME_MAX];
+        if (aiGetMaterialString(am, AI_MATKEY_NAME, &name) == aiReturn_SUCCESS && name.length)
+            snprintf(name_buf, sizeof name_buf, "%s", name.data);
+        else
+            snprintf(name_buf, sizeof name_buf, "material%u", i);
+        m.name = name_buf;
+        struct aiColor4D col;
+        m.base_color = lx_v4(1, 1, 1, 1);
+        if (aiGetMaterialColor(am, AI_MATKEY_BASE_COLOR, &col) == aiReturn_SUCCESS ||
+            aiGetMaterialColor(am, AI_MATKEY_COLOR_DIFFUSE, &col) == aiReturn_SUCCESS)
+            m.base_color = lx_v4(col.r, col.g, col.b, col.a);
+        if (!(isfinite(m.base_color.x) && isfinite(m.base_color.y) && isfinite(m.base_color.z)) ||
+            m.base_color.x < 0 || m.base_color.y < 0 || m.base_color.z < 0)
+            return lx_fail(LX_ERR_FORMAT, "%s: material '%s': base colour is not a finite "
+                           "non-negative colour", c->path, name_buf);
+        struct aiString tex;
+        unsigned uv = 0;
+        if (aiGetMaterialTexture(am, aiTextureType_NORMALS, 0, &tex, NULL, &uv, NULL, NULL, NULL,
+                                 NULL) == aiReturn_SUCCESS) {
+            load_texture(c, &tex, true, "normal", name_buf, &m.normal_map, &m.normal_map_path);
+            m.normal_uv_set = (int)uv;
+        }
+        uv = 0;
+        if (aiGetMaterialTexture(am, aiTextureType_BASE_COLOR, 0, &tex, NULL, &uv, NULL, NULL,
+                                 NULL, NULL) == aiReturn_SUCCESS ||
+            aiGetMaterialTexture(am, aiTextureType_DIFFUSE, 0, &tex, NULL, &uv, NULL, NULL, NULL,
+                                 NULL) == aiReturn_SUCCESS) {
+            load_texture(c, &tex, false, "base colour", name_buf, &m.base_color_map, NULL);
+            m.base_color_uv_set = (int)uv;
+        }
+        if (m.normal_uv_set >= LX_MAX_UV_SETS || m.base_color_uv_set >= LX_MAX_UV_SETS) {
+            lx_log(LX_LOG_WARN, "%s: material '%s': textures on UV sets above 1 are not "
+                   "supported; ignored", c->path, name_buf);
+            if (m.normal_uv_set >= LX_MAX_UV_SETS) {
+                lx_image_free(&m.normal_map);
+                m.normal_uv_set = 0;
+            }
+            if (m.base_color_uv_set >= LX_MAX_UV_SETS) {
+                lx_image_free(&m.base_color_map);
+                m.base_color_uv_set = 0;
+            }
+        }
+        m.normal_scale = 1.0f;
+        lx_status st = lx_scene_add_material(c->scene, &m, NULL);
+        lx_image_free(&m.normal_map);
+        lx_image_free(&m.base_color_map);
+        free(m.normal_map_path);
+        if (st != LX_OK)
+            return st;
+    }
+    if (c->scene->material_count == 0) {
+        lx_material m = {.name = "default", .base_color = {1, 1, 1, 1}, .normal_scale = 1};
+        return lx_scene_add_material(c->scene, &m, NULL);
+    }
+    return LX_OK;
+}
+
+static lx_status import_mesh(import_ctx *c, unsigned i)
+{
+    const struct aiMesh *am = c->ai->mMeshes[i];
+    char name[LX_NAME_MAX];
+    if (am->mName.length)
+        snprintf(name, sizeof name, "%s", am->mName.data);
+    else
+        snprintf(name, sizeof name, "mesh%u", i);
+    c->mesh_map[i] = UINT32_MAX;
+    if (!(am->mPrimitiveTypes & aiPrimitiveType_TRIANGLE) || am->mNumFaces == 0) {
+        lx_log(LX_LOG_WARN, "%s: mesh '%s' has no triangles (points or lines); skipped", c->path,
+               name);
+        return LX_OK;
+    }
+    uint32_t nv = am->mNumVertices;
+    lx_mesh m = {0};
+    m.name = name;
+    m.vertex_count = nv;
+    m.material = am->mMaterialIndex < c->scene->material_count ? am->mMaterialIndex : 0;
+    lx_status st = LX_OK;
+    m.positions = malloc(sizeof(lx_vec3) * (nv ? nv : 1));
+    m.indices = malloc(sizeof(uint32_t) * 3 * (size_t)am->mNumFaces);
+    if (!m.positions || !m.indices) {
+        st = lx_fail(LX_ERR_NOMEM, "%s: out of memory reading mesh '%s'", c->path, name);
+        goto done;
+    }
+    for (uint32_t v = 0; v < nv; v++)
+        m.positions[v] = lx_v3(am->mVertices[v].x, am->mVertices[v].y, am->mVertices[v].z);
+    if (am->mNormals) {
+        m.normals = malloc(sizeof(lx_vec3) * nv);
+        if (!m.normals) {
+            st = lx_fail(LX_ERR_NOMEM, "%s: out of memory", c->path);
+            goto done;
+        }
+        for (uint32_t v = 0; v < nv; v++)
+            m.normals[v] = lx_v3(am->mNormals[v].x, am->mNormals[v].y, am->mNormals[v].z);
+    }
+    for (int k = 0; k < LX_MAX_UV_SETS; k++) {
+        if (!am->mTextureCoords[k])
+            continue;
+        m.uv[k] = malloc(sizeof(lx_vec2) * nv);
+        if (!m.uv[k]) {
+            st = lx_fail(LX_ERR_NOMEM, "%s: out of memory", c->path);
+            goto done;
+        }
+        /* aiProcess_FlipUVs already put the origin at the top-left */
+        for (uint32_t v = 0; v < nv; v++)
+            m.uv[k][v] = lx_v2(am->mTextureCoords[k][v].x, am->mTextureCoords[k][v].y);
+    }
+    if (am->mTangents && am->mBitangents && am->mNormals) {
+        m.tangents = malloc(sizeof(lx_vec4) * nv);
+        if (!m.tangents) {
+            st = lx_fail(LX_ERR_NOMEM, "%s: out of memory", c->path);
+            goto done;
+        }
+        for (uint32_t v = 0; v < nv; v++) {
+            lx_vec3 t = lx_v3(am->mTangents[v].x, am->mTangents[v].y, am->mTangents[v].z);
+            lx_vec3 b = lx_v3(am->mBitangents[v].x, am->mBitangents[v].y, am->mBitangents[v].z);
+            float w = lx_dot(lx_cross(m.normals[v], t), b) < 0.0f ? -1.0f : 1.0f;
+            m.tangents[v] = lx_v4(t.x, t.y, t.z, w);
+        }
+    }
+    uint32_t tri = 0, skipped = 0, not_tri = 0;
+    for (unsigned f = 0; f < am->mNumFaces; f++) {
+        const struct aiFace *face = &am->mFaces[f];
+        if (face->mNumIndices != 3) {
+            not_tri++;
+            continue;
+        }
+        uint32_t *dst = &m.indices[3 * tri];
+        for (int k = 0; k < 3; k++) {
+            dst[k] = face->mIndices[k];
+            if (dst[k] >= nv) {
+                st = lx_fail(LX_ERR_FORMAT, "%s: mesh '%s': face %u: index %u out of range "
+                             "(count %u)", c->path, name, f, dst[k], nv);
+                goto done;
+            }
+        }
+        if (!lx_vec3_finite(m.positions[dst[0]]) || !lx_vec3_finite(m.positions[dst[1]]) ||
+            !lx_vec3_finite(m.positions[dst[2]])) {
+            st = lx_fail(LX_ERR_FORMAT, "%s: mesh '%s': face %u: position is not finite",
+                         c->path, name, f);
+            goto done;
+        }
+        if (lx_triangle_degenerate(m.positions[dst[0]], m.positions[dst[1]],
+                                   m.positions[dst[2]])) {
+            if (!c->desc->skip_degenerate) {
+                st = lx_fail(LX_ERR_FORMAT, "%s: mesh '%s': triangle %u has zero area "
+                             "(--skip-degenerate drops such triangles)", c->path, name, f);
+                goto done;
+            }
+            skipped++;
+            continue;
+        }
+        tri++;
+    }
+    if (skipped)
+        lx_log(LX_LOG_WARN, "%s: mesh '%s': %u zero-area triangles skipped", c->path, name,
+               skipped);
+    if (not_tri)
+        lx_log(LX_LOG_WARN, "%s: mesh '%s': %u point/line primitives skipped", c->path, name,
+               not_tri);
+    if (tri == 0) {
+        lx_log(LX_LOG_WARN, "%s: mesh '%s' has no usable triangles; skipped", c->path, name);
+        goto done;
+    }
+    m.triangle_count = tri;
+    st = lx_scene_add_mesh(c->scene, &m, &c->mesh_map[i]);
+done:
+    free(m.positions);
+    free(m.normals);
+    free(m.tangents);
+    free(m.indices);
+    for (int k = 0; k < LX_MAX_UV_SETS; k++)
+        free(m.uv[k]);
+    return st;
+}
+
+/* A node name unique in the scene: the node's own, else "node<N>", with
+ * "_2", "_3"... appended on collisions. */
+static void unique_node_name(const lx_scene *s, const char *base, char *out, size_t size)
+{
+    snprintf(out, size, "%s", base);
+    for (int n = 2;; n++) {
+        bool taken = false;
+        for (uint32_t i = 0; i < s->node_count && !taken; i++)
+            taken = strcmp(s->nodes[i].name, out) == 0;
+        if (!taken)
+            return;
+        snprintf(out, size, "%s_%d", base, n);
+    }
+}
+
+static lx_status import_node(import_ctx *c, const struct aiNode *node, const lx_mat4 *parent,
+                             int depth, uint32_t *counter)
+{
+    if (depth > 256)
+        return lx_fail(LX_ERR_FORMAT, "%s: node hierarchy deeper than 256 levels", c->path);
+    lx_mat4 local = mat4_from_ai(&node->mTransformation);
+    lx_mat4 world = lx_mat4_mul(parent, &local);
+    (*counter)++;
+    if (node->mNumMeshes) {
+        uint32_t *meshes = malloc(sizeof(uint32_t) * node->mNumMeshes);
+        if (!meshes)
+            return lx_fail(LX_ERR_NOMEM, "%s: out of memory", c->path);
+        uint32_t n = 0;
+        for (unsigned k = 0; k < node->mNumMeshes; k++) {
+            unsigned mi = node->mMeshes[k];
+            if (mi >= c->ai->mNumMeshes) {
+                free(meshes);
+                return lx_fail(LX_ERR_FORMAT, "%s: node '%s': mesh %u out of range (count %u)",
+                               c->path, node->mName.data, mi, c->ai->mNumMeshes);
+            }
+            if (c->mesh_map[mi] != UINT32_MAX)
+                meshes[n++] = c->mesh_map[mi];
+        }
+        lx_status st = LX_OK;
+        if (n) {
+            char base[LX_NAME_MAX], name[LX_NAME_MAX + 16];
+            if (node->mName.length)
+                snprintf(base, sizeof base, "%s", node->mName.data);
+            else
+                snprintf(base, sizeof base, "node%u", *counter - 1);
+            unique_node_name(c->scene, base, name, sizeof name);
+            st = lx_scene_add_node(c->scene, name, &world, meshes, n, NULL);
+        }
+        free(meshes);
+        if (st != LX_OK)
+            return st;
+    }
+    for (unsigned k = 0; k < node->mNumChildren; k++) {
+        lx_status st = import_node(c, node->mChildren[k], &world, depth + 1, counter);
+        if (st != LX_OK)
+            return st;
+    }
+    return LX_OK;
+}
+
+lx_status lx_scene_load(const char *path, const lx_scene_load_desc *desc, lx_scene **out)
+{
+    *out = NULL;
+    lx_scene_load_desc defaults = {0};
+    if (!desc)
+        desc = &defaults;
+    struct stat st_buf;
+    if (stat(path, &st_buf) != 0)
+        return lx_fail(LX_ERR_IO, "%s: cannot open: no such file", path);
+    if (!S_ISREG(st_buf.st_mode))
+        return lx_fail(LX_ERR_IO, "%s: not a regular file", path);
+    FILE *probe = fopen(path, "rb");
+    if (!probe)
+        return lx_fail(LX_ERR_IO, "%s: cannot open: permission denied or unreadable", path);
+    fclose(probe);
+
+    struct aiPropertyStore *props = aiCreatePropertyStore();
+    /* Smooth normals where a file has none, but keep hard edges hard. */
+    aiSetImportPropertyFloat(props, AI_CONFIG_PP_GSN_MAX_SMOOTHING_ANGLE, 60.0f);
+    unsigned flags = aiProcess_Triangulate | aiProcess_SortByPType | aiProcess_FlipUVs |
+                     aiProcess_GenSmoothNormals | aiProcess_JoinIdenticalVertices |
+                     aiProcess_ValidateDataStructure;
+    const struct aiScene *ai = aiImportFileExWithProperties(path, flags, NULL, props);
+    aiReleasePropertyStore(props);
+    if (!ai) {
+        const char *why = aiGetErrorString();
+        return lx_fail(LX_ERR_FORMAT, "%s: cannot import: %s", path,
+                       why && why[0] ? why : "unknown format or corrupt file");
+    }
+    if ((ai->mFlags & AI_SCENE_FLAGS_INCOMPLETE) || !ai->mRootNode) {
+        aiReleaseImport(ai);
+        return lx_fail(LX_ERR_FORMAT, "%s: cannot import: the file is incomplete", path);
+    }
+    import_ctx c = {.path = path, .ai = ai, .desc = desc};
+    lx_status st = lx_scene_create(path, &c.scene);
+    if (st != LX_OK) {
+        aiReleaseImport(ai);
+        return st;
+    }
+    c.folder = lx_path_dirname(path);
+    c.mesh_map = malloc(sizeof(uint32_t) * (ai->mNumMeshes ? ai->mNumMeshes : 1));
+    if (!c.folder || !c.mesh_map)
+        st = lx_fail(LX_ERR_NOMEM, "%s: out of memory", path);
+    if (st == LX_OK)
+        st = import_materials(&c);
+    for (unsigned i = 0; st == LX_OK && i < ai->mNumMeshes; i++)
+        st = import_mesh(&c, i);
+    if (st == LX_OK) {
+        lx_mat4 root = lx_mat4_identity();
+        uint32_t counter = 0;
+        st = import_node(&c, ai->mRootNode, &root, 0, &counter);
+    }
+    if (st == LX_OK && (has_extension(path, ".gltf") || has_extension(path, ".glb")))
+        st = lx_gltf_lights_load(c.scene, path);
+    aiReleaseImport(ai);
+    free(c.mesh_map);
+    free(c.folder);
+    if (st != LX_OK) {
+        lx_scene_destroy(c.scene);
+        return st;
+    }
+    *out = c.scene;
+    return LX_OK;
+}

@@ -1,0 +1,315 @@
+/* The scene container: meshes, materials, nodes and lights, their
+ * validation and programmatic construction. */
+#include "luxel/scene.h"
+
+#include <stdio.h>
+#include <stdlib.h>
+#include <string.h>
+
+/* Grows *array (of elem bytes, *capacity entries) to hold count + 1. */
+static lx_status grow(void **array, uint32_t *capacity, uint32_t count, size_t elem,
+                      const char *what)
+{
+    if (count < *capacity)
+        return LX_OK;
+    if (count >= UINT32_MAX / 2)
+        return lx_fail(LX_ERR_NOMEM, "too many %s (%u)", what, count);
+    uint32_t cap = *capacity ? *capacity * 2 : 8;
+    void *p = realloc(*array, (size_t)cap * elem);
+    if (!p)
+        return lx_fail(LX_ERR_NOMEM, "out of memory adding %s", what);
+    memset((char *)p + (size_t)*capacity * elem, 0, (size_t)(cap - *capacity) * elem);
+    *array = p;
+    *capacity = cap;
+    return LX_OK;
+}
+
+lx_status lx_scene_create(const char *name, lx_scene **out)
+{
+    *out = NULL;
+    lx_scene *s = calloc(1, sizeof *s);
+    if (!s || !(s->path = lx_strdup(name ? name : "scene"))) {
+        free(s);
+        return lx_fail(LX_ERR_NOMEM, "out of memory creating a scene");
+    }
+    *out = s;
+    return LX_OK;
+}
+
+static void mesh_free(lx_mesh *m)
+{
+    free(m->name);
+    free(m->positions);
+    free(m->normals);
+    free(m->tangents);
+    for (int i = 0; i < LX_MAX_UV_SETS; i++)
+        free(m->uv[i]);
+    free(m->indices);
+}
+
+static void material_free(lx_material *m)
+{
+    free(m->name);
+    free(m->normal_map_path);
+    lx_image_free(&m->normal_map);
+    lx_image_free(&m->base_color_map);
+}
+
+void lx_scene_destroy(lx_scene *s)
+{
+    if (!s)
+        return;
+    for (uint32_t i = 0; i < s->mesh_count; i++)
+        mesh_free(&s->meshes[i]);
+    for (uint32_t i = 0; i < s->material_count; i++)
+        material_free(&s->materials[i]);
+    for (uint32_t i = 0; i < s->node_count; i++) {
+        free(s->nodes[i].name);
+        free(s->nodes[i].meshes);
+    }
+    free(s->meshes);
+    free(s->materials);
+    free(s->nodes);
+    free(s->lights);
+    free(s->path);
+    free(s);
+}
+
+static void *dup_array(const void *src, size_t count, size_t elem)
+{
+    if (!src)
+        return NULL;
+    void *p = malloc(count * elem);
+    if (p)
+        memcpy(p, src, count * elem);
+    return p;
+}
+
+/* Area-weighted vertex normals from the faces. */
+static void compute_normals(lx_mesh *m)
+{
+    memset(m->normals, 0, sizeof(lx_vec3) * m->vertex_count);
+    for (uint32_t t = 0; t < m->triangle_count; t++) {
+        const uint32_t *idx = &m->indices[3 * t];
+        lx_vec3 a = m->positions[idx[0]], b = m->positions[idx[1]], c = m->positions[idx[2]];
+        lx_vec3 n = lx_cross(lx_sub(b, a), lx_sub(c, a));
+        for (int k = 0; k < 3; k++)
+            m->normals[idx[k]] = lx_add(m->normals[idx[k]], n);
+    }
+    for (uint32_t v = 0; v < m->vertex_count; v++)
+        m->normals[v] = lx_normalize(m->normals[v]);
+}
+
+/* A triangle is degenerate in space when its area is negligible next to
+ * its edges: its geometric normal cannot be trusted. */
+bool lx_triangle_degenerate(lx_vec3 a, lx_vec3 b, lx_vec3 c)
+{
+    lx_vec3 e1 = lx_sub(b, a), e2 = lx_sub(c, a), e3 = lx_sub(c, b);
+    float cross_len = lx_length(lx_cross(e1, e2));
+    float longest = fmaxf(lx_dot(e1, e1), fmaxf(lx_dot(e2, e2), lx_dot(e3, e3)));
+    return !(cross_len > 1e-6f * longest) || longest == 0.0f;
+}
+
+static lx_status validate_mesh(const lx_scene *s, const lx_mesh *m, const char *name)
+{
+    if (m->vertex_count == 0 || m->triangle_count == 0 || !m->positions || !m->indices)
+        return lx_fail(LX_ERR_INVALID, "%s: mesh '%s': no triangles", s->path, name);
+    for (uint32_t v = 0; v < m->vertex_count; v++) {
+        if (!lx_vec3_finite(m->positions[v]))
+            return lx_fail(LX_ERR_FORMAT, "%s: mesh '%s': vertex %u: position is not finite",
+                           s->path, name, v);
+        if (m->normals && !lx_vec3_finite(m->normals[v]))
+            return lx_fail(LX_ERR_FORMAT, "%s: mesh '%s': vertex %u: normal is not finite",
+                           s->path, name, v);
+        for (int k = 0; k < LX_MAX_UV_SETS; k++)
+            if (m->uv[k] && !(isfinite(m->uv[k][v].x) && isfinite(m->uv[k][v].y)))
+                return lx_fail(LX_ERR_FORMAT,
+                               "%s: mesh '%s': vertex %u: TEXCOORD_%d is not finite", s->path,
+                               name, v, k);
+        if (m->tangents) {
+            lx_vec4 t = m->tangents[v];
+            if (!(isfinite(t.x) && isfinite(t.y) && isfinite(t.z) && isfinite(t.w)))
+                return lx_fail(LX_ERR_FORMAT,
+                               "%s: mesh '%s': vertex %u: tangent is not finite", s->path, name,
+                               v);
+        }
+    }
+    for (uint32_t t = 0; t < m->triangle_count; t++) {
+        const uint32_t *idx = &m->indices[3 * t];
+        for (int k = 0; k < 3; k++)
+            if (idx[k] >= m->vertex_count)
+                return lx_fail(LX_ERR_FORMAT,
+                               "%s: mesh '%s': triangle %u: index %u out of range (count %u)",
+                               s->path, name, t, idx[k], m->vertex_count);
+        if (lx_triangle_degenerate(m->positions[idx[0]], m->positions[idx[1]],
+                                   m->positions[idx[2]]))
+            return lx_fail(LX_ERR_FORMAT, "%s: mesh '%s': triangle %u has zero area", s->path,
+                           name, t);
+    }
+    if (m->material >= s->material_count && s->material_count > 0)
+        return lx_fail(LX_ERR_INVALID, "%s: mesh '%s': material %u out of range (count %u)",
+                       s->path, name, m->material, s->material_count);
+    return LX_OK;
+}
+
+lx_status lx_scene_add_mesh(lx_scene *s, const lx_mesh *src, uint32_t *index)
+{
+    char fallback[32];
+    snprintf(fallback, sizeof fallback, "mesh%u", s->mesh_count);
+    const char *name = src->name && src->name[0] ? src->name : fallback;
+    lx_status st = validate_mesh(s, src, name);
+    if (st != LX_OK)
+        return st;
+    st = grow((void **)&s->meshes, &s->mesh_capacity, s->mesh_count, sizeof(lx_mesh), "meshes");
+    if (st != LX_OK)
+        return st;
+    lx_mesh m = *src;
+    size_t nv = src->vertex_count;
+    size_t ni;
+    if (!lx_size_mul(src->triangle_count, 3, 1, &ni))
+        return lx_fail(LX_ERR_NOMEM, "%s: mesh '%s' is too large", s->path, name);
+    m.name = lx_strdup(name);
+    m.positions = dup_array(src->positions, nv, sizeof(lx_vec3));
+    m.normals = src->normals ? dup_array(src->normals, nv, sizeof(lx_vec3))
+                             : malloc(nv * sizeof(lx_vec3));
+    m.tangents = dup_array(src->tangents, nv, sizeof(lx_vec4));
+    for (int k = 0; k < LX_MAX_UV_SETS; k++)
+        m.uv[k] = dup_array(src->uv[k], nv, sizeof(lx_vec2));
+    m.indices = dup_array(src->indices, ni, sizeof(uint32_t));
+    bool ok = m.name && m.positions && m.normals && m.indices &&
+              (!src->tangents || m.tangents);
+    for (int k = 0; k < LX_MAX_UV_SETS; k++)
+        ok = ok && (!src->uv[k] || m.uv[k]);
+    if (!ok) {
+        mesh_free(&m);
+        return lx_fail(LX_ERR_NOMEM, "%s: out of memory copying mesh '%s'", s->path, name);
+    }
+    if (!src->normals)
+        compute_normals(&m);
+    else
+        for (size_t v = 0; v < nv; v++) {
+            /* renormalize; a zero normal falls back to the face normals */
+            float len = lx_length(m.normals[v]);
+            if (!(len > 1e-12f)) {
+                compute_normals(&m);
+                break;
+            }
+            m.normals[v] = lx_scale(m.normals[v], 1.0f / len);
+        }
+    if (index)
+        *index = s->mesh_count;
+    s->meshes[s->mesh_count++] = m;
+    return LX_OK;
+}
+
+lx_status lx_scene_add_material(lx_scene *s, const lx_material *src, uint32_t *index)
+{
+    lx_status st = grow((void **)&s->materials, &s->material_capacity, s->material_count,
+                        sizeof(lx_material), "materials");
+    if (st != LX_OK)
+        return st;
+    lx_material m = *src;
+    char fallback[32];
+    snprintf(fallback, sizeof fallback, "material%u", s->material_count);
+    m.name = lx_strdup(src->name && src->name[0] ? src->name : fallback);
+    m.normal_map_path = src->normal_map_path ? lx_strdup(src->normal_map_path) : NULL;
+    memset(&m.normal_map, 0, sizeof m.normal_map);
+    memset(&m.base_color_map, 0, sizeof m.base_color_map);
+    const lx_image *maps[2] = {&src->normal_map, &src->base_color_map};
+    lx_image *dst[2] = {&m.normal_map, &m.base_color_map};
+    for (int i = 0; i < 2; i++) {
+        if (maps[i]->width <= 0)
+            continue;
+        if (lx_image_alloc(dst[i], maps[i]->width, maps[i]->height, maps[i]->channels) != LX_OK) {
+            material_free(&m);
+            return LX_ERR_NOMEM;
+        }
+        memcpy(dst[i]->data, maps[i]->data,
+               sizeof(float) * (size_t)maps[i]->width * maps[i]->height * maps[i]->channels);
+    }
+    if (m.normal_scale == 0.0f)
+        m.normal_scale = 1.0f;
+    if (index)
+        *index = s->material_count;
+    s->materials[s->material_count++] = m;
+    return LX_OK;
+}
+
+lx_status lx_scene_add_node(lx_scene *s, const char *name, const lx_mat4 *world,
+                            const uint32_t *meshes, uint32_t mesh_count, uint32_t *index)
+{
+    if (!name || !name[0])
+        return lx_fail(LX_ERR_INVALID, "%s: a node needs a name", s->path);
+    for (uint32_t i = 0; i < s->node_count; i++)
+        if (strcmp(s->nodes[i].name, name) == 0)
+            return lx_fail(LX_ERR_INVALID, "%s: node name '%s' is used twice", s->path, name);
+    if (!lx_mat4_finite(world))
+        return lx_fail(LX_ERR_FORMAT, "%s: node '%s': transform is not finite", s->path, name);
+    if (!(fabsf(lx_mat4_det3(world)) > 1e-20f))
+        return lx_fail(LX_ERR_FORMAT, "%s: node '%s': transform is singular (zero scale)",
+                       s->path, name);
+    for (uint32_t i = 0; i < mesh_count; i++)
+        if (meshes[i] >= s->mesh_count)
+            return lx_fail(LX_ERR_INVALID, "%s: node '%s': mesh %u out of range (count %u)",
+                           s->path, name, meshes[i], s->mesh_count);
+    lx_status st =
+        grow((void **)&s->nodes, &s->node_capacity, s->node_count, sizeof(lx_node), "nodes");
+    if (st != LX_OK)
+        return st;
+    lx_node n = {0};
+    n.name = lx_strdup(name);
+    n.world = *world;
+    n.mesh_count = mesh_count;
+    n.meshes = mesh_count ? dup_array(meshes, mesh_count, sizeof(uint32_t)) : NULL;
+    if (!n.name || (mesh_count && !n.meshes)) {
+        free(n.name);
+        free(n.meshes);
+        return lx_fail(LX_ERR_NOMEM, "out of memory adding node '%s'", name);
+    }
+    if (index)
+        *index = s->node_count;
+    s->nodes[s->node_count++] = n;
+    return LX_OK;
+}
+
+lx_status lx_scene_add_light(lx_scene *s, const lx_light *light)
+{
+    lx_status st = lx_light_validate(light);
+    if (st != LX_OK) {
+        lx_error_prefix(s->path);
+        return st;
+    }
+    if (light->name[0])
+        for (uint32_t i = 0; i < s->light_count; i++)
+            if (strcmp(s->lights[i].name, light->name) == 0) {
+                s->lights[i] = *light;
+                return LX_OK;
+            }
+    st = grow((void **)&s->lights, &s->light_capacity, s->light_count, sizeof(lx_light),
+              "lights");
+    if (st != LX_OK)
+        return st;
+    s->lights[s->light_count++] = *light;
+    return LX_OK;
+}
+
+bool lx_scene_bounds(const lx_scene *s, lx_vec3 *lo, lx_vec3 *hi)
+{
+    bool any = false;
+    lx_vec3 a = lx_v3(INFINITY, INFINITY, INFINITY), b = lx_v3(-INFINITY, -INFINITY, -INFINITY);
+    for (uint32_t n = 0; n < s->node_count; n++) {
+        const lx_node *node = &s->nodes[n];
+        for (uint32_t k = 0; k < node->mesh_count; k++) {
+            const lx_mesh *m = &s->meshes[node->meshes[k]];
+            for (uint32_t v = 0; v < m->vertex_count; v++) {
+                lx_vec3 p = lx_mat4_point(&node->world, m->positions[v]);
+                a = lx_v3(fminf(a.x, p.x), fminf(a.y, p.y), fminf(a.z, p.z));
+                b = lx_v3(fmaxf(b.x, p.x), fmaxf(b.y, p.y), fmaxf(b.z, p.z));
+                any = true;
+            }
+        }
+    }
+    *lo = a;
+    *hi = b;
+    return any;
+}

@@ -1,0 +1,171 @@
+/* Helpers shared by luxel's tests. */
+#define _POSIX_C_SOURCE 200809L
+#include "helpers.h"
+
+#include <dirent.h>
+#include <stdio.h>
+#include <stdlib.h>
+#include <string.h>
+#include <sys/stat.h>
+#include <unistd.h>
+
+static void mkdirs(const char *path)
+{
+    char buf[1024];
+    snprintf(buf, sizeof buf, "%s", path);
+    for (char *p = buf + 1; *p; p++)
+        if (*p == '/') {
+            *p = '\0';
+            mkdir(buf, 0777);
+            *p = '/';
+        }
+    mkdir(buf, 0777);
+}
+
+static void remove_tree(const char *path)
+{
+    DIR *d = opendir(path);
+    if (!d)
+        return;
+    struct dirent *e;
+    char child[2048];
+    while ((e = readdir(d))) {
+        if (!strcmp(e->d_name, ".") || !strcmp(e->d_name, ".."))
+            continue;
+        snprintf(child, sizeof child, "%s/%s", path, e->d_name);
+        struct stat st;
+        if (lstat(child, &st) == 0 && S_ISDIR(st.st_mode))
+            remove_tree(child);
+        else
+            unlink(child);
+    }
+    closedir(d);
+    rmdir(path);
+}
+
+const char *lx_test_dir(const char *tag)
+{
+    static char path[1024];
+    const char *base = getenv("LX_TEST_TMP");
+    snprintf(path, sizeof path, "%s/%s", base && base[0] ? base : "/tmp/luxel-test", tag);
+    remove_tree(path);
+    mkdirs(path);
+    return path;
+}
+
+int lx_test_count_files(const char *dir)
+{
+    DIR *d = opendir(dir);
+    if (!d)
+        return -1;
+    int n = 0;
+    struct dirent *e;
+    while ((e = readdir(d)))
+        if (strcmp(e->d_name, ".") && strcmp(e->d_name, ".."))
+            n++;
+    closedir(d);
+    return n;
+}
+
+lx_mesh lx_test_plane(const char *name, float size, float height, float cx, float cz, int n)
+{
+    lx_mesh m = {0};
+    m.name = lx_strdup(name);
+    m.vertex_count = (uint32_t)((n + 1) * (n + 1));
+    m.triangle_count = (uint32_t)(2 * n * n);
+    m.positions = malloc(sizeof(lx_vec3) * m.vertex_count);
+    m.normals = malloc(sizeof(lx_vec3) * m.vertex_count);
+    m.uv[0] = malloc(sizeof(lx_vec2) * m.vertex_count);
+    m.uv[1] = malloc(sizeof(lx_vec2) * m.vertex_count);
+    m.indices = malloc(sizeof(uint32_t) * 3 * m.triangle_count);
+    for (int j = 0; j <= n; j++)
+        for (int i = 0; i <= n; i++) {
+            uint32_t v = (uint32_t)(j * (n + 1) + i);
+            float u = (float)i / n, w = (float)j / n;
+            m.positions[v] = lx_v3(cx - size / 2 + u * size, height, cz - size / 2 + w * size);
+            m.normals[v] = lx_v3(0, 1, 0);
+            m.uv[0][v] = m.uv[1][v] = lx_v2(u, w);
+        }
+    uint32_t t = 0;
+    for (int j = 0; j < n; j++)
+        for (int i = 0; i < n; i++) {
+            uint32_t a = (uint32_t)(j * (n + 1) + i), b = a + 1, c = a + (uint32_t)(n + 1),
+                     d = c + 1;
+            /* counter-clockwise seen from +Y: a, c, b and b, c, d */
+            uint32_t tri[6] = {a, c, b, b, c, d};
+            memcpy(&m.indices[3 * t], tri, sizeof tri);
+            t += 2;
+        }
+    return m;
+}
+
+lx_mesh lx_test_box(const char *name, lx_vec3 lo, lx_vec3 hi, bool inward)
+{
+    lx_mesh m = {0};
+    m.name = lx_strdup(name);
+    m.vertex_count = 24;
+    m.triangle_count = 12;
+    m.positions = malloc(sizeof(lx_vec3) * 24);
+    m.normals = malloc(sizeof(lx_vec3) * 24);
+    m.uv[0] = malloc(sizeof(lx_vec2) * 24);
+    m.uv[1] = malloc(sizeof(lx_vec2) * 24);
+    m.indices = malloc(sizeof(uint32_t) * 36);
+    /* each face: outward normal n, and axes s, t with s x t = n */
+    const lx_vec3 normals[6] = {{1, 0, 0}, {-1, 0, 0}, {0, 1, 0}, {0, -1, 0}, {0, 0, 1}, {0, 0, -1}};
+    for (int f = 0; f < 6; f++) {
+        lx_vec3 n = normals[f];
+        lx_vec3 s = fabsf(n.y) > 0.5f ? lx_v3(1, 0, 0) : lx_v3(0, 1, 0);
+        lx_vec3 t = lx_cross(n, s);
+        s = lx_cross(t, n);
+        lx_vec3 c = lx_scale(lx_add(lo, hi), 0.5f), e = lx_scale(lx_sub(hi, lo), 0.5f);
+        lx_vec3 centre = lx_add(c, lx_mul(n, e));
+        const float cs[4][2] = {{-1, -1}, {1, -1}, {1, 1}, {-1, 1}};
+        for (int k = 0; k < 4; k++) {
+            lx_vec3 p = lx_add(centre, lx_add(lx_mul(lx_scale(s, cs[k][0]), e),
+                                              lx_mul(lx_scale(t, cs[k][1]), e)));
+            int v = f * 4 + k;
+            m.positions[v] = p;
+            m.normals[v] = inward ? lx_neg(n) : n;
+            /* 3x2 grid of charts with a gutter */
+            float cu = (float)(f % 3) / 3.0f, cv = (float)(f / 3) / 2.0f;
+            float u = cu + (0.05f + 0.9f * (cs[k][0] + 1) / 2) / 3.0f;
+            float w = cv + (0.05f + 0.9f * (cs[k][1] + 1) / 2) / 2.0f;
+            m.uv[0][v] = m.uv[1][v] = lx_v2(u, w);
+        }
+        uint32_t b = (uint32_t)f * 4;
+        uint32_t out[6] = {b, b + 1, b + 2, b, b + 2, b + 3};
+        uint32_t in[6] = {b, b + 2, b + 1, b, b + 3, b + 2};
+        memcpy(&m.indices[6 * f], inward ? in : out, sizeof out);
+    }
+    return m;
+}
+
+void lx_test_mesh_free(lx_mesh *m)
+{
+    free(m->name);
+    free(m->positions);
+    free(m->normals);
+    free(m->tangents);
+    for (int k = 0; k < LX_MAX_UV_SETS; k++)
+        free(m->uv[k]);
+    free(m->indices);
+    memset(m, 0, sizeof *m);
+}
+
+void lx_test_add(lx_scene *scene, lx_mesh *mesh)
+{
+    if (scene->material_count == 0) {
+        lx_material mat = {.name = "white", .base_color = {1, 1, 1, 1}};
+        lx_scene_add_material(scene, &mat, NULL);
+    }
+    uint32_t idx;
+    if (lx_scene_add_mesh(scene, mesh, &idx) != LX_OK) {
+        fprintf(stderr, "lx_test_add: %s\n", lx_last_error());
+        abort();
+    }
+    lx_mat4 id = lx_mat4_identity();
+    if (lx_scene_add_node(scene, mesh->name, &id, &idx, 1, NULL) != LX_OK) {
+        fprintf(stderr, "lx_test_add: %s\n", lx_last_error());
+        abort();
+    }
+}

@@ -1,0 +1,30 @@
+/* Helpers shared by luxel's tests: temporary folders and small scenes built
+ * in code (planes, boxes) with known geometry. */
+#ifndef LX_TEST_HELPERS_H
+#define LX_TEST_HELPERS_H
+
+#include "luxel/luxel.h"
+
+/* A fresh folder under $LX_TEST_TMP (or /tmp) named after tag; returned
+ * path is static storage until the next call. */
+const char *lx_test_dir(const char *tag);
+
+/* Number of entries in a folder (excluding . and ..), -1 if missing. */
+int lx_test_count_files(const char *dir);
+
+/* A square of side `size` in the plane y = height, normal +Y, centred at
+ * (cx, cz), with TEXCOORD_1 covering [0,1]^2 (u along +x, v along +z) and
+ * TEXCOORD_0 equal to it. Split into 2*n*n triangles. */
+lx_mesh lx_test_plane(const char *name, float size, float height, float cx, float cz, int n);
+
+/* An axis-aligned box [lo, hi] with 6 faces; normals point outward, or
+ * inward when `inward`; each face its own UV chart in a 3x2 grid. */
+lx_mesh lx_test_box(const char *name, lx_vec3 lo, lx_vec3 hi, bool inward);
+
+void lx_test_mesh_free(lx_mesh *m);
+
+/* Adds mesh as its own node named like the mesh with an identity transform
+ * (and a default material when the scene has none). */
+void lx_test_add(lx_scene *scene, lx_mesh *mesh);
+
+#endif

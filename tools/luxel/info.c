@@ -1,0 +1,119 @@
+/* luxel info: what a scene holds, as luxel sees it after import: meshes
+ * with their triangles and UV sets, materials, nodes, lights with their
+ * physical units, and bounds. */
+#define _POSIX_C_SOURCE 200809L
+#include "cli.h"
+
+#include <getopt.h>
+#include <stdio.h>
+#include <string.h>
+
+static const char *info_usage =
+    "usage: luxel info SCENE [options]\n"
+    "\n"
+    "Lists the meshes (triangles, UV sets), materials, nodes, lights (type and\n"
+    "physical units) and bounds of a glTF 2.0 or OBJ scene.\n"
+    "\n"
+    "options:\n"
+    "  --lights FILE.json   apply a lights file first (docs/lights-json.md)\n"
+    "  -h, --help           show this help\n";
+
+static void print_light(const lx_light *l)
+{
+    const char *unit = l->type == LX_LIGHT_DIRECTIONAL ? "lx" : "cd";
+    printf("  %-12s %-16s %10.4g %s", lx_light_type_name(l->type), l->name, l->intensity,
+           l->model == LX_MODEL_CLASSIC ? "(classic units)" : unit);
+    printf("  colour (%.3g, %.3g, %.3g)", l->color.x, l->color.y, l->color.z);
+    if (l->type != LX_LIGHT_DIRECTIONAL)
+        printf("  at (%.3g, %.3g, %.3g)", l->position.x, l->position.y, l->position.z);
+    if (l->type != LX_LIGHT_POINT)
+        printf("  toward (%.3g, %.3g, %.3g)", l->direction.x, l->direction.y, l->direction.z);
+    if (l->type == LX_LIGHT_SPOT)
+        printf("  cone %.1f..%.1f deg", LX_RAD2DEG(l->inner_angle), LX_RAD2DEG(l->outer_angle));
+    if (l->range > 0)
+        printf("  range %.3g m", l->range);
+    else if (l->type != LX_LIGHT_DIRECTIONAL)
+        printf("  range unlimited");
+    printf("  shadow %s%s\n", lx_shadow_mode_name(l->shadow), l->dynamic ? "  dynamic" : "");
+}
+
+int cmd_info(int argc, char **argv)
+{
+    static const struct option options[] = {{"lights", required_argument, NULL, 'l'},
+                                            {"help", no_argument, NULL, 'h'},
+                                            {NULL, 0, NULL, 0}};
+    const char *lights = NULL;
+    opterr = 0;
+    optind = 1;
+    int c;
+    while ((c = getopt_long(argc, argv, ":h", options, NULL)) != -1) {
+        switch (c) {
+        case 'l':
+            lights = optarg;
+            break;
+        case 'h':
+            fputs(info_usage, stdout);
+            return EXIT_OK;
+        case ':':
+            return cli_usage_error("info", "option '%s' needs a value", argv[optind - 1]);
+        default:
+            return cli_usage_error("info", "unknown option '%s'", argv[optind - 1]);
+        }
+    }
+    if (optind >= argc)
+        return cli_usage_error("info", "no scene given");
+    if (optind + 1 < argc)
+        return cli_usage_error("info", "one scene at a time ('%s' is extra)", argv[optind + 1]);
+    const char *path = argv[optind];
+    lx_scene *s;
+    if (lx_scene_load(path, NULL, &s) != LX_OK) {
+        cli_error("%s", lx_last_error());
+        return EXIT_FAILED;
+    }
+    if (lights && lx_lights_json_apply(s, lights) != LX_OK) {
+        cli_error("%s", lx_last_error());
+        lx_scene_destroy(s);
+        return EXIT_FAILED;
+    }
+    printf("scene %s\n", path);
+    uint64_t tris = 0;
+    printf("meshes: %u\n", s->mesh_count);
+    for (uint32_t i = 0; i < s->mesh_count; i++) {
+        const lx_mesh *m = &s->meshes[i];
+        tris += m->triangle_count;
+        printf("  %-24s %8u triangles %8u vertices  UV sets:", m->name, m->triangle_count,
+               m->vertex_count);
+        bool any = false;
+        for (int k = 0; k < LX_MAX_UV_SETS; k++)
+            if (m->uv[k]) {
+                printf(" TEXCOORD_%d", k);
+                any = true;
+            }
+        printf("%s%s  material '%s'\n", any ? "" : " none", m->tangents ? "  tangents" : "",
+               s->materials[m->material].name);
+    }
+    printf("materials: %u\n", s->material_count);
+    for (uint32_t i = 0; i < s->material_count; i++) {
+        const lx_material *m = &s->materials[i];
+        printf("  %-24s base colour (%.3g, %.3g, %.3g)%s%s\n", m->name, m->base_color.x,
+               m->base_color.y, m->base_color.z, m->base_color_map.width ? " + texture" : "",
+               m->normal_map.width ? "  normal map" : "");
+    }
+    printf("nodes: %u\n", s->node_count);
+    for (uint32_t i = 0; i < s->node_count; i++) {
+        const lx_node *n = &s->nodes[i];
+        printf("  %-24s at (%.3g, %.3g, %.3g), %u mesh%s\n", n->name, n->world.m[12],
+               n->world.m[13], n->world.m[14], n->mesh_count, n->mesh_count == 1 ? "" : "es");
+    }
+    printf("lights: %u\n", s->light_count);
+    for (uint32_t i = 0; i < s->light_count; i++)
+        print_light(&s->lights[i]);
+    if (s->ambient.x > 0 || s->ambient.y > 0 || s->ambient.z > 0)
+        printf("ambient: (%.3g, %.3g, %.3g) lx\n", s->ambient.x, s->ambient.y, s->ambient.z);
+    lx_vec3 lo, hi;
+    if (lx_scene_bounds(s, &lo, &hi))
+        printf("bounds: (%.4g, %.4g, %.4g) .. (%.4g, %.4g, %.4g) m, %llu triangles\n", lo.x, lo.y,
+               lo.z, hi.x, hi.y, hi.z, (unsigned long long)tris);
+    lx_scene_destroy(s);
+    return EXIT_OK;
+}
