@@ -4,6 +4,7 @@ BUILD_ASAN ?= build-asan
 BUILD_FUZZ ?= build-fuzz
 JOBS       ?= $(shell nproc)
 CMAKE_FLAGS ?=
+FUZZ_SECONDS ?= 60
 
 .PHONY: all deps configure demo check check-asan bench fuzz clean
 
@@ -19,7 +20,7 @@ configure: deps
 # Generate the example scenes, bake the room, write lightmaps and previews.
 demo: all
 	$(BUILD)/bin/gen_scenes examples/scenes
-	$(BUILD)/bin/luxel bake examples/scenes/room.glb -o lightmaps/room --resolution 128
+	$(BUILD)/bin/luxel bake examples/scenes/room.glb -o lightmaps/room
 	@echo "demo: lightmaps and previews are in lightmaps/room/ (see lightmaps/room/manifest.json)"
 
 check: all
@@ -36,7 +37,9 @@ bench: all
 fuzz: deps
 	@test -f $(BUILD_FUZZ)/CMakeCache.txt || CC=clang cmake -S . -B $(BUILD_FUZZ) -DCMAKE_BUILD_TYPE=Debug -DLX_FUZZ=ON
 	cmake --build $(BUILD_FUZZ) -j $(JOBS)
-	@for f in $(BUILD_FUZZ)/bin/fuzz_*; do echo "== $$f"; $$f -max_total_time=60 fuzz/corpus/$$(basename $$f) || exit 1; done
+	@for f in $(BUILD_FUZZ)/bin/fuzz_*; do \
+		corpus=$(BUILD_FUZZ)/corpus/$$(basename $$f); mkdir -p $$corpus; \
+		echo "== $$f"; $$f -max_total_time=$(FUZZ_SECONDS) $$corpus || exit 1; done
 
 clean:
 	rm -rf $(BUILD) $(BUILD_ASAN) $(BUILD_FUZZ)

@@ -11,7 +11,7 @@ packages=(
     libstb-dev         # PNG/JPEG/TGA/HDR codecs
     libopenexr-dev     # OpenEXR (OpenEXRCore C API)
     libcmocka-dev      # unit tests
-    clang libclang-rt-14-dev  # sanitizer and fuzzer builds
+    clang libclang-rt-14-dev libomp-dev  # sanitizer and fuzzer builds (clang)
 )
 
 missing=()

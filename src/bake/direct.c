@@ -81,12 +81,13 @@ lx_status lx_bake_lights(lx_baker *b, const uint32_t *lights, uint32_t light_cou
             return st;
         b->tracer_dirty = false;
     }
-    uint64_t total_tiles = 0;
+    /* progress counts texels (plus one per tile, so empty tiles count too) */
+    uint64_t total_work = 0;
     for (uint32_t m = 0; m < b->map_count; m++)
-        total_tiles += b->maps[m].tile_count;
+        total_work += b->maps[m].info.used_texels + b->maps[m].tile_count;
     int threads = lx_thread_count(b->desc.threads);
     volatile int cancelled = 0;
-    uint64_t done_tiles = 0;
+    uint64_t done_work = 0;
 
     for (uint32_t m = 0; m < b->map_count && !cancelled; m++) {
         lx_lightmap *map = &b->maps[m];
@@ -113,9 +114,9 @@ lx_status lx_bake_lights(lx_baker *b, const uint32_t *lights, uint32_t light_cou
             }
             uint64_t done;
 #pragma omp atomic capture
-            done = ++done_tiles;
-            if (b->desc.progress && omp_get_thread_num() == 0 && (done & 15) == 0) {
-                float f = progress_base + progress_span * (float)done / (float)total_tiles;
+            done = done_work += count + 1;
+            if (b->desc.progress && omp_get_thread_num() == 0 && (tile & 15) == 0) {
+                float f = progress_base + progress_span * (float)((double)done / (double)total_work);
                 if (!b->desc.progress(b->desc.progress_user, f))
                     cancelled = 1;
             }

@@ -31,6 +31,7 @@ typedef struct cli_progress {
     bool enabled;
     bool drawn;
     double start;
+    double last_draw;
 } cli_progress;
 void cli_progress_init(cli_progress *p, const char *label, bool quiet);
 bool cli_progress_update(void *user, float fraction);

@@ -162,6 +162,7 @@ void cli_progress_init(cli_progress *p, const char *label, bool quiet)
     p->enabled = !quiet && isatty(2);
     p->drawn = false;
     p->start = cli_now();
+    p->last_draw = 0.0;
 }
 
 bool cli_progress_update(void *user, float fraction)
@@ -172,8 +173,10 @@ bool cli_progress_update(void *user, float fraction)
     if (!p->enabled)
         return true;
     double elapsed = cli_now() - p->start;
-    if (elapsed < 1.0)
+    /* appear after a second, redraw at most ten times a second */
+    if (elapsed < 1.0 || (elapsed - p->last_draw < 0.1 && fraction < 1.0f))
         return true;
+    p->last_draw = elapsed;
     const int width = 30;
     int filled = (int)(fraction * width + 0.5f);
     char bar[64];
