@@ -1,0 +1,229 @@
+/* Punctual light evaluation: Filament's physically based light model (seed
+ * 001, "Physically based punctual lights": inverse square law with the
+ * smooth range window (1 - (d/r)^4)^2, the spot's smooth angular
+ * attenuation, N.L), the seed-000 "classic" CSLight falloff
+ * ((1 - d/range) |N.L|)^2 * colour * intensity of its DynamicLight kernel,
+ * the seed's dynamic blur shadow factor and its ambient wish list item
+ * (ambient that falls off with the light's reach and adds across lights). */
+#include "luxel/light.h"
+
+#include <math.h>
+#include <stdio.h>
+#include <string.h>
+
+/* Filament clamps d^2 so a texel sitting on the light does not blow up. */
+#define LX_MIN_DISTANCE_SQ 1e-4f
+/* Filament's floor on cos(inner) - cos(outer): keeps the spot scale finite. */
+#define LX_MIN_SPOT_COS_DELTA 1e-4f
+/* Allowed deviation of a direction's length from 1. */
+#define LX_DIRECTION_TOLERANCE 1e-3f
+/* Angles read from files as float pi/2 land a hair above the float constant. */
+#define LX_ANGLE_SLACK 1e-6f
+
+lx_light lx_light_defaults(lx_light_type type) {
+    lx_light l;
+    memset(&l, 0, sizeof l);
+    l.type = type;
+    l.position = lx_v3(0.0f, 0.0f, 0.0f);
+    l.direction = lx_v3(0.0f, -1.0f, 0.0f);
+    l.color = lx_v3(1.0f, 1.0f, 1.0f);
+    l.intensity = 1.0f;
+    l.range = 0.0f;
+    l.inner_angle = 0.0f;
+    l.outer_angle = LX_PI / 4.0f;
+    l.model = LX_MODEL_PHYSICAL;
+    l.shadow = LX_SHADOW_HARD;
+    l.blur_power = 1.0f;
+    l.blur_multiplier = 1.0f;
+    l.ambient = lx_v3(0.0f, 0.0f, 0.0f);
+    l.dynamic = false;
+    return l;
+}
+
+/* The light's name for messages; names are not guaranteed NUL-terminated
+ * in a struct handed to us, so print at most the buffer. */
+static int name_len(const lx_light *light) {
+    const void *nul = memchr(light->name, '\0', sizeof light->name);
+    return nul ? (int)((const char *)nul - light->name) : (int)sizeof light->name;
+}
+
+static lx_status invalid(const lx_light *light, const char *what) {
+    int n = name_len(light);
+    if (n == 0) return lx_fail(LX_ERR_INVALID, "light (unnamed): %s", what);
+    return lx_fail(LX_ERR_INVALID, "light '%.*s': %s", n, light->name, what);
+}
+
+static lx_status check_vec(const lx_light *light, const char *field, lx_vec3 v, bool non_negative) {
+    char msg[160];
+    if (!lx_vec3_finite(v)) {
+        snprintf(msg, sizeof msg, "%s is not finite", field);
+        return invalid(light, msg);
+    }
+    if (non_negative && (v.x < 0.0f || v.y < 0.0f || v.z < 0.0f)) {
+        snprintf(msg, sizeof msg, "%s [%g, %g, %g] has a negative component", field, v.x, v.y, v.z);
+        return invalid(light, msg);
+    }
+    return LX_OK;
+}
+
+/* A scalar that must be finite and >= 0. */
+static lx_status check_non_negative(const lx_light *light, const char *field, float v) {
+    char msg[160];
+    if (!isfinite(v)) {
+        snprintf(msg, sizeof msg, "%s is not finite", field);
+        return invalid(light, msg);
+    }
+    if (v < 0.0f) {
+        snprintf(msg, sizeof msg, "%s %g is negative", field, v);
+        return invalid(light, msg);
+    }
+    return LX_OK;
+}
+
+lx_status lx_light_validate(const lx_light *light) {
+    char msg[200];
+    lx_status st;
+    if (!light) return lx_fail(LX_ERR_INVALID, "light: NULL pointer");
+    if (!memchr(light->name, '\0', sizeof light->name))
+        return invalid(light, "name is not NUL-terminated within LX_LIGHT_NAME_MAX bytes");
+    if ((unsigned)light->type > (unsigned)LX_LIGHT_DIRECTIONAL) {
+        snprintf(msg, sizeof msg, "type %d is not a light type", (int)light->type);
+        return invalid(light, msg);
+    }
+    if ((unsigned)light->model > (unsigned)LX_MODEL_CLASSIC) {
+        snprintf(msg, sizeof msg, "model %d is not a falloff model", (int)light->model);
+        return invalid(light, msg);
+    }
+    if ((unsigned)light->shadow > (unsigned)LX_SHADOW_BLUR) {
+        snprintf(msg, sizeof msg, "shadow %d is not a shadow mode", (int)light->shadow);
+        return invalid(light, msg);
+    }
+    if ((st = check_vec(light, "position", light->position, false)) != LX_OK) return st;
+    if ((st = check_vec(light, "direction", light->direction, false)) != LX_OK) return st;
+    if (light->type != LX_LIGHT_POINT) {
+        float len = lx_length(light->direction);
+        if (fabsf(len - 1.0f) > LX_DIRECTION_TOLERANCE) {
+            snprintf(msg, sizeof msg, "direction [%g, %g, %g] is not unit length (length %g)",
+                     light->direction.x, light->direction.y, light->direction.z, len);
+            return invalid(light, msg);
+        }
+    }
+    if ((st = check_vec(light, "color", light->color, true)) != LX_OK) return st;
+    if ((st = check_non_negative(light, "intensity", light->intensity)) != LX_OK) return st;
+    if ((st = check_non_negative(light, "range", light->range)) != LX_OK) return st;
+    if (light->model == LX_MODEL_CLASSIC && light->type != LX_LIGHT_DIRECTIONAL &&
+        !(light->range > 0.0f))
+        return invalid(light, "the classic model needs a range above 0");
+    if (!isfinite(light->inner_angle)) return invalid(light, "inner_angle is not finite");
+    if (!isfinite(light->outer_angle)) return invalid(light, "outer_angle is not finite");
+    if (light->type == LX_LIGHT_SPOT) {
+        float inner_deg = LX_RAD2DEG(light->inner_angle);
+        float outer_deg = LX_RAD2DEG(light->outer_angle);
+        if (light->inner_angle < 0.0f) {
+            snprintf(msg, sizeof msg, "inner_angle %g deg is negative", inner_deg);
+            return invalid(light, msg);
+        }
+        if (!(light->outer_angle > 0.0f)) {
+            snprintf(msg, sizeof msg, "outer_angle %g deg must be above 0", outer_deg);
+            return invalid(light, msg);
+        }
+        if (light->outer_angle > 0.5f * LX_PI + LX_ANGLE_SLACK) {
+            snprintf(msg, sizeof msg, "outer_angle %g deg is above 90 deg", outer_deg);
+            return invalid(light, msg);
+        }
+        if (light->inner_angle > light->outer_angle) {
+            snprintf(msg, sizeof msg, "inner_angle %g deg is above outer_angle %g deg", inner_deg,
+                     outer_deg);
+            return invalid(light, msg);
+        }
+    }
+    if ((st = check_non_negative(light, "blur_power", light->blur_power)) != LX_OK) return st;
+    if ((st = check_non_negative(light, "blur_multiplier", light->blur_multiplier)) != LX_OK)
+        return st;
+    if ((st = check_vec(light, "ambient", light->ambient, true)) != LX_OK) return st;
+    return LX_OK;
+}
+
+float lx_light_range_window(float distance_sq, float range) {
+    if (!(range > 0.0f)) return 1.0f;
+    float factor = distance_sq / (range * range);
+    float smooth = 1.0f - factor * factor;
+    if (!(smooth > 0.0f)) return 0.0f;
+    return smooth * smooth;
+}
+
+float lx_light_spot_attenuation(const lx_light *light, float cos_angle) {
+    if (light->type != LX_LIGHT_SPOT) return 1.0f;
+    float cos_outer = cosf(light->outer_angle);
+    float cos_inner = cosf(light->inner_angle);
+    /* inner == outer (Blender's glTF export) means a hard-edged cone; the
+     * smooth ramp below would otherwise still be 1e-4 wide in cosine. */
+    if (!(light->inner_angle < light->outer_angle)) return cos_angle >= cos_outer ? 1.0f : 0.0f;
+    float delta = cos_inner - cos_outer;
+    float scale = 1.0f / (delta > LX_MIN_SPOT_COS_DELTA ? delta : LX_MIN_SPOT_COS_DELTA);
+    float offset = -cos_outer * scale;
+    float t = lx_saturate(cos_angle * scale + offset);
+    return t * t;
+}
+
+static bool evaluate_directional(const lx_light *light, lx_vec3 n, lx_light_eval *out) {
+    out->to_light = lx_neg(light->direction);
+    out->distance = INFINITY;
+    out->ambient = light->ambient;
+    float ndotl = lx_dot(n, out->to_light);
+    if (!(ndotl > 0.0f)) return false;
+    float e;
+    if (light->model == LX_MODEL_CLASSIC)
+        e = ndotl * ndotl * light->intensity; /* no distance term at infinity */
+    else
+        e = light->intensity * ndotl;
+    out->illuminance = lx_scale(light->color, e);
+    return e > 0.0f;
+}
+
+bool lx_light_evaluate(const lx_light *light, lx_vec3 p, lx_vec3 n, lx_light_eval *out) {
+    if (!light || !out) return false;
+    out->illuminance = lx_v3(0.0f, 0.0f, 0.0f);
+    if (light->type == LX_LIGHT_DIRECTIONAL) return evaluate_directional(light, n, out);
+
+    lx_vec3 to_light = lx_sub(light->position, p);
+    float dist_sq = lx_dot(to_light, to_light);
+    float dist = sqrtf(dist_sq);
+    /* The seed wants ambient to reach only as far as the light does: the
+     * same window as the direct light, so several lights' ambients blend. */
+    out->ambient = lx_scale(light->ambient, lx_light_range_window(dist_sq, light->range));
+    out->distance = dist;
+    if (!(dist > 0.0f)) {
+        out->to_light = n; /* no direction from a point onto itself */
+        return false;
+    }
+    out->to_light = lx_scale(to_light, 1.0f / dist);
+    float ndotl = lx_dot(n, out->to_light);
+    if (!(ndotl > 0.0f)) return false;
+    float spot = lx_light_spot_attenuation(light, -lx_dot(light->direction, out->to_light));
+    if (!(spot > 0.0f)) return false;
+
+    float e;
+    if (light->model == LX_MODEL_CLASSIC) {
+        if (!(dist < light->range)) return false;
+        float v = (1.0f - dist / light->range) * ndotl;
+        e = v * v * light->intensity * spot;
+    } else {
+        float window = lx_light_range_window(dist_sq, light->range);
+        float d2 = dist_sq > LX_MIN_DISTANCE_SQ ? dist_sq : LX_MIN_DISTANCE_SQ;
+        e = light->intensity * window * spot * ndotl / d2;
+    }
+    if (!(e > 0.0f)) return false;
+    out->illuminance = lx_scale(light->color, e);
+    return true;
+}
+
+float lx_light_blur_visibility(const lx_light *light, float occluder_distance,
+                               float light_distance) {
+    /* An occluder with no measurable ray to compare against: fully shadowed. */
+    if (!(light_distance > 0.0f) || !(occluder_distance >= 0.0f)) return 0.0f;
+    float ratio = occluder_distance / light_distance;
+    float v = powf(ratio, light->blur_power) * light->blur_multiplier;
+    if (!(v > 0.0f)) return 0.0f;
+    return v < 1.0f ? v : 1.0f;
+}

@@ -1,0 +1,154 @@
+/* Photometric units of Filament's physical light model (seed 001): luminous
+ * power (lm) to intensity (cd) for point lights I = P / 4pi and for spot
+ * lights I = P / pi or I = P / (2pi (1 - cos outer)), watts through
+ * 683 lm/W, lux for directional lights; exposure from EV100 (1 / (1.2 *
+ * 2^EV100)) and EV100 from average luminance with K = 12.5; unit and enum
+ * names. */
+#include "luxel/light.h"
+
+#include <math.h>
+#include <stdio.h>
+#include <string.h>
+
+/* pi in double: M_PI is not part of C11. */
+#define LX_PI_D 3.14159265358979323846
+
+/* "light 'key'" or "light (unnamed)" for messages. */
+static void light_label(const lx_light *light, char *buf, size_t size) {
+    const void *nul = memchr(light->name, '\0', sizeof light->name);
+    int n = nul ? (int)((const char *)nul - light->name) : (int)sizeof light->name;
+    if (n == 0)
+        snprintf(buf, size, "light (unnamed)");
+    else
+        snprintf(buf, size, "light '%.*s'", n, light->name);
+}
+
+lx_status lx_light_intensity_to_native(const lx_light *light, float value, lx_light_unit unit,
+                                       lx_spot_conversion spot_conversion, float *native) {
+    if (!light || !native) return lx_fail(LX_ERR_INVALID, "light: NULL pointer");
+    char who[LX_LIGHT_NAME_MAX + 16];
+    light_label(light, who, sizeof who);
+    if (!isfinite(value)) return lx_fail(LX_ERR_INVALID, "%s: intensity is not finite", who);
+    if (value < 0.0f) return lx_fail(LX_ERR_INVALID, "%s: intensity %g is negative", who, value);
+    if ((unsigned)unit > (unsigned)LX_UNIT_LUX)
+        return lx_fail(LX_ERR_INVALID, "%s: unit %d is not a light unit", who, (int)unit);
+
+    if (light->type == LX_LIGHT_DIRECTIONAL) {
+        if (unit != LX_UNIT_DEFAULT && unit != LX_UNIT_LUX)
+            return lx_fail(LX_ERR_INVALID, "%s: directional lights take lux, not %s", who,
+                           lx_light_unit_symbol(unit));
+        *native = value;
+        return LX_OK;
+    }
+    if (light->type != LX_LIGHT_POINT && light->type != LX_LIGHT_SPOT)
+        return lx_fail(LX_ERR_INVALID, "%s: type %d is not a light type", who, (int)light->type);
+    if (unit == LX_UNIT_LUX)
+        return lx_fail(LX_ERR_INVALID, "%s: %s lights take cd, lm or W, not lx", who,
+                       lx_light_type_name(light->type));
+    if (unit == LX_UNIT_DEFAULT || unit == LX_UNIT_CANDELA) {
+        *native = value;
+        return LX_OK;
+    }
+
+    double lumens = unit == LX_UNIT_WATT ? (double)value * LX_LUMENS_PER_WATT : (double)value;
+    double candela;
+    if (light->type == LX_LIGHT_POINT) {
+        candela = lumens / (4.0 * LX_PI_D);
+    } else if (spot_conversion == LX_SPOT_POWER_CONE) {
+        /* Solid angle of the outer cone: the power stays inside it, so a
+         * narrower cone gets brighter. */
+        double outer = light->outer_angle;
+        if (!(outer > 0.0) || !(outer <= LX_PI_D))
+            return lx_fail(LX_ERR_INVALID,
+                           "%s: outer_angle %g deg cannot convert lumens over the cone", who,
+                           outer * 180.0 / LX_PI_D);
+        candela = lumens / (2.0 * LX_PI_D * (1.0 - cos(outer)));
+    } else if (spot_conversion == LX_SPOT_POWER_PI) {
+        /* Filament's default: the cone does not change the illuminance. */
+        candela = lumens / LX_PI_D;
+    } else {
+        return lx_fail(LX_ERR_INVALID, "%s: spot conversion %d is unknown", who,
+                       (int)spot_conversion);
+    }
+    float result = (float)candela;
+    if (!isfinite(result))
+        return lx_fail(LX_ERR_INVALID, "%s: intensity %g %s overflows as candela", who, value,
+                       lx_light_unit_symbol(unit));
+    *native = result;
+    return LX_OK;
+}
+
+/* ASCII case-insensitive equality ("W", "w", "Lumen"). */
+static bool same_word(const char *a, const char *b) {
+    for (; *a && *b; a++, b++) {
+        char ca = (*a >= 'A' && *a <= 'Z') ? (char)(*a - 'A' + 'a') : *a;
+        char cb = (*b >= 'A' && *b <= 'Z') ? (char)(*b - 'A' + 'a') : *b;
+        if (ca != cb) return false;
+    }
+    return *a == *b;
+}
+
+lx_light_unit lx_light_unit_from_string(const char *s) {
+    static const struct {
+        const char *word;
+        lx_light_unit unit;
+    } words[] = {
+        {"cd", LX_UNIT_CANDELA}, {"candela", LX_UNIT_CANDELA}, {"candelas", LX_UNIT_CANDELA},
+        {"lm", LX_UNIT_LUMEN},   {"lumen", LX_UNIT_LUMEN},     {"lumens", LX_UNIT_LUMEN},
+        {"W", LX_UNIT_WATT},     {"watt", LX_UNIT_WATT},       {"watts", LX_UNIT_WATT},
+        {"lx", LX_UNIT_LUX},     {"lux", LX_UNIT_LUX},
+    };
+    if (!s) return LX_UNIT_DEFAULT;
+    for (size_t i = 0; i < sizeof words / sizeof words[0]; i++)
+        if (same_word(s, words[i].word)) return words[i].unit;
+    return LX_UNIT_DEFAULT;
+}
+
+const char *lx_light_unit_symbol(lx_light_unit unit) {
+    switch (unit) {
+    case LX_UNIT_DEFAULT:
+        return "default";
+    case LX_UNIT_CANDELA:
+        return "cd";
+    case LX_UNIT_LUMEN:
+        return "lm";
+    case LX_UNIT_WATT:
+        return "W";
+    case LX_UNIT_LUX:
+        return "lx";
+    }
+    return "unknown";
+}
+
+const char *lx_light_type_name(lx_light_type type) {
+    switch (type) {
+    case LX_LIGHT_POINT:
+        return "point";
+    case LX_LIGHT_SPOT:
+        return "spot";
+    case LX_LIGHT_DIRECTIONAL:
+        return "directional";
+    }
+    return "unknown";
+}
+
+const char *lx_shadow_mode_name(lx_shadow_mode mode) {
+    switch (mode) {
+    case LX_SHADOW_HARD:
+        return "hard";
+    case LX_SHADOW_NONE:
+        return "none";
+    case LX_SHADOW_BLUR:
+        return "blur";
+    }
+    return "unknown";
+}
+
+float lx_exposure_from_ev100(float ev100) {
+    return (float)(1.0 / (1.2 * exp2((double)ev100)));
+}
+
+float lx_ev100_from_luminance(double average_luminance) {
+    if (!(average_luminance > 0.0) || !isfinite(average_luminance)) return 0.0f;
+    return (float)log2(average_luminance * 100.0 / 12.5);
+}

@@ -1,0 +1,382 @@
+/* Tests of the lights JSON reader (src/scene/lights_json.c, the schema of
+ * docs/lights-json.md): the documented example with its unit and angle
+ * conversions worked out here, overrides by name, and every malformed
+ * input failing with a message that names the file, light and field. */
+#define _POSIX_C_SOURCE 200809L
+#include <stdarg.h>
+#include <stddef.h>
+#include <setjmp.h>
+#include <stdint.h>
+#include <cmocka.h>
+
+#include <math.h>
+#include <stdio.h>
+#include <stdlib.h>
+#include <string.h>
+#include <sys/stat.h>
+#include <unistd.h>
+
+#include "luxel/scene.h"
+
+#define PI_D 3.14159265358979323846
+
+static void assert_rel(double got, double want, double tol) {
+    double scale = fabs(want) > 1e-30 ? fabs(want) : 1.0;
+    if (!(fabs(got - want) <= tol * scale)) fail_msg("got %.9g, want %.9g", got, want);
+}
+
+static void assert_vec(lx_vec3 v, double x, double y, double z) {
+    if (!(fabs(v.x - x) < 1e-5 && fabs(v.y - y) < 1e-5 && fabs(v.z - z) < 1e-5))
+        fail_msg("got [%g, %g, %g], want [%g, %g, %g]", v.x, v.y, v.z, x, y, z);
+}
+
+static lx_scene *new_scene(void) {
+    lx_scene *s;
+    assert_int_equal(lx_scene_create("test", &s), LX_OK);
+    return s;
+}
+
+static lx_status apply(lx_scene *s, const char *text) {
+    return lx_lights_json_apply_text(s, text, strlen(text), "lights.json");
+}
+
+static const char *example =
+    "{\"ambient\": [0.02, 0.02, 0.02],\n"
+    " \"lights\": [\n"
+    "   {\"name\": \"key\", \"type\": \"point\", \"position\": [0, 2, 0], \"color\": [1, 1, 1],\n"
+    "    \"intensity\": 800, \"unit\": \"cd\", \"range\": 10, \"shadow\": \"hard\", "
+    "\"dynamic\": false},\n"
+    "   {\"type\": \"spot\", \"position\": [0, 3, 0], \"direction\": [0, -1, 0], "
+    "\"inner_angle\": 20, \"outer_angle\": 30,\n"
+    "    \"intensity\": 1200, \"unit\": \"cd\", \"shadow\": \"blur\", \"blur_power\": 1.0, "
+    "\"blur_multiplier\": 1.0},\n"
+    "   {\"type\": \"directional\", \"direction\": [0.3, -1, 0.2], \"intensity\": 100000, "
+    "\"unit\": \"lx\", \"shadow\": \"hard\"},\n"
+    "   {\"type\": \"point\", \"position\": [2, 1, 0], \"intensity\": 1, \"range\": 5, "
+    "\"model\": \"classic\", \"ambient\": [0.1, 0, 0]}]}\n";
+
+static void test_example(void **state) {
+    (void)state;
+    lx_scene *s = new_scene();
+    assert_int_equal(apply(s, example), LX_OK);
+    assert_int_equal(s->light_count, 4);
+    assert_vec(s->ambient, 0.02, 0.02, 0.02);
+
+    const lx_light *k = &s->lights[0];
+    assert_string_equal(k->name, "key");
+    assert_int_equal(k->type, LX_LIGHT_POINT);
+    assert_vec(k->position, 0, 2, 0);
+    assert_vec(k->color, 1, 1, 1);
+    assert_true(k->intensity == 800.0f && k->range == 10.0f);
+    assert_int_equal(k->shadow, LX_SHADOW_HARD);
+    assert_int_equal(k->model, LX_MODEL_PHYSICAL);
+    assert_false(k->dynamic);
+
+    const lx_light *sp = &s->lights[1];
+    assert_string_equal(sp->name, "");
+    assert_int_equal(sp->type, LX_LIGHT_SPOT);
+    assert_vec(sp->direction, 0, -1, 0);
+    assert_rel(sp->inner_angle, 20.0 * PI_D / 180.0, 1e-6);
+    assert_rel(sp->outer_angle, 30.0 * PI_D / 180.0, 1e-6);
+    assert_true(sp->intensity == 1200.0f);
+    assert_int_equal(sp->shadow, LX_SHADOW_BLUR);
+    assert_true(sp->blur_power == 1.0f && sp->blur_multiplier == 1.0f);
+
+    const lx_light *d = &s->lights[2];
+    double len = sqrt(0.09 + 1.0 + 0.04);
+    assert_int_equal(d->type, LX_LIGHT_DIRECTIONAL);
+    assert_vec(d->direction, 0.3 / len, -1.0 / len, 0.2 / len);
+    assert_true(d->intensity == 100000.0f);
+
+    const lx_light *c = &s->lights[3];
+    assert_int_equal(c->model, LX_MODEL_CLASSIC);
+    assert_vec(c->ambient, 0.1, 0, 0);
+    assert_true(c->range == 5.0f && c->intensity == 1.0f);
+    assert_int_equal(c->shadow, LX_SHADOW_HARD); /* default */
+    lx_scene_destroy(s);
+}
+
+static void test_units(void **state) {
+    (void)state;
+    lx_scene *s = new_scene();
+    assert_int_equal(apply(s,
+                           "{\"lights\": ["
+                           "{\"name\": \"a\", \"type\": \"point\", \"position\": [0,0,0], "
+                           "\"intensity\": 1000, \"unit\": \"lm\"},"
+                           "{\"name\": \"b\", \"type\": \"point\", \"position\": [0,0,0], "
+                           "\"intensity\": 10, \"unit\": \"W\"},"
+                           "{\"name\": \"c\", \"type\": \"spot\", \"position\": [0,0,0], "
+                           "\"direction\": [0,0,-1], \"outer_angle\": 30, \"intensity\": 1000, "
+                           "\"unit\": \"lumen\"},"
+                           "{\"name\": \"d\", \"type\": \"spot\", \"position\": [0,0,0], "
+                           "\"direction\": [0,0,-1], \"outer_angle\": 30, \"intensity\": 1000, "
+                           "\"unit\": \"lm\", \"spot_conversion\": \"cone\"},"
+                           "{\"name\": \"e\", \"type\": \"directional\", \"direction\": [0,-2,0], "
+                           "\"intensity\": 5}]}"),
+                     LX_OK);
+    assert_int_equal(s->light_count, 5);
+    assert_rel(s->lights[0].intensity, 1000.0 / (4 * PI_D), 1e-6);
+    assert_rel(s->lights[1].intensity, 6830.0 / (4 * PI_D), 1e-6);
+    assert_rel(s->lights[2].intensity, 1000.0 / PI_D, 1e-6);
+    assert_rel(s->lights[3].intensity, 1000.0 / (2 * PI_D * (1 - cos(PI_D / 6))), 1e-5);
+    assert_true(s->lights[4].intensity == 5.0f);
+    assert_vec(s->lights[4].direction, 0, -1, 0);
+    /* Defaults of a new light. */
+    assert_vec(s->lights[0].color, 1, 1, 1);
+    assert_true(s->lights[0].range == 0.0f);
+    assert_rel(s->lights[0].outer_angle, PI_D / 4, 1e-6);
+    lx_scene_destroy(s);
+}
+
+static void test_override(void **state) {
+    (void)state;
+    lx_scene *s = new_scene();
+    lx_light lamp = lx_light_defaults(LX_LIGHT_SPOT);
+    strcpy(lamp.name, "lamp");
+    lamp.position = lx_v3(1, 2, 3);
+    lamp.direction = lx_v3(0, 0, -1);
+    lamp.intensity = 50.0f;
+    lamp.range = 7.0f;
+    lamp.inner_angle = 0.2f;
+    lamp.outer_angle = 0.5f;
+    assert_int_equal(lx_scene_add_light(s, &lamp), LX_OK);
+    s->ambient = lx_v3(0.5f, 0.5f, 0.5f);
+
+    /* Only the given keys change; type, position, direction stay. */
+    assert_int_equal(apply(s, "{\"lights\": [{\"name\": \"lamp\", \"intensity\": 100, "
+                              "\"shadow\": \"none\", \"dynamic\": true}]}"),
+                     LX_OK);
+    assert_int_equal(s->light_count, 1);
+    const lx_light *l = &s->lights[0];
+    assert_int_equal(l->type, LX_LIGHT_SPOT);
+    assert_vec(l->position, 1, 2, 3);
+    assert_vec(l->direction, 0, 0, -1);
+    assert_true(l->intensity == 100.0f && l->range == 7.0f);
+    assert_true(l->inner_angle == 0.2f && l->outer_angle == 0.5f);
+    assert_int_equal(l->shadow, LX_SHADOW_NONE);
+    assert_true(l->dynamic);
+    assert_vec(s->ambient, 0.5, 0.5, 0.5); /* no "ambient": unchanged */
+
+    /* A later entry of the same file overrides an earlier one the same way. */
+    assert_int_equal(apply(s, "{\"lights\": ["
+                              "{\"name\": \"new\", \"type\": \"point\", \"position\": [4,5,6], "
+                              "\"intensity\": 3},"
+                              "{\"name\": \"new\", \"color\": [1, 0, 0]}]}"),
+                     LX_OK);
+    assert_int_equal(s->light_count, 2);
+    assert_string_equal(s->lights[1].name, "new");
+    assert_vec(s->lights[1].position, 4, 5, 6);
+    assert_vec(s->lights[1].color, 1, 0, 0);
+    assert_true(s->lights[1].intensity == 3.0f);
+
+    /* Lumens over an overridden spot use its (possibly new) cone. */
+    assert_int_equal(apply(s, "{\"lights\": [{\"name\": \"lamp\", \"outer_angle\": 60, "
+                              "\"intensity\": 100, \"unit\": \"lm\", "
+                              "\"spot_conversion\": \"cone\"}]}"),
+                     LX_OK);
+    assert_rel(s->lights[0].intensity, 100.0 / (2 * PI_D * 0.5), 1e-5);
+    lx_scene_destroy(s);
+}
+
+typedef struct bad_case {
+    const char *json;
+    lx_status status;
+    const char *message;
+} bad_case;
+
+static const bad_case bad_cases[] = {
+    {"{\"lights\": [{\"type\": \"point\", \"position\": [0,0,0]}, {\"type\": \"point\", "
+     "\"position\": [0,0,0]}, {\"type\": \"point\", \"position\": [0,0,0], \"intesity\": 5}]}",
+     LX_ERR_FORMAT, "lights.json: lights[2]: unknown key 'intesity'"},
+    {"{\"light\": []}", LX_ERR_FORMAT, "lights.json: unknown key 'light'"},
+    {"{\"lights\": [{\"type\": \"area\", \"position\": [0,0,0]}]}", LX_ERR_FORMAT,
+     "lights[0]: unknown type 'area'"},
+    {"{\"lights\": [{\"type\": \"point\", \"position\": [0,0,0], \"intensity\": 1e999}]}",
+     LX_ERR_FORMAT, "lights[0]: intensity is not a finite number"},
+    {"{\"lights\": [{\"type\": \"point\", \"position\": [0,-1e999,0]}]}", LX_ERR_FORMAT,
+     "position[1] is not a finite number"},
+    {"{\"lights\": [{\"type\": \"point\", \"position\": [0,0,0], \"range\": 1e39}]}", LX_ERR_FORMAT,
+     "range is not a finite number"},
+    {"{\"lights\": [{\"type\": \"point\", \"position\": [0,0,0], \"intensity\": NaN}]}",
+     LX_ERR_FORMAT, "lights.json: line 1, column"},
+    {"{\"lights\": [{\"name\": \"key\", \"type\": \"point\", \"position\": [0,0,0], "
+     "\"intensity\": -5}]}",
+     LX_ERR_INVALID, "lights.json: lights[0] ('key'): intensity -5 is negative"},
+    {"{\"lights\": [{\"name\": \"key\", \"type\": \"spot\", \"position\": [0,0,0], "
+     "\"direction\": [0,-1,0], \"inner_angle\": 40, \"outer_angle\": 30}]}",
+     LX_ERR_INVALID, "lights[0] ('key'): inner_angle 40 deg is above outer_angle 30 deg"},
+    {"{\"lights\": [{\"type\": \"spot\", \"position\": [0,0,0], \"direction\": [0,-1,0], "
+     "\"outer_angle\": 120}]}",
+     LX_ERR_INVALID, "outer_angle 120 deg is above 90 deg"},
+    {"{\"lights\": [{\"type\": \"point\", \"position\": [0,1]}]}", LX_ERR_FORMAT,
+     "lights[0]: position must be an array of 3 numbers, not 2"},
+    {"{\"lights\": [{\"type\": \"point\", \"position\": [0,\"1\",2]}]}", LX_ERR_FORMAT,
+     "position[1] must be a number"},
+    {"{\"lights\": [{\"type\": \"point\", \"position\": {\"x\": 1}}]}", LX_ERR_FORMAT,
+     "position must be an array of 3 numbers"},
+    {"{\"lights\": [{\"type\": \"point\", \"position\": [0,0,0], \"color\": [1,1,1,1]}]}",
+     LX_ERR_FORMAT, "color must be an array of 3 numbers, not 4"},
+    {"{\"lights\": [{\"type\": \"point\", \"position\": [0,0,0], \"color\": [1,-1,1]}]}",
+     LX_ERR_INVALID, "color [1, -1, 1] has a negative component"},
+    {"{\n  \"lights\": [\n    {\"type\": \"point\",, \"position\": [0,0,0]}\n  ]\n}", LX_ERR_FORMAT,
+     "lights.json: line 3, column 23: malformed JSON"},
+    {"{\"lights\": [", LX_ERR_FORMAT, "unexpected end"},
+    {"", LX_ERR_FORMAT, "lights.json: line 1, column 1"},
+    {"{\"lights\": []} trailing", LX_ERR_FORMAT, "line 1, column 16"},
+    {"[1, 2, 3]", LX_ERR_FORMAT, "lights.json: the top level must be an object"},
+    {"\"lights\"", LX_ERR_FORMAT, "top level must be an object"},
+    {"{\"lights\": {}}", LX_ERR_FORMAT, "lights must be an array"},
+    {"{\"lights\": [42]}", LX_ERR_FORMAT, "lights[0]: must be an object"},
+    {"{\"ambient\": [0, 0]}", LX_ERR_FORMAT, "ambient must be an array of 3 numbers, not 2"},
+    {"{\"ambient\": [0, -0.1, 0]}", LX_ERR_INVALID, "ambient [0, -0.1, 0]"},
+    {"{\"lights\": [{\"type\": \"point\", \"position\": [0,0,0], \"intensity\": 1, "
+     "\"unit\": \"kW\"}]}",
+     LX_ERR_FORMAT, "unknown unit 'kW'"},
+    {"{\"lights\": [{\"type\": \"point\", \"position\": [0,0,0], \"shadow\": \"soft\"}]}",
+     LX_ERR_FORMAT, "unknown shadow 'soft' (expected hard, none, blur)"},
+    {"{\"lights\": [{\"type\": \"point\", \"position\": [0,0,0], \"model\": \"fancy\"}]}",
+     LX_ERR_FORMAT, "unknown model 'fancy'"},
+    {"{\"lights\": [{\"type\": \"spot\", \"position\": [0,0,0], \"direction\": [0,-1,0], "
+     "\"intensity\": 1, \"unit\": \"lm\", \"spot_conversion\": \"sphere\"}]}",
+     LX_ERR_FORMAT, "unknown spot_conversion 'sphere'"},
+    {"{\"lights\": [{\"type\": 3, \"position\": [0,0,0]}]}", LX_ERR_FORMAT,
+     "type must be a string"},
+    {"{\"lights\": [{\"type\": \"directional\", \"direction\": [0,0,0]}]}", LX_ERR_INVALID,
+     "lights[0]: direction [0, 0, 0] has zero length"},
+    {"{\"lights\": [{\"name\": \"sun\", \"type\": \"directional\", \"direction\": [0,-1,0], "
+     "\"intensity\": 5, \"unit\": \"W\"}]}",
+     LX_ERR_INVALID, "lights[0] ('sun'): unit: directional lights take lux, not W"},
+    {"{\"lights\": [{\"type\": \"point\", \"position\": [0,0,0], \"intensity\": 5, "
+     "\"unit\": \"lux\"}]}",
+     LX_ERR_INVALID, "point lights take cd, lm or W, not lx"},
+    {"{\"lights\": [{\"position\": [0,0,0]}]}", LX_ERR_FORMAT, "lights[0]: missing 'type'"},
+    {"{\"lights\": [{\"type\": \"point\"}]}", LX_ERR_FORMAT, "missing 'position'"},
+    {"{\"lights\": [{\"type\": \"spot\", \"position\": [0,0,0]}]}", LX_ERR_FORMAT,
+     "missing 'direction'"},
+    {"{\"lights\": [{\"type\": \"point\", \"position\": [0,0,0], \"model\": \"classic\"}]}",
+     LX_ERR_INVALID, "classic model needs a range above 0"},
+    {"{\"lights\": [{\"type\": \"point\", \"position\": [0,0,0], \"range\": -1}]}", LX_ERR_INVALID,
+     "range -1 is negative"},
+    {"{\"lights\": [{\"type\": \"point\", \"position\": [0,0,0], \"blur_power\": -1}]}",
+     LX_ERR_INVALID, "blur_power -1 is negative"},
+    {"{\"lights\": [{\"type\": \"point\", \"position\": [0,0,0], \"type\": \"spot\"}]}",
+     LX_ERR_FORMAT, "key 'type' appears twice"},
+    {"{\"lights\": [{\"type\": \"point\", \"position\": [0,0,0], \"dynamic\": \"yes\"}]}",
+     LX_ERR_FORMAT, "dynamic must be true or false"},
+    {"{\"lights\": [{\"type\": \"point\", \"position\": [0,0,0], \"unit\": \"lm\"}]}",
+     LX_ERR_FORMAT, "'unit' is given without 'intensity'"},
+    {"{\"lights\": [{\"name\": 5, \"type\": \"point\", \"position\": [0,0,0]}]}", LX_ERR_FORMAT,
+     "name must be a string"},
+    {"{\"lights\": [{\"name\": \"0123456789012345678901234567890123456789012345678901234567890"
+     "123456789\", \"type\": \"point\", \"position\": [0,0,0]}]}",
+     LX_ERR_INVALID, "is longer than 63 bytes"},
+};
+
+static void test_bad_input(void **state) {
+    (void)state;
+    for (size_t i = 0; i < sizeof bad_cases / sizeof bad_cases[0]; i++) {
+        lx_scene *s = new_scene();
+        lx_status st = apply(s, bad_cases[i].json);
+        if (st != bad_cases[i].status || !strstr(lx_last_error(), bad_cases[i].message))
+            fail_msg("case %zu: %s '%s', want %s with '%s'", i, lx_status_name(st), lx_last_error(),
+                     lx_status_name(bad_cases[i].status), bad_cases[i].message);
+        assert_int_equal(s->light_count, 0);
+        lx_scene_destroy(s);
+    }
+}
+
+static void test_bad_bytes(void **state) {
+    (void)state;
+    lx_scene *s = new_scene();
+    const char with_nul[] = "{\"lights\": []}\0{}";
+    assert_int_equal(lx_lights_json_apply_text(s, with_nul, sizeof with_nul - 1, "x.json"),
+                     LX_ERR_FORMAT);
+    assert_non_null(strstr(lx_last_error(), "x.json: byte 14 is a NUL byte"));
+    /* Not NUL-terminated: only size bytes are read. */
+    const char cut[] = "{\"lights\": []}XXXX";
+    assert_int_equal(lx_lights_json_apply_text(s, cut, 14, "x.json"), LX_OK);
+    /* A UTF-8 byte order mark is fine. */
+    const char bom[] = "\xEF\xBB\xBF{\"ambient\": [1, 2, 3]}";
+    assert_int_equal(lx_lights_json_apply_text(s, bom, strlen(bom), "x.json"), LX_OK);
+    assert_vec(s->ambient, 1, 2, 3);
+    /* More than 64 MiB is refused before parsing. */
+    size_t big = ((size_t)64 << 20) + 1;
+    char *text = malloc(big);
+    assert_non_null(text);
+    memset(text, ' ', big);
+    assert_int_equal(lx_lights_json_apply_text(s, text, big, "big.json"), LX_ERR_FORMAT);
+    assert_non_null(strstr(lx_last_error(), "64 MiB"));
+    free(text);
+    lx_scene_destroy(s);
+}
+
+/* An invalid file changes nothing, even when its first lights are good. */
+static void test_all_or_nothing(void **state) {
+    (void)state;
+    lx_scene *s = new_scene();
+    assert_int_equal(apply(s, "{\"lights\": [{\"name\": \"a\", \"type\": \"point\", "
+                              "\"position\": [0,0,0], \"intensity\": 2}]}"),
+                     LX_OK);
+    assert_int_equal(apply(s, "{\"ambient\": [9, 9, 9], \"lights\": ["
+                              "{\"name\": \"a\", \"intensity\": 7},"
+                              "{\"name\": \"b\", \"type\": \"point\", \"position\": [0,0,0]},"
+                              "{\"name\": \"c\", \"type\": \"point\", \"position\": [0,0,0], "
+                              "\"intensity\": -1}]}"),
+                     LX_ERR_INVALID);
+    assert_non_null(strstr(lx_last_error(), "lights[2] ('c'): intensity -1 is negative"));
+    assert_int_equal(s->light_count, 1);
+    assert_true(s->lights[0].intensity == 2.0f);
+    assert_vec(s->ambient, 0, 0, 0);
+    lx_scene_destroy(s);
+}
+
+static const char *tmp_dir(void) {
+    const char *dir = getenv("LX_TEST_TMP");
+    if (!dir || !dir[0]) dir = "/tmp";
+    mkdir(dir, 0777);
+    return dir;
+}
+
+static void test_file(void **state) {
+    (void)state;
+    char path[512];
+    snprintf(path, sizeof path, "%s/test_lights_json_%ld.json", tmp_dir(), (long)getpid());
+    FILE *fp = fopen(path, "wb");
+    assert_non_null(fp);
+    fputs(example, fp);
+    fclose(fp);
+    lx_scene *s = new_scene();
+    assert_int_equal(lx_lights_json_apply(s, path), LX_OK);
+    assert_int_equal(s->light_count, 4);
+
+    /* Errors name the path as given. */
+    fp = fopen(path, "wb");
+    fputs("{\"lights\": [{\"type\": \"lamp\"}]}", fp);
+    fclose(fp);
+    assert_int_equal(lx_lights_json_apply(s, path), LX_ERR_FORMAT);
+    assert_non_null(strstr(lx_last_error(), path));
+    assert_non_null(strstr(lx_last_error(), "unknown type 'lamp'"));
+
+    /* Files over 64 MiB are refused without reading them. */
+    fp = fopen(path, "wb");
+    assert_int_equal(fseek(fp, (long)(64 << 20), SEEK_SET), 0);
+    fputc(' ', fp);
+    fclose(fp);
+    assert_int_not_equal(lx_lights_json_apply(s, path), LX_OK);
+    assert_non_null(strstr(lx_last_error(), path));
+    remove(path);
+
+    assert_int_equal(lx_lights_json_apply(s, path), LX_ERR_IO);
+    assert_int_equal(s->light_count, 4);
+    lx_scene_destroy(s);
+}
+
+int main(void) {
+    const struct CMUnitTest tests[] = {
+        cmocka_unit_test(test_example),   cmocka_unit_test(test_units),
+        cmocka_unit_test(test_override),  cmocka_unit_test(test_bad_input),
+        cmocka_unit_test(test_bad_bytes), cmocka_unit_test(test_all_or_nothing),
+        cmocka_unit_test(test_file),
+    };
+    return cmocka_run_group_tests(tests, NULL, NULL);
+}
