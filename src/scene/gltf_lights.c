@@ -7,6 +7,8 @@
  * are T * R * S (or "matrix"), parent times child, column-major. */
 #include "luxel/scene.h"
 
+#include "json_text.h"
+
 #include <cjson/cJSON.h>
 #include <errno.h>
 #include <stdarg.h>
@@ -81,27 +83,7 @@ static lx_status parse_json(const char *file, const char *text, size_t size, cJS
         return failf(file, LX_ERR_FORMAT,
                      "neither glTF JSON (NUL byte at offset %zu) nor GLB (no 'glTF' magic)",
                      (size_t)(nul - text));
-    char *buf = malloc(size + 1); /* terminated: cJSON then rejects trailing garbage */
-    if (!buf) return failf(file, LX_ERR_NOMEM, "cannot allocate %zu bytes for the JSON", size + 1);
-    memcpy(buf, text, size);
-    buf[size] = '\0';
-    size_t skip = size >= 3 && memcmp(buf, "\xEF\xBB\xBF", 3) == 0 ? 3 : 0;
-    const char *end = NULL;
-    *root = cJSON_ParseWithLengthOpts(buf + skip, size - skip + 1, &end, 1);
-    if (*root) {
-        free(buf);
-        return LX_OK;
-    }
-    size_t off = end && end >= buf && end <= buf + size ? (size_t)(end - buf) : 0;
-    size_t line = 1, col = 1;
-    for (size_t i = 0; i < off; i++, col++)
-        if (buf[i] == '\n') {
-            line++;
-            col = 0;
-        }
-    free(buf);
-    return failf(file, LX_ERR_FORMAT, "line %zu, column %zu: malformed JSON%s", line, col,
-                 off >= size ? ": unexpected end" : "");
+    return lx_json_parse_text(file, text, size, root);
 }
 
 /* ---- typed values --------------------------------------------------------- */

@@ -5,6 +5,8 @@
  * in the scene unless the whole file is valid. */
 #include "luxel/scene.h"
 
+#include "json_text.h"
+
 #include <cjson/cJSON.h>
 #include <stdarg.h>
 #include <stdio.h>
@@ -36,52 +38,13 @@ static lx_status fail(const ctx *c, lx_status st, const char *fmt, ...) {
 
 /* ---- parsing the text -------------------------------------------------- */
 
-/* Reports a cJSON syntax error at pos with its line and column. */
-static lx_status syntax_error(const char *file, const char *text, size_t size, const char *pos) {
-    size_t off = pos && pos >= text && pos <= text + size ? (size_t)(pos - text) : 0;
-    size_t line = 1, col = 1;
-    for (size_t i = 0; i < off; i++) {
-        if (text[i] == '\n') {
-            line++;
-            col = 1;
-        } else {
-            col++;
-        }
-    }
-    if (off >= size)
-        return lx_fail(LX_ERR_FORMAT, "%s: line %zu, column %zu: malformed JSON: unexpected end",
-                       file, line, col);
-    char near[24];
-    size_t n = 0;
-    for (size_t i = off; i < size && n < 16 && text[i] != '\n'; i++)
-        near[n++] = (text[i] >= 0x20 && text[i] < 0x7f) ? text[i] : '?';
-    near[n] = '\0';
-    return lx_fail(LX_ERR_FORMAT, "%s: line %zu, column %zu: malformed JSON near '%s'", file, line,
-                   col, near);
-}
-
 /* Parses size bytes (not necessarily NUL-terminated) into *root. */
 static lx_status parse_json(const char *file, const char *text, size_t size, cJSON **root) {
     *root = NULL;
     if (size > LX_LIGHTS_JSON_MAX)
         return lx_fail(LX_ERR_FORMAT,
                        "%s: %zu bytes is more than the 64 MiB a lights file may have", file, size);
-    const char *nul = memchr(text, '\0', size);
-    if (nul)
-        return lx_fail(LX_ERR_FORMAT, "%s: byte %zu is a NUL byte, not JSON text", file,
-                       (size_t)(nul - text));
-    /* A copy with a terminator: cJSON then also rejects trailing garbage. */
-    char *buf = malloc(size + 1);
-    if (!buf) return lx_fail(LX_ERR_NOMEM, "%s: cannot allocate %zu bytes", file, size + 1);
-    memcpy(buf, text, size);
-    buf[size] = '\0';
-    size_t skip = size >= 3 && memcmp(buf, "\xEF\xBB\xBF", 3) == 0 ? 3 : 0; /* UTF-8 BOM */
-    const char *end = NULL;
-    *root = cJSON_ParseWithLengthOpts(buf + skip, size - skip + 1, &end, 1);
-    lx_status st = LX_OK;
-    if (!*root) st = syntax_error(file, buf, size, end);
-    free(buf);
-    return st;
+    return lx_json_parse_text(file, text, size, root);
 }
 
 /* ---- typed fields ------------------------------------------------------ */
