@@ -10,7 +10,11 @@
  *   Evaluation follows Filament's physically based model (seed 001): inverse
  *   square law with the smooth window (1 - (d/r)^4)^2, the spot's smooth
  *   angular attenuation, N.L. The seed-000 "classic" model is
- *   ((1 - d/range) * |N.L|)^2 * colour * intensity, in the light's own units.
+ *   ((1 - d/range) * |N.L|)^2 * colour * intensity, in the light's own units
+ *   (a classic spot also takes the cone attenuation; a classic directional
+ *   light gives (N.L)^2 * colour * intensity). Distances below 1 cm are
+ *   taken as 1 cm in the inverse square law (Filament's 1e-4 m^2 floor).
+ *   A spot with inner == outer is a hard-edged cone (as Blender exports).
  * ERRORS  Validation functions return LX_ERR_INVALID naming the light.
  * MEMORY  lx_light is plain data.
  * THREADING  Pure functions.

@@ -118,16 +118,20 @@ bool lx_triangle_degenerate(lx_vec3 a, lx_vec3 b, lx_vec3 c);
 bool lx_scene_bounds(const lx_scene *scene, lx_vec3 *lo, lx_vec3 *hi);
 
 /* Reads a lights JSON file (docs/lights-json.md) and applies it: its
- * "ambient" sets scene->ambient, each light is added or replaces the scene
- * light of the same name. Fails naming the file and the field. */
+ * "ambient" sets scene->ambient, each light is added or overrides the scene
+ * light of the same name (an override starts from that light and changes
+ * only the keys given). All or nothing: on failure, naming the file and the
+ * field, the scene is unchanged. */
 lx_status lx_lights_json_apply(lx_scene *scene, const char *path);
 /* Same from text already in memory; name is used in messages. */
 lx_status lx_lights_json_apply_text(lx_scene *scene, const char *text, size_t size,
                                     const char *name);
 
-/* Reads the KHR_lights_punctual lights of a .gltf or .glb file and adds
- * them, placed by their nodes' world transforms. Files without the
- * extension add nothing. */
+/* Reads the KHR_lights_punctual lights of a .gltf or .glb file (of its
+ * default scene, else the first, else every parentless node) and adds them,
+ * placed by their nodes' world transforms. A light is named after the glTF
+ * light, else its node, else "light<N>"; repeated names get "_2", "_3"...
+ * Files without the extension add nothing. */
 lx_status lx_gltf_lights_load(lx_scene *scene, const char *path);
 lx_status lx_gltf_lights_load_memory(lx_scene *scene, const void *bytes, size_t size,
                                      const char *name);
