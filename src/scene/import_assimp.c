@@ -310,6 +310,12 @@ static lx_status import_node(import_ctx *c, const struct aiNode *node, const lx_
                 meshes[n++] = c->mesh_map[mi];
         }
         lx_status st = LX_OK;
+        if (n && lx_mat4_finite(&world) && !(fabsf(lx_mat4_det3(&world)) > 1e-20f)) {
+            /* exporters hide objects with a zero scale: nothing to bake */
+            lx_log(LX_LOG_WARN, "%s: node '%s' has a zero scale; skipped", c->path,
+                   node->mName.data);
+            n = 0;
+        }
         if (n) {
             char base[LX_NAME_MAX], name[LX_NAME_MAX + 16];
             if (node->mName.length)
