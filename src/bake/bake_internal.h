@@ -50,6 +50,15 @@ struct lx_baker {
     float bias;          /* shadow ray origin offset, metres */
 };
 
+/* Bytes a lightmap needs per texel at most: raster scratch, mask, baked and
+ * real-time RGB, and a texel record with its world-space copies. */
+#define LX_BYTES_PER_TEXEL (4 * 4 + 2 + 2 * 12 + sizeof(lx_texel) + 3 * 12)
+
+/* The size of node's lightmap under desc (texel_map.c); 0 x 0 when the node
+ * has no UVs. */
+void lx_texel_map_size(const lx_scene *scene, uint32_t node, const lx_bake_desc *desc,
+                       int *width, int *height);
+
 /* Builds the texel map of scene node `node` into map (texel_map.c).
  * Returns LX_OK with map->info.used_texels == 0 and a warning when the
  * node has no UVs to bake. */

@@ -81,16 +81,22 @@ lx_status lx_baker_create(const lx_scene *scene, const lx_bake_desc *in, lx_bake
     b->bias = desc.shadow_bias > 0.0f ? desc.shadow_bias : 1e-5f * b->scene_diagonal;
 
     /* memory for every lightmap together, before allocating any */
-    if (desc.texel_density == 0.0f) {
-        uint64_t px = (uint64_t)desc.resolution * (uint64_t)desc.resolution;
-        uint64_t bytes = px * (64 + sizeof(lx_texel)) * (uint64_t)scene->node_count;
-        char what[96];
-        snprintf(what, sizeof what, "%u lightmaps of %dx%d", scene->node_count,
-                 desc.resolution, desc.resolution);
-        if ((st = lx_check_memory(bytes, what)) != LX_OK) {
-            lx_baker_destroy(b);
-            return st;
-        }
+    uint64_t bytes = 0;
+    int largest = 0;
+    uint32_t with_uvs = 0;
+    for (uint32_t n = 0; n < scene->node_count; n++) {
+        int w, h;
+        lx_texel_map_size(scene, n, &desc, &w, &h);
+        bytes += (uint64_t)w * (uint64_t)h * LX_BYTES_PER_TEXEL;
+        largest = w > largest ? w : largest;
+        with_uvs += w > 0;
+    }
+    char what[400];
+    snprintf(what, sizeof what, "%s: baking %u lightmaps (the largest %dx%d)", scene->path, with_uvs,
+             largest, largest);
+    if ((st = lx_check_memory(bytes, what)) != LX_OK) {
+        lx_baker_destroy(b);
+        return st;
     }
     for (uint32_t n = 0; n < scene->node_count; n++) {
         b->node_world[n] = scene->nodes[n].world;

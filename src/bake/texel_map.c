@@ -19,6 +19,7 @@ typedef struct raster_ctx {
     float *distance;    /* 0 for centre coverage, else texel-space distance */
     uint8_t *strict;    /* centre strictly inside the owner */
     uint32_t overlap;
+    uint32_t *slot_overlap; /* overlapping texels counted by the later mesh */
 } raster_ctx;
 
 typedef struct slot {
@@ -136,7 +137,7 @@ static void bbox(const double *v[3], int pad, const raster_ctx *r, int *x0, int 
     *y1 = (int)fmin(floor(maxy) + pad, r->height - 1.0);
 }
 
-static void raster_centres(raster_ctx *r, const double *v[3], uint32_t id)
+static void raster_centres(raster_ctx *r, const double *v[3], uint32_t id, uint32_t slot_index)
 {
     int x0, y0, x1, y1;
     bbox(v, 0, r, &x0, &y0, &x1, &y1);
@@ -152,8 +153,10 @@ static void raster_centres(raster_ctx *r, const double *v[3], uint32_t id)
             bool strict = w[0] > strict_eps && w[1] > strict_eps && w[2] > strict_eps;
             if (r->owner[p] != UINT32_MAX) {
                 /* an edge shared by neighbours is not an overlap */
-                if (strict && r->strict[p])
+                if (strict && r->strict[p]) {
                     r->overlap++;
+                    r->slot_overlap[slot_index]++;
+                }
                 continue;
             }
             r->owner[p] = id;
@@ -197,7 +200,7 @@ static void raster_borders(raster_ctx *r, const double *v[3], uint32_t id)
 
 /* Lightmap size for texel density: R^2 * uv_area = T^2 * world_area. */
 static int size_from_density(const lx_scene *scene, const lx_node *node, const slot *slots,
-                             uint32_t slot_count, const lx_bake_desc *desc)
+                             uint32_t slot_count, const lx_bake_desc *desc, bool warn)
 {
     double world_area = 0, uv_area = 0;
     for (uint32_t s = 0; s < slot_count; s++) {
@@ -213,7 +216,6 @@ static int size_from_density(const lx_scene *scene, const lx_node *node, const s
                                   (double)(uc.x - ua.x) * (ub.y - ua.y));
         }
     }
-    (void)scene;
     if (!(uv_area > 0))
         return 4;
     double r = desc->texel_density * sqrt(world_area / uv_area);
@@ -221,9 +223,10 @@ static int size_from_density(const lx_scene *scene, const lx_node *node, const s
     if (size < 4)
         size = 4;
     if (size > desc->max_resolution) {
-        lx_log(LX_LOG_WARN,
-               "node '%s': %.0f texels per side needed for %.3g texels/m; capped at %d",
-               node->name, r, desc->texel_density, desc->max_resolution);
+        if (warn)
+            lx_log(LX_LOG_WARN,
+                   "%s: node '%s': %.0f texels per side needed for %.3g texels/m; capped at %d",
+                   scene->path, node->name, r, desc->texel_density, desc->max_resolution);
         size = desc->max_resolution;
     }
     return size;
@@ -305,7 +308,7 @@ static lx_vec3 sample_albedo(const lx_material *mat, const lx_mesh *m, const uin
 
 /* Choose the node's lightmap UV set and its meshes with UVs. */
 static uint32_t collect_slots(const lx_scene *scene, const lx_node *node, slot *slots,
-                              int *uv_set)
+                              int *uv_set, bool warn)
 {
     bool all_have_uv1 = true;
     for (uint32_t k = 0; k < node->mesh_count; k++) {
@@ -319,11 +322,12 @@ static uint32_t collect_slots(const lx_scene *scene, const lx_node *node, slot *
         const lx_mesh *m = &scene->meshes[node->meshes[k]];
         const lx_vec2 *uv = m->uv[*uv_set];
         if (!uv) {
-            lx_log(LX_LOG_WARN, "%s: node '%s': mesh '%s' has no UVs; it gets no lightmap "
+            if (warn)
+                lx_log(LX_LOG_WARN, "%s: node '%s': mesh '%s' has no UVs; it gets no lightmap "
                    "texels (it still casts shadows)", scene->path, node->name, m->name);
             continue;
         }
-        if (*uv_set == 0)
+        if (*uv_set == 0 && warn)
             lx_log(LX_LOG_WARN, "%s: node '%s': mesh '%s' has no TEXCOORD_1; its lightmap "
                    "uses TEXCOORD_0", scene->path, node->name, m->name);
         slots[n++] = (slot){m, node->meshes[k], first, uv};
@@ -346,23 +350,22 @@ lx_status lx_texel_map_build(const lx_scene *scene, uint32_t node_index,
         return lx_fail(LX_ERR_NOMEM, "out of memory");
     }
     int uv_set;
-    uint32_t slot_count = collect_slots(scene, node, slots, &uv_set);
+    uint32_t slot_count = collect_slots(scene, node, slots, &uv_set, true);
     map->info.uv_set = uv_set;
     if (slot_count == 0) {
         free(slots);
         return LX_OK;
     }
-    int size = desc->texel_density > 0 ? size_from_density(scene, node, slots, slot_count, desc)
-                                       : desc->resolution;
+    int size = desc->texel_density > 0
+                   ? size_from_density(scene, node, slots, slot_count, desc, true)
+                   : desc->resolution;
     int w = size, h = size;
     map->info.width = w;
     map->info.height = h;
-    /* raster scratch + mask + two RGB buffers + worst-case texel records */
     uint64_t pixels = (uint64_t)w * (uint64_t)h;
-    uint64_t per_pixel = 4 + 4 + 4 + 4 + 1 + 1 + 12 + 12 + sizeof(lx_texel) + 3 * 12;
-    char what[160];
-    snprintf(what, sizeof what, "lightmap '%s' (%dx%d)", node->name, w, h);
-    lx_status st = lx_check_memory(pixels * per_pixel, what);
+    char what[400];
+    snprintf(what, sizeof what, "%s: lightmap '%s' (%dx%d)", scene->path, node->name, w, h);
+    lx_status st = lx_check_memory(pixels * LX_BYTES_PER_TEXEL, what);
     if (st != LX_OK) {
         free(slots);
         return st;
@@ -378,7 +381,8 @@ lx_status lx_texel_map_build(const lx_scene *scene, uint32_t node_index,
     for (uint32_t s = 0; s < slot_count; s++)
         total_triangles += slots[s].mesh->triangle_count;
     uint8_t *skip = malloc(total_triangles ? total_triangles : 1);
-    if (!r.owner || !r.b1 || !r.b2 || !r.distance || !r.strict || !skip) {
+    r.slot_overlap = calloc(slot_count, sizeof(uint32_t));
+    if (!r.owner || !r.b1 || !r.b2 || !r.distance || !r.strict || !skip || !r.slot_overlap) {
         st = lx_fail(LX_ERR_NOMEM, "%s: out of memory", what);
         goto done;
     }
@@ -402,15 +406,17 @@ lx_status lx_texel_map_build(const lx_scene *scene, uint32_t node_index,
                 uv_to_texel(&r, slots[s].uv[i[2]], c);
                 const double *v[3] = {a, b, c};
                 if (pass == 0)
-                    raster_centres(&r, v, slots[s].first_triangle + t);
+                    raster_centres(&r, v, slots[s].first_triangle + t, s);
                 else
                     raster_borders(&r, v, slots[s].first_triangle + t);
             }
         }
     map->info.overlap_texels = r.overlap;
-    if (r.overlap)
-        lx_log(LX_LOG_WARN, "%s: node '%s': %u texels are covered by overlapping lightmap UVs",
-               scene->path, node->name, r.overlap);
+    for (uint32_t s = 0; s < slot_count; s++)
+        if (r.slot_overlap[s])
+            lx_log(LX_LOG_WARN,
+                   "%s: mesh '%s' (node '%s'): %u texels are covered by overlapping lightmap UVs",
+                   scene->path, slots[s].mesh->name, node->name, r.slot_overlap[s]);
 
     /* gather covered texels tile by tile */
     uint32_t used = 0;
@@ -506,9 +512,27 @@ done:
     free(r.b2);
     free(r.distance);
     free(r.strict);
+    free(r.slot_overlap);
     free(skip);
     free(slots);
     return st;
+}
+
+void lx_texel_map_size(const lx_scene *scene, uint32_t node_index, const lx_bake_desc *desc,
+                       int *width, int *height)
+{
+    const lx_node *node = &scene->nodes[node_index];
+    *width = *height = 0;
+    slot *slots = calloc(node->mesh_count ? node->mesh_count : 1, sizeof *slots);
+    if (!slots)
+        return;
+    int uv_set;
+    uint32_t n = collect_slots(scene, node, slots, &uv_set, false);
+    if (n)
+        *width = *height = desc->texel_density > 0
+                               ? size_from_density(scene, node, slots, n, desc, false)
+                               : desc->resolution;
+    free(slots);
 }
 
 void lx_texel_map_transform(lx_lightmap *map, const lx_mat4 *world)

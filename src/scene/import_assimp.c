@@ -10,6 +10,9 @@
 #include <assimp/material.h>
 #include <assimp/postprocess.h>
 #include <assimp/scene.h>
+#include <errno.h>
+#include <float.h>
+#include <pthread.h>
 #include <stdio.h>
 #include <stdlib.h>
 #include <string.h>
@@ -26,6 +29,71 @@ typedef struct import_ctx {
     uint32_t *mesh_map; /* assimp mesh -> lx mesh index, UINT32_MAX if skipped */
     char *folder;
 } import_ctx;
+
+/* assimp reports some repairs only through its log (it drops faces whose
+ * indices are out of range); the log is process-wide, so imports are
+ * serialized and the log is watched while one runs. */
+static pthread_mutex_t import_lock = PTHREAD_MUTEX_INITIALIZER;
+static bool dropped_faces;
+
+static void on_assimp_log(const char *message, char *user)
+{
+    (void)user;
+    if (strstr(message, "out-of-range indices"))
+        dropped_faces = true;
+}
+
+/* OBJ text numbers that assimp would silently read as 0 ("nan", "inf",
+ * values beyond float range) are refused before import. */
+static lx_status check_obj_numbers(const char *path)
+{
+    FILE *fp = fopen(path, "rb");
+    if (!fp)
+        return lx_fail(LX_ERR_IO, "%s: cannot open: %s", path, strerror(errno));
+    char line[4096];
+    char object[128] = "";
+    unsigned long number = 0;
+    lx_status st = LX_OK;
+    while (st == LX_OK && fgets(line, sizeof line, fp)) {
+        number++;
+        if ((line[0] == 'o' || line[0] == 'g') && (line[1] == ' ' || line[1] == '\t')) {
+            snprintf(object, sizeof object, "%s", line + 2);
+            object[strcspn(object, "\r\n")] = '\0';
+            continue;
+        }
+        const char *kind = NULL;
+        if (strncmp(line, "v ", 2) == 0 || strncmp(line, "v\t", 2) == 0)
+            kind = "v";
+        else if (strncmp(line, "vt", 2) == 0 && (line[2] == ' ' || line[2] == '\t'))
+            kind = "vt";
+        else if (strncmp(line, "vn", 2) == 0 && (line[2] == ' ' || line[2] == '\t'))
+            kind = "vn";
+        if (!kind)
+            continue;
+        const char *p = line + strlen(kind);
+        for (;;) {
+            while (*p == ' ' || *p == '\t')
+                p++;
+            if (!*p || *p == '\n' || *p == '\r' || *p == '#')
+                break;
+            char *end;
+            double v = strtod(p, &end);
+            if (end == p)
+                break; /* not a number: assimp reports it */
+            if (!isfinite(v) || fabs(v) > FLT_MAX) {
+                int len = (int)(end - p) < 32 ? (int)(end - p) : 32;
+                st = lx_fail(LX_ERR_FORMAT,
+                             "%s: line %lu%s%s%s: '%s' value '%.*s' is not finite", path,
+                             number, object[0] ? ": object '" : "", object,
+                             object[0] ? "'" : "", kind, len, p);
+                break;
+            }
+            p = end;
+        }
+    }
+    fclose(fp);
+    return st;
+}
 
 static lx_mat4 mat4_from_ai(const struct aiMatrix4x4 *a)
 {
@@ -353,22 +421,39 @@ lx_status lx_scene_load(const char *path, const lx_scene_load_desc *desc, lx_sce
         return lx_fail(LX_ERR_IO, "%s: cannot open: permission denied or unreadable", path);
     fclose(probe);
 
+    if (has_extension(path, ".obj")) {
+        lx_status st = check_obj_numbers(path);
+        if (st != LX_OK)
+            return st;
+    }
     struct aiPropertyStore *props = aiCreatePropertyStore();
     /* Smooth normals where a file has none, but keep hard edges hard. */
     aiSetImportPropertyFloat(props, AI_CONFIG_PP_GSN_MAX_SMOOTHING_ANGLE, 60.0f);
     unsigned flags = aiProcess_Triangulate | aiProcess_SortByPType | aiProcess_FlipUVs |
                      aiProcess_GenSmoothNormals | aiProcess_JoinIdenticalVertices |
                      aiProcess_ValidateDataStructure;
+    pthread_mutex_lock(&import_lock);
+    struct aiLogStream log = {on_assimp_log, NULL};
+    dropped_faces = false;
+    aiAttachLogStream(&log);
     const struct aiScene *ai = aiImportFileExWithProperties(path, flags, NULL, props);
+    aiDetachLogStream(&log);
+    bool dropped = dropped_faces;
+    char why[512];
+    snprintf(why, sizeof why, "%s", ai ? "" : aiGetErrorString());
+    pthread_mutex_unlock(&import_lock);
     aiReleasePropertyStore(props);
-    if (!ai) {
-        const char *why = aiGetErrorString();
+    if (!ai)
         return lx_fail(LX_ERR_FORMAT, "%s: cannot import: %s", path,
-                       why && why[0] ? why : "unknown format or corrupt file");
-    }
-    if ((ai->mFlags & AI_SCENE_FLAGS_INCOMPLETE) || !ai->mRootNode) {
+                       why[0] ? why : "unknown format or corrupt file");
+    if (dropped) {
         aiReleaseImport(ai);
-        return lx_fail(LX_ERR_FORMAT, "%s: cannot import: the file is incomplete", path);
+        return lx_fail(LX_ERR_FORMAT, "%s: some faces have indices out of range", path);
+    }
+    /* assimp flags a scene without meshes incomplete; lights alone are fine */
+    if (!ai->mRootNode) {
+        aiReleaseImport(ai);
+        return lx_fail(LX_ERR_FORMAT, "%s: cannot import: the file has no scene", path);
     }
     import_ctx c = {.path = path, .ai = ai, .desc = desc};
     lx_status st = lx_scene_create(path, &c.scene);

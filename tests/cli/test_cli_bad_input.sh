@@ -1,0 +1,413 @@
+# End-to-end tests of `luxel bake` / `luxel info` on bad input (DESIGN.md
+# section 4 and the issue's list): missing, unreadable and corrupt files,
+# non-finite coordinates, zero-area triangles in space and in UV, overlapping
+# lightmap UVs, impossible resolutions and memory requests, unknown options
+# and malformed lights JSON. Every failure must exit with the exact status
+# (1 failed run, 2 usage error), print exactly one "luxel: error:" line that
+# names the file (or, for usage errors, the option) and the problem, and
+# leave no file behind.
+#
+# Inputs are written here: scenes by gen_scenes, OBJ and glTF by heredoc and
+# printf (tests/cli/common.sh), corrupt files with head -c.
+#
+# usage: bash test_cli_bad_input.sh LUXEL GEN_SCENES WORKDIR
+set -u
+. "$(dirname "${BASH_SOURCE[0]}")/common.sh" "$@"
+
+"$GEN" "$WORK/scenes" >/dev/null || { echo "gen_scenes failed"; exit 1; }
+ROOM=$WORK/scenes/room.glb
+RETRO=$WORK/scenes/retro.glb
+IN=$WORK/in
+mkdir -p "$IN" "$WORK/out" "$WORK/cwd"
+cd "$WORK/cwd" || exit 1 # the default output folder (./lightmaps) would land here
+
+CASE=0
+# bad LABEL STATUS "NEEDLE|NEEDLE..." ARGS...: `luxel ARGS -o DIR` must exit
+# with STATUS, print one error line holding every needle and leave DIR
+# missing or empty.
+bad() {
+    local label=$1 status=$2 needles=$3
+    shift 3
+    CASE=$((CASE + 1))
+    local out=$WORK/out/case$CASE
+    [ -n "${PRECREATE:-}" ] && mkdir -p "$out" # an existing, empty folder stays empty
+    run "$LUXEL" "$@" -o "$out"
+    expect_rc "$status" "$label"
+    local list=()
+    IFS='|' read -ra list <<<"$needles"
+    expect_error "$label" "${list[@]}"
+    expect_no_output "$label" "$out"
+}
+
+# bad_info LABEL "NEEDLE|..." SCENE: `luxel info` fails with status 1, one
+# error line and nothing on stdout.
+bad_info() {
+    local label=$1 needles=$2
+    shift 2
+    run "$LUXEL" info "$@"
+    expect_rc 1 "info: $label"
+    local list=()
+    IFS='|' read -ra list <<<"$needles"
+    expect_error "info: $label" "${list[@]}"
+    check "info: $label: nothing on stdout" test ! -s "$OUT"
+}
+
+# ---- files that cannot be read -------------------------------------------------
+
+bad "missing file" 1 "missing.glb" bake "$IN/missing.glb"
+bad_info "missing file" "missing.glb" "$IN/missing.glb"
+bad "missing .obj" 1 "gone.obj" bake "$IN/gone.obj"
+PRECREATE=1 bad "missing file, -o folder already there" 1 "missing.glb" bake "$IN/missing.glb"
+
+mkdir "$IN/folder.glb"
+bad "a directory named like a scene" 1 "folder.glb" bake "$IN/folder.glb"
+bad_info "a directory" "folder.glb" "$IN/folder.glb"
+
+cp "$ROOM" "$IN/locked.glb"
+chmod 000 "$IN/locked.glb"
+if [ "$(id -u)" -eq 0 ]; then
+    echo "skip  unreadable file: running as root, permissions do not apply"
+else
+    bad "unreadable file (mode 000)" 1 "locked.glb" bake "$IN/locked.glb"
+    bad_info "unreadable file" "locked.glb" "$IN/locked.glb"
+fi
+chmod 644 "$IN/locked.glb"
+
+# ---- corrupt and truncated files ------------------------------------------------
+
+head -c 6000 /dev/urandom >"$IN/noise.glb"
+bad "random bytes named .glb" 1 "noise.glb" bake "$IN/noise.glb"
+bad_info "random bytes" "noise.glb" "$IN/noise.glb"
+cp "$IN/noise.glb" "$IN/noise.obj"
+bad "random bytes named .obj" 1 "noise.obj" bake "$IN/noise.obj"
+
+size=$(stat -c %s "$ROOM")
+head -c $((size / 2)) "$ROOM" >"$IN/half.glb"
+bad "room.glb cut at half its size" 1 "half.glb" bake "$IN/half.glb"
+bad_info "room.glb cut at half" "half.glb" "$IN/half.glb"
+head -c $((size - 1)) "$ROOM" >"$IN/short.glb"
+bad "room.glb one byte short" 1 "short.glb" bake "$IN/short.glb"
+head -c 12 "$ROOM" >"$IN/header.glb"
+bad "room.glb's 12-byte header alone" 1 "header.glb" bake "$IN/header.glb"
+: >"$IN/empty.glb"
+bad "empty .glb" 1 "empty.glb" bake "$IN/empty.glb"
+: >"$IN/empty.obj"
+bad "empty .obj" 1 "empty.obj" bake "$IN/empty.obj"
+
+cat >"$IN/broken.gltf" <<'EOF'
+{"asset": {"version": "2.0"}, "scene": 0, "scenes": [{"nodes": [0]}],
+ "nodes": [{"name": "n", "mesh": 0}], "meshes": [{"primitives": [{"attributes": {"POS
+EOF
+bad "a .gltf with broken JSON" 1 "broken.gltf" bake "$IN/broken.gltf"
+bad_info "a .gltf with broken JSON" "broken.gltf" "$IN/broken.gltf"
+
+printf '{}' >"$IN/not_gltf.gltf"
+bad "a .gltf that is JSON but not glTF" 1 "not_gltf.gltf" bake "$IN/not_gltf.gltf"
+
+write_gltf "$IN/nobin.gltf" quad quad "0 0 0  0 0 1  1 0 1" "0 0  0 1  1 1" || exit 1
+rm "$IN/nobin.bin"
+bad "a .gltf whose .bin is missing" 1 "nobin" bake "$IN/nobin.gltf"
+
+# ---- non-finite coordinates ---------------------------------------------------------
+
+for v in nan inf -inf 1e39; do
+    cat >"$IN/v_$v.obj" <<EOF
+o tri
+v $v 0 0
+v 1 0 0
+v 0 0 1
+vt 0 0
+vt 1 0
+vt 0 1
+f 1/1 2/2 3/3
+EOF
+    bad "OBJ with 'v $v 0 0'" 1 "v_$v.obj|not finite|tri" bake "$IN/v_$v.obj"
+    bad "OBJ with 'v $v 0 0' and --skip-degenerate" 1 "v_$v.obj|not finite" \
+        bake "$IN/v_$v.obj" --skip-degenerate
+done
+bad_info "OBJ with a NaN position" "v_nan.obj|not finite" "$IN/v_nan.obj"
+
+write_gltf "$IN/nan_pos.gltf" nan_mesh nan_node "0 0 0  0 nan 1  1 0 1" "0 0  0 1  1 1" || exit 1
+bad "glTF with a NaN position" 1 "nan_pos.gltf|not finite|nan_mesh" bake "$IN/nan_pos.gltf"
+write_gltf "$IN/inf_uv.gltf" inf_mesh inf_node "0 0 0  0 0 1  1 0 1" "0 0  inf 1  1 1" || exit 1
+bad "glTF with an infinite UV" 1 "inf_uv.gltf|not finite|inf_mesh" bake "$IN/inf_uv.gltf"
+
+cat >"$IN/vt_nan.obj" <<'EOF'
+o tri
+v 0 0 0
+v 1 0 0
+v 0 0 1
+vt 0 0
+vt 1 nan
+vt 0 1
+f 1/1 2/2 3/3
+EOF
+bad "OBJ with 'vt 1 nan'" 1 "vt_nan.obj|not finite" bake "$IN/vt_nan.obj"
+
+# ---- zero-area triangles -------------------------------------------------------------
+
+# two good triangles and a third through three collinear points
+cat >"$IN/sliver.obj" <<'EOF'
+o floor
+v 0 0 0
+v 0 0 1
+v 1 0 1
+v 1 0 0
+v 2 0 2
+vt 0 0
+vt 0 1
+vt 1 1
+vt 1 0
+vt 0.5 0.5
+f 1/1 2/2 3/3
+f 1/1 3/3 4/4
+f 1/1 3/3 5/5
+EOF
+bad "OBJ with a zero-area triangle" 1 "sliver.obj|zero area|floor" bake "$IN/sliver.obj"
+bad_info "OBJ with a zero-area triangle" "sliver.obj|zero area|floor" "$IN/sliver.obj"
+run "$LUXEL" bake "$IN/sliver.obj" --resolution 32 --skip-degenerate -o "$WORK/out/sliver_ok"
+expect_rc 0 "--skip-degenerate bakes the zero-area OBJ"
+expect_stderr_has "--skip-degenerate: a warning naming the file, the mesh and the count" \
+    "^luxel: warning: .*sliver\.obj.*'floor'.*1 zero-area"
+check "--skip-degenerate: no error line" test -z "$(grep '^luxel: error' "$ERR")"
+check "--skip-degenerate: the lightmap is written" test -f "$WORK/out/sliver_ok/floor.exr"
+
+write_gltf "$IN/sliver.gltf" sliver_mesh sliver_node \
+    "0 0 0  0 0 1  1 0 1   0 0 0  0.5 0 0.5  1 0 1" \
+    "0 0  0 1  1 1   0 0  0.5 0.5  1 1" || exit 1
+bad "glTF with a zero-area triangle" 1 "sliver.gltf|zero area|sliver_mesh" bake "$IN/sliver.gltf"
+run "$LUXEL" bake "$IN/sliver.gltf" --resolution 32 --skip-degenerate -o "$WORK/out/gsliver_ok"
+expect_rc 0 "--skip-degenerate bakes the zero-area glTF"
+expect_stderr_has "--skip-degenerate (glTF): a warning naming the mesh" \
+    "^luxel: warning: .*sliver\.gltf.*sliver_mesh.*zero-area"
+
+# a triangle whose three UVs are the same point: zero area in UV
+cat >"$IN/flat_uv.obj" <<'EOF'
+o floor
+v 0 0 0
+v 0 0 1
+v 1 0 1
+v 1 0 0
+vt 0.125 0.875
+vt 0.125 0.125
+vt 0.875 0.125
+vt 0.5 0.5
+f 1/1 2/2 3/3
+f 1/4 3/4 4/4
+EOF
+bad "OBJ with a zero-UV-area triangle" 1 "flat_uv.obj|zero area|floor" \
+    bake "$IN/flat_uv.obj" --resolution 32
+run "$LUXEL" bake "$IN/flat_uv.obj" --resolution 32 --skip-degenerate -o "$WORK/out/flat_ok"
+expect_rc 0 "--skip-degenerate bakes the zero-UV-area OBJ"
+expect_stderr_has "--skip-degenerate: a warning about the zero-UV-area triangle" \
+    "^luxel: warning: .*flat_uv\.obj.*'floor'.*1 .*zero UV area"
+check "--skip-degenerate (UV): the lightmap is written" test -f "$WORK/out/flat_ok/floor.exr"
+
+write_gltf "$IN/flat_uv.gltf" flat_mesh flat_node \
+    "0 0 0  0 0 1  1 0 1   0 0 0  1 0 1  1 0 0" \
+    "0.125 0.125  0.125 0.875  0.875 0.875   0.5 0.5  0.5 0.5  0.5 0.5" || exit 1
+bad "glTF with a zero-UV-area triangle" 1 "flat_uv.gltf|zero area|flat_mesh" \
+    bake "$IN/flat_uv.gltf" --resolution 32
+
+# ---- overlapping lightmap UVs: a warning, not an error -------------------------------
+
+# Both triangles of a quad mapped onto the same UV triangle A (1/8, 1/8),
+# B (1/8, 3/4), C (7/8, 1/8) (luxel's top-left origin). At 30x30 no texel
+# centre lies on an edge, so the overlap is every texel whose centre is
+# inside ABC. Counted here with integer edge functions in units of 1/480
+# (texel centre x + 1/2 is 16x + 8).
+count_inside() { # AX AY BX BY CX CY
+    local ax=$1 ay=$2 bx=$3 by=$4 cx=$5 cy=$6 n=0 x y px py e1 e2 e3
+    for ((y = 0; y < 30; y++)); do
+        for ((x = 0; x < 30; x++)); do
+            px=$((16 * x + 8)) py=$((16 * y + 8))
+            e1=$(((bx - ax) * (py - ay) - (by - ay) * (px - ax)))
+            e2=$(((cx - bx) * (py - by) - (cy - by) * (px - bx)))
+            e3=$(((ax - cx) * (py - cy) - (ay - cy) * (px - cx)))
+            if { [ $e1 -gt 0 ] && [ $e2 -gt 0 ] && [ $e3 -gt 0 ]; } ||
+                { [ $e1 -lt 0 ] && [ $e2 -lt 0 ] && [ $e3 -lt 0 ]; }; then
+                n=$((n + 1))
+            fi
+        done
+    done
+    echo $n
+}
+OVERLAP=$(count_inside 60 60 60 360 420 60)
+
+# OBJ: V bottom-up, so vt v = 1 - v
+cat >"$IN/overlap.obj" <<'EOF'
+o floor
+v 0 0 0
+v 0 0 1
+v 1 0 1
+v 1 0 0
+vt 0.125 0.875
+vt 0.125 0.25
+vt 0.875 0.875
+f 1/1 2/2 3/3
+f 1/1 3/2 4/3
+EOF
+run "$LUXEL" bake "$IN/overlap.obj" --resolution 30 -o "$WORK/out/overlap_obj"
+expect_rc 0 "overlapping UVs (OBJ) still bake"
+check "overlapping UVs (OBJ): no error line" test -z "$(grep '^luxel: error' "$ERR")"
+expect_stderr_has "overlapping UVs (OBJ): a warning with the count, $OVERLAP texels" \
+    "^luxel: warning: .*overlap\.obj.* $OVERLAP texels .*overlapping"
+expect_stderr_has "overlapping UVs (OBJ): the warning names the mesh 'floor'" \
+    "^luxel: warning: .*floor.*overlapping"
+check "overlapping UVs (OBJ): the manifest records $OVERLAP overlapping texels" \
+    grep -Eq "\"overlapping_texels\":[[:space:]]*$OVERLAP\b" "$WORK/out/overlap_obj/manifest.json"
+
+write_gltf "$IN/overlap.gltf" shared_mesh shared_node \
+    "0 0 0  0 0 1  1 0 1   0 0 0  1 0 1  1 0 0" \
+    "0.125 0.125  0.125 0.75  0.875 0.125   0.125 0.125  0.125 0.75  0.875 0.125" || exit 1
+run "$LUXEL" bake "$IN/overlap.gltf" --resolution 30 -o "$WORK/out/overlap_gltf"
+expect_rc 0 "overlapping UVs (glTF) still bake"
+check "overlapping UVs (glTF): the lightmap is written" \
+    test -f "$WORK/out/overlap_gltf/shared_node.exr"
+expect_stderr_has "overlapping UVs (glTF): a warning with the count, $OVERLAP texels" \
+    "^luxel: warning: .*overlap\.gltf.* $OVERLAP texels .*overlapping"
+expect_stderr_has "overlapping UVs (glTF): the warning names the mesh 'shared_mesh'" \
+    "^luxel: warning: .*shared_mesh.*overlapping"
+
+# ---- nothing to bake ----------------------------------------------------------------------
+
+printf 'o bare\nv 0 0 0\nv 1 0 0\nv 0 0 1\nf 1 2 3\n' >"$IN/no_uv.obj"
+bad "an OBJ without texture coordinates" 1 "no_uv.obj" bake "$IN/no_uv.obj"
+
+cat >"$IN/lights_only.gltf" <<'EOF'
+{"asset": {"version": "2.0"}, "scene": 0, "scenes": [{"nodes": [0]}],
+ "nodes": [{"name": "lamp", "translation": [0, 2, 0],
+            "extensions": {"KHR_lights_punctual": {"light": 0}}}],
+ "extensionsUsed": ["KHR_lights_punctual"],
+ "extensions": {"KHR_lights_punctual": {"lights": [{"type": "point", "intensity": 5}]}}}
+EOF
+bad "a glTF with lights but no meshes" 1 "lights_only.gltf" bake "$IN/lights_only.gltf"
+
+# ---- resolutions and memory -------------------------------------------------------------
+
+bad "--resolution 0" 2 "--resolution|'0'" bake "$ROOM" --resolution 0
+bad "--resolution 99999" 2 "--resolution|'99999'" bake "$ROOM" --resolution 99999
+bad "--resolution -1" 2 "--resolution|'-1'" bake "$ROOM" --resolution -1
+bad "--max-resolution 99999" 2 "--max-resolution" bake "$ROOM" --texel-density 10 \
+    --max-resolution 99999
+
+# A scene of 1024 separate unit quads (one node each): every lightmap of
+# N x N texels holds at least its N*N RGB float32 results (12 bytes a
+# texel), all at once since nothing is written before everything is baked.
+{
+    for ((i = 0; i < 1024; i++)); do
+        x=$((i % 32 * 2)) z=$((i / 32 * 2)) b=$((i * 4))
+        printf 'o quad_%d\nv %d 0 %d\nv %d 0 %d\nv %d 0 %d\nv %d 0 %d\n' "$i" \
+            $x $z $x $((z + 1)) $((x + 1)) $((z + 1)) $((x + 1)) $z
+        printf 'vt 0.125 0.875\nvt 0.125 0.125\nvt 0.875 0.125\nvt 0.875 0.875\n'
+        printf 'f %d/%d %d/%d %d/%d\nf %d/%d %d/%d %d/%d\n' $((b + 1)) $((b + 1)) \
+            $((b + 2)) $((b + 2)) $((b + 3)) $((b + 3)) $((b + 1)) $((b + 1)) \
+            $((b + 3)) $((b + 3)) $((b + 4)) $((b + 4))
+    done
+} >"$IN/many.obj"
+MEM_BYTES=$(($(awk '/^MemTotal:/ { print $2 }' /proc/meminfo) * 1024))
+
+# oom_case LABEL NODES SIDE ARGS...: when NODES maps of SIDE^2 texels cannot
+# fit in this machine's memory, the bake must fail up front saying how much
+# it needs. A 2 GiB address-space limit keeps a bake that tries anyway from
+# taking the machine down: it then fails on malloc instead.
+oom_case() {
+    local label=$1 nodes=$2 side=$3
+    shift 3
+    local floor=$((nodes * side * side * 12))
+    if [ "$floor" -le "$MEM_BYTES" ]; then
+        echo "skip  $label: this machine has $MEM_BYTES bytes, the request needs >= $floor"
+        return
+    fi
+    if ! bash -c 'ulimit -v 2097152 && "$@"; exit $?' probe "$LUXEL" --version >/dev/null 2>&1; then
+        echo "skip  $label: luxel cannot run with a 2 GiB address-space limit (sanitizer build?)"
+        return
+    fi
+    CASE=$((CASE + 1))
+    local out=$WORK/out/case$CASE
+    run bash -c 'ulimit -v 2097152 && exec "$@"' oom "$LUXEL" "$@" -o "$out"
+    expect_rc 1 "$label"
+    local scene
+    scene=$(basename "$2")
+    expect_error "$label" "$scene" "needs" "GiB"
+    expect_no_output "$label" "$out"
+}
+oom_case "--resolution 16384 on 1024 nodes" 1024 16384 bake "$IN/many.obj" --resolution 16384
+oom_case "--resolution 16384 on retro.glb (8 nodes)" 8 16384 bake "$RETRO" --resolution 16384
+# 1024 maps of 2048^2 are >= 48 GiB together though each alone is small:
+# the sum must be checked up front, not discovered by running out.
+oom_case "--texel-density 1e6 --max-resolution 2048 on 1024 nodes" 1024 2048 \
+    bake "$IN/many.obj" --texel-density 1000000 --max-resolution 2048 -q
+
+# ---- options ---------------------------------------------------------------------------
+
+bad "unknown option" 2 "--no-such-option" bake "$ROOM" --no-such-option
+bad "unknown option with a value" 2 "--colour" bake "$ROOM" --colour=red
+bad "--format given twice, second bad" 2 "--format|'gif'" bake "$ROOM" --format pfm --format gif
+
+: >"$IN/plain_file"
+run "$LUXEL" bake "$ROOM" --resolution 16 -o "$IN/plain_file/sub"
+expect_rc 1 "-o below a regular file"
+expect_error "-o below a regular file" "plain_file"
+check "-o below a regular file: the file is untouched" test ! -s "$IN/plain_file"
+
+# A failure while writing: tall_box.exr cannot be written because a folder
+# of that name is in the way. The files already written for room must go
+# again; the folder that was there before stays.
+mkdir -p "$WORK/out/midway/tall_box.exr"
+run "$LUXEL" bake "$ROOM" --resolution 16 -o "$WORK/out/midway"
+expect_rc 1 "a write fails halfway"
+expect_error "a write fails halfway" "tall_box.exr"
+check "a write fails halfway: this run's files are removed, the old folder stays" \
+    test "$(ls -A "$WORK/out/midway")" = "tall_box.exr"
+check "a write fails halfway: no temporary file is left" \
+    test -z "$(ls -A "$WORK/out/midway/tall_box.exr")"
+
+# ---- malformed lights JSON ---------------------------------------------------------------
+
+printf '{"lights": [\n  {"type": "point",, "position": [0, 1, 0], "intensity": 5}\n]}\n' \
+    >"$IN/syntax.json"
+PRECREATE=1 bad "lights JSON with a syntax error" 1 "syntax.json|line 2" \
+    bake "$ROOM" --lights "$IN/syntax.json"
+bad_info "lights JSON with a syntax error" "syntax.json|line 2" "$ROOM" --lights "$IN/syntax.json"
+
+printf '{"lights": [{"type": "point", "position": [0, 1, 0], "intensity": 5,\n  "colour_temperature": 3000}]}\n' \
+    >"$IN/unknown_key.json"
+bad "lights JSON with an unknown key" 1 "unknown_key.json|colour_temperature" \
+    bake "$ROOM" --lights "$IN/unknown_key.json"
+
+printf '{"lights": [{"type": "point", "position": [0, 1, 0], "intensity": "bright"}]}\n' \
+    >"$IN/wrong_type.json"
+bad "lights JSON: intensity is a string" 1 "wrong_type.json|intensity" \
+    bake "$ROOM" --lights "$IN/wrong_type.json"
+
+printf '{"lights": [{"type": "point", "position": [0, 1, 0], "intensity": 1e999}]}\n' \
+    >"$IN/huge.json"
+bad "lights JSON: intensity 1e999" 1 "huge.json|intensity" bake "$ROOM" --lights "$IN/huge.json"
+
+printf '{"lights": [{"type": "point", "position": [0, 1e999, 0], "intensity": 5}]}\n' \
+    >"$IN/huge_pos.json"
+bad "lights JSON: position 1e999" 1 "huge_pos.json|position" bake "$ROOM" --lights "$IN/huge_pos.json"
+
+printf '{"lights": [{"type": "laser", "position": [0, 1, 0], "intensity": 5}]}\n' \
+    >"$IN/bad_type.json"
+bad "lights JSON: unknown light type" 1 "bad_type.json|type|laser" \
+    bake "$ROOM" --lights "$IN/bad_type.json"
+
+printf '{"lights": [{"type": "point", "position": [0, 1], "intensity": 5}]}\n' >"$IN/short_vec.json"
+bad "lights JSON: position with 2 numbers" 1 "short_vec.json|position" \
+    bake "$ROOM" --lights "$IN/short_vec.json"
+
+printf '{"ambient": [0.1, 0.1, 0.1], "lights": [{"type": "point", "position": [0, 1, 0], "intensity": -5}]}\n' \
+    >"$IN/negative.json"
+bad "lights JSON: negative intensity" 1 "negative.json|intensity" \
+    bake "$ROOM" --lights "$IN/negative.json"
+
+printf '' >"$IN/empty.json"
+bad "empty lights JSON" 1 "empty.json" bake "$ROOM" --lights "$IN/empty.json"
+bad "missing lights JSON" 1 "no_lights.json" bake "$ROOM" --lights "$IN/no_lights.json"
+mkdir "$IN/folder.json"
+bad "a folder as lights JSON" 1 "folder.json" bake "$ROOM" --lights "$IN/folder.json"
+
+check "no failing run wrote anything in the working folder" test -z "$(ls -A "$WORK/cwd")"
+finish

@@ -1,0 +1,283 @@
+# End-to-end tests of `luxel bake` on the example scenes: the files it
+# writes and their containers (EXR, PFM, Radiance HDR, PNG), the manifest,
+# --texel-density sizing, determinism across thread counts, the lights
+# JSON (docs/lights-json.md) and --quantity radiance.
+#
+# Expected values come from outside the baker: file format specifications
+# (magic numbers, the PFM header), the generator's description of its scenes
+# (examples/gen_scenes.c: node names, areas, the boxes' white 0.8 albedo),
+# the texel-density rule R^2 * uv_area = T^2 * world_area with uv_area <= 1,
+# and radiance = irradiance * albedo / pi for a Lambertian surface.
+#
+# usage: bash test_cli_bake.sh LUXEL GEN_SCENES WORKDIR
+set -u
+. "$(dirname "${BASH_SOURCE[0]}")/common.sh" "$@"
+
+"$GEN" "$WORK/scenes" >/dev/null || { echo "gen_scenes failed"; exit 1; }
+ROOM=$WORK/scenes/room.glb
+RETRO=$WORK/scenes/retro.glb
+NODES="room tall_box short_box"
+
+# manifest_get FILE NODE KEY: the value of KEY in NODE's manifest entry
+# (cJSON prints one key per line; entries start with "node").
+manifest_get() {
+    awk -v node="$2" -v key="$3" '
+        /"node":/ { cur = $0; sub(/.*"node":[ \t]*"/, "", cur); sub(/".*/, "", cur) }
+        cur == node && $0 ~ "\"" key "\":" {
+            v = $0; sub(/^[^:]*:[ \t]*/, "", v); sub(/,?[ \t]*$/, "", v); gsub(/"/, "", v)
+            print v; exit
+        }' "$1"
+}
+
+# ---- the default: EXR plus PNG previews plus manifest --------------------
+
+run "$LUXEL" bake "$ROOM" --resolution 128 -o "$WORK/exr"
+expect_rc 0 "bake room.glb"
+expect_files "bake room.glb writes a lightmap and a preview per node and a manifest" \
+    "$WORK/exr" room.exr room.png tall_box.exr tall_box.png short_box.exr short_box.png \
+    manifest.json
+expect_stdout_has "bake prints the manifest's path" "exr/manifest\.json$"
+check "bake: no error or warning for room.glb" test -z "$(grep -E '^luxel: (error|warning)' "$ERR")"
+for n in $NODES; do
+    # OpenEXR magic 76 2f 31 01, PNG signature 89 50 4e 47 0d 0a 1a 0a
+    check "$n.exr is an OpenEXR file" test "$(magic "$WORK/exr/$n.exr" 4)" = "762f3101"
+    check "$n.png is a PNG file" test "$(magic "$WORK/exr/$n.png" 8)" = "89504e470d0a1a0a"
+done
+
+M=$WORK/exr/manifest.json
+check "manifest: quantity irradiance" grep -Eq '"quantity":[[:space:]]*"irradiance"' "$M"
+check "manifest: unit lx" grep -Eq '"unit":[[:space:]]*"lx"' "$M"
+check "manifest: format exr" grep -Eq '"format":[[:space:]]*"exr"' "$M"
+check "manifest: three entries" test "$(grep -c '"node":' "$M")" -eq 3
+for n in $NODES; do
+    check "manifest: node $n" grep -Eq "\"node\":[[:space:]]*\"$n\"" "$M"
+    check "manifest: $n file $n.exr" test "$(manifest_get "$M" "$n" file)" = "$n.exr"
+    check "manifest: $n preview $n.png" test "$(manifest_get "$M" "$n" preview)" = "$n.png"
+    check "manifest: $n width 128" test "$(manifest_get "$M" "$n" width)" = 128
+    check "manifest: $n height 128" test "$(manifest_get "$M" "$n" height)" = 128
+    check "manifest: $n uv_set TEXCOORD_1" test "$(manifest_get "$M" "$n" uv_set)" = TEXCOORD_1
+done
+
+run "$LUXEL" bake "$ROOM" --resolution 128 -o "$WORK/exr" -q
+expect_rc 0 "bake again into the same folder"
+check "bake -q: nothing on stderr" test ! -s "$ERR"
+expect_files "baking again replaces the files" "$WORK/exr" room.exr room.png tall_box.exr \
+    tall_box.png short_box.exr short_box.png manifest.json
+
+run "$LUXEL" bake "$ROOM" --resolution 32 -q -o "$WORK/deep/er/folder"
+expect_rc 0 "bake -o into a folder that does not exist yet"
+check "the nested output folder was created" test -f "$WORK/deep/er/folder/manifest.json"
+
+mkdir "$WORK/cwd" && cd "$WORK/cwd" && run "$LUXEL" bake "$ROOM" --resolution 32 -q
+cd "$WORK" || exit 1
+expect_rc 0 "bake without -o"
+check "bake without -o writes ./lightmaps" test -f "$WORK/cwd/lightmaps/manifest.json"
+
+mkdir -p "$WORK/my scenes" && cp "$ROOM" "$WORK/my scenes/the room.glb"
+run "$LUXEL" bake "$WORK/my scenes/the room.glb" --resolution 16 -q -o "$WORK/with space/out"
+expect_rc 0 "bake a scene whose path has spaces, into a folder with a space"
+check "paths with spaces: the manifest is written" test -f "$WORK/with space/out/manifest.json"
+
+# Node names become file names: one that climbs out of the folder must not.
+mkdir -p "$WORK/escape"
+write_gltf "$WORK/escape/scene.gltf" quad "../../x" "0 0 0  0 0 1  1 0 1" "0 0  0 1  1 1" || exit 1
+run "$LUXEL" bake "$WORK/escape/scene.gltf" --resolution 16 -q -o "$WORK/escape/a/b"
+expect_rc 0 "a node named '../../x'"
+check "'../../x': three files, all inside the output folder" \
+    test "$(ls -A "$WORK/escape/a/b" | wc -l)" -eq 3
+check "'../../x': nothing written beside the output folder" \
+    test "$(ls -A "$WORK/escape" | LC_ALL=C sort | tr '\n' ' ')" = "a scene.bin scene.gltf "
+check "'../../x': nothing written two levels up" test "$(ls -A "$WORK/escape/a")" = "b"
+
+# ---- other formats ------------------------------------------------------------
+
+run "$LUXEL" bake "$ROOM" --resolution 128 --format pfm -q -o "$WORK/pfm"
+expect_rc 0 "--format pfm"
+expect_files "--format pfm: .pfm, .png preview and manifest" "$WORK/pfm" room.pfm room.png \
+    tall_box.pfm tall_box.png short_box.pfm short_box.png manifest.json
+check "manifest: format pfm" grep -Eq '"format":[[:space:]]*"pfm"' "$WORK/pfm/manifest.json"
+for n in $NODES; do
+    f=$WORK/pfm/$n.pfm
+    # PFM: "PF\n" (colour), "W H\n", then the scale, negative for little-endian
+    check "$n.pfm starts with PF / 128 128" test "$(head -n 2 "$f" | tr '\n' '|')" = "PF|128 128|"
+    scale=$(head -n 3 "$f" | tail -n 1)
+    check "$n.pfm scale '$scale' is negative (little-endian)" \
+        awk -v s="$scale" 'BEGIN { exit !(s ~ /^-[0-9.]+$/ && s + 0 < 0) }'
+    hdr=$(head -n 3 "$f" | wc -c)
+    check "$n.pfm holds exactly 128*128 RGB float32 after its header" \
+        test "$(stat -c %s "$f")" -eq $((hdr + 128 * 128 * 3 * 4))
+done
+
+run "$LUXEL" bake "$ROOM" --resolution 64 --format hdr -q -o "$WORK/hdr"
+expect_rc 0 "--format hdr"
+expect_files "--format hdr: .hdr, .png preview and manifest" "$WORK/hdr" room.hdr room.png \
+    tall_box.hdr tall_box.png short_box.hdr short_box.png manifest.json
+for n in $NODES; do
+    check "$n.hdr starts with #?RADIANCE" test "$(head -n 1 "$WORK/hdr/$n.hdr")" = "#?RADIANCE"
+    check "$n.hdr has the size line -Y 64 +X 64" grep -aq '^-Y 64 +X 64$' "$WORK/hdr/$n.hdr"
+done
+
+run "$LUXEL" bake "$ROOM" --resolution 64 --format png -q -o "$WORK/png"
+expect_rc 0 "--format png"
+expect_files "--format png writes no separate preview" "$WORK/png" room.png tall_box.png \
+    short_box.png manifest.json
+check "--format png: the manifest lists no preview" \
+    test -z "$(grep '"preview"' "$WORK/png/manifest.json")"
+for n in $NODES; do
+    check "$n.png (format png) is a PNG" test "$(magic "$WORK/png/$n.png" 8)" = "89504e470d0a1a0a"
+done
+
+run "$LUXEL" bake "$ROOM" --resolution 64 --half -q -o "$WORK/half"
+expect_rc 0 "--half"
+check "--half writes EXR" test "$(magic "$WORK/half/room.exr" 4)" = "762f3101"
+
+# ---- texel density -----------------------------------------------------------
+
+run "$LUXEL" bake "$ROOM" --texel-density 13 -q -o "$WORK/td13"
+expect_rc 0 "--texel-density 13"
+run "$LUXEL" bake "$ROOM" --texel-density 26 -q -o "$WORK/td26"
+expect_rc 0 "--texel-density 26"
+# world areas (gen_scenes.c): room 4x4 floor + 4x4 ceiling + three 4x3 walls
+# = 68 m^2; tall box 1.2x1.8x1.2 = 2*1.44 + 4*2.16 = 11.52 m^2; cube 0.9 m
+# = 6*0.81 = 4.86 m^2. With uv_area <= 1: R >= T * sqrt(world_area).
+for spec in room:68 tall_box:11.52 short_box:4.86; do
+    n=${spec%%:*} area=${spec#*:}
+    w13=$(manifest_get "$WORK/td13/manifest.json" "$n" width)
+    h13=$(manifest_get "$WORK/td13/manifest.json" "$n" height)
+    w26=$(manifest_get "$WORK/td26/manifest.json" "$n" width)
+    check "--texel-density: $n width $w13 is a multiple of 4" test $((w13 % 4)) -eq 0
+    check "--texel-density: $n height $h13 is a multiple of 4" test $((h13 % 4)) -eq 0
+    check "--texel-density: $n width $w26 (T=26) is a multiple of 4" test $((w26 % 4)) -eq 0
+    check "--texel-density 13: $n width $w13 >= 13 * sqrt($area)" \
+        awk -v w="$w13" -v a="$area" 'BEGIN { exit !(w >= 13 * sqrt(a) - 1e-9) }'
+    # R is proportional to T; each size is rounded to a multiple of 4
+    check "--texel-density: doubling T doubles $n's size ($w13 -> $w26)" \
+        test $((w26 - 2 * w13)) -le 4 -a $((w26 - 2 * w13)) -ge -4
+done
+check "--texel-density: the room (68 m^2) gets more texels than the cube (4.86 m^2)" \
+    test "$(manifest_get "$WORK/td13/manifest.json" room width)" -gt \
+    "$(manifest_get "$WORK/td13/manifest.json" short_box width)"
+
+run "$LUXEL" bake "$ROOM" --texel-density 1000 --max-resolution 64 -q -o "$WORK/tdcap"
+expect_rc 0 "--texel-density 1000 --max-resolution 64"
+for n in $NODES; do
+    w=$(manifest_get "$WORK/tdcap/manifest.json" "$n" width)
+    check "--max-resolution 64 caps $n at 64 (got $w)" test "$w" -eq 64
+done
+
+run "$LUXEL" bake "$RETRO" --texel-density 8 -o "$WORK/retro"
+expect_rc 0 "bake retro.glb --texel-density 8"
+RN="ground pillar_0 pillar_1 pillar_2 pillar_3 wall stair gate"
+want=(manifest.json)
+for n in $RN; do want+=("$n.exr" "$n.png"); done
+expect_files "retro: a lightmap and a preview for each of the 8 nodes" "$WORK/retro" "${want[@]}"
+g=$(manifest_get "$WORK/retro/manifest.json" ground width)
+check "retro: the 24 m ground gets >= 8*24 = 192 texels a side (got $g)" test "$g" -ge 192
+check "retro: the ground's size $g is a multiple of 4" test $((g % 4)) -eq 0
+expect_stderr_has "retro: the summary counts 8 lightmaps and 3 lights" \
+    'baked 8 lightmaps .* 3 lights'
+
+# ---- determinism --------------------------------------------------------------
+
+for fmt in exr pfm; do
+    run "$LUXEL" bake "$ROOM" --resolution 96 --format $fmt --threads 1 -q -o "$WORK/t1_$fmt"
+    expect_rc 0 "--threads 1 --format $fmt"
+    run "$LUXEL" bake "$ROOM" --resolution 96 --format $fmt --threads 2 -q -o "$WORK/t2_$fmt"
+    expect_rc 0 "--threads 2 --format $fmt"
+    run "$LUXEL" bake "$ROOM" --resolution 96 --format $fmt --threads 2 -q -o "$WORK/t2b_$fmt"
+    for n in $NODES; do
+        check "--threads 1 and 2 give byte-identical $n.$fmt" \
+            cmp -s "$WORK/t1_$fmt/$n.$fmt" "$WORK/t2_$fmt/$n.$fmt"
+        check "two runs give byte-identical $n.$fmt" \
+            cmp -s "$WORK/t2_$fmt/$n.$fmt" "$WORK/t2b_$fmt/$n.$fmt"
+        check "--threads 1 and 2 give byte-identical $n.png" \
+            cmp -s "$WORK/t1_$fmt/$n.png" "$WORK/t2_$fmt/$n.png"
+    done
+done
+
+# ---- lights JSON ---------------------------------------------------------------
+
+# The example of docs/lights-json.md: a "key" point light, a spot with
+# blurred shadows, a directional sun and a classic-model point light with
+# its own ambient, plus scene ambient.
+cat >"$WORK/lights.json" <<'EOF'
+{"ambient": [0.02, 0.02, 0.02],
+ "lights": [
+   {"name": "key", "type": "point", "position": [0, 2, 0], "color": [1, 1, 1],
+    "intensity": 800, "unit": "cd", "range": 10, "shadow": "hard", "dynamic": false},
+   {"type": "spot", "position": [0, 3, 0], "direction": [0, -1, 0],
+    "inner_angle": 20, "outer_angle": 30,
+    "intensity": 1200, "unit": "cd", "shadow": "blur", "blur_power": 1.0, "blur_multiplier": 1.0},
+   {"type": "directional", "direction": [0.3, -1, 0.2], "intensity": 100000, "unit": "lx",
+    "shadow": "hard"},
+   {"type": "point", "position": [2, 1, 0], "intensity": 1, "range": 5, "model": "classic",
+    "ambient": [0.1, 0, 0]}]}
+EOF
+run "$LUXEL" info "$ROOM" --lights "$WORK/lights.json"
+expect_rc 0 "info --lights (example)"
+expect_stdout_has "info --lights: 2 scene + 4 file lights" '^lights: 6$'
+expect_stdout_has "info --lights: key, 800 cd, range 10 m" '^ +point +key +800 cd .*at \(0, 2, 0\).*range 10 m'
+expect_stdout_has "info --lights: spot with blurred shadows, cone 20..30 deg" \
+    '^ +spot +([^ ]+ +)?1200 cd .*cone 20\.0\.\.30\.0 deg.*shadow blur'
+expect_stdout_has "info --lights: the sun in lux" '^ +directional .* lx '
+expect_stdout_has "info --lights: the classic light" 'classic'
+expect_stdout_has "info --lights: scene ambient" '^ambient: \(0\.02, 0\.02, 0\.02\) lx'
+expect_stdout_has "info --lights: the glTF lights stay" '^ +point +ceiling_lamp +150 cd'
+
+run "$LUXEL" bake "$ROOM" --resolution 64 --lights "$WORK/lights.json" -o "$WORK/lights"
+expect_rc 0 "bake --lights (example)"
+expect_stderr_has "bake --lights: the summary counts 6 lights" 'baked 3 lightmaps .* 6 lights'
+check "bake --lights wrote the manifest" test -f "$WORK/lights/manifest.json"
+run "$LUXEL" bake "$ROOM" --resolution 64 -q -o "$WORK/nolights"
+check "bake --lights: the file's lights change the lightmap" \
+    test -n "$(cmp -s "$WORK/lights/room.exr" "$WORK/nolights/room.exr" || echo differs)"
+
+# a light named like a glTF light replaces it (only the keys given change)
+cat >"$WORK/spot.json" <<'EOF'
+{"lights": [{"name": "spot", "type": "spot", "position": [0, 2.5, 0], "direction": [0, -1, 0],
+             "inner_angle": 10, "outer_angle": 25, "intensity": 777, "unit": "cd"}]}
+EOF
+run "$LUXEL" info "$ROOM" --lights "$WORK/spot.json"
+expect_rc 0 "info --lights (replacing spot)"
+expect_stdout_has "the replaced scene still has 2 lights" '^lights: 2$'
+expect_stdout_has "'spot' now has the file's values" \
+    '^ +spot +spot +777 cd .*at \(0, 2\.5, 0\).*toward \(0, -1, 0\).*cone 10\.0\.\.25\.0 deg'
+check "the glTF's 400 cd spot is gone" test -z "$(grep -E ' 400 cd' "$OUT")"
+run "$LUXEL" bake "$ROOM" --resolution 32 --lights "$WORK/spot.json" -q -o "$WORK/spot"
+expect_rc 0 "bake --lights (replacing spot)"
+
+# an override that names only some keys keeps the rest (docs/lights-json.md)
+printf '{"lights": [{"name": "ceiling_lamp", "intensity": 300, "shadow": "blur"}]}\n' \
+    >"$WORK/lamp.json"
+run "$LUXEL" info "$ROOM" --lights "$WORK/lamp.json"
+expect_rc 0 "info --lights (partial override of ceiling_lamp)"
+expect_stdout_has "ceiling_lamp: new intensity and shadows, same place, colour and range" \
+    '^ +point +ceiling_lamp +300 cd +colour \(1, 0\.95, 0\.85\) +at \(0, 2\.7, 0\) +range 12 m +shadow blur'
+expect_stdout_has "the partial override adds no light" '^lights: 2$'
+
+# ---- radiance ------------------------------------------------------------------
+
+run "$LUXEL" bake "$ROOM" --resolution 64 --format pfm -q -o "$WORK/irr"
+expect_rc 0 "--quantity irradiance (explicit default) as pfm"
+run "$LUXEL" bake "$ROOM" --resolution 64 --format pfm --quantity radiance -q -o "$WORK/rad"
+expect_rc 0 "--quantity radiance"
+check "manifest: quantity radiance" grep -Eq '"quantity":[[:space:]]*"radiance"' "$WORK/rad/manifest.json"
+check "manifest: radiance in nits" grep -Eq '"unit":[[:space:]]*"(nt|nits|cd/m2)"' "$WORK/rad/manifest.json"
+# The boxes are white with albedo 0.8 (gen_scenes.c), so every texel's
+# radiance is its irradiance * 0.8 / pi = 0.254648 * irradiance.
+pfm_floats() { # one float per line after the header
+    od -An -v -tf4 -w4 -j "$(head -n 3 "$1" | wc -c)" "$1"
+}
+for n in tall_box short_box; do
+    pfm_floats "$WORK/irr/$n.pfm" >"$WORK/irr_$n.txt"
+    pfm_floats "$WORK/rad/$n.pfm" >"$WORK/rad_$n.txt"
+    check "radiance = irradiance * 0.8 / pi on every texel of $n" \
+        awk -v k=0.254647909 '
+            { e = $1 + 0; l = $2 + 0
+              if (e > 1e-3) { lit++; if (l < k * e * 0.999 || l > k * e * 1.001) bad++ }
+              else if (l > 1e-3 * k + 1e-6) bad++ }
+            END { if (bad || lit < 100) { printf "        %d bad of %d lit\n", bad, lit; exit 1 } }' \
+        <(paste "$WORK/irr_$n.txt" "$WORK/rad_$n.txt")
+done
+
+finish
