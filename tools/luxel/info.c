@@ -21,7 +21,7 @@ static const char *info_usage =
 static void print_light(const lx_light *l)
 {
     const char *unit = l->type == LX_LIGHT_DIRECTIONAL ? "lx" : "cd";
-    printf("  %-12s %-16s %10.4g %s", lx_light_type_name(l->type), l->name[0] ? l->name : "-",
+    printf("  %-12s %-16s %10.6g %s", lx_light_type_name(l->type), l->name[0] ? l->name : "-",
            l->intensity,
            l->model == LX_MODEL_CLASSIC ? "(classic units)" : unit);
     printf("  colour (%.3g, %.3g, %.3g)", l->color.x, l->color.y, l->color.z);
