@@ -34,9 +34,13 @@ check-asan: deps
 bench: all
 	$(BUILD)/bin/bench_bake
 
-fuzz: deps
+fuzz: all
 	@test -f $(BUILD_FUZZ)/CMakeCache.txt || CC=clang cmake -S . -B $(BUILD_FUZZ) -DCMAKE_BUILD_TYPE=Debug -DLX_FUZZ=ON
 	cmake --build $(BUILD_FUZZ) -j $(JOBS)
+	@# seed the scene fuzzer with the example scenes (first byte picks .glb)
+	$(BUILD)/bin/gen_scenes $(BUILD_FUZZ)/seeds
+	@mkdir -p $(BUILD_FUZZ)/corpus/fuzz_scene
+	@(printf '\000'; cat $(BUILD_FUZZ)/seeds/room.glb) > $(BUILD_FUZZ)/corpus/fuzz_scene/room
 	@for f in $(BUILD_FUZZ)/bin/fuzz_*; do \
 		corpus=$(BUILD_FUZZ)/corpus/$$(basename $$f); mkdir -p $$corpus; \
 		echo "== $$f"; $$f -max_total_time=$(FUZZ_SECONDS) $$corpus || exit 1; done
