@@ -1,0 +1,366 @@
+/* Images: allocation, the sRGB transfer function (IEC 61966-2-1:1999),
+ * format detection, channel conversion and the checks shared by every
+ * reader and writer. The codecs live in image_io.c (stb), image_pfm.c and
+ * image_exr.c. */
+#include "image_internal.h"
+
+#include <ctype.h>
+#include <math.h>
+#include <stdint.h>
+#include <stdlib.h>
+#include <string.h>
+
+/* ---- allocation ----------------------------------------------------------- */
+
+lx_status lx_image_alloc(lx_image *img, int width, int height, int channels)
+{
+    memset(img, 0, sizeof *img);
+    if (width < 1 || height < 1 || channels < 1 || channels > 4)
+        return lx_fail(LX_ERR_INVALID, "image %dx%d with %d channels: width and height must be "
+                                       ">= 1 and channels 1..4",
+                       width, height, channels);
+    size_t count, bytes;
+    if (!lx_size_mul((size_t)width, (size_t)height, (size_t)channels, &count) ||
+        !lx_size_mul(count, sizeof(float), 1, &bytes))
+        return lx_fail(LX_ERR_NOMEM, "image %dx%d with %d channels: size overflows memory",
+                       width, height, channels);
+    char what[96];
+    snprintf(what, sizeof what, "image %dx%d (%d channels)", width, height, channels);
+    lx_status s = lx_check_memory(bytes, what);
+    if (s != LX_OK)
+        return s;
+    float *data = calloc(count, sizeof(float));
+    if (!data)
+        return lx_fail(LX_ERR_NOMEM, "%s: cannot allocate %zu bytes", what, bytes);
+    img->width = width;
+    img->height = height;
+    img->channels = channels;
+    img->data = data;
+    return LX_OK;
+}
+
+void lx_image_free(lx_image *img)
+{
+    if (!img)
+        return;
+    free(img->data);
+    memset(img, 0, sizeof *img);
+}
+
+/* ---- sRGB ------------------------------------------------------------------ */
+
+/* Computed in double so 8-bit code values round the same way as the
+ * published formula; the segments meet at 0.04045 / 0.0031308. */
+float lx_srgb_to_linear(float c)
+{
+    double v = c;
+    if (v <= 0.04045)
+        return (float)(v / 12.92);
+    return (float)pow((v + 0.055) / 1.055, 2.4);
+}
+
+float lx_linear_to_srgb(float c)
+{
+    double v = c;
+    if (v <= 0.0031308)
+        return (float)(v * 12.92);
+    return (float)(1.055 * pow(v, 1.0 / 2.4) - 0.055);
+}
+
+/* ---- formats ------------------------------------------------------------- */
+
+static const struct {
+    const char *ext;
+    lx_image_format format;
+} format_exts[] = {
+    {"exr", LX_IMAGE_EXR}, {"hdr", LX_IMAGE_HDR}, {"pfm", LX_IMAGE_PFM}, {"png", LX_IMAGE_PNG},
+    {"jpg", LX_IMAGE_JPG}, {"jpeg", LX_IMAGE_JPG}, {"tga", LX_IMAGE_TGA},
+};
+
+lx_image_format lx_image_format_from_path(const char *path)
+{
+    if (!path)
+        return LX_IMAGE_AUTO;
+    const char *slash = strrchr(path, '/');
+    const char *base = slash ? slash + 1 : path;
+    const char *dot = strrchr(base, '.');
+    if (!dot || dot == base)
+        return LX_IMAGE_AUTO;
+    const char *ext = dot + 1;
+    for (size_t i = 0; i < sizeof format_exts / sizeof format_exts[0]; i++) {
+        const char *a = ext, *b = format_exts[i].ext;
+        while (*a && *b && tolower((unsigned char)*a) == *b) {
+            a++;
+            b++;
+        }
+        if (!*a && !*b)
+            return format_exts[i].format;
+    }
+    return LX_IMAGE_AUTO;
+}
+
+const char *lx_image_format_extension(lx_image_format format)
+{
+    switch (format) {
+    case LX_IMAGE_EXR: return "exr";
+    case LX_IMAGE_HDR: return "hdr";
+    case LX_IMAGE_PFM: return "pfm";
+    case LX_IMAGE_PNG: return "png";
+    case LX_IMAGE_JPG: return "jpg";
+    case LX_IMAGE_TGA: return "tga";
+    case LX_IMAGE_AUTO: break;
+    }
+    return NULL;
+}
+
+/* The format named by the file's first bytes (AUTO when none matches).
+ * Content wins over the extension so a JPEG saved as .png still loads. */
+static lx_image_format sniff_format(const unsigned char *d, size_t n)
+{
+    if (n >= 4 && d[0] == 0x76 && d[1] == 0x2f && d[2] == 0x31 && d[3] == 0x01)
+        return LX_IMAGE_EXR;
+    if (n >= 8 && memcmp(d, "\x89PNG\r\n\x1a\n", 8) == 0)
+        return LX_IMAGE_PNG;
+    if (n >= 3 && d[0] == 0xff && d[1] == 0xd8 && d[2] == 0xff)
+        return LX_IMAGE_JPG;
+    if (n >= 2 && d[0] == '#' && d[1] == '?')
+        return LX_IMAGE_HDR;
+    if (n >= 3 && d[0] == 'P' && (d[1] == 'F' || d[1] == 'f') && isspace(d[2]))
+        return LX_IMAGE_PFM;
+    return LX_IMAGE_AUTO;
+}
+
+/* TGA has no signature. Only a plausible header goes to stb, so stb's other
+ * decoders (GIF, PSD, PIC, ...) never see luxel's input: all of their
+ * signatures fail this test. */
+static bool plausible_tga(const unsigned char *d, size_t n)
+{
+    if (n < 18 || d[1] > 1)
+        return false;
+    switch (d[2]) {
+    case 1: case 2: case 3: case 9: case 10: case 11: return true;
+    default: return false;
+    }
+}
+
+static const char *format_title(lx_image_format f)
+{
+    switch (f) {
+    case LX_IMAGE_EXR: return "an OpenEXR file (bad magic number)";
+    case LX_IMAGE_HDR: return "a Radiance HDR file (no \"#?\" header)";
+    case LX_IMAGE_PFM: return "a PFM file (header must start with \"PF\" or \"Pf\")";
+    case LX_IMAGE_PNG: return "a PNG file (no PNG signature)";
+    case LX_IMAGE_JPG: return "a JPEG file (no JPEG marker)";
+    case LX_IMAGE_TGA: return "a TGA file (implausible header)";
+    case LX_IMAGE_AUTO: break;
+    }
+    return "an image";
+}
+
+/* ---- loading ----------------------------------------------------------------- */
+
+static lx_status check_finite(const lx_image *img, const char *name)
+{
+    size_t n = (size_t)img->width * (size_t)img->height * (size_t)img->channels;
+    for (size_t i = 0; i < n; i++) {
+        if (!isfinite(img->data[i])) {
+            size_t px = i / (size_t)img->channels;
+            return lx_fail(LX_ERR_FORMAT, "%s: pixel (%zu, %zu) channel %zu is not finite (%s)",
+                           name, px % (size_t)img->width, px / (size_t)img->width,
+                           i % (size_t)img->channels, isnan(img->data[i]) ? "NaN" : "infinity");
+        }
+    }
+    return LX_OK;
+}
+
+/* Rewrites img with `want` channels: 1 grey, 2 grey+alpha, 3 RGB, 4 RGBA.
+ * Grey from colour is Rec.709 luminance; missing alpha is 1. */
+static lx_status convert_channels(lx_image *img, int want, const char *name)
+{
+    int have = img->channels;
+    if (want == 0 || want == have)
+        return LX_OK;
+    lx_image out;
+    lx_status s = lx_image_alloc(&out, img->width, img->height, want);
+    if (s != LX_OK) {
+        lx_error_prefix(name);
+        return s;
+    }
+    size_t n = (size_t)img->width * (size_t)img->height;
+    bool have_alpha = have == 2 || have == 4;
+    for (size_t i = 0; i < n; i++) {
+        const float *p = img->data + i * (size_t)have;
+        float *q = out.data + i * (size_t)want;
+        float r, g, b;
+        if (have >= 3) {
+            r = p[0];
+            g = p[1];
+            b = p[2];
+        } else {
+            r = g = b = p[0];
+        }
+        float a = have_alpha ? p[have - 1] : 1.0f;
+        if (want <= 2) {
+            q[0] = have >= 3 ? (float)(0.2126 * r + 0.7152 * g + 0.0722 * b) : r;
+            if (want == 2)
+                q[1] = a;
+        } else {
+            q[0] = r;
+            q[1] = g;
+            q[2] = b;
+            if (want == 4)
+                q[3] = a;
+        }
+    }
+    lx_image_free(img);
+    *img = out;
+    return LX_OK;
+}
+
+lx_status lx_image_load_memory(const void *bytes, size_t size, const char *name,
+                               const lx_image_load_desc *desc, lx_image *out)
+{
+    if (!out)
+        return lx_fail(LX_ERR_INVALID, "lx_image_load_memory: out is NULL");
+    memset(out, 0, sizeof *out);
+    if (!name)
+        name = "<memory>";
+    lx_image_load_desc d = {0};
+    if (desc)
+        d = *desc;
+    if (d.channels < 0 || d.channels > 4)
+        return lx_fail(LX_ERR_INVALID, "%s: requested %d channels (expected 0..4)", name,
+                       d.channels);
+    if (!bytes && size > 0)
+        return lx_fail(LX_ERR_INVALID, "%s: no data", name);
+    if (size == 0)
+        return lx_fail(LX_ERR_FORMAT, "%s: empty file", name);
+
+    const unsigned char *data = bytes;
+    lx_image_format format = sniff_format(data, size);
+    if (format == LX_IMAGE_AUTO) {
+        lx_image_format named = lx_image_format_from_path(name);
+        if (named == LX_IMAGE_AUTO)
+            return lx_fail(LX_ERR_UNSUPPORTED,
+                           "%s: unknown image format (expected EXR, HDR, PFM, PNG, JPEG or "
+                           "TGA)",
+                           name);
+        if (named != LX_IMAGE_TGA || !plausible_tga(data, size))
+            return lx_fail(LX_ERR_FORMAT, "%s: not %s", name, format_title(named));
+        format = LX_IMAGE_TGA;
+    }
+
+    lx_status s;
+    switch (format) {
+    case LX_IMAGE_EXR: s = lx_img_load_exr(data, size, name, out); break;
+    case LX_IMAGE_PFM: s = lx_img_load_pfm(data, size, name, out); break;
+    default:
+        s = lx_img_load_stb(data, size, name, format == LX_IMAGE_TGA, d.raw_8bit, out);
+        break;
+    }
+    if (s == LX_OK)
+        s = check_finite(out, name);
+    if (s == LX_OK)
+        s = convert_channels(out, d.channels, name);
+    if (s != LX_OK)
+        lx_image_free(out);
+    return s;
+}
+
+lx_status lx_image_load(const char *path, const lx_image_load_desc *desc, lx_image *out)
+{
+    if (out)
+        memset(out, 0, sizeof *out);
+    if (!path || !out)
+        return lx_fail(LX_ERR_INVALID, "lx_image_load: path and out must not be NULL");
+    /* Files are read whole: every decoder here works from memory. */
+    size_t max_size = SIZE_MAX > 0xffffffffu ? (size_t)1 << 36 : (size_t)0x7fffffff;
+    char *buf;
+    size_t size;
+    lx_status s = lx_read_file(path, max_size, &buf, &size);
+    if (s != LX_OK)
+        return s;
+    s = lx_image_load_memory(buf, size, path, desc, out);
+    free(buf);
+    return s;
+}
+
+/* ---- writing ------------------------------------------------------------- */
+
+/* Every value must survive the trip into the file: finite, finite after
+ * exposure, and inside the format's range (half floats, RGBE). Runs before
+ * the output is opened so a bad image leaves nothing behind. */
+static lx_status check_writable(const char *path, const lx_image *img, lx_image_format format,
+                                float exposure, bool half)
+{
+    size_t n = (size_t)img->width * (size_t)img->height * (size_t)img->channels;
+    for (size_t i = 0; i < n; i++) {
+        float v = img->data[i];
+        /* exposure scales light, never alpha */
+        int c = (int)(i % (size_t)img->channels);
+        bool alpha = (img->channels == 2 || img->channels == 4) && c == img->channels - 1;
+        float e = alpha ? v : v * exposure;
+        const char *problem = NULL;
+        if (!isfinite(v))
+            problem = isnan(v) ? "is NaN" : "is infinite";
+        else if (!isfinite(e))
+            problem = "overflows when multiplied by the exposure";
+        else if (format == LX_IMAGE_EXR && half && fabsf(e) > LX_HALF_MAX)
+            problem = "exceeds the half-float range (65504); write a 32-bit float EXR instead";
+        else if (format == LX_IMAGE_HDR && e >= LX_RGBE_LIMIT)
+            problem = "exceeds the Radiance HDR range (2^127)";
+        if (problem) {
+            size_t px = i / (size_t)img->channels;
+            return lx_fail(LX_ERR_INVALID, "%s: pixel (%zu, %zu) channel %zu: value %g %s", path,
+                           px % (size_t)img->width, px / (size_t)img->width,
+                           i % (size_t)img->channels, (double)e, problem);
+        }
+    }
+    return LX_OK;
+}
+
+lx_status lx_image_write(const char *path, const lx_image *img, const lx_image_write_desc *desc)
+{
+    if (!path || !img)
+        return lx_fail(LX_ERR_INVALID, "lx_image_write: path and img must not be NULL");
+    lx_image_write_desc d = {0};
+    if (desc)
+        d = *desc;
+    size_t count;
+    if (!img->data || img->width < 1 || img->height < 1 || img->channels < 1 ||
+        img->channels > 4 ||
+        !lx_size_mul((size_t)img->width, (size_t)img->height, (size_t)img->channels, &count))
+        return lx_fail(LX_ERR_INVALID, "%s: invalid image (%dx%d, %d channels, data %s)", path,
+                       img->width, img->height, img->channels, img->data ? "set" : "NULL");
+    if (d.format != LX_IMAGE_AUTO && !lx_image_format_extension(d.format))
+        return lx_fail(LX_ERR_INVALID, "%s: unknown image format %d in lx_image_write_desc", path,
+                       (int)d.format);
+    lx_image_format format = d.format != LX_IMAGE_AUTO ? d.format : lx_image_format_from_path(path);
+    if (!lx_image_format_extension(format))
+        return lx_fail(LX_ERR_INVALID,
+                       "%s: cannot tell the image format from the name (use .exr, .hdr, .pfm, "
+                       ".png, .jpg or .tga)",
+                       path);
+    float exposure = d.exposure == 0.0f ? 1.0f : d.exposure;
+    if (!isfinite(exposure) || exposure < 0.0f)
+        return lx_fail(LX_ERR_INVALID, "%s: exposure %g must be a finite value >= 0", path,
+                       (double)d.exposure);
+    lx_status s = check_writable(path, img, format, exposure, d.half);
+    if (s != LX_OK)
+        return s;
+
+    lx_out_file f;
+    s = lx_out_open(&f, path);
+    if (s != LX_OK)
+        return s;
+    switch (format) {
+    case LX_IMAGE_PFM: s = lx_img_write_pfm(f.fp, path, img, exposure); break;
+    case LX_IMAGE_EXR: s = lx_img_write_exr(f.fp, path, img, exposure, d.half); break;
+    default: s = lx_img_write_stb(f.fp, path, img, format, exposure); break;
+    }
+    if (s != LX_OK) {
+        lx_out_abort(&f);
+        return s;
+    }
+    return lx_out_commit(&f);
+}

@@ -1,0 +1,502 @@
+/* OpenEXR reading and writing through OpenEXR 3's C API, OpenEXRCore (see
+ * openexr.com, "Reading and Writing Image Files with the C-language API").
+ * Reads part 0 of scanline or tiled files (level 0), channels R, G, B, A or
+ * Y, A; writes one scanline part with ZIP compression. Half floats are
+ * converted with round-to-nearest-even (IEEE 754-2008 binary16). */
+#define _POSIX_C_SOURCE 200809L
+#include "image_internal.h"
+
+#include <limits.h>
+#include <stdint.h>
+#include <stdlib.h>
+#include <string.h>
+#include <sys/types.h>
+
+#include <openexr.h>
+
+/* OpenEXRCore reports details through a callback (its default prints to
+ * stderr, which a library must not do); the last one is kept for the
+ * message luxel returns. */
+static _Thread_local char exr_detail[512];
+
+static void exr_on_error(exr_const_context_t ctxt, exr_result_t code, const char *msg)
+{
+    (void)ctxt;
+    snprintf(exr_detail, sizeof exr_detail, "%s", msg ? msg : exr_get_default_error_message(code));
+}
+
+static lx_status exr_failure(exr_result_t rv, lx_status status, const char *name,
+                             const char *doing)
+{
+    const char *detail = exr_detail[0] ? exr_detail : exr_get_default_error_message(rv);
+    if (rv == EXR_ERR_OUT_OF_MEMORY)
+        status = LX_ERR_NOMEM;
+    return lx_fail(status, "%s: %s: %s", name, doing, detail);
+}
+
+/* ---- reading ------------------------------------------------------------- */
+
+typedef struct exr_memory {
+    const unsigned char *data;
+    size_t size;
+} exr_memory;
+
+static int64_t memory_read(exr_const_context_t ctxt, void *user, void *buffer, uint64_t sz,
+                           uint64_t offset, exr_stream_error_func_ptr_t error_cb)
+{
+    (void)ctxt;
+    (void)error_cb;
+    const exr_memory *m = user;
+    if (offset >= m->size)
+        return 0;
+    uint64_t n = m->size - offset;
+    if (n > sz)
+        n = sz;
+    memcpy(buffer, m->data + offset, (size_t)n);
+    return (int64_t)n;
+}
+
+static int64_t memory_size(exr_const_context_t ctxt, void *user)
+{
+    (void)ctxt;
+    return (int64_t)((const exr_memory *)user)->size;
+}
+
+/* The file channel read into each image channel (NULL: none, reads 0). */
+typedef struct channel_map {
+    int channels;
+    const char *names[4];
+} channel_map;
+
+static int map_slot(const channel_map *map, const char *name)
+{
+    for (int i = 0; i < map->channels; i++)
+        if (map->names[i] && strcmp(map->names[i], name) == 0)
+            return i;
+    return -1;
+}
+
+static lx_status choose_channels(const exr_attr_chlist_t *list, const char *name,
+                                 channel_map *map)
+{
+    bool has[5] = {false};
+    static const char *const wanted[5] = {"R", "G", "B", "A", "Y"};
+    for (int i = 0; i < list->num_channels; i++) {
+        const exr_attr_chlist_entry_t *e = &list->entries[i];
+        /* every channel is decoded (see decode_block), so none may be
+         * subsampled */
+        if (e->x_sampling != 1 || e->y_sampling != 1)
+            return lx_fail(LX_ERR_UNSUPPORTED, "%s: channel %s is subsampled (%dx%d)", name,
+                           e->name.str ? e->name.str : "?", e->x_sampling, e->y_sampling);
+        for (int k = 0; k < 5; k++)
+            if (e->name.str && strcmp(e->name.str, wanted[k]) == 0)
+                has[k] = true;
+    }
+    memset(map, 0, sizeof *map);
+    if (has[0] || has[1] || has[2]) {
+        /* a missing colour channel reads as 0 */
+        map->channels = has[3] ? 4 : 3;
+        map->names[0] = has[0] ? "R" : NULL;
+        map->names[1] = has[1] ? "G" : NULL;
+        map->names[2] = has[2] ? "B" : NULL;
+        map->names[3] = has[3] ? "A" : NULL;
+    } else if (has[4]) {
+        map->channels = has[3] ? 2 : 1;
+        map->names[0] = "Y";
+        map->names[1] = has[3] ? "A" : NULL;
+    } else {
+        char found[256] = "";
+        for (int i = 0; i < list->num_channels && strlen(found) < 200; i++)
+            snprintf(found + strlen(found), sizeof found - strlen(found), "%s%s", i ? ", " : "",
+                     list->entries[i].name.str ? list->entries[i].name.str : "?");
+        return lx_fail(LX_ERR_UNSUPPORTED,
+                       "%s: no R, G, B or Y channel (the file has: %s); luxel reads RGB(A) or "
+                       "Y(A) images",
+                       name, found[0] ? found : "no channels");
+    }
+    return LX_OK;
+}
+
+/* A decoder and the image it fills; one block = one chunk (scanlines or a
+ * tile) whose top-left pixel is (x0, y0) in image coordinates. */
+typedef struct exr_reader {
+    exr_context_t ctx;
+    exr_decode_pipeline_t dec;
+    bool started;
+    channel_map map;
+    lx_image *img;
+    const char *name;
+    float *planes; /* one chunk, channel after channel */
+    size_t planes_size;
+} exr_reader;
+
+/* Every channel of the chunk is decoded, planar, into r->planes, and the
+ * wanted ones are interleaved here. OpenEXRCore 3.1 crashes when some
+ * channel of a half-float file is skipped (NULL pointer), and its
+ * interleaving unpackers assume output pointers in the file's channel order
+ * (A, B, G, R), which would swap luxel's R and A. */
+static lx_status decode_block(exr_reader *r, const exr_chunk_info_t *ci, int64_t x0, int64_t y0)
+{
+    lx_image *img = r->img;
+    if (x0 < 0 || y0 < 0 || ci->width < 1 || ci->height < 1 || x0 + ci->width > img->width ||
+        y0 + ci->height > img->height)
+        return lx_fail(LX_ERR_FORMAT, "%s: chunk %d (%dx%d at %lld, %lld) lies outside the "
+                                      "data window",
+                       r->name, ci->idx, ci->width, ci->height, (long long)x0, (long long)y0);
+    exr_result_t rv = r->started ? exr_decoding_update(r->ctx, 0, ci, &r->dec)
+                                 : exr_decoding_initialize(r->ctx, 0, ci, &r->dec);
+    if (rv != EXR_ERR_SUCCESS)
+        return exr_failure(rv, LX_ERR_FORMAT, r->name, "chunk");
+    size_t plane = (size_t)ci->width * (size_t)ci->height;
+    size_t need = plane * (size_t)(r->dec.channel_count > 0 ? r->dec.channel_count : 1);
+    if (need > r->planes_size) {
+        float *p = realloc(r->planes, need * sizeof(float));
+        if (!p)
+            return lx_fail(LX_ERR_NOMEM, "%s: cannot allocate %zu bytes", r->name,
+                           need * sizeof(float));
+        r->planes = p;
+        r->planes_size = need;
+    }
+    int nc = img->channels;
+    int from[4] = {-1, -1, -1, -1}; /* image channel -> decoded plane */
+    for (int c = 0; c < r->dec.channel_count; c++) {
+        exr_coding_channel_info_t *ch = &r->dec.channels[c];
+        if (ch->width != ci->width || ch->height != ci->height)
+            return lx_fail(LX_ERR_FORMAT, "%s: chunk %d: channel %s is %dx%d, expected %dx%d",
+                           r->name, ci->idx, ch->channel_name ? ch->channel_name : "?",
+                           ch->width, ch->height, ci->width, ci->height);
+        int slot = ch->channel_name ? map_slot(&r->map, ch->channel_name) : -1;
+        if (slot >= 0 && from[slot] < 0)
+            from[slot] = c;
+        /* the library converts half/uint/float to float while unpacking */
+        ch->user_data_type = EXR_PIXEL_FLOAT;
+        ch->user_bytes_per_element = 4;
+        ch->user_pixel_stride = 4;
+        ch->user_line_stride = ci->width * 4;
+        ch->decode_to_ptr = (uint8_t *)(r->planes + (size_t)c * plane);
+    }
+    if (!r->started) {
+        rv = exr_decoding_choose_default_routines(r->ctx, 0, &r->dec);
+        if (rv != EXR_ERR_SUCCESS)
+            return exr_failure(rv, LX_ERR_UNSUPPORTED, r->name, "chunk");
+        r->started = true;
+    }
+    rv = exr_decoding_run(r->ctx, 0, &r->dec);
+    if (rv != EXR_ERR_SUCCESS) {
+        char doing[64];
+        snprintf(doing, sizeof doing, "chunk %d", ci->idx);
+        return exr_failure(rv, LX_ERR_FORMAT, r->name, doing);
+    }
+    for (int s = 0; s < nc; s++) {
+        if (from[s] < 0)
+            continue; /* absent colour channel: stays 0 */
+        const float *src = r->planes + (size_t)from[s] * plane;
+        for (int y = 0; y < ci->height; y++) {
+            float *dst = img->data + ((size_t)(y0 + y) * (size_t)img->width + (size_t)x0) * nc + s;
+            for (int x = 0; x < ci->width; x++, dst += nc)
+                *dst = *src++;
+        }
+    }
+    return LX_OK;
+}
+
+static lx_status read_scanlines(exr_reader *r, const exr_attr_box2i_t *dw)
+{
+    int32_t lines;
+    exr_result_t rv = exr_get_scanlines_per_chunk(r->ctx, 0, &lines);
+    if (rv != EXR_ERR_SUCCESS || lines < 1)
+        return exr_failure(rv, LX_ERR_FORMAT, r->name, "scanlines per chunk");
+    for (int64_t y = dw->min.y; y <= dw->max.y; y += lines) {
+        exr_chunk_info_t ci;
+        rv = exr_read_scanline_chunk_info(r->ctx, 0, (int)y, &ci);
+        if (rv != EXR_ERR_SUCCESS) {
+            char doing[64];
+            snprintf(doing, sizeof doing, "scanline %lld", (long long)y);
+            return exr_failure(rv, LX_ERR_FORMAT, r->name, doing);
+        }
+        lx_status s = decode_block(r, &ci, 0, (int64_t)ci.start_y - dw->min.y);
+        if (s != LX_OK)
+            return s;
+    }
+    return LX_OK;
+}
+
+static lx_status read_tiles(exr_reader *r)
+{
+    uint32_t tw, th;
+    exr_tile_level_mode_t level_mode;
+    exr_tile_round_mode_t round_mode;
+    exr_result_t rv = exr_get_tile_descriptor(r->ctx, 0, &tw, &th, &level_mode, &round_mode);
+    if (rv != EXR_ERR_SUCCESS || tw < 1 || th < 1)
+        return exr_failure(rv, LX_ERR_FORMAT, r->name, "tile description");
+    int64_t nx = ((int64_t)r->img->width + tw - 1) / tw;
+    int64_t ny = ((int64_t)r->img->height + th - 1) / th;
+    for (int64_t ty = 0; ty < ny; ty++) {
+        for (int64_t tx = 0; tx < nx; tx++) {
+            exr_chunk_info_t ci;
+            rv = exr_read_tile_chunk_info(r->ctx, 0, (int)tx, (int)ty, 0, 0, &ci);
+            if (rv != EXR_ERR_SUCCESS) {
+                char doing[64];
+                snprintf(doing, sizeof doing, "tile (%lld, %lld)", (long long)tx, (long long)ty);
+                return exr_failure(rv, LX_ERR_FORMAT, r->name, doing);
+            }
+            lx_status s = decode_block(r, &ci, tx * tw, ty * th);
+            if (s != LX_OK)
+                return s;
+        }
+    }
+    return LX_OK;
+}
+
+static lx_status read_part(exr_reader *r)
+{
+    exr_storage_t storage;
+    exr_result_t rv = exr_get_storage(r->ctx, 0, &storage);
+    if (rv != EXR_ERR_SUCCESS)
+        return exr_failure(rv, LX_ERR_FORMAT, r->name, "header");
+    if (storage != EXR_STORAGE_SCANLINE && storage != EXR_STORAGE_TILED)
+        return lx_fail(LX_ERR_UNSUPPORTED, "%s: deep EXR images are not supported", r->name);
+    exr_attr_box2i_t dw;
+    const exr_attr_chlist_t *list;
+    rv = exr_get_data_window(r->ctx, 0, &dw);
+    if (rv == EXR_ERR_SUCCESS)
+        rv = exr_get_channels(r->ctx, 0, &list);
+    if (rv != EXR_ERR_SUCCESS || !list)
+        return exr_failure(rv, LX_ERR_FORMAT, r->name, "header");
+    int64_t w = (int64_t)dw.max.x - dw.min.x + 1, h = (int64_t)dw.max.y - dw.min.y + 1;
+    if (w < 1 || h < 1 || w > INT_MAX || h > INT_MAX)
+        return lx_fail(LX_ERR_FORMAT, "%s: invalid data window (%d, %d)-(%d, %d)", r->name,
+                       dw.min.x, dw.min.y, dw.max.x, dw.max.y);
+    int parts = 1;
+    exr_attr_box2i_t display;
+    if (exr_get_count(r->ctx, &parts) == EXR_ERR_SUCCESS && parts > 1)
+        lx_log(LX_LOG_INFO, "%s: %d parts, reading the first", r->name, parts);
+    if (exr_get_display_window(r->ctx, 0, &display) == EXR_ERR_SUCCESS &&
+        memcmp(&display, &dw, sizeof dw) != 0)
+        lx_log(LX_LOG_INFO, "%s: reading the data window (%d, %d)-(%d, %d), not the display "
+                            "window",
+               r->name, dw.min.x, dw.min.y, dw.max.x, dw.max.y);
+    lx_status s = choose_channels(list, r->name, &r->map);
+    if (s != LX_OK)
+        return s;
+    s = lx_image_alloc(r->img, (int)w, (int)h, r->map.channels);
+    if (s != LX_OK) {
+        lx_error_prefix(r->name);
+        return s;
+    }
+    return storage == EXR_STORAGE_TILED ? read_tiles(r) : read_scanlines(r, &dw);
+}
+
+lx_status lx_img_load_exr(const unsigned char *data, size_t size, const char *name, lx_image *out)
+{
+    memset(out, 0, sizeof *out);
+    exr_memory mem = {data, size};
+    exr_context_initializer_t init = EXR_DEFAULT_CONTEXT_INITIALIZER;
+    init.error_handler_fn = exr_on_error;
+    init.user_data = &mem;
+    init.read_fn = memory_read;
+    init.size_fn = memory_size;
+    /* A damaged offset table is an error, not something to guess around. */
+    init.flags = EXR_CONTEXT_FLAG_DISABLE_CHUNK_RECONSTRUCTION;
+    exr_detail[0] = '\0';
+
+    exr_reader r = {.dec = EXR_DECODE_PIPELINE_INITIALIZER, .img = out, .name = name};
+    exr_result_t rv = exr_start_read(&r.ctx, name, &init);
+    if (rv != EXR_ERR_SUCCESS) {
+        exr_finish(&r.ctx);
+        return exr_failure(rv, LX_ERR_FORMAT, name, "header");
+    }
+    lx_status s = read_part(&r);
+    if (r.started || r.dec.channels)
+        exr_decoding_destroy(r.ctx, &r.dec);
+    exr_finish(&r.ctx);
+    free(r.planes);
+    if (s != LX_OK)
+        lx_image_free(out);
+    return s;
+}
+
+/* ---- writing ------------------------------------------------------------- */
+
+/* binary16 from binary32, round to nearest even. The caller has checked
+ * |f| <= 65504, so the result is finite. */
+static uint16_t float_to_half(float f)
+{
+    uint32_t x;
+    memcpy(&x, &f, sizeof x);
+    uint16_t sign = (uint16_t)((x >> 16) & 0x8000u);
+    uint32_t ax = x & 0x7fffffffu;
+    if (ax >= 0x47800000u) /* >= 2^16: out of range (not reached) */
+        return sign | 0x7c00u;
+    if (ax < 0x38800000u) { /* below 2^-14: subnormal half or zero */
+        if (ax < 0x33000000u) /* below 2^-25: rounds to zero */
+            return sign;
+        uint32_t e = ax >> 23, m = (ax & 0x7fffffu) | 0x800000u;
+        uint32_t shift = 126 - e; /* 14..24 */
+        uint32_t h = m >> shift, rem = m & ((1u << shift) - 1), halfway = 1u << (shift - 1);
+        if (rem > halfway || (rem == halfway && (h & 1u)))
+            h++;
+        return sign | (uint16_t)h;
+    }
+    uint32_t r = ax - 0x38000000u; /* rebias the exponent from 127 to 15 */
+    uint32_t h = r >> 13, rem = r & 0x1fffu;
+    if (rem > 0x1000u || (rem == 0x1000u && (h & 1u)))
+        h++;
+    return sign | (uint16_t)h;
+}
+
+typedef struct exr_out {
+    FILE *fp;
+    bool failed;
+} exr_out;
+
+/* OpenEXRCore writes with pwrite semantics: it comes back to fill in the
+ * chunk offset table at the end. */
+static int64_t file_write(exr_const_context_t ctxt, void *user, const void *buffer, uint64_t sz,
+                          uint64_t offset, exr_stream_error_func_ptr_t error_cb)
+{
+    (void)ctxt;
+    (void)error_cb;
+    exr_out *o = user;
+    if (offset > (uint64_t)INT64_MAX || fseeko(o->fp, (off_t)offset, SEEK_SET) != 0 ||
+        fwrite(buffer, 1, (size_t)sz, o->fp) != sz) {
+        o->failed = true;
+        return -1;
+    }
+    return (int64_t)sz;
+}
+
+/* Channels in the alphabetical order EXR stores them, each with its index
+ * in luxel's interleaved pixel. */
+static int exr_channel_layout(int channels, const char **names, int *index)
+{
+    static const char *const rgba[4] = {"A", "B", "G", "R"};
+    static const int rgba_index[4] = {3, 2, 1, 0};
+    switch (channels) {
+    case 1: names[0] = "Y", index[0] = 0; return 1;
+    case 2: names[0] = "A", index[0] = 1, names[1] = "Y", index[1] = 0; return 2;
+    case 3:
+        for (int i = 0; i < 3; i++)
+            names[i] = rgba[i + 1], index[i] = rgba_index[i + 1];
+        return 3;
+    default:
+        for (int i = 0; i < 4; i++)
+            names[i] = rgba[i], index[i] = rgba_index[i];
+        return 4;
+    }
+}
+
+/* pixels holds the channels planar, in file order (plane k = names[k]),
+ * for the same reason the reader decodes planar. */
+static lx_status write_exr_pixels(exr_context_t ctx, const char *path, const lx_image *img,
+                                  const uint8_t *pixels, int bytes_per_value, uint16_t type,
+                                  const char *const *names, int count)
+{
+    int32_t lines;
+    exr_result_t rv = exr_get_scanlines_per_chunk(ctx, 0, &lines);
+    if (rv != EXR_ERR_SUCCESS || lines < 1)
+        return exr_failure(rv, LX_ERR_IO, path, "writing");
+    size_t row_bytes = (size_t)img->width * (size_t)bytes_per_value;
+    size_t plane_bytes = row_bytes * (size_t)img->height;
+    exr_encode_pipeline_t enc = EXR_ENCODE_PIPELINE_INITIALIZER;
+    bool started = false;
+    lx_status s = LX_OK;
+    for (int y = 0; y < img->height && s == LX_OK; y += lines) {
+        exr_chunk_info_t ci;
+        rv = exr_write_scanline_chunk_info(ctx, 0, y, &ci);
+        if (rv == EXR_ERR_SUCCESS)
+            rv = started ? exr_encoding_update(ctx, 0, &ci, &enc)
+                         : exr_encoding_initialize(ctx, 0, &ci, &enc);
+        if (rv != EXR_ERR_SUCCESS) {
+            s = exr_failure(rv, LX_ERR_IO, path, "writing");
+            break;
+        }
+        for (int c = 0; c < enc.channel_count; c++) {
+            exr_coding_channel_info_t *ch = &enc.channels[c];
+            int k = 0;
+            while (k < count - 1 && strcmp(ch->channel_name, names[k]) != 0)
+                k++;
+            ch->user_data_type = type;
+            ch->user_bytes_per_element = (int16_t)bytes_per_value;
+            ch->user_pixel_stride = bytes_per_value;
+            ch->user_line_stride = (int32_t)row_bytes;
+            ch->encode_from_ptr = pixels + (size_t)k * plane_bytes + (size_t)y * row_bytes;
+        }
+        if (!started) {
+            rv = exr_encoding_choose_default_routines(ctx, 0, &enc);
+            started = rv == EXR_ERR_SUCCESS;
+        }
+        if (rv == EXR_ERR_SUCCESS)
+            rv = exr_encoding_run(ctx, 0, &enc);
+        if (rv != EXR_ERR_SUCCESS)
+            s = exr_failure(rv, LX_ERR_IO, path, "writing");
+    }
+    if (started || enc.channels)
+        exr_encoding_destroy(ctx, &enc);
+    return s;
+}
+
+lx_status lx_img_write_exr(FILE *fp, const char *path, const lx_image *img, float exposure,
+                           bool half)
+{
+    if ((int64_t)img->width * 4 > INT32_MAX)
+        return lx_fail(LX_ERR_UNSUPPORTED, "%s: %d pixels per row is too wide for EXR", path,
+                       img->width);
+    const char *names[4];
+    int index[4];
+    int count = exr_channel_layout(img->channels, names, index);
+    int nc = img->channels;
+    size_t plane = (size_t)img->width * (size_t)img->height;
+    int bytes_per_value = half ? 2 : 4;
+    size_t bytes = plane * (size_t)nc * (size_t)bytes_per_value;
+    uint8_t *pixels = malloc(bytes);
+    if (!pixels)
+        return lx_fail(LX_ERR_NOMEM, "%s: cannot allocate %zu bytes", path, bytes);
+    bool has_alpha = nc == 2 || nc == 4;
+    for (int k = 0; k < count; k++) {
+        int c = index[k];
+        float e = has_alpha && c == nc - 1 ? 1.0f : exposure; /* alpha is not light */
+        const float *src = img->data + c;
+        if (half) {
+            uint16_t *dst = (uint16_t *)pixels + (size_t)k * plane;
+            for (size_t i = 0; i < plane; i++, src += nc)
+                dst[i] = float_to_half(*src * e);
+        } else {
+            float *dst = (float *)pixels + (size_t)k * plane;
+            for (size_t i = 0; i < plane; i++, src += nc)
+                dst[i] = *src * e;
+        }
+    }
+
+    exr_out o = {fp, false};
+    exr_context_initializer_t init = EXR_DEFAULT_CONTEXT_INITIALIZER;
+    init.error_handler_fn = exr_on_error;
+    init.user_data = &o;
+    init.write_fn = file_write;
+    exr_detail[0] = '\0';
+
+    exr_context_t ctx = NULL;
+    int part = 0;
+    exr_pixel_type_t type = half ? EXR_PIXEL_HALF : EXR_PIXEL_FLOAT;
+    exr_result_t rv = exr_start_write(&ctx, path, EXR_WRITE_FILE_DIRECTLY, &init);
+    if (rv == EXR_ERR_SUCCESS)
+        rv = exr_add_part(ctx, NULL, EXR_STORAGE_SCANLINE, &part);
+    if (rv == EXR_ERR_SUCCESS)
+        rv = exr_initialize_required_attr_simple(ctx, part, img->width, img->height,
+                                                 EXR_COMPRESSION_ZIP);
+    for (int k = 0; k < count && rv == EXR_ERR_SUCCESS; k++)
+        rv = exr_add_channel(ctx, part, names[k], type, EXR_PERCEPTUALLY_LOGARITHMIC, 1, 1);
+    if (rv == EXR_ERR_SUCCESS)
+        rv = exr_write_header(ctx);
+    lx_status s = rv == EXR_ERR_SUCCESS ? LX_OK : exr_failure(rv, LX_ERR_IO, path, "header");
+    if (s == LX_OK)
+        s = write_exr_pixels(ctx, path, img, pixels, bytes_per_value, (uint16_t)type, names,
+                             count);
+    free(pixels);
+    rv = exr_finish(&ctx);
+    if (s == LX_OK && rv != EXR_ERR_SUCCESS)
+        s = exr_failure(rv, LX_ERR_IO, path, "finishing");
+    if (s == LX_OK && o.failed)
+        s = lx_fail(LX_ERR_IO, "%s: write failed", path);
+    return s;
+}

@@ -1,0 +1,449 @@
+/* PNG/JPEG/TGA/Radiance HDR through stb_image and stb_image_write (the
+ * implementations are compiled into Debian's libstb). 8-bit and 16-bit data
+ * use the sRGB transfer function of IEC 61966-2-1:1999; alpha stays linear. */
+#include "image_internal.h"
+
+#include <limits.h>
+#include <math.h>
+#include <stdint.h>
+#include <stdlib.h>
+#include <string.h>
+
+#include <stb/stb_image.h>
+#include <stb/stb_image_write.h>
+
+/* ---- reading ------------------------------------------------------------- */
+
+static lx_status stb_failure(const char *name)
+{
+    const char *why = stbi_failure_reason();
+    if (!why)
+        why = "unknown error";
+    lx_status s = strcmp(why, "outofmem") == 0 ? LX_ERR_NOMEM : LX_ERR_FORMAT;
+    return lx_fail(s, "%s: cannot decode: %s", name, why);
+}
+
+/* Offset just past the next '\n' (or the end), as stb's header reader
+ * splits lines. */
+static size_t next_line(const unsigned char *d, size_t size, size_t pos, bool *empty)
+{
+    size_t start = pos;
+    while (pos < size && d[pos] != '\n')
+        pos++;
+    *empty = pos == start;
+    return pos < size ? pos + 1 : pos;
+}
+
+/* Walks a Radiance file's pixel data the way stb_image 2.27 decodes it and
+ * fails where stb would not: stb reads zeros past the end of the data
+ * (a truncated file loads as black), and a zero-length run makes its RLE
+ * loop spin forever. After this check stb never runs out of data. */
+static lx_status check_hdr_data(const unsigned char *d, size_t size, int w, int h,
+                                const char *name)
+{
+    bool empty;
+    size_t pos = next_line(d, size, 0, &empty); /* "#?RADIANCE" */
+    do
+        pos = next_line(d, size, pos, &empty);
+    while (!empty && pos < size);
+    pos = next_line(d, size, pos, &empty); /* "-Y h +X w" */
+    size_t flat = (size_t)w * (size_t)h * 4; /* w, h < 2^24 (stb's limit) */
+    if (w < 8 || w >= 32768) {
+        if (size - pos < flat)
+            goto truncated;
+        return LX_OK;
+    }
+    for (int y = 0; y < h; y++) {
+        if (size - pos < 4)
+            goto truncated;
+        const unsigned char *p = d + pos;
+        if (p[0] != 2 || p[1] != 2 || (p[2] & 0x80)) {
+            /* not run-length encoded: stb reads the whole image flat from here */
+            if (size - pos < flat)
+                goto truncated;
+            return LX_OK;
+        }
+        if ((p[2] << 8 | p[3]) != w)
+            return lx_fail(LX_ERR_FORMAT, "%s: scanline %d: run-length header gives width %d, "
+                                          "expected %d",
+                           name, y, p[2] << 8 | p[3], w);
+        pos += 4;
+        for (int c = 0; c < 4; c++) {
+            for (int x = 0; x < w;) {
+                if (pos >= size)
+                    goto truncated;
+                int count = d[pos++];
+                bool run = count > 128;
+                if (run)
+                    count -= 128;
+                if (count == 0 || count > w - x)
+                    return lx_fail(LX_ERR_FORMAT, "%s: scanline %d: bad run length %d", name, y,
+                                   count);
+                size_t bytes = run ? 1 : (size_t)count;
+                if (size - pos < bytes)
+                    goto truncated;
+                pos += bytes;
+                x += count;
+            }
+        }
+    }
+    return LX_OK;
+truncated:
+    return lx_fail(LX_ERR_FORMAT, "%s: truncated: pixel data ends at byte %zu", name, size);
+}
+
+/* The tables a JPEG has defined so far and the components of its frame. */
+typedef struct jpeg_state {
+    bool huffman[2][4], quant[4], frame, progressive, coded[4];
+    int components, ids[4], quant_of[4];
+} jpeg_state;
+
+/* Checks one SOS header (at body) against what is defined: stb decodes
+ * with whatever its uninitialised tables hold otherwise. */
+static lx_status check_jpeg_scan(jpeg_state *j, const unsigned char *d, size_t size, size_t body,
+                                 const char *name)
+{
+    size_t ns = d[body], q = body + 1;
+    if (q + 2 * ns + 3 > size)
+        return LX_OK; /* stb reads zeros and fails the scan */
+    int ss = d[q + 2 * ns], ah = d[q + 2 * ns + 2] >> 4;
+    bool dc = !j->progressive || (ss == 0 && ah == 0), ac = !j->progressive || ss > 0;
+    for (size_t k = 0; k < ns; k++) {
+        int id = d[q + 2 * k], td = d[q + 2 * k + 1] >> 4, ta = d[q + 2 * k + 1] & 15;
+        for (int i = 0; i < j->components; i++) {
+            if (j->ids[i] != id || td > 3 || ta > 3)
+                continue;
+            if ((dc && !j->huffman[0][td]) || (ac && !j->huffman[1][ta]))
+                return lx_fail(LX_ERR_FORMAT,
+                               "%s: corrupt JPEG: scan of component %d uses an undefined "
+                               "Huffman table",
+                               name, id);
+            if (j->quant_of[i] > 3 || !j->quant[j->quant_of[i]])
+                return lx_fail(LX_ERR_FORMAT,
+                               "%s: corrupt JPEG: component %d uses an undefined "
+                               "quantization table",
+                               name, id);
+            if (dc)
+                j->coded[i] = true;
+        }
+    }
+    return LX_OK;
+}
+
+/* Walks a JPEG's markers the way stb_image 2.27 does and rejects what stb
+ * mishandles (found by fuzz/fuzz_image.c):
+ * - a Huffman table whose 16 code counts sum past 256: stb writes past it;
+ * - a scan using a table never defined, a component no scan codes
+ *   (baseline) or without a DC first pass (progressive): stb decodes with
+ *   or returns uninitialised memory;
+ * - a file smaller than its image can be (every 8x8 block costs at least one
+ *   bit): stb "decodes" the missing data as zeros. */
+static lx_status check_jpeg(const unsigned char *d, size_t size, const char *name)
+{
+    jpeg_state j = {.components = 0};
+    size_t pos = 2; /* after SOI */
+    while (pos < size) {
+        if (d[pos] != 0xff) { /* stb skips padding between segments */
+            pos++;
+            continue;
+        }
+        while (pos < size && d[pos] == 0xff)
+            pos++;
+        if (pos + 2 >= size)
+            break;
+        int m = d[pos++];
+        if (m == 0xd9) /* EOI: stb stops */
+            break;
+        if (m == 0x00 || m == 0x01 || (m >= 0xd0 && m <= 0xd7))
+            continue; /* no length field */
+        size_t len = (size_t)d[pos] << 8 | d[pos + 1], body = pos + 2, p = body;
+        /* stb reads DHT and DQT tables while the declared length lasts,
+         * even past it */
+        for (long left = (long)len - 2; m == 0xc4 && left > 0 && p < size;) {
+            int n = 0, tc = d[p] >> 4, th = d[p] & 15;
+            if (tc > 1 || th > 3)
+                break; /* stb rejects the table first */
+            for (size_t i = p + 1; i < p + 17 && i < size; i++)
+                n += d[i];
+            if (n > 256)
+                return lx_fail(LX_ERR_FORMAT,
+                               "%s: corrupt JPEG: Huffman table at byte %zu has %d codes "
+                               "(at most 256)",
+                               name, p, n);
+            j.huffman[tc][th] = true;
+            p += 17 + (size_t)n;
+            left -= 17 + n;
+        }
+        for (long left = (long)len - 2; m == 0xdb && left > 0 && p < size;) {
+            int precision = d[p] >> 4, t = d[p] & 15;
+            if (precision > 1 || t > 3)
+                break;
+            j.quant[t] = true;
+            p += precision ? 129 : 65;
+            left -= precision ? 129 : 65;
+        }
+        if ((m == 0xc0 || m == 0xc1 || m == 0xc2) && !j.frame && body + 6 <= size) {
+            j.frame = true; /* stb reads the first frame header only */
+            j.progressive = m == 0xc2;
+            uint64_t h = (uint64_t)d[body + 1] << 8 | d[body + 2];
+            uint64_t w = (uint64_t)d[body + 3] << 8 | d[body + 4];
+            j.components = d[body + 5] < 4 ? d[body + 5] : 4;
+            for (int i = 0; i < j.components; i++) {
+                size_t c = body + 6 + 3 * (size_t)i;
+                j.ids[i] = c < size ? d[c] : 0;
+                j.quant_of[i] = c + 2 < size ? d[c + 2] : 0;
+            }
+            if (w * h > 512 * (uint64_t)size)
+                return lx_fail(LX_ERR_FORMAT,
+                               "%s: truncated: a %llux%llu JPEG needs more than %zu bytes", name,
+                               (unsigned long long)w, (unsigned long long)h, size);
+        }
+        if (m == 0xda && j.frame && body < size) {
+            lx_status s = check_jpeg_scan(&j, d, size, body, name);
+            if (s != LX_OK)
+                return s;
+        }
+        if (len < 2)
+            break; /* stb fails here */
+        pos += len;
+        if (m == 0xda) {
+            /* entropy-coded data runs to the next marker: 0xff followed by
+             * neither a stuffed 0, fill, nor a restart marker */
+            while (pos + 1 < size &&
+                   !(d[pos] == 0xff && d[pos + 1] != 0x00 && d[pos + 1] != 0xff &&
+                     (d[pos + 1] < 0xd0 || d[pos + 1] > 0xd7)))
+                pos++;
+        }
+    }
+    for (int i = 0; i < j.components; i++)
+        if (!j.coded[i])
+            return lx_fail(LX_ERR_FORMAT, "%s: corrupt JPEG: component %d has no %sscan data",
+                           name, j.ids[i], j.progressive ? "DC " : "");
+    return LX_OK;
+}
+
+/* stb_image reads zeros past the end of a TGA, so a cut file loads as
+ * black and a 30-byte header can claim a 6403x28525 image that stb then
+ * allocates and "decodes". The data must at least hold the pixels
+ * (uncompressed) or one packet per 128 pixels (run-length encoded). The
+ * header has passed plausible_tga() in image.c (18 bytes or more). */
+static lx_status check_tga_size(const unsigned char *d, size_t size, const char *name)
+{
+    size_t w = d[12] | (size_t)d[13] << 8, h = d[14] | (size_t)d[15] << 8;
+    size_t pixel_bytes = ((size_t)d[16] + 7) / 8;
+    size_t map_bytes = d[1] ? (d[5] | (size_t)d[6] << 8) * (((size_t)d[7] + 7) / 8) : 0;
+    size_t offset = 18 + (size_t)d[0] + map_bytes;
+    size_t have = size > offset ? size - offset : 0;
+    bool rle = d[2] >= 9;
+    size_t need = rle ? (w * h + 127) / 128 * (1 + pixel_bytes) : w * h * pixel_bytes;
+    if (have < need)
+        return lx_fail(LX_ERR_FORMAT, "%s: truncated: %zux%zu %s needs %s%zu bytes of pixels, "
+                                      "found %zu",
+                       name, w, h, rle ? "run-length TGA" : "TGA", rle ? "at least " : "", need,
+                       have);
+    return LX_OK;
+}
+
+static bool is_alpha(int c, int channels)
+{
+    return (channels == 2 || channels == 4) && c == channels - 1;
+}
+
+lx_status lx_img_load_stb(const unsigned char *data, size_t size, const char *name, bool is_tga,
+                          bool raw_8bit, lx_image *out)
+{
+    memset(out, 0, sizeof *out);
+    if (size > INT_MAX)
+        return lx_fail(LX_ERR_UNSUPPORTED, "%s: %zu bytes is more than stb_image reads (2 GiB)",
+                       name, size);
+    int len = (int)size;
+    lx_status s = LX_OK;
+    if (size >= 3 && data[0] == 0xff && data[1] == 0xd8 && data[2] == 0xff)
+        s = check_jpeg(data, size, name);
+    else if (is_tga)
+        s = check_tga_size(data, size, name);
+    if (s != LX_OK)
+        return s;
+
+    /* Size up front, so a header claiming a huge image fails with luxel's
+     * message before stb allocates. 4 channels is the most stb returns. */
+    int w, h, comp;
+    if (!stbi_info_from_memory(data, len, &w, &h, &comp))
+        return stb_failure(name);
+    size_t bytes;
+    if (w < 1 || h < 1 || !lx_size_mul((size_t)w, (size_t)h, 4 * sizeof(float), &bytes))
+        return lx_fail(LX_ERR_FORMAT, "%s: invalid image size %dx%d", name, w, h);
+    char what[64];
+    snprintf(what, sizeof what, "image %dx%d", w, h);
+    s = lx_check_memory(bytes, what);
+    if (s != LX_OK) {
+        lx_error_prefix(name);
+        return s;
+    }
+
+    /* stbi_loadf would also accept 8-bit files and apply its own gamma and
+     * scale; luxel decodes those itself, so loadf is only for real HDR. */
+    bool hdr = stbi_is_hdr_from_memory(data, len) != 0;
+    bool wide = !hdr && stbi_is_16_bit_from_memory(data, len) != 0;
+    if (hdr) {
+        s = check_hdr_data(data, size, w, h, name);
+        if (s != LX_OK)
+            return s;
+    }
+    void *pixels;
+    if (hdr)
+        pixels = stbi_loadf_from_memory(data, len, &w, &h, &comp, 0);
+    else if (wide)
+        pixels = stbi_load_16_from_memory(data, len, &w, &h, &comp, 0);
+    else
+        pixels = stbi_load_from_memory(data, len, &w, &h, &comp, 0);
+    if (!pixels)
+        return stb_failure(name);
+
+    s = lx_image_alloc(out, w, h, comp);
+    if (s != LX_OK) {
+        stbi_image_free(pixels);
+        lx_error_prefix(name);
+        return s;
+    }
+    size_t n = (size_t)w * (size_t)h * (size_t)comp;
+    if (hdr) {
+        memcpy(out->data, pixels, n * sizeof(float));
+    } else if (wide) {
+        const stbi_us *p = pixels;
+        for (size_t i = 0; i < n; i++) {
+            float v = (float)p[i] / 65535.0f;
+            bool linear = raw_8bit || is_alpha((int)(i % (size_t)comp), comp);
+            out->data[i] = linear ? v : lx_srgb_to_linear(v);
+        }
+    } else {
+        float to_linear[256], to_unit[256];
+        for (int k = 0; k < 256; k++) {
+            to_unit[k] = (float)k / 255.0f;
+            to_linear[k] = raw_8bit ? to_unit[k] : lx_srgb_to_linear(to_unit[k]);
+        }
+        const stbi_uc *p = pixels;
+        for (size_t i = 0; i < n; i++) {
+            bool alpha = is_alpha((int)(i % (size_t)comp), comp);
+            out->data[i] = alpha ? to_unit[p[i]] : to_linear[p[i]];
+        }
+    }
+    stbi_image_free(pixels);
+    return LX_OK;
+}
+
+/* ---- writing ------------------------------------------------------------- */
+
+/* Errors show in ferror(fp), which lx_out_commit checks. */
+static void write_to_file(void *context, void *data, int size)
+{
+    fwrite(data, 1, (size_t)size, (FILE *)context);
+}
+
+/* thresholds[k - 1] is the linear value from which code k is the nearest
+ * 8-bit sRGB code, so encoding is an exact search instead of a pow per
+ * value. */
+static void srgb_thresholds(double thresholds[255])
+{
+    for (int k = 1; k <= 255; k++) {
+        double c = ((double)k - 0.5) / 255.0;
+        thresholds[k - 1] = c <= 0.04045 ? c / 12.92 : pow((c + 0.055) / 1.055, 2.4);
+    }
+}
+
+static unsigned char encode_srgb8(const double thresholds[255], float v)
+{
+    int lo = 0, hi = 255; /* answer in [lo, hi]: count of thresholds <= v */
+    while (lo < hi) {
+        int mid = (lo + hi + 1) / 2;
+        if ((double)v >= thresholds[mid - 1])
+            lo = mid;
+        else
+            hi = mid - 1;
+    }
+    return (unsigned char)lo;
+}
+
+static unsigned char encode_unorm8(float v)
+{
+    v = v < 0.0f ? 0.0f : v > 1.0f ? 1.0f : v;
+    return (unsigned char)(v * 255.0f + 0.5f);
+}
+
+static lx_status write_8bit(FILE *fp, const char *path, const lx_image *img,
+                            lx_image_format format, float exposure)
+{
+    int c = img->channels;
+    /* stb_image_write sizes its buffers with int arithmetic */
+    if ((int64_t)img->height * ((int64_t)img->width * c + 1) > INT_MAX / 2)
+        return lx_fail(LX_ERR_UNSUPPORTED, "%s: %dx%d is too large for the %s writer", path,
+                       img->width, img->height, lx_image_format_extension(format));
+    size_t n = (size_t)img->width * (size_t)img->height * (size_t)c;
+    unsigned char *bytes = malloc(n);
+    if (!bytes)
+        return lx_fail(LX_ERR_NOMEM, "%s: cannot allocate %zu bytes", path, n);
+    double thresholds[255];
+    srgb_thresholds(thresholds);
+    for (size_t i = 0; i < n; i++) {
+        float v = img->data[i];
+        bytes[i] = is_alpha((int)(i % (size_t)c), c) ? encode_unorm8(v)
+                                                      : encode_srgb8(thresholds, v * exposure);
+    }
+    int ok;
+    switch (format) {
+    case LX_IMAGE_JPG:
+        ok = stbi_write_jpg_to_func(write_to_file, fp, img->width, img->height, c, bytes, 95);
+        break;
+    case LX_IMAGE_TGA:
+        ok = stbi_write_tga_to_func(write_to_file, fp, img->width, img->height, c, bytes);
+        break;
+    default:
+        ok = stbi_write_png_to_func(write_to_file, fp, img->width, img->height, c, bytes,
+                                    img->width * c);
+        break;
+    }
+    free(bytes);
+    if (!ok)
+        return lx_fail(LX_ERR_IO, "%s: cannot encode %s", path,
+                       lx_image_format_extension(format));
+    return LX_OK;
+}
+
+static lx_status write_hdr(FILE *fp, const char *path, const lx_image *img, float exposure)
+{
+    int c = img->channels;
+    /* stb_image_write indexes the values with int arithmetic */
+    if ((int64_t)img->height * img->width * c > INT_MAX)
+        return lx_fail(LX_ERR_UNSUPPORTED, "%s: %dx%d is too large for the hdr writer", path,
+                       img->width, img->height);
+    size_t n = (size_t)img->width * (size_t)img->height * (size_t)c;
+    float *values = malloc(n * sizeof(float));
+    if (!values)
+        return lx_fail(LX_ERR_NOMEM, "%s: cannot allocate %zu bytes", path, n * sizeof(float));
+    /* RGBE has no sign: stb would cast a negative mantissa to unsigned char. */
+    size_t negative = 0;
+    for (size_t i = 0; i < n; i++) {
+        float v = is_alpha((int)(i % (size_t)c), c) ? img->data[i] : img->data[i] * exposure;
+        if (v < 0.0f) {
+            v = 0.0f;
+            negative++;
+        }
+        values[i] = v;
+    }
+    if (negative)
+        lx_log(LX_LOG_WARN, "%s: %zu negative values written as 0 (Radiance HDR has no sign)",
+               path, negative);
+    int ok = stbi_write_hdr_to_func(write_to_file, fp, img->width, img->height, c, values);
+    free(values);
+    if (!ok)
+        return lx_fail(LX_ERR_IO, "%s: cannot encode hdr", path);
+    return LX_OK;
+}
+
+lx_status lx_img_write_stb(FILE *fp, const char *path, const lx_image *img,
+                           lx_image_format format, float exposure)
+{
+    if (format == LX_IMAGE_HDR)
+        return write_hdr(fp, path, img, exposure);
+    return write_8bit(fp, path, img, format, exposure);
+}
