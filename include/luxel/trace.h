@@ -1,6 +1,6 @@
 /* luxel/trace.h - ray queries over a scene: occlusion and closest hit
- * through Intel Embree 3, every node an instance of its meshes so a node can
- * move without rebuilding the meshes' BVHs.
+ * through Intel Embree 3, over one flat world-space BVH of every node's
+ * meshes. A node can move; the BVH is rebuilt at the next commit.
  *
  * CONVENTIONS  World space, metres. A ray covers origin + t*dir for t in
  *   [tmin, tmax]; dir need not be unit length (t is then in units of |dir|).
@@ -53,8 +53,8 @@ void lx_tracer_destroy(lx_tracer *tracer);
 
 /* Moves a node; takes effect at the next lx_tracer_commit. */
 lx_status lx_tracer_set_node_transform(lx_tracer *tracer, uint32_t node, const lx_mat4 *world);
-/* Rebuilds the top-level structure after nodes moved (cheap: meshes keep
- * their own BVHs). */
+/* Rebuilds the BVH after nodes moved (about a millisecond per 10k
+ * triangles). */
 lx_status lx_tracer_commit(lx_tracer *tracer);
 
 /* True when anything blocks the ray within [tmin, tmax]. */

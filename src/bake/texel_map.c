@@ -91,15 +91,18 @@ static void closest_on_triangle(const double a[2], const double b[2], const doub
     w[0] = 1 - w[1] - w[2];
 }
 
-/* Does triangle abc overlap the axis-aligned square [x0,x0+1]x[y0,y0+1]?
- * Separating axes: the square's two axes and the triangle's edge normals. */
+/* Does triangle abc overlap the axis-aligned square [x0,x0+1]x[y0,y0+1]
+ * with a positive area? Separating axes: the square's two axes and the
+ * triangle's edge normals; touching along an edge or at a corner is not
+ * overlapping (a chart whose border runs along texel edges covers no extra
+ * ring of texels). */
 static bool triangle_overlaps_texel(const double *v[3], double x0, double y0)
 {
     double minx = fmin(v[0][0], fmin(v[1][0], v[2][0]));
     double maxx = fmax(v[0][0], fmax(v[1][0], v[2][0]));
     double miny = fmin(v[0][1], fmin(v[1][1], v[2][1]));
     double maxy = fmax(v[0][1], fmax(v[1][1], v[2][1]));
-    if (maxx < x0 || minx > x0 + 1 || maxy < y0 || miny > y0 + 1)
+    if (maxx <= x0 || minx >= x0 + 1 || maxy <= y0 || miny >= y0 + 1)
         return false;
     double corners[4][2] = {{x0, y0}, {x0 + 1, y0}, {x0, y0 + 1}, {x0 + 1, y0 + 1}};
     for (int e = 0; e < 3; e++) {
@@ -109,7 +112,7 @@ static bool triangle_overlaps_texel(const double *v[3], double x0, double y0)
         bool all_out = true;
         for (int k = 0; k < 4 && all_out; k++) {
             double s = nx * (corners[k][0] - p[0]) + ny * (corners[k][1] - p[1]);
-            all_out = side > 0 ? s < 0 : s > 0;
+            all_out = side > 0 ? s <= 0 : s >= 0;
         }
         if (all_out)
             return false;
