@@ -207,7 +207,6 @@ lx_status lx_baker_bake(lx_baker *b)
     if (!idx)
         return lx_fail(LX_ERR_NOMEM, "out of memory");
     uint32_t n = select_lights(b, false, idx);
-    clear_buffers(b, false);
     lx_status st = lx_bake_lights(b, idx, n, b->ambient, false, 0.0f, 1.0f);
     if (st != LX_OK)
         clear_buffers(b, false);
@@ -222,7 +221,6 @@ lx_status lx_baker_update(lx_baker *b)
     if (!idx)
         return lx_fail(LX_ERR_NOMEM, "out of memory");
     uint32_t n = select_lights(b, true, idx);
-    clear_buffers(b, true);
     lx_bake_desc saved = b->desc;
     b->desc.progress = NULL; /* per-frame work reports no progress */
     lx_status st = lx_bake_lights(b, idx, n, lx_v3(0, 0, 0), true, 0.0f, 1.0f);

@@ -81,50 +81,66 @@ lx_status lx_bake_lights(lx_baker *b, const uint32_t *lights, uint32_t light_cou
             return st;
         b->tracer_dirty = false;
     }
-    /* progress counts texels (plus one per tile, so empty tiles count too) */
+    /* One parallel loop over every tile of every map: fork and join once
+     * per pass, which matters for the per-frame update. */
+    uint32_t *map_first_tile = malloc(sizeof(uint32_t) * (b->map_count + 1));
+    if (!map_first_tile)
+        return lx_fail(LX_ERR_NOMEM, "out of memory");
     uint64_t total_work = 0;
-    for (uint32_t m = 0; m < b->map_count; m++)
+    map_first_tile[0] = 0;
+    for (uint32_t m = 0; m < b->map_count; m++) {
+        map_first_tile[m + 1] = map_first_tile[m] + b->maps[m].tile_count;
+        /* progress counts texels, plus one per tile so empty tiles count */
         total_work += b->maps[m].info.used_texels + b->maps[m].tile_count;
+    }
+    int tiles = (int)map_first_tile[b->map_count];
     int threads = lx_thread_count(b->desc.threads);
+    bool report = b->desc.progress != NULL;
     volatile int cancelled = 0;
     uint64_t done_work = 0;
 
-    for (uint32_t m = 0; m < b->map_count && !cancelled; m++) {
-        lx_lightmap *map = &b->maps[m];
-        float *target = to_realtime ? map->realtime : map->baked;
-        int tiles = (int)map->tile_count;
 #pragma omp parallel for schedule(dynamic, 4) num_threads(threads)
-        for (int tile = 0; tile < tiles; tile++) {
-            if (cancelled)
-                continue;
-            uint32_t first = map->tile_start[tile];
-            uint32_t count = map->tile_start[tile + 1] - first;
-            if (count) {
-                lx_vec3 accum[LX_TILE * LX_TILE];
-                for (uint32_t k = 0; k < count; k++)
-                    accum[k] = ambient;
-                for (uint32_t l = 0; l < light_count; l++)
-                    light_tile(b, map, first, count, &b->lights[lights[l]], accum);
-                for (uint32_t k = 0; k < count; k++) {
-                    float *px = target + (size_t)map->texels[first + k].pixel * 3;
-                    px[0] += accum[k].x;
-                    px[1] += accum[k].y;
-                    px[2] += accum[k].z;
-                }
+    for (int global = 0; global < tiles; global++) {
+        if (cancelled)
+            continue;
+        uint32_t m = 0;
+        while (map_first_tile[m + 1] <= (uint32_t)global)
+            m++;
+        const lx_lightmap *map = &b->maps[m];
+        uint32_t tile = (uint32_t)global - map_first_tile[m];
+        float *target = to_realtime ? map->realtime : map->baked;
+        uint32_t first = map->tile_start[tile];
+        uint32_t count = map->tile_start[tile + 1] - first;
+        if (count) {
+            lx_vec3 accum[LX_TILE * LX_TILE];
+            for (uint32_t k = 0; k < count; k++)
+                accum[k] = ambient;
+            for (uint32_t l = 0; l < light_count; l++)
+                light_tile(b, map, first, count, &b->lights[lights[l]], accum);
+            /* every texel belongs to one tile: plain stores, no clearing */
+            for (uint32_t k = 0; k < count; k++) {
+                float *px = target + (size_t)map->texels[first + k].pixel * 3;
+                px[0] = accum[k].x;
+                px[1] = accum[k].y;
+                px[2] = accum[k].z;
             }
+        }
+        if (report) {
             uint64_t done;
 #pragma omp atomic capture
             done = done_work += count + 1;
-            if (b->desc.progress && omp_get_thread_num() == 0 && (tile & 15) == 0) {
-                float f = progress_base + progress_span * (float)((double)done / (double)total_work);
-                if (!b->desc.progress(b->desc.progress_user, f))
+            if (omp_get_thread_num() == 0 && (global & 15) == 0) {
+                double f = (double)done / (double)total_work;
+                if (!b->desc.progress(b->desc.progress_user,
+                                      progress_base + progress_span * (float)f))
                     cancelled = 1;
             }
         }
     }
+    free(map_first_tile);
     if (cancelled)
         return lx_fail(LX_ERR_CANCELLED, "bake cancelled");
-    if (b->desc.progress && !b->desc.progress(b->desc.progress_user, progress_base + progress_span))
+    if (report && !b->desc.progress(b->desc.progress_user, progress_base + progress_span))
         return lx_fail(LX_ERR_CANCELLED, "bake cancelled");
     return LX_OK;
 }
