@@ -3,6 +3,7 @@
 #include "helpers.h"
 
 #include <dirent.h>
+#include <signal.h>
 #include <stdio.h>
 #include <stdlib.h>
 #include <string.h>
@@ -168,4 +169,22 @@ void lx_test_add(lx_scene *scene, lx_mesh *mesh)
         fprintf(stderr, "lx_test_add: %s\n", lx_last_error());
         abort();
     }
+}
+
+static void watchdog_fired(int sig)
+{
+    (void)sig;
+    static const char msg[] = "lx_test_watchdog: the test did not finish in time (hang?)\n";
+    ssize_t r = write(2, msg, sizeof msg - 1);
+    (void)r;
+    _exit(1);
+}
+
+void lx_test_watchdog(unsigned seconds)
+{
+    struct sigaction sa;
+    memset(&sa, 0, sizeof sa);
+    sa.sa_handler = watchdog_fired;
+    sigaction(SIGALRM, &sa, NULL);
+    alarm(seconds);
 }

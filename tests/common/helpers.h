@@ -27,4 +27,9 @@ void lx_test_mesh_free(lx_mesh *m);
  * (and a default material when the scene has none). */
 void lx_test_add(lx_scene *scene, lx_mesh *mesh);
 
+/* Ends the process with a failure message on stderr (exit status 1) when
+ * it is still running after `seconds`: a hang in the code under test then
+ * fails the test instead of stalling the whole run. */
+void lx_test_watchdog(unsigned seconds);
+
 #endif

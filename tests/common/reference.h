@@ -1,0 +1,118 @@
+/* The test oracle: seed 000's brute-force per-texel lighting, written
+ * independently of src/bake and src/trace so the fast path (rasterized
+ * texel maps, Embree) can be checked against it.
+ *
+ * - Texel map: for every texel, every triangle of the node's meshes is
+ *   searched (mesh order, then triangle order) for the first whose UV
+ *   triangle contains the texel centre ((x+0.5)/W, (y+0.5)/H) with
+ *   barycentrics >= 0; the same barycentrics on the world triangle give the
+ *   texel's position and interpolated normal (seed 000's UvToWorld kernel).
+ *   Lightmap UVs are TEXCOORD_1 when the mesh has them, else TEXCOORD_0.
+ *   Normal maps are not applied (the reference scenes have none).
+ * - Rays: Moller-Trumbore in double precision against EVERY triangle of
+ *   EVERY node in world space, both faces (seed 000's shadow loop).
+ * - Lighting: for every light, lx_light_evaluate (the light model is tested
+ *   on its own in tests/light) and, unless the light's shadow mode is NONE,
+ *   a shadow ray toward the light whose origin is offset along the
+ *   geometric normal (on the light's side) by
+ *     bias = 1e-5 * scene bounding-box diagonal + 4e-6 * max|p| component,
+ *   tmax = distance - 2 * bias (the rule of src/bake/direct.c, so results
+ *   compare); plus the light's ambient and the scene ambient.
+ *
+ * Everything is slow and simple on purpose. Near-ties (a ray passing within
+ * a relative edge_eps of a triangle edge, a texel centre on an edge) are
+ * reported as ambiguous so tests can skip them instead of guessing.
+ */
+#ifndef LX_TEST_REFERENCE_H
+#define LX_TEST_REFERENCE_H
+
+#include "luxel/luxel.h"
+
+/* A triangle in world space (double), with where it came from. */
+typedef struct lx_ref_triangle {
+    double p[3][3];
+    uint32_t node, mesh, triangle;
+} lx_ref_triangle;
+
+/* Every triangle of every node of scene, transformed by the node's world
+ * matrix, in node / mesh / triangle order. */
+typedef struct lx_ref_scene {
+    lx_ref_triangle *tris;
+    uint32_t count;
+    double lo[3], hi[3]; /* world bounds */
+    float diagonal;      /* |hi - lo|, 1 when empty */
+} lx_ref_scene;
+
+void lx_ref_scene_build(const lx_scene *scene, lx_ref_scene *out);
+void lx_ref_scene_free(lx_ref_scene *rs);
+
+/* Moller-Trumbore (double, no culling). Fills t, u (weight of vertex 1),
+ * v (weight of vertex 2) of the ray's intersection with the triangle's
+ * plane and returns true when t is in [tmin, tmax] and u, v, 1-u-v >= 0.
+ * *margin (may be NULL) is min(u, v, 1-u-v) of the plane hit (negative when
+ * outside), or -INFINITY when the ray is parallel to the plane. */
+bool lx_ref_intersect(const lx_ref_triangle *tri, const double o[3], const double d[3], double tmin,
+                      double tmax, double *t, double *u, double *v, double *margin);
+
+typedef struct lx_ref_hit {
+    double t, u, v;
+    uint32_t node, mesh, triangle;
+} lx_ref_hit;
+
+/* Nearest hit over all triangles of rs within [tmin, tmax]; false if none.
+ * *ambiguous (may be NULL) is set when some triangle's plane is crossed
+ * within [tmin, tmax] with a barycentric margin within +-edge_eps, when a
+ * triangle is hit within 1e-6 (relative to max(1, |tmax|)) of tmin or tmax,
+ * or when the two nearest hits are that close in t: the answer then
+ * depends on rounding. */
+bool lx_ref_closest(const lx_ref_scene *rs, lx_vec3 origin, lx_vec3 dir, double tmin, double tmax,
+                    double edge_eps, lx_ref_hit *hit, bool *ambiguous);
+
+/* Any hit within [tmin, tmax]; *ambiguous as for lx_ref_closest (but only
+ * edge and range-end near misses count). */
+bool lx_ref_occluded(const lx_ref_scene *rs, lx_vec3 origin, lx_vec3 dir, double tmin, double tmax,
+                     double edge_eps, bool *ambiguous);
+
+/* One texel of the reference texel map. */
+typedef struct lx_ref_texel {
+    bool used;
+    uint32_t mesh;            /* scene mesh index */
+    uint32_t triangle;        /* in that mesh */
+    double bary[3];           /* weights of the triangle's vertices 0, 1, 2 */
+    double margin;            /* min(bary): how far inside the centre is */
+    lx_vec3 position;         /* world */
+    lx_vec3 normal;           /* world, interpolated vertex normals, unit */
+    lx_vec3 geometric_normal; /* world, unit (normal matrix x object face normal) */
+} lx_ref_texel;
+
+typedef struct lx_ref_map {
+    uint32_t node;
+    int width, height;
+    lx_ref_texel *texels; /* width * height, row 0 at the top */
+} lx_ref_map;
+
+/* The seed's every-texel-times-every-triangle UV -> world map of node. */
+void lx_ref_texel_map(const lx_scene *scene, uint32_t node, int width, int height, lx_ref_map *out);
+void lx_ref_map_free(lx_ref_map *map);
+
+/* The UV set a mesh's lightmap uses (1 when TEXCOORD_1 exists, else 0;
+ * -1 when it has none). */
+int lx_ref_uv_set(const lx_mesh *mesh);
+
+/* Barycentrics (w0, w1, w2) of (px, py) in UV triangle abc (double);
+ * false when the UV triangle is degenerate. */
+bool lx_ref_uv_barycentric(lx_vec2 a, lx_vec2 b, lx_vec2 c, double px, double py, double w[3]);
+
+/* Light arriving at a surface point: sum over lights of ambient + shadowed
+ * direct light (see the header comment), plus `ambient`. n is the shading
+ * normal, ng the geometric normal (either sign). *ambiguous (may be NULL)
+ * is set when a shadow ray was ambiguous in the sense of lx_ref_occluded
+ * with edge_eps. */
+lx_vec3 lx_ref_shade(const lx_ref_scene *rs, const lx_light *lights, uint32_t light_count,
+                     lx_vec3 ambient, lx_vec3 p, lx_vec3 n, lx_vec3 ng, double edge_eps,
+                     bool *ambiguous);
+
+/* Shadow-ray bias for point p in rs (the rule of src/bake/direct.c). */
+float lx_ref_bias(const lx_ref_scene *rs, lx_vec3 p);
+
+#endif
