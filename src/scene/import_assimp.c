@@ -6,6 +6,7 @@
 #include "luxel/scene.h"
 
 #include <assimp/cimport.h>
+#include <assimp/GltfMaterial.h>
 #include <assimp/config.h>
 #include <assimp/material.h>
 #include <assimp/postprocess.h>
@@ -185,6 +186,12 @@ static lx_status import_materials(import_ctx *c)
                                  NULL) == aiReturn_SUCCESS) {
             load_texture(c, &tex, true, "normal", name_buf, &m.normal_map, &m.normal_map_path);
             m.normal_uv_set = (int)uv;
+            /* glTF normalTexture.scale scales the map's x and y */
+            ai_real scale = 1;
+            if (aiGetMaterialFloatArray(am, AI_MATKEY_GLTF_TEXTURE_SCALE(aiTextureType_NORMALS, 0),
+                                        &scale, NULL) == aiReturn_SUCCESS &&
+                isfinite(scale))
+                m.normal_scale = scale;
         }
         uv = 0;
         if (aiGetMaterialTexture(am, aiTextureType_BASE_COLOR, 0, &tex, NULL, &uv, NULL, NULL,
@@ -206,7 +213,8 @@ static lx_status import_materials(import_ctx *c)
                 m.base_color_uv_set = 0;
             }
         }
-        m.normal_scale = 1.0f;
+        if (m.normal_scale == 0.0f)
+            m.normal_scale = 1.0f;
         lx_status st = lx_scene_add_material(c->scene, &m, NULL);
         lx_image_free(&m.normal_map);
         lx_image_free(&m.base_color_map);
