@@ -281,7 +281,7 @@ static double auto_ev100(const lx_baker *b, const lx_image *images, const bake_a
 }
 
 static cJSON *manifest_entry(const lx_scene *scene, const lx_lightmap_info *info,
-                             const char *file, const char *preview)
+                             const char *file, const char *preview, lx_quantity quantity)
 {
     cJSON *e = cJSON_CreateObject();
     cJSON_AddStringToObject(e, "node", info->name);
@@ -300,6 +300,9 @@ static cJSON *manifest_entry(const lx_scene *scene, const lx_lightmap_info *info
     cJSON_AddNumberToObject(e, "width", info->width);
     cJSON_AddNumberToObject(e, "height", info->height);
     cJSON_AddStringToObject(e, "uv_set", info->uv_set == 1 ? "TEXCOORD_1" : "TEXCOORD_0");
+    cJSON_AddStringToObject(e, "quantity",
+                            quantity == LX_QUANTITY_RADIANCE ? "radiance" : "irradiance");
+    cJSON_AddStringToObject(e, "unit", quantity == LX_QUANTITY_RADIANCE ? "nt" : "lx");
     cJSON_AddNumberToObject(e, "used_texels", info->used_texels);
     if (info->overlap_texels)
         cJSON_AddNumberToObject(e, "overlapping_texels", info->overlap_texels);
@@ -430,7 +433,8 @@ int cmd_bake(int argc, char **argv)
             }
             free(path);
         }
-        cJSON_AddItemToArray(list, manifest_entry(scene, info, file, want_preview ? preview : NULL));
+        cJSON_AddItemToArray(list, manifest_entry(scene, info, file, want_preview ? preview : NULL,
+                                                  a.desc.quantity));
     }
     if (!failed) {
         char *text = cJSON_Print(manifest);
