@@ -33,6 +33,7 @@ check-asan: deps
 
 bench: all
 	$(BUILD)/bin/bench_bake
+	$(BUILD)/bin/bench_realtime
 
 fuzz: all
 	@test -f $(BUILD_FUZZ)/CMakeCache.txt || CC=clang cmake -S . -B $(BUILD_FUZZ) -DCMAKE_BUILD_TYPE=Debug -DLX_FUZZ=ON

@@ -1,0 +1,518 @@
+/* bench_bake - the static bake's speed (DESIGN.md section 8), each figure
+ * with its baseline measured in the same run:
+ *
+ *  1. Full bake of a generated ~100k-triangle scene (tests/common/scenes.h),
+ *     one 1024x1024 lightmap, 4 point lights with hard shadows: texel-light
+ *     samples per second of lx_baker_bake, against raw occlusion throughput
+ *     for exactly the rays the bake casts (regenerated with
+ *     lx_bench_rays_build: same 8x8 tiles, same OpenMP schedule and threads):
+ *       - lx_tracer_occluded, one ray per call   (the baseline of the target:
+ *                                                 bake >= 0.80x of it)
+ *       - lx_tracer_occluded_batch, 64-ray coherent and incoherent batches
+ *       - Embree directly on one flat world-space BVH built here:
+ *         rtcOccluded1 and coherent rtcOccluded1M (no luxel wrapper)
+ *     Check: summing the lights over the rays lx_tracer_occluded finds
+ *     unoccluded must rebuild the bake's lightmap exactly.
+ *  2. Brute-force reference: tests/common/reference.h, the tests' oracle
+ *     (seed 000's every-texel x every-triangle UV search, then every light x
+ *     every triangle in double precision), on a ~2k-triangle scene at
+ *     128x128 with the bake's OpenMP threads, against lx_baker_create +
+ *     lx_baker_bake: the speed-up, and their agreement (texels within 1%,
+ *     near-tie texels the oracle flags left out).
+ *
+ * The real-time update rate is bench_realtime's.
+ *
+ * Usage: bench_bake [--res N] [--reps N] [--threads N] [--only bake|brute]
+ *                   [--skip-raw]
+ * --res sets the full bake's resolution; --skip-raw times the bake alone.
+ * The last line is a one-line summary.
+ */
+#define _POSIX_C_SOURCE 200809L
+#include "helpers.h"
+#include "reference.h"
+#include "scenes.h"
+
+#include <embree3/rtcore.h>
+#include <math.h>
+#include <omp.h>
+#include <stdio.h>
+#include <stdlib.h>
+#include <string.h>
+
+#define TILE LX_BENCH_TILE
+
+static int g_threads, g_reps = 3, g_res = 1024;
+static bool g_skip_raw;
+
+/* ---- raw throughput: the lx_tracer modes, then Embree on a flat BVH ------ */
+
+typedef enum raw_mode {
+    RAW_SINGLE,      /* lx_tracer_occluded */
+    RAW_BATCH,       /* lx_tracer_occluded_batch coherent */
+    RAW_BATCH_INCOH, /* lx_tracer_occluded_batch incoherent */
+    RAW_FLAT_1,      /* rtcOccluded1 on a flat BVH */
+    RAW_FLAT_1M,     /* rtcOccluded1M coherent on a flat BVH */
+    RAW_MODES
+} raw_mode;
+
+static const char *raw_names[RAW_MODES] = {
+    "lx_tracer_occluded, 1 ray/call",      "lx_tracer_occluded_batch coherent",
+    "lx_tracer_occluded_batch incoherent", "Embree flat BVH, rtcOccluded1",
+    "Embree flat BVH, rtcOccluded1M coh.",
+};
+
+static void to_rtc(const lx_ray *r, struct RTCRay *o) {
+    o->org_x = r->origin.x, o->org_y = r->origin.y, o->org_z = r->origin.z;
+    o->dir_x = r->dir.x, o->dir_y = r->dir.y, o->dir_z = r->dir.z;
+    o->tnear = r->tmin, o->tfar = r->tmax, o->time = 0.0f;
+    o->mask = 0xFFFFFFFFu, o->id = 0, o->flags = 0;
+}
+
+/* Every ray once straight through Embree (rtcOccluded1 or coherent
+ * rtcOccluded1M), same tiles and schedule; returns seconds. */
+static double flat_run(bool stream, RTCScene flat, const lx_bench_rays *rs, int threads,
+                       uint8_t *occluded) {
+    const int L = rs->lights;
+    double t0 = lx_bench_now();
+#pragma omp parallel for schedule(dynamic, 4) num_threads(threads)
+    for (int tile = 0; tile < rs->tiles; tile++) {
+        struct RTCIntersectContext ctx;
+        rtcInitIntersectContext(&ctx);
+        if (stream) ctx.flags = RTC_INTERSECT_CONTEXT_FLAG_COHERENT;
+        struct RTCRay buf[TILE * TILE];
+        for (int l = 0; l < L; l++) {
+            uint32_t s = rs->batch[(size_t)tile * L + l], e = rs->batch[(size_t)tile * L + l + 1];
+            uint32_t n = e - s;
+            const lx_ray *r = rs->rays + s;
+            uint8_t *o = occluded + s;
+            if (!stream) {
+                for (uint32_t j = 0; j < n; j++) {
+                    to_rtc(&r[j], &buf[0]);
+                    rtcOccluded1(flat, &ctx, &buf[0]);
+                    o[j] = buf[0].tfar < 0.0f;
+                }
+            } else if (n) {
+                for (uint32_t j = 0; j < n; j++)
+                    to_rtc(&r[j], &buf[j]);
+                rtcOccluded1M(flat, &ctx, buf, n, sizeof(struct RTCRay));
+                for (uint32_t j = 0; j < n; j++)
+                    o[j] = buf[j].tfar < 0.0f;
+            }
+        }
+    }
+    return lx_bench_now() - t0;
+}
+
+static double raw_run(raw_mode mode, const lx_tracer *tr, RTCScene flat, const lx_bench_rays *rs,
+                      uint8_t *occluded) {
+    switch (mode) {
+    case RAW_SINGLE:
+        return lx_bench_trace(tr, rs, LX_BENCH_SINGLE, g_threads, occluded);
+    case RAW_BATCH:
+        return lx_bench_trace(tr, rs, LX_BENCH_BATCH, g_threads, occluded);
+    case RAW_BATCH_INCOH:
+        return lx_bench_trace(tr, rs, LX_BENCH_BATCH_INCOHERENT, g_threads, occluded);
+    case RAW_FLAT_1:
+        return flat_run(false, flat, rs, g_threads, occluded);
+    default:
+        return flat_run(true, flat, rs, g_threads, occluded);
+    }
+}
+
+/* One Embree scene holding every triangle in world space (what a user of
+ * raw Embree would build for a static bake), same flags as the tracer. */
+static RTCScene flat_scene(RTCDevice dev, const lx_scene *scene) {
+    RTCScene s = rtcNewScene(dev);
+    rtcSetSceneFlags(s, RTC_SCENE_FLAG_ROBUST);
+    rtcSetSceneBuildQuality(s, RTC_BUILD_QUALITY_HIGH);
+    uint32_t nv = 0, nt = 0;
+    for (uint32_t n = 0; n < scene->node_count; n++)
+        for (uint32_t k = 0; k < scene->nodes[n].mesh_count; k++) {
+            const lx_mesh *m = &scene->meshes[scene->nodes[n].meshes[k]];
+            nv += m->vertex_count;
+            nt += m->triangle_count;
+        }
+    RTCGeometry g = rtcNewGeometry(dev, RTC_GEOMETRY_TYPE_TRIANGLE);
+    float *v = rtcSetNewGeometryBuffer(g, RTC_BUFFER_TYPE_VERTEX, 0, RTC_FORMAT_FLOAT3,
+                                       3 * sizeof(float), nv);
+    unsigned *ix = rtcSetNewGeometryBuffer(g, RTC_BUFFER_TYPE_INDEX, 0, RTC_FORMAT_UINT3,
+                                           3 * sizeof(unsigned), nt);
+    uint32_t vb = 0, tb = 0;
+    for (uint32_t n = 0; n < scene->node_count; n++)
+        for (uint32_t k = 0; k < scene->nodes[n].mesh_count; k++) {
+            const lx_mesh *m = &scene->meshes[scene->nodes[n].meshes[k]];
+            for (uint32_t i = 0; i < m->vertex_count; i++) {
+                lx_vec3 p = lx_mat4_point(&scene->nodes[n].world, m->positions[i]);
+                v[3 * (vb + i)] = p.x, v[3 * (vb + i) + 1] = p.y, v[3 * (vb + i) + 2] = p.z;
+            }
+            for (uint32_t i = 0; i < 3 * m->triangle_count; i++)
+                ix[3 * tb + i] = vb + m->indices[i];
+            vb += m->vertex_count;
+            tb += m->triangle_count;
+        }
+    rtcCommitGeometry(g);
+    rtcAttachGeometry(s, g);
+    rtcReleaseGeometry(g);
+    rtcCommitScene(s);
+    return s;
+}
+
+/* The bake's per-sample work without the rays: lx_light_evaluate and the
+ * shadow ray for every texel and light, over the same tiles and schedule. */
+static double eval_run(const lx_baker *b, const lx_bench_rays *rs) {
+    const int L = rs->lights;
+    double sink = 0;
+    double t0 = lx_bench_now();
+#pragma omp parallel for schedule(dynamic, 4) num_threads(g_threads) reduction(+ : sink)
+    for (int tile = 0; tile < rs->tiles; tile++) {
+        lx_ray rays[TILE * TILE];
+        lx_vec3 accum[TILE * TILE] = {{0}};
+        for (int l = 0; l < L; l++) {
+            const lx_light *light = lx_baker_light(b, (uint32_t)l);
+            uint32_t n = 0;
+            for (uint32_t i = rs->tile_texel[tile]; i < rs->tile_texel[tile + 1]; i++) {
+                const lx_texel_sample *t = &rs->texel[i];
+                lx_light_eval e;
+                bool direct = lx_light_evaluate(light, t->position, t->normal, &e);
+                accum[i - rs->tile_texel[tile]] =
+                    lx_add(accum[i - rs->tile_texel[tile]], e.illuminance);
+                if (direct)
+                    rays[n++] = lx_bench_shadow_ray(rs->bias, t->position, t->geometric_normal, &e);
+            }
+            for (uint32_t j = 0; j < n; j++)
+                sink += rays[j].tmax;
+        }
+        for (int k = 0; k < TILE * TILE; k++)
+            sink += accum[k].y;
+    }
+    double dt = lx_bench_now() - t0;
+    if (sink == 42.0) printf(" ");
+    return dt;
+}
+
+/* The lightmap rebuilt from the rays lx_tracer_occluded left unoccluded,
+ * summed in the bake's order; returns the channels that differ from the
+ * bake's. *blocked counts the occluded rays. */
+static uint64_t rebuild_differs(const lx_baker *b, const lx_bench_rays *rs, const uint8_t *occ,
+                                uint64_t *blocked) {
+    const lx_lightmap_info *info = lx_baker_lightmap_info(b, 0);
+    size_t pixels = (size_t)info->width * info->height;
+    float *mine = calloc(pixels * 3, sizeof(float));
+    if (!mine) lx_bench_die("calloc");
+    *blocked = 0;
+    for (int tile = 0; tile < rs->tiles; tile++)
+        for (int l = 0; l < rs->lights; l++)
+            for (uint32_t j = rs->batch[(size_t)tile * rs->lights + l];
+                 j < rs->batch[(size_t)tile * rs->lights + l + 1]; j++) {
+                if (occ[j]) {
+                    (*blocked)++;
+                    continue;
+                }
+                float *o = mine + 3 * (size_t)rs->pixel[j];
+                o[0] += rs->illuminance[j].x, o[1] += rs->illuminance[j].y,
+                    o[2] += rs->illuminance[j].z;
+            }
+    lx_image img;
+    if (lx_baker_apply_alloc(b, 0, &img) != LX_OK) lx_bench_die("lx_baker_apply_alloc");
+    const uint8_t *mask = lx_baker_mask(b, 0);
+    uint64_t differ = 0;
+    for (size_t p = 0; p < pixels; p++)
+        if (mask[p])
+            for (int c = 0; c < 3; c++)
+                differ += img.data[3 * p + c] != mine[3 * p + c];
+    lx_image_free(&img);
+    free(mine);
+    return differ;
+}
+
+/* ---- [1] the full bake ---------------------------------------------------- */
+
+typedef struct bake_result {
+    bool ran, raw;
+    double samples_s, vs_single, vs_batch, vs_flat1;
+} bake_result;
+
+static bake_result bench_full_bake(void) {
+    bake_result res = {.ran = true, .raw = !g_skip_raw};
+    lx_test_scene_info si_;
+    /* 441 spheres x 224 triangles + a 2,048-triangle ground = 100,832 */
+    lx_scene *scene = lx_test_spheres_scene("bench-100k", 40.0f, 32, 21, 16, 8, false, &si_);
+    printf("\n[1] FULL BAKE  %u triangles (ground %u + %u spheres = %u, %u nodes), "
+           "%dx%d lightmap, %u point lights, hard shadows, %d threads\n",
+           si_.triangles, si_.ground_triangles, si_.spheres, si_.sphere_triangles, si_.nodes, g_res,
+           g_res, scene->light_count, g_threads);
+
+    lx_bake_desc desc = {.resolution = g_res, .threads = g_threads};
+    lx_baker *b;
+    double t0 = lx_bench_now();
+    if (lx_baker_create(scene, &desc, &b) != LX_OK) lx_bench_die("lx_baker_create");
+    double t_create = lx_bench_now() - t0;
+    if (lx_baker_lightmap_count(b) != 1) {
+        fprintf(stderr, "bench_bake: expected 1 lightmap, got %u\n", lx_baker_lightmap_count(b));
+        exit(1);
+    }
+    const lx_lightmap_info *info = lx_baker_lightmap_info(b, 0);
+
+    t0 = lx_bench_now();
+    lx_bench_rays rs;
+    lx_bench_rays_build(b, scene, &rs);
+    double t_rays = lx_bench_now() - t0;
+
+    lx_tracer *tr = NULL;
+    RTCDevice dev = NULL;
+    RTCScene flat = NULL;
+    double t_tracer = 0, t_flat = 0;
+    uint8_t *occ[RAW_MODES] = {0};
+    if (!g_skip_raw) {
+        t0 = lx_bench_now();
+        if (lx_tracer_create(scene, &tr) != LX_OK) lx_bench_die("lx_tracer_create");
+        t_tracer = lx_bench_now() - t0;
+        dev = rtcNewDevice(NULL);
+        t0 = lx_bench_now();
+        flat = flat_scene(dev, scene);
+        t_flat = lx_bench_now() - t0;
+        for (int m = 0; m < RAW_MODES; m++)
+            if (!(occ[m] = malloc(rs.count + 1))) lx_bench_die("malloc");
+    }
+
+    double best_bake = INFINITY, best_eval = INFINITY, best_raw[RAW_MODES];
+    for (int m = 0; m < RAW_MODES; m++)
+        best_raw[m] = INFINITY;
+    /* interleaved repetitions so machine noise hits every figure alike */
+    for (int rep = 0; rep < g_reps; rep++) {
+        t0 = lx_bench_now();
+        if (lx_baker_bake(b) != LX_OK) lx_bench_die("lx_baker_bake");
+        best_bake = fmin(best_bake, lx_bench_now() - t0);
+        if (g_skip_raw) continue;
+        best_eval = fmin(best_eval, eval_run(b, &rs));
+        for (int m = 0; m < RAW_MODES; m++)
+            best_raw[m] = fmin(best_raw[m], raw_run((raw_mode)m, tr, flat, &rs, occ[m]));
+    }
+
+    printf("  setup: lx_baker_create %.2f s, ray regeneration %.2f s", t_create, t_rays);
+    if (!g_skip_raw) printf(", extra lx_tracer %.2f s, flat Embree BVH %.2f s", t_tracer, t_flat);
+    printf("\n  used texels %u of %d; texel-light samples %llu; shadow rays %llu "
+           "(%llu samples with the light behind/out of range: no ray)\n",
+           info->used_texels, info->width * info->height, (unsigned long long)rs.samples,
+           (unsigned long long)rs.count, (unsigned long long)rs.behind);
+    uint64_t disagree[RAW_MODES] = {0};
+    if (!g_skip_raw) {
+        uint64_t blocked;
+        uint64_t differ = rebuild_differs(b, &rs, occ[RAW_SINGLE], &blocked);
+        for (int m = 0; m < RAW_MODES; m++)
+            for (uint64_t j = 0; j < rs.count; j++)
+                disagree[m] += occ[m][j] != occ[RAW_SINGLE][j];
+        printf("  %.1f%% of rays blocked; check: the lightmap rebuilt from the regenerated rays "
+               "%s the bake's (%llu differing channels)\n",
+               100.0 * (double)blocked / (double)(rs.count ? rs.count : 1),
+               differ == 0 ? "equals" : "DIFFERS FROM", (unsigned long long)differ);
+    }
+
+    char a[32], c[32];
+    res.samples_s = (double)rs.samples / best_bake;
+    printf("\n  %-40s %12s %14s %12s\n", "figure (best of reps)", "time", "per second",
+           "bake / this");
+    printf("  %-40s %10.3f s %12ssamples/s\n", "lx_baker_bake (samples)", best_bake,
+           lx_bench_si(res.samples_s, a));
+    printf("  %-40s %12s %12srays/s\n", "lx_baker_bake (rays cast)", "",
+           lx_bench_si((double)rs.count / best_bake, c));
+    if (g_skip_raw) {
+        printf("\n  => %ssamples/s (raw throughput skipped: --skip-raw)\n",
+               lx_bench_si(res.samples_s, a));
+    } else {
+        for (int m = 0; m < RAW_MODES; m++) {
+            double rays_s = (double)rs.count / best_raw[m];
+            printf("  %-40s %10.3f s %12srays/s %11.2fx%s\n", raw_names[m], best_raw[m],
+                   lx_bench_si(rays_s, a), res.samples_s / rays_s,
+                   disagree[m] ? "  (occlusion differs!)" : "");
+        }
+        printf("  %-40s %10.3f s  (lx_light_evaluate + shadow ray, no tracing)\n",
+               "bake's per-sample work alone", best_eval);
+        printf("  %-40s %10.3f s  (bake - its rays as coherent batches; overlaps the line "
+               "above)\n",
+               "bake's time beyond its rays", best_bake - best_raw[RAW_BATCH]);
+        res.vs_single = res.samples_s / ((double)rs.count / best_raw[RAW_SINGLE]);
+        res.vs_batch = res.samples_s / ((double)rs.count / best_raw[RAW_BATCH]);
+        res.vs_flat1 = res.samples_s / ((double)rs.count / best_raw[RAW_FLAT_1]);
+        printf("\n  => bake at %.2fx single-ray lx_tracer_occluded (target >= 0.80x: %s), "
+               "%.2fx the coherent batch, %.2fx flat rtcOccluded1\n",
+               res.vs_single, res.vs_single >= 0.8 ? "MET" : "NOT MET", res.vs_batch, res.vs_flat1);
+    }
+    for (int m = 0; m < RAW_MODES; m++)
+        free(occ[m]);
+    if (flat) rtcReleaseScene(flat);
+    if (dev) rtcReleaseDevice(dev);
+    lx_tracer_destroy(tr);
+    lx_bench_rays_free(&rs);
+    lx_baker_destroy(b);
+    lx_scene_destroy(scene);
+    return res;
+}
+
+/* ---- [2] the brute-force reference ---------------------------------------- */
+
+/* tests/common/reference.h on every texel of node 0's lightmap: the
+ * oracle's own serial texel map, then its shading on the bake's OpenMP
+ * threads. Returns seconds; ambiguous[p] marks texels with a near-tie ray. */
+static double brute_reference(const lx_scene *scene, int w, int h, float *out, uint8_t *ambiguous,
+                              uint32_t *used_out) {
+    double t0 = lx_bench_now();
+    lx_ref_scene rs;
+    lx_ref_scene_build(scene, &rs);
+    lx_ref_map map;
+    lx_ref_texel_map(scene, 0, w, h, &map);
+    uint32_t used = 0;
+#pragma omp parallel for schedule(dynamic, 1) num_threads(g_threads) reduction(+ : used)
+    for (int y = 0; y < h; y++)
+        for (int x = 0; x < w; x++) {
+            size_t p = (size_t)y * w + x;
+            const lx_ref_texel *t = &map.texels[p];
+            if (!t->used) continue;
+            used++;
+            bool amb = false;
+            lx_vec3 e = lx_ref_shade(&rs, scene->lights, scene->light_count, scene->ambient,
+                                     t->position, t->normal, t->geometric_normal, 1e-5, &amb);
+            out[3 * p] = e.x, out[3 * p + 1] = e.y, out[3 * p + 2] = e.z;
+            ambiguous[p] = amb;
+        }
+    double dt = lx_bench_now() - t0;
+    lx_ref_map_free(&map);
+    lx_ref_scene_free(&rs);
+    *used_out = used;
+    return dt;
+}
+
+/* Texels whose irradiance (green) differs from ref by more than 1%, near
+ * ties (skip) counted apart. */
+static uint32_t count_differ(const float *ref, const float *img, const uint8_t *skip, size_t n,
+                             uint32_t *skipped_differ, double *max_rel) {
+    uint32_t bad = 0;
+    *skipped_differ = 0;
+    *max_rel = 0;
+    for (size_t p = 0; p < n; p++) {
+        double r = ref[3 * p + 1], v = img[3 * p + 1];
+        double rel = fabs(r - v) / fmax(fabs(r), 1e-3);
+        if (rel <= 0.01) continue;
+        if (skip[p]) {
+            (*skipped_differ)++;
+            continue;
+        }
+        bad++;
+        if (rel > *max_rel) *max_rel = rel;
+    }
+    return bad;
+}
+
+typedef struct brute_result {
+    bool ran;
+    double speedup;
+    uint32_t bad, used;
+} brute_result;
+
+static brute_result bench_brute_force(void) {
+    lx_test_scene_info si_;
+    /* 1,152-triangle ground + 9 spheres x 96 = 2,016 triangles */
+    lx_scene *scene = lx_test_spheres_scene("bench-2k", 10.0f, 24, 3, 12, 5, false, &si_);
+    const int res = 128;
+    const size_t pixels = (size_t)res * res;
+    printf("\n[2] BRUTE-FORCE REFERENCE  %u triangles (ground %u + %u spheres), %dx%d, "
+           "%u point lights, hard shadows, %d threads for both\n",
+           si_.triangles, si_.ground_triangles, si_.spheres, res, res, scene->light_count,
+           g_threads);
+
+    double best = INFINITY, best_create = 0, best_bake = 0;
+    lx_image img = {0};
+    /* ms-scale on shared cores: best of at least 4 x reps and 1 s of tries */
+    int tries = 0;
+    for (double start = lx_bench_now(); tries < 4 * g_reps || lx_bench_now() - start < 1.0;
+         tries++) {
+        lx_bake_desc desc = {.resolution = res, .threads = g_threads, .padding = LX_PADDING_NONE};
+        lx_baker *b;
+        double t0 = lx_bench_now();
+        if (lx_baker_create(scene, &desc, &b) != LX_OK) lx_bench_die("lx_baker_create");
+        double t1 = lx_bench_now();
+        if (lx_baker_bake(b) != LX_OK) lx_bench_die("lx_baker_bake");
+        double t2 = lx_bench_now();
+        if (t2 - t0 < best) best = t2 - t0, best_create = t1 - t0, best_bake = t2 - t1;
+        if (tries == 0 && lx_baker_apply_alloc(b, 0, &img) != LX_OK)
+            lx_bench_die("lx_baker_apply_alloc");
+        lx_baker_destroy(b);
+    }
+
+    float *ref = calloc(pixels * 3, sizeof(float));
+    uint8_t *amb = calloc(pixels, 1);
+    if (!ref || !amb) lx_bench_die("calloc");
+    brute_result r = {.ran = true};
+    double t_ref = brute_reference(scene, res, res, ref, amb, &r.used);
+    uint32_t skipped, n_amb = 0;
+    double max_rel;
+    r.bad = count_differ(ref, img.data, amb, pixels, &skipped, &max_rel);
+    for (size_t p = 0; p < pixels; p++)
+        n_amb += amb[p];
+    r.speedup = t_ref / best;
+
+    char a[32], c[32];
+    printf("\n  %-40s %12s %14s %12s\n", "figure", "time", "per second", "this / bake");
+    printf("  %-40s %10.4f s %12stexels/s %11s  (create %.2f ms + bake %.2f ms, best of %d)\n",
+           "lx_baker_create + lx_baker_bake", best, lx_bench_si(r.used / best, a), "",
+           1e3 * best_create, 1e3 * best_bake, tries);
+    printf("  %-40s %10.3f s %12stexels/s %11.0fx\n", "tests/common/reference.h oracle", t_ref,
+           lx_bench_si(r.used / t_ref, c), r.speedup);
+    printf("  agreement: %u of %u texels differ by > 1%% (max %.2g) %s; %u near-tie texels "
+           "left out (%u of them differ)\n",
+           r.bad, r.used, max_rel, r.bad ? "(DIFFERS)" : "(agrees)", n_amb, skipped);
+    printf("\n  => bake %.0fx faster than the brute-force reference\n", r.speedup);
+    free(amb);
+    free(ref);
+    lx_image_free(&img);
+    lx_scene_destroy(scene);
+    return r;
+}
+
+int main(int argc, char **argv) {
+    const char *only = NULL;
+    for (int i = 1; i < argc; i++) {
+        if (!strcmp(argv[i], "--res") && i + 1 < argc)
+            g_res = atoi(argv[++i]);
+        else if (!strcmp(argv[i], "--reps") && i + 1 < argc)
+            g_reps = atoi(argv[++i]);
+        else if (!strcmp(argv[i], "--threads") && i + 1 < argc)
+            g_threads = atoi(argv[++i]);
+        else if (!strcmp(argv[i], "--only") && i + 1 < argc &&
+                 (!strcmp(argv[i + 1], "bake") || !strcmp(argv[i + 1], "brute")))
+            only = argv[++i];
+        else if (!strcmp(argv[i], "--skip-raw"))
+            g_skip_raw = true;
+        else {
+            fprintf(stderr,
+                    "usage: %s [--res N] [--reps N] [--threads N] [--only bake|brute] "
+                    "[--skip-raw]\n",
+                    argv[0]);
+            return 2;
+        }
+    }
+    if (g_reps < 1) g_reps = 1;
+    g_threads = lx_thread_count(g_threads);
+    lx_bench_header("bench_bake", g_threads);
+    double t0 = lx_bench_now();
+    bake_result bake = {0};
+    brute_result brute = {0};
+    if (!only || !strcmp(only, "bake")) bake = bench_full_bake();
+    if (!only || !strcmp(only, "brute")) brute = bench_brute_force();
+
+    char a[32], load[32];
+    printf("\ntotal bench time %.1f s\n", lx_bench_now() - t0);
+    printf("bench_bake:");
+    if (bake.ran && bake.raw)
+        printf(" %dx%d bake %ssamples/s = %.2fx lx_tracer_occluded 1 ray/call (target >= 0.80x: "
+               "%s), %.2fx coherent batch, %.2fx flat rtcOccluded1;",
+               g_res, g_res, lx_bench_si(bake.samples_s, a), bake.vs_single,
+               bake.vs_single >= 0.8 ? "MET" : "NOT MET", bake.vs_batch, bake.vs_flat1);
+    else if (bake.ran)
+        printf(" %dx%d bake %ssamples/s;", g_res, g_res, lx_bench_si(bake.samples_s, a));
+    if (brute.ran)
+        printf(" %.0fx faster than the brute-force reference (%u of %u texels differ);",
+               brute.speedup, brute.bad, brute.used);
+    printf(" %d threads, load %s\n", g_threads, lx_bench_load(load, sizeof load));
+    return 0;
+}

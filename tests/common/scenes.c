@@ -1,0 +1,318 @@
+/* Generated benchmark scenes, the bake's shadow rays regenerated, and the
+ * machine report (see scenes.h). */
+#define _POSIX_C_SOURCE 200809L
+#include "scenes.h"
+#include "helpers.h"
+
+#include <embree3/rtcore.h>
+#include <math.h>
+#include <stdio.h>
+#include <stdlib.h>
+#include <string.h>
+#include <time.h>
+#include <unistd.h>
+
+static const char *program = "bench";
+
+double lx_bench_now(void) {
+    struct timespec ts;
+    clock_gettime(CLOCK_MONOTONIC, &ts);
+    return (double)ts.tv_sec + 1e-9 * (double)ts.tv_nsec;
+}
+
+_Noreturn void lx_bench_die(const char *what) {
+    fprintf(stderr, "%s: %s: %s\n", program, what, lx_last_error());
+    exit(1);
+}
+
+static void *xmalloc(size_t size) {
+    void *p = malloc(size ? size : 1);
+    if (!p) {
+        fprintf(stderr, "%s: out of memory (%zu bytes)\n", program, size);
+        exit(1);
+    }
+    return p;
+}
+
+/* ---- scenes -------------------------------------------------------------- */
+
+static uint32_t rng_state = 12345u;
+
+void lx_test_rand_seed(uint32_t seed) {
+    rng_state = seed;
+}
+
+float lx_test_rand(void) {
+    rng_state = rng_state * 1664525u + 1013904223u;
+    return (float)(rng_state >> 8) / 16777216.0f;
+}
+
+lx_mesh lx_test_spheres_mesh(const char *name, const lx_vec3 *centre, const float *radius,
+                             int count, int slices, int stacks) {
+    lx_mesh m = {0};
+    uint32_t vps = (uint32_t)(2 + slices * (stacks - 1));
+    uint32_t tps = (uint32_t)(2 * slices * (stacks - 1));
+    m.name = lx_strdup(name);
+    if (!m.name) lx_bench_die("lx_strdup");
+    m.vertex_count = vps * (uint32_t)count;
+    m.triangle_count = tps * (uint32_t)count;
+    m.positions = xmalloc(sizeof(lx_vec3) * m.vertex_count);
+    m.normals = xmalloc(sizeof(lx_vec3) * m.vertex_count);
+    m.indices = xmalloc(sizeof(uint32_t) * 3 * m.triangle_count);
+    uint32_t *ix = m.indices;
+    for (int s = 0; s < count; s++) {
+        uint32_t base = vps * (uint32_t)s;
+        lx_vec3 *p = m.positions + base, *n = m.normals + base;
+        n[0] = lx_v3(0, 1, 0);
+        for (int j = 1; j < stacks; j++) {
+            float th = LX_PI * (float)j / (float)stacks;
+            for (int i = 0; i < slices; i++) {
+                float ph = 2.0f * LX_PI * (float)i / (float)slices;
+                n[1 + (j - 1) * slices + i] =
+                    lx_v3(sinf(th) * cosf(ph), cosf(th), sinf(th) * sinf(ph));
+            }
+        }
+        n[vps - 1] = lx_v3(0, -1, 0);
+        for (uint32_t v = 0; v < vps; v++)
+            p[v] = lx_madd(centre[s], n[v], radius[s]);
+#define RING(j, i) (base + 1u + (uint32_t)((j)-1) * (uint32_t)slices + (uint32_t)((i) % slices))
+        for (int i = 0; i < slices; i++) { /* top fan, outward winding */
+            *ix++ = base;
+            *ix++ = RING(1, i + 1);
+            *ix++ = RING(1, i);
+        }
+        for (int j = 1; j < stacks - 1; j++)
+            for (int i = 0; i < slices; i++) {
+                uint32_t a = RING(j, i), b = RING(j, i + 1), c = RING(j + 1, i),
+                         d = RING(j + 1, i + 1);
+                *ix++ = a, *ix++ = b, *ix++ = c;
+                *ix++ = b, *ix++ = d, *ix++ = c;
+            }
+        for (int i = 0; i < slices; i++) { /* bottom fan */
+            *ix++ = base + vps - 1;
+            *ix++ = RING(stacks - 1, i);
+            *ix++ = RING(stacks - 1, i + 1);
+        }
+#undef RING
+    }
+    return m;
+}
+
+lx_light lx_test_point_light(int k, float size, float height, bool dynamic) {
+    lx_light l = lx_light_defaults(LX_LIGHT_POINT);
+    snprintf(l.name, sizeof l.name, "light%d", k);
+    float sx = (k & 1) ? 0.27f : -0.23f, sz = (k & 2) ? 0.21f : -0.29f;
+    l.position = lx_v3(sx * size, height * (1.0f + 0.1f * (float)k), sz * size);
+    static const lx_vec3 colors[4] = {{1, 0.9f, 0.8f}, {0.8f, 0.9f, 1}, {1, 1, 1}, {1, 0.8f, 0.6f}};
+    l.color = colors[k & 3];
+    l.intensity = 40.0f * height * height; /* ~40 lux under each light */
+    l.shadow = LX_SHADOW_HARD;
+    l.dynamic = dynamic;
+    return l;
+}
+
+lx_scene *lx_test_spheres_scene(const char *name, float size, int ground_n, int grid, int slices,
+                                int stacks, bool dynamic, lx_test_scene_info *info) {
+    lx_scene *scene;
+    if (lx_scene_create(name, &scene) != LX_OK) lx_bench_die("lx_scene_create");
+    lx_test_rand_seed(12345u);
+    lx_mesh ground = lx_test_plane("ground", size, 0.0f, 0.0f, 0.0f, ground_n);
+    lx_test_add(scene, &ground);
+    memset(info, 0, sizeof *info);
+    info->ground_triangles = ground.triangle_count;
+    info->triangles = ground.triangle_count;
+    info->nodes = 1;
+    lx_test_mesh_free(&ground);
+
+    float spacing = size / (float)grid;
+    lx_vec3 *centre = xmalloc(sizeof(lx_vec3) * (size_t)grid);
+    float *radius = xmalloc(sizeof(float) * (size_t)grid);
+    for (int row = 0; row < grid; row++) {
+        for (int i = 0; i < grid; i++) {
+            float r = spacing * (0.18f + 0.14f * lx_test_rand());
+            float x =
+                -size / 2 + spacing * ((float)i + 0.5f) + spacing * 0.15f * (lx_test_rand() - 0.5f);
+            float z = -size / 2 + spacing * ((float)row + 0.5f) +
+                      spacing * 0.15f * (lx_test_rand() - 0.5f);
+            float y = r + spacing * (0.1f + 0.9f * lx_test_rand());
+            centre[i] = lx_v3(x, y, z);
+            radius[i] = r;
+        }
+        char nm[32];
+        snprintf(nm, sizeof nm, "spheres%d", row);
+        lx_mesh m = lx_test_spheres_mesh(nm, centre, radius, grid, slices, stacks);
+        lx_test_add(scene, &m);
+        info->triangles += m.triangle_count;
+        info->sphere_triangles += m.triangle_count;
+        info->spheres += (uint32_t)grid;
+        info->nodes++;
+        lx_test_mesh_free(&m);
+    }
+    free(centre);
+    free(radius);
+    for (int k = 0; k < LX_BENCH_LIGHTS; k++) {
+        lx_light l = lx_test_point_light(k, size, 0.2f * size, dynamic);
+        if (lx_scene_add_light(scene, &l) != LX_OK) lx_bench_die("lx_scene_add_light");
+    }
+    return scene;
+}
+
+/* ---- the bake's shadow rays ---------------------------------------------- */
+
+lx_ray lx_bench_shadow_ray(float base_bias, lx_vec3 p, lx_vec3 ng, const lx_light_eval *e) {
+    lx_vec3 side = lx_dot(ng, e->to_light) >= 0.0f ? ng : lx_neg(ng);
+    float bias = base_bias + 4e-6f * lx_max_abs_component(p);
+    lx_ray r;
+    r.origin = lx_madd(p, side, bias);
+    r.dir = e->to_light;
+    r.tmin = 0.0f;
+    r.tmax = isfinite(e->distance) ? e->distance - 2.0f * bias : INFINITY;
+    if (r.tmax < 0.0f) r.tmax = 0.0f;
+    return r;
+}
+
+/* The scale-aware bias lx_baker_create picks (1e-5 x scene diagonal). */
+static float auto_bias(const lx_scene *scene) {
+    lx_vec3 lo, hi;
+    float diag = lx_scene_bounds(scene, &lo, &hi) ? lx_length(lx_sub(hi, lo)) : 1.0f;
+    if (!(diag > 0.0f)) diag = 1.0f;
+    return 1e-5f * diag;
+}
+
+void lx_bench_rays_build(const lx_baker *b, const lx_scene *scene, lx_bench_rays *rs) {
+    enum { TILE = LX_BENCH_TILE };
+    const lx_lightmap_info *info = lx_baker_lightmap_info(b, 0);
+    const uint8_t *mask = lx_baker_mask(b, 0);
+    int w = info->width, h = info->height;
+    int tx_n = (w + TILE - 1) / TILE, ty_n = (h + TILE - 1) / TILE;
+    uint32_t L = lx_baker_light_count(b);
+    memset(rs, 0, sizeof *rs);
+    rs->tiles = tx_n * ty_n;
+    rs->lights = (int)L;
+    rs->bias = auto_bias(scene);
+    size_t cap = (size_t)info->used_texels * L + 1;
+    rs->rays = xmalloc(sizeof(lx_ray) * cap);
+    rs->illuminance = xmalloc(sizeof(lx_vec3) * cap);
+    rs->pixel = xmalloc(sizeof(uint32_t) * cap);
+    rs->batch = xmalloc(sizeof(uint32_t) * ((size_t)rs->tiles * L + 1));
+    rs->texel = xmalloc(sizeof(lx_texel_sample) * ((size_t)info->used_texels + 1));
+    rs->tile_texel = xmalloc(sizeof(uint32_t) * ((size_t)rs->tiles + 1));
+    uint64_t n = 0;
+    uint32_t used = 0;
+    lx_texel_sample ts[TILE * TILE];
+    uint32_t px[TILE * TILE];
+    for (int ty = 0; ty < ty_n; ty++)
+        for (int tx = 0; tx < tx_n; tx++) {
+            int cnt = 0;
+            for (int y = ty * TILE; y < (ty + 1) * TILE && y < h; y++)
+                for (int x = tx * TILE; x < (tx + 1) * TILE && x < w; x++)
+                    if (mask[(size_t)y * w + x] && lx_baker_texel(b, 0, x, y, &ts[cnt]))
+                        px[cnt++] = (uint32_t)(y * w + x);
+            int tile = ty * tx_n + tx;
+            rs->tile_texel[tile] = used;
+            memcpy(rs->texel + used, ts, sizeof(lx_texel_sample) * (size_t)cnt);
+            used += (uint32_t)cnt;
+            for (uint32_t l = 0; l < L; l++) {
+                rs->batch[(size_t)tile * L + l] = (uint32_t)n;
+                const lx_light *light = lx_baker_light(b, l);
+                for (int k = 0; k < cnt; k++) {
+                    lx_light_eval e;
+                    rs->samples++;
+                    if (!lx_light_evaluate(light, ts[k].position, ts[k].normal, &e)) {
+                        rs->behind++;
+                        continue;
+                    }
+                    rs->rays[n] =
+                        lx_bench_shadow_ray(rs->bias, ts[k].position, ts[k].geometric_normal, &e);
+                    rs->illuminance[n] = e.illuminance;
+                    rs->pixel[n] = px[k];
+                    n++;
+                }
+            }
+        }
+    rs->batch[(size_t)rs->tiles * L] = (uint32_t)n;
+    rs->tile_texel[rs->tiles] = used;
+    rs->count = n;
+}
+
+void lx_bench_rays_free(lx_bench_rays *rs) {
+    free(rs->rays);
+    free(rs->illuminance);
+    free(rs->pixel);
+    free(rs->batch);
+    free(rs->texel);
+    free(rs->tile_texel);
+    memset(rs, 0, sizeof *rs);
+}
+
+double lx_bench_trace(const lx_tracer *tr, const lx_bench_rays *rs, lx_bench_trace_mode mode,
+                      int threads, uint8_t *occluded) {
+    const int L = rs->lights;
+    double t0 = lx_bench_now();
+#pragma omp parallel for schedule(dynamic, 4) num_threads(threads)
+    for (int tile = 0; tile < rs->tiles; tile++)
+        for (int l = 0; l < L; l++) {
+            uint32_t s = rs->batch[(size_t)tile * L + l], e = rs->batch[(size_t)tile * L + l + 1];
+            if (mode == LX_BENCH_SINGLE)
+                for (uint32_t j = s; j < e; j++)
+                    occluded[j] = lx_tracer_occluded(tr, &rs->rays[j]);
+            else if (e > s)
+                lx_tracer_occluded_batch(tr, rs->rays + s, e - s, mode == LX_BENCH_BATCH,
+                                         occluded + s);
+        }
+    return lx_bench_now() - t0;
+}
+
+/* ---- report -------------------------------------------------------------- */
+
+static void cpu_model(char *out, size_t size) {
+    snprintf(out, size, "unknown CPU");
+    FILE *f = fopen("/proc/cpuinfo", "r");
+    if (!f) return;
+    char line[512];
+    while (fgets(line, sizeof line, f))
+        if (!strncmp(line, "model name", 10)) {
+            char *c = strchr(line, ':');
+            if (c) {
+                c++;
+                while (*c == ' ' || *c == '\t')
+                    c++;
+                c[strcspn(c, "\n")] = '\0';
+                snprintf(out, size, "%s", c);
+            }
+            break;
+        }
+    fclose(f);
+}
+
+const char *lx_bench_load(char *buf, size_t size) {
+    snprintf(buf, size, "?");
+    FILE *f = fopen("/proc/loadavg", "r");
+    if (!f) return buf;
+    double l1;
+    if (fscanf(f, "%lf", &l1) == 1) snprintf(buf, size, "%.2f", l1);
+    fclose(f);
+    return buf;
+}
+
+void lx_bench_header(const char *prog, int threads) {
+    program = prog;
+    char cpu[256], load[32];
+    cpu_model(cpu, sizeof cpu);
+    printf("%s  machine: %s, %ld logical CPUs, %d threads, Embree %s\n", prog, cpu,
+           sysconf(_SC_NPROCESSORS_ONLN), threads, RTC_VERSION_STRING);
+    printf("load average (1 min) at start: %s (other processes share these cores)\n",
+           lx_bench_load(load, sizeof load));
+}
+
+const char *lx_bench_si(double v, char *buf) {
+    if (v >= 1e9)
+        snprintf(buf, 32, "%.2f G", v / 1e9);
+    else if (v >= 1e6)
+        snprintf(buf, 32, "%.2f M", v / 1e6);
+    else if (v >= 1e3)
+        snprintf(buf, 32, "%.2f k", v / 1e3);
+    else
+        snprintf(buf, 32, "%.2f ", v);
+    return buf;
+}
