@@ -23,20 +23,7 @@
 #define LX_GLB_HEADER 12u
 #define LX_GLB_CHUNK_HEADER 8u
 
-static lx_status failf(const char *file, lx_status st, const char *fmt, ...)
-#if defined(__GNUC__)
-    __attribute__((format(printf, 3, 4)))
-#endif
-    ;
-
-static lx_status failf(const char *file, lx_status st, const char *fmt, ...) {
-    char msg[512];
-    va_list ap;
-    va_start(ap, fmt);
-    vsnprintf(msg, sizeof msg, fmt, ap);
-    va_end(ap);
-    return lx_fail(st, "%s: %s", file, msg);
-}
+#define failf(file, st, ...) lx_json_fail(st, file, NULL, __VA_ARGS__)
 
 /* ---- the container ------------------------------------------------------ */
 

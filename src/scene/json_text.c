@@ -2,6 +2,8 @@
  * glTF), reporting syntax errors by line and column. */
 #include "json_text.h"
 
+#include <stdarg.h>
+#include <stdio.h>
 #include <stdlib.h>
 #include <string.h>
 
@@ -51,4 +53,17 @@ lx_status lx_json_parse_text(const char *file, const char *text, size_t size, cJ
         st = syntax_error(file, buf, size, end);
     free(buf);
     return st;
+}
+
+lx_status lx_json_fail(lx_status status, const char *file, const char *where, const char *fmt,
+                       ...)
+{
+    char msg[512];
+    va_list ap;
+    va_start(ap, fmt);
+    vsnprintf(msg, sizeof msg, fmt, ap);
+    va_end(ap);
+    if (where && where[0])
+        return lx_fail(status, "%s: %s: %s", file, where, msg);
+    return lx_fail(status, "%s: %s", file, msg);
 }

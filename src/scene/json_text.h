@@ -13,4 +13,13 @@
  * "<file>: line L, column C: malformed JSON near '...'". */
 lx_status lx_json_parse_text(const char *file, const char *text, size_t size, cJSON **root);
 
+/* lx_fail with "<file>: " and, when where is not empty, "<where>: " in
+ * front of the formatted message. */
+lx_status lx_json_fail(lx_status status, const char *file, const char *where, const char *fmt,
+                       ...)
+#if defined(__GNUC__)
+    __attribute__((format(printf, 4, 5)))
+#endif
+    ;
+
 #endif

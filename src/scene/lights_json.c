@@ -20,21 +20,7 @@ typedef struct ctx {
     char where[128];  /* "lights[2] ('key')" or "" at the root */
 } ctx;
 
-static lx_status fail(const ctx *c, lx_status st, const char *fmt, ...)
-#if defined(__GNUC__)
-    __attribute__((format(printf, 3, 4)))
-#endif
-    ;
-
-static lx_status fail(const ctx *c, lx_status st, const char *fmt, ...) {
-    char msg[512];
-    va_list ap;
-    va_start(ap, fmt);
-    vsnprintf(msg, sizeof msg, fmt, ap);
-    va_end(ap);
-    if (c->where[0]) return lx_fail(st, "%s: %s: %s", c->file, c->where, msg);
-    return lx_fail(st, "%s: %s", c->file, msg);
-}
+#define fail(c, st, ...) lx_json_fail(st, (c)->file, (c)->where, __VA_ARGS__)
 
 /* ---- parsing the text -------------------------------------------------- */
 
