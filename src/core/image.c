@@ -274,7 +274,8 @@ lx_status lx_image_load(const char *path, const lx_image_load_desc *desc, lx_ima
     if (!path || !out)
         return lx_fail(LX_ERR_INVALID, "lx_image_load: path and out must not be NULL");
     /* Files are read whole: every decoder here works from memory. */
-    size_t max_size = SIZE_MAX > 0xffffffffu ? (size_t)1 << 36 : (size_t)0x7fffffff;
+    uint64_t limit = (uint64_t)1 << 36; /* 64 GiB */
+    size_t max_size = limit > SIZE_MAX ? SIZE_MAX : (size_t)limit;
     char *buf;
     size_t size;
     lx_status s = lx_read_file(path, max_size, &buf, &size);
@@ -311,9 +312,11 @@ static lx_status check_writable(const char *path, const lx_image *img, lx_image_
             problem = "exceeds the Radiance HDR range (2^127)";
         if (problem) {
             size_t px = i / (size_t)img->channels;
-            return lx_fail(LX_ERR_INVALID, "%s: pixel (%zu, %zu) channel %zu: value %g %s", path,
-                           px % (size_t)img->width, px / (size_t)img->width,
-                           i % (size_t)img->channels, (double)e, problem);
+            char value[48] = "";
+            if (isfinite(v))
+                snprintf(value, sizeof value, ": value %g", (double)e);
+            return lx_fail(LX_ERR_INVALID, "%s: pixel (%zu, %zu) channel %d%s %s", path,
+                           px % (size_t)img->width, px / (size_t)img->width, c, value, problem);
         }
     }
     return LX_OK;

@@ -107,6 +107,8 @@ static lx_status check_jpeg_scan(jpeg_state *j, const unsigned char *d, size_t s
     if (q + 2 * ns + 3 > size)
         return LX_OK; /* stb reads zeros and fails the scan */
     int ss = d[q + 2 * ns], ah = d[q + 2 * ns + 2] >> 4;
+    /* dc: a baseline scan or a progressive DC first pass, which reads the DC
+     * Huffman table; ac: a pass that reads the AC table */
     bool dc = !j->progressive || (ss == 0 && ah == 0), ac = !j->progressive || ss > 0;
     for (size_t k = 0; k < ns; k++) {
         int id = d[q + 2 * k], td = d[q + 2 * k + 1] >> 4, ta = d[q + 2 * k + 1] & 15;
@@ -117,6 +119,12 @@ static lx_status check_jpeg_scan(jpeg_state *j, const unsigned char *d, size_t s
                 return lx_fail(LX_ERR_FORMAT,
                                "%s: corrupt JPEG: scan of component %d uses an undefined "
                                "Huffman table",
+                               name, id);
+            /* progressive: the DC first pass zeroes a component's blocks,
+             * which every later pass refines */
+            if (!dc && !j->coded[i])
+                return lx_fail(LX_ERR_FORMAT,
+                               "%s: corrupt JPEG: scan of component %d before its first DC scan",
                                name, id);
             if (j->quant_of[i] > 3 || !j->quant[j->quant_of[i]])
                 return lx_fail(LX_ERR_FORMAT,

@@ -288,19 +288,13 @@ static void test_pfm_bad(void **state)
     struct {
         const char *bytes, *mentions;
     } cases[] = {
-        {"PF\n", "width"},
-        {"PF\n4", "height"},
-        {"PF\n4 4", "scale"},
-        {"PF\n4 4\n-1.0", "line break"},
-        {"PF\n0 4\n-1.0\n", "width 0"},
-        {"PF\n-4 4\n-1.0\n", "width"},
-        {"PF\n4 x\n-1.0\n", "height"},
+        {"PF\n", "width"}, {"PF\n4", "height"}, {"PF\n4 4", "scale"},
+        {"PF\n4 4\n-1.0", "line break"}, {"PF\n0 4\n-1.0\n", "width 0"},
+        {"PF\n-4 4\n-1.0\n", "width"}, {"PF\n4 x\n-1.0\n", "height"},
         {"PF\n99999999999 4\n-1.0\n", "out of range"},
         {"PF\n2147483647 2147483647\n-1.0\n", "overflow"},
         {"PF\n2147483647 1\n-1.0\n", "expected 25769803764 bytes of pixels, found 0"},
-        {"PF\n4 4\n0\n", "scale"},
-        {"PF\n4 4\nnan\n", "scale"},
-        {"PF\n4 4\n-1.0x\n", "scale"},
+        {"PF\n4 4\n0\n", "scale"}, {"PF\n4 4\nnan\n", "scale"}, {"PF\n4 4\n-1.0x\n", "scale"},
         {"PF\n4 4\n-1.0\n\x01\x02", "truncated: expected 192 bytes of pixels, found 2"},
         {"PF\n256 256\n-1.0\n", "expected 786432 bytes of pixels, found 0"},
         {"PF\n1 1\n-1.000000000000000000000000000000000000000000000000000000000000000000",
@@ -742,7 +736,8 @@ static void test_fuzz_exr_half_extra_channel(void **state)
  * Radiance RLE with a zero-length run (stb loops forever) or cut inside the
  * runs (stb reads zeros), a JPEG Huffman table of more than 256 codes (stb
  * writes past the table), a JPEG without scans (stb returns uninitialised
- * memory), tiny JPEG and TGA files claiming huge images. */
+ * memory) or with an AC scan before the DC one (stb refines uninitialised
+ * coefficients), tiny JPEG and TGA files claiming huge images. */
 static void test_fuzz_stb_guards(void **state)
 {
     (void)state;
@@ -756,14 +751,20 @@ static void test_fuzz_stb_guards(void **state)
     memset(jpg + 7, 0xff, 16);                                           /* 16 x 255 codes */
     load_fails(jpg, sizeof jpg, "huff.jpg", LX_ERR_FORMAT, "table at byte 6 has 4080 codes");
     /* SOI, quantization table 0, a 1x1 grey frame, a scan without Huffman tables, EOI */
-    unsigned char jpg2[100] = {0xff, 0xd8, 0xff, 0xdb, 0, 67, 0};
+    unsigned char jpg2[128] = {0xff, 0xd8, 0xff, 0xdb, 0, 67, 0};
     const unsigned char frame[] = {0xff, 0xc0, 0, 11, 8, 0, 1, 0, 1, 1, 1, 0x11, 0};
     const unsigned char scan[] = {0xff, 0xda, 0, 8, 1, 1, 0, 0, 63, 0, 0xff, 0xd9};
     memcpy(jpg2 + 71, frame, 13);
     memcpy(jpg2 + 84, scan, 12);
     load_fails(jpg2, 96, "nodht.jpg", LX_ERR_FORMAT, "scan of component 1 uses an undefined");
+    /* progressive: an AC table (one 1-bit code), then an AC scan before any DC scan */
+    const unsigned char ac[] = {0xff, 0xc4, 0, 20, 0x10, 1, [21] = 0, 0xff, 0xda, 0, 8, 1, 1, 0, 1,
+                                63, 0};
+    jpg2[72] = 0xc2;
+    memcpy(jpg2 + 84, ac, sizeof ac);
+    load_fails(jpg2, 84 + sizeof ac, "ac.jpg", LX_ERR_FORMAT, "1 before its first DC scan");
     memcpy(jpg2 + 84, scan + 10, 2); /* EOI: no scan at all */
-    load_fails(jpg2, 86, "noscan.jpg", LX_ERR_FORMAT, "component 1 has no scan data");
+    load_fails(jpg2, 86, "noscan.jpg", LX_ERR_FORMAT, "component 1 has no DC scan data");
     memset(jpg2 + 76, 0xff, 4); /* 65535x65535 */
     load_fails(jpg2, 86, "huge.jpg", LX_ERR_FORMAT, "65535x65535 JPEG needs more than 86");
     const unsigned char tga[20] = {0, 0, 10, [12] = 0x03, 0x19, 0x6d, 0x6f, 32};
