@@ -21,7 +21,9 @@ configure: deps
 demo: all
 	$(BUILD)/bin/gen_scenes examples/scenes
 	$(BUILD)/bin/luxel bake examples/scenes/room.glb -o lightmaps/room
-	@echo "demo: lightmaps and previews are in lightmaps/room/ (see lightmaps/room/manifest.json)"
+	$(BUILD)/bin/luxel bake examples/scenes/retro.glb --texel-density 8 \
+		--lights examples/retro-night.json -o lightmaps/retro
+	@echo "demo: lightmaps, PNG previews and manifest.json are in lightmaps/room/ and lightmaps/retro/"
 
 check: all
 	cd $(BUILD) && ctest --output-on-failure -j $(JOBS)
