@@ -133,6 +133,92 @@ bool lx_light_evaluate(const lx_light *light, lx_vec3 p, lx_vec3 n, lx_light_eva
 float lx_light_blur_visibility(const lx_light *light, float occluder_distance,
                                float light_distance);
 
+/* ---- colour ------------------------------------------------------------- */
+
+#define LX_MIN_TEMPERATURE 1000.0f  /* kelvin: range of Krystek's approximation */
+#define LX_MAX_TEMPERATURE 40000.0f
+
+/* CIE 1931 xy chromaticity of a black body at kelvin (Planckian locus in
+ * CIE 1960 UCS by Krystek's rational approximation). Fails with
+ * LX_ERR_INVALID outside [LX_MIN_TEMPERATURE, LX_MAX_TEMPERATURE]. */
+lx_status lx_temperature_to_xy(float kelvin, float *x, float *y);
+
+/* Linear Rec.709/sRGB colour of a black body at kelvin (seed 001): xy, to
+ * XYZ at Y = 1, to linear sRGB with the standard matrix, normalized so the
+ * largest channel is 1. Components below 0 (outside the sRGB gamut, below
+ * about 1900 K) are set to 0. */
+lx_status lx_temperature_to_rgb(float kelvin, lx_vec3 *rgb);
+
+/* A colour given in sRGB (gamma-encoded, 0..1 per channel) as linear RGB. */
+lx_vec3 lx_srgb_color_to_linear(lx_vec3 srgb);
+
+/* ---- photometric profiles (IES LM-63) ----------------------------------- */
+
+/* A luminaire's candela distribution read from an IES LM-63 file (1986,
+ * 1991, 1995 and 2002 variants), in photometric type C: vertical angle 0 is
+ * straight down the luminaire's axis (nadir), horizontal angles go around
+ * it. Candela values already include the candela multiplier and the
+ * ballast factors. */
+typedef struct lx_ies_profile lx_ies_profile;
+
+/* Reads an IES file; errors name the file and line. */
+lx_status lx_ies_load(const char *path, lx_ies_profile **out);
+/* Same from text in memory; name is used in messages. */
+lx_status lx_ies_parse(const char *text, size_t size, const char *name, lx_ies_profile **out);
+void lx_ies_free(lx_ies_profile *profile);
+
+/* Candela toward (vertical, horizontal) in degrees, interpolated between
+ * the file's angles and extended by its horizontal symmetry. */
+float lx_ies_candela(const lx_ies_profile *profile, float vertical_deg, float horizontal_deg);
+/* Luminous flux in lumens: the candela distribution integrated numerically
+ * over the sphere. */
+double lx_ies_total_lumens(const lx_ies_profile *profile);
+/* Largest candela value. */
+float lx_ies_peak_candela(const lx_ies_profile *profile);
+
+/* Horizontal symmetry of a profile, from its first and last horizontal
+ * angles: 0 only; 0-90; 0-180; 90-270; 0 to more than 180 (full, the
+ * last plane wrapping to 0/360). */
+typedef enum lx_ies_symmetry {
+    LX_IES_ROTATIONAL = 0, /* one plane: the same in every direction around the axis */
+    LX_IES_QUADRANT,       /* 0-90, mirrored into the other quadrants */
+    LX_IES_BILATERAL,      /* 0-180, mirrored about the 0-180 plane */
+    LX_IES_BILATERAL_90,   /* 90-270, mirrored about the 90-270 plane */
+    LX_IES_FULL            /* 0-360 */
+} lx_ies_symmetry;
+
+/* The header of an IES file, as read. Scale factors are the file's own
+ * (the profile's candela values already include them). */
+typedef struct lx_ies_info {
+    const char *version;        /* "LM-63-2002", "LM-63-1995", "LM-63-1991" or "LM-63-1986" */
+    int keyword_count;          /* lines before TILT=, see lx_ies_keyword */
+    bool tilt_included;         /* TILT=INCLUDE (the tilt data is read and checked, not applied) */
+    int lamp_count;
+    double lumens_per_lamp;     /* -1 for absolute photometry */
+    double multiplier;          /* candela multiplier */
+    double ballast_factor;
+    double ballast_lamp_factor; /* 1995+: "future use", normally 1 */
+    double input_watts;
+    int photometric_type;       /* 1 = C, 2 = B, 3 = A */
+    int units;                  /* 1 = feet, 2 = metres (width, length, height) */
+    double width, length, height;
+    int vertical_count, horizontal_count;
+    const float *vertical_angles;   /* degrees, increasing; borrowed until lx_ies_free */
+    const float *horizontal_angles; /* degrees, increasing; borrowed until lx_ies_free */
+    lx_ies_symmetry symmetry;
+} lx_ies_info;
+
+/* Fills out with the profile's header; pointers are borrowed until
+ * lx_ies_free. */
+void lx_ies_get_info(const lx_ies_profile *profile, lx_ies_info *out);
+/* The index-th line before TILT= (0 <= index < keyword_count): key is the
+ * keyword without brackets ("TEST", "MANUFAC"), or "" for a 1986 label
+ * line; value the rest of the line, trimmed. Borrowed until lx_ies_free;
+ * NULL when index is out of range. */
+const char *lx_ies_keyword(const lx_ies_profile *profile, int index, const char **value);
+/* "rotational", "quadrant", "bilateral 0-180", "bilateral 90-270", "full". */
+const char *lx_ies_symmetry_name(lx_ies_symmetry symmetry);
+
 /* ---- exposure ------------------------------------------------------------ */
 
 /* Photometric exposure multiplier for an EV100: 1 / (1.2 * 2^ev100). */

@@ -173,7 +173,7 @@ static const char *const light_keys[] = {
     "name",        "type",   "position",        "direction",       "color",
     "intensity",   "unit",   "spot_conversion", "range",           "inner_angle",
     "outer_angle", "shadow", "blur_power",      "blur_multiplier", "model",
-    "ambient",     "dynamic"};
+    "ambient",     "dynamic", "srgb",         "temperature"};
 static const char *const type_names[] = {"point", "spot", "directional"};
 static const char *const shadow_names[] = {"hard", "none", "blur"};
 static const char *const model_names[] = {"physical", "classic"};
@@ -250,9 +250,31 @@ static lx_status read_light(ctx *c, const cJSON *obj, const name_table *names,
         return fail(c, LX_ERR_FORMAT, "missing 'direction' for a %s light",
                     lx_light_type_name(l.type));
     }
-    if ((it = cJSON_GetObjectItemCaseSensitive(obj, "color")) &&
-        (st = get_color(c, it, "color", &l.color)) != LX_OK)
+    /* one way to give the colour: linear RGB, sRGB-encoded, or kelvin */
+    const cJSON *color_items[3] = {cJSON_GetObjectItemCaseSensitive(obj, "color"),
+                                   cJSON_GetObjectItemCaseSensitive(obj, "srgb"),
+                                   cJSON_GetObjectItemCaseSensitive(obj, "temperature")};
+    if (!!color_items[0] + !!color_items[1] + !!color_items[2] > 1)
+        return fail(c, LX_ERR_FORMAT, "give one of 'color', 'srgb' and 'temperature', not several");
+    if (color_items[0] && (st = get_color(c, color_items[0], "color", &l.color)) != LX_OK)
         return st;
+    if (color_items[1]) {
+        lx_vec3 srgb;
+        if ((st = get_color(c, color_items[1], "srgb", &srgb)) != LX_OK)
+            return st;
+        if (srgb.x > 1.0f || srgb.y > 1.0f || srgb.z > 1.0f)
+            return fail(c, LX_ERR_INVALID, "srgb [%g, %g, %g] has a component above 1", srgb.x,
+                        srgb.y, srgb.z);
+        l.color = lx_srgb_color_to_linear(srgb);
+    }
+    if (color_items[2]) {
+        float kelvin;
+        if ((st = get_float(c, color_items[2], "temperature", &kelvin)) != LX_OK)
+            return st;
+        if (lx_temperature_to_rgb(kelvin, &l.color) != LX_OK)
+            return fail(c, LX_ERR_INVALID, "temperature %g K is outside %g..%g K",
+                        (double)kelvin, (double)LX_MIN_TEMPERATURE, (double)LX_MAX_TEMPERATURE);
+    }
     if ((it = cJSON_GetObjectItemCaseSensitive(obj, "ambient")) &&
         (st = get_color(c, it, "ambient", &l.ambient)) != LX_OK)
         return st;

@@ -330,6 +330,38 @@ static void test_all_or_nothing(void **state) {
     lx_scene_destroy(s);
 }
 
+/* Colours given as sRGB or kelvin: sRGB through the IEC 61966-2-1 curve
+ * (0.5 -> 0.214041), kelvin through lx_temperature_to_rgb (tested on its
+ * own against the Planckian locus). */
+static void test_colour_forms(void **state) {
+    (void)state;
+    lx_scene *s = new_scene();
+    assert_int_equal(apply(s, "{\"lights\": ["
+                              "{\"type\": \"point\", \"position\": [0,1,0], \"srgb\": [0.5, 1, 0]},"
+                              "{\"type\": \"point\", \"position\": [0,1,0], \"temperature\": 2700}]}"),
+                     LX_OK);
+    assert_int_equal(s->light_count, 2);
+    assert_vec(s->lights[0].color, 0.214041, 1.0, 0.0);
+    lx_vec3 warm;
+    assert_int_equal(lx_temperature_to_rgb(2700.0f, &warm), LX_OK);
+    assert_vec(s->lights[1].color, warm.x, warm.y, warm.z);
+    lx_scene_destroy(s);
+
+    const char *bad[] = {
+        "{\"lights\": [{\"type\": \"point\", \"position\": [0,1,0], \"srgb\": [1.5, 0, 0]}]}",
+        "{\"lights\": [{\"type\": \"point\", \"position\": [0,1,0], \"temperature\": 300}]}",
+        "{\"lights\": [{\"type\": \"point\", \"position\": [0,1,0], \"temperature\": 3000, "
+        "\"color\": [1, 1, 1]}]}"};
+    const char *say[] = {"srgb", "temperature", "not several"};
+    for (int i = 0; i < 3; i++) {
+        s = new_scene();
+        assert_int_not_equal(apply(s, bad[i]), LX_OK);
+        assert_non_null(strstr(lx_last_error(), say[i]));
+        assert_int_equal(s->light_count, 0);
+        lx_scene_destroy(s);
+    }
+}
+
 static const char *tmp_dir(void) {
     const char *dir = getenv("LX_TEST_TMP");
     if (!dir || !dir[0]) dir = "/tmp";
@@ -376,7 +408,7 @@ int main(void) {
         cmocka_unit_test(test_example),   cmocka_unit_test(test_units),
         cmocka_unit_test(test_override),  cmocka_unit_test(test_bad_input),
         cmocka_unit_test(test_bad_bytes), cmocka_unit_test(test_all_or_nothing),
-        cmocka_unit_test(test_file),
+        cmocka_unit_test(test_file),      cmocka_unit_test(test_colour_forms),
     };
     return cmocka_run_group_tests(tests, NULL, NULL);
 }
