@@ -225,6 +225,10 @@ const char *lx_ies_symmetry_name(lx_ies_symmetry symmetry);
 float lx_exposure_from_ev100(float ev100);
 /* EV100 that maps an average luminance (nits) to middle grey (K = 12.5). */
 float lx_ev100_from_luminance(double average_luminance);
+/* EV100 of camera settings: log2(N^2 / t * 100 / S) for f-number N,
+ * shutter time t in seconds and ISO sensitivity S. Fails with
+ * LX_ERR_INVALID unless all three are finite and > 0. */
+lx_status lx_ev100_from_camera(float aperture, float shutter_seconds, float iso, float *ev100);
 
 #ifdef __cplusplus
 }

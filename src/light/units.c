@@ -152,3 +152,14 @@ float lx_ev100_from_luminance(double average_luminance) {
     if (!(average_luminance > 0.0) || !isfinite(average_luminance)) return 0.0f;
     return (float)log2(average_luminance * 100.0 / 12.5);
 }
+
+lx_status lx_ev100_from_camera(float aperture, float shutter_seconds, float iso, float *ev100) {
+    if (!(aperture > 0.0f && isfinite(aperture)) || !(shutter_seconds > 0.0f && isfinite(shutter_seconds)) ||
+        !(iso > 0.0f && isfinite(iso)))
+        return lx_fail(LX_ERR_INVALID,
+                       "camera settings f/%g, %g s, ISO %g: each must be a finite number above 0",
+                       (double)aperture, (double)shutter_seconds, (double)iso);
+    double n = aperture;
+    *ev100 = (float)log2(n * n / shutter_seconds * 100.0 / iso);
+    return LX_OK;
+}

@@ -102,6 +102,25 @@ static void srgb_colours(void **state)
     assert_true(fabsf(l.z - 0.04045f / 12.92f) < 1e-6f);
 }
 
+/* Camera exposure: EV100 = log2(N^2/t * 100/S); "sunny 16" (f/16, 1/100 s,
+ * ISO 100) is log2(25600) = 14.64; f/1.4 at 1 s, ISO 100 is log2(1.96). */
+static void camera_ev100(void **state)
+{
+    (void)state;
+    float ev;
+    assert_int_equal(lx_ev100_from_camera(16.0f, 0.01f, 100.0f, &ev), LX_OK);
+    assert_true(fabs(ev - log2(25600.0)) < 1e-4);
+    assert_int_equal(lx_ev100_from_camera(1.4f, 1.0f, 100.0f, &ev), LX_OK);
+    assert_true(fabs(ev - log2(1.96)) < 1e-4);
+    /* doubling ISO lowers EV100 by one stop */
+    float ev200;
+    assert_int_equal(lx_ev100_from_camera(1.4f, 1.0f, 200.0f, &ev200), LX_OK);
+    assert_true(fabs(ev - ev200 - 1.0) < 1e-5);
+    assert_true(fabsf(lx_exposure_from_ev100(ev) - 1.0f / (1.2f * powf(2.0f, ev))) < 1e-6f);
+    assert_int_equal(lx_ev100_from_camera(0.0f, 1.0f, 100.0f, &ev), LX_ERR_INVALID);
+    assert_int_equal(lx_ev100_from_camera(2.0f, NAN, 100.0f, &ev), LX_ERR_INVALID);
+}
+
 int main(void)
 {
     const struct CMUnitTest tests[] = {
@@ -110,6 +129,7 @@ int main(void)
         cmocka_unit_test(rgb_round_trips_to_xy),
         cmocka_unit_test(out_of_range),
         cmocka_unit_test(srgb_colours),
+        cmocka_unit_test(camera_ev100),
     };
     return cmocka_run_group_tests(tests, NULL, NULL);
 }
