@@ -1,6 +1,5 @@
-/* Tests of images and their files: the sRGB curve against IEC 61966-2-1,
- * PFM bytes against the format's definition, round trips through every
- * format, and bad files (truncated, corrupted, NaN) failing cleanly. */
+/* Tests of images and their files: the sRGB curve against IEC 61966-2-1, PFM bytes against
+ * the format's definition, round trips through every format, bad files failing cleanly. */
 #define _POSIX_C_SOURCE 200809L
 #include <stdarg.h>
 #include <stddef.h>
@@ -38,8 +37,7 @@ static int count_files(const char *dir, bool remove_them)
     return n;
 }
 
-/* A fresh, empty folder for one test: $LX_TEST_TMP/image/<name>, made with
- * mkdir -p semantics ($LX_TEST_TMP defaults to /tmp). */
+/* A fresh, empty folder $LX_TEST_TMP/image/<name> (mkdir -p; $LX_TEST_TMP defaults to /tmp) */
 static const char *test_dir(const char *name)
 {
     static char dir[1024];
@@ -113,8 +111,7 @@ static lx_image load_ok(const char *path, const lx_image_load_desc *desc)
     return img;
 }
 
-/* The sRGB formulas of IEC 61966-2-1, written out independently of the
- * library (double precision). */
+/* The sRGB formulas of IEC 61966-2-1, written out independently of the library. */
 static double ref_linear_to_srgb(double v)
 {
     return v <= 0.0031308 ? 12.92 * v : 1.055 * pow(v, 1.0 / 2.4) - 0.055;
@@ -422,9 +419,8 @@ static void test_hdr_round_trip(void **state)
     assert_int_equal(lx_image_write(p, &img, NULL), LX_OK);
     lx_image back = load_ok(p, NULL);
     assert_true(back.channels == 3 && back.width == 41 && back.height == 9);
-    /* RGBE shares one exponent per pixel over 8-bit mantissas: each value
-     * is within 1/256 of the pixel's power-of-two scale 2^e (stb truncates,
-     * so up to 1/128 of the largest component). */
+    /* RGBE: 8-bit mantissas share the pixel's exponent, so each value is within 1/256 of
+     * the pixel's power-of-two scale 2^e (stb truncates: up to 1/128 of the largest) */
     for (int i = 0; i < 41 * 9; i++) {
         const float *v = img.data + i * 3, *g = back.data + i * 3;
         int e;
@@ -449,8 +445,8 @@ static int ref_srgb8(double linear)
 
 static int code8(float v) { return (int)lroundf(v * 255.0f); }
 
-/* Writes values (w x 1, c channels) as PNG with exposure, checks the 8-bit
- * codes in the file, and that decoding gives each code's linear value. */
+/* Writes values (w x 1, c channels) as PNG with exposure, checks the 8-bit codes in the
+ * file, and that decoding gives each code's linear value. */
 static void check_png(const char *p, const float *values, int w, int c, float exposure,
                       const int *codes)
 {
@@ -486,8 +482,8 @@ static void test_png_code_values(void **state)
               2.0f, (const int[]){188, 128, 255, 128});
 }
 
-/* A hand-built PNG (ISO/IEC 15948 chunks around a zlib stream of one
- * stored block) reaches the 16-bit path stb_image_write cannot produce. */
+/* Hand-built PNGs (ISO/IEC 15948 chunks around a zlib stream): the 16-bit path
+ * stb_image_write cannot produce, and a bad stream. */
 static void put_be32(unsigned char *b, uint32_t v)
 {
     for (int i = 0; i < 4; i++)
@@ -507,14 +503,12 @@ static size_t put_chunk(unsigned char *out, const char *type, const void *data, 
     return 12 + n;
 }
 
-static void test_png_16bit(void **state)
+static void test_png_built(void **state)
 {
     (void)state;
     /* 3x1 grey, 16 bits: 0, 32768, 65535 */
-    unsigned char png[256] = "\x89PNG\r\n\x1a\n";
-    size_t n = 8;
-    const unsigned char ihdr[13] = {0, 0, 0, 3, 0, 0, 0, 1, 16, 0, 0, 0, 0};
-    n += put_chunk(png + n, "IHDR", ihdr, 13);
+    unsigned char png[256] = "\x89PNG\r\n\x1a\n", ihdr[13] = {0, 0, 0, 3, 0, 0, 0, 1, 16};
+    size_t n = 8 + put_chunk(png + 8, "IHDR", ihdr, 13);
     const unsigned char raw[7] = {0, 0x00, 0x00, 0x80, 0x00, 0xff, 0xff}; /* filter 0 */
     unsigned char z[18] = {0x78, 0x01, 1, 7, 0, 0xf8, 0xff};
     memcpy(z + 7, raw, 7);
@@ -537,6 +531,14 @@ static void test_png_16bit(void **state)
         assert_float_equal(img.data[2], 1.0f, 1e-6f);
         lx_image_free(&img);
     }
+    /* fuzz: 2x1 grey whose fixed-Huffman block (03 3e 00) copies 3 bytes from distance code
+     * 30, which stb 2.27 reads as distance 0, copying bytes it never wrote */
+    ihdr[3] = 2;
+    ihdr[8] = 8;
+    n = 8 + put_chunk(png + 8, "IHDR", ihdr, 13);
+    n += put_chunk(png + n, "IDAT", (const unsigned char[]){0x78, 1, 0x03, 0x3e, 0, 0, 0, 0, 0}, 9);
+    n += put_chunk(png + n, "IEND", "", 0);
+    load_fails(png, n, "dist.png", LX_ERR_FORMAT, "dist.png: corrupt PNG: the compressed image");
 }
 
 static void test_8bit_formats_round_trip(void **state)
@@ -701,9 +703,8 @@ static void test_write_errors(void **state)
 
 /* ---- found by fuzz/fuzz_image.c ------------------------------------------- */
 
-/* A half-float EXR with a channel luxel does not read (here "0" beside
- * B, G, R): OpenEXRCore 3.1 crashed decoding it with that channel skipped.
- * Made by renaming the "A" of a luxel RGBA file; the list stays sorted. */
+/* A half-float EXR with a channel luxel does not read ("0" beside B, G, R, made by renaming
+ * the "A" of an RGBA file): OpenEXRCore 3.1 crashed decoding it with that channel skipped. */
 static void test_fuzz_exr_half_extra_channel(void **state)
 {
     (void)state;
@@ -732,12 +733,10 @@ static void test_fuzz_exr_half_extra_channel(void **state)
     lx_image_free(&img);
 }
 
-/* Inputs on which stb_image 2.27 misbehaves, refused before stb sees them:
- * Radiance RLE with a zero-length run (stb loops forever) or cut inside the
- * runs (stb reads zeros), a JPEG Huffman table of more than 256 codes (stb
- * writes past the table), a JPEG without scans (stb returns uninitialised
- * memory) or with an AC scan before the DC one (stb refines uninitialised
- * coefficients), tiny JPEG and TGA files claiming huge images. */
+/* Inputs stb_image 2.27 mishandles, now refused before stb sees them: Radiance RLE with a
+ * zero-length run (stb loops forever) or cut inside the runs (reads zeros); JPEGs with a
+ * Huffman table of over 256 codes (writes past it), no scan or an AC scan before the DC one
+ * (uses uninitialised memory), tiny JPEG and TGA files claiming huge images. */
 static void test_fuzz_stb_guards(void **state)
 {
     (void)state;
@@ -786,7 +785,7 @@ int main(void)
         cmocka_unit_test(test_exr_truncated_and_corrupted),
         cmocka_unit_test(test_hdr_round_trip),
         cmocka_unit_test(test_png_code_values),
-        cmocka_unit_test(test_png_16bit),
+        cmocka_unit_test(test_png_built),
         cmocka_unit_test(test_8bit_formats_round_trip),
         cmocka_unit_test(test_8bit_and_hdr_bad),
         cmocka_unit_test(test_channel_conversion),
