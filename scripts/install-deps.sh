@@ -9,6 +9,7 @@ packages=(
     libassimp-dev      # scene import (glTF 2.0, OBJ, ...)
     libcjson-dev       # JSON
     libstb-dev         # PNG/JPEG/TGA/HDR codecs
+    zlib1g-dev         # checks PNG data before stb decodes it
     libopenexr-dev     # OpenEXR (OpenEXRCore C API)
     libcmocka-dev      # unit tests
     clang libclang-rt-14-dev libomp-dev  # sanitizer and fuzzer builds (clang)

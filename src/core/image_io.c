@@ -3,6 +3,8 @@
  * use the sRGB transfer function of IEC 61966-2-1:1999; alpha stays linear. */
 #include "image_internal.h"
 
+#include <zlib.h>
+
 #include <limits.h>
 #include <math.h>
 #include <stdint.h>
@@ -255,180 +257,34 @@ static lx_status check_tga_size(const unsigned char *d, size_t size, const char 
 /* ---- PNG: the DEFLATE stream stb inflates ----------------------------------
  * stb_image 2.27 maps the invalid distance codes 30 and 31 to distance 0 and
  * copies bytes it never wrote into the image (found by fuzzing; valgrind
- * shows the uninitialised reads). The stream is walked first, after RFC
- * 1951 and in the manner of zlib's puff.c, rejecting what zlib rejects. */
-
-typedef struct bit_reader {
-    const unsigned char *d;
-    size_t size, pos;
-    uint32_t buf;
-    int n;
-    bool over; /* read past the end */
-} bit_reader;
-
-static int get_bits(bit_reader *b, int need)
-{
-    uint32_t v = b->buf;
-    while (b->n < need) {
-        if (b->pos >= b->size) {
-            b->over = true;
-            return 0;
-        }
-        v |= (uint32_t)b->d[b->pos++] << b->n;
-        b->n += 8;
-    }
-    b->buf = need < 32 ? v >> need : 0;
-    b->n -= need;
-    return (int)(v & ((1u << need) - 1));
-}
-
-typedef struct huffman {
-    short count[16], symbol[288];
-} huffman;
-
-/* Canonical code from code lengths: 0 complete, > 0 incomplete, < 0
- * over-subscribed. */
-static int build_huffman(huffman *h, const unsigned char *lengths, int n)
-{
-    memset(h->count, 0, sizeof h->count);
-    for (int s = 0; s < n; s++)
-        h->count[lengths[s]]++;
-    if (h->count[0] == n)
-        return 0;
-    int left = 1;
-    for (int len = 1; len < 16; len++) {
-        left = 2 * left - h->count[len];
-        if (left < 0)
-            return left;
-    }
-    short offset[16] = {0};
-    for (int len = 1; len < 15; len++)
-        offset[len + 1] = (short)(offset[len] + h->count[len]);
-    for (int s = 0; s < n; s++)
-        if (lengths[s])
-            h->symbol[offset[lengths[s]]++] = (short)s;
-    return left;
-}
-
-static int decode_symbol(bit_reader *b, const huffman *h)
-{
-    int code = 0, first = 0, index = 0;
-    for (int len = 1; len < 16; len++) {
-        code |= get_bits(b, 1);
-        if (b->over)
-            return -1;
-        if (code - h->count[len] < first)
-            return h->symbol[index + code - first];
-        index += h->count[len];
-        first = (first + h->count[len]) << 1;
-        code <<= 1;
-    }
-    return -1; /* no such code */
-}
-
-/* One compressed block's symbols; false on an invalid one. */
-static bool inflate_codes(bit_reader *b, const huffman *lengths, const huffman *distances)
-{
-    static const unsigned char length_extra[29] = {0, 0, 0, 0, 0, 0, 0, 0, 1, 1, 1, 1, 2, 2, 2,
-                                                   2, 3, 3, 3, 3, 4, 4, 4, 4, 5, 5, 5, 5, 0};
-    for (;;) {
-        int sym = decode_symbol(b, lengths);
-        if (sym < 0 || sym > 285)
-            return false;
-        if (sym == 256)
-            return true;
-        if (sym < 256)
-            continue;
-        get_bits(b, length_extra[sym - 257]);
-        sym = decode_symbol(b, distances);
-        if (sym < 0 || sym > 29) /* 30, 31: the codes stb turns into distance 0 */
-            return false;
-        get_bits(b, sym < 4 ? 0 : sym / 2 - 1);
-        if (b->over)
-            return false;
-    }
-}
-
-static bool inflate_dynamic(bit_reader *b, huffman *lengths, huffman *distances)
-{
-    static const unsigned char order[19] = {16, 17, 18, 0, 8,  7, 9,  6, 10, 5,
-                                            11, 4,  12, 3, 13, 2, 14, 1, 15};
-    int nlen = get_bits(b, 5) + 257, ndist = get_bits(b, 5) + 1, ncode = get_bits(b, 4) + 4;
-    if (b->over || nlen > 286 || ndist > 30)
-        return false;
-    unsigned char len[320] = {0};
-    for (int i = 0; i < ncode; i++)
-        len[order[i]] = (unsigned char)get_bits(b, 3);
-    if (build_huffman(lengths, len, 19) != 0)
-        return false; /* code length codes must be complete */
-    for (int i = 0; i < nlen + ndist;) {
-        int sym = decode_symbol(b, lengths), repeat, value = 0;
-        if (sym < 0)
-            return false;
-        if (sym < 16) {
-            len[i++] = (unsigned char)sym;
-            continue;
-        }
-        if (sym == 16) {
-            if (i == 0)
-                return false;
-            value = len[i - 1];
-            repeat = 3 + get_bits(b, 2);
-        } else {
-            repeat = sym == 17 ? 3 + get_bits(b, 3) : 11 + get_bits(b, 7);
-        }
-        if (b->over || i + repeat > nlen + ndist)
-            return false;
-        while (repeat--)
-            len[i++] = (unsigned char)value;
-    }
-    if (len[256] == 0)
-        return false; /* no end-of-block code */
-    /* incomplete codes are allowed only as a single code, as in zlib */
-    int err = build_huffman(lengths, len, nlen);
-    if (err < 0 || (err > 0 && nlen - lengths->count[0] != 1))
-        return false;
-    err = build_huffman(distances, len + nlen, ndist);
-    if (err < 0 || (err > 0 && ndist - distances->count[0] != 1))
-        return false;
-    return inflate_codes(b, lengths, distances);
-}
+ * shows the uninitialised reads). zlib inflates the stream first, into a
+ * scratch buffer, and what zlib rejects never reaches stb. */
 
 static bool inflate_check(const unsigned char *d, size_t size, bool zlib_header)
 {
-    bit_reader b = {d, size, zlib_header ? 2 : 0, 0, 0, false};
-    huffman lengths, distances;
-    for (int last = 0; !last;) {
-        last = get_bits(&b, 1);
-        int type = get_bits(&b, 2);
-        if (b.over || type == 3)
-            return false;
-        if (type == 0) { /* stored: byte aligned LEN, ~LEN, bytes */
-            b.buf = 0;
-            b.n = 0;
-            if (b.size - b.pos < 4)
-                return false;
-            size_t len = d[b.pos] | (size_t)d[b.pos + 1] << 8;
-            if ((len ^ (d[b.pos + 2] | (size_t)d[b.pos + 3] << 8)) != 0xffff ||
-                b.size - b.pos - 4 < len)
-                return false;
-            b.pos += 4 + len;
-        } else if (type == 1) {
-            unsigned char len[318];
-            memset(len, 8, 144);
-            memset(len + 144, 9, 112);
-            memset(len + 256, 7, 24);
-            memset(len + 280, 8, 8);
-            memset(len + 288, 5, 30);
-            build_huffman(&lengths, len, 288);
-            build_huffman(&distances, len + 288, 30);
-            if (!inflate_codes(&b, &lengths, &distances))
-                return false;
-        } else if (!inflate_dynamic(&b, &lengths, &distances)) {
-            return false;
+    z_stream zs;
+    memset(&zs, 0, sizeof zs);
+    /* negative window bits: a raw stream without the zlib header */
+    if (inflateInit2(&zs, zlib_header ? 15 : -15) != Z_OK)
+        return false;
+    unsigned char scratch[16384];
+    int ret = Z_OK;
+    size_t offset = 0;
+    while (ret == Z_OK) {
+        if (zs.avail_in == 0) {
+            size_t chunk = size - offset < (size_t)1 << 30 ? size - offset : (size_t)1 << 30;
+            if (chunk == 0)
+                break; /* input ended before the stream did */
+            zs.next_in = (unsigned char *)d + offset;
+            zs.avail_in = (uInt)chunk;
+            offset += chunk;
         }
+        zs.next_out = scratch;
+        zs.avail_out = sizeof scratch;
+        ret = inflate(&zs, Z_NO_FLUSH);
     }
-    return true;
+    inflateEnd(&zs);
+    return ret == Z_STREAM_END;
 }
 
 /* Gathers the IDAT chunks (the one zlib stream stb inflates) and checks it.
