@@ -135,7 +135,8 @@ lx_status lx_out_commit(lx_out_file *f)
 {
     FILE *fp = f->fp;
     f->fp = NULL;
-    int failed = ferror(fp);
+    /* on disk before the rename, so a crash never leaves an empty target */
+    int failed = fflush(fp) != 0 || ferror(fp) || fsync(fileno(fp)) != 0;
     if (fclose(fp) != 0)
         failed = 1;
     if (failed) {
