@@ -11,6 +11,7 @@ enum { EXIT_OK = 0, EXIT_FAILED = 1, EXIT_USAGE = 2 };
 
 int cmd_bake(int argc, char **argv);
 int cmd_info(int argc, char **argv);
+int cmd_ies(int argc, char **argv);
 
 /* "luxel: error: <message>" on stderr. */
 void cli_error(const char *fmt, ...) __attribute__((format(printf, 1, 2)));

@@ -23,6 +23,7 @@ static const char *main_usage =
     "commands:\n"
     "  bake SCENE    bake lightmaps for a glTF 2.0 (.gltf/.glb) or OBJ scene\n"
     "  info SCENE    list a scene's meshes, materials, lights and bounds\n"
+    "  ies FILE      show an IES photometric file: header, lumens, beam; --plot\n"
     "\n"
     "options:\n"
     "  -h, --help    show this help (luxel <command> --help for a command)\n"
@@ -228,6 +229,8 @@ int main(int argc, char **argv)
         return cmd_bake(argc - 1, argv + 1);
     if (strcmp(cmd, "info") == 0)
         return cmd_info(argc - 1, argv + 1);
+    if (strcmp(cmd, "ies") == 0)
+        return cmd_ies(argc - 1, argv + 1);
     if (cmd[0] == '-')
         return cli_usage_error(NULL, "unknown option '%s'", cmd);
     return cli_usage_error(NULL, "unknown command '%s'", cmd);
