@@ -61,7 +61,8 @@ static const char *raw_names[RAW_MODES] = {
     "Embree flat BVH, rtcOccluded1M coh.",
 };
 
-static void to_rtc(const lx_ray *r, struct RTCRay *o) {
+static void to_rtc(const lx_ray *r, struct RTCRay *o)
+{
     o->org_x = r->origin.x, o->org_y = r->origin.y, o->org_z = r->origin.z;
     o->dir_x = r->dir.x, o->dir_y = r->dir.y, o->dir_z = r->dir.z;
     o->tnear = r->tmin, o->tfar = r->tmax, o->time = 0.0f;
@@ -71,14 +72,16 @@ static void to_rtc(const lx_ray *r, struct RTCRay *o) {
 /* Every ray once straight through Embree (rtcOccluded1 or coherent
  * rtcOccluded1M), same tiles and schedule; returns seconds. */
 static double flat_run(bool stream, RTCScene flat, const lx_bench_rays *rs, int threads,
-                       uint8_t *occluded) {
+                       uint8_t *occluded)
+{
     const int L = rs->lights;
     double t0 = lx_bench_now();
 #pragma omp parallel for schedule(dynamic, 4) num_threads(threads)
     for (int tile = 0; tile < rs->tiles; tile++) {
         struct RTCIntersectContext ctx;
         rtcInitIntersectContext(&ctx);
-        if (stream) ctx.flags = RTC_INTERSECT_CONTEXT_FLAG_COHERENT;
+        if (stream)
+            ctx.flags = RTC_INTERSECT_CONTEXT_FLAG_COHERENT;
         struct RTCRay buf[TILE * TILE];
         for (int l = 0; l < L; l++) {
             uint32_t s = rs->batch[(size_t)tile * L + l], e = rs->batch[(size_t)tile * L + l + 1];
@@ -104,7 +107,8 @@ static double flat_run(bool stream, RTCScene flat, const lx_bench_rays *rs, int 
 }
 
 static double raw_run(raw_mode mode, const lx_tracer *tr, RTCScene flat, const lx_bench_rays *rs,
-                      uint8_t *occluded) {
+                      uint8_t *occluded)
+{
     switch (mode) {
     case RAW_SINGLE:
         return lx_bench_trace(tr, rs, LX_BENCH_SINGLE, g_threads, occluded);
@@ -121,7 +125,8 @@ static double raw_run(raw_mode mode, const lx_tracer *tr, RTCScene flat, const l
 
 /* One Embree scene holding every triangle in world space (what a user of
  * raw Embree would build for a static bake), same flags as the tracer. */
-static RTCScene flat_scene(RTCDevice dev, const lx_scene *scene) {
+static RTCScene flat_scene(RTCDevice dev, const lx_scene *scene)
+{
     RTCScene s = rtcNewScene(dev);
     rtcSetSceneFlags(s, RTC_SCENE_FLAG_ROBUST);
     rtcSetSceneBuildQuality(s, RTC_BUILD_QUALITY_HIGH);
@@ -159,7 +164,8 @@ static RTCScene flat_scene(RTCDevice dev, const lx_scene *scene) {
 
 /* The bake's per-sample work without the rays: lx_light_evaluate and the
  * shadow ray for every texel and light, over the same tiles and schedule. */
-static double eval_run(const lx_baker *b, const lx_bench_rays *rs) {
+static double eval_run(const lx_baker *b, const lx_bench_rays *rs)
+{
     const int L = rs->lights;
     double sink = 0;
     double t0 = lx_bench_now();
@@ -186,7 +192,8 @@ static double eval_run(const lx_baker *b, const lx_bench_rays *rs) {
             sink += accum[k].y;
     }
     double dt = lx_bench_now() - t0;
-    if (sink == 42.0) printf(" ");
+    if (sink == 42.0)
+        printf(" ");
     return dt;
 }
 
@@ -194,11 +201,13 @@ static double eval_run(const lx_baker *b, const lx_bench_rays *rs) {
  * summed in the bake's order; returns the channels that differ from the
  * bake's. *blocked counts the occluded rays. */
 static uint64_t rebuild_differs(const lx_baker *b, const lx_bench_rays *rs, const uint8_t *occ,
-                                uint64_t *blocked) {
+                                uint64_t *blocked)
+{
     const lx_lightmap_info *info = lx_baker_lightmap_info(b, 0);
     size_t pixels = (size_t)info->width * info->height;
     float *mine = calloc(pixels * 3, sizeof(float));
-    if (!mine) lx_bench_die("calloc");
+    if (!mine)
+        lx_bench_die("calloc");
     *blocked = 0;
     for (int tile = 0; tile < rs->tiles; tile++)
         for (int l = 0; l < rs->lights; l++)
@@ -213,7 +222,8 @@ static uint64_t rebuild_differs(const lx_baker *b, const lx_bench_rays *rs, cons
                     o[2] += rs->illuminance[j].z;
             }
     lx_image img;
-    if (lx_baker_apply_alloc(b, 0, &img) != LX_OK) lx_bench_die("lx_baker_apply_alloc");
+    if (lx_baker_apply_alloc(b, 0, &img) != LX_OK)
+        lx_bench_die("lx_baker_apply_alloc");
     const uint8_t *mask = lx_baker_mask(b, 0);
     uint64_t differ = 0;
     for (size_t p = 0; p < pixels; p++)
@@ -232,7 +242,8 @@ typedef struct bake_result {
     double samples_s, vs_single, vs_batch, vs_flat1;
 } bake_result;
 
-static bake_result bench_full_bake(void) {
+static bake_result bench_full_bake(void)
+{
     bake_result res = {.ran = true, .raw = !g_skip_raw};
     lx_test_scene_info si_;
     /* 441 spheres x 224 triangles + a 2,048-triangle ground = 100,832 */
@@ -245,7 +256,8 @@ static bake_result bench_full_bake(void) {
     lx_bake_desc desc = {.resolution = g_res, .threads = g_threads};
     lx_baker *b;
     double t0 = lx_bench_now();
-    if (lx_baker_create(scene, &desc, &b) != LX_OK) lx_bench_die("lx_baker_create");
+    if (lx_baker_create(scene, &desc, &b) != LX_OK)
+        lx_bench_die("lx_baker_create");
     double t_create = lx_bench_now() - t0;
     if (lx_baker_lightmap_count(b) != 1) {
         fprintf(stderr, "bench_bake: expected 1 lightmap, got %u\n", lx_baker_lightmap_count(b));
@@ -265,14 +277,16 @@ static bake_result bench_full_bake(void) {
     uint8_t *occ[RAW_MODES] = {0};
     if (!g_skip_raw) {
         t0 = lx_bench_now();
-        if (lx_tracer_create(scene, &tr) != LX_OK) lx_bench_die("lx_tracer_create");
+        if (lx_tracer_create(scene, &tr) != LX_OK)
+            lx_bench_die("lx_tracer_create");
         t_tracer = lx_bench_now() - t0;
         dev = rtcNewDevice(NULL);
         t0 = lx_bench_now();
         flat = flat_scene(dev, scene);
         t_flat = lx_bench_now() - t0;
         for (int m = 0; m < RAW_MODES; m++)
-            if (!(occ[m] = malloc(rs.count + 1))) lx_bench_die("malloc");
+            if (!(occ[m] = malloc(rs.count + 1)))
+                lx_bench_die("malloc");
     }
 
     double best_bake = INFINITY, best_eval = INFINITY, best_raw[RAW_MODES];
@@ -281,16 +295,19 @@ static bake_result bench_full_bake(void) {
     /* interleaved repetitions so machine noise hits every figure alike */
     for (int rep = 0; rep < g_reps; rep++) {
         t0 = lx_bench_now();
-        if (lx_baker_bake(b) != LX_OK) lx_bench_die("lx_baker_bake");
+        if (lx_baker_bake(b) != LX_OK)
+            lx_bench_die("lx_baker_bake");
         best_bake = fmin(best_bake, lx_bench_now() - t0);
-        if (g_skip_raw) continue;
+        if (g_skip_raw)
+            continue;
         best_eval = fmin(best_eval, eval_run(b, &rs));
         for (int m = 0; m < RAW_MODES; m++)
             best_raw[m] = fmin(best_raw[m], raw_run((raw_mode)m, tr, flat, &rs, occ[m]));
     }
 
     printf("  setup: lx_baker_create %.2f s, ray regeneration %.2f s", t_create, t_rays);
-    if (!g_skip_raw) printf(", extra lx_tracer %.2f s, flat Embree BVH %.2f s", t_tracer, t_flat);
+    if (!g_skip_raw)
+        printf(", extra lx_tracer %.2f s, flat Embree BVH %.2f s", t_tracer, t_flat);
     printf("\n  used texels %u of %d; texel-light samples %llu; shadow rays %llu "
            "(%llu samples with the light behind/out of range: no ray)\n",
            info->used_texels, info->width * info->height, (unsigned long long)rs.samples,
@@ -340,8 +357,10 @@ static bake_result bench_full_bake(void) {
     }
     for (int m = 0; m < RAW_MODES; m++)
         free(occ[m]);
-    if (flat) rtcReleaseScene(flat);
-    if (dev) rtcReleaseDevice(dev);
+    if (flat)
+        rtcReleaseScene(flat);
+    if (dev)
+        rtcReleaseDevice(dev);
     lx_tracer_destroy(tr);
     lx_bench_rays_free(&rs);
     lx_baker_destroy(b);
@@ -355,7 +374,8 @@ static bake_result bench_full_bake(void) {
  * oracle's own serial texel map, then its shading on the bake's OpenMP
  * threads. Returns seconds; ambiguous[p] marks texels with a near-tie ray. */
 static double brute_reference(const lx_scene *scene, int w, int h, float *out, uint8_t *ambiguous,
-                              uint32_t *used_out) {
+                              uint32_t *used_out)
+{
     double t0 = lx_bench_now();
     lx_ref_scene rs;
     lx_ref_scene_build(scene, &rs);
@@ -367,7 +387,8 @@ static double brute_reference(const lx_scene *scene, int w, int h, float *out, u
         for (int x = 0; x < w; x++) {
             size_t p = (size_t)y * w + x;
             const lx_ref_texel *t = &map.texels[p];
-            if (!t->used) continue;
+            if (!t->used)
+                continue;
             used++;
             bool amb = false;
             lx_vec3 e = lx_ref_shade(&rs, scene->lights, scene->light_count, scene->ambient,
@@ -385,20 +406,23 @@ static double brute_reference(const lx_scene *scene, int w, int h, float *out, u
 /* Texels whose irradiance (green) differs from ref by more than 1%, near
  * ties (skip) counted apart. */
 static uint32_t count_differ(const float *ref, const float *img, const uint8_t *skip, size_t n,
-                             uint32_t *skipped_differ, double *max_rel) {
+                             uint32_t *skipped_differ, double *max_rel)
+{
     uint32_t bad = 0;
     *skipped_differ = 0;
     *max_rel = 0;
     for (size_t p = 0; p < n; p++) {
         double r = ref[3 * p + 1], v = img[3 * p + 1];
         double rel = fabs(r - v) / fmax(fabs(r), 1e-3);
-        if (rel <= 0.01) continue;
+        if (rel <= 0.01)
+            continue;
         if (skip[p]) {
             (*skipped_differ)++;
             continue;
         }
         bad++;
-        if (rel > *max_rel) *max_rel = rel;
+        if (rel > *max_rel)
+            *max_rel = rel;
     }
     return bad;
 }
@@ -409,7 +433,8 @@ typedef struct brute_result {
     uint32_t bad, used;
 } brute_result;
 
-static brute_result bench_brute_force(void) {
+static brute_result bench_brute_force(void)
+{
     lx_test_scene_info si_;
     /* 1,152-triangle ground + 9 spheres x 96 = 2,016 triangles */
     lx_scene *scene = lx_test_spheres_scene("bench-2k", 10.0f, 24, 3, 12, 5, false, &si_);
@@ -429,11 +454,14 @@ static brute_result bench_brute_force(void) {
         lx_bake_desc desc = {.resolution = res, .threads = g_threads, .padding = LX_PADDING_NONE};
         lx_baker *b;
         double t0 = lx_bench_now();
-        if (lx_baker_create(scene, &desc, &b) != LX_OK) lx_bench_die("lx_baker_create");
+        if (lx_baker_create(scene, &desc, &b) != LX_OK)
+            lx_bench_die("lx_baker_create");
         double t1 = lx_bench_now();
-        if (lx_baker_bake(b) != LX_OK) lx_bench_die("lx_baker_bake");
+        if (lx_baker_bake(b) != LX_OK)
+            lx_bench_die("lx_baker_bake");
         double t2 = lx_bench_now();
-        if (t2 - t0 < best) best = t2 - t0, best_create = t1 - t0, best_bake = t2 - t1;
+        if (t2 - t0 < best)
+            best = t2 - t0, best_create = t1 - t0, best_bake = t2 - t1;
         if (tries == 0 && lx_baker_apply_alloc(b, 0, &img) != LX_OK)
             lx_bench_die("lx_baker_apply_alloc");
         lx_baker_destroy(b);
@@ -441,7 +469,8 @@ static brute_result bench_brute_force(void) {
 
     float *ref = calloc(pixels * 3, sizeof(float));
     uint8_t *amb = calloc(pixels, 1);
-    if (!ref || !amb) lx_bench_die("calloc");
+    if (!ref || !amb)
+        lx_bench_die("calloc");
     brute_result r = {.ran = true};
     double t_ref = brute_reference(scene, res, res, ref, amb, &r.used);
     uint32_t skipped, n_amb = 0;
@@ -469,7 +498,8 @@ static brute_result bench_brute_force(void) {
     return r;
 }
 
-int main(int argc, char **argv) {
+int main(int argc, char **argv)
+{
     const char *only = NULL;
     for (int i = 1; i < argc; i++) {
         if (!strcmp(argv[i], "--res") && i + 1 < argc)
@@ -491,14 +521,17 @@ int main(int argc, char **argv) {
             return 2;
         }
     }
-    if (g_reps < 1) g_reps = 1;
+    if (g_reps < 1)
+        g_reps = 1;
     g_threads = lx_thread_count(g_threads);
     lx_bench_header("bench_bake", g_threads);
     double t0 = lx_bench_now();
     bake_result bake = {0};
     brute_result brute = {0};
-    if (!only || !strcmp(only, "bake")) bake = bench_full_bake();
-    if (!only || !strcmp(only, "brute")) brute = bench_brute_force();
+    if (!only || !strcmp(only, "bake"))
+        bake = bench_full_bake();
+    if (!only || !strcmp(only, "brute"))
+        brute = bench_brute_force();
 
     char a[32], load[32];
     printf("\ntotal bench time %.1f s\n", lx_bench_now() - t0);

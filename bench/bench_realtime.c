@@ -28,7 +28,8 @@
 static int g_threads, g_reps = 3, g_res = 256;
 static bool g_skip_raw;
 
-int main(int argc, char **argv) {
+int main(int argc, char **argv)
+{
     for (int i = 1; i < argc; i++) {
         if (!strcmp(argv[i], "--res") && i + 1 < argc)
             g_res = atoi(argv[++i]);
@@ -43,7 +44,8 @@ int main(int argc, char **argv) {
             return 2;
         }
     }
-    if (g_reps < 1) g_reps = 1;
+    if (g_reps < 1)
+        g_reps = 1;
     g_threads = lx_thread_count(g_threads);
     lx_bench_header("bench_realtime", g_threads);
 
@@ -58,13 +60,16 @@ int main(int argc, char **argv) {
     lx_bake_desc desc = {.resolution = g_res, .threads = g_threads};
     lx_baker *b;
     double t0 = lx_bench_now();
-    if (lx_baker_create(scene, &desc, &b) != LX_OK) lx_bench_die("lx_baker_create");
+    if (lx_baker_create(scene, &desc, &b) != LX_OK)
+        lx_bench_die("lx_baker_create");
     double t1 = lx_bench_now();
-    if (lx_baker_bake(b) != LX_OK) lx_bench_die("lx_baker_bake");
+    if (lx_baker_bake(b) != LX_OK)
+        lx_bench_die("lx_baker_bake");
     double t2 = lx_bench_now();
     printf("  setup: lx_baker_create %.3f s, first lx_baker_bake %.3f s\n", t1 - t0, t2 - t1);
     lx_image img;
-    if (lx_image_alloc(&img, g_res, g_res, 3) != LX_OK) lx_bench_die("lx_image_alloc");
+    if (lx_image_alloc(&img, g_res, g_res, 3) != LX_OK)
+        lx_bench_die("lx_image_alloc");
     lx_light base[LX_BENCH_LIGHTS];
     uint32_t L = lx_baker_light_count(b);
     for (uint32_t l = 0; l < L && l < LX_BENCH_LIGHTS; l++)
@@ -81,12 +86,15 @@ int main(int argc, char **argv) {
             float ph = 0.05f * (float)frames + 1.57f * (float)l;
             m.position =
                 lx_add(m.position, lx_v3(0.15f * size * cosf(ph), 0.0f, 0.15f * size * sinf(ph)));
-            if (lx_baker_set_light(b, l, &m) != LX_OK) lx_bench_die("lx_baker_set_light");
+            if (lx_baker_set_light(b, l, &m) != LX_OK)
+                lx_bench_die("lx_baker_set_light");
         }
         t1 = lx_bench_now();
-        if (lx_baker_update(b) != LX_OK) lx_bench_die("lx_baker_update");
+        if (lx_baker_update(b) != LX_OK)
+            lx_bench_die("lx_baker_update");
         t2 = lx_bench_now();
-        if (lx_baker_apply(b, 0, &img) != LX_OK) lx_bench_die("lx_baker_apply");
+        if (lx_baker_apply(b, 0, &img) != LX_OK)
+            lx_bench_die("lx_baker_apply");
         double t3 = lx_bench_now();
         t_set += t1 - t0, t_update += t2 - t1, t_apply += t3 - t2;
         min_update = fmin(min_update, t2 - t1);
@@ -105,9 +113,11 @@ int main(int argc, char **argv) {
     if (!g_skip_raw) {
         lx_bench_rays_build(b, scene, &rs);
         lx_tracer *tr;
-        if (lx_tracer_create(scene, &tr) != LX_OK) lx_bench_die("lx_tracer_create");
+        if (lx_tracer_create(scene, &tr) != LX_OK)
+            lx_bench_die("lx_tracer_create");
         uint8_t *occ = malloc(rs.count + 1);
-        if (!occ) lx_bench_die("malloc");
+        if (!occ)
+            lx_bench_die("malloc");
         best_batch = best_single = INFINITY;
         for (int rep = 0; rep < 5 * g_reps; rep++) {
             best_batch = fmin(best_batch, lx_bench_trace(tr, &rs, LX_BENCH_BATCH, g_threads, occ));

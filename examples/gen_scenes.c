@@ -105,7 +105,8 @@ enum {
 
 /* ---- errors and temporary files ---------------------------------------- */
 
-static void error(const char *fmt, ...) {
+static void error(const char *fmt, ...)
+{
     va_list ap;
     fputs("gen_scenes: error: ", stderr);
     va_start(ap, fmt);
@@ -119,8 +120,10 @@ static void error(const char *fmt, ...) {
 static char g_tmp_path[4096];
 static volatile sig_atomic_t g_tmp_active;
 
-static void on_signal(int sig) {
-    if (g_tmp_active) unlink(g_tmp_path);
+static void on_signal(int sig)
+{
+    if (g_tmp_active)
+        unlink(g_tmp_path);
     signal(sig, SIG_DFL);
     raise(sig);
 }
@@ -133,13 +136,16 @@ typedef struct {
     int failed; /* sticky: set on the first allocation failure */
 } bytes;
 
-static int bytes_reserve(bytes *b, size_t extra) {
-    if (b->failed) return -1;
+static int bytes_reserve(bytes *b, size_t extra)
+{
+    if (b->failed)
+        return -1;
     if (extra > SIZE_MAX - b->len) {
         b->failed = 1;
         return -1;
     }
-    if (b->len + extra <= b->cap) return 0;
+    if (b->len + extra <= b->cap)
+        return 0;
     size_t cap = b->cap ? b->cap : 1024;
     while (cap < b->len + extra) {
         if (cap > SIZE_MAX / 2) {
@@ -158,25 +164,29 @@ static int bytes_reserve(bytes *b, size_t extra) {
     return 0;
 }
 
-static void bytes_append(bytes *b, const void *p, size_t n) {
+static void bytes_append(bytes *b, const void *p, size_t n)
+{
     if (n > 0 && bytes_reserve(b, n) == 0) {
         memcpy(b->data + b->len, p, n);
         b->len += n;
     }
 }
 
-static void bytes_fill(bytes *b, unsigned char c, size_t n) {
+static void bytes_fill(bytes *b, unsigned char c, size_t n)
+{
     if (n > 0 && bytes_reserve(b, n) == 0) { /* n = 0: data may still be NULL */
         memset(b->data + b->len, c, n);
         b->len += n;
     }
 }
 
-static void bytes_pad(bytes *b, unsigned char c) {
+static void bytes_pad(bytes *b, unsigned char c)
+{
     bytes_fill(b, c, (4 - b->len % 4) % 4);
 }
 
-static void bytes_printf(bytes *b, const char *fmt, ...) {
+static void bytes_printf(bytes *b, const char *fmt, ...)
+{
     va_list ap;
     va_start(ap, fmt);
     int n = vsnprintf(NULL, 0, fmt, ap);
@@ -186,7 +196,8 @@ static void bytes_printf(bytes *b, const char *fmt, ...) {
         return;
     }
     /* +1 for vsnprintf's terminator, which is then dropped */
-    if (bytes_reserve(b, (size_t)n + 1) != 0) return;
+    if (bytes_reserve(b, (size_t)n + 1) != 0)
+        return;
     va_start(ap, fmt);
     vsnprintf((char *)b->data + b->len, (size_t)n + 1, fmt, ap);
     va_end(ap);
@@ -194,18 +205,21 @@ static void bytes_printf(bytes *b, const char *fmt, ...) {
 }
 
 /* Binary glTF is little-endian whatever the host is. */
-static void put_u32(bytes *b, uint32_t v) {
+static void put_u32(bytes *b, uint32_t v)
+{
     unsigned char c[4] = {(unsigned char)v, (unsigned char)(v >> 8), (unsigned char)(v >> 16),
                           (unsigned char)(v >> 24)};
     bytes_append(b, c, 4);
 }
 
-static void put_u16(bytes *b, uint16_t v) {
+static void put_u16(bytes *b, uint16_t v)
+{
     unsigned char c[2] = {(unsigned char)v, (unsigned char)(v >> 8)};
     bytes_append(b, c, 2);
 }
 
-static void put_f32(bytes *b, float f) {
+static void put_f32(bytes *b, float f)
+{
     uint32_t u;
     memcpy(&u, &f, 4);
     put_u32(b, u);
@@ -213,19 +227,23 @@ static void put_f32(bytes *b, float f) {
 
 /* Shortest decimal that reads back as the same float (0.95, not
  * 0.949999988); 9 digits always do, which accessor min/max rely on. */
-static void json_float(bytes *js, float f) {
+static void json_float(bytes *js, float f)
+{
     char s[32];
     for (int prec = 6; prec <= 9; prec++) {
         snprintf(s, sizeof s, "%.*g", prec, (double)f);
-        if (strtof(s, NULL) == f) break;
+        if (strtof(s, NULL) == f)
+            break;
     }
     bytes_printf(js, "%s", s);
 }
 
-static void json_floats(bytes *js, const float *v, int n) {
+static void json_floats(bytes *js, const float *v, int n)
+{
     bytes_printf(js, "[");
     for (int i = 0; i < n; i++) {
-        if (i) bytes_printf(js, ",");
+        if (i)
+            bytes_printf(js, ",");
         json_float(js, v[i]);
     }
     bytes_printf(js, "]");
@@ -277,7 +295,8 @@ typedef struct {
     int full; /* a builder ran out of room: a bug in this file */
 } scene;
 
-static int add_material(scene *sc, const char *name, float r, float g, float b) {
+static int add_material(scene *sc, const char *name, float r, float g, float b)
+{
     if (sc->nmats == MAX_MATERIALS) {
         sc->full = 1;
         return 0;
@@ -290,7 +309,8 @@ static int add_material(scene *sc, const char *name, float r, float g, float b) 
     return sc->nmats++;
 }
 
-static mesh *add_mesh(scene *sc, const char *name, int *index) {
+static mesh *add_mesh(scene *sc, const char *name, int *index)
+{
     static mesh spare; /* absorbs writes after an overflow */
     if (sc->nmeshes == MAX_MESHES) {
         sc->full = 1;
@@ -302,7 +322,8 @@ static mesh *add_mesh(scene *sc, const char *name, int *index) {
     return m;
 }
 
-static int mesh_prim(scene *sc, mesh *m, int mat) {
+static int mesh_prim(scene *sc, mesh *m, int mat)
+{
     if (m->nprims == MAX_PRIMS) {
         sc->full = 1;
         return 0;
@@ -312,7 +333,8 @@ static int mesh_prim(scene *sc, mesh *m, int mat) {
 }
 
 static void add_face(scene *sc, mesh *m, int prim, const float o[3], const float u[3],
-                     const float v[3], int nu, int nv) {
+                     const float v[3], int nu, int nv)
+{
     if (m->nfaces == MAX_FACES) {
         sc->full = 1;
         return;
@@ -329,7 +351,8 @@ static void add_face(scene *sc, mesh *m, int prim, const float o[3], const float
 /* Axis-aligned box with outward normals: x, z centred on (cx, cz), y from cy
  * to cy + sy; mask picks the faces. */
 static void add_box(scene *sc, mesh *m, int prim, float cx, float cy, float cz, float sx, float sy,
-                    float sz, int mask) {
+                    float sz, int mask)
+{
     float x0 = cx - 0.5f * sx, x1 = cx + 0.5f * sx;
     float y0 = cy, y1 = cy + sy;
     float z0 = cz - 0.5f * sz, z1 = cz + 0.5f * sz;
@@ -350,7 +373,8 @@ static void add_box(scene *sc, mesh *m, int prim, float cx, float cy, float cz, 
                  (float[3]){0.0f, 0.0f, sz}, 1, 1);
 }
 
-static node *add_node(scene *sc, const char *name, float x, float y, float z) {
+static node *add_node(scene *sc, const char *name, float x, float y, float z)
+{
     static node spare;
     if (sc->nnodes == MAX_NODES) {
         sc->full = 1;
@@ -367,7 +391,8 @@ static node *add_node(scene *sc, const char *name, float x, float y, float z) {
     return n;
 }
 
-static void node_yaw(node *n, double degrees) {
+static void node_yaw(node *n, double degrees)
+{
     double half = 0.5 * degrees * PI / 180.0;
     n->r[0] = 0.0f;
     n->r[1] = (float)sin(half);
@@ -377,7 +402,8 @@ static void node_yaw(node *n, double degrees) {
 
 /* Rotation taking local -Z to direction d, keeping local +X horizontal so
  * the light has no roll. */
-static void node_aim(node *n, double dx, double dy, double dz) {
+static void node_aim(node *n, double dx, double dy, double dz)
+{
     double len = sqrt(dx * dx + dy * dy + dz * dz);
     double z[3] = {-dx / len, -dy / len, -dz / len};
     double up[3] = {0.0, 1.0, 0.0};
@@ -426,14 +452,16 @@ static void node_aim(node *n, double dx, double dy, double dz) {
 }
 
 static void node_mesh(scene *sc, const char *name, int mesh_index, float x, float y, float z,
-                      double yaw_degrees) {
+                      double yaw_degrees)
+{
     node *n = add_node(sc, name, x, y, z);
     n->mesh = mesh_index;
     node_yaw(n, yaw_degrees);
 }
 
 static node *node_light(scene *sc, const char *name, light_type type, float r, float g, float b,
-                        float intensity, float range, float x, float y, float z) {
+                        float intensity, float range, float x, float y, float z)
+{
     static light spare;
     light *l = &spare;
     if (sc->nlights == MAX_LIGHTS)
@@ -454,7 +482,8 @@ static node *node_light(scene *sc, const char *name, light_type type, float r, f
 
 /* ---- the two scenes ------------------------------------------------------ */
 
-static void build_room(scene *sc) {
+static void build_room(scene *sc)
+{
     sc->name = "room";
     int white = add_material(sc, "white", 0.8f, 0.8f, 0.8f);
     int red = add_material(sc, "red", 0.63f, 0.065f, 0.05f);
@@ -500,7 +529,8 @@ static void build_room(scene *sc) {
 
 /* Steps climbing in +z, local z from -n*run to 0, top step at n*rise; no
  * back face (it leans on a wall) and no bottom. */
-static void add_stair(scene *sc, mesh *m, int prim, int n, float width, float rise, float run) {
+static void add_stair(scene *sc, mesh *m, int prim, int n, float width, float rise, float run)
+{
     float hw = 0.5f * width;
     for (int i = 0; i < n; i++) {
         float z0 = -(float)(n - i) * run, z1 = z0 + run;
@@ -516,7 +546,8 @@ static void add_stair(scene *sc, mesh *m, int prim, int n, float width, float ri
     }
 }
 
-static void build_retro(scene *sc) {
+static void build_retro(scene *sc)
+{
     sc->name = "retro";
     int grey = add_material(sc, "ground", 0.6f, 0.6f, 0.6f);
     int stone = add_material(sc, "stone", 0.55f, 0.52f, 0.48f);
@@ -575,12 +606,14 @@ typedef struct {
     int rot;           /* 1: the face's u edge runs along the chart's v */
 } chart;
 
-static double vlen(const float v[3]) {
+static double vlen(const float v[3])
+{
     return sqrt((double)v[0] * v[0] + (double)v[1] * v[1] + (double)v[2] * v[2]);
 }
 
 /* Shelf packing at `scale` UV units per metre; 0 if everything fits. */
-static int shelf_pack(const mesh *m, const int *order, double scale, chart *charts) {
+static int shelf_pack(const mesh *m, const int *order, double scale, chart *charts)
+{
     const double g = LM_GUTTER;
     double x = g, y = g, shelf_h = 0.0;
     for (int k = 0; k < m->nfaces; k++) {
@@ -595,18 +628,21 @@ static int shelf_pack(const mesh *m, const int *order, double scale, chart *char
             x = g;
             shelf_h = 0.0;
         }
-        if (x + c->w + g > 1.0) return -1;
+        if (x + c->w + g > 1.0)
+            return -1;
         c->x = x;
         c->y = y;
         x += c->w + g;
-        if (c->h > shelf_h) shelf_h = c->h;
+        if (c->h > shelf_h)
+            shelf_h = c->h;
     }
     return y + shelf_h + g <= 1.0 ? 0 : -1;
 }
 
 /* Largest common scale (within 0.2%) at which the shelf packer fits every
  * face of the mesh, so texel density is uniform within the mesh. */
-static int pack_charts(const mesh *m, chart *charts) {
+static int pack_charts(const mesh *m, chart *charts)
+{
     const double g = LM_GUTTER;
     int order[MAX_FACES];
     double area = 0.0, longest = 0.0;
@@ -616,14 +652,16 @@ static int pack_charts(const mesh *m, chart *charts) {
         longest = fmax(longest, fmax(fw, fh));
         order[i] = i;
     }
-    if (m->nfaces == 0 || area <= 0.0) return -1;
+    if (m->nfaces == 0 || area <= 0.0)
+        return -1;
     /* tallest chart first (insertion sort: stable, so the output is fixed) */
     for (int i = 1; i < m->nfaces; i++) {
         int k = order[i], j = i;
         double hk = fmin(vlen(m->faces[k].u), vlen(m->faces[k].v));
         while (j > 0) {
             const face *p = &m->faces[order[j - 1]];
-            if (fmin(vlen(p->u), vlen(p->v)) >= hk) break;
+            if (fmin(vlen(p->u), vlen(p->v)) >= hk)
+                break;
             order[j] = order[j - 1];
             j--;
         }
@@ -632,7 +670,8 @@ static int pack_charts(const mesh *m, chart *charts) {
     /* upper bounds: the longest side fits, and the total area fits */
     double s = fmin((1.0 - 2.0 * g) / longest, (1.0 - 2.0 * g) / sqrt(area));
     for (int it = 0; it < 10000; it++, s *= 0.998)
-        if (shelf_pack(m, order, s, charts) == 0) return 0;
+        if (shelf_pack(m, order, s, charts) == 0)
+            return 0;
     return -1;
 }
 
@@ -663,8 +702,10 @@ enum { GL_UNSIGNED_SHORT = 5123, GL_UNSIGNED_INT = 5125, GL_FLOAT = 5126 };
 
 /* One bufferView per accessor, each starting 4-aligned. */
 static int add_floats(glb_data *d, const float *v, size_t count, int ncomp, const char *type,
-                      int bounds) {
-    if (d->naccs == MAX_ACCESSORS) return -1;
+                      int bounds)
+{
+    if (d->naccs == MAX_ACCESSORS)
+        return -1;
     int i = d->naccs++;
     accessor *a = &d->accs[i];
     bytes_pad(&d->bin, 0);
@@ -685,8 +726,10 @@ static int add_floats(glb_data *d, const float *v, size_t count, int ncomp, cons
     return i;
 }
 
-static int add_indices(glb_data *d, const uint32_t *idx, size_t count, size_t nverts) {
-    if (d->naccs == MAX_ACCESSORS) return -1;
+static int add_indices(glb_data *d, const uint32_t *idx, size_t count, size_t nverts)
+{
+    if (d->naccs == MAX_ACCESSORS)
+        return -1;
     int i = d->naccs++;
     int wide = nverts > 65535;
     bytes_pad(&d->bin, 0);
@@ -705,22 +748,26 @@ static int add_indices(glb_data *d, const uint32_t *idx, size_t count, size_t nv
 }
 
 /* Vertex arrays of one primitive: 4 vertices and 6 indices per quad. */
-static int emit_primitive(glb_data *d, const mesh *m, const chart *charts, int prim, int acc[5]) {
+static int emit_primitive(glb_data *d, const mesh *m, const chart *charts, int prim, int acc[5])
+{
     size_t nquads = 0;
     for (int i = 0; i < m->nfaces; i++)
-        if (m->faces[i].prim == prim) nquads += (size_t)m->faces[i].nu * (size_t)m->faces[i].nv;
+        if (m->faces[i].prim == prim)
+            nquads += (size_t)m->faces[i].nu * (size_t)m->faces[i].nv;
     size_t nv = nquads * 4, ni = nquads * 6;
     float *pos = malloc(nv * 3 * sizeof *pos), *nrm = malloc(nv * 3 * sizeof *nrm);
     float *uv0 = malloc(nv * 2 * sizeof *uv0), *uv1 = malloc(nv * 2 * sizeof *uv1);
     uint32_t *idx = malloc(ni * sizeof *idx);
     int rc = -1;
-    if (!pos || !nrm || !uv0 || !uv1 || !idx || nquads == 0) goto done;
+    if (!pos || !nrm || !uv0 || !uv1 || !idx || nquads == 0)
+        goto done;
 
     size_t v = 0, n = 0;
     for (int fi = 0; fi < m->nfaces; fi++) {
         const face *f = &m->faces[fi];
         const chart *c = &charts[fi];
-        if (f->prim != prim) continue;
+        if (f->prim != prim)
+            continue;
         double nx = (double)f->u[1] * f->v[2] - (double)f->u[2] * f->v[1];
         double ny = (double)f->u[2] * f->v[0] - (double)f->u[0] * f->v[2];
         double nz = (double)f->u[0] * f->v[1] - (double)f->u[1] * f->v[0];
@@ -771,7 +818,8 @@ done:
 }
 
 static void emit_json(bytes *js, const scene *sc, const glb_data *d,
-                      int acc[MAX_MESHES][MAX_PRIMS][5]) {
+                      int acc[MAX_MESHES][MAX_PRIMS][5])
+{
     bytes_printf(js, "{\"asset\":{\"version\":\"2.0\",\"generator\":\"luxel "
                      "examples/gen_scenes\"},\n");
     if (sc->nlights > 0) {
@@ -808,7 +856,8 @@ static void emit_json(bytes *js, const scene *sc, const glb_data *d,
     for (int i = 0; i < sc->nnodes; i++) {
         const node *n = &sc->nodes[i];
         bytes_printf(js, "%s {\"name\":\"%s\"", i ? ",\n" : "", n->name);
-        if (n->mesh >= 0) bytes_printf(js, ",\"mesh\":%d", n->mesh);
+        if (n->mesh >= 0)
+            bytes_printf(js, ",\"mesh\":%d", n->mesh);
         if (n->t[0] != 0.0f || n->t[1] != 0.0f || n->t[2] != 0.0f) {
             bytes_printf(js, ",\"translation\":");
             json_floats(js, n->t, 3);
@@ -873,7 +922,8 @@ static void emit_json(bytes *js, const scene *sc, const glb_data *d,
 }
 
 /* Whole .glb file of a scene into out. */
-static int make_glb(const scene *sc, const char *file, bytes *out) {
+static int make_glb(const scene *sc, const char *file, bytes *out)
+{
     static glb_data d; /* large; static keeps it off the stack */
     int acc[MAX_MESHES][MAX_PRIMS][5];
     bytes js = {0};
@@ -933,7 +983,8 @@ done:
 /* ---- output ---------------------------------------------------------------- */
 
 /* Write to OUTDIR/.NAME.XXXXXX, then rename over OUTDIR/NAME. */
-static int write_atomic(const char *dir, const char *name, const bytes *b) {
+static int write_atomic(const char *dir, const char *name, const bytes *b)
+{
     char path[4096];
     int n1 = snprintf(path, sizeof path, "%s/%s", dir, name);
     int n2 = snprintf(g_tmp_path, sizeof g_tmp_path, "%s/.%s.XXXXXX", dir, name);
@@ -957,7 +1008,8 @@ static int write_atomic(const char *dir, const char *name, const bytes *b) {
     ok = ok && fflush(f) == 0 && fsync(fd) == 0;
     int saved = errno;
     if (f ? fclose(f) != 0 : close(fd) != 0) {
-        if (ok) saved = errno;
+        if (ok)
+            saved = errno;
         ok = 0;
     }
     if (!ok) {
@@ -966,13 +1018,15 @@ static int write_atomic(const char *dir, const char *name, const bytes *b) {
         error("%s: cannot rename temporary file into place: %s", path, strerror(errno));
         ok = 0;
     }
-    if (!ok) unlink(g_tmp_path);
+    if (!ok)
+        unlink(g_tmp_path);
     g_tmp_active = 0;
     return ok ? 0 : -1;
 }
 
 /* mkdir -p: `make demo` and the CLI tests name folders that may not exist. */
-static int make_dirs(const char *dir) {
+static int make_dirs(const char *dir)
+{
     char path[4096];
     size_t n = strlen(dir);
     if (n >= sizeof path) {
@@ -981,7 +1035,8 @@ static int make_dirs(const char *dir) {
     }
     memcpy(path, dir, n + 1);
     for (size_t i = 1; i <= n; i++) {
-        if (path[i] != '/' && path[i] != '\0') continue;
+        if (path[i] != '/' && path[i] != '\0')
+            continue;
         char saved = path[i];
         path[i] = '\0';
         struct stat st;
@@ -999,14 +1054,16 @@ static int make_dirs(const char *dir) {
     return 0;
 }
 
-static void usage(FILE *f) {
+static void usage(FILE *f)
+{
     fprintf(f, "usage: gen_scenes OUTDIR\n"
                "Writes OUTDIR/room.glb and OUTDIR/retro.glb (binary glTF 2.0 example\n"
                "scenes with lightmap UVs in TEXCOORD_1 and KHR_lights_punctual lights),\n"
                "creating OUTDIR if needed.\n");
 }
 
-int main(int argc, char **argv) {
+int main(int argc, char **argv)
+{
     if (argc == 2 && (!strcmp(argv[1], "-h") || !strcmp(argv[1], "--help"))) {
         usage(stdout);
         return 0;

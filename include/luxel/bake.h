@@ -58,10 +58,10 @@ typedef struct lx_bake_desc {
                             world and UV areas, rounded to a multiple of 4 */
     int max_resolution;  /* cap for texel_density sizes, 0 = 4096 */
     lx_quantity quantity;
-    int padding;         /* texels of dilation, 0 = 2, LX_PADDING_NONE = none */
-    int threads;         /* 0 = all cores */
+    int padding;          /* texels of dilation, 0 = 2, LX_PADDING_NONE = none */
+    int threads;          /* 0 = all cores */
     bool skip_degenerate; /* zero-UV-area triangles: warn and skip, not fail */
-    float shadow_bias;   /* ray origin offset in metres, 0 = scale-aware auto */
+    float shadow_bias;    /* ray origin offset in metres, 0 = scale-aware auto */
     lx_progress_fn progress;
     void *progress_user;
 } lx_bake_desc;
@@ -70,11 +70,11 @@ typedef struct lx_bake_desc {
 lx_bake_desc lx_bake_desc_defaults(const lx_bake_desc *desc);
 
 typedef struct lx_lightmap_info {
-    uint32_t node;          /* scene node index */
-    const char *name;       /* node name */
+    uint32_t node;    /* scene node index */
+    const char *name; /* node name */
     int width, height;
-    int uv_set;             /* 1 = TEXCOORD_1, 0 = TEXCOORD_0 */
-    uint32_t used_texels;   /* texels covered by triangles */
+    int uv_set;              /* 1 = TEXCOORD_1, 0 = TEXCOORD_0 */
+    uint32_t used_texels;    /* texels covered by triangles */
     uint32_t overlap_texels; /* texels claimed by two triangles' interiors */
 } lx_lightmap_info;
 
@@ -117,8 +117,8 @@ lx_status lx_baker_apply_rgba8(const lx_baker *baker, uint32_t map, float exposu
                                uint8_t *out);
 
 typedef struct lx_texel_sample {
-    lx_vec3 position;  /* world, on the triangle */
-    lx_vec3 normal;    /* world shading normal (normal map applied) */
+    lx_vec3 position; /* world, on the triangle */
+    lx_vec3 normal;   /* world shading normal (normal map applied) */
     lx_vec3 geometric_normal;
     uint32_t mesh;     /* scene mesh index */
     uint32_t triangle; /* triangle in that mesh */

@@ -130,8 +130,8 @@ lx_status lx_image_alloc(lx_image *img, int width, int height, int channels);
 void lx_image_free(lx_image *img);
 
 typedef struct lx_image_load_desc {
-    bool raw_8bit;    /* 8-bit data is mapped to [0,1] without sRGB decoding */
-    int channels;     /* wanted channel count, 0 = as stored */
+    bool raw_8bit; /* 8-bit data is mapped to [0,1] without sRGB decoding */
+    int channels;  /* wanted channel count, 0 = as stored */
 } lx_image_load_desc;
 
 /* Loads PNG/JPEG/TGA/HDR (stb_image), PFM and EXR. desc may be NULL.

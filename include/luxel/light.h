@@ -117,10 +117,10 @@ float lx_light_range_window(float distance_sq, float range);
 float lx_light_spot_attenuation(const lx_light *light, float cos_angle);
 
 typedef struct lx_light_eval {
-    lx_vec3 to_light;   /* unit vector from the point toward the light */
-    float distance;     /* to the light, INFINITY for directional */
+    lx_vec3 to_light;    /* unit vector from the point toward the light */
+    float distance;      /* to the light, INFINITY for directional */
     lx_vec3 illuminance; /* unshadowed, N.L included: lux (physical model) */
-    lx_vec3 ambient;    /* the light's ambient contribution at the point */
+    lx_vec3 ambient;     /* the light's ambient contribution at the point */
 } lx_light_eval;
 
 /* Evaluates light at point p with unit normal n. Returns false when the
@@ -135,7 +135,7 @@ float lx_light_blur_visibility(const lx_light *light, float occluder_distance,
 
 /* ---- colour ------------------------------------------------------------- */
 
-#define LX_MIN_TEMPERATURE 1000.0f  /* kelvin: range of Krystek's approximation */
+#define LX_MIN_TEMPERATURE 1000.0f /* kelvin: range of Krystek's approximation */
 #define LX_MAX_TEMPERATURE 40000.0f
 
 /* CIE 1931 xy chromaticity of a black body at kelvin (Planckian locus in
@@ -190,17 +190,17 @@ typedef enum lx_ies_symmetry {
 /* The header of an IES file, as read. Scale factors are the file's own
  * (the profile's candela values already include them). */
 typedef struct lx_ies_info {
-    const char *version;        /* "LM-63-2002", "LM-63-1995", "LM-63-1991" or "LM-63-1986" */
-    int keyword_count;          /* lines before TILT=, see lx_ies_keyword */
-    bool tilt_included;         /* TILT=INCLUDE (the tilt data is read and checked, not applied) */
+    const char *version; /* "LM-63-2002", "LM-63-1995", "LM-63-1991" or "LM-63-1986" */
+    int keyword_count;   /* lines before TILT=, see lx_ies_keyword */
+    bool tilt_included;  /* TILT=INCLUDE (the tilt data is read and checked, not applied) */
     int lamp_count;
-    double lumens_per_lamp;     /* -1 for absolute photometry */
-    double multiplier;          /* candela multiplier */
+    double lumens_per_lamp; /* -1 for absolute photometry */
+    double multiplier;      /* candela multiplier */
     double ballast_factor;
     double ballast_lamp_factor; /* 1995+: "future use", normally 1 */
     double input_watts;
-    int photometric_type;       /* 1 = C, 2 = B, 3 = A */
-    int units;                  /* 1 = feet, 2 = metres (width, length, height) */
+    int photometric_type; /* 1 = C, 2 = B, 3 = A */
+    int units;            /* 1 = feet, 2 = metres (width, length, height) */
     double width, length, height;
     int vertical_count, horizontal_count;
     const float *vertical_angles;   /* degrees, increasing; borrowed until lx_ies_free */

@@ -25,26 +25,67 @@ extern "C" {
 #define LX_DEG2RAD(d) ((d) * (LX_PI / 180.0f))
 #define LX_RAD2DEG(r) ((r) * (180.0f / LX_PI))
 
-typedef struct lx_vec2 { float x, y; } lx_vec2;
-typedef struct lx_vec3 { float x, y, z; } lx_vec3;
-typedef struct lx_vec4 { float x, y, z, w; } lx_vec4;
-typedef struct lx_mat4 { float m[16]; } lx_mat4;
+typedef struct lx_vec2 {
+    float x, y;
+} lx_vec2;
+typedef struct lx_vec3 {
+    float x, y, z;
+} lx_vec3;
+typedef struct lx_vec4 {
+    float x, y, z, w;
+} lx_vec4;
+typedef struct lx_mat4 {
+    float m[16];
+} lx_mat4;
 
-static inline lx_vec2 lx_v2(float x, float y) { lx_vec2 r = {x, y}; return r; }
-static inline lx_vec3 lx_v3(float x, float y, float z) { lx_vec3 r = {x, y, z}; return r; }
-static inline lx_vec4 lx_v4(float x, float y, float z, float w) { lx_vec4 r = {x, y, z, w}; return r; }
+static inline lx_vec2 lx_v2(float x, float y)
+{
+    lx_vec2 r = {x, y};
+    return r;
+}
+static inline lx_vec3 lx_v3(float x, float y, float z)
+{
+    lx_vec3 r = {x, y, z};
+    return r;
+}
+static inline lx_vec4 lx_v4(float x, float y, float z, float w)
+{
+    lx_vec4 r = {x, y, z, w};
+    return r;
+}
 
-static inline lx_vec3 lx_add(lx_vec3 a, lx_vec3 b) { return lx_v3(a.x + b.x, a.y + b.y, a.z + b.z); }
-static inline lx_vec3 lx_sub(lx_vec3 a, lx_vec3 b) { return lx_v3(a.x - b.x, a.y - b.y, a.z - b.z); }
-static inline lx_vec3 lx_mul(lx_vec3 a, lx_vec3 b) { return lx_v3(a.x * b.x, a.y * b.y, a.z * b.z); }
-static inline lx_vec3 lx_scale(lx_vec3 a, float s) { return lx_v3(a.x * s, a.y * s, a.z * s); }
-static inline lx_vec3 lx_neg(lx_vec3 a) { return lx_v3(-a.x, -a.y, -a.z); }
-static inline float lx_dot(lx_vec3 a, lx_vec3 b) { return a.x * b.x + a.y * b.y + a.z * b.z; }
+static inline lx_vec3 lx_add(lx_vec3 a, lx_vec3 b)
+{
+    return lx_v3(a.x + b.x, a.y + b.y, a.z + b.z);
+}
+static inline lx_vec3 lx_sub(lx_vec3 a, lx_vec3 b)
+{
+    return lx_v3(a.x - b.x, a.y - b.y, a.z - b.z);
+}
+static inline lx_vec3 lx_mul(lx_vec3 a, lx_vec3 b)
+{
+    return lx_v3(a.x * b.x, a.y * b.y, a.z * b.z);
+}
+static inline lx_vec3 lx_scale(lx_vec3 a, float s)
+{
+    return lx_v3(a.x * s, a.y * s, a.z * s);
+}
+static inline lx_vec3 lx_neg(lx_vec3 a)
+{
+    return lx_v3(-a.x, -a.y, -a.z);
+}
+static inline float lx_dot(lx_vec3 a, lx_vec3 b)
+{
+    return a.x * b.x + a.y * b.y + a.z * b.z;
+}
 static inline lx_vec3 lx_cross(lx_vec3 a, lx_vec3 b)
 {
     return lx_v3(a.y * b.z - a.z * b.y, a.z * b.x - a.x * b.z, a.x * b.y - a.y * b.x);
 }
-static inline float lx_length(lx_vec3 a) { return sqrtf(lx_dot(a, a)); }
+static inline float lx_length(lx_vec3 a)
+{
+    return sqrtf(lx_dot(a, a));
+}
 static inline lx_vec3 lx_normalize(lx_vec3 a)
 {
     float len = lx_length(a);
@@ -74,7 +115,10 @@ static inline float lx_clampf(float x, float lo, float hi)
 {
     return x < lo ? lo : (x > hi ? hi : x);
 }
-static inline float lx_saturate(float x) { return lx_clampf(x, 0.0f, 1.0f); }
+static inline float lx_saturate(float x)
+{
+    return lx_clampf(x, 0.0f, 1.0f);
+}
 
 /* Any unit vector perpendicular to n (n must be unit length). */
 static inline lx_vec3 lx_perpendicular(lx_vec3 n)

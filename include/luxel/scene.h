@@ -43,43 +43,43 @@ typedef struct lx_mesh {
     char *name;
     uint32_t vertex_count;
     uint32_t triangle_count;
-    lx_vec3 *positions;               /* vertex_count */
-    lx_vec3 *normals;                 /* vertex_count, unit length */
-    lx_vec4 *tangents;                /* vertex_count or NULL */
-    lx_vec2 *uv[LX_MAX_UV_SETS];      /* vertex_count each, or NULL */
-    uint32_t *indices;                /* 3 * triangle_count */
-    uint32_t material;                /* index into scene->materials */
+    lx_vec3 *positions;          /* vertex_count */
+    lx_vec3 *normals;            /* vertex_count, unit length */
+    lx_vec4 *tangents;           /* vertex_count or NULL */
+    lx_vec2 *uv[LX_MAX_UV_SETS]; /* vertex_count each, or NULL */
+    uint32_t *indices;           /* 3 * triangle_count */
+    uint32_t material;           /* index into scene->materials */
 } lx_mesh;
 
 typedef struct lx_material {
     char *name;
-    lx_vec4 base_color;   /* linear RGBA factor */
+    lx_vec4 base_color;      /* linear RGBA factor */
     lx_image base_color_map; /* linear RGBA (sRGB-decoded), width 0 if none */
     int base_color_uv_set;
-    lx_image normal_map;  /* raw tangent-space normals in [0,1], width 0 if none */
-    float normal_scale;   /* glTF normalTexture.scale, 1 by default */
-    int normal_uv_set;    /* UV set the normal map uses */
+    lx_image normal_map;   /* raw tangent-space normals in [0,1], width 0 if none */
+    float normal_scale;    /* glTF normalTexture.scale, 1 by default */
+    int normal_uv_set;     /* UV set the normal map uses */
     char *normal_map_path; /* where it came from (for messages), or NULL */
 } lx_material;
 
 typedef struct lx_node {
-    char *name;           /* unique within the scene */
-    lx_mat4 world;        /* object to world */
-    uint32_t *meshes;     /* indices into scene->meshes */
+    char *name;       /* unique within the scene */
+    lx_mat4 world;    /* object to world */
+    uint32_t *meshes; /* indices into scene->meshes */
     uint32_t mesh_count;
 } lx_node;
 
 typedef struct lx_scene {
-    char *path;           /* file the scene came from, or a given name */
+    char *path; /* file the scene came from, or a given name */
     lx_mesh *meshes;
     uint32_t mesh_count;
     lx_material *materials;
     uint32_t material_count;
-    lx_node *nodes;       /* only nodes that carry meshes */
+    lx_node *nodes; /* only nodes that carry meshes */
     uint32_t node_count;
     lx_light *lights;
     uint32_t light_count;
-    lx_vec3 ambient;      /* constant scene ambient (lux) */
+    lx_vec3 ambient; /* constant scene ambient (lux) */
     /* internal bookkeeping for growth; do not touch */
     uint32_t mesh_capacity, material_capacity, node_capacity, light_capacity;
 } lx_scene;

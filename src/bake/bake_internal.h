@@ -17,28 +17,28 @@ typedef struct lx_texel {
     lx_vec3 position;  /* object space */
     lx_vec3 normal;    /* object space shading normal, normal map applied */
     lx_vec3 geometric_normal;
-    lx_vec3 albedo;    /* base colour (factor x texture) */
+    lx_vec3 albedo; /* base colour (factor x texture) */
 } lx_texel;
 
 typedef struct lx_lightmap {
     lx_lightmap_info info;
     char *name;
-    lx_texel *texels;    /* info.used_texels, grouped by tile */
+    lx_texel *texels;     /* info.used_texels, grouped by tile */
     uint32_t *tile_start; /* tile_count + 1 offsets into texels */
     uint32_t tile_count;
     lx_vec3 *world_position; /* per texel, for the node's current transform */
     lx_vec3 *world_normal;
     lx_vec3 *world_geometric_normal;
-    uint8_t *mask;     /* width * height */
-    float *baked;      /* width * height * 3 */
-    float *realtime;   /* width * height * 3 */
+    uint8_t *mask;   /* width * height */
+    float *baked;    /* width * height * 3 */
+    float *realtime; /* width * height * 3 */
 } lx_lightmap;
 
 struct lx_baker {
     lx_bake_desc desc;
     lx_lightmap *maps;
     uint32_t map_count;
-    uint32_t *node_map;  /* scene node -> map index or UINT32_MAX */
+    uint32_t *node_map; /* scene node -> map index or UINT32_MAX */
     uint32_t node_count;
     lx_mat4 *node_world;
     lx_light *lights;
@@ -47,7 +47,7 @@ struct lx_baker {
     lx_tracer *tracer;
     bool tracer_dirty;
     float scene_diagonal;
-    float bias;          /* shadow ray origin offset, metres */
+    float bias; /* shadow ray origin offset, metres */
 };
 
 /* Bytes a lightmap needs per texel at most: raster scratch, mask, baked and
@@ -56,8 +56,8 @@ struct lx_baker {
 
 /* The size of node's lightmap under desc (texel_map.c); 0 x 0 when the node
  * has no UVs. */
-void lx_texel_map_size(const lx_scene *scene, uint32_t node, const lx_bake_desc *desc,
-                       int *width, int *height);
+void lx_texel_map_size(const lx_scene *scene, uint32_t node, const lx_bake_desc *desc, int *width,
+                       int *height);
 
 /* Builds the texel map of scene node `node` into map (texel_map.c).
  * Returns LX_OK with map->info.used_texels == 0 and a warning when the

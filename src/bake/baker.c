@@ -92,8 +92,8 @@ lx_status lx_baker_create(const lx_scene *scene, const lx_bake_desc *in, lx_bake
         with_uvs += w > 0;
     }
     char what[400];
-    snprintf(what, sizeof what, "%s: baking %u lightmaps (the largest %dx%d)", scene->path, with_uvs,
-             largest, largest);
+    snprintf(what, sizeof what, "%s: baking %u lightmaps (the largest %dx%d)", scene->path,
+             with_uvs, largest, largest);
     if ((st = lx_check_memory(bytes, what)) != LX_OK) {
         lx_baker_destroy(b);
         return st;
@@ -137,7 +137,10 @@ void lx_baker_destroy(lx_baker *b)
     free(b);
 }
 
-uint32_t lx_baker_lightmap_count(const lx_baker *b) { return b->map_count; }
+uint32_t lx_baker_lightmap_count(const lx_baker *b)
+{
+    return b->map_count;
+}
 
 const lx_lightmap_info *lx_baker_lightmap_info(const lx_baker *b, uint32_t map)
 {
@@ -149,7 +152,10 @@ const uint8_t *lx_baker_mask(const lx_baker *b, uint32_t map)
     return map < b->map_count ? b->maps[map].mask : NULL;
 }
 
-uint32_t lx_baker_light_count(const lx_baker *b) { return b->light_count; }
+uint32_t lx_baker_light_count(const lx_baker *b)
+{
+    return b->light_count;
+}
 
 const lx_light *lx_baker_light(const lx_baker *b, uint32_t light)
 {
@@ -159,8 +165,7 @@ const lx_light *lx_baker_light(const lx_baker *b, uint32_t light)
 lx_status lx_baker_set_light(lx_baker *b, uint32_t light, const lx_light *value)
 {
     if (light >= b->light_count)
-        return lx_fail(LX_ERR_INVALID, "light %u out of range (count %u)", light,
-                       b->light_count);
+        return lx_fail(LX_ERR_INVALID, "light %u out of range (count %u)", light, b->light_count);
     lx_status st = lx_light_validate(value);
     if (st != LX_OK)
         return st;
@@ -238,8 +243,8 @@ lx_status lx_baker_apply(const lx_baker *b, uint32_t map_index, lx_image *out)
     const lx_lightmap *map = &b->maps[map_index];
     int w = map->info.width, h = map->info.height;
     if (!out || out->width != w || out->height != h || out->channels != 3 || !out->data)
-        return lx_fail(LX_ERR_INVALID, "lightmap '%s': output must be a %dx%d RGB image",
-                       map->name, w, h);
+        return lx_fail(LX_ERR_INVALID, "lightmap '%s': output must be a %dx%d RGB image", map->name,
+                       w, h);
     size_t pixels = (size_t)w * h;
     memset(out->data, 0, pixels * 3 * sizeof(float));
     for (uint32_t i = 0; i < map->info.used_texels; i++) {

@@ -33,8 +33,8 @@ static lx_ray shadow_ray(const lx_baker *b, lx_vec3 p, lx_vec3 ng, const lx_ligh
     return r;
 }
 
-static void light_tile(const lx_baker *b, const lx_lightmap *map, uint32_t first,
-                       uint32_t count, const lx_light *light, lx_vec3 *accum)
+static void light_tile(const lx_baker *b, const lx_lightmap *map, uint32_t first, uint32_t count,
+                       const lx_light *light, lx_vec3 *accum)
 {
     lx_ray rays[LX_TILE * LX_TILE];
     pending_ray pending[LX_TILE * LX_TILE];
@@ -71,9 +71,8 @@ static void light_tile(const lx_baker *b, const lx_lightmap *map, uint32_t first
             accum[pending[j].texel] = lx_add(accum[pending[j].texel], pending[j].illuminance);
 }
 
-lx_status lx_bake_lights(lx_baker *b, const uint32_t *lights, uint32_t light_count,
-                         lx_vec3 ambient, bool to_realtime, float progress_base,
-                         float progress_span)
+lx_status lx_bake_lights(lx_baker *b, const uint32_t *lights, uint32_t light_count, lx_vec3 ambient,
+                         bool to_realtime, float progress_base, float progress_span)
 {
     if (b->tracer_dirty) {
         lx_status st = lx_tracer_commit(b->tracer);

@@ -14,10 +14,10 @@
 
 typedef struct raster_ctx {
     int width, height;
-    uint32_t *owner;    /* per pixel: node-local triangle id, UINT32_MAX = none */
-    float *b1, *b2;     /* barycentrics of vertices 1 and 2 */
-    float *distance;    /* 0 for centre coverage, else texel-space distance */
-    uint8_t *strict;    /* centre strictly inside the owner */
+    uint32_t *owner; /* per pixel: node-local triangle id, UINT32_MAX = none */
+    float *b1, *b2;  /* barycentrics of vertices 1 and 2 */
+    float *distance; /* 0 for centre coverage, else texel-space distance */
+    uint8_t *strict; /* centre strictly inside the owner */
     uint32_t overlap;
     uint32_t *slot_overlap; /* overlapping texels counted by the later mesh */
 } raster_ctx;
@@ -246,9 +246,8 @@ static lx_status check_uv_triangles(const lx_scene *scene, const slot *s, const 
         double e1x = b.x - a.x, e1y = b.y - a.y, e2x = c.x - a.x, e2y = c.y - a.y;
         double cross = e1x * e2y - e2x * e1y;
         double longest = fmax(e1x * e1x + e1y * e1y,
-                              fmax(e2x * e2x + e2y * e2y,
-                                   (c.x - b.x) * (double)(c.x - b.x) +
-                                       (c.y - b.y) * (double)(c.y - b.y)));
+                              fmax(e2x * e2x + e2y * e2y, (c.x - b.x) * (double)(c.x - b.x) +
+                                                              (c.y - b.y) * (double)(c.y - b.y)));
         skip[t] = 0;
         if (!(fabs(cross) > 1e-7 * longest) || longest == 0.0) {
             if (!desc->skip_degenerate)
@@ -310,8 +309,8 @@ static lx_vec3 sample_albedo(const lx_material *mat, const lx_mesh *m, const uin
 }
 
 /* Choose the node's lightmap UV set and its meshes with UVs. */
-static uint32_t collect_slots(const lx_scene *scene, const lx_node *node, slot *slots,
-                              int *uv_set, bool warn)
+static uint32_t collect_slots(const lx_scene *scene, const lx_node *node, slot *slots, int *uv_set,
+                              bool warn)
 {
     bool all_have_uv1 = true;
     for (uint32_t k = 0; k < node->mesh_count; k++) {
@@ -326,21 +325,25 @@ static uint32_t collect_slots(const lx_scene *scene, const lx_node *node, slot *
         const lx_vec2 *uv = m->uv[*uv_set];
         if (!uv) {
             if (warn)
-                lx_log(LX_LOG_WARN, "%s: node '%s': mesh '%s' has no UVs; it gets no lightmap "
-                   "texels (it still casts shadows)", scene->path, node->name, m->name);
+                lx_log(LX_LOG_WARN,
+                       "%s: node '%s': mesh '%s' has no UVs; it gets no lightmap "
+                       "texels (it still casts shadows)",
+                       scene->path, node->name, m->name);
             continue;
         }
         if (*uv_set == 0 && warn)
-            lx_log(LX_LOG_WARN, "%s: node '%s': mesh '%s' has no TEXCOORD_1; its lightmap "
-                   "uses TEXCOORD_0", scene->path, node->name, m->name);
+            lx_log(LX_LOG_WARN,
+                   "%s: node '%s': mesh '%s' has no TEXCOORD_1; its lightmap "
+                   "uses TEXCOORD_0",
+                   scene->path, node->name, m->name);
         slots[n++] = (slot){m, node->meshes[k], first, uv};
         first += m->triangle_count;
     }
     return n;
 }
 
-lx_status lx_texel_map_build(const lx_scene *scene, uint32_t node_index,
-                             const lx_bake_desc *desc, lx_lightmap *map)
+lx_status lx_texel_map_build(const lx_scene *scene, uint32_t node_index, const lx_bake_desc *desc,
+                             lx_lightmap *map)
 {
     const lx_node *node = &scene->nodes[node_index];
     memset(map, 0, sizeof *map);
@@ -488,9 +491,9 @@ lx_status lx_texel_map_build(const lx_scene *scene, uint32_t node_index,
                     tx_->position =
                         lx_add(lx_add(lx_scale(pa, w0), lx_scale(pb, w1)), lx_scale(pc, w2));
                     tx_->geometric_normal = lx_normalize(lx_cross(lx_sub(pb, pa), lx_sub(pc, pa)));
-                    lx_vec3 nrm = lx_add(lx_add(lx_scale(m->normals[i[0]], w0),
-                                                lx_scale(m->normals[i[1]], w1)),
-                                         lx_scale(m->normals[i[2]], w2));
+                    lx_vec3 nrm = lx_add(
+                        lx_add(lx_scale(m->normals[i[0]], w0), lx_scale(m->normals[i[1]], w1)),
+                        lx_scale(m->normals[i[2]], w2));
                     nrm = lx_length(nrm) > 1e-12f ? lx_normalize(nrm) : tx_->geometric_normal;
                     const lx_material *mat = &scene->materials[m->material];
                     if (tangents[s])

@@ -12,22 +12,38 @@ static _Thread_local char error_message[LX_ERROR_MAX];
 static lx_log_fn log_fn;
 static void *log_user;
 
-const char *lx_version(void) { return LX_VERSION; }
+const char *lx_version(void)
+{
+    return LX_VERSION;
+}
 
-const char *lx_last_error(void) { return error_message; }
+const char *lx_last_error(void)
+{
+    return error_message;
+}
 
-void lx_clear_error(void) { error_message[0] = '\0'; }
+void lx_clear_error(void)
+{
+    error_message[0] = '\0';
+}
 
 const char *lx_status_name(lx_status status)
 {
     switch (status) {
-    case LX_OK: return "LX_OK";
-    case LX_ERR_IO: return "LX_ERR_IO";
-    case LX_ERR_FORMAT: return "LX_ERR_FORMAT";
-    case LX_ERR_INVALID: return "LX_ERR_INVALID";
-    case LX_ERR_NOMEM: return "LX_ERR_NOMEM";
-    case LX_ERR_UNSUPPORTED: return "LX_ERR_UNSUPPORTED";
-    case LX_ERR_CANCELLED: return "LX_ERR_CANCELLED";
+    case LX_OK:
+        return "LX_OK";
+    case LX_ERR_IO:
+        return "LX_ERR_IO";
+    case LX_ERR_FORMAT:
+        return "LX_ERR_FORMAT";
+    case LX_ERR_INVALID:
+        return "LX_ERR_INVALID";
+    case LX_ERR_NOMEM:
+        return "LX_ERR_NOMEM";
+    case LX_ERR_UNSUPPORTED:
+        return "LX_ERR_UNSUPPORTED";
+    case LX_ERR_CANCELLED:
+        return "LX_ERR_CANCELLED";
     }
     return "LX_ERR_UNKNOWN";
 }

@@ -16,14 +16,15 @@ lx_status lx_image_alloc(lx_image *img, int width, int height, int channels)
 {
     memset(img, 0, sizeof *img);
     if (width < 1 || height < 1 || channels < 1 || channels > 4)
-        return lx_fail(LX_ERR_INVALID, "image %dx%d with %d channels: width and height must be "
-                                       ">= 1 and channels 1..4",
+        return lx_fail(LX_ERR_INVALID,
+                       "image %dx%d with %d channels: width and height must be "
+                       ">= 1 and channels 1..4",
                        width, height, channels);
     size_t count, bytes;
     if (!lx_size_mul((size_t)width, (size_t)height, (size_t)channels, &count) ||
         !lx_size_mul(count, sizeof(float), 1, &bytes))
-        return lx_fail(LX_ERR_NOMEM, "image %dx%d with %d channels: size overflows memory",
-                       width, height, channels);
+        return lx_fail(LX_ERR_NOMEM, "image %dx%d with %d channels: size overflows memory", width,
+                       height, channels);
     char what[96];
     snprintf(what, sizeof what, "image %dx%d (%d channels)", width, height, channels);
     lx_status s = lx_check_memory(bytes, what);
@@ -73,7 +74,7 @@ static const struct {
     const char *ext;
     lx_image_format format;
 } format_exts[] = {
-    {"exr", LX_IMAGE_EXR}, {"hdr", LX_IMAGE_HDR}, {"pfm", LX_IMAGE_PFM}, {"png", LX_IMAGE_PNG},
+    {"exr", LX_IMAGE_EXR}, {"hdr", LX_IMAGE_HDR},  {"pfm", LX_IMAGE_PFM}, {"png", LX_IMAGE_PNG},
     {"jpg", LX_IMAGE_JPG}, {"jpeg", LX_IMAGE_JPG}, {"tga", LX_IMAGE_TGA},
 };
 
@@ -102,13 +103,20 @@ lx_image_format lx_image_format_from_path(const char *path)
 const char *lx_image_format_extension(lx_image_format format)
 {
     switch (format) {
-    case LX_IMAGE_EXR: return "exr";
-    case LX_IMAGE_HDR: return "hdr";
-    case LX_IMAGE_PFM: return "pfm";
-    case LX_IMAGE_PNG: return "png";
-    case LX_IMAGE_JPG: return "jpg";
-    case LX_IMAGE_TGA: return "tga";
-    case LX_IMAGE_AUTO: break;
+    case LX_IMAGE_EXR:
+        return "exr";
+    case LX_IMAGE_HDR:
+        return "hdr";
+    case LX_IMAGE_PFM:
+        return "pfm";
+    case LX_IMAGE_PNG:
+        return "png";
+    case LX_IMAGE_JPG:
+        return "jpg";
+    case LX_IMAGE_TGA:
+        return "tga";
+    case LX_IMAGE_AUTO:
+        break;
     }
     return NULL;
 }
@@ -138,21 +146,35 @@ static bool plausible_tga(const unsigned char *d, size_t n)
     if (n < 18 || d[1] > 1)
         return false;
     switch (d[2]) {
-    case 1: case 2: case 3: case 9: case 10: case 11: return true;
-    default: return false;
+    case 1:
+    case 2:
+    case 3:
+    case 9:
+    case 10:
+    case 11:
+        return true;
+    default:
+        return false;
     }
 }
 
 static const char *format_title(lx_image_format f)
 {
     switch (f) {
-    case LX_IMAGE_EXR: return "an OpenEXR file (bad magic number)";
-    case LX_IMAGE_HDR: return "a Radiance HDR file (no \"#?\" header)";
-    case LX_IMAGE_PFM: return "a PFM file (header must start with \"PF\" or \"Pf\")";
-    case LX_IMAGE_PNG: return "a PNG file (no PNG signature)";
-    case LX_IMAGE_JPG: return "a JPEG file (no JPEG marker)";
-    case LX_IMAGE_TGA: return "a TGA file (implausible header)";
-    case LX_IMAGE_AUTO: break;
+    case LX_IMAGE_EXR:
+        return "an OpenEXR file (bad magic number)";
+    case LX_IMAGE_HDR:
+        return "a Radiance HDR file (no \"#?\" header)";
+    case LX_IMAGE_PFM:
+        return "a PFM file (header must start with \"PF\" or \"Pf\")";
+    case LX_IMAGE_PNG:
+        return "a PNG file (no PNG signature)";
+    case LX_IMAGE_JPG:
+        return "a JPEG file (no JPEG marker)";
+    case LX_IMAGE_TGA:
+        return "a TGA file (implausible header)";
+    case LX_IMAGE_AUTO:
+        break;
     }
     return "an image";
 }
@@ -252,8 +274,12 @@ lx_status lx_image_load_memory(const void *bytes, size_t size, const char *name,
 
     lx_status s;
     switch (format) {
-    case LX_IMAGE_EXR: s = lx_img_load_exr(data, size, name, out); break;
-    case LX_IMAGE_PFM: s = lx_img_load_pfm(data, size, name, out); break;
+    case LX_IMAGE_EXR:
+        s = lx_img_load_exr(data, size, name, out);
+        break;
+    case LX_IMAGE_PFM:
+        s = lx_img_load_pfm(data, size, name, out);
+        break;
     default:
         s = lx_img_load_stb(data, size, name, format == LX_IMAGE_TGA, d.raw_8bit, out);
         break;
@@ -330,8 +356,7 @@ lx_status lx_image_write(const char *path, const lx_image *img, const lx_image_w
     if (desc)
         d = *desc;
     size_t count;
-    if (!img->data || img->width < 1 || img->height < 1 || img->channels < 1 ||
-        img->channels > 4 ||
+    if (!img->data || img->width < 1 || img->height < 1 || img->channels < 1 || img->channels > 4 ||
         !lx_size_mul((size_t)img->width, (size_t)img->height, (size_t)img->channels, &count))
         return lx_fail(LX_ERR_INVALID, "%s: invalid image (%dx%d, %d channels, data %s)", path,
                        img->width, img->height, img->channels, img->data ? "set" : "NULL");
@@ -357,9 +382,15 @@ lx_status lx_image_write(const char *path, const lx_image *img, const lx_image_w
     if (s != LX_OK)
         return s;
     switch (format) {
-    case LX_IMAGE_PFM: s = lx_img_write_pfm(f.fp, path, img, exposure); break;
-    case LX_IMAGE_EXR: s = lx_img_write_exr(f.fp, path, img, exposure, d.half); break;
-    default: s = lx_img_write_stb(f.fp, path, img, format, exposure); break;
+    case LX_IMAGE_PFM:
+        s = lx_img_write_pfm(f.fp, path, img, exposure);
+        break;
+    case LX_IMAGE_EXR:
+        s = lx_img_write_exr(f.fp, path, img, exposure, d.half);
+        break;
+    default:
+        s = lx_img_write_stb(f.fp, path, img, format, exposure);
+        break;
     }
     if (s != LX_OK) {
         lx_out_abort(&f);

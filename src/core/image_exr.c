@@ -25,8 +25,7 @@ static void exr_on_error(exr_const_context_t ctxt, exr_result_t code, const char
     snprintf(exr_detail, sizeof exr_detail, "%s", msg ? msg : exr_get_default_error_message(code));
 }
 
-static lx_status exr_failure(exr_result_t rv, lx_status status, const char *name,
-                             const char *doing)
+static lx_status exr_failure(exr_result_t rv, lx_status status, const char *name, const char *doing)
 {
     const char *detail = exr_detail[0] ? exr_detail : exr_get_default_error_message(rv);
     if (rv == EXR_ERR_OUT_OF_MEMORY)
@@ -76,8 +75,7 @@ static int map_slot(const channel_map *map, const char *name)
     return -1;
 }
 
-static lx_status choose_channels(const exr_attr_chlist_t *list, const char *name,
-                                 channel_map *map)
+static lx_status choose_channels(const exr_attr_chlist_t *list, const char *name, channel_map *map)
 {
     bool has[5] = {false};
     static const char *const wanted[5] = {"R", "G", "B", "A", "Y"};
@@ -140,8 +138,9 @@ static lx_status decode_block(exr_reader *r, const exr_chunk_info_t *ci, int64_t
     lx_image *img = r->img;
     if (x0 < 0 || y0 < 0 || ci->width < 1 || ci->height < 1 || x0 + ci->width > img->width ||
         y0 + ci->height > img->height)
-        return lx_fail(LX_ERR_FORMAT, "%s: chunk %d (%dx%d at %lld, %lld) lies outside the "
-                                      "data window",
+        return lx_fail(LX_ERR_FORMAT,
+                       "%s: chunk %d (%dx%d at %lld, %lld) lies outside the "
+                       "data window",
                        r->name, ci->idx, ci->width, ci->height, (long long)x0, (long long)y0);
     exr_result_t rv = r->started ? exr_decoding_update(r->ctx, 0, ci, &r->dec)
                                  : exr_decoding_initialize(r->ctx, 0, ci, &r->dec);
@@ -163,8 +162,8 @@ static lx_status decode_block(exr_reader *r, const exr_chunk_info_t *ci, int64_t
         exr_coding_channel_info_t *ch = &r->dec.channels[c];
         if (ch->width != ci->width || ch->height != ci->height)
             return lx_fail(LX_ERR_FORMAT, "%s: chunk %d: channel %s is %dx%d, expected %dx%d",
-                           r->name, ci->idx, ch->channel_name ? ch->channel_name : "?",
-                           ch->width, ch->height, ci->width, ci->height);
+                           r->name, ci->idx, ch->channel_name ? ch->channel_name : "?", ch->width,
+                           ch->height, ci->width, ci->height);
         int slot = ch->channel_name ? map_slot(&r->map, ch->channel_name) : -1;
         if (slot >= 0 && from[slot] < 0)
             from[slot] = c;
@@ -273,8 +272,9 @@ static lx_status read_part(exr_reader *r)
         lx_log(LX_LOG_INFO, "%s: %d parts, reading the first", r->name, parts);
     if (exr_get_display_window(r->ctx, 0, &display) == EXR_ERR_SUCCESS &&
         memcmp(&display, &dw, sizeof dw) != 0)
-        lx_log(LX_LOG_INFO, "%s: reading the data window (%d, %d)-(%d, %d), not the display "
-                            "window",
+        lx_log(LX_LOG_INFO,
+               "%s: reading the data window (%d, %d)-(%d, %d), not the display "
+               "window",
                r->name, dw.min.x, dw.min.y, dw.max.x, dw.max.y);
     lx_status s = choose_channels(list, r->name, &r->map);
     if (s != LX_OK)
@@ -328,7 +328,7 @@ static uint16_t float_to_half(float f)
     uint32_t ax = x & 0x7fffffffu;
     if (ax >= 0x47800000u) /* >= 2^16: out of range (not reached) */
         return sign | 0x7c00u;
-    if (ax < 0x38800000u) { /* below 2^-14: subnormal half or zero */
+    if (ax < 0x38800000u) {   /* below 2^-14: subnormal half or zero */
         if (ax < 0x33000000u) /* below 2^-25: rounds to zero */
             return sign;
         uint32_t e = ax >> 23, m = (ax & 0x7fffffu) | 0x800000u;
@@ -373,8 +373,12 @@ static int exr_channel_layout(int channels, const char **names, int *index)
     static const char *const rgba[4] = {"A", "B", "G", "R"};
     static const int rgba_index[4] = {3, 2, 1, 0};
     switch (channels) {
-    case 1: names[0] = "Y", index[0] = 0; return 1;
-    case 2: names[0] = "A", index[0] = 1, names[1] = "Y", index[1] = 0; return 2;
+    case 1:
+        names[0] = "Y", index[0] = 0;
+        return 1;
+    case 2:
+        names[0] = "A", index[0] = 1, names[1] = "Y", index[1] = 0;
+        return 2;
     case 3:
         for (int i = 0; i < 3; i++)
             names[i] = rgba[i + 1], index[i] = rgba_index[i + 1];
@@ -490,8 +494,7 @@ lx_status lx_img_write_exr(FILE *fp, const char *path, const lx_image *img, floa
         rv = exr_write_header(ctx);
     lx_status s = rv == EXR_ERR_SUCCESS ? LX_OK : exr_failure(rv, LX_ERR_IO, path, "header");
     if (s == LX_OK)
-        s = write_exr_pixels(ctx, path, img, pixels, bytes_per_value, (uint16_t)type, names,
-                             count);
+        s = write_exr_pixels(ctx, path, img, pixels, bytes_per_value, (uint16_t)type, names, count);
     free(pixels);
     rv = exr_finish(&ctx);
     if (s == LX_OK && rv != EXR_ERR_SUCCESS)

@@ -40,15 +40,14 @@ static size_t next_line(const unsigned char *d, size_t size, size_t pos, bool *e
  * fails where stb would not: stb reads zeros past the end of the data
  * (a truncated file loads as black), and a zero-length run makes its RLE
  * loop spin forever. After this check stb never runs out of data. */
-static lx_status check_hdr_data(const unsigned char *d, size_t size, int w, int h,
-                                const char *name)
+static lx_status check_hdr_data(const unsigned char *d, size_t size, int w, int h, const char *name)
 {
     bool empty;
     size_t pos = next_line(d, size, 0, &empty); /* "#?RADIANCE" */
     do
         pos = next_line(d, size, pos, &empty);
     while (!empty && pos < size);
-    pos = next_line(d, size, pos, &empty); /* "-Y h +X w" */
+    pos = next_line(d, size, pos, &empty);   /* "-Y h +X w" */
     size_t flat = (size_t)w * (size_t)h * 4; /* w, h < 2^24 (stb's limit) */
     if (w < 8 || w >= 32768) {
         if (size - pos < flat)
@@ -66,8 +65,9 @@ static lx_status check_hdr_data(const unsigned char *d, size_t size, int w, int 
             return LX_OK;
         }
         if ((p[2] << 8 | p[3]) != w)
-            return lx_fail(LX_ERR_FORMAT, "%s: scanline %d: run-length header gives width %d, "
-                                          "expected %d",
+            return lx_fail(LX_ERR_FORMAT,
+                           "%s: scanline %d: run-length header gives width %d, "
+                           "expected %d",
                            name, y, p[2] << 8 | p[3], w);
         pos += 4;
         for (int c = 0; c < 4; c++) {
@@ -219,16 +219,15 @@ static lx_status check_jpeg(const unsigned char *d, size_t size, const char *nam
         if (m == 0xda) {
             /* entropy-coded data runs to the next marker: 0xff followed by
              * neither a stuffed 0, fill, nor a restart marker */
-            while (pos + 1 < size &&
-                   !(d[pos] == 0xff && d[pos + 1] != 0x00 && d[pos + 1] != 0xff &&
-                     (d[pos + 1] < 0xd0 || d[pos + 1] > 0xd7)))
+            while (pos + 1 < size && !(d[pos] == 0xff && d[pos + 1] != 0x00 && d[pos + 1] != 0xff &&
+                                       (d[pos + 1] < 0xd0 || d[pos + 1] > 0xd7)))
                 pos++;
         }
     }
     for (int i = 0; i < j.components; i++)
         if (!j.coded[i])
-            return lx_fail(LX_ERR_FORMAT, "%s: corrupt JPEG: component %d has no %sscan data",
-                           name, j.ids[i], j.progressive ? "DC " : "");
+            return lx_fail(LX_ERR_FORMAT, "%s: corrupt JPEG: component %d has no %sscan data", name,
+                           j.ids[i], j.progressive ? "DC " : "");
     return LX_OK;
 }
 
@@ -247,8 +246,9 @@ static lx_status check_tga_size(const unsigned char *d, size_t size, const char 
     bool rle = d[2] >= 9;
     size_t need = rle ? (w * h + 127) / 128 * (1 + pixel_bytes) : w * h * pixel_bytes;
     if (have < need)
-        return lx_fail(LX_ERR_FORMAT, "%s: truncated: %zux%zu %s needs %s%zu bytes of pixels, "
-                                      "found %zu",
+        return lx_fail(LX_ERR_FORMAT,
+                       "%s: truncated: %zux%zu %s needs %s%zu bytes of pixels, "
+                       "found %zu",
                        name, w, h, rle ? "run-length TGA" : "TGA", rle ? "at least " : "", need,
                        have);
     return LX_OK;
@@ -298,8 +298,8 @@ static lx_status check_png_data(const unsigned char *d, size_t size, const char 
     size_t n = 0;
     bool header = true;
     for (size_t pos = 8; size - pos >= 12;) {
-        size_t len = (size_t)d[pos] << 24 | (size_t)d[pos + 1] << 16 | (size_t)d[pos + 2] << 8 |
-                     d[pos + 3];
+        size_t len =
+            (size_t)d[pos] << 24 | (size_t)d[pos + 1] << 16 | (size_t)d[pos + 2] << 8 | d[pos + 3];
         const unsigned char *type = d + pos + 4;
         if (len > size - pos - 12 || memcmp(type, "IEND", 4) == 0)
             break;
@@ -450,8 +450,8 @@ static unsigned char encode_unorm8(float v)
     return (unsigned char)(v * 255.0f + 0.5f);
 }
 
-static lx_status write_8bit(FILE *fp, const char *path, const lx_image *img,
-                            lx_image_format format, float exposure)
+static lx_status write_8bit(FILE *fp, const char *path, const lx_image *img, lx_image_format format,
+                            float exposure)
 {
     int c = img->channels;
     /* stb_image_write sizes its buffers with int arithmetic */
@@ -467,7 +467,7 @@ static lx_status write_8bit(FILE *fp, const char *path, const lx_image *img,
     for (size_t i = 0; i < n; i++) {
         float v = img->data[i];
         bytes[i] = is_alpha((int)(i % (size_t)c), c) ? encode_unorm8(v)
-                                                      : encode_srgb8(thresholds, v * exposure);
+                                                     : encode_srgb8(thresholds, v * exposure);
     }
     int ok;
     switch (format) {
@@ -484,8 +484,7 @@ static lx_status write_8bit(FILE *fp, const char *path, const lx_image *img,
     }
     free(bytes);
     if (!ok)
-        return lx_fail(LX_ERR_IO, "%s: cannot encode %s", path,
-                       lx_image_format_extension(format));
+        return lx_fail(LX_ERR_IO, "%s: cannot encode %s", path, lx_image_format_extension(format));
     return LX_OK;
 }
 
@@ -511,8 +510,8 @@ static lx_status write_hdr(FILE *fp, const char *path, const lx_image *img, floa
         values[i] = v;
     }
     if (negative)
-        lx_log(LX_LOG_WARN, "%s: %zu negative values written as 0 (Radiance HDR has no sign)",
-               path, negative);
+        lx_log(LX_LOG_WARN, "%s: %zu negative values written as 0 (Radiance HDR has no sign)", path,
+               negative);
     int ok = stbi_write_hdr_to_func(write_to_file, fp, img->width, img->height, c, values);
     free(values);
     if (!ok)
@@ -520,8 +519,8 @@ static lx_status write_hdr(FILE *fp, const char *path, const lx_image *img, floa
     return LX_OK;
 }
 
-lx_status lx_img_write_stb(FILE *fp, const char *path, const lx_image *img,
-                           lx_image_format format, float exposure)
+lx_status lx_img_write_stb(FILE *fp, const char *path, const lx_image *img, lx_image_format format,
+                           float exposure)
 {
     if (format == LX_IMAGE_HDR)
         return write_hdr(fp, path, img, exposure);

@@ -19,8 +19,7 @@ static lx_status next_field(const unsigned char *d, size_t size, size_t *pos, ch
 {
     size_t p = *pos;
     if (p >= size || !isspace(d[p]))
-        return lx_fail(LX_ERR_FORMAT, "%s: header: expected whitespace before the %s", name,
-                       what);
+        return lx_fail(LX_ERR_FORMAT, "%s: header: expected whitespace before the %s", name, what);
     while (p < size && isspace(d[p]))
         p++;
     size_t n = 0;
@@ -40,13 +39,13 @@ static lx_status parse_size(const char *tok, const char *name, const char *what,
 {
     for (const char *c = tok; *c; c++)
         if (!isdigit((unsigned char)*c))
-            return lx_fail(LX_ERR_FORMAT, "%s: header: %s \"%s\" is not a positive integer",
-                           name, what, tok);
+            return lx_fail(LX_ERR_FORMAT, "%s: header: %s \"%s\" is not a positive integer", name,
+                           what, tok);
     errno = 0;
     long v = strtol(tok, NULL, 10);
     if (errno || v < 1 || v > INT_MAX)
-        return lx_fail(LX_ERR_FORMAT, "%s: header: %s %s is out of range (1..%d)", name, what,
-                       tok, INT_MAX);
+        return lx_fail(LX_ERR_FORMAT, "%s: header: %s %s is out of range (1..%d)", name, what, tok,
+                       INT_MAX);
     *out = (int)v;
     return LX_OK;
 }
@@ -86,10 +85,9 @@ static int scale_sign(const char *t)
 
 static float float_from_bytes(const unsigned char *b, bool little)
 {
-    uint32_t u = little ? (uint32_t)b[0] | (uint32_t)b[1] << 8 | (uint32_t)b[2] << 16 |
-                              (uint32_t)b[3] << 24
-                        : (uint32_t)b[3] | (uint32_t)b[2] << 8 | (uint32_t)b[1] << 16 |
-                              (uint32_t)b[0] << 24;
+    uint32_t u =
+        little ? (uint32_t)b[0] | (uint32_t)b[1] << 8 | (uint32_t)b[2] << 16 | (uint32_t)b[3] << 24
+               : (uint32_t)b[3] | (uint32_t)b[2] << 8 | (uint32_t)b[1] << 16 | (uint32_t)b[0] << 24;
     float f;
     memcpy(&f, &u, sizeof f);
     return f;
@@ -99,8 +97,7 @@ lx_status lx_img_load_pfm(const unsigned char *data, size_t size, const char *na
 {
     memset(out, 0, sizeof *out);
     if (size < 2 || data[0] != 'P' || (data[1] != 'F' && data[1] != 'f'))
-        return lx_fail(LX_ERR_FORMAT, "%s: not a PFM file (header must start with PF or Pf)",
-                       name);
+        return lx_fail(LX_ERR_FORMAT, "%s: not a PFM file (header must start with PF or Pf)", name);
     int channels = data[1] == 'F' ? 3 : 1;
     size_t pos = 2;
     char tok[64];

@@ -47,8 +47,7 @@ lx_status lx_check_memory(uint64_t bytes, const char *what)
     char need_s[32], have_s[32];
     format_bytes(bytes, need_s, sizeof need_s);
     format_bytes(have, have_s, sizeof have_s);
-    return lx_fail(LX_ERR_NOMEM, "%s needs %s of memory, the machine has %s", what, need_s,
-                   have_s);
+    return lx_fail(LX_ERR_NOMEM, "%s needs %s of memory, the machine has %s", what, need_s, have_s);
 }
 
 int lx_thread_count(int requested)
@@ -143,8 +142,7 @@ lx_status lx_out_commit(lx_out_file *f)
         int err = errno;
         char *path = lx_strdup(f->path);
         lx_out_abort(f);
-        lx_status s = lx_fail(LX_ERR_IO, "%s: write failed: %s", path ? path : "?",
-                              strerror(err));
+        lx_status s = lx_fail(LX_ERR_IO, "%s: write failed: %s", path ? path : "?", strerror(err));
         free(path);
         return s;
     }
@@ -152,8 +150,8 @@ lx_status lx_out_commit(lx_out_file *f)
         int err = errno;
         char *path = lx_strdup(f->path);
         lx_out_abort(f);
-        lx_status s = lx_fail(LX_ERR_IO, "%s: cannot rename temporary file: %s",
-                              path ? path : "?", strerror(err));
+        lx_status s = lx_fail(LX_ERR_IO, "%s: cannot rename temporary file: %s", path ? path : "?",
+                              strerror(err));
         free(path);
         return s;
     }

@@ -284,7 +284,10 @@ static lx_status read_tilt(ies_reader *r)
 
 /* ---- symmetry ------------------------------------------------------------- */
 
-static bool near(float a, double b) { return fabs((double)a - b) <= IES_ANGLE_EPS; }
+static bool near(float a, double b)
+{
+    return fabs((double)a - b) <= IES_ANGLE_EPS;
+}
 
 static lx_status classify(lx_ies_profile *p, const char *name, int vline, int hline)
 {
@@ -425,8 +428,9 @@ static lx_status parse(lx_ies_profile *p, ies_reader *r)
             p->peak = p->cd[i];
     }
     if (next_token(r))
-        return lx_fail(LX_ERR_FORMAT, "%s: line %d: unexpected '%.20s' after the %llu candela values",
-                       r->name, r->tok_line, r->tok, (unsigned long long)total);
+        return lx_fail(LX_ERR_FORMAT,
+                       "%s: line %d: unexpected '%.20s' after the %llu candela values", r->name,
+                       r->tok_line, r->tok, (unsigned long long)total);
     return classify(p, r->name, vline, hline);
 }
 
@@ -543,7 +547,10 @@ static void horizontal_weights(const lx_ies_profile *p, float h, int *h0, int *h
     *h1 = i + 1;
 }
 
-static float lerp(float a, float b, float t) { return a + (b - a) * t; }
+static float lerp(float a, float b, float t)
+{
+    return a + (b - a) * t;
+}
 
 static float candela_at(const lx_ies_profile *p, float v, int h0, int h1, float th)
 {
@@ -600,15 +607,18 @@ double lx_ies_total_lumens(const lx_ies_profile *p)
         double column = 0.0;
         for (int i = 0; i < nt; i++) {
             double theta = (i + 0.5) * dt;
-            column += (double)candela_at(p, (float)(theta * (180.0 / IES_PI)), h0, h1, th) *
-                      sin(theta);
+            column +=
+                (double)candela_at(p, (float)(theta * (180.0 / IES_PI)), h0, h1, th) * sin(theta);
         }
         sum += column;
     }
     return sum * dt * dp;
 }
 
-float lx_ies_peak_candela(const lx_ies_profile *p) { return p ? p->peak : 0.0f; }
+float lx_ies_peak_candela(const lx_ies_profile *p)
+{
+    return p ? p->peak : 0.0f;
+}
 
 /* ---- header access --------------------------------------------------------- */
 
@@ -650,11 +660,16 @@ const char *lx_ies_keyword(const lx_ies_profile *p, int index, const char **valu
 const char *lx_ies_symmetry_name(lx_ies_symmetry s)
 {
     switch (s) {
-    case LX_IES_ROTATIONAL: return "rotational";
-    case LX_IES_QUADRANT: return "quadrant";
-    case LX_IES_BILATERAL: return "bilateral 0-180";
-    case LX_IES_BILATERAL_90: return "bilateral 90-270";
-    case LX_IES_FULL: return "full";
+    case LX_IES_ROTATIONAL:
+        return "rotational";
+    case LX_IES_QUADRANT:
+        return "quadrant";
+    case LX_IES_BILATERAL:
+        return "bilateral 0-180";
+    case LX_IES_BILATERAL_90:
+        return "bilateral 90-270";
+    case LX_IES_FULL:
+        return "full";
     }
     return "unknown";
 }

@@ -20,7 +20,8 @@
 /* Angles read from files as float pi/2 land a hair above the float constant. */
 #define LX_ANGLE_SLACK 1e-6f
 
-lx_light lx_light_defaults(lx_light_type type) {
+lx_light lx_light_defaults(lx_light_type type)
+{
     lx_light l;
     memset(&l, 0, sizeof l);
     l.type = type;
@@ -42,18 +43,22 @@ lx_light lx_light_defaults(lx_light_type type) {
 
 /* The light's name for messages; names are not guaranteed NUL-terminated
  * in a struct handed to us, so print at most the buffer. */
-static int name_len(const lx_light *light) {
+static int name_len(const lx_light *light)
+{
     const void *nul = memchr(light->name, '\0', sizeof light->name);
     return nul ? (int)((const char *)nul - light->name) : (int)sizeof light->name;
 }
 
-static lx_status invalid(const lx_light *light, const char *what) {
+static lx_status invalid(const lx_light *light, const char *what)
+{
     int n = name_len(light);
-    if (n == 0) return lx_fail(LX_ERR_INVALID, "light (unnamed): %s", what);
+    if (n == 0)
+        return lx_fail(LX_ERR_INVALID, "light (unnamed): %s", what);
     return lx_fail(LX_ERR_INVALID, "light '%.*s': %s", n, light->name, what);
 }
 
-static lx_status check_vec(const lx_light *light, const char *field, lx_vec3 v, bool non_negative) {
+static lx_status check_vec(const lx_light *light, const char *field, lx_vec3 v, bool non_negative)
+{
     char msg[160];
     if (!lx_vec3_finite(v)) {
         snprintf(msg, sizeof msg, "%s is not finite", field);
@@ -67,7 +72,8 @@ static lx_status check_vec(const lx_light *light, const char *field, lx_vec3 v, 
 }
 
 /* A scalar that must be finite and >= 0. */
-static lx_status check_non_negative(const lx_light *light, const char *field, float v) {
+static lx_status check_non_negative(const lx_light *light, const char *field, float v)
+{
     char msg[160];
     if (!isfinite(v)) {
         snprintf(msg, sizeof msg, "%s is not finite", field);
@@ -80,10 +86,12 @@ static lx_status check_non_negative(const lx_light *light, const char *field, fl
     return LX_OK;
 }
 
-lx_status lx_light_validate(const lx_light *light) {
+lx_status lx_light_validate(const lx_light *light)
+{
     char msg[200];
     lx_status st;
-    if (!light) return lx_fail(LX_ERR_INVALID, "light: NULL pointer");
+    if (!light)
+        return lx_fail(LX_ERR_INVALID, "light: NULL pointer");
     if (!memchr(light->name, '\0', sizeof light->name))
         return invalid(light, "name is not NUL-terminated within LX_LIGHT_NAME_MAX bytes");
     if ((unsigned)light->type > (unsigned)LX_LIGHT_DIRECTIONAL) {
@@ -98,8 +106,10 @@ lx_status lx_light_validate(const lx_light *light) {
         snprintf(msg, sizeof msg, "shadow %d is not a shadow mode", (int)light->shadow);
         return invalid(light, msg);
     }
-    if ((st = check_vec(light, "position", light->position, false)) != LX_OK) return st;
-    if ((st = check_vec(light, "direction", light->direction, false)) != LX_OK) return st;
+    if ((st = check_vec(light, "position", light->position, false)) != LX_OK)
+        return st;
+    if ((st = check_vec(light, "direction", light->direction, false)) != LX_OK)
+        return st;
     if (light->type != LX_LIGHT_POINT) {
         float len = lx_length(light->direction);
         if (fabsf(len - 1.0f) > LX_DIRECTION_TOLERANCE) {
@@ -108,14 +118,19 @@ lx_status lx_light_validate(const lx_light *light) {
             return invalid(light, msg);
         }
     }
-    if ((st = check_vec(light, "color", light->color, true)) != LX_OK) return st;
-    if ((st = check_non_negative(light, "intensity", light->intensity)) != LX_OK) return st;
-    if ((st = check_non_negative(light, "range", light->range)) != LX_OK) return st;
+    if ((st = check_vec(light, "color", light->color, true)) != LX_OK)
+        return st;
+    if ((st = check_non_negative(light, "intensity", light->intensity)) != LX_OK)
+        return st;
+    if ((st = check_non_negative(light, "range", light->range)) != LX_OK)
+        return st;
     if (light->model == LX_MODEL_CLASSIC && light->type != LX_LIGHT_DIRECTIONAL &&
         !(light->range > 0.0f))
         return invalid(light, "the classic model needs a range above 0");
-    if (!isfinite(light->inner_angle)) return invalid(light, "inner_angle is not finite");
-    if (!isfinite(light->outer_angle)) return invalid(light, "outer_angle is not finite");
+    if (!isfinite(light->inner_angle))
+        return invalid(light, "inner_angle is not finite");
+    if (!isfinite(light->outer_angle))
+        return invalid(light, "outer_angle is not finite");
     if (light->type == LX_LIGHT_SPOT) {
         float inner_deg = LX_RAD2DEG(light->inner_angle);
         float outer_deg = LX_RAD2DEG(light->outer_angle);
@@ -137,28 +152,36 @@ lx_status lx_light_validate(const lx_light *light) {
             return invalid(light, msg);
         }
     }
-    if ((st = check_non_negative(light, "blur_power", light->blur_power)) != LX_OK) return st;
+    if ((st = check_non_negative(light, "blur_power", light->blur_power)) != LX_OK)
+        return st;
     if ((st = check_non_negative(light, "blur_multiplier", light->blur_multiplier)) != LX_OK)
         return st;
-    if ((st = check_vec(light, "ambient", light->ambient, true)) != LX_OK) return st;
+    if ((st = check_vec(light, "ambient", light->ambient, true)) != LX_OK)
+        return st;
     return LX_OK;
 }
 
-float lx_light_range_window(float distance_sq, float range) {
-    if (!(range > 0.0f)) return 1.0f;
+float lx_light_range_window(float distance_sq, float range)
+{
+    if (!(range > 0.0f))
+        return 1.0f;
     float factor = distance_sq / (range * range);
     float smooth = 1.0f - factor * factor;
-    if (!(smooth > 0.0f)) return 0.0f;
+    if (!(smooth > 0.0f))
+        return 0.0f;
     return smooth * smooth;
 }
 
-float lx_light_spot_attenuation(const lx_light *light, float cos_angle) {
-    if (light->type != LX_LIGHT_SPOT) return 1.0f;
+float lx_light_spot_attenuation(const lx_light *light, float cos_angle)
+{
+    if (light->type != LX_LIGHT_SPOT)
+        return 1.0f;
     float cos_outer = cosf(light->outer_angle);
     float cos_inner = cosf(light->inner_angle);
     /* inner == outer (Blender's glTF export) means a hard-edged cone; the
      * smooth ramp below would otherwise still be 1e-4 wide in cosine. */
-    if (!(light->inner_angle < light->outer_angle)) return cos_angle >= cos_outer ? 1.0f : 0.0f;
+    if (!(light->inner_angle < light->outer_angle))
+        return cos_angle >= cos_outer ? 1.0f : 0.0f;
     float delta = cos_inner - cos_outer;
     float scale = 1.0f / (delta > LX_MIN_SPOT_COS_DELTA ? delta : LX_MIN_SPOT_COS_DELTA);
     float offset = -cos_outer * scale;
@@ -166,12 +189,14 @@ float lx_light_spot_attenuation(const lx_light *light, float cos_angle) {
     return t * t;
 }
 
-static bool evaluate_directional(const lx_light *light, lx_vec3 n, lx_light_eval *out) {
+static bool evaluate_directional(const lx_light *light, lx_vec3 n, lx_light_eval *out)
+{
     out->to_light = lx_neg(light->direction);
     out->distance = INFINITY;
     out->ambient = light->ambient;
     float ndotl = lx_dot(n, out->to_light);
-    if (!(ndotl > 0.0f)) return false;
+    if (!(ndotl > 0.0f))
+        return false;
     float e;
     if (light->model == LX_MODEL_CLASSIC)
         e = ndotl * ndotl * light->intensity; /* no distance term at infinity */
@@ -181,10 +206,13 @@ static bool evaluate_directional(const lx_light *light, lx_vec3 n, lx_light_eval
     return e > 0.0f;
 }
 
-bool lx_light_evaluate(const lx_light *light, lx_vec3 p, lx_vec3 n, lx_light_eval *out) {
-    if (!light || !out) return false;
+bool lx_light_evaluate(const lx_light *light, lx_vec3 p, lx_vec3 n, lx_light_eval *out)
+{
+    if (!light || !out)
+        return false;
     out->illuminance = lx_v3(0.0f, 0.0f, 0.0f);
-    if (light->type == LX_LIGHT_DIRECTIONAL) return evaluate_directional(light, n, out);
+    if (light->type == LX_LIGHT_DIRECTIONAL)
+        return evaluate_directional(light, n, out);
 
     lx_vec3 to_light = lx_sub(light->position, p);
     float dist_sq = lx_dot(to_light, to_light);
@@ -199,13 +227,16 @@ bool lx_light_evaluate(const lx_light *light, lx_vec3 p, lx_vec3 n, lx_light_eva
     }
     out->to_light = lx_scale(to_light, 1.0f / dist);
     float ndotl = lx_dot(n, out->to_light);
-    if (!(ndotl > 0.0f)) return false;
+    if (!(ndotl > 0.0f))
+        return false;
     float spot = lx_light_spot_attenuation(light, -lx_dot(light->direction, out->to_light));
-    if (!(spot > 0.0f)) return false;
+    if (!(spot > 0.0f))
+        return false;
 
     float e;
     if (light->model == LX_MODEL_CLASSIC) {
-        if (!(dist < light->range)) return false;
+        if (!(dist < light->range))
+            return false;
         float v = (1.0f - dist / light->range) * ndotl;
         e = v * v * light->intensity * spot;
     } else {
@@ -213,17 +244,20 @@ bool lx_light_evaluate(const lx_light *light, lx_vec3 p, lx_vec3 n, lx_light_eva
         float d2 = dist_sq > LX_MIN_DISTANCE_SQ ? dist_sq : LX_MIN_DISTANCE_SQ;
         e = light->intensity * window * spot * ndotl / d2;
     }
-    if (!(e > 0.0f)) return false;
+    if (!(e > 0.0f))
+        return false;
     out->illuminance = lx_scale(light->color, e);
     return true;
 }
 
-float lx_light_blur_visibility(const lx_light *light, float occluder_distance,
-                               float light_distance) {
+float lx_light_blur_visibility(const lx_light *light, float occluder_distance, float light_distance)
+{
     /* An occluder with no measurable ray to compare against: fully shadowed. */
-    if (!(light_distance > 0.0f) || !(occluder_distance >= 0.0f)) return 0.0f;
+    if (!(light_distance > 0.0f) || !(occluder_distance >= 0.0f))
+        return 0.0f;
     float ratio = occluder_distance / light_distance;
     float v = powf(ratio, light->blur_power) * light->blur_multiplier;
-    if (!(v > 0.0f)) return 0.0f;
+    if (!(v > 0.0f))
+        return 0.0f;
     return v < 1.0f ? v : 1.0f;
 }

@@ -14,7 +14,8 @@
 #define LX_PI_D 3.14159265358979323846
 
 /* "light 'key'" or "light (unnamed)" for messages. */
-static void light_label(const lx_light *light, char *buf, size_t size) {
+static void light_label(const lx_light *light, char *buf, size_t size)
+{
     const void *nul = memchr(light->name, '\0', sizeof light->name);
     int n = nul ? (int)((const char *)nul - light->name) : (int)sizeof light->name;
     if (n == 0)
@@ -24,12 +25,16 @@ static void light_label(const lx_light *light, char *buf, size_t size) {
 }
 
 lx_status lx_light_intensity_to_native(const lx_light *light, float value, lx_light_unit unit,
-                                       lx_spot_conversion spot_conversion, float *native) {
-    if (!light || !native) return lx_fail(LX_ERR_INVALID, "light: NULL pointer");
+                                       lx_spot_conversion spot_conversion, float *native)
+{
+    if (!light || !native)
+        return lx_fail(LX_ERR_INVALID, "light: NULL pointer");
     char who[LX_LIGHT_NAME_MAX + 16];
     light_label(light, who, sizeof who);
-    if (!isfinite(value)) return lx_fail(LX_ERR_INVALID, "%s: intensity is not finite", who);
-    if (value < 0.0f) return lx_fail(LX_ERR_INVALID, "%s: intensity %g is negative", who, value);
+    if (!isfinite(value))
+        return lx_fail(LX_ERR_INVALID, "%s: intensity is not finite", who);
+    if (value < 0.0f)
+        return lx_fail(LX_ERR_INVALID, "%s: intensity %g is negative", who, value);
     if ((unsigned)unit > (unsigned)LX_UNIT_LUX)
         return lx_fail(LX_ERR_INVALID, "%s: unit %d is not a light unit", who, (int)unit);
 
@@ -79,16 +84,19 @@ lx_status lx_light_intensity_to_native(const lx_light *light, float value, lx_li
 }
 
 /* ASCII case-insensitive equality ("W", "w", "Lumen"). */
-static bool same_word(const char *a, const char *b) {
+static bool same_word(const char *a, const char *b)
+{
     for (; *a && *b; a++, b++) {
         char ca = (*a >= 'A' && *a <= 'Z') ? (char)(*a - 'A' + 'a') : *a;
         char cb = (*b >= 'A' && *b <= 'Z') ? (char)(*b - 'A' + 'a') : *b;
-        if (ca != cb) return false;
+        if (ca != cb)
+            return false;
     }
     return *a == *b;
 }
 
-lx_light_unit lx_light_unit_from_string(const char *s) {
+lx_light_unit lx_light_unit_from_string(const char *s)
+{
     static const struct {
         const char *word;
         lx_light_unit unit;
@@ -98,13 +106,16 @@ lx_light_unit lx_light_unit_from_string(const char *s) {
         {"W", LX_UNIT_WATT},     {"watt", LX_UNIT_WATT},       {"watts", LX_UNIT_WATT},
         {"lx", LX_UNIT_LUX},     {"lux", LX_UNIT_LUX},
     };
-    if (!s) return LX_UNIT_DEFAULT;
+    if (!s)
+        return LX_UNIT_DEFAULT;
     for (size_t i = 0; i < sizeof words / sizeof words[0]; i++)
-        if (same_word(s, words[i].word)) return words[i].unit;
+        if (same_word(s, words[i].word))
+            return words[i].unit;
     return LX_UNIT_DEFAULT;
 }
 
-const char *lx_light_unit_symbol(lx_light_unit unit) {
+const char *lx_light_unit_symbol(lx_light_unit unit)
+{
     switch (unit) {
     case LX_UNIT_DEFAULT:
         return "default";
@@ -120,7 +131,8 @@ const char *lx_light_unit_symbol(lx_light_unit unit) {
     return "unknown";
 }
 
-const char *lx_light_type_name(lx_light_type type) {
+const char *lx_light_type_name(lx_light_type type)
+{
     switch (type) {
     case LX_LIGHT_POINT:
         return "point";
@@ -132,7 +144,8 @@ const char *lx_light_type_name(lx_light_type type) {
     return "unknown";
 }
 
-const char *lx_shadow_mode_name(lx_shadow_mode mode) {
+const char *lx_shadow_mode_name(lx_shadow_mode mode)
+{
     switch (mode) {
     case LX_SHADOW_HARD:
         return "hard";
@@ -144,18 +157,22 @@ const char *lx_shadow_mode_name(lx_shadow_mode mode) {
     return "unknown";
 }
 
-float lx_exposure_from_ev100(float ev100) {
+float lx_exposure_from_ev100(float ev100)
+{
     return (float)(1.0 / (1.2 * exp2((double)ev100)));
 }
 
-float lx_ev100_from_luminance(double average_luminance) {
-    if (!(average_luminance > 0.0) || !isfinite(average_luminance)) return 0.0f;
+float lx_ev100_from_luminance(double average_luminance)
+{
+    if (!(average_luminance > 0.0) || !isfinite(average_luminance))
+        return 0.0f;
     return (float)log2(average_luminance * 100.0 / 12.5);
 }
 
-lx_status lx_ev100_from_camera(float aperture, float shutter_seconds, float iso, float *ev100) {
-    if (!(aperture > 0.0f && isfinite(aperture)) || !(shutter_seconds > 0.0f && isfinite(shutter_seconds)) ||
-        !(iso > 0.0f && isfinite(iso)))
+lx_status lx_ev100_from_camera(float aperture, float shutter_seconds, float iso, float *ev100)
+{
+    if (!(aperture > 0.0f && isfinite(aperture)) ||
+        !(shutter_seconds > 0.0f && isfinite(shutter_seconds)) || !(iso > 0.0f && isfinite(iso)))
         return lx_fail(LX_ERR_INVALID,
                        "camera settings f/%g, %g s, ISO %g: each must be a finite number above 0",
                        (double)aperture, (double)shutter_seconds, (double)iso);

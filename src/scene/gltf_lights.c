@@ -26,18 +26,21 @@
 
 /* ---- the container ------------------------------------------------------ */
 
-static uint32_t le32(const uint8_t *p) {
+static uint32_t le32(const uint8_t *p)
+{
     return (uint32_t)p[0] | (uint32_t)p[1] << 8 | (uint32_t)p[2] << 16 | (uint32_t)p[3] << 24;
 }
 
 /* Checks a GLB's header and first chunk header (head holds the first
  * head_len bytes of a file of total bytes) and finds the JSON chunk. */
 static lx_status glb_locate(const char *file, const uint8_t *head, size_t head_len, uint64_t total,
-                            uint64_t *json_offset, uint32_t *json_size) {
+                            uint64_t *json_offset, uint32_t *json_size)
+{
     if (total < LX_GLB_HEADER || head_len < LX_GLB_HEADER)
         return failf(file, LX_ERR_FORMAT, "truncated GLB: %llu bytes, the header needs 12",
                      (unsigned long long)total);
-    if (le32(head) != LX_GLB_MAGIC) return failf(file, LX_ERR_FORMAT, "not a GLB file (bad magic)");
+    if (le32(head) != LX_GLB_MAGIC)
+        return failf(file, LX_ERR_FORMAT, "not a GLB file (bad magic)");
     uint32_t version = le32(head + 4), length = le32(head + 8);
     if (version != 2)
         return failf(file, LX_ERR_UNSUPPORTED, "GLB version %u (only version 2 is supported)",
@@ -62,7 +65,8 @@ static lx_status glb_locate(const char *file, const uint8_t *head, size_t head_l
     return LX_OK;
 }
 
-static lx_status parse_json(const char *file, const char *text, size_t size, cJSON **root) {
+static lx_status parse_json(const char *file, const char *text, size_t size, cJSON **root)
+{
     *root = NULL;
     const char *nul = memchr(text, '\0', size);
     if (nul)
@@ -75,7 +79,8 @@ static lx_status parse_json(const char *file, const char *text, size_t size, cJS
 /* ---- typed values --------------------------------------------------------- */
 
 /* Numbers: finite, also as a float. */
-static bool number(const cJSON *item, float *out) {
+static bool number(const cJSON *item, float *out)
+{
     if (!cJSON_IsNumber(item) || !isfinite(item->valuedouble) ||
         !isfinite((float)item->valuedouble))
         return false;
@@ -84,35 +89,44 @@ static bool number(const cJSON *item, float *out) {
 }
 
 /* An array of exactly n finite numbers. */
-static bool numbers(const cJSON *item, float *out, int n) {
-    if (!cJSON_IsArray(item) || cJSON_GetArraySize(item) != n) return false;
+static bool numbers(const cJSON *item, float *out, int n)
+{
+    if (!cJSON_IsArray(item) || cJSON_GetArraySize(item) != n)
+        return false;
     int i = 0;
     for (const cJSON *e = item->child; e; e = e->next)
-        if (!number(e, &out[i++])) return false;
+        if (!number(e, &out[i++]))
+            return false;
     return true;
 }
 
 /* An integer index in [0, count). */
-static bool index_in(const cJSON *item, size_t count, size_t *out) {
-    if (!cJSON_IsNumber(item)) return false;
+static bool index_in(const cJSON *item, size_t count, size_t *out)
+{
+    if (!cJSON_IsNumber(item))
+        return false;
     double v = item->valuedouble;
-    if (!(v >= 0.0) || v != floor(v) || v >= (double)count) return false;
+    if (!(v >= 0.0) || v != floor(v) || v >= (double)count)
+        return false;
     *out = (size_t)v;
     return true;
 }
 
-static const cJSON *get(const cJSON *obj, const char *key) {
+static const cJSON *get(const cJSON *obj, const char *key)
+{
     return cJSON_IsObject(obj) ? cJSON_GetObjectItemCaseSensitive(obj, key) : NULL;
 }
 
 /* The string at key, or NULL when absent or not a string. */
-static const char *get_string(const cJSON *obj, const char *key) {
+static const char *get_string(const cJSON *obj, const char *key)
+{
     const cJSON *s = get(obj, key);
     return cJSON_IsString(s) && s->valuestring ? s->valuestring : NULL;
 }
 
 /* "node 3 ('Lamp')" for messages. */
-static void label(char *buf, size_t size, const char *what, size_t index, const cJSON *obj) {
+static void label(char *buf, size_t size, const char *what, size_t index, const cJSON *obj)
+{
     const char *name = get_string(obj, "name");
     if (name)
         snprintf(buf, size, "%s %zu ('%.60s')", what, index, name);
@@ -127,12 +141,15 @@ typedef struct def {
     const char *name; /* the definition's own name or NULL; owned by cJSON */
 } def;
 
-static lx_status read_def(const char *file, const cJSON *obj, size_t index, def *out) {
+static lx_status read_def(const char *file, const cJSON *obj, size_t index, def *out)
+{
     char who[128];
     label(who, sizeof who, "KHR_lights_punctual light", index, obj);
-    if (!cJSON_IsObject(obj)) return failf(file, LX_ERR_FORMAT, "%s is not an object", who);
+    if (!cJSON_IsObject(obj))
+        return failf(file, LX_ERR_FORMAT, "%s is not an object", who);
     const char *type = get_string(obj, "type");
-    if (!type) return failf(file, LX_ERR_FORMAT, "%s: missing 'type'", who);
+    if (!type)
+        return failf(file, LX_ERR_FORMAT, "%s: missing 'type'", who);
     lx_light_type t;
     if (strcmp(type, "point") == 0)
         t = LX_LIGHT_POINT;
@@ -199,7 +216,8 @@ static lx_status read_def(const char *file, const cJSON *obj, size_t index, def 
 
 /* ---- node transforms ---------------------------------------------------- */
 
-static lx_status local_matrix(const char *file, const cJSON *node, const char *who, lx_mat4 *m) {
+static lx_status local_matrix(const char *file, const cJSON *node, const char *who, lx_mat4 *m)
+{
     const cJSON *it;
     if ((it = get(node, "matrix"))) {
         if (!numbers(it, m->m, 16))
@@ -234,7 +252,8 @@ typedef struct graph {
     size_t reached;
 } graph;
 
-static void graph_free(graph *g) {
+static void graph_free(graph *g)
+{
     free(g->nodes);
     free(g->parent);
     free(g->world);
@@ -244,7 +263,8 @@ static void graph_free(graph *g) {
 
 /* Checks children (in range, one parent each, no cycles) and computes every
  * node's world matrix from the roots down, without recursion. */
-static lx_status build_graph(const char *file, const cJSON *root, graph *g) {
+static lx_status build_graph(const char *file, const cJSON *root, graph *g)
+{
     const cJSON *nodes = get(root, "nodes");
     if (nodes && !cJSON_IsArray(nodes))
         return failf(file, LX_ERR_FORMAT, "'nodes' must be an array");
@@ -279,7 +299,8 @@ static lx_status build_graph(const char *file, const cJSON *root, graph *g) {
             break;
         }
         const cJSON *children = get(g->nodes[i], "children");
-        if (!children) continue;
+        if (!children)
+            continue;
         if (!cJSON_IsArray(children)) {
             st = failf(file, LX_ERR_FORMAT, "%s: children must be an array", who);
             break;
@@ -301,14 +322,16 @@ static lx_status build_graph(const char *file, const cJSON *root, graph *g) {
     /* One parent each: a cycle is a loop of nodes no root reaches. */
     size_t top = 0;
     for (i = 0; i < n && st == LX_OK; i++)
-        if (g->parent[i] < 0) stack[top++] = i;
+        if (g->parent[i] < 0)
+            stack[top++] = i;
     while (top > 0 && st == LX_OK) {
         size_t k = stack[--top];
         g->order[g->reached++] = k;
         seen[k] = true;
         label(who, sizeof who, "node", k, g->nodes[k]);
         lx_mat4 local;
-        if ((st = local_matrix(file, g->nodes[k], who, &local)) != LX_OK) break;
+        if ((st = local_matrix(file, g->nodes[k], who, &local)) != LX_OK)
+            break;
         g->world[k] = g->parent[k] < 0 ? local : lx_mat4_mul(&g->world[g->parent[k]], &local);
         if (!lx_mat4_finite(&g->world[k]))
             st = failf(file, LX_ERR_FORMAT, "%s: world transform is not finite", who);
@@ -332,14 +355,16 @@ static lx_status build_graph(const char *file, const cJSON *root, graph *g) {
 
 /* Marks the nodes of the default scene ("scene", else scenes[0]), or every
  * node when the file has no scenes. */
-static lx_status select_scene(const char *file, const cJSON *root, graph *g) {
+static lx_status select_scene(const char *file, const cJSON *root, graph *g)
+{
     const cJSON *scenes = get(root, "scenes");
     if (scenes && !cJSON_IsArray(scenes))
         return failf(file, LX_ERR_FORMAT, "'scenes' must be an array");
     size_t scene_count = (size_t)(scenes ? cJSON_GetArraySize(scenes) : 0);
     const cJSON *which = get(root, "scene");
     if (scene_count == 0) {
-        if (which) return failf(file, LX_ERR_FORMAT, "'scene' is given but there are no scenes");
+        if (which)
+            return failf(file, LX_ERR_FORMAT, "'scene' is given but there are no scenes");
         for (size_t i = 0; i < g->count; i++)
             g->included[i] = true;
         return LX_OK;
@@ -348,12 +373,14 @@ static lx_status select_scene(const char *file, const cJSON *root, graph *g) {
     if (which && !index_in(which, scene_count, &s))
         return failf(file, LX_ERR_FORMAT, "'scene' is not a scene index (%zu scenes)", scene_count);
     const cJSON *sc = cJSON_GetArrayItem(scenes, (int)s);
-    if (!cJSON_IsObject(sc)) return failf(file, LX_ERR_FORMAT, "scene %zu is not an object", s);
+    if (!cJSON_IsObject(sc))
+        return failf(file, LX_ERR_FORMAT, "scene %zu is not an object", s);
     const cJSON *roots = get(sc, "nodes");
     if (roots && !cJSON_IsArray(roots))
         return failf(file, LX_ERR_FORMAT, "scene %zu: nodes must be an array", s);
     bool *marked = calloc(g->count ? g->count : 1, sizeof *marked);
-    if (!marked) return failf(file, LX_ERR_NOMEM, "out of memory for %zu nodes", g->count);
+    if (!marked)
+        return failf(file, LX_ERR_NOMEM, "out of memory for %zu nodes", g->count);
     for (const cJSON *r = roots ? roots->child : NULL; r; r = r->next) {
         size_t k;
         if (!index_in(r, g->count, &k)) {
@@ -382,7 +409,8 @@ typedef struct strmap {
     size_t mask;
 } strmap;
 
-static bool strmap_init(strmap *m, size_t capacity) {
+static bool strmap_init(strmap *m, size_t capacity)
+{
     size_t n = 16;
     while (n < capacity * 2)
         n *= 2;
@@ -392,7 +420,8 @@ static bool strmap_init(strmap *m, size_t capacity) {
     return m->keys && m->values;
 }
 
-static void strmap_free(strmap *m) {
+static void strmap_free(strmap *m)
+{
     if (m->keys)
         for (size_t i = 0; i <= m->mask; i++)
             free(m->keys[i]);
@@ -400,7 +429,8 @@ static void strmap_free(strmap *m) {
     free(m->values);
 }
 
-static size_t strmap_slot(const strmap *m, const char *key) {
+static size_t strmap_slot(const strmap *m, const char *key)
+{
     uint32_t h = 2166136261u; /* FNV-1a */
     for (const char *p = key; *p; p++)
         h = (h ^ (uint8_t)*p) * 16777619u;
@@ -410,23 +440,29 @@ static size_t strmap_slot(const strmap *m, const char *key) {
     return i;
 }
 
-static bool strmap_get(const strmap *m, const char *key, size_t *value) {
+static bool strmap_get(const strmap *m, const char *key, size_t *value)
+{
     size_t i = strmap_slot(m, key);
-    if (!m->keys[i]) return false;
-    if (value) *value = m->values[i];
+    if (!m->keys[i])
+        return false;
+    if (value)
+        *value = m->values[i];
     return true;
 }
 
-static bool strmap_put(strmap *m, const char *key, size_t value) {
+static bool strmap_put(strmap *m, const char *key, size_t value)
+{
     size_t i = strmap_slot(m, key);
-    if (!m->keys[i] && !(m->keys[i] = lx_strdup(key))) return false;
+    if (!m->keys[i] && !(m->keys[i] = lx_strdup(key)))
+        return false;
     m->values[i] = value;
     return true;
 }
 
 /* Copies at most max bytes of src into dst without splitting a UTF-8
  * sequence; true when it had to cut. */
-static bool copy_truncated(char *dst, const char *src, size_t max) {
+static bool copy_truncated(char *dst, const char *src, size_t max)
+{
     size_t n = strlen(src);
     bool cut = n > max;
     if (cut) {
@@ -442,7 +478,8 @@ static bool copy_truncated(char *dst, const char *src, size_t max) {
 /* Gives out the base name, or base_2, base_3... when taken. next remembers
  * where each base's suffixes stopped so many copies stay linear. */
 static lx_status unique_name(const char *file, const char *base_in, strmap *used, strmap *next,
-                             char out[LX_LIGHT_NAME_MAX]) {
+                             char out[LX_LIGHT_NAME_MAX])
+{
     char base[LX_LIGHT_NAME_MAX];
     if (copy_truncated(base, base_in, LX_LIGHT_NAME_MAX - 1))
         lx_log(LX_LOG_WARN, "%s: light name '%s...' cut to %d bytes", file, base,
@@ -457,12 +494,14 @@ static lx_status unique_name(const char *file, const char *base_in, strmap *used
             int len = snprintf(suffix, sizeof suffix, "_%zu", k);
             copy_truncated(out, base, LX_LIGHT_NAME_MAX - 1 - (size_t)len);
             strcat(out, suffix);
-            if (!strmap_get(used, out, NULL)) break;
+            if (!strmap_get(used, out, NULL))
+                break;
         }
         if (!strmap_put(next, base, k + 1))
             return failf(file, LX_ERR_NOMEM, "out of memory naming lights");
     }
-    if (!strmap_put(used, out, 0)) return failf(file, LX_ERR_NOMEM, "out of memory naming lights");
+    if (!strmap_put(used, out, 0))
+        return failf(file, LX_ERR_NOMEM, "out of memory naming lights");
     return LX_OK;
 }
 
@@ -470,12 +509,15 @@ static lx_status unique_name(const char *file, const char *base_in, strmap *used
 
 /* The light index a node references, or false when it has none. */
 static lx_status node_light(const char *file, const cJSON *node, const char *who, size_t def_count,
-                            bool *has, size_t *index) {
+                            bool *has, size_t *index)
+{
     *has = false;
     const cJSON *ext = get(get(node, "extensions"), "KHR_lights_punctual");
-    if (!ext) return LX_OK;
+    if (!ext)
+        return LX_OK;
     const cJSON *li = get(ext, "light");
-    if (!li) return failf(file, LX_ERR_FORMAT, "%s: KHR_lights_punctual without 'light'", who);
+    if (!li)
+        return failf(file, LX_ERR_FORMAT, "%s: KHR_lights_punctual without 'light'", who);
     if (!index_in(li, def_count, index))
         return failf(file, LX_ERR_FORMAT, "%s: light %g is out of range (%zu lights)", who,
                      cJSON_IsNumber(li) ? li->valuedouble : -1.0, def_count);
@@ -484,7 +526,8 @@ static lx_status node_light(const char *file, const cJSON *node, const char *who
 }
 
 /* Places one light instance by its node's world matrix. */
-static lx_status place(const char *file, const lx_mat4 *world, const char *who, lx_light *l) {
+static lx_status place(const char *file, const lx_mat4 *world, const char *who, lx_light *l)
+{
     l->position = lx_mat4_point(world, lx_v3(0.0f, 0.0f, 0.0f));
     lx_vec3 d = lx_mat4_vector(world, lx_v3(0.0f, 0.0f, -1.0f));
     double len = sqrt((double)d.x * d.x + (double)d.y * d.y + (double)d.z * d.z);
@@ -498,10 +541,12 @@ static lx_status place(const char *file, const lx_mat4 *world, const char *who, 
 }
 
 static lx_status load_lights(lx_scene *scene, const char *file, const cJSON *root, const def *defs,
-                             size_t def_count) {
+                             size_t def_count)
+{
     graph g = {0};
     lx_status st = build_graph(file, root, &g);
-    if (st == LX_OK) st = select_scene(file, root, &g);
+    if (st == LX_OK)
+        st = select_scene(file, root, &g);
     size_t count = 0;
     char who[128];
     for (size_t i = 0; i < g.count && st == LX_OK; i++) {
@@ -533,10 +578,14 @@ static lx_status load_lights(lx_scene *scene, const char *file, const cJSON *roo
         char fallback[32];
         snprintf(fallback, sizeof fallback, "light%zu", li);
         const char *base = defs[li].name;
-        if (!base || !base[0]) base = get_string(g.nodes[i], "name");
-        if (!base || !base[0]) base = fallback;
-        if ((st = unique_name(file, base, &used, &next, l->name)) != LX_OK) break;
-        if ((st = place(file, &g.world[i], who, l)) != LX_OK) break;
+        if (!base || !base[0])
+            base = get_string(g.nodes[i], "name");
+        if (!base || !base[0])
+            base = fallback;
+        if ((st = unique_name(file, base, &used, &next, l->name)) != LX_OK)
+            break;
+        if ((st = place(file, &g.world[i], who, l)) != LX_OK)
+            break;
         if ((st = lx_light_validate(l)) != LX_OK) {
             lx_error_prefix(who);
             lx_error_prefix(file);
@@ -554,10 +603,12 @@ static lx_status load_lights(lx_scene *scene, const char *file, const cJSON *roo
     return st;
 }
 
-static lx_status load_json(lx_scene *scene, const char *file, const char *text, size_t size) {
+static lx_status load_json(lx_scene *scene, const char *file, const char *text, size_t size)
+{
     cJSON *root;
     lx_status st = parse_json(file, text, size, &root);
-    if (st != LX_OK) return st;
+    if (st != LX_OK)
+        return st;
     def *defs = NULL;
     size_t def_count = 0;
     const cJSON *khr = get(get(root, "extensions"), "KHR_lights_punctual");
@@ -575,7 +626,8 @@ static lx_status load_json(lx_scene *scene, const char *file, const char *text, 
         size_t i = 0;
         for (const cJSON *e = list ? list->child : NULL; e && st == LX_OK; e = e->next, i++)
             st = read_def(file, e, i, &defs[i]);
-        if (st == LX_OK) st = load_lights(scene, file, root, defs, def_count);
+        if (st == LX_OK)
+            st = load_lights(scene, file, root, defs, def_count);
     }
     free(defs);
     cJSON_Delete(root);
@@ -583,26 +635,34 @@ static lx_status load_json(lx_scene *scene, const char *file, const char *text, 
 }
 
 lx_status lx_gltf_lights_load_memory(lx_scene *scene, const void *bytes, size_t size,
-                                     const char *name) {
+                                     const char *name)
+{
     const char *file = name && name[0] ? name : "glTF";
-    if (!scene) return failf(file, LX_ERR_INVALID, "no scene to add the lights to");
-    if (!bytes && size > 0) return failf(file, LX_ERR_INVALID, "no bytes");
+    if (!scene)
+        return failf(file, LX_ERR_INVALID, "no scene to add the lights to");
+    if (!bytes && size > 0)
+        return failf(file, LX_ERR_INVALID, "no bytes");
     const uint8_t *b = bytes ? bytes : (const uint8_t *)"";
     if (size >= 4 && memcmp(b, "glTF", 4) == 0) {
         uint64_t off;
         uint32_t len;
         lx_status st = glb_locate(file, b, size, size, &off, &len);
-        if (st != LX_OK) return st;
+        if (st != LX_OK)
+            return st;
         return load_json(scene, file, (const char *)b + off, len);
     }
     return load_json(scene, file, (const char *)b, size);
 }
 
-lx_status lx_gltf_lights_load(lx_scene *scene, const char *path) {
-    if (!path) return lx_fail(LX_ERR_INVALID, "glTF lights: no path");
-    if (!scene) return failf(path, LX_ERR_INVALID, "no scene to add the lights to");
+lx_status lx_gltf_lights_load(lx_scene *scene, const char *path)
+{
+    if (!path)
+        return lx_fail(LX_ERR_INVALID, "glTF lights: no path");
+    if (!scene)
+        return failf(path, LX_ERR_INVALID, "no scene to add the lights to");
     FILE *fp = fopen(path, "rb");
-    if (!fp) return failf(path, LX_ERR_IO, "cannot open: %s", strerror(errno));
+    if (!fp)
+        return failf(path, LX_ERR_IO, "cannot open: %s", strerror(errno));
     uint8_t head[20];
     size_t head_len = fread(head, 1, sizeof head, fp);
     if (head_len < 4 || memcmp(head, "glTF", 4) != 0) {
@@ -611,14 +671,16 @@ lx_status lx_gltf_lights_load(lx_scene *scene, const char *path) {
         char *text;
         size_t size;
         lx_status st = lx_read_file(path, LX_GLTF_TEXT_MAX, &text, &size);
-        if (st != LX_OK) return st;
+        if (st != LX_OK)
+            return st;
         st = load_json(scene, path, text, size);
         free(text);
         return st;
     }
     /* A .glb: read only the JSON chunk, not the binary buffers. */
     long total = -1;
-    if (fseek(fp, 0, SEEK_END) == 0) total = ftell(fp);
+    if (fseek(fp, 0, SEEK_END) == 0)
+        total = ftell(fp);
     uint64_t off;
     uint32_t len;
     lx_status st = total < 0 ? failf(path, LX_ERR_IO, "cannot tell the file's size")
@@ -629,7 +691,8 @@ lx_status lx_gltf_lights_load(lx_scene *scene, const char *path) {
     if (st == LX_OK && (fseek(fp, (long)off, SEEK_SET) != 0 || fread(json, 1, len, fp) != len))
         st = failf(path, LX_ERR_IO, "cannot read the JSON chunk");
     fclose(fp);
-    if (st == LX_OK) st = load_json(scene, path, json, len);
+    if (st == LX_OK)
+        st = load_json(scene, path, json, len);
     free(json);
     return st;
 }

@@ -83,9 +83,8 @@ static lx_status check_obj_numbers(const char *path)
                 break; /* not a number: assimp reports it */
             if (!isfinite(v) || fabs(v) > FLT_MAX) {
                 int len = (int)(end - p) < 32 ? (int)(end - p) : 32;
-                st = lx_fail(LX_ERR_FORMAT,
-                             "%s: line %lu%s%s%s: '%s' value '%.*s' is not finite", path,
-                             number, object[0] ? ": object '" : "", object,
+                st = lx_fail(LX_ERR_FORMAT, "%s: line %lu%s%s%s: '%s' value '%.*s' is not finite",
+                             path, number, object[0] ? ": object '" : "", object,
                              object[0] ? "'" : "", kind, len, p);
                 break;
             }
@@ -113,9 +112,8 @@ static bool has_extension(const char *path, const char *ext)
 /* Loads a texture named by a material: "*N" is embedded in the file, other
  * paths are relative to the scene's folder. Failures are warnings: the
  * material then goes without the map. */
-static void load_texture(import_ctx *c, const struct aiString *tex_path, bool raw,
-                         const char *what, const char *material, lx_image *out,
-                         char **out_path)
+static void load_texture(import_ctx *c, const struct aiString *tex_path, bool raw, const char *what,
+                         const char *material, lx_image *out, char **out_path)
 {
     const char *p = tex_path->data;
     lx_image_load_desc ld = {.raw_8bit = raw, .channels = raw ? 3 : 4};
@@ -178,8 +176,10 @@ static lx_status import_materials(import_ctx *c)
             m.base_color = lx_v4(col.r, col.g, col.b, col.a);
         if (!(isfinite(m.base_color.x) && isfinite(m.base_color.y) && isfinite(m.base_color.z)) ||
             m.base_color.x < 0 || m.base_color.y < 0 || m.base_color.z < 0)
-            return lx_fail(LX_ERR_FORMAT, "%s: material '%s': base colour is not a finite "
-                           "non-negative colour", c->path, name_buf);
+            return lx_fail(LX_ERR_FORMAT,
+                           "%s: material '%s': base colour is not a finite "
+                           "non-negative colour",
+                           c->path, name_buf);
         struct aiString tex;
         unsigned uv = 0;
         if (aiGetMaterialTexture(am, aiTextureType_NORMALS, 0, &tex, NULL, &uv, NULL, NULL, NULL,
@@ -194,16 +194,18 @@ static lx_status import_materials(import_ctx *c)
                 m.normal_scale = scale;
         }
         uv = 0;
-        if (aiGetMaterialTexture(am, aiTextureType_BASE_COLOR, 0, &tex, NULL, &uv, NULL, NULL,
-                                 NULL, NULL) == aiReturn_SUCCESS ||
+        if (aiGetMaterialTexture(am, aiTextureType_BASE_COLOR, 0, &tex, NULL, &uv, NULL, NULL, NULL,
+                                 NULL) == aiReturn_SUCCESS ||
             aiGetMaterialTexture(am, aiTextureType_DIFFUSE, 0, &tex, NULL, &uv, NULL, NULL, NULL,
                                  NULL) == aiReturn_SUCCESS) {
             load_texture(c, &tex, false, "base colour", name_buf, &m.base_color_map, NULL);
             m.base_color_uv_set = (int)uv;
         }
         if (m.normal_uv_set >= LX_MAX_UV_SETS || m.base_color_uv_set >= LX_MAX_UV_SETS) {
-            lx_log(LX_LOG_WARN, "%s: material '%s': textures on UV sets above 1 are not "
-                   "supported; ignored", c->path, name_buf);
+            lx_log(LX_LOG_WARN,
+                   "%s: material '%s': textures on UV sets above 1 are not "
+                   "supported; ignored",
+                   c->path, name_buf);
             if (m.normal_uv_set >= LX_MAX_UV_SETS) {
                 lx_image_free(&m.normal_map);
                 m.normal_uv_set = 0;
@@ -302,22 +304,25 @@ static lx_status import_mesh(import_ctx *c, unsigned i)
         for (int k = 0; k < 3; k++) {
             dst[k] = face->mIndices[k];
             if (dst[k] >= nv) {
-                st = lx_fail(LX_ERR_FORMAT, "%s: mesh '%s': face %u: index %u out of range "
-                             "(count %u)", c->path, name, f, dst[k], nv);
+                st = lx_fail(LX_ERR_FORMAT,
+                             "%s: mesh '%s': face %u: index %u out of range "
+                             "(count %u)",
+                             c->path, name, f, dst[k], nv);
                 goto done;
             }
         }
         if (!lx_vec3_finite(m.positions[dst[0]]) || !lx_vec3_finite(m.positions[dst[1]]) ||
             !lx_vec3_finite(m.positions[dst[2]])) {
-            st = lx_fail(LX_ERR_FORMAT, "%s: mesh '%s': face %u: position is not finite",
-                         c->path, name, f);
+            st = lx_fail(LX_ERR_FORMAT, "%s: mesh '%s': face %u: position is not finite", c->path,
+                         name, f);
             goto done;
         }
-        if (lx_triangle_degenerate(m.positions[dst[0]], m.positions[dst[1]],
-                                   m.positions[dst[2]])) {
+        if (lx_triangle_degenerate(m.positions[dst[0]], m.positions[dst[1]], m.positions[dst[2]])) {
             if (!c->desc->skip_degenerate) {
-                st = lx_fail(LX_ERR_FORMAT, "%s: mesh '%s': triangle %u has zero area "
-                             "(--skip-degenerate drops such triangles)", c->path, name, f);
+                st = lx_fail(LX_ERR_FORMAT,
+                             "%s: mesh '%s': triangle %u has zero area "
+                             "(--skip-degenerate drops such triangles)",
+                             c->path, name, f);
                 goto done;
             }
             skipped++;

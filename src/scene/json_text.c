@@ -55,8 +55,7 @@ lx_status lx_json_parse_text(const char *file, const char *text, size_t size, cJ
     return st;
 }
 
-lx_status lx_json_fail(lx_status status, const char *file, const char *where, const char *fmt,
-                       ...)
+lx_status lx_json_fail(lx_status status, const char *file, const char *where, const char *fmt, ...)
 {
     char msg[512];
     va_list ap;

@@ -15,8 +15,7 @@ lx_status lx_json_parse_text(const char *file, const char *text, size_t size, cJ
 
 /* lx_fail with "<file>: " and, when where is not empty, "<where>: " in
  * front of the formatted message. */
-lx_status lx_json_fail(lx_status status, const char *file, const char *where, const char *fmt,
-                       ...)
+lx_status lx_json_fail(lx_status status, const char *file, const char *where, const char *fmt, ...)
 #if defined(__GNUC__)
     __attribute__((format(printf, 4, 5)))
 #endif

@@ -24,7 +24,8 @@ typedef struct ctx {
 /* ---- parsing the text -------------------------------------------------- */
 
 /* Parses size bytes (not necessarily NUL-terminated) into *root. */
-static lx_status parse_json(const char *file, const char *text, size_t size, cJSON **root) {
+static lx_status parse_json(const char *file, const char *text, size_t size, cJSON **root)
+{
     *root = NULL;
     if (size > LX_LIGHTS_JSON_MAX)
         return lx_fail(LX_ERR_FORMAT,
@@ -34,8 +35,10 @@ static lx_status parse_json(const char *file, const char *text, size_t size, cJS
 
 /* ---- typed fields ------------------------------------------------------ */
 
-static lx_status get_float(const ctx *c, const cJSON *item, const char *field, float *out) {
-    if (!cJSON_IsNumber(item)) return fail(c, LX_ERR_FORMAT, "%s must be a number", field);
+static lx_status get_float(const ctx *c, const cJSON *item, const char *field, float *out)
+{
+    if (!cJSON_IsNumber(item))
+        return fail(c, LX_ERR_FORMAT, "%s must be a number", field);
     double v = item->valuedouble;
     if (!isfinite(v) || !isfinite((float)v))
         return fail(c, LX_ERR_FORMAT, "%s is not a finite number", field);
@@ -43,31 +46,36 @@ static lx_status get_float(const ctx *c, const cJSON *item, const char *field, f
     return LX_OK;
 }
 
-static lx_status get_non_negative(const ctx *c, const cJSON *item, const char *field, float *out) {
+static lx_status get_non_negative(const ctx *c, const cJSON *item, const char *field, float *out)
+{
     lx_status st = get_float(c, item, field, out);
     if (st == LX_OK && *out < 0.0f)
         return fail(c, LX_ERR_INVALID, "%s %g is negative", field, *out);
     return st;
 }
 
-static lx_status get_vec3(const ctx *c, const cJSON *item, const char *field, lx_vec3 *out) {
+static lx_status get_vec3(const ctx *c, const cJSON *item, const char *field, lx_vec3 *out)
+{
     if (!cJSON_IsArray(item))
         return fail(c, LX_ERR_FORMAT, "%s must be an array of 3 numbers", field);
     int n = cJSON_GetArraySize(item);
-    if (n != 3) return fail(c, LX_ERR_FORMAT, "%s must be an array of 3 numbers, not %d", field, n);
+    if (n != 3)
+        return fail(c, LX_ERR_FORMAT, "%s must be an array of 3 numbers, not %d", field, n);
     float v[3];
     int i = 0;
     for (const cJSON *e = item->child; e; e = e->next, i++) {
         char name[48];
         snprintf(name, sizeof name, "%s[%d]", field, i);
         lx_status st = get_float(c, e, name, &v[i]);
-        if (st != LX_OK) return st;
+        if (st != LX_OK)
+            return st;
     }
     *out = lx_v3(v[0], v[1], v[2]);
     return LX_OK;
 }
 
-static lx_status get_color(const ctx *c, const cJSON *item, const char *field, lx_vec3 *out) {
+static lx_status get_color(const ctx *c, const cJSON *item, const char *field, lx_vec3 *out)
+{
     lx_status st = get_vec3(c, item, field, out);
     if (st == LX_OK && (out->x < 0.0f || out->y < 0.0f || out->z < 0.0f))
         return fail(c, LX_ERR_INVALID, "%s [%g, %g, %g] has a negative component", field, out->x,
@@ -75,7 +83,8 @@ static lx_status get_color(const ctx *c, const cJSON *item, const char *field, l
     return st;
 }
 
-static lx_status get_string(const ctx *c, const cJSON *item, const char *field, const char **out) {
+static lx_status get_string(const ctx *c, const cJSON *item, const char *field, const char **out)
+{
     if (!cJSON_IsString(item) || !item->valuestring)
         return fail(c, LX_ERR_FORMAT, "%s must be a string", field);
     *out = item->valuestring;
@@ -84,10 +93,12 @@ static lx_status get_string(const ctx *c, const cJSON *item, const char *field, 
 
 /* Maps a string to one of the names; fails listing the accepted ones. */
 static lx_status get_enum(const ctx *c, const cJSON *item, const char *field,
-                          const char *const *names, int count, int *out) {
+                          const char *const *names, int count, int *out)
+{
     const char *s = NULL;
     lx_status st = get_string(c, item, field, &s);
-    if (st != LX_OK) return st;
+    if (st != LX_OK)
+        return st;
     for (int i = 0; i < count; i++)
         if (strcmp(s, names[i]) == 0) {
             *out = i;
@@ -103,13 +114,15 @@ static lx_status get_enum(const ctx *c, const cJSON *item, const char *field,
 
 /* Every key of obj must be in allowed, once. An object has at most as many
  * keys as allowed before this fails, so the duplicate scan stays short. */
-static lx_status check_keys(const ctx *c, const cJSON *obj, const char *const *allowed, int count) {
+static lx_status check_keys(const ctx *c, const cJSON *obj, const char *const *allowed, int count)
+{
     for (const cJSON *e = obj->child; e; e = e->next) {
         const char *key = e->string ? e->string : "";
         bool known = false;
         for (int i = 0; i < count && !known; i++)
             known = strcmp(key, allowed[i]) == 0;
-        if (!known) return fail(c, LX_ERR_FORMAT, "unknown key '%.40s'", key);
+        if (!known)
+            return fail(c, LX_ERR_FORMAT, "unknown key '%.40s'", key);
         for (const cJSON *p = obj->child; p != e; p = p->next)
             if (strcmp(p->string, key) == 0)
                 return fail(c, LX_ERR_FORMAT, "key '%s' appears twice", key);
@@ -125,31 +138,36 @@ typedef struct name_table {
     size_t mask;
 } name_table;
 
-static uint32_t hash_name(const char *s) {
+static uint32_t hash_name(const char *s)
+{
     uint32_t h = 2166136261u; /* FNV-1a */
     for (; *s; s++)
         h = (h ^ (uint8_t)*s) * 16777619u;
     return h;
 }
 
-static lx_status table_init(name_table *t, size_t capacity) {
+static lx_status table_init(name_table *t, size_t capacity)
+{
     size_t n = 16;
     while (n < capacity * 2)
         n *= 2;
     t->slots = malloc(n * sizeof *t->slots);
     t->names = calloc(n, sizeof *t->names);
     t->mask = n - 1;
-    if (!t->slots || !t->names) return LX_ERR_NOMEM;
+    if (!t->slots || !t->names)
+        return LX_ERR_NOMEM;
     return LX_OK;
 }
 
-static void table_free(name_table *t) {
+static void table_free(name_table *t)
+{
     free(t->slots);
     free(t->names);
 }
 
 /* Sets name -> value (the name's storage must outlive the table). */
-static void table_put(name_table *t, const char *name, int32_t value) {
+static void table_put(name_table *t, const char *name, int32_t value)
+{
     size_t i = hash_name(name) & t->mask;
     while (t->names[i] && strcmp(t->names[i], name) != 0)
         i = (i + 1) & t->mask;
@@ -157,7 +175,8 @@ static void table_put(name_table *t, const char *name, int32_t value) {
     t->slots[i] = value;
 }
 
-static bool table_get(const name_table *t, const char *name, int32_t *value) {
+static bool table_get(const name_table *t, const char *name, int32_t *value)
+{
     size_t i = hash_name(name) & t->mask;
     for (; t->names[i]; i = (i + 1) & t->mask)
         if (strcmp(t->names[i], name) == 0) {
@@ -169,11 +188,16 @@ static bool table_get(const name_table *t, const char *name, int32_t *value) {
 
 /* ---- one light ---------------------------------------------------------- */
 
-static const char *const light_keys[] = {
-    "name",        "type",   "position",        "direction",       "color",
-    "intensity",   "unit",   "spot_conversion", "range",           "inner_angle",
-    "outer_angle", "shadow", "blur_power",      "blur_multiplier", "model",
-    "ambient",     "dynamic", "srgb",         "temperature"};
+static const char *const light_keys[] = {"name",        "type",
+                                         "position",    "direction",
+                                         "color",       "intensity",
+                                         "unit",        "spot_conversion",
+                                         "range",       "inner_angle",
+                                         "outer_angle", "shadow",
+                                         "blur_power",  "blur_multiplier",
+                                         "model",       "ambient",
+                                         "dynamic",     "srgb",
+                                         "temperature"};
 static const char *const type_names[] = {"point", "spot", "directional"};
 static const char *const shadow_names[] = {"hard", "none", "blur"};
 static const char *const model_names[] = {"physical", "classic"};
@@ -183,7 +207,8 @@ static const char *const conversion_names[] = {"pi", "cone"};
 
 /* Repeats the light module's "light 'key': problem" message as "file:
  * lights[i] ('key'): problem": where already names the light. */
-static lx_status restate(const ctx *c, lx_status st, const lx_light *l) {
+static lx_status restate(const ctx *c, lx_status st, const lx_light *l)
+{
     char label[LX_LIGHT_NAME_MAX + 24], msg[512];
     if (l->name[0])
         snprintf(label, sizeof label, "light '%s': ", l->name);
@@ -198,19 +223,22 @@ static lx_status restate(const ctx *c, lx_status st, const lx_light *l) {
 /* Fills out from obj; a light named like one in names (earlier in the file
  * or already in the scene) starts from that light. */
 static lx_status read_light(ctx *c, const cJSON *obj, const name_table *names,
-                            const lx_light *pending, const lx_scene *scene, lx_light *out) {
+                            const lx_light *pending, const lx_scene *scene, lx_light *out)
+{
     lx_status st;
     const cJSON *name_item = cJSON_GetObjectItemCaseSensitive(obj, "name");
     const char *name = "";
     if (name_item) {
-        if ((st = get_string(c, name_item, "name", &name)) != LX_OK) return st;
+        if ((st = get_string(c, name_item, "name", &name)) != LX_OK)
+            return st;
         if (strlen(name) >= LX_LIGHT_NAME_MAX)
             return fail(c, LX_ERR_INVALID, "name '%.20s...' is longer than %d bytes", name,
                         LX_LIGHT_NAME_MAX - 1);
         size_t len = strlen(c->where);
         snprintf(c->where + len, sizeof c->where - len, " ('%s')", name);
     }
-    if ((st = check_keys(c, obj, light_keys, COUNT(light_keys))) != LX_OK) return st;
+    if ((st = check_keys(c, obj, light_keys, COUNT(light_keys))) != LX_OK)
+        return st;
 
     /* An override by name starts from the existing light: only the keys
      * the file gives change. */
@@ -223,7 +251,8 @@ static lx_status read_light(ctx *c, const cJSON *obj, const name_table *names,
     lx_light l;
     if (is_override) {
         l = found >= 0 ? pending[found] : scene->lights[-(found + 1)];
-        if (type_item) l.type = (lx_light_type)type;
+        if (type_item)
+            l.type = (lx_light_type)type;
     } else {
         if (!type_item)
             return fail(c, LX_ERR_FORMAT, "missing 'type' (point, spot or directional)");
@@ -233,14 +262,16 @@ static lx_status read_light(ctx *c, const cJSON *obj, const name_table *names,
 
     const cJSON *it;
     if ((it = cJSON_GetObjectItemCaseSensitive(obj, "position"))) {
-        if ((st = get_vec3(c, it, "position", &l.position)) != LX_OK) return st;
+        if ((st = get_vec3(c, it, "position", &l.position)) != LX_OK)
+            return st;
     } else if (!is_override && l.type != LX_LIGHT_DIRECTIONAL) {
         return fail(c, LX_ERR_FORMAT, "missing 'position' for a %s light",
                     lx_light_type_name(l.type));
     }
     if ((it = cJSON_GetObjectItemCaseSensitive(obj, "direction"))) {
         lx_vec3 d;
-        if ((st = get_vec3(c, it, "direction", &d)) != LX_OK) return st;
+        if ((st = get_vec3(c, it, "direction", &d)) != LX_OK)
+            return st;
         /* The length in float can overflow even for finite components. */
         double len = sqrt((double)d.x * d.x + (double)d.y * d.y + (double)d.z * d.z);
         if (!(len > 1e-20))
@@ -272,8 +303,8 @@ static lx_status read_light(ctx *c, const cJSON *obj, const name_table *names,
         if ((st = get_float(c, color_items[2], "temperature", &kelvin)) != LX_OK)
             return st;
         if (lx_temperature_to_rgb(kelvin, &l.color) != LX_OK)
-            return fail(c, LX_ERR_INVALID, "temperature %g K is outside %g..%g K",
-                        (double)kelvin, (double)LX_MIN_TEMPERATURE, (double)LX_MAX_TEMPERATURE);
+            return fail(c, LX_ERR_INVALID, "temperature %g K is outside %g..%g K", (double)kelvin,
+                        (double)LX_MIN_TEMPERATURE, (double)LX_MAX_TEMPERATURE);
     }
     if ((it = cJSON_GetObjectItemCaseSensitive(obj, "ambient")) &&
         (st = get_color(c, it, "ambient", &l.ambient)) != LX_OK)
@@ -283,20 +314,24 @@ static lx_status read_light(ctx *c, const cJSON *obj, const name_table *names,
         return st;
     float deg;
     if ((it = cJSON_GetObjectItemCaseSensitive(obj, "inner_angle"))) {
-        if ((st = get_non_negative(c, it, "inner_angle", &deg)) != LX_OK) return st;
+        if ((st = get_non_negative(c, it, "inner_angle", &deg)) != LX_OK)
+            return st;
         l.inner_angle = LX_DEG2RAD(deg);
     }
     if ((it = cJSON_GetObjectItemCaseSensitive(obj, "outer_angle"))) {
-        if ((st = get_non_negative(c, it, "outer_angle", &deg)) != LX_OK) return st;
+        if ((st = get_non_negative(c, it, "outer_angle", &deg)) != LX_OK)
+            return st;
         l.outer_angle = LX_DEG2RAD(deg);
     }
     int e = 0;
     if ((it = cJSON_GetObjectItemCaseSensitive(obj, "shadow"))) {
-        if ((st = get_enum(c, it, "shadow", shadow_names, 3, &e)) != LX_OK) return st;
+        if ((st = get_enum(c, it, "shadow", shadow_names, 3, &e)) != LX_OK)
+            return st;
         l.shadow = (lx_shadow_mode)e;
     }
     if ((it = cJSON_GetObjectItemCaseSensitive(obj, "model"))) {
-        if ((st = get_enum(c, it, "model", model_names, 2, &e)) != LX_OK) return st;
+        if ((st = get_enum(c, it, "model", model_names, 2, &e)) != LX_OK)
+            return st;
         l.model = (lx_falloff_model)e;
     }
     if ((it = cJSON_GetObjectItemCaseSensitive(obj, "blur_power")) &&
@@ -306,28 +341,32 @@ static lx_status read_light(ctx *c, const cJSON *obj, const name_table *names,
         (st = get_non_negative(c, it, "blur_multiplier", &l.blur_multiplier)) != LX_OK)
         return st;
     if ((it = cJSON_GetObjectItemCaseSensitive(obj, "dynamic"))) {
-        if (!cJSON_IsBool(it)) return fail(c, LX_ERR_FORMAT, "dynamic must be true or false");
+        if (!cJSON_IsBool(it))
+            return fail(c, LX_ERR_FORMAT, "dynamic must be true or false");
         l.dynamic = cJSON_IsTrue(it);
     }
 
     /* Units last: lumens over a spot's cone need the final outer angle. */
     lx_spot_conversion conv = LX_SPOT_POWER_PI;
     if ((it = cJSON_GetObjectItemCaseSensitive(obj, "spot_conversion"))) {
-        if ((st = get_enum(c, it, "spot_conversion", conversion_names, 2, &e)) != LX_OK) return st;
+        if ((st = get_enum(c, it, "spot_conversion", conversion_names, 2, &e)) != LX_OK)
+            return st;
         conv = (lx_spot_conversion)e;
     }
     lx_light_unit unit = LX_UNIT_DEFAULT;
     const cJSON *unit_item = cJSON_GetObjectItemCaseSensitive(obj, "unit");
     if (unit_item) {
         const char *s = NULL;
-        if ((st = get_string(c, unit_item, "unit", &s)) != LX_OK) return st;
+        if ((st = get_string(c, unit_item, "unit", &s)) != LX_OK)
+            return st;
         unit = lx_light_unit_from_string(s);
         if (unit == LX_UNIT_DEFAULT)
             return fail(c, LX_ERR_FORMAT, "unknown unit '%.40s' (expected cd, lm, W or lx)", s);
     }
     if ((it = cJSON_GetObjectItemCaseSensitive(obj, "intensity"))) {
         float value;
-        if ((st = get_non_negative(c, it, "intensity", &value)) != LX_OK) return st;
+        if ((st = get_non_negative(c, it, "intensity", &value)) != LX_OK)
+            return st;
         if (unit == LX_UNIT_LUX && l.type != LX_LIGHT_DIRECTIONAL)
             return fail(c, LX_ERR_INVALID, "unit: %s lights take cd, lm or W, not lx",
                         lx_light_type_name(l.type));
@@ -340,7 +379,8 @@ static lx_status read_light(ctx *c, const cJSON *obj, const name_table *names,
         return fail(c, LX_ERR_FORMAT, "'unit' is given without 'intensity'");
     }
 
-    if ((st = lx_light_validate(&l)) != LX_OK) return restate(c, st, &l);
+    if ((st = lx_light_validate(&l)) != LX_OK)
+        return restate(c, st, &l);
     *out = l;
     return LX_OK;
 }
@@ -349,15 +389,18 @@ static lx_status read_light(ctx *c, const cJSON *obj, const name_table *names,
 
 static const char *const root_keys[] = {"ambient", "lights"};
 
-static lx_status apply_root(lx_scene *scene, const cJSON *root, const char *file) {
+static lx_status apply_root(lx_scene *scene, const cJSON *root, const char *file)
+{
     ctx c = {.file = file, .where = ""};
     if (!cJSON_IsObject(root))
         return fail(&c, LX_ERR_FORMAT, "the top level must be an object with \"lights\"");
     lx_status st = check_keys(&c, root, root_keys, COUNT(root_keys));
-    if (st != LX_OK) return st;
+    if (st != LX_OK)
+        return st;
     const cJSON *amb = cJSON_GetObjectItemCaseSensitive(root, "ambient");
     lx_vec3 ambient = scene->ambient;
-    if (amb && (st = get_color(&c, amb, "ambient", &ambient)) != LX_OK) return st;
+    if (amb && (st = get_color(&c, amb, "ambient", &ambient)) != LX_OK)
+        return st;
 
     const cJSON *list = cJSON_GetObjectItemCaseSensitive(root, "lights");
     size_t count = 0;
@@ -367,7 +410,8 @@ static lx_status apply_root(lx_scene *scene, const cJSON *root, const char *file
         for (const cJSON *e = list->child; e; e = e->next)
             count++;
     }
-    if (count > INT32_MAX / 4) return fail(&c, LX_ERR_INVALID, "%zu lights are too many", count);
+    if (count > INT32_MAX / 4)
+        return fail(&c, LX_ERR_INVALID, "%zu lights are too many", count);
     lx_light *pending = malloc((count ? count : 1) * sizeof *pending);
     name_table names = {0};
     if (!pending || table_init(&names, count + scene->light_count) != LX_OK) {
@@ -376,7 +420,8 @@ static lx_status apply_root(lx_scene *scene, const cJSON *root, const char *file
         return fail(&c, LX_ERR_NOMEM, "out of memory for %zu lights", count);
     }
     for (uint32_t i = 0; i < scene->light_count; i++)
-        if (scene->lights[i].name[0]) table_put(&names, scene->lights[i].name, -(int32_t)i - 1);
+        if (scene->lights[i].name[0])
+            table_put(&names, scene->lights[i].name, -(int32_t)i - 1);
 
     size_t i = 0;
     for (const cJSON *e = list ? list->child : NULL; e && st == LX_OK; e = e->next, i++) {
@@ -385,7 +430,8 @@ static lx_status apply_root(lx_scene *scene, const cJSON *root, const char *file
             st = fail(&c, LX_ERR_FORMAT, "must be an object");
         else
             st = read_light(&c, e, &names, pending, scene, &pending[i]);
-        if (st == LX_OK && pending[i].name[0]) table_put(&names, pending[i].name, (int32_t)i);
+        if (st == LX_OK && pending[i].name[0])
+            table_put(&names, pending[i].name, (int32_t)i);
     }
     table_free(&names);
     if (st == LX_OK) {
@@ -403,24 +449,31 @@ static lx_status apply_root(lx_scene *scene, const cJSON *root, const char *file
 }
 
 lx_status lx_lights_json_apply_text(lx_scene *scene, const char *text, size_t size,
-                                    const char *name) {
+                                    const char *name)
+{
     const char *file = name && name[0] ? name : "lights.json";
-    if (!scene) return lx_fail(LX_ERR_INVALID, "%s: no scene to apply the lights to", file);
-    if (!text && size > 0) return lx_fail(LX_ERR_INVALID, "%s: no text", file);
+    if (!scene)
+        return lx_fail(LX_ERR_INVALID, "%s: no scene to apply the lights to", file);
+    if (!text && size > 0)
+        return lx_fail(LX_ERR_INVALID, "%s: no text", file);
     cJSON *root;
     lx_status st = parse_json(file, text ? text : "", size, &root);
-    if (st != LX_OK) return st;
+    if (st != LX_OK)
+        return st;
     st = apply_root(scene, root, file);
     cJSON_Delete(root);
     return st;
 }
 
-lx_status lx_lights_json_apply(lx_scene *scene, const char *path) {
-    if (!path) return lx_fail(LX_ERR_INVALID, "lights JSON: no path");
+lx_status lx_lights_json_apply(lx_scene *scene, const char *path)
+{
+    if (!path)
+        return lx_fail(LX_ERR_INVALID, "lights JSON: no path");
     char *text;
     size_t size;
     lx_status st = lx_read_file(path, LX_LIGHTS_JSON_MAX, &text, &size);
-    if (st != LX_OK) return st;
+    if (st != LX_OK)
+        return st;
     st = lx_lights_json_apply_text(scene, text, size, path);
     free(text);
     return st;

@@ -119,19 +119,17 @@ static lx_status validate_mesh(const lx_scene *s, const lx_mesh *m, const char *
             return lx_fail(LX_ERR_FORMAT, "%s: mesh '%s': vertex %u: position is not finite",
                            s->path, name, v);
         if (m->normals && !lx_vec3_finite(m->normals[v]))
-            return lx_fail(LX_ERR_FORMAT, "%s: mesh '%s': vertex %u: normal is not finite",
-                           s->path, name, v);
+            return lx_fail(LX_ERR_FORMAT, "%s: mesh '%s': vertex %u: normal is not finite", s->path,
+                           name, v);
         for (int k = 0; k < LX_MAX_UV_SETS; k++)
             if (m->uv[k] && !(isfinite(m->uv[k][v].x) && isfinite(m->uv[k][v].y)))
-                return lx_fail(LX_ERR_FORMAT,
-                               "%s: mesh '%s': vertex %u: TEXCOORD_%d is not finite", s->path,
-                               name, v, k);
+                return lx_fail(LX_ERR_FORMAT, "%s: mesh '%s': vertex %u: TEXCOORD_%d is not finite",
+                               s->path, name, v, k);
         if (m->tangents) {
             lx_vec4 t = m->tangents[v];
             if (!(isfinite(t.x) && isfinite(t.y) && isfinite(t.z) && isfinite(t.w)))
-                return lx_fail(LX_ERR_FORMAT,
-                               "%s: mesh '%s': vertex %u: tangent is not finite", s->path, name,
-                               v);
+                return lx_fail(LX_ERR_FORMAT, "%s: mesh '%s': vertex %u: tangent is not finite",
+                               s->path, name, v);
         }
     }
     for (uint32_t t = 0; t < m->triangle_count; t++) {
@@ -143,8 +141,8 @@ static lx_status validate_mesh(const lx_scene *s, const lx_mesh *m, const char *
                                s->path, name, t, idx[k], m->vertex_count);
         if (lx_triangle_degenerate(m->positions[idx[0]], m->positions[idx[1]],
                                    m->positions[idx[2]]))
-            return lx_fail(LX_ERR_FORMAT, "%s: mesh '%s': triangle %u has zero area", s->path,
-                           name, t);
+            return lx_fail(LX_ERR_FORMAT, "%s: mesh '%s': triangle %u has zero area", s->path, name,
+                           t);
     }
     if (m->material >= s->material_count && s->material_count > 0)
         return lx_fail(LX_ERR_INVALID, "%s: mesh '%s': material %u out of range (count %u)",
@@ -170,14 +168,13 @@ lx_status lx_scene_add_mesh(lx_scene *s, const lx_mesh *src, uint32_t *index)
         return lx_fail(LX_ERR_NOMEM, "%s: mesh '%s' is too large", s->path, name);
     m.name = lx_strdup(name);
     m.positions = dup_array(src->positions, nv, sizeof(lx_vec3));
-    m.normals = src->normals ? dup_array(src->normals, nv, sizeof(lx_vec3))
-                             : malloc(nv * sizeof(lx_vec3));
+    m.normals =
+        src->normals ? dup_array(src->normals, nv, sizeof(lx_vec3)) : malloc(nv * sizeof(lx_vec3));
     m.tangents = dup_array(src->tangents, nv, sizeof(lx_vec4));
     for (int k = 0; k < LX_MAX_UV_SETS; k++)
         m.uv[k] = dup_array(src->uv[k], nv, sizeof(lx_vec2));
     m.indices = dup_array(src->indices, ni, sizeof(uint32_t));
-    bool ok = m.name && m.positions && m.normals && m.indices &&
-              (!src->tangents || m.tangents);
+    bool ok = m.name && m.positions && m.normals && m.indices && (!src->tangents || m.tangents);
     for (int k = 0; k < LX_MAX_UV_SETS; k++)
         ok = ok && (!src->uv[k] || m.uv[k]);
     if (!ok) {
@@ -246,8 +243,8 @@ lx_status lx_scene_add_node(lx_scene *s, const char *name, const lx_mat4 *world,
     if (!lx_mat4_finite(world))
         return lx_fail(LX_ERR_FORMAT, "%s: node '%s': transform is not finite", s->path, name);
     if (!(fabsf(lx_mat4_det3(world)) > 1e-20f))
-        return lx_fail(LX_ERR_FORMAT, "%s: node '%s': transform is singular (zero scale)",
-                       s->path, name);
+        return lx_fail(LX_ERR_FORMAT, "%s: node '%s': transform is singular (zero scale)", s->path,
+                       name);
     for (uint32_t i = 0; i < mesh_count; i++)
         if (meshes[i] >= s->mesh_count)
             return lx_fail(LX_ERR_INVALID, "%s: node '%s': mesh %u out of range (count %u)",
@@ -285,8 +282,7 @@ lx_status lx_scene_add_light(lx_scene *s, const lx_light *light)
                 s->lights[i] = *light;
                 return LX_OK;
             }
-    st = grow((void **)&s->lights, &s->light_capacity, s->light_count, sizeof(lx_light),
-              "lights");
+    st = grow((void **)&s->lights, &s->light_capacity, s->light_count, sizeof(lx_light), "lights");
     if (st != LX_OK)
         return st;
     s->lights[s->light_count++] = *light;

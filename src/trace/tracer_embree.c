@@ -134,8 +134,10 @@ lx_status lx_tracer_create(const lx_scene *scene, lx_tracer **out)
                     rtcReleaseGeometry(geom);
                 lx_tracer_destroy(tr);
                 return st != LX_OK ? st
-                                   : lx_fail(LX_ERR_NOMEM, "%s: out of memory for the rays of "
-                                             "mesh '%s'", scene->path, m->name);
+                                   : lx_fail(LX_ERR_NOMEM,
+                                             "%s: out of memory for the rays of "
+                                             "mesh '%s'",
+                                             scene->path, m->name);
             }
             rtcAttachGeometryByID(tr->scene, geom, g);
             tr->geometries[g] = geom;

@@ -20,14 +20,17 @@
 
 /* ---- helpers ---------------------------------------------------------------- */
 
-static double window_ref(double d, double r) {
-    if (r <= 0.0) return 1.0;
+static double window_ref(double d, double r)
+{
+    if (r <= 0.0)
+        return 1.0;
     double f = 1.0 - pow(d / r, 4.0);
     return f > 0.0 ? f * f : 0.0;
 }
 
 /* Filament's smooth spot attenuation, written out. */
-static double spot_ref(double cos_angle, double inner, double outer) {
+static double spot_ref(double cos_angle, double inner, double outer)
+{
     double t = (cos_angle - cos(outer)) / (cos(inner) - cos(outer));
     t = t < 0 ? 0 : (t > 1 ? 1 : t);
     return t * t;
@@ -35,12 +38,14 @@ static double spot_ref(double cos_angle, double inner, double outer) {
 
 /* Illuminance (lux, before colour) of a point or spot light at p with
  * normal n, unshadowed. */
-static double point_ref(const lx_light *l, lx_vec3 p, lx_vec3 n) {
+static double point_ref(const lx_light *l, lx_vec3 p, lx_vec3 n)
+{
     double lx = (double)l->position.x - p.x, ly = (double)l->position.y - p.y,
            lz = (double)l->position.z - p.z;
     double d = sqrt(lx * lx + ly * ly + lz * lz);
     double cos_t = (lx * n.x + ly * n.y + lz * n.z) / d;
-    if (cos_t <= 0) return 0;
+    if (cos_t <= 0)
+        return 0;
     double e = l->intensity * cos_t / (d * d) * window_ref(d, l->range);
     if (l->type == LX_LIGHT_SPOT) {
         double ca = -(lx * l->direction.x + ly * l->direction.y + lz * l->direction.z) / d;
@@ -50,31 +55,36 @@ static double point_ref(const lx_light *l, lx_vec3 p, lx_vec3 n) {
 }
 
 static void check_close(double got, double want, double rel, double abs_floor, const char *what,
-                        int x, int y) {
+                        int x, int y)
+{
     if (!(fabs(got - want) <= rel * fabs(want) + abs_floor))
         fail_msg("%s texel (%d, %d): got %.9g, want %.9g (rel %g, floor %g)", what, x, y, got, want,
                  rel, abs_floor);
 }
 
-static lx_scene *new_scene(void) {
+static lx_scene *new_scene(void)
+{
     lx_scene *s;
     assert_int_equal(lx_scene_create("analytic", &s), LX_OK);
     return s;
 }
 
 static uint32_t add_plane(lx_scene *s, const char *name, float size, float height, float cx,
-                          float cz, int n) {
+                          float cz, int n)
+{
     lx_mesh m = lx_test_plane(name, size, height, cx, cz, n);
     lx_test_add(s, &m);
     lx_test_mesh_free(&m);
     return s->node_count - 1;
 }
 
-static void add_light(lx_scene *s, lx_light l) {
+static void add_light(lx_scene *s, lx_light l)
+{
     assert_int_equal(lx_scene_add_light(s, &l), LX_OK);
 }
 
-static lx_light point_light(const char *name, lx_vec3 pos, float intensity, float range) {
+static lx_light point_light(const char *name, lx_vec3 pos, float intensity, float range)
+{
     lx_light l = lx_light_defaults(LX_LIGHT_POINT);
     snprintf(l.name, sizeof l.name, "%s", name);
     l.position = pos;
@@ -83,7 +93,8 @@ static lx_light point_light(const char *name, lx_vec3 pos, float intensity, floa
     return l;
 }
 
-static lx_light dir_light(const char *name, lx_vec3 dir, float lux) {
+static lx_light dir_light(const char *name, lx_vec3 dir, float lux)
+{
     lx_light l = lx_light_defaults(LX_LIGHT_DIRECTIONAL);
     snprintf(l.name, sizeof l.name, "%s", name);
     l.direction = lx_normalize(dir);
@@ -91,43 +102,53 @@ static lx_light dir_light(const char *name, lx_vec3 dir, float lux) {
     return l;
 }
 
-static lx_baker *bake(const lx_scene *s, int resolution, int padding, lx_quantity q) {
+static lx_baker *bake(const lx_scene *s, int resolution, int padding, lx_quantity q)
+{
     lx_bake_desc d = {.resolution = resolution, .padding = padding, .quantity = q};
     lx_baker *b = NULL;
     lx_status st = lx_baker_create(s, &d, &b);
-    if (st != LX_OK) fail_msg("lx_baker_create: %s", lx_last_error());
+    if (st != LX_OK)
+        fail_msg("lx_baker_create: %s", lx_last_error());
     st = lx_baker_bake(b);
-    if (st != LX_OK) fail_msg("lx_baker_bake: %s", lx_last_error());
+    if (st != LX_OK)
+        fail_msg("lx_baker_bake: %s", lx_last_error());
     return b;
 }
 
-static uint32_t map_of(const lx_baker *b, uint32_t node) {
+static uint32_t map_of(const lx_baker *b, uint32_t node)
+{
     for (uint32_t m = 0; m < lx_baker_lightmap_count(b); m++)
-        if (lx_baker_lightmap_info(b, m)->node == node) return m;
+        if (lx_baker_lightmap_info(b, m)->node == node)
+            return m;
     fail_msg("no lightmap for node %u", node);
     return UINT32_MAX;
 }
 
-static lx_image apply(const lx_baker *b, uint32_t map) {
+static lx_image apply(const lx_baker *b, uint32_t map)
+{
     lx_image img;
-    if (lx_baker_apply_alloc(b, map, &img) != LX_OK) fail_msg("apply: %s", lx_last_error());
+    if (lx_baker_apply_alloc(b, map, &img) != LX_OK)
+        fail_msg("apply: %s", lx_last_error());
     return img;
 }
 
 /* Position of texel (x, y) of a lx_test_plane through its UV layout. */
 static lx_vec3 plane_uv_to_world(float size, float height, float cx, float cz, int x, int y, int w,
-                                 int h) {
+                                 int h)
+{
     double u = (x + 0.5) / w, v = (y + 0.5) / h;
     return lx_v3((float)(cx - size / 2.0 + u * size), height, (float)(cz - size / 2.0 + v * size));
 }
 
 typedef double (*irradiance_fn)(const void *ctx, lx_vec3 p, lx_vec3 n);
 
-static double point_fn(const void *ctx, lx_vec3 p, lx_vec3 n) {
+static double point_fn(const void *ctx, lx_vec3 p, lx_vec3 n)
+{
     return point_ref((const lx_light *)ctx, p, n);
 }
 
-static double dir_fn(const void *ctx, lx_vec3 p, lx_vec3 n) {
+static double dir_fn(const void *ctx, lx_vec3 p, lx_vec3 n)
+{
     const lx_light *l = ctx;
     double c = -((double)l->direction.x * n.x + (double)l->direction.y * n.y +
                  (double)l->direction.z * n.z);
@@ -139,7 +160,8 @@ static double dir_fn(const void *ctx, lx_vec3 p, lx_vec3 n) {
  * position against the plane's UV layout and its value against fn.
  * Returns the number of texels with a non-zero expected value. */
 static int check_plane_light(lx_light light, irradiance_fn fn, double rel, double floor_rel,
-                             int *zero_count) {
+                             int *zero_count)
+{
     const float size = 4.0f, height = 0.0f, cx = 0.25f, cz = -0.5f;
     const int res = 64;
     lx_scene *s = new_scene();
@@ -186,7 +208,8 @@ static int check_plane_light(lx_light light, irradiance_fn fn, double rel, doubl
                     assert_true(px[c] == 0.0f);
             }
         }
-    if (zero_count) *zero_count = zero;
+    if (zero_count)
+        *zero_count = zero;
     lx_image_free(&img);
     lx_baker_destroy(b);
     lx_scene_destroy(s);
@@ -195,7 +218,8 @@ static int check_plane_light(lx_light light, irradiance_fn fn, double rel, doubl
 
 /* ---- (a) closed forms -------------------------------------------------------- */
 
-static void test_point_light_inverse_square(void **state) {
+static void test_point_light_inverse_square(void **state)
+{
     (void)state;
     lx_light l = point_light("bulb", lx_v3(0.3f, 1.5f, -0.2f), 120.0f, 3.0f);
     l.color = lx_v3(1.0f, 0.5f, 0.25f);
@@ -210,7 +234,8 @@ static void test_point_light_inverse_square(void **state) {
     assert_int_equal(check_plane_light(l, point_fn, 1e-4, 1e-7, NULL), 64 * 64);
 }
 
-static void test_spot_light_cone(void **state) {
+static void test_spot_light_cone(void **state)
+{
     (void)state;
     lx_light l = lx_light_defaults(LX_LIGHT_SPOT);
     strcpy(l.name, "spot");
@@ -262,7 +287,8 @@ static void test_spot_light_cone(void **state) {
     lx_scene_destroy(s);
 }
 
-static void test_directional_cosine(void **state) {
+static void test_directional_cosine(void **state)
+{
     (void)state;
     lx_light l = dir_light("sun", lx_v3(0.3f, -1.0f, 0.2f), 5.0f);
     l.color = lx_v3(0.9f, 0.8f, 0.7f);
@@ -274,7 +300,8 @@ static void test_directional_cosine(void **state) {
 
 /* ---- (b) occluder: the shadow is the projection of the square --------------- */
 
-static void test_occluder_projection(void **state) {
+static void test_occluder_projection(void **state)
+{
     (void)state;
     const float size = 4.0f, occ = 1.0f, occ_h = 1.0f, ocx = 0.3f, ocz = 0.2f;
     const int res = 64;
@@ -328,7 +355,8 @@ static void test_occluder_projection(void **state) {
     for (int y = 0; y < res; y++)
         for (int x = 0; x < res; x++) {
             lx_texel_sample ts;
-            if (!lx_baker_texel(b, map, x, y, &ts)) continue;
+            if (!lx_baker_texel(b, map, x, y, &ts))
+                continue;
             check_close(img.data[3 * (y * res + x)], point_ref(&l, ts.position, lx_v3(0, 1, 0)),
                         1e-4, 0, "occluder top", x, y);
             n++;
@@ -341,7 +369,8 @@ static void test_occluder_projection(void **state) {
 
 /* ---- (c) closed box: no light gets in ------------------------------------------ */
 
-static void assert_all_zero(const lx_baker *b, uint32_t map, const char *what) {
+static void assert_all_zero(const lx_baker *b, uint32_t map, const char *what)
+{
     lx_image img = apply(b, map);
     const lx_lightmap_info *info = lx_baker_lightmap_info(b, map);
     assert_true(info->used_texels > 0);
@@ -352,7 +381,8 @@ static void assert_all_zero(const lx_baker *b, uint32_t map, const char *what) {
     lx_image_free(&img);
 }
 
-static void test_closed_room_dark(void **state) {
+static void test_closed_room_dark(void **state)
+{
     (void)state;
     lx_scene *s = new_scene();
     lx_mesh room = lx_test_box("room", lx_v3(-1, -1, -1), lx_v3(1, 1, 1), true);
@@ -367,7 +397,8 @@ static void test_closed_room_dark(void **state) {
     lx_scene_destroy(s);
 }
 
-static void test_plane_inside_box_dark(void **state) {
+static void test_plane_inside_box_dark(void **state)
+{
     (void)state;
     lx_scene *s = new_scene();
     lx_mesh box = lx_test_box("box", lx_v3(-1, -1, -1), lx_v3(1, 1, 1), false);
@@ -391,7 +422,8 @@ static void test_plane_inside_box_dark(void **state) {
 
 /* ---- (d) grazing light: no acne ------------------------------------------------ */
 
-static void grazing_case(float size, float cx, float cz, int n, float elevation_deg) {
+static void grazing_case(float size, float cx, float cz, int n, float elevation_deg)
+{
     lx_scene *s = new_scene();
     uint32_t node = add_plane(s, "ground", size, 0.0f, cx, cz, n);
     float e = LX_DEG2RAD(elevation_deg), a = LX_DEG2RAD(30.0f);
@@ -417,7 +449,8 @@ static void grazing_case(float size, float cx, float cz, int n, float elevation_
     lx_scene_destroy(s);
 }
 
-static void test_grazing_no_acne(void **state) {
+static void test_grazing_no_acne(void **state)
+{
     (void)state;
     const float elevations[] = {1.0f, 2.0f, 3.0f, 5.0f};
     for (int i = 0; i < 4; i++) {
@@ -429,7 +462,8 @@ static void test_grazing_no_acne(void **state) {
 
 /* ---- (e) ambient ------------------------------------------------------------- */
 
-static void test_scene_ambient_adds(void **state) {
+static void test_scene_ambient_adds(void **state)
+{
     (void)state;
     const lx_vec3 amb = lx_v3(0.1f, 0.2f, 0.3f);
     lx_scene *s = new_scene();
@@ -466,7 +500,8 @@ static void test_scene_ambient_adds(void **state) {
     lx_scene_destroy(s);
 }
 
-static void test_light_ambient_falloff_and_blend(void **state) {
+static void test_light_ambient_falloff_and_blend(void **state)
+{
     (void)state;
     lx_scene *s = new_scene();
     uint32_t node = add_plane(s, "ground", 6.0f, 0.0f, 0.0f, 0.0f, 6);
@@ -511,7 +546,8 @@ static void test_light_ambient_falloff_and_blend(void **state) {
 
 /* ---- (f) radiance = irradiance x base colour / pi -------------------------------- */
 
-static void test_radiance_quantity(void **state) {
+static void test_radiance_quantity(void **state)
+{
     (void)state;
     lx_scene *s = new_scene();
     lx_material mat = {.name = "paint", .base_color = {0.5f, 0.25f, 0.8f, 1.0f}};
@@ -545,7 +581,8 @@ static void test_radiance_quantity(void **state) {
 
 /* A plane whose UV chart is [0.26, 0.76]^2: at 32 texels its borders fall
  * at 8.32 and 24.32, inside texel columns 8 and 24. */
-static lx_scene *chart_scene(uint32_t *node) {
+static lx_scene *chart_scene(uint32_t *node)
+{
     lx_scene *s = new_scene();
     lx_mesh m = lx_test_plane("chart", 2.0f, 0.0f, 0.0f, 0.0f, 2);
     for (uint32_t v = 0; v < m.vertex_count; v++)
@@ -558,7 +595,8 @@ static lx_scene *chart_scene(uint32_t *node) {
     return s;
 }
 
-static void test_dilation(void **state) {
+static void test_dilation(void **state)
+{
     (void)state;
     const int res = 32;
     uint32_t node;
@@ -605,7 +643,8 @@ static void test_dilation(void **state) {
     lx_scene_destroy(s);
 }
 
-int main(void) {
+int main(void)
+{
     const struct CMUnitTest tests[] = {
         cmocka_unit_test(test_point_light_inverse_square),
         cmocka_unit_test(test_spot_light_cone),

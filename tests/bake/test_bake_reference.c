@@ -29,7 +29,8 @@
 
 /* ---- scene building --------------------------------------------------------- */
 
-static lx_scene *new_scene(const char *name) {
+static lx_scene *new_scene(const char *name)
+{
     lx_scene *s;
     assert_int_equal(lx_scene_create(name, &s), LX_OK);
     lx_material mat = {.name = "white", .base_color = {1, 1, 1, 1}};
@@ -37,26 +38,32 @@ static lx_scene *new_scene(const char *name) {
     return s;
 }
 
-static uint32_t add_mesh(lx_scene *s, lx_mesh *m) {
+static uint32_t add_mesh(lx_scene *s, lx_mesh *m)
+{
     uint32_t idx;
-    if (lx_scene_add_mesh(s, m, &idx) != LX_OK) fail_msg("add mesh: %s", lx_last_error());
+    if (lx_scene_add_mesh(s, m, &idx) != LX_OK)
+        fail_msg("add mesh: %s", lx_last_error());
     lx_test_mesh_free(m);
     return idx;
 }
 
 static uint32_t add_node(lx_scene *s, const char *name, lx_mat4 world, const uint32_t *meshes,
-                         uint32_t count) {
+                         uint32_t count)
+{
     uint32_t idx;
     if (lx_scene_add_node(s, name, &world, meshes, count, &idx) != LX_OK)
         fail_msg("add node: %s", lx_last_error());
     return idx;
 }
 
-static void add_light(lx_scene *s, lx_light l) {
-    if (lx_scene_add_light(s, &l) != LX_OK) fail_msg("add light: %s", lx_last_error());
+static void add_light(lx_scene *s, lx_light l)
+{
+    if (lx_scene_add_light(s, &l) != LX_OK)
+        fail_msg("add light: %s", lx_last_error());
 }
 
-static lx_light point(const char *name, lx_vec3 p, float cd, float range, lx_shadow_mode sh) {
+static lx_light point(const char *name, lx_vec3 p, float cd, float range, lx_shadow_mode sh)
+{
     lx_light l = lx_light_defaults(LX_LIGHT_POINT);
     snprintf(l.name, sizeof l.name, "%s", name);
     l.position = p;
@@ -66,7 +73,8 @@ static lx_light point(const char *name, lx_vec3 p, float cd, float range, lx_sha
     return l;
 }
 
-static lx_light spot(const char *name, lx_vec3 p, lx_vec3 target, float cd, lx_shadow_mode sh) {
+static lx_light spot(const char *name, lx_vec3 p, lx_vec3 target, float cd, lx_shadow_mode sh)
+{
     lx_light l = lx_light_defaults(LX_LIGHT_SPOT);
     snprintf(l.name, sizeof l.name, "%s", name);
     l.position = p;
@@ -79,7 +87,8 @@ static lx_light spot(const char *name, lx_vec3 p, lx_vec3 target, float cd, lx_s
     return l;
 }
 
-static lx_light sun(const char *name, lx_vec3 dir, float lux, lx_shadow_mode sh) {
+static lx_light sun(const char *name, lx_vec3 dir, float lux, lx_shadow_mode sh)
+{
     lx_light l = lx_light_defaults(LX_LIGHT_DIRECTIONAL);
     snprintf(l.name, sizeof l.name, "%s", name);
     l.direction = lx_normalize(dir);
@@ -89,14 +98,16 @@ static lx_light sun(const char *name, lx_vec3 dir, float lux, lx_shadow_mode sh)
     return l;
 }
 
-static lx_vec4 axis_angle(lx_vec3 axis, float deg) {
+static lx_vec4 axis_angle(lx_vec3 axis, float deg)
+{
     axis = lx_normalize(axis);
     float h = LX_DEG2RAD(deg) / 2;
     return lx_v4(axis.x * sinf(h), axis.y * sinf(h), axis.z * sinf(h), cosf(h));
 }
 
 /* remaps a mesh's lightmap UVs (uv[1]) into the rectangle [u0,u1]x[v0,v1] */
-static void remap_uv1(lx_mesh *m, float u0, float v0, float u1, float v1) {
+static void remap_uv1(lx_mesh *m, float u0, float v0, float u1, float v1)
+{
     float lo[2] = {INFINITY, INFINITY}, hi[2] = {-INFINITY, -INFINITY};
     for (uint32_t i = 0; i < m->vertex_count; i++) {
         lo[0] = fminf(lo[0], m->uv[1][i].x), hi[0] = fmaxf(hi[0], m->uv[1][i].x);
@@ -113,7 +124,8 @@ static void remap_uv1(lx_mesh *m, float u0, float v0, float u1, float v1) {
 
 /* Separating-axis gap between a 2D triangle and the square [x0,x0+1]x[y0,y0+1]
  * (texel units): > 0 separated, 0 touching, < 0 overlapping. */
-static double tri_square_gap(const double t[3][2], double x0, double y0) {
+static double tri_square_gap(const double t[3][2], double x0, double y0)
+{
     const double sq[4][2] = {{x0, y0}, {x0 + 1, y0}, {x0 + 1, y0 + 1}, {x0, y0 + 1}};
     double axes[5][2] = {{1, 0}, {0, 1}};
     for (int e = 0; e < 3; e++) {
@@ -137,7 +149,8 @@ static double tri_square_gap(const double t[3][2], double x0, double y0) {
     return gap;
 }
 
-static double seg_dist(const double p[2], const double a[2], const double b[2]) {
+static double seg_dist(const double p[2], const double a[2], const double b[2])
+{
     double dx = b[0] - a[0], dy = b[1] - a[1];
     double t = ((p[0] - a[0]) * dx + (p[1] - a[1]) * dy) / (dx * dx + dy * dy);
     t = t < 0 ? 0 : (t > 1 ? 1 : t);
@@ -145,7 +158,8 @@ static double seg_dist(const double p[2], const double a[2], const double b[2]) 
 }
 
 /* Distance from p to triangle t (2D). */
-static double tri_dist(const double t[3][2], const double p[2]) {
+static double tri_dist(const double t[3][2], const double p[2])
+{
     double w[3];
     if (lx_ref_uv_barycentric(lx_v2((float)t[0][0], (float)t[0][1]),
                               lx_v2((float)t[1][0], (float)t[1][1]),
@@ -156,7 +170,8 @@ static double tri_dist(const double t[3][2], const double p[2]) {
 }
 
 /* A triangle's lightmap UVs in texel units. */
-static void uv_texels(const lx_mesh *m, uint32_t tri, int w, int h, double out[3][2]) {
+static void uv_texels(const lx_mesh *m, uint32_t tri, int w, int h, double out[3][2])
+{
     const lx_vec2 *uv = m->uv[lx_ref_uv_set(m)];
     for (int k = 0; k < 3; k++) {
         lx_vec2 t = uv[m->indices[3 * tri + k]];
@@ -168,7 +183,8 @@ static void uv_texels(const lx_mesh *m, uint32_t tri, int w, int h, double out[3
 /* Barycentrics of world point p on a world triangle (Ericson 3.4, the
  * seed's checkIntersectionInTri); *off = distance from the triangle's plane
  * point with those barycentrics. */
-static void world_bary(const lx_ref_triangle *t, lx_vec3 p, double w[3], double *off) {
+static void world_bary(const lx_ref_triangle *t, lx_vec3 p, double w[3], double *off)
+{
     double e1[3], e2[3], q[3];
     for (int c = 0; c < 3; c++) {
         e1[c] = t->p[1][c] - t->p[0][c];
@@ -193,7 +209,8 @@ static void world_bary(const lx_ref_triangle *t, lx_vec3 p, double w[3], double 
 }
 
 static const lx_ref_triangle *find_tri(const lx_ref_scene *rs, uint32_t node, uint32_t mesh,
-                                       uint32_t tri) {
+                                       uint32_t tri)
+{
     for (uint32_t i = 0; i < rs->count; i++)
         if (rs->tris[i].node == node && rs->tris[i].mesh == mesh && rs->tris[i].triangle == tri)
             return &rs->tris[i];
@@ -206,12 +223,14 @@ typedef struct stats {
     int ref_texels, fast_only, shadowed, compared, skipped;
 } stats;
 
-static bool close_rel(double a, double b, double rel) {
+static bool close_rel(double a, double b, double rel)
+{
     return fabs(a - b) <= rel * fmax(fabs(a), fabs(b)) + 1e-30;
 }
 
 static void compare_map(const lx_scene *scene, const lx_ref_scene *rs, const lx_baker *b,
-                        uint32_t map, stats *st) {
+                        uint32_t map, stats *st)
+{
     const lx_lightmap_info *info = lx_baker_lightmap_info(b, map);
     const lx_node *node = &scene->nodes[info->node];
     const int w = info->width, h = info->height;
@@ -301,11 +320,13 @@ static void compare_map(const lx_scene *scene, const lx_ref_scene *rs, const lx_
                 double d_min = INFINITY, diam = 0;
                 for (uint32_t k = 0; k < node->mesh_count; k++) {
                     const lx_mesh *mk = &scene->meshes[node->meshes[k]];
-                    if (lx_ref_uv_set(mk) < 0) continue;
+                    if (lx_ref_uv_set(mk) < 0)
+                        continue;
                     for (uint32_t tr = 0; tr < mk->triangle_count; tr++) {
                         double tt[3][2];
                         uv_texels(mk, tr, w, h, tt);
-                        if (tri_square_gap(tt, x, y) > -1e-9) continue;
+                        if (tri_square_gap(tt, x, y) > -1e-9)
+                            continue;
                         d_min = fmin(d_min, tri_dist(tt, c));
                     }
                 }
@@ -319,12 +340,14 @@ static void compare_map(const lx_scene *scene, const lx_ref_scene *rs, const lx_
                 assert_true(d_lib <= sqrt(0.5) + 2e-3 * diam + 1e-4);
             }
 
-            if (!fast) continue;
+            if (!fast)
+                continue;
             /* lighting: the reference at the fast path's own sample, and at
              * the reference's sample, against the baked value */
             const float *px = &img.data[3 * (y * w + x)];
             for (int pass = 0; pass < 2; pass++) {
-                if (pass == 1 && !rt->used) break;
+                if (pass == 1 && !rt->used)
+                    break;
                 lx_vec3 p = pass == 0 ? s.position : rt->position;
                 lx_vec3 n = pass == 0 ? s.normal : rt->normal;
                 lx_vec3 ng = pass == 0 ? s.geometric_normal : rt->geometric_normal;
@@ -358,10 +381,12 @@ static void compare_map(const lx_scene *scene, const lx_ref_scene *rs, const lx_
     lx_ref_map_free(&ref);
 }
 
-static stats compare_scene(const lx_scene *scene, int resolution) {
+static stats compare_scene(const lx_scene *scene, int resolution)
+{
     lx_bake_desc d = {.resolution = resolution, .padding = LX_PADDING_NONE};
     lx_baker *b;
-    if (lx_baker_create(scene, &d, &b) != LX_OK) fail_msg("baker: %s", lx_last_error());
+    if (lx_baker_create(scene, &d, &b) != LX_OK)
+        fail_msg("baker: %s", lx_last_error());
     assert_int_equal(lx_baker_bake(b), LX_OK);
     lx_ref_scene rs;
     lx_ref_scene_build(scene, &rs);
@@ -379,7 +404,8 @@ static stats compare_scene(const lx_scene *scene, int resolution) {
 
 /* ---- scenes -------------------------------------------------------------------- */
 
-static void test_plane_box_occluder(void **state) {
+static void test_plane_box_occluder(void **state)
+{
     (void)state;
     lx_scene *s = new_scene("plane+box");
     lx_mat4 id = lx_mat4_identity();
@@ -400,7 +426,8 @@ static void test_plane_box_occluder(void **state) {
     lx_scene_destroy(s);
 }
 
-static void test_transformed_nodes(void **state) {
+static void test_transformed_nodes(void **state)
+{
     (void)state;
     lx_scene *s = new_scene("transformed");
     lx_mat4 id = lx_mat4_identity();
@@ -425,7 +452,8 @@ static void test_transformed_nodes(void **state) {
     lx_scene_destroy(s);
 }
 
-static void test_multi_mesh_node(void **state) {
+static void test_multi_mesh_node(void **state)
+{
     (void)state;
     lx_scene *s = new_scene("multi-mesh");
     lx_mat4 id = lx_mat4_identity();
@@ -460,7 +488,8 @@ static void test_multi_mesh_node(void **state) {
     lx_scene_destroy(s);
 }
 
-static void test_blur_shadows(void **state) {
+static void test_blur_shadows(void **state)
+{
     (void)state;
     lx_scene *s = new_scene("blur");
     lx_mat4 id = lx_mat4_identity();
@@ -485,7 +514,8 @@ static void test_blur_shadows(void **state) {
  * outside (columns and rows 7 and 24) only touch the chart along a line or
  * at a corner, with no area in common: the chart does not cover them. The
  * reference covers 8..23 by their centres, and nothing else overlaps. */
-static void test_touching_texels_not_covered(void **state) {
+static void test_touching_texels_not_covered(void **state)
+{
     (void)state;
     lx_scene *s = new_scene("aligned chart");
     lx_mat4 id = lx_mat4_identity();
@@ -515,7 +545,8 @@ static void test_touching_texels_not_covered(void **state) {
     lx_scene_destroy(s);
 }
 
-int main(void) {
+int main(void)
+{
     const struct CMUnitTest tests[] = {
         cmocka_unit_test(test_plane_box_occluder),
         cmocka_unit_test(test_transformed_nodes),

@@ -18,7 +18,8 @@
 
 /* ---- helpers ------------------------------------------------------------------ */
 
-static lx_light point(const char *name, lx_vec3 p, float cd, bool dynamic) {
+static lx_light point(const char *name, lx_vec3 p, float cd, bool dynamic)
+{
     lx_light l = lx_light_defaults(LX_LIGHT_POINT);
     snprintf(l.name, sizeof l.name, "%s", name);
     l.position = p;
@@ -27,12 +28,15 @@ static lx_light point(const char *name, lx_vec3 p, float cd, bool dynamic) {
     return l;
 }
 
-static void add_light(lx_scene *s, lx_light l) {
-    if (lx_scene_add_light(s, &l) != LX_OK) fail_msg("add light: %s", lx_last_error());
+static void add_light(lx_scene *s, lx_light l)
+{
+    if (lx_scene_add_light(s, &l) != LX_OK)
+        fail_msg("add light: %s", lx_last_error());
 }
 
 static uint32_t add_plane(lx_scene *s, const char *name, float size, float height, float cx,
-                          float cz, int n) {
+                          float cz, int n)
+{
     lx_mesh m = lx_test_plane(name, size, height, cx, cz, n);
     lx_test_add(s, &m);
     lx_test_mesh_free(&m);
@@ -40,7 +44,8 @@ static uint32_t add_plane(lx_scene *s, const char *name, float size, float heigh
 }
 
 /* ground (node 0, 4 x 4 m) and an occluding plate (node 1) at height 1 */
-static lx_scene *base_scene(void) {
+static lx_scene *base_scene(void)
+{
     lx_scene *s;
     assert_int_equal(lx_scene_create("realtime", &s), LX_OK);
     add_plane(s, "ground", 4.0f, 0.0f, 0.0f, 0.0f, 4);
@@ -48,28 +53,35 @@ static lx_scene *base_scene(void) {
     return s;
 }
 
-static lx_baker *make_baker(const lx_scene *s, int res, int padding, int threads) {
+static lx_baker *make_baker(const lx_scene *s, int res, int padding, int threads)
+{
     lx_bake_desc d = {.resolution = res, .padding = padding, .threads = threads};
     lx_baker *b;
-    if (lx_baker_create(s, &d, &b) != LX_OK) fail_msg("baker: %s", lx_last_error());
+    if (lx_baker_create(s, &d, &b) != LX_OK)
+        fail_msg("baker: %s", lx_last_error());
     return b;
 }
 
-static lx_image apply(const lx_baker *b, uint32_t map) {
+static lx_image apply(const lx_baker *b, uint32_t map)
+{
     lx_image img;
-    if (lx_baker_apply_alloc(b, map, &img) != LX_OK) fail_msg("apply: %s", lx_last_error());
+    if (lx_baker_apply_alloc(b, map, &img) != LX_OK)
+        fail_msg("apply: %s", lx_last_error());
     return img;
 }
 
-static uint32_t map_of(const lx_baker *b, uint32_t node) {
+static uint32_t map_of(const lx_baker *b, uint32_t node)
+{
     for (uint32_t m = 0; m < lx_baker_lightmap_count(b); m++)
-        if (lx_baker_lightmap_info(b, m)->node == node) return m;
+        if (lx_baker_lightmap_info(b, m)->node == node)
+            return m;
     fail_msg("no lightmap for node %u", node);
     return 0;
 }
 
 /* Bakes scene s (static lights only) and returns the applied map of node. */
-static lx_image bake_alone(const lx_scene *s, uint32_t node, int res) {
+static lx_image bake_alone(const lx_scene *s, uint32_t node, int res)
+{
     lx_baker *b = make_baker(s, res, 0, 0);
     assert_int_equal(lx_baker_bake(b), LX_OK);
     lx_image img = apply(b, map_of(b, node));
@@ -77,8 +89,8 @@ static lx_image bake_alone(const lx_scene *s, uint32_t node, int res) {
     return img;
 }
 
-static void assert_sum(const lx_image *got, const lx_image *a, const lx_image *b,
-                       const char *what) {
+static void assert_sum(const lx_image *got, const lx_image *a, const lx_image *b, const char *what)
+{
     assert_int_equal(got->width, a->width);
     assert_int_equal(got->width, b->width);
     int n = got->width * got->height * 3;
@@ -94,13 +106,15 @@ static void assert_sum(const lx_image *got, const lx_image *a, const lx_image *b
     assert_true(nonzero > n / 4);
 }
 
-static bool images_differ(const lx_image *a, const lx_image *b) {
+static bool images_differ(const lx_image *a, const lx_image *b)
+{
     return memcmp(a->data, b->data, sizeof(float) * a->width * a->height * a->channels) != 0;
 }
 
 /* ---- baked + dynamic ------------------------------------------------------- */
 
-static void test_apply_is_baked_plus_dynamic(void **state) {
+static void test_apply_is_baked_plus_dynamic(void **state)
+{
     (void)state;
     const int res = 48;
     const lx_vec3 ambient = lx_v3(0.02f, 0.03f, 0.04f);
@@ -213,7 +227,8 @@ static void test_apply_is_baked_plus_dynamic(void **state) {
 /* Checks the ground's shadow under the plate (node 1, moved by offset) lit
  * by a point light at L: shadowed texels are those inside the projection
  * of the plate, with one texel of tolerance at the edge. */
-static void check_projected_shadow(const lx_baker *b, lx_vec3 L, lx_vec3 offset, const char *what) {
+static void check_projected_shadow(const lx_baker *b, lx_vec3 L, lx_vec3 offset, const char *what)
+{
     const double plate = 0.8, h = 1.0 + offset.y, cx = 0.2 + offset.x, cz = 0.1 + offset.z;
     uint32_t map = map_of(b, 0);
     const lx_lightmap_info *info = lx_baker_lightmap_info(b, map);
@@ -245,7 +260,8 @@ static void check_projected_shadow(const lx_baker *b, lx_vec3 L, lx_vec3 offset,
     lx_image_free(&img);
 }
 
-static void test_moving_occluder_moves_shadow(void **state) {
+static void test_moving_occluder_moves_shadow(void **state)
+{
     (void)state;
     const lx_vec3 L = lx_v3(-0.1f, 3.0f, 0.05f);
     lx_scene *s = base_scene();
@@ -285,7 +301,8 @@ static void test_moving_occluder_moves_shadow(void **state) {
     lx_scene_destroy(s);
 }
 
-static void test_moving_lit_node_moves_texels(void **state) {
+static void test_moving_lit_node_moves_texels(void **state)
+{
     (void)state;
     lx_scene *s;
     assert_int_equal(lx_scene_create("moving", &s), LX_OK);
@@ -334,7 +351,8 @@ static void test_moving_lit_node_moves_texels(void **state) {
         double c = (lx * n_want.x + ly * n_want.y + lz * n_want.z) / d;
         double e = c > 0 ? lamp.intensity * c / (d * d) : 0.0;
         float v = img.data[3 * i];
-        if (!(fabs(v - e) <= 1e-4 * e + 1e-7)) fail_msg("moved texel %d: %g, want %g", i, v, e);
+        if (!(fabs(v - e) <= 1e-4 * e + 1e-7))
+            fail_msg("moved texel %d: %g, want %g", i, v, e);
     }
     lx_image_free(&img);
     free(before);
@@ -344,11 +362,13 @@ static void test_moving_lit_node_moves_texels(void **state) {
 
 /* ---- the 8-bit apply ------------------------------------------------------------ */
 
-static double srgb_encode(double v) {
+static double srgb_encode(double v)
+{
     return v <= 0.0031308 ? 12.92 * v : 1.055 * pow(v, 1.0 / 2.4) - 0.055;
 }
 
-static void test_apply_rgba8(void **state) {
+static void test_apply_rgba8(void **state)
+{
     (void)state;
     lx_scene *s;
     assert_int_equal(lx_scene_create("rgba8", &s), LX_OK);
@@ -371,7 +391,8 @@ static void test_apply_rgba8(void **state) {
                 for (int c = 0; c < 3; c++) {
                     double v = (double)img.data[3 * i + c] * exposures[e];
                     double sat = v < 0 ? 0 : (v > 1 ? 1 : v);
-                    if (srgb) sat = srgb_encode(sat);
+                    if (srgb)
+                        sat = srgb_encode(sat);
                     int want = (int)floor(sat * 255.0 + 0.5);
                     int got = out[4 * i + c];
                     if (abs(got - want) > (srgb ? 1 : 0))
@@ -384,9 +405,11 @@ static void test_apply_rgba8(void **state) {
                         partial++;
                     }
                 }
-                if (mask[i]) assert_int_equal(out[4 * i + 3], 255);
+                if (mask[i])
+                    assert_int_equal(out[4 * i + 3], 255);
             }
-            if (exposures[e] >= 1.0f) assert_true(saturated > 0);
+            if (exposures[e] >= 1.0f)
+                assert_true(saturated > 0);
             assert_true(partial > 0);
         }
     assert_int_equal(lx_baker_apply_rgba8(b, 5, 1.0f, false, out), LX_ERR_INVALID);
@@ -398,7 +421,8 @@ static void test_apply_rgba8(void **state) {
 
 /* ---- determinism ------------------------------------------------------------------ */
 
-static void run_once(const lx_scene *s, int threads, lx_image *maps, uint8_t **bytes) {
+static void run_once(const lx_scene *s, int threads, lx_image *maps, uint8_t **bytes)
+{
     lx_baker *b = make_baker(s, 64, 0, threads);
     assert_int_equal(lx_baker_bake(b), LX_OK);
     assert_int_equal(lx_baker_update(b), LX_OK);
@@ -410,7 +434,8 @@ static void run_once(const lx_scene *s, int threads, lx_image *maps, uint8_t **b
     lx_baker_destroy(b);
 }
 
-static void test_threads_bit_identical(void **state) {
+static void test_threads_bit_identical(void **state)
+{
     (void)state;
     lx_scene *s = base_scene();
     lx_mesh box = lx_test_box("box", lx_v3(-1.5f, 0.0f, 0.8f), lx_v3(-0.7f, 0.9f, 1.6f), false);
@@ -456,7 +481,8 @@ static void test_threads_bit_identical(void **state) {
     lx_scene_destroy(s);
 }
 
-int main(void) {
+int main(void)
+{
     const struct CMUnitTest tests[] = {
         cmocka_unit_test(test_apply_is_baked_plus_dynamic),
         cmocka_unit_test(test_moving_occluder_moves_shadow),

@@ -112,7 +112,8 @@ lx_mesh lx_test_box(const char *name, lx_vec3 lo, lx_vec3 hi, bool inward)
     m.uv[1] = malloc(sizeof(lx_vec2) * 24);
     m.indices = malloc(sizeof(uint32_t) * 36);
     /* each face: outward normal n, and axes s, t with s x t = n */
-    const lx_vec3 normals[6] = {{1, 0, 0}, {-1, 0, 0}, {0, 1, 0}, {0, -1, 0}, {0, 0, 1}, {0, 0, -1}};
+    const lx_vec3 normals[6] = {{1, 0, 0},  {-1, 0, 0}, {0, 1, 0},
+                                {0, -1, 0}, {0, 0, 1},  {0, 0, -1}};
     for (int f = 0; f < 6; f++) {
         lx_vec3 n = normals[f];
         lx_vec3 s = fabsf(n.y) > 0.5f ? lx_v3(1, 0, 0) : lx_v3(0, 1, 0);
@@ -122,8 +123,8 @@ lx_mesh lx_test_box(const char *name, lx_vec3 lo, lx_vec3 hi, bool inward)
         lx_vec3 centre = lx_add(c, lx_mul(n, e));
         const float cs[4][2] = {{-1, -1}, {1, -1}, {1, 1}, {-1, 1}};
         for (int k = 0; k < 4; k++) {
-            lx_vec3 p = lx_add(centre, lx_add(lx_mul(lx_scale(s, cs[k][0]), e),
-                                              lx_mul(lx_scale(t, cs[k][1]), e)));
+            lx_vec3 p = lx_add(
+                centre, lx_add(lx_mul(lx_scale(s, cs[k][0]), e), lx_mul(lx_scale(t, cs[k][1]), e)));
             int v = f * 4 + k;
             m.positions[v] = p;
             m.normals[v] = inward ? lx_neg(n) : n;

@@ -10,24 +10,30 @@
 
 /* ---- small double vector helpers ----------------------------------------- */
 
-static void d_sub(const double a[3], const double b[3], double r[3]) {
+static void d_sub(const double a[3], const double b[3], double r[3])
+{
     r[0] = a[0] - b[0], r[1] = a[1] - b[1], r[2] = a[2] - b[2];
 }
-static double d_dot(const double a[3], const double b[3]) {
+static double d_dot(const double a[3], const double b[3])
+{
     return a[0] * b[0] + a[1] * b[1] + a[2] * b[2];
 }
-static void d_cross(const double a[3], const double b[3], double r[3]) {
+static void d_cross(const double a[3], const double b[3], double r[3])
+{
     r[0] = a[1] * b[2] - a[2] * b[1];
     r[1] = a[2] * b[0] - a[0] * b[2];
     r[2] = a[0] * b[1] - a[1] * b[0];
 }
-static void d_normalize(double a[3]) {
+static void d_normalize(double a[3])
+{
     double l = sqrt(d_dot(a, a));
-    if (l > 0) a[0] /= l, a[1] /= l, a[2] /= l;
+    if (l > 0)
+        a[0] /= l, a[1] /= l, a[2] /= l;
 }
 
 /* world = M * (p, 1), column-major M (m[col*4 + row]) */
-static void d_point(const lx_mat4 *m, const double p[3], double r[3]) {
+static void d_point(const lx_mat4 *m, const double p[3], double r[3])
+{
     for (int row = 0; row < 3; row++)
         r[row] = (double)m->m[0 * 4 + row] * p[0] + (double)m->m[1 * 4 + row] * p[1] +
                  (double)m->m[2 * 4 + row] * p[2] + (double)m->m[3 * 4 + row];
@@ -36,7 +42,8 @@ static void d_point(const lx_mat4 *m, const double p[3], double r[3]) {
 /* Normal matrix: inverse transpose of M's upper 3x3, from the adjugate.
  * n_world = cof(A) n / det(A); the 1/det keeps the orientation of
  * mirrored transforms consistent with transforming the normal. */
-static void d_normal_matrix(const lx_mat4 *m, double nm[3][3]) {
+static void d_normal_matrix(const lx_mat4 *m, double nm[3][3])
+{
     double a[3][3]; /* a[row][col] */
     for (int r = 0; r < 3; r++)
         for (int c = 0; c < 3; c++)
@@ -53,21 +60,25 @@ static void d_normal_matrix(const lx_mat4 *m, double nm[3][3]) {
             nm[r][c] = cof[r][c] / det; /* (A^-1)^T = cof(A) / det */
 }
 
-static void d_apply3(double m[3][3], const double v[3], double r[3]) {
+static void d_apply3(double m[3][3], const double v[3], double r[3])
+{
     for (int i = 0; i < 3; i++)
         r[i] = m[i][0] * v[0] + m[i][1] * v[1] + m[i][2] * v[2];
 }
 
-static void from_vec(lx_vec3 v, double r[3]) {
+static void from_vec(lx_vec3 v, double r[3])
+{
     r[0] = v.x, r[1] = v.y, r[2] = v.z;
 }
-static lx_vec3 to_vec(const double r[3]) {
+static lx_vec3 to_vec(const double r[3])
+{
     return lx_v3((float)r[0], (float)r[1], (float)r[2]);
 }
 
 /* ---- scene in world space ---------------------------------------------------- */
 
-void lx_ref_scene_build(const lx_scene *scene, lx_ref_scene *out) {
+void lx_ref_scene_build(const lx_scene *scene, lx_ref_scene *out)
+{
     memset(out, 0, sizeof *out);
     uint32_t n = 0;
     for (uint32_t i = 0; i < scene->node_count; i++)
@@ -102,10 +113,12 @@ void lx_ref_scene_build(const lx_scene *scene, lx_ref_scene *out) {
         d_sub(out->hi, out->lo, d);
         out->diagonal = (float)sqrt(d_dot(d, d));
     }
-    if (!(out->diagonal > 0.0f)) out->diagonal = 1.0f;
+    if (!(out->diagonal > 0.0f))
+        out->diagonal = 1.0f;
 }
 
-void lx_ref_scene_free(lx_ref_scene *rs) {
+void lx_ref_scene_free(lx_ref_scene *rs)
+{
     free(rs->tris);
     memset(rs, 0, sizeof *rs);
 }
@@ -113,16 +126,19 @@ void lx_ref_scene_free(lx_ref_scene *rs) {
 /* ---- rays ----------------------------------------------------------------- */
 
 bool lx_ref_intersect(const lx_ref_triangle *tri, const double o[3], const double d[3], double tmin,
-                      double tmax, double *t, double *u, double *v, double *margin) {
+                      double tmax, double *t, double *u, double *v, double *margin)
+{
     /* Moller & Trumbore, "Fast, minimum storage ray-triangle intersection" */
     double e1[3], e2[3], pv[3], tv[3], qv[3];
     d_sub(tri->p[1], tri->p[0], e1);
     d_sub(tri->p[2], tri->p[0], e2);
     d_cross(d, e2, pv);
     double det = d_dot(e1, pv);
-    if (margin) *margin = -INFINITY;
+    if (margin)
+        *margin = -INFINITY;
     *t = *u = *v = NAN;
-    if (det == 0.0) return false;
+    if (det == 0.0)
+        return false;
     double inv = 1.0 / det;
     d_sub(o, tri->p[0], tv);
     double uu = d_dot(tv, pv) * inv;
@@ -131,28 +147,34 @@ bool lx_ref_intersect(const lx_ref_triangle *tri, const double o[3], const doubl
     double tt = d_dot(e2, qv) * inv;
     *t = tt, *u = uu, *v = vv;
     double m = fmin(fmin(uu, vv), 1.0 - uu - vv);
-    if (margin) *margin = m;
+    if (margin)
+        *margin = m;
     return m >= 0.0 && tt >= tmin && tt <= tmax;
 }
 
 /* Distances along a ray closer than this (relative, at least 1e-6 absolute)
  * are within float rounding of each other. */
-static double t_slack(double tmax) {
+static double t_slack(double tmax)
+{
     return 1e-6 * (isfinite(tmax) && fabs(tmax) > 1.0 ? fabs(tmax) : 1.0);
 }
 
 /* Does this plane crossing make the answer depend on rounding? */
-static bool near_tie(double t, double margin, double tmin, double tmax, double eps) {
+static bool near_tie(double t, double margin, double tmin, double tmax, double eps)
+{
     double s = t_slack(tmax);
-    if (!isfinite(margin) || !(t >= tmin - s && t <= tmax + s)) return false;
-    if (fabs(margin) < eps) return true; /* passes next to an edge */
+    if (!isfinite(margin) || !(t >= tmin - s && t <= tmax + s))
+        return false;
+    if (fabs(margin) < eps)
+        return true; /* passes next to an edge */
     if (margin >= 0 && (fabs(t - tmin) <= s || fabs(t - tmax) <= s))
         return true; /* hits right at an end of the range */
     return false;
 }
 
 bool lx_ref_closest(const lx_ref_scene *rs, lx_vec3 origin, lx_vec3 dir, double tmin, double tmax,
-                    double edge_eps, lx_ref_hit *hit, bool *ambiguous) {
+                    double edge_eps, lx_ref_hit *hit, bool *ambiguous)
+{
     double o[3], d[3];
     from_vec(origin, o);
     from_vec(dir, d);
@@ -163,8 +185,10 @@ bool lx_ref_closest(const lx_ref_scene *rs, lx_vec3 origin, lx_vec3 dir, double 
     for (uint32_t i = 0; i < rs->count; i++) {
         double t, u, v, margin;
         bool h = lx_ref_intersect(&rs->tris[i], o, d, tmin, tmax, &t, &u, &v, &margin);
-        if (near_tie(t, margin, tmin, tmax, edge_eps)) amb = true;
-        if (!h) continue;
+        if (near_tie(t, margin, tmin, tmax, edge_eps))
+            amb = true;
+        if (!h)
+            continue;
         if (t < best.t) {
             second = best.t;
             best = (lx_ref_hit){t, u, v, rs->tris[i].node, rs->tris[i].mesh, rs->tris[i].triangle};
@@ -173,39 +197,50 @@ bool lx_ref_closest(const lx_ref_scene *rs, lx_vec3 origin, lx_vec3 dir, double 
             second = t;
         }
     }
-    if (found && isfinite(second) && second - best.t <= t_slack(best.t)) amb = true;
-    if (hit) *hit = best;
-    if (ambiguous) *ambiguous = amb;
+    if (found && isfinite(second) && second - best.t <= t_slack(best.t))
+        amb = true;
+    if (hit)
+        *hit = best;
+    if (ambiguous)
+        *ambiguous = amb;
     return found;
 }
 
 bool lx_ref_occluded(const lx_ref_scene *rs, lx_vec3 origin, lx_vec3 dir, double tmin, double tmax,
-                     double edge_eps, bool *ambiguous) {
+                     double edge_eps, bool *ambiguous)
+{
     double o[3], d[3];
     from_vec(origin, o);
     from_vec(dir, d);
     bool blocked = false, amb = false;
     for (uint32_t i = 0; i < rs->count; i++) {
         double t, u, v, margin;
-        if (lx_ref_intersect(&rs->tris[i], o, d, tmin, tmax, &t, &u, &v, &margin)) blocked = true;
-        if (near_tie(t, margin, tmin, tmax, edge_eps)) amb = true;
+        if (lx_ref_intersect(&rs->tris[i], o, d, tmin, tmax, &t, &u, &v, &margin))
+            blocked = true;
+        if (near_tie(t, margin, tmin, tmax, edge_eps))
+            amb = true;
     }
-    if (ambiguous) *ambiguous = amb;
+    if (ambiguous)
+        *ambiguous = amb;
     return blocked;
 }
 
 /* ---- texel map ---------------------------------------------------------- */
 
-int lx_ref_uv_set(const lx_mesh *mesh) {
-    if (mesh->uv[1]) return 1;
+int lx_ref_uv_set(const lx_mesh *mesh)
+{
+    if (mesh->uv[1])
+        return 1;
     return mesh->uv[0] ? 0 : -1;
 }
 
-bool lx_ref_uv_barycentric(lx_vec2 a, lx_vec2 b, lx_vec2 c, double px, double py, double w[3]) {
+bool lx_ref_uv_barycentric(lx_vec2 a, lx_vec2 b, lx_vec2 c, double px, double py, double w[3])
+{
     /* seed 000's UvToWorld: P - P1 = v (P2 - P1) + w (P3 - P1), Cramer's rule */
     double ax = a.x, ay = a.y, bx = b.x, by = b.y, cx = c.x, cy = c.y;
     double denom = (bx - ax) * (cy - ay) - (cx - ax) * (by - ay);
-    if (denom == 0.0) return false;
+    if (denom == 0.0)
+        return false;
     double v = ((px - ax) * (cy - ay) - (cx - ax) * (py - ay)) / denom;
     double ww = ((bx - ax) * (py - ay) - (px - ax) * (by - ay)) / denom;
     w[0] = 1.0 - v - ww;
@@ -215,7 +250,8 @@ bool lx_ref_uv_barycentric(lx_vec2 a, lx_vec2 b, lx_vec2 c, double px, double py
 }
 
 void lx_ref_texel_map(const lx_scene *scene, uint32_t node_index, int width, int height,
-                      lx_ref_map *out) {
+                      lx_ref_map *out)
+{
     const lx_node *node = &scene->nodes[node_index];
     out->node = node_index;
     out->width = width;
@@ -230,13 +266,16 @@ void lx_ref_texel_map(const lx_scene *scene, uint32_t node_index, int width, int
             for (uint32_t k = 0; k < node->mesh_count && !tx->used; k++) {
                 const lx_mesh *m = &scene->meshes[node->meshes[k]];
                 int set = lx_ref_uv_set(m);
-                if (set < 0) continue;
+                if (set < 0)
+                    continue;
                 const lx_vec2 *uv = m->uv[set];
                 for (uint32_t t = 0; t < m->triangle_count; t++) {
                     const uint32_t *i = &m->indices[3 * t];
                     double w[3];
-                    if (!lx_ref_uv_barycentric(uv[i[0]], uv[i[1]], uv[i[2]], pu, pv, w)) continue;
-                    if (!(w[0] >= 0 && w[1] >= 0 && w[2] >= 0)) continue;
+                    if (!lx_ref_uv_barycentric(uv[i[0]], uv[i[1]], uv[i[2]], pu, pv, w))
+                        continue;
+                    if (!(w[0] >= 0 && w[1] >= 0 && w[2] >= 0))
+                        continue;
                     tx->used = true;
                     tx->mesh = node->meshes[k];
                     tx->triangle = t;
@@ -274,21 +313,24 @@ void lx_ref_texel_map(const lx_scene *scene, uint32_t node_index, int width, int
         }
 }
 
-void lx_ref_map_free(lx_ref_map *map) {
+void lx_ref_map_free(lx_ref_map *map)
+{
     free(map->texels);
     memset(map, 0, sizeof *map);
 }
 
 /* ---- lighting --------------------------------------------------------------- */
 
-float lx_ref_bias(const lx_ref_scene *rs, lx_vec3 p) {
+float lx_ref_bias(const lx_ref_scene *rs, lx_vec3 p)
+{
     float m = fmaxf(fabsf(p.x), fmaxf(fabsf(p.y), fabsf(p.z)));
     return 1e-5f * rs->diagonal + 4e-6f * m;
 }
 
 lx_vec3 lx_ref_shade(const lx_ref_scene *rs, const lx_light *lights, uint32_t light_count,
                      lx_vec3 ambient, lx_vec3 p, lx_vec3 n, lx_vec3 ng, double edge_eps,
-                     bool *ambiguous) {
+                     bool *ambiguous)
+{
     double sum[3] = {ambient.x, ambient.y, ambient.z};
     bool amb = false;
     for (uint32_t l = 0; l < light_count; l++) {
@@ -296,7 +338,8 @@ lx_vec3 lx_ref_shade(const lx_ref_scene *rs, const lx_light *lights, uint32_t li
         lx_light_eval e;
         bool direct = lx_light_evaluate(light, p, n, &e);
         sum[0] += e.ambient.x, sum[1] += e.ambient.y, sum[2] += e.ambient.z;
-        if (!direct) continue;
+        if (!direct)
+            continue;
         double vis = 1.0;
         if (light->shadow != LX_SHADOW_NONE) {
             double side = ng.x * e.to_light.x + ng.y * e.to_light.y + ng.z * e.to_light.z;
@@ -305,7 +348,8 @@ lx_vec3 lx_ref_shade(const lx_ref_scene *rs, const lx_light *lights, uint32_t li
             lx_vec3 o = lx_v3((float)(p.x + s * bias * ng.x), (float)(p.y + s * bias * ng.y),
                               (float)(p.z + s * bias * ng.z));
             double tmax = isfinite(e.distance) ? e.distance - 2.0 * bias : INFINITY;
-            if (tmax < 0) tmax = 0;
+            if (tmax < 0)
+                tmax = 0;
             bool a = false;
             if (light->shadow == LX_SHADOW_HARD) {
                 vis = lx_ref_occluded(rs, o, e.to_light, 0.0, tmax, edge_eps, &a) ? 0.0 : 1.0;
@@ -323,6 +367,7 @@ lx_vec3 lx_ref_shade(const lx_ref_scene *rs, const lx_light *lights, uint32_t li
         sum[1] += vis * e.illuminance.y;
         sum[2] += vis * e.illuminance.z;
     }
-    if (ambiguous) *ambiguous = amb;
+    if (ambiguous)
+        *ambiguous = amb;
     return to_vec(sum);
 }

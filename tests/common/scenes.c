@@ -14,18 +14,21 @@
 
 static const char *program = "bench";
 
-double lx_bench_now(void) {
+double lx_bench_now(void)
+{
     struct timespec ts;
     clock_gettime(CLOCK_MONOTONIC, &ts);
     return (double)ts.tv_sec + 1e-9 * (double)ts.tv_nsec;
 }
 
-_Noreturn void lx_bench_die(const char *what) {
+_Noreturn void lx_bench_die(const char *what)
+{
     fprintf(stderr, "%s: %s: %s\n", program, what, lx_last_error());
     exit(1);
 }
 
-static void *xmalloc(size_t size) {
+static void *xmalloc(size_t size)
+{
     void *p = malloc(size ? size : 1);
     if (!p) {
         fprintf(stderr, "%s: out of memory (%zu bytes)\n", program, size);
@@ -38,22 +41,26 @@ static void *xmalloc(size_t size) {
 
 static uint32_t rng_state = 12345u;
 
-void lx_test_rand_seed(uint32_t seed) {
+void lx_test_rand_seed(uint32_t seed)
+{
     rng_state = seed;
 }
 
-float lx_test_rand(void) {
+float lx_test_rand(void)
+{
     rng_state = rng_state * 1664525u + 1013904223u;
     return (float)(rng_state >> 8) / 16777216.0f;
 }
 
 lx_mesh lx_test_spheres_mesh(const char *name, const lx_vec3 *centre, const float *radius,
-                             int count, int slices, int stacks) {
+                             int count, int slices, int stacks)
+{
     lx_mesh m = {0};
     uint32_t vps = (uint32_t)(2 + slices * (stacks - 1));
     uint32_t tps = (uint32_t)(2 * slices * (stacks - 1));
     m.name = lx_strdup(name);
-    if (!m.name) lx_bench_die("lx_strdup");
+    if (!m.name)
+        lx_bench_die("lx_strdup");
     m.vertex_count = vps * (uint32_t)count;
     m.triangle_count = tps * (uint32_t)count;
     m.positions = xmalloc(sizeof(lx_vec3) * m.vertex_count);
@@ -98,7 +105,8 @@ lx_mesh lx_test_spheres_mesh(const char *name, const lx_vec3 *centre, const floa
     return m;
 }
 
-lx_light lx_test_point_light(int k, float size, float height, bool dynamic) {
+lx_light lx_test_point_light(int k, float size, float height, bool dynamic)
+{
     lx_light l = lx_light_defaults(LX_LIGHT_POINT);
     snprintf(l.name, sizeof l.name, "light%d", k);
     float sx = (k & 1) ? 0.27f : -0.23f, sz = (k & 2) ? 0.21f : -0.29f;
@@ -112,9 +120,11 @@ lx_light lx_test_point_light(int k, float size, float height, bool dynamic) {
 }
 
 lx_scene *lx_test_spheres_scene(const char *name, float size, int ground_n, int grid, int slices,
-                                int stacks, bool dynamic, lx_test_scene_info *info) {
+                                int stacks, bool dynamic, lx_test_scene_info *info)
+{
     lx_scene *scene;
-    if (lx_scene_create(name, &scene) != LX_OK) lx_bench_die("lx_scene_create");
+    if (lx_scene_create(name, &scene) != LX_OK)
+        lx_bench_die("lx_scene_create");
     lx_test_rand_seed(12345u);
     lx_mesh ground = lx_test_plane("ground", size, 0.0f, 0.0f, 0.0f, ground_n);
     lx_test_add(scene, &ground);
@@ -152,14 +162,16 @@ lx_scene *lx_test_spheres_scene(const char *name, float size, int ground_n, int 
     free(radius);
     for (int k = 0; k < LX_BENCH_LIGHTS; k++) {
         lx_light l = lx_test_point_light(k, size, 0.2f * size, dynamic);
-        if (lx_scene_add_light(scene, &l) != LX_OK) lx_bench_die("lx_scene_add_light");
+        if (lx_scene_add_light(scene, &l) != LX_OK)
+            lx_bench_die("lx_scene_add_light");
     }
     return scene;
 }
 
 /* ---- the bake's shadow rays ---------------------------------------------- */
 
-lx_ray lx_bench_shadow_ray(float base_bias, lx_vec3 p, lx_vec3 ng, const lx_light_eval *e) {
+lx_ray lx_bench_shadow_ray(float base_bias, lx_vec3 p, lx_vec3 ng, const lx_light_eval *e)
+{
     lx_vec3 side = lx_dot(ng, e->to_light) >= 0.0f ? ng : lx_neg(ng);
     float bias = base_bias + 4e-6f * lx_max_abs_component(p);
     lx_ray r;
@@ -167,19 +179,23 @@ lx_ray lx_bench_shadow_ray(float base_bias, lx_vec3 p, lx_vec3 ng, const lx_ligh
     r.dir = e->to_light;
     r.tmin = 0.0f;
     r.tmax = isfinite(e->distance) ? e->distance - 2.0f * bias : INFINITY;
-    if (r.tmax < 0.0f) r.tmax = 0.0f;
+    if (r.tmax < 0.0f)
+        r.tmax = 0.0f;
     return r;
 }
 
 /* The scale-aware bias lx_baker_create picks (1e-5 x scene diagonal). */
-static float auto_bias(const lx_scene *scene) {
+static float auto_bias(const lx_scene *scene)
+{
     lx_vec3 lo, hi;
     float diag = lx_scene_bounds(scene, &lo, &hi) ? lx_length(lx_sub(hi, lo)) : 1.0f;
-    if (!(diag > 0.0f)) diag = 1.0f;
+    if (!(diag > 0.0f))
+        diag = 1.0f;
     return 1e-5f * diag;
 }
 
-void lx_bench_rays_build(const lx_baker *b, const lx_scene *scene, lx_bench_rays *rs) {
+void lx_bench_rays_build(const lx_baker *b, const lx_scene *scene, lx_bench_rays *rs)
+{
     enum { TILE = LX_BENCH_TILE };
     const lx_lightmap_info *info = lx_baker_lightmap_info(b, 0);
     const uint8_t *mask = lx_baker_mask(b, 0);
@@ -235,7 +251,8 @@ void lx_bench_rays_build(const lx_baker *b, const lx_scene *scene, lx_bench_rays
     rs->count = n;
 }
 
-void lx_bench_rays_free(lx_bench_rays *rs) {
+void lx_bench_rays_free(lx_bench_rays *rs)
+{
     free(rs->rays);
     free(rs->illuminance);
     free(rs->pixel);
@@ -246,7 +263,8 @@ void lx_bench_rays_free(lx_bench_rays *rs) {
 }
 
 double lx_bench_trace(const lx_tracer *tr, const lx_bench_rays *rs, lx_bench_trace_mode mode,
-                      int threads, uint8_t *occluded) {
+                      int threads, uint8_t *occluded)
+{
     const int L = rs->lights;
     double t0 = lx_bench_now();
 #pragma omp parallel for schedule(dynamic, 4) num_threads(threads)
@@ -265,10 +283,12 @@ double lx_bench_trace(const lx_tracer *tr, const lx_bench_rays *rs, lx_bench_tra
 
 /* ---- report -------------------------------------------------------------- */
 
-static void cpu_model(char *out, size_t size) {
+static void cpu_model(char *out, size_t size)
+{
     snprintf(out, size, "unknown CPU");
     FILE *f = fopen("/proc/cpuinfo", "r");
-    if (!f) return;
+    if (!f)
+        return;
     char line[512];
     while (fgets(line, sizeof line, f))
         if (!strncmp(line, "model name", 10)) {
@@ -285,17 +305,21 @@ static void cpu_model(char *out, size_t size) {
     fclose(f);
 }
 
-const char *lx_bench_load(char *buf, size_t size) {
+const char *lx_bench_load(char *buf, size_t size)
+{
     snprintf(buf, size, "?");
     FILE *f = fopen("/proc/loadavg", "r");
-    if (!f) return buf;
+    if (!f)
+        return buf;
     double l1;
-    if (fscanf(f, "%lf", &l1) == 1) snprintf(buf, size, "%.2f", l1);
+    if (fscanf(f, "%lf", &l1) == 1)
+        snprintf(buf, size, "%.2f", l1);
     fclose(f);
     return buf;
 }
 
-void lx_bench_header(const char *prog, int threads) {
+void lx_bench_header(const char *prog, int threads)
+{
     program = prog;
     char cpu[256], load[32];
     cpu_model(cpu, sizeof cpu);
@@ -305,7 +329,8 @@ void lx_bench_header(const char *prog, int threads) {
            lx_bench_load(load, sizeof load));
 }
 
-const char *lx_bench_si(double v, char *buf) {
+const char *lx_bench_si(double v, char *buf)
+{
     if (v >= 1e9)
         snprintf(buf, 32, "%.2f G", v / 1e9);
     else if (v >= 1e6)

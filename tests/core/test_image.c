@@ -160,9 +160,9 @@ static void test_srgb_curve(void **state)
 static void test_format_names(void **state)
 {
     (void)state;
-    const char *paths[] = {"a/b/sky.EXR", "x.hdr",   "x.Pfm", "x.png", "x.jpg", "x.JPEG",
-                           "x.tga",       "x.pngx",  "d.png/f", ".png", "noext"};
-    const lx_image_format want[] = {LX_IMAGE_EXR, LX_IMAGE_HDR, LX_IMAGE_PFM,  LX_IMAGE_PNG,
+    const char *paths[] = {"a/b/sky.EXR", "x.hdr",  "x.Pfm",   "x.png", "x.jpg", "x.JPEG",
+                           "x.tga",       "x.pngx", "d.png/f", ".png",  "noext"};
+    const lx_image_format want[] = {LX_IMAGE_EXR, LX_IMAGE_HDR, LX_IMAGE_PFM, LX_IMAGE_PNG,
                                     LX_IMAGE_JPG, LX_IMAGE_JPG, LX_IMAGE_TGA};
     for (size_t i = 0; i < sizeof paths / sizeof paths[0]; i++)
         assert_int_equal(lx_image_format_from_path(paths[i]), i < 7 ? want[i] : LX_IMAGE_AUTO);
@@ -285,13 +285,19 @@ static void test_pfm_bad(void **state)
     struct {
         const char *bytes, *mentions;
     } cases[] = {
-        {"PF\n", "width"}, {"PF\n4", "height"}, {"PF\n4 4", "scale"},
-        {"PF\n4 4\n-1.0", "line break"}, {"PF\n0 4\n-1.0\n", "width 0"},
-        {"PF\n-4 4\n-1.0\n", "width"}, {"PF\n4 x\n-1.0\n", "height"},
+        {"PF\n", "width"},
+        {"PF\n4", "height"},
+        {"PF\n4 4", "scale"},
+        {"PF\n4 4\n-1.0", "line break"},
+        {"PF\n0 4\n-1.0\n", "width 0"},
+        {"PF\n-4 4\n-1.0\n", "width"},
+        {"PF\n4 x\n-1.0\n", "height"},
         {"PF\n99999999999 4\n-1.0\n", "out of range"},
         {"PF\n2147483647 2147483647\n-1.0\n", "overflow"},
         {"PF\n2147483647 1\n-1.0\n", "expected 25769803764 bytes of pixels, found 0"},
-        {"PF\n4 4\n0\n", "scale"}, {"PF\n4 4\nnan\n", "scale"}, {"PF\n4 4\n-1.0x\n", "scale"},
+        {"PF\n4 4\n0\n", "scale"},
+        {"PF\n4 4\nnan\n", "scale"},
+        {"PF\n4 4\n-1.0x\n", "scale"},
         {"PF\n4 4\n-1.0\n\x01\x02", "truncated: expected 192 bytes of pixels, found 2"},
         {"PF\n256 256\n-1.0\n", "expected 786432 bytes of pixels, found 0"},
         {"PF\n1 1\n-1.000000000000000000000000000000000000000000000000000000000000000000",
@@ -339,8 +345,8 @@ static void test_exr_half_round_trip(void **state)
     const char *dir = test_dir("exr_half");
     lx_image img = make(19, 17, 4);
     fill(&img, -60000.0f, 60000.0f, 7);
-    float specials[] = {65504.0f, -65504.0f, 6.1035156e-5f, 5.9604645e-8f, 1e-9f, 0.1f,
-                        1.0f,     0.333f,    2049.0f};
+    float specials[] = {65504.0f, -65504.0f, 6.1035156e-5f, 5.9604645e-8f, 1e-9f,
+                        0.1f,     1.0f,      0.333f,        2049.0f};
     memcpy(img.data, specials, sizeof specials);
     const char *p = path_in(dir, "h.exr");
     lx_image_write_desc wd = {.half = true};
@@ -443,7 +449,10 @@ static int ref_srgb8(double linear)
     return linear >= 1.0 ? 255 : (int)floor(255.0 * ref_linear_to_srgb(linear) + 0.5);
 }
 
-static int code8(float v) { return (int)lroundf(v * 255.0f); }
+static int code8(float v)
+{
+    return (int)lroundf(v * 255.0f);
+}
 
 /* Writes values (w x 1, c channels) as PNG with exposure, checks the 8-bit codes in the
  * file, and that decoding gives each code's linear value. */
@@ -474,12 +483,12 @@ static void test_png_code_values(void **state)
     (void)state;
     const char *dir = test_dir("png");
     /* known codes; code 128 starts at linear 0.214041 (0.214 encodes to 127.49) */
-    check_png(path_in(dir, "known.png"), (const float[]){0.5f, 0.2142f, 0.0f, 1.0f}, 4, 1,
-              1.0f, (const int[]){188, 128, 0, 255});
+    check_png(path_in(dir, "known.png"), (const float[]){0.5f, 0.2142f, 0.0f, 1.0f}, 4, 1, 1.0f,
+              (const int[]){188, 128, 0, 255});
     const float values[] = {2.0f, -1.0f, 0.0031308f, 0.001f, 0.18f, 0.9f, 0.05f, 0.7f};
     check_png(path_in(dir, "grey.png"), values, 8, 1, 1.0f, NULL);
-    check_png(path_in(dir, "rgba.png"), (const float[]){0.25f, 0.1071f, 1.0f, 0.5f}, 1, 4,
-              2.0f, (const int[]){188, 128, 255, 128});
+    check_png(path_in(dir, "rgba.png"), (const float[]){0.25f, 0.1071f, 1.0f, 0.5f}, 1, 4, 2.0f,
+              (const int[]){188, 128, 255, 128});
 }
 
 /* Hand-built PNGs (ISO/IEC 15948 chunks around a zlib stream): the 16-bit path
@@ -747,7 +756,7 @@ static void test_fuzz_stb_guards(void **state)
     buf[hl + 6] = 0x80 + 8; /* the next channel starts a run, then the file ends */
     load_fails(buf, hl + 8, "cut.hdr", LX_ERR_FORMAT, "cut.hdr: truncated");
     unsigned char jpg[64] = {0xff, 0xd8, 0xff, 0xc4, 0x00, 0x13, 0x00}; /* SOI, DHT */
-    memset(jpg + 7, 0xff, 16);                                           /* 16 x 255 codes */
+    memset(jpg + 7, 0xff, 16);                                          /* 16 x 255 codes */
     load_fails(jpg, sizeof jpg, "huff.jpg", LX_ERR_FORMAT, "table at byte 6 has 4080 codes");
     /* SOI, quantization table 0, a 1x1 grey frame, a scan without Huffman tables, EOI */
     unsigned char jpg2[128] = {0xff, 0xd8, 0xff, 0xdb, 0, 67, 0};
@@ -757,8 +766,8 @@ static void test_fuzz_stb_guards(void **state)
     memcpy(jpg2 + 84, scan, 12);
     load_fails(jpg2, 96, "nodht.jpg", LX_ERR_FORMAT, "scan of component 1 uses an undefined");
     /* progressive: an AC table (one 1-bit code), then an AC scan before any DC scan */
-    const unsigned char ac[] = {0xff, 0xc4, 0, 20, 0x10, 1, [21] = 0, 0xff, 0xda, 0, 8, 1, 1, 0, 1,
-                                63, 0};
+    const unsigned char ac[] = {0xff, 0xc4, 0, 20, 0x10, 1, [21] = 0, 0xff, 0xda,
+                                0,    8,    1, 1,  0,    1, 63,       0};
     jpg2[72] = 0xc2;
     memcpy(jpg2 + 84, ac, sizeof ac);
     load_fails(jpg2, 84 + sizeof ac, "ac.jpg", LX_ERR_FORMAT, "1 before its first DC scan");

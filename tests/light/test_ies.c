@@ -398,17 +398,17 @@ static void test_truncated(void **state)
 
 static void test_not_numbers(void **state)
 {
-    parse_fails(HEAD "1 -1 1 2 1 1 2 0 0 0\n1 1 0\n0 90\n0\n10 nan\n", LX_ERR_FORMAT,
-                "line 8", "'nan' is not a finite number");
-    parse_fails(HEAD "1 -1 1 2 1 1 2 0 0 0\n1 1 0\n0 inf\n0\n10 10\n", LX_ERR_FORMAT,
-                "line 6", "not a finite number");
-    parse_fails(HEAD "1 -1 1 2 1 1 2 0 0 0\n1 1 0\n0 90\n0\n10 1e999\n", LX_ERR_FORMAT,
-                "line 8", "not a finite number");
-    parse_fails(HEAD "1 -1 1 2 1 1 2 0 0 0\n1 1 0\n0 90\n0\n10 abc\n", LX_ERR_FORMAT,
-                "line 8", "'abc' is not a number");
+    parse_fails(HEAD "1 -1 1 2 1 1 2 0 0 0\n1 1 0\n0 90\n0\n10 nan\n", LX_ERR_FORMAT, "line 8",
+                "'nan' is not a finite number");
+    parse_fails(HEAD "1 -1 1 2 1 1 2 0 0 0\n1 1 0\n0 inf\n0\n10 10\n", LX_ERR_FORMAT, "line 6",
+                "not a finite number");
+    parse_fails(HEAD "1 -1 1 2 1 1 2 0 0 0\n1 1 0\n0 90\n0\n10 1e999\n", LX_ERR_FORMAT, "line 8",
+                "not a finite number");
+    parse_fails(HEAD "1 -1 1 2 1 1 2 0 0 0\n1 1 0\n0 90\n0\n10 abc\n", LX_ERR_FORMAT, "line 8",
+                "'abc' is not a number");
     parse_fails(HEAD "1 lots 1 2 1 1 2 0 0 0\n", LX_ERR_FORMAT, "line 4: lumens per lamp", NULL);
-    parse_fails(HEAD "1 -1 1 2 1 1 2 0 0 0\n1 1 0\n0 90\n0\n10 10 12\n", LX_ERR_FORMAT,
-                "line 8", "unexpected '12'");
+    parse_fails(HEAD "1 -1 1 2 1 1 2 0 0 0\n1 1 0\n0 90\n0\n10 10 12\n", LX_ERR_FORMAT, "line 8",
+                "unexpected '12'");
 }
 
 static void test_negative_values(void **state)
@@ -424,8 +424,8 @@ static void test_negative_values(void **state)
 
 static void test_angles_out_of_order(void **state)
 {
-    parse_fails(HEAD "1 -1 1 3 1 1 2 0 0 0\n1 1 0\n0\n60 45\n0\n1 2 3\n", LX_ERR_FORMAT,
-                "line 7", "vertical angles out of order: 45 follows 60");
+    parse_fails(HEAD "1 -1 1 3 1 1 2 0 0 0\n1 1 0\n0\n60 45\n0\n1 2 3\n", LX_ERR_FORMAT, "line 7",
+                "vertical angles out of order: 45 follows 60");
     parse_fails(HEAD "1 -1 1 2 3 1 2 0 0 0\n1 1 0\n0 90\n0 90 90\n1 2 3 4 5 6\n", LX_ERR_FORMAT,
                 "line 7", "horizontal angles out of order");
     parse_fails(HEAD "1 -1 1 2 1 1 2 0 0 0\n1 1 0\n0 190\n0\n1 2\n", LX_ERR_FORMAT, "line 6",
@@ -436,8 +436,8 @@ static void test_angles_out_of_order(void **state)
 
 static void test_bad_symmetry(void **state)
 {
-    parse_fails(HEAD "1 -1 1 2 2 1 2 0 0 0\n1 1 0\n0 90\n0 120\n1 2 3 4\n", LX_ERR_FORMAT,
-                "line 7", "horizontal angles 0..120 match no symmetry");
+    parse_fails(HEAD "1 -1 1 2 2 1 2 0 0 0\n1 1 0\n0 90\n0 120\n1 2 3 4\n", LX_ERR_FORMAT, "line 7",
+                "horizontal angles 0..120 match no symmetry");
     parse_fails(HEAD "1 -1 1 2 2 1 2 0 0 0\n1 1 0\n0 90\n10 180\n1 2 3 4\n", LX_ERR_FORMAT,
                 "line 7", "match no symmetry");
     parse_fails(HEAD "1 -1 1 2 1 1 2 0 0 0\n1 1 0\n0 90\n45\n1 2\n", LX_ERR_FORMAT, "line 7",
@@ -468,8 +468,7 @@ static void test_bad_counts(void **state)
     parse_fails(HEAD "1 -1 1 2 1e9 1 2 0 0 0\n", LX_ERR_FORMAT, "line 4",
                 "number of horizontal angles");
     parse_fails(HEAD "1 -1 1 2.5 1 1 2 0 0 0\n", LX_ERR_FORMAT, "line 4", "whole number");
-    parse_fails(HEAD "1 -1 1 100000\n100000 1 2 0 0 0\n", LX_ERR_FORMAT, "line 5",
-                "more than the");
+    parse_fails(HEAD "1 -1 1 100000\n100000 1 2 0 0 0\n", LX_ERR_FORMAT, "line 5", "more than the");
     parse_fails(HEAD "0 -1 1 2 1 1 2 0 0 0\n", LX_ERR_FORMAT, "line 4", "number of lamps");
     parse_fails(HEAD "1 -1 1 2 1 4 2 0 0 0\n", LX_ERR_FORMAT, "line 4", "photometric type");
     parse_fails(HEAD "1 -1 1 2 1 1 3 0 0 0\n", LX_ERR_FORMAT, "line 4", "units type");
@@ -479,10 +478,10 @@ static void test_bad_counts(void **state)
 
 static void test_types_a_b(void **state)
 {
-    parse_fails(HEAD "1 -1 1 2 1 2 2 0 0 0\n1 1 0\n-90 90\n0\n1 2\n", LX_ERR_UNSUPPORTED,
-                "line 4", "photometric type B");
-    parse_fails(HEAD "1 -1 1 2 1 3 2 0 0 0\n1 1 0\n-90 90\n0\n1 2\n", LX_ERR_UNSUPPORTED,
-                "line 4", "photometric type A");
+    parse_fails(HEAD "1 -1 1 2 1 2 2 0 0 0\n1 1 0\n-90 90\n0\n1 2\n", LX_ERR_UNSUPPORTED, "line 4",
+                "photometric type B");
+    parse_fails(HEAD "1 -1 1 2 1 3 2 0 0 0\n1 1 0\n-90 90\n0\n1 2\n", LX_ERR_UNSUPPORTED, "line 4",
+                "photometric type A");
 }
 
 static void test_garbage(void **state)

@@ -15,13 +15,15 @@
 
 #define PI_D 3.14159265358979323846
 
-static void assert_rel(double got, double want, double tol) {
+static void assert_rel(double got, double want, double tol)
+{
     double scale = fabs(want) > 1e-30 ? fabs(want) : 1.0;
     if (!(fabs(got - want) <= tol * scale))
         fail_msg("got %.9g, want %.9g (relative tolerance %g)", got, want, tol);
 }
 
-static void assert_fails(lx_status st, lx_status want, const char *needle) {
+static void assert_fails(lx_status st, lx_status want, const char *needle)
+{
     if (st != want)
         fail_msg("status %s, want %s (message: %s)", lx_status_name(st), lx_status_name(want),
                  lx_last_error());
@@ -30,19 +32,23 @@ static void assert_fails(lx_status st, lx_status want, const char *needle) {
 }
 
 /* Filament's window written out: (1 - (d/r)^4)^2, clamped, 1 for r = 0. */
-static double window_ref(double d, double r) {
-    if (r <= 0.0) return 1.0;
+static double window_ref(double d, double r)
+{
+    if (r <= 0.0)
+        return 1.0;
     double f = 1.0 - pow(d / r, 4.0);
     return f > 0.0 ? f * f : 0.0;
 }
 
-static lx_light named(lx_light_type type, const char *name) {
+static lx_light named(lx_light_type type, const char *name)
+{
     lx_light l = lx_light_defaults(type);
     strcpy(l.name, name);
     return l;
 }
 
-static void test_defaults(void **state) {
+static void test_defaults(void **state)
+{
     (void)state;
     lx_light l = lx_light_defaults(LX_LIGHT_SPOT);
     assert_int_equal(l.type, LX_LIGHT_SPOT);
@@ -59,7 +65,8 @@ static void test_defaults(void **state) {
     assert_int_equal(lx_light_validate(&d), LX_OK);
 }
 
-static void test_range_window(void **state) {
+static void test_range_window(void **state)
+{
     (void)state;
     assert_true(lx_light_range_window(0.0f, 4.0f) == 1.0f);
     assert_true(lx_light_range_window(16.0f, 4.0f) == 0.0f);
@@ -69,7 +76,8 @@ static void test_range_window(void **state) {
     assert_rel(lx_light_range_window(9.0f, 5.0f), window_ref(3.0, 5.0), 1e-6);
 }
 
-static void test_point_inverse_square(void **state) {
+static void test_point_inverse_square(void **state)
+{
     (void)state;
     lx_light l = named(LX_LIGHT_POINT, "bulb");
     l.position = lx_v3(0.5f, 2.0f, -1.0f);
@@ -105,14 +113,16 @@ static void test_point_inverse_square(void **state) {
 }
 
 /* A spot 3 m above the floor pointing down; the floor point at angle deg. */
-static lx_light_eval spot_at(const lx_light *l, double deg, bool *lit) {
+static lx_light_eval spot_at(const lx_light *l, double deg, bool *lit)
+{
     lx_vec3 p = lx_v3((float)(3.0 * tan(deg * PI_D / 180.0)), 0.0f, 0.0f);
     lx_light_eval ev;
     *lit = lx_light_evaluate(l, p, lx_v3(0, 1, 0), &ev);
     return ev;
 }
 
-static double spot_ref(double deg, double inner, double outer, double intensity) {
+static double spot_ref(double deg, double inner, double outer, double intensity)
+{
     double c = cos(deg * PI_D / 180.0);
     double ci = cos(inner * PI_D / 180.0), co = cos(outer * PI_D / 180.0);
     double t = (c - co) / fmax(ci - co, 1e-4);
@@ -121,7 +131,8 @@ static double spot_ref(double deg, double inner, double outer, double intensity)
     return intensity * t * t * c / (d * d);
 }
 
-static void test_spot(void **state) {
+static void test_spot(void **state)
+{
     (void)state;
     lx_light l = named(LX_LIGHT_SPOT, "spot");
     l.position = lx_v3(0, 3, 0);
@@ -155,7 +166,8 @@ static void test_spot(void **state) {
     assert_true(lx_light_spot_attenuation(&p, -1.0f) == 1.0f);
 }
 
-static void test_spot_hard_edge(void **state) {
+static void test_spot_hard_edge(void **state)
+{
     (void)state;
     /* Blender writes innerConeAngle == outerConeAngle: a hard-edged cone. */
     lx_light l = named(LX_LIGHT_SPOT, "blender");
@@ -181,7 +193,8 @@ static void test_spot_hard_edge(void **state) {
     assert_int_equal(lx_light_validate(&l), LX_OK);
 }
 
-static void test_directional(void **state) {
+static void test_directional(void **state)
+{
     (void)state;
     lx_light l = named(LX_LIGHT_DIRECTIONAL, "sun");
     double dx = 0.3, dy = -1.0, dz = 0.2, len = sqrt(dx * dx + dy * dy + dz * dz);
@@ -202,7 +215,8 @@ static void test_directional(void **state) {
     assert_rel(ev.illuminance.x, 100000.0 * dx / len, 1e-5);
 }
 
-static void test_classic(void **state) {
+static void test_classic(void **state)
+{
     (void)state;
     lx_light l = named(LX_LIGHT_POINT, "classic");
     l.model = LX_MODEL_CLASSIC;
@@ -232,7 +246,8 @@ static void test_classic(void **state) {
     assert_true(ev.illuminance.x == 0.0f);
 }
 
-static void test_ambient(void **state) {
+static void test_ambient(void **state)
+{
     (void)state;
     lx_light red = named(LX_LIGHT_POINT, "red");
     red.position = lx_v3(0, 0, 0);
@@ -264,7 +279,8 @@ static void test_ambient(void **state) {
     assert_rel(a.ambient.y, 0.2, 1e-6);
 }
 
-static void test_blur(void **state) {
+static void test_blur(void **state)
+{
     (void)state;
     lx_light l = named(LX_LIGHT_POINT, "b");
     l.shadow = LX_SHADOW_BLUR;
@@ -279,7 +295,8 @@ static void test_blur(void **state) {
     assert_true(lx_light_blur_visibility(&l, 1.0f, 0.0f) == 0.0f);
 }
 
-static void test_conversions(void **state) {
+static void test_conversions(void **state)
+{
     (void)state;
     lx_light p = named(LX_LIGHT_POINT, "p");
     float v;
@@ -319,7 +336,8 @@ static void test_conversions(void **state) {
                  "not finite");
 }
 
-static void test_unit_names(void **state) {
+static void test_unit_names(void **state)
+{
     (void)state;
     const struct {
         const char *s;
@@ -343,7 +361,8 @@ static void test_unit_names(void **state) {
     assert_string_equal(lx_shadow_mode_name(LX_SHADOW_BLUR), "blur");
 }
 
-static void test_exposure(void **state) {
+static void test_exposure(void **state)
+{
     (void)state;
     assert_rel(lx_exposure_from_ev100(0.0f), 1.0 / 1.2, 1e-6);
     assert_rel(lx_exposure_from_ev100(1.0f), 1.0 / 2.4, 1e-6);
@@ -356,7 +375,8 @@ static void test_exposure(void **state) {
     assert_true(lx_ev100_from_luminance(-3.0) == 0.0f);
 }
 
-static void test_validation(void **state) {
+static void test_validation(void **state)
+{
     (void)state;
     lx_light l = named(LX_LIGHT_SPOT, "key");
     l.inner_angle = LX_DEG2RAD(40.0f);
@@ -411,7 +431,8 @@ static void test_validation(void **state) {
     assert_fails(lx_light_validate(&l), LX_ERR_INVALID, "not NUL-terminated");
 }
 
-int main(void) {
+int main(void)
+{
     const struct CMUnitTest tests[] = {
         cmocka_unit_test(test_defaults),
         cmocka_unit_test(test_range_window),

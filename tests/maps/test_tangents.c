@@ -19,26 +19,32 @@
  * lx_test_plane puts s along +x and t along +z. */
 typedef lx_vec2 (*layout_fn)(float s, float t);
 
-static lx_vec2 standard(float s, float t) {
+static lx_vec2 standard(float s, float t)
+{
     return lx_v2(s, t);
 }
-static lx_vec2 mirror_u(float s, float t) {
+static lx_vec2 mirror_u(float s, float t)
+{
     return lx_v2(1 - s, t);
 }
-static lx_vec2 mirror_v(float s, float t) {
+static lx_vec2 mirror_v(float s, float t)
+{
     return lx_v2(s, 1 - t);
 }
 /* a quarter turn: u along +z, v along -x */
-static lx_vec2 quarter(float s, float t) {
+static lx_vec2 quarter(float s, float t)
+{
     return lx_v2(t, 1 - s);
 }
 /* shear: u = (s + t/2)/2, v = t, so x = 4u - v - 1, z = 2v - 1:
  * dP/du = (4, 0, 0), dP/dv = (-1, 0, 2) */
-static lx_vec2 shear(float s, float t) {
+static lx_vec2 shear(float s, float t)
+{
     return lx_v2(0.5f * (s + 0.5f * t), t);
 }
 
-static lx_mesh plane_with(layout_fn f, int set) {
+static lx_mesh plane_with(layout_fn f, int set)
+{
     lx_mesh m = lx_test_plane("plane", 2.0f, 0.0f, 0.0f, 0.0f, 3);
     for (uint32_t v = 0; v < m.vertex_count; v++) {
         lx_vec3 p = m.positions[v];
@@ -49,21 +55,24 @@ static lx_mesh plane_with(layout_fn f, int set) {
     return m;
 }
 
-static void assert_vec(lx_vec3 got, lx_vec3 want, float tol, const char *what) {
+static void assert_vec(lx_vec3 got, lx_vec3 want, float tol, const char *what)
+{
     if (!(fabsf(got.x - want.x) <= tol && fabsf(got.y - want.y) <= tol &&
           fabsf(got.z - want.z) <= tol))
         fail_msg("%s: got (%g, %g, %g), want (%g, %g, %g)", what, got.x, got.y, got.z, want.x,
                  want.y, want.z);
 }
 
-static lx_vec3 xyz(lx_vec4 t) {
+static lx_vec3 xyz(lx_vec4 t)
+{
     return lx_v3(t.x, t.y, t.z);
 }
 
 /* Every vertex: tangent == t_want, w == w_want, and the frame's
  * bitangent points toward decreasing v (-dP/dv). */
 static void check_frames(const lx_mesh *m, int set, lx_vec3 t_want, float w_want,
-                         lx_vec3 minus_dpdv) {
+                         lx_vec3 minus_dpdv)
+{
     lx_vec4 *t = malloc(sizeof *t * m->vertex_count);
     assert_int_equal(lx_compute_tangents(m, set, t), LX_OK);
     for (uint32_t v = 0; v < m->vertex_count; v++) {
@@ -85,7 +94,8 @@ static void check_frames(const lx_mesh *m, int set, lx_vec3 t_want, float w_want
     free(t);
 }
 
-static void test_standard_layout(void **state) {
+static void test_standard_layout(void **state)
+{
     (void)state;
     for (int set = 0; set < 2; set++) {
         lx_mesh m = plane_with(standard, set);
@@ -95,7 +105,8 @@ static void test_standard_layout(void **state) {
     }
 }
 
-static void test_mirrored_uvs_flip_w(void **state) {
+static void test_mirrored_uvs_flip_w(void **state)
+{
     (void)state;
     lx_mesh m = plane_with(mirror_u, 0);
     /* u grows toward -x; v still along +z: b = cross(+y, -x) w = +z w = -z */
@@ -107,7 +118,8 @@ static void test_mirrored_uvs_flip_w(void **state) {
     lx_test_mesh_free(&m);
 }
 
-static void test_rotated_layout_keeps_w(void **state) {
+static void test_rotated_layout_keeps_w(void **state)
+{
     (void)state;
     lx_mesh m = plane_with(quarter, 0);
     /* u along +z, v along -x: -v is +x = cross(+y, +z): w = +1 */
@@ -115,7 +127,8 @@ static void test_rotated_layout_keeps_w(void **state) {
     lx_test_mesh_free(&m);
 }
 
-static void test_sheared_layout_follows_dpdu(void **state) {
+static void test_sheared_layout_follows_dpdu(void **state)
+{
     (void)state;
     lx_mesh m = plane_with(shear, 0);
     /* dP/du is along +x exactly; dP/dv = (-1, 0, 2) is not perpendicular
@@ -124,7 +137,8 @@ static void test_sheared_layout_follows_dpdu(void **state) {
     lx_test_mesh_free(&m);
 }
 
-static void test_rotated_plane(void **state) {
+static void test_rotated_plane(void **state)
+{
     (void)state;
     lx_mesh m = plane_with(standard, 0);
     /* rotate positions and normals: the frame rotates with them */
@@ -141,7 +155,8 @@ static void test_rotated_plane(void **state) {
     lx_test_mesh_free(&m);
 }
 
-static void test_missing_uvs_fail(void **state) {
+static void test_missing_uvs_fail(void **state)
+{
     (void)state;
     lx_mesh m = plane_with(standard, 0);
     lx_vec4 *t = malloc(sizeof *t * m.vertex_count);
@@ -155,7 +170,8 @@ static void test_missing_uvs_fail(void **state) {
     lx_test_mesh_free(&m);
 }
 
-int main(void) {
+int main(void)
+{
     const struct CMUnitTest tests[] = {
         cmocka_unit_test(test_standard_layout),
         cmocka_unit_test(test_mirrored_uvs_flip_w),

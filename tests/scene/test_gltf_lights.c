@@ -22,36 +22,43 @@
 #define PI_D 3.14159265358979323846
 #define S45 "0.7071067811865476" /* sin 45 deg = cos 45 deg */
 
-static void assert_vec(lx_vec3 v, double x, double y, double z) {
+static void assert_vec(lx_vec3 v, double x, double y, double z)
+{
     if (!(fabs(v.x - x) < 1e-5 && fabs(v.y - y) < 1e-5 && fabs(v.z - z) < 1e-5))
         fail_msg("got [%g, %g, %g], want [%g, %g, %g]", v.x, v.y, v.z, x, y, z);
 }
 
-static lx_scene *new_scene(void) {
+static lx_scene *new_scene(void)
+{
     lx_scene *s;
     assert_int_equal(lx_scene_create("test", &s), LX_OK);
     return s;
 }
 
-static void tmp_path(char *out, size_t size, const char *name) {
+static void tmp_path(char *out, size_t size, const char *name)
+{
     const char *dir = getenv("LX_TEST_TMP");
-    if (!dir || !dir[0]) dir = "/tmp";
+    if (!dir || !dir[0])
+        dir = "/tmp";
     mkdir(dir, 0777);
     snprintf(out, size, "%s/test_gltf_lights_%ld_%s", dir, (long)getpid(), name);
 }
 
-static void write_file(const char *path, const void *bytes, size_t size) {
+static void write_file(const char *path, const void *bytes, size_t size)
+{
     FILE *fp = fopen(path, "wb");
     assert_non_null(fp);
     assert_int_equal(fwrite(bytes, 1, size, fp), size);
     fclose(fp);
 }
 
-static lx_status load_text(lx_scene *s, const char *json) {
+static lx_status load_text(lx_scene *s, const char *json)
+{
     return lx_gltf_lights_load_memory(s, json, strlen(json), "t.gltf");
 }
 
-static void expect_fail(const char *json, lx_status want, const char *needle) {
+static void expect_fail(const char *json, lx_status want, const char *needle)
+{
     lx_scene *s = new_scene();
     lx_status st = load_text(s, json);
     if (st != want || !strstr(lx_last_error(), needle))
@@ -97,7 +104,8 @@ static const char *nested =
     "   {\"extensions\": {\"KHR_lights_punctual\": {\"light\": 0}}},\n"
     "   {\"name\": \"elsewhere\", \"extensions\": {\"KHR_lights_punctual\": {\"light\": 1}}}]}\n";
 
-static void check_nested(const lx_scene *s) {
+static void check_nested(const lx_scene *s)
+{
     assert_int_equal(s->light_count, 4);
     const lx_light *spot = &s->lights[0];
     assert_string_equal(spot->name, "Spot");
@@ -127,7 +135,8 @@ static void check_nested(const lx_scene *s) {
     assert_vec(s->lights[3].direction, 0, 0, -1);
 }
 
-static void test_nested_nodes(void **state) {
+static void test_nested_nodes(void **state)
+{
     (void)state;
     lx_scene *s = new_scene();
     assert_int_equal(load_text(s, nested), LX_OK);
@@ -145,7 +154,8 @@ static void test_nested_nodes(void **state) {
 }
 
 /* A GLB: header, JSON chunk padded with spaces, and a small BIN chunk. */
-static uint8_t *make_glb(const char *json, size_t *size) {
+static uint8_t *make_glb(const char *json, size_t *size)
+{
     size_t jlen = strlen(json), jpad = (jlen + 3) & ~(size_t)3;
     size_t total = 12 + 8 + jpad + 8 + 4;
     uint8_t *b = calloc(1, total);
@@ -163,12 +173,14 @@ static uint8_t *make_glb(const char *json, size_t *size) {
     return b;
 }
 
-static void put32(uint8_t *p, uint32_t v) {
+static void put32(uint8_t *p, uint32_t v)
+{
     for (int k = 0; k < 4; k++)
         p[k] = (uint8_t)(v >> (8 * k));
 }
 
-static void test_glb(void **state) {
+static void test_glb(void **state)
+{
     (void)state;
     size_t size;
     uint8_t *glb = make_glb(nested, &size);
@@ -230,7 +242,8 @@ static void test_glb(void **state) {
     lx_scene_destroy(s);
 }
 
-static void test_blender_cone_and_defaults(void **state) {
+static void test_blender_cone_and_defaults(void **state)
+{
     (void)state;
     lx_scene *s = new_scene();
     assert_int_equal(
@@ -264,7 +277,8 @@ static void test_blender_cone_and_defaults(void **state) {
     lx_scene_destroy(s);
 }
 
-static void test_no_extension(void **state) {
+static void test_no_extension(void **state)
+{
     (void)state;
     lx_scene *s = new_scene();
     assert_int_equal(load_text(s, "{\"asset\": {\"version\": \"2.0\"}, \"nodes\": [{}]}"), LX_OK);
@@ -273,7 +287,8 @@ static void test_no_extension(void **state) {
     lx_scene_destroy(s);
 }
 
-static void test_scene_choice_and_names(void **state) {
+static void test_scene_choice_and_names(void **state)
+{
     (void)state;
     lx_scene *s = new_scene();
     /* "scene": 1 picks the second scene only; names collide into _2, _2_2. */
@@ -318,7 +333,8 @@ static void test_scene_choice_and_names(void **state) {
 #define LIGHTS1 "{\"extensions\": {\"KHR_lights_punctual\": {\"lights\": [{\"type\": \"point\"}]}},"
 #define USE0 "\"extensions\": {\"KHR_lights_punctual\": {\"light\": 0}}"
 
-static void test_bad_graphs(void **state) {
+static void test_bad_graphs(void **state)
+{
     (void)state;
     expect_fail(LIGHTS1 "\"nodes\": [{\"children\": [1]}, {\"children\": [0], " USE0 "}]}",
                 LX_ERR_FORMAT, "t.gltf: the node hierarchy has a cycle through node");
@@ -351,7 +367,8 @@ static void test_bad_graphs(void **state) {
     expect_fail(LIGHTS1 "\"nodes\": [3]}", LX_ERR_FORMAT, "node 0 is not an object");
 }
 
-static void test_bad_lights(void **state) {
+static void test_bad_lights(void **state)
+{
     (void)state;
 #define ONE(light)                                                                                 \
     "{\"extensions\": {\"KHR_lights_punctual\": {\"lights\": [" light "]}},"                       \
@@ -388,7 +405,8 @@ static void test_bad_lights(void **state) {
 #undef ONE
 }
 
-static void test_io_errors(void **state) {
+static void test_io_errors(void **state)
+{
     (void)state;
     lx_scene *s = new_scene();
     assert_int_equal(lx_gltf_lights_load(s, "/nonexistent/dir/x.gltf"), LX_ERR_IO);
@@ -396,7 +414,8 @@ static void test_io_errors(void **state) {
     lx_scene_destroy(s);
 }
 
-int main(void) {
+int main(void)
+{
     const struct CMUnitTest tests[] = {
         cmocka_unit_test(test_nested_nodes),
         cmocka_unit_test(test_glb),

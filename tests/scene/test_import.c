@@ -119,8 +119,10 @@ static int gb_mesh(gltf_builder *g, const char *name, int nv, const float *pos, 
     int a_uv0 = gb_float_accessor(g, uv0, nv, 2, false);
     int a_uv1 = uv1 ? gb_float_accessor(g, uv1, nv, 2, false) : -1;
     int a_idx = gb_index_accessor(g, idx, ni);
-    APPEND(g->meshes, "%s{\"name\":\"%s\",\"primitives\":[{\"attributes\":{\"POSITION\":%d,"
-           "\"TEXCOORD_0\":%d", g->mesh_count ? "," : "", name, a_pos, a_uv0);
+    APPEND(g->meshes,
+           "%s{\"name\":\"%s\",\"primitives\":[{\"attributes\":{\"POSITION\":%d,"
+           "\"TEXCOORD_0\":%d",
+           g->mesh_count ? "," : "", name, a_pos, a_uv0);
     if (a_uv1 >= 0)
         APPEND(g->meshes, ",\"TEXCOORD_1\":%d", a_uv1);
     APPEND(g->meshes, "},\"indices\":%d,\"mode\":4}]}", a_idx);
@@ -177,8 +179,7 @@ static char *gb_json(const gltf_builder *g, const char *uri)
     append(json, size, ",\"meshes\":[%s],\"accessors\":[%s],\"bufferViews\":[%s]", g->meshes,
            g->accessors, g->views);
     if (uri)
-        append(json, size, ",\"buffers\":[{\"uri\":\"%s\",\"byteLength\":%zu}]}", uri,
-               g->bin_size);
+        append(json, size, ",\"buffers\":[{\"uri\":\"%s\",\"byteLength\":%zu}]}", uri, g->bin_size);
     else
         append(json, size, ",\"buffers\":[{\"byteLength\":%zu}]}", g->bin_size);
     return json;
@@ -287,8 +288,8 @@ static void load_fails(const char *path, const lx_scene_load_desc *desc, lx_stat
         s = NULL;
     }
     if (st != want)
-        fail_msg("lx_scene_load(%s): status %d, want %d (message '%s')", path, (int)st,
-                 (int)want, st == LX_OK ? "" : lx_last_error());
+        fail_msg("lx_scene_load(%s): status %d, want %d (message '%s')", path, (int)st, (int)want,
+                 st == LX_OK ? "" : lx_last_error());
     assert_null(s);
     const char *msg = lx_last_error();
     assert_non_null(msg);
@@ -426,8 +427,7 @@ static void test_node_transforms(void **state)
             "\"translation\":[1,2,3],\"rotation\":[0,0.70710678118654752,0,0.70710678118654752]",
             true);
     gb_node(&g, "mat", mesh, "\"matrix\":[2,0,0,0, 0,1,0,0, 0,0,1,0, 0,0,-5,1]", true);
-    gb_node(&g, "parent", -1, "\"translation\":[10,0,0],\"scale\":[2,2,2],\"children\":[3]",
-            true);
+    gb_node(&g, "parent", -1, "\"translation\":[10,0,0],\"scale\":[2,2,2],\"children\":[3]", true);
     gb_node(&g, "child", mesh, "\"translation\":[0,1,0]", false);
     char path[1024];
     path_in(path, sizeof path, dir, "nodes.gltf");
@@ -464,8 +464,8 @@ static void test_node_transforms(void **state)
 static void build_room_like(gltf_builder *g)
 {
     gb_init(g);
-    static const float uv1[] = {0.0625f, 0.0625f, 0.0625f, 0.9375f, 0.9375f, 0.9375f,
-                                0.9375f, 0.0625f};
+    static const float uv1[] = {0.0625f, 0.0625f, 0.0625f, 0.9375f,
+                                0.9375f, 0.9375f, 0.9375f, 0.0625f};
     int room = gb_mesh(g, "room", 4, QUAD_POS, QUAD_UV, uv1, 6, QUAD_IDX);
     int tall = gb_mesh(g, "tall_box", 4, QUAD_POS, QUAD_UV, uv1, 6, QUAD_IDX);
     int shrt = gb_mesh(g, "short_box", 4, QUAD_POS, QUAD_UV, uv1, 6, QUAD_IDX);
@@ -474,12 +474,17 @@ static void build_room_like(gltf_builder *g)
     gb_node(g, "short_box", shrt, "\"translation\":[0.5,0,0.5]", true);
     /* lights: a point light at (0,2.5,0); a spot at (1,2,1) turned -90 deg
      * about X (quaternion [-sin 45, 0, 0, cos 45]) so its -Z points down -Y */
-    gb_node(g, "lamp_node", -1, "\"translation\":[0,2.5,0],"
-            "\"extensions\":{\"KHR_lights_punctual\":{\"light\":0}}", true);
-    gb_node(g, "spot_node", -1, "\"translation\":[1,2,1],"
+    gb_node(g, "lamp_node", -1,
+            "\"translation\":[0,2.5,0],"
+            "\"extensions\":{\"KHR_lights_punctual\":{\"light\":0}}",
+            true);
+    gb_node(g, "spot_node", -1,
+            "\"translation\":[1,2,1],"
             "\"rotation\":[-0.70710678118654752,0,0,0.70710678118654752],"
-            "\"extensions\":{\"KHR_lights_punctual\":{\"light\":1}}", true);
-    APPEND(g->extensions, "\"KHR_lights_punctual\":{\"lights\":["
+            "\"extensions\":{\"KHR_lights_punctual\":{\"light\":1}}",
+            true);
+    APPEND(g->extensions,
+           "\"KHR_lights_punctual\":{\"lights\":["
            "{\"name\":\"ceiling_lamp\",\"type\":\"point\",\"intensity\":150,\"range\":12},"
            "{\"name\":\"spot\",\"type\":\"spot\",\"intensity\":400,"
            "\"spot\":{\"innerConeAngle\":0.25,\"outerConeAngle\":0.5}}]}");
@@ -592,13 +597,12 @@ static void test_lights_only_gltf(void **state)
     const char *dir = lx_test_dir("test_import_lights_only");
     char path[1024];
     path_in(path, sizeof path, dir, "lights_only.gltf");
-    write_text(path,
-               "{\"asset\":{\"version\":\"2.0\"},\"scene\":0,\"scenes\":[{\"nodes\":[0]}],"
-               "\"nodes\":[{\"name\":\"lamp\",\"translation\":[0,2,0],"
-               "\"extensions\":{\"KHR_lights_punctual\":{\"light\":0}}}],"
-               "\"extensionsUsed\":[\"KHR_lights_punctual\"],"
-               "\"extensions\":{\"KHR_lights_punctual\":{\"lights\":["
-               "{\"name\":\"bulb\",\"type\":\"point\",\"intensity\":5}]}}}");
+    write_text(path, "{\"asset\":{\"version\":\"2.0\"},\"scene\":0,\"scenes\":[{\"nodes\":[0]}],"
+                     "\"nodes\":[{\"name\":\"lamp\",\"translation\":[0,2,0],"
+                     "\"extensions\":{\"KHR_lights_punctual\":{\"light\":0}}}],"
+                     "\"extensionsUsed\":[\"KHR_lights_punctual\"],"
+                     "\"extensions\":{\"KHR_lights_punctual\":{\"lights\":["
+                     "{\"name\":\"bulb\",\"type\":\"point\",\"intensity\":5}]}}}");
     lx_scene *s = load_ok(path, NULL);
     assert_int_equal(s->node_count, 0);
     assert_int_equal(s->mesh_count, 0);
@@ -668,7 +672,8 @@ static void test_garbage_and_empty(void **state)
     /* JSON cut off in the middle */
     char path[1024];
     path_in(path, sizeof path, dir, "broken.gltf");
-    write_text(path, "{\"asset\":{\"version\":\"2.0\"},\"scenes\":[{\"nodes\":[0]}],\"nodes\":[{\"me");
+    write_text(path,
+               "{\"asset\":{\"version\":\"2.0\"},\"scenes\":[{\"nodes\":[0]}],\"nodes\":[{\"me");
     load_fails(path, NULL, LX_ERR_FORMAT, NULL, NULL);
 }
 
@@ -760,11 +765,10 @@ static void test_nonfinite_transform(void **state)
 }
 
 /* Three triangles, the third of zero area (three collinear points). */
-static const char *degenerate_obj =
-    "o floor\n"
-    "v 0 0 0\nv 0 0 1\nv 1 0 1\nv 1 0 0\nv 2 0 2\n"
-    "vt 0 0\nvt 0 1\nvt 1 1\nvt 1 0\nvt 0.5 0.5\n"
-    "f 1/1 2/2 3/3\nf 1/1 3/3 4/4\nf 1/1 3/3 5/5\n";
+static const char *degenerate_obj = "o floor\n"
+                                    "v 0 0 0\nv 0 0 1\nv 1 0 1\nv 1 0 0\nv 2 0 2\n"
+                                    "vt 0 0\nvt 0 1\nvt 1 1\nvt 1 0\nvt 0.5 0.5\n"
+                                    "f 1/1 2/2 3/3\nf 1/1 3/3 4/4\nf 1/1 3/3 5/5\n";
 
 static void test_degenerate_obj(void **state)
 {

@@ -20,23 +20,28 @@
 
 #define PI_D 3.14159265358979323846
 
-static void assert_rel(double got, double want, double tol) {
+static void assert_rel(double got, double want, double tol)
+{
     double scale = fabs(want) > 1e-30 ? fabs(want) : 1.0;
-    if (!(fabs(got - want) <= tol * scale)) fail_msg("got %.9g, want %.9g", got, want);
+    if (!(fabs(got - want) <= tol * scale))
+        fail_msg("got %.9g, want %.9g", got, want);
 }
 
-static void assert_vec(lx_vec3 v, double x, double y, double z) {
+static void assert_vec(lx_vec3 v, double x, double y, double z)
+{
     if (!(fabs(v.x - x) < 1e-5 && fabs(v.y - y) < 1e-5 && fabs(v.z - z) < 1e-5))
         fail_msg("got [%g, %g, %g], want [%g, %g, %g]", v.x, v.y, v.z, x, y, z);
 }
 
-static lx_scene *new_scene(void) {
+static lx_scene *new_scene(void)
+{
     lx_scene *s;
     assert_int_equal(lx_scene_create("test", &s), LX_OK);
     return s;
 }
 
-static lx_status apply(lx_scene *s, const char *text) {
+static lx_status apply(lx_scene *s, const char *text)
+{
     return lx_lights_json_apply_text(s, text, strlen(text), "lights.json");
 }
 
@@ -55,7 +60,8 @@ static const char *example =
     "   {\"type\": \"point\", \"position\": [2, 1, 0], \"intensity\": 1, \"range\": 5, "
     "\"model\": \"classic\", \"ambient\": [0.1, 0, 0]}]}\n";
 
-static void test_example(void **state) {
+static void test_example(void **state)
+{
     (void)state;
     lx_scene *s = new_scene();
     assert_int_equal(apply(s, example), LX_OK);
@@ -96,7 +102,8 @@ static void test_example(void **state) {
     lx_scene_destroy(s);
 }
 
-static void test_units(void **state) {
+static void test_units(void **state)
+{
     (void)state;
     lx_scene *s = new_scene();
     assert_int_equal(apply(s,
@@ -128,7 +135,8 @@ static void test_units(void **state) {
     lx_scene_destroy(s);
 }
 
-static void test_override(void **state) {
+static void test_override(void **state)
+{
     (void)state;
     lx_scene *s = new_scene();
     lx_light lamp = lx_light_defaults(LX_LIGHT_SPOT);
@@ -272,7 +280,8 @@ static const bad_case bad_cases[] = {
      LX_ERR_INVALID, "is longer than 63 bytes"},
 };
 
-static void test_bad_input(void **state) {
+static void test_bad_input(void **state)
+{
     (void)state;
     for (size_t i = 0; i < sizeof bad_cases / sizeof bad_cases[0]; i++) {
         lx_scene *s = new_scene();
@@ -285,7 +294,8 @@ static void test_bad_input(void **state) {
     }
 }
 
-static void test_bad_bytes(void **state) {
+static void test_bad_bytes(void **state)
+{
     (void)state;
     lx_scene *s = new_scene();
     const char with_nul[] = "{\"lights\": []}\0{}";
@@ -311,7 +321,8 @@ static void test_bad_bytes(void **state) {
 }
 
 /* An invalid file changes nothing, even when its first lights are good. */
-static void test_all_or_nothing(void **state) {
+static void test_all_or_nothing(void **state)
+{
     (void)state;
     lx_scene *s = new_scene();
     assert_int_equal(apply(s, "{\"lights\": [{\"name\": \"a\", \"type\": \"point\", "
@@ -333,12 +344,14 @@ static void test_all_or_nothing(void **state) {
 /* Colours given as sRGB or kelvin: sRGB through the IEC 61966-2-1 curve
  * (0.5 -> 0.214041), kelvin through lx_temperature_to_rgb (tested on its
  * own against the Planckian locus). */
-static void test_colour_forms(void **state) {
+static void test_colour_forms(void **state)
+{
     (void)state;
     lx_scene *s = new_scene();
-    assert_int_equal(apply(s, "{\"lights\": ["
-                              "{\"type\": \"point\", \"position\": [0,1,0], \"srgb\": [0.5, 1, 0]},"
-                              "{\"type\": \"point\", \"position\": [0,1,0], \"temperature\": 2700}]}"),
+    assert_int_equal(apply(s,
+                           "{\"lights\": ["
+                           "{\"type\": \"point\", \"position\": [0,1,0], \"srgb\": [0.5, 1, 0]},"
+                           "{\"type\": \"point\", \"position\": [0,1,0], \"temperature\": 2700}]}"),
                      LX_OK);
     assert_int_equal(s->light_count, 2);
     assert_vec(s->lights[0].color, 0.214041, 1.0, 0.0);
@@ -362,14 +375,17 @@ static void test_colour_forms(void **state) {
     }
 }
 
-static const char *tmp_dir(void) {
+static const char *tmp_dir(void)
+{
     const char *dir = getenv("LX_TEST_TMP");
-    if (!dir || !dir[0]) dir = "/tmp";
+    if (!dir || !dir[0])
+        dir = "/tmp";
     mkdir(dir, 0777);
     return dir;
 }
 
-static void test_file(void **state) {
+static void test_file(void **state)
+{
     (void)state;
     char path[512];
     snprintf(path, sizeof path, "%s/test_lights_json_%ld.json", tmp_dir(), (long)getpid());
@@ -403,7 +419,8 @@ static void test_file(void **state) {
     lx_scene_destroy(s);
 }
 
-int main(void) {
+int main(void)
+{
     const struct CMUnitTest tests[] = {
         cmocka_unit_test(test_example),   cmocka_unit_test(test_units),
         cmocka_unit_test(test_override),  cmocka_unit_test(test_bad_input),

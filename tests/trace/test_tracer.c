@@ -25,26 +25,31 @@
 /* ---- a small deterministic generator (xorshift64*) -------------------------- */
 
 static uint64_t rng_state;
-static double rnd(void) {
+static double rnd(void)
+{
     rng_state ^= rng_state >> 12;
     rng_state ^= rng_state << 25;
     rng_state ^= rng_state >> 27;
     return (double)((rng_state * 2685821657736338717ull) >> 11) / 9007199254740992.0;
 }
-static float rnd_range(float lo, float hi) {
+static float rnd_range(float lo, float hi)
+{
     return lo + (hi - lo) * (float)rnd();
 }
 
 /* ---- the scene ------------------------------------------------------------------ */
 
-static uint32_t add_mesh(lx_scene *s, lx_mesh *m) {
+static uint32_t add_mesh(lx_scene *s, lx_mesh *m)
+{
     uint32_t idx;
-    if (lx_scene_add_mesh(s, m, &idx) != LX_OK) fail_msg("add mesh: %s", lx_last_error());
+    if (lx_scene_add_mesh(s, m, &idx) != LX_OK)
+        fail_msg("add mesh: %s", lx_last_error());
     lx_test_mesh_free(m);
     return idx;
 }
 
-static lx_mesh soup(int count) {
+static lx_mesh soup(int count)
+{
     lx_mesh m = {0};
     m.name = lx_strdup("soup");
     m.vertex_count = (uint32_t)(3 * count);
@@ -62,7 +67,8 @@ static lx_mesh soup(int count) {
     return m;
 }
 
-static lx_vec4 axis_angle(lx_vec3 axis, float deg) {
+static lx_vec4 axis_angle(lx_vec3 axis, float deg)
+{
     axis = lx_normalize(axis);
     float h = LX_DEG2RAD(deg) / 2;
     return lx_v4(axis.x * sinf(h), axis.y * sinf(h), axis.z * sinf(h), cosf(h));
@@ -70,7 +76,8 @@ static lx_vec4 axis_angle(lx_vec3 axis, float deg) {
 
 /* nodes: 0 box (identity), 1 the same box turned and scaled, 2 a plane,
  * 3 the soup and a small plane together, 4 the box mirrored */
-static lx_scene *make_scene(void) {
+static lx_scene *make_scene(void)
+{
     rng_state = 0x9E3779B97F4A7C15ull;
     lx_scene *s;
     assert_int_equal(lx_scene_create("tracer", &s), LX_OK);
@@ -109,7 +116,8 @@ typedef struct ray_case {
 
 /* RAYS random rays inside the scene's bounds (grown by 1 m): random
  * directions of length 0.5..2, half with a finite range, some with tmin. */
-static void make_rays(const lx_ref_scene *rs, ray_case *rc, uint64_t seed) {
+static void make_rays(const lx_ref_scene *rs, ray_case *rc, uint64_t seed)
+{
     rng_state = seed;
     for (int i = 0; i < RAYS; i++) {
         lx_vec3 o = lx_v3(rnd_range((float)rs->lo[0] - 1, (float)rs->hi[0] + 1),
@@ -129,7 +137,8 @@ static void make_rays(const lx_ref_scene *rs, ray_case *rc, uint64_t seed) {
                                    (float)(b0 * t->p[0][1] + b1 * t->p[1][1] + b2 * t->p[2][1]),
                                    (float)(b0 * t->p[0][2] + b1 * t->p[1][2] + b2 * t->p[2][2]));
             d = lx_sub(target, o);
-            if (lx_length(d) < 1e-3f) d = lx_v3(0, -1, 0);
+            if (lx_length(d) < 1e-3f)
+                d = lx_v3(0, -1, 0);
         }
         d = lx_scale(lx_normalize(d), rnd_range(0.5f, 2.0f));
         rc[i].ray.origin = o;
@@ -139,14 +148,16 @@ static void make_rays(const lx_ref_scene *rs, ray_case *rc, uint64_t seed) {
     }
 }
 
-static void reference_answers(const lx_ref_scene *rs, ray_case *rc) {
+static void reference_answers(const lx_ref_scene *rs, ray_case *rc)
+{
     for (int i = 0; i < RAYS; i++)
         rc[i].hit = lx_ref_closest(rs, rc[i].ray.origin, rc[i].ray.dir, rc[i].ray.tmin,
                                    rc[i].ray.tmax, EDGE_EPS, &rc[i].ref, &rc[i].ambiguous);
 }
 
 /* Compares every unambiguous ray's closest hit, occlusion and distance. */
-static void compare_single(const lx_tracer *tr, const ray_case *rc, const char *what) {
+static void compare_single(const lx_tracer *tr, const ray_case *rc, const char *what)
+{
     int hits = 0, misses = 0, skipped = 0;
     for (int i = 0; i < RAYS; i++) {
         if (rc[i].ambiguous) {
@@ -186,13 +197,15 @@ static void compare_single(const lx_tracer *tr, const ray_case *rc, const char *
 }
 
 /* Garbage on the stack below the caller, as a real caller leaves it. */
-__attribute__((noinline)) static void dirty_stack(void) {
+__attribute__((noinline)) static void dirty_stack(void)
+{
     volatile unsigned char junk[64 * 1024];
     for (size_t i = 0; i < sizeof junk; i++)
         junk[i] = 0xFF;
 }
 
-static void compare_batch(const lx_tracer *tr, const ray_case *rc, bool coherent, bool dirty) {
+static void compare_batch(const lx_tracer *tr, const ray_case *rc, bool coherent, bool dirty)
+{
     /* in chunks of 64 (a bake tile's texels), plus odd sizes */
     lx_ray rays[RAYS];
     uint8_t occ[RAYS];
@@ -202,8 +215,10 @@ static void compare_batch(const lx_tracer *tr, const ray_case *rc, bool coherent
     int at = 0, k = 0;
     while (at < RAYS) {
         int n = sizes[k++ % 8];
-        if (n > RAYS - at) n = RAYS - at;
-        if (dirty) dirty_stack();
+        if (n > RAYS - at)
+            n = RAYS - at;
+        if (dirty)
+            dirty_stack();
         lx_tracer_occluded_batch(tr, rays + at, (uint32_t)n, coherent, occ + at);
         at += n;
     }
@@ -215,7 +230,8 @@ static void compare_batch(const lx_tracer *tr, const ray_case *rc, bool coherent
 
 /* ---- tests ------------------------------------------------------------------------- */
 
-static void test_random_rays(void **state) {
+static void test_random_rays(void **state)
+{
     (void)state;
     lx_scene *s = make_scene();
     lx_tracer *tr;
@@ -239,7 +255,8 @@ static void test_random_rays(void **state) {
         lx_ref_hit w;
         bool amb;
         bool hit = lx_ref_closest(&rs, o, d, 0.0, 2.0, EDGE_EPS, &w, &amb);
-        if (amb) continue;
+        if (amb)
+            continue;
         lx_hit h;
         lx_ray r = {o, 0.0f, d, 2.0f};
         assert_int_equal(lx_tracer_closest(tr, &r, &h), hit);
@@ -257,7 +274,8 @@ static void test_random_rays(void **state) {
     lx_scene_destroy(s);
 }
 
-static void test_move_node_and_commit(void **state) {
+static void test_move_node_and_commit(void **state)
+{
     (void)state;
     lx_scene *s = make_scene();
     lx_tracer *tr;
@@ -315,7 +333,8 @@ static void test_move_node_and_commit(void **state) {
 /* The baker calls the batch with coherent = true for a tile's shadow rays.
  * With a dirty stack (as the baker leaves it) this must still answer, and
  * answer the same as the reference. */
-static void test_coherent_batch(void **state) {
+static void test_coherent_batch(void **state)
+{
     (void)state;
     lx_scene *s = make_scene();
     lx_tracer *tr;
@@ -375,7 +394,8 @@ static void test_coherent_batch(void **state) {
     lx_scene_destroy(s);
 }
 
-int main(void) {
+int main(void)
+{
     const struct CMUnitTest tests[] = {
         cmocka_unit_test(test_random_rays), cmocka_unit_test(test_move_node_and_commit),
         cmocka_unit_test(test_coherent_batch), /* last: a hang ends the program */

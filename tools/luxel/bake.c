@@ -111,8 +111,10 @@ static int parse_args(int argc, char **argv, bake_args *a)
             break;
         case OPT_TEXEL_DENSITY:
             if (!cli_parse_float(optarg, 1e-6, 1e6, &f))
-                return cli_usage_error("bake", "--texel-density must be a positive number of "
-                                       "texels per metre, not '%s'", optarg);
+                return cli_usage_error("bake",
+                                       "--texel-density must be a positive number of "
+                                       "texels per metre, not '%s'",
+                                       optarg);
             a->desc.texel_density = (float)f;
             break;
         case OPT_MAX_RESOLUTION:
@@ -146,13 +148,17 @@ static int parse_args(int argc, char **argv, bake_args *a)
             else if (strcmp(optarg, "radiance") == 0)
                 a->desc.quantity = LX_QUANTITY_RADIANCE;
             else
-                return cli_usage_error("bake", "--quantity must be irradiance or radiance, "
-                                       "not '%s'", optarg);
+                return cli_usage_error("bake",
+                                       "--quantity must be irradiance or radiance, "
+                                       "not '%s'",
+                                       optarg);
             break;
         case OPT_AMBIENT:
             if (!cli_parse_rgb(optarg, &a->ambient))
-                return cli_usage_error("bake", "--ambient must be R,G,B with finite values >= 0, "
-                                       "not '%s'", optarg);
+                return cli_usage_error("bake",
+                                       "--ambient must be R,G,B with finite values >= 0, "
+                                       "not '%s'",
+                                       optarg);
             a->has_ambient = true;
             break;
         case OPT_EXPOSURE:
@@ -280,8 +286,8 @@ static double auto_ev100(const lx_baker *b, const lx_image *images, const bake_a
     return n ? lx_ev100_from_luminance(sum / (double)n) : 0.0;
 }
 
-static cJSON *manifest_entry(const lx_scene *scene, const lx_lightmap_info *info,
-                             const char *file, const char *preview, lx_quantity quantity)
+static cJSON *manifest_entry(const lx_scene *scene, const lx_lightmap_info *info, const char *file,
+                             const char *preview, lx_quantity quantity)
 {
     cJSON *e = cJSON_CreateObject();
     cJSON_AddStringToObject(e, "node", info->name);
@@ -401,7 +407,8 @@ int cmd_bake(int argc, char **argv)
     cJSON_AddStringToObject(manifest, "scene", a.scene);
     cJSON_AddStringToObject(manifest, "quantity",
                             a.desc.quantity == LX_QUANTITY_RADIANCE ? "radiance" : "irradiance");
-    cJSON_AddStringToObject(manifest, "unit", a.desc.quantity == LX_QUANTITY_RADIANCE ? "nt" : "lx");
+    cJSON_AddStringToObject(manifest, "unit",
+                            a.desc.quantity == LX_QUANTITY_RADIANCE ? "nt" : "lx");
     cJSON_AddStringToObject(manifest, "format", lx_image_format_extension(a.format));
     cJSON_AddNumberToObject(manifest, "preview_ev100", ev);
     cJSON *list = cJSON_AddArrayToObject(manifest, "lightmaps");
@@ -412,7 +419,8 @@ int cmd_bake(int argc, char **argv)
         snprintf(file, sizeof file, "%s.%s", stems[m], lx_image_format_extension(a.format));
         snprintf(preview, sizeof preview, "%s.png", stems[m]);
         char *path = lx_path_join(a.output, file);
-        lx_image_write_desc wd = {.format = a.format, .half = a.half,
+        lx_image_write_desc wd = {.format = a.format,
+                                  .half = a.half,
                                   .exposure = a.format == LX_IMAGE_PNG ? exposure : 1.0f};
         if (!path || lx_image_write(path, &images[m], &wd) != LX_OK) {
             cli_error("%s", path ? lx_last_error() : "out of memory");

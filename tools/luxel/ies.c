@@ -225,8 +225,8 @@ int cmd_ies(int argc, char **argv)
     printf("input watts: %g\n", in.input_watts);
     printf("photometric type: %s\n", types[in.photometric_type & 3]);
     printf("units: %s\n", in.units == 1 ? "feet" : "metres");
-    printf("luminous opening: width %g, length %g, height %g %s\n", in.width, in.length,
-           in.height, in.units == 1 ? "ft" : "m");
+    printf("luminous opening: width %g, length %g, height %g %s\n", in.width, in.length, in.height,
+           in.units == 1 ? "ft" : "m");
     print_angles("vertical angles", in.vertical_count, in.vertical_angles);
     print_angles("horizontal angles", in.horizontal_count, in.horizontal_angles);
     printf("symmetry: %s\n", lx_ies_symmetry_name(in.symmetry));

@@ -22,8 +22,7 @@ static void print_light(const lx_light *l)
 {
     const char *unit = l->type == LX_LIGHT_DIRECTIONAL ? "lx" : "cd";
     printf("  %-12s %-16s %10.6g %s", lx_light_type_name(l->type), l->name[0] ? l->name : "-",
-           l->intensity,
-           l->model == LX_MODEL_CLASSIC ? "(classic units)" : unit);
+           l->intensity, l->model == LX_MODEL_CLASSIC ? "(classic units)" : unit);
     printf("  colour (%.3g, %.3g, %.3g)", l->color.x, l->color.y, l->color.z);
     if (l->type != LX_LIGHT_DIRECTIONAL)
         printf("  at (%.3g, %.3g, %.3g)", l->position.x, l->position.y, l->position.z);

@@ -134,7 +134,10 @@ void cli_install_signal_handlers(void)
     sigaction(SIGTERM, &sa, NULL);
 }
 
-bool cli_interrupted(void) { return interrupted != 0; }
+bool cli_interrupted(void)
+{
+    return interrupted != 0;
+}
 
 void cli_track_output(const char *path)
 {
@@ -153,7 +156,10 @@ void cli_remove_tracked_outputs(void)
     tracked_count = 0;
 }
 
-void cli_set_writing(bool w) { writing = w; }
+void cli_set_writing(bool w)
+{
+    writing = w;
+}
 
 /* ---- progress bar -------------------------------------------------------- */
 
