@@ -106,7 +106,10 @@ lx_status lx_out_open(lx_out_file *f, const char *path)
         return lx_fail(LX_ERR_NOMEM, "%s: out of memory", path);
     }
     memcpy(f->tmp_path, path, len);
-    memcpy(f->tmp_path + len, ".tmp.XXXXXX", 12);
+    /* mkstemp's template: ".tmp." then six X that it replaces */
+    memcpy(f->tmp_path + len, ".tmp.", 5);
+    memset(f->tmp_path + len + 5, 'X', 6);
+    f->tmp_path[len + 11] = '\0';
     int fd = mkstemp(f->tmp_path);
     if (fd < 0) {
         int err = errno;
