@@ -113,6 +113,12 @@ lx_status lx_baker_create(const lx_scene *scene, const lx_bake_desc *in, lx_bake
             continue;
         }
         b->node_map[n] = b->map_count++;
+        /* building large texel maps takes long enough to report and stop */
+        if (desc.progress &&
+            !desc.progress(desc.progress_user, (float)(n + 1) / (float)scene->node_count)) {
+            lx_baker_destroy(b);
+            return lx_fail(LX_ERR_CANCELLED, "bake cancelled");
+        }
     }
     st = lx_tracer_create(scene, &b->tracer);
     if (st != LX_OK) {

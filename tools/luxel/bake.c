@@ -357,13 +357,17 @@ int cmd_bake(int argc, char **argv)
     }
 
     cli_progress progress;
-    cli_progress_init(&progress, "bake", a.quiet);
+    cli_progress_init(&progress, "texel maps", a.quiet);
     a.desc.progress = cli_progress_update;
     a.desc.progress_user = &progress;
-    if (lx_baker_create(scene, &a.desc, &baker) != LX_OK) {
-        cli_error("%s", lx_last_error());
+    lx_status created = lx_baker_create(scene, &a.desc, &baker);
+    cli_progress_finish(&progress);
+    if (created != LX_OK) {
+        cli_error("%s", created == LX_ERR_CANCELLED ? "interrupted; nothing written"
+                                                    : lx_last_error());
         goto done;
     }
+    cli_progress_init(&progress, "bake", a.quiet);
     maps = lx_baker_lightmap_count(baker);
     if (maps == 0) {
         cli_error("%s: no mesh has UVs to bake a lightmap on", a.scene);
