@@ -96,7 +96,9 @@ const uint8_t *lx_baker_mask(const lx_baker *baker, uint32_t map);
 lx_status lx_baker_bake(lx_baker *baker);
 
 /* Light access: index as in scene->lights. Changing a static light takes
- * effect at the next lx_baker_bake, a dynamic one at the next update. */
+ * effect at the next lx_baker_bake, a dynamic one at the next update.
+ * Turning a static light dynamic counts it twice (baked and real-time)
+ * until the next lx_baker_bake. */
 uint32_t lx_baker_light_count(const lx_baker *baker);
 const lx_light *lx_baker_light(const lx_baker *baker, uint32_t light);
 lx_status lx_baker_set_light(lx_baker *baker, uint32_t light, const lx_light *value);
@@ -105,7 +107,8 @@ lx_status lx_baker_set_light(lx_baker *baker, uint32_t light, const lx_light *va
  * structures follow at the next update. Baked light on it is not rebaked. */
 lx_status lx_baker_set_node_transform(lx_baker *baker, uint32_t node, const lx_mat4 *world);
 
-/* Re-evaluates the dynamic lights into the real-time buffers. */
+/* Re-evaluates the dynamic lights into the real-time buffers. Reports to
+ * desc.progress like lx_baker_bake (leave it NULL for per-frame use). */
 lx_status lx_baker_update(lx_baker *baker);
 
 /* baked + real-time for one lightmap, in the desc's quantity, padded.
@@ -130,7 +133,8 @@ typedef struct lx_texel_sample {
 bool lx_baker_texel(const lx_baker *baker, uint32_t map, int x, int y, lx_texel_sample *out);
 
 /* Fills unused texels (mask 0) from used neighbours, one ring per pass, so
- * bilinear sampling and mips do not bleed black. mask is updated. */
+ * bilinear sampling and mips do not bleed black. mask is updated.
+ * channels must be 1..4 (otherwise nothing happens). */
 void lx_dilate(float *data, uint8_t *mask, int width, int height, int channels, int passes);
 
 #ifdef __cplusplus

@@ -201,15 +201,30 @@ static inline float lx_mat4_det3(const lx_mat4 *m)
     return a[0] * (a[5] * a[10] - a[9] * a[6]) - a[4] * (a[1] * a[10] - a[9] * a[2]) +
            a[8] * (a[1] * a[6] - a[5] * a[2]);
 }
-/* Normal matrix (inverse transpose of the upper 3x3) as an lx_mat4 with no
- * translation; false when the matrix is singular. Transform normals with
- * lx_mat4_vector and renormalize. */
+/* Normal matrix: the inverse transpose of the upper 3x3, up to a positive
+ * scale, as an lx_mat4 with no translation; false when the matrix is
+ * singular. Transform normals with lx_mat4_vector and renormalize. */
 static inline bool lx_mat4_normal_matrix(const lx_mat4 *m, lx_mat4 *out)
 {
-    const float *a = m->m;
+    float a[11];
+    for (int i = 0; i < 11; i++)
+        a[i] = m->m[i];
     float det = lx_mat4_det3(m);
-    if (!(fabsf(det) > 1e-30f))
-        return false;
+    if (!isfinite(det) || !(fabsf(det) > 1e-30f)) {
+        /* a very large or small scale: rescale to a largest element of 1,
+         * which keeps the direction of every normal */
+        float s = 0.0f;
+        for (int i = 0; i < 11; i++)
+            s = fmaxf(s, fabsf(a[i]));
+        if (!(s > 0.0f) || !isfinite(s))
+            return false;
+        lx_mat4 scaled = lx_mat4_identity();
+        for (int i = 0; i < 11; i++)
+            scaled.m[i] = a[i] = a[i] / s;
+        det = lx_mat4_det3(&scaled);
+        if (!(fabsf(det) > 1e-30f))
+            return false;
+    }
     float inv = 1.0f / det;
     /* cofactor matrix / det = inverse transpose */
     lx_mat4 r = lx_mat4_identity();

@@ -227,15 +227,12 @@ lx_status lx_baker_bake(lx_baker *b)
 
 lx_status lx_baker_update(lx_baker *b)
 {
-    uint32_t idx_buf[64];
+    uint32_t idx_buf[64] = {0};
     uint32_t *idx = b->light_count <= 64 ? idx_buf : malloc(sizeof(uint32_t) * b->light_count);
     if (!idx)
         return lx_fail(LX_ERR_NOMEM, "out of memory");
     uint32_t n = select_lights(b, true, idx);
-    lx_bake_desc saved = b->desc;
-    b->desc.progress = NULL; /* per-frame work reports no progress */
     lx_status st = lx_bake_lights(b, idx, n, lx_v3(0, 0, 0), true, 0.0f, 1.0f);
-    b->desc = saved;
     if (idx != idx_buf)
         free(idx);
     return st;

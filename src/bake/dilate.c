@@ -8,7 +8,7 @@
 
 void lx_dilate(float *data, uint8_t *mask, int width, int height, int channels, int passes)
 {
-    if (passes <= 0 || width <= 0 || height <= 0)
+    if (passes <= 0 || width <= 0 || height <= 0 || channels < 1 || channels > 4)
         return;
     size_t pixels = (size_t)width * height;
     uint8_t *next = malloc(pixels);

@@ -126,24 +126,31 @@ static void uv_to_texel(const raster_ctx *r, lx_vec2 uv, double out[2])
     out[1] = (double)uv.y * r->height;
 }
 
-static void bbox(const double *v[3], int pad, const raster_ctx *r, int *x0, int *y0, int *x1,
+/* The texel rectangle a triangle may touch, grown by pad; false when it
+ * lies wholly outside the lightmap. Clamped in double before converting, so
+ * UVs far outside [0,1] neither overflow an int nor cost a long loop. */
+static bool bbox(const double *v[3], int pad, const raster_ctx *r, int *x0, int *y0, int *x1,
                  int *y1)
 {
-    double minx = fmin(v[0][0], fmin(v[1][0], v[2][0]));
-    double maxx = fmax(v[0][0], fmax(v[1][0], v[2][0]));
-    double miny = fmin(v[0][1], fmin(v[1][1], v[2][1]));
-    double maxy = fmax(v[0][1], fmax(v[1][1], v[2][1]));
-    /* clamp in double before converting: UVs far outside [0,1] stay cheap */
-    *x0 = (int)fmax(floor(minx) - pad, 0.0);
-    *y0 = (int)fmax(floor(miny) - pad, 0.0);
-    *x1 = (int)fmin(floor(maxx) + pad, r->width - 1.0);
-    *y1 = (int)fmin(floor(maxy) + pad, r->height - 1.0);
+    double minx = fmin(v[0][0], fmin(v[1][0], v[2][0])) - pad;
+    double maxx = fmax(v[0][0], fmax(v[1][0], v[2][0])) + pad;
+    double miny = fmin(v[0][1], fmin(v[1][1], v[2][1])) - pad;
+    double maxy = fmax(v[0][1], fmax(v[1][1], v[2][1])) + pad;
+    double w = r->width, h = r->height;
+    if (!(maxx >= 0.0 && minx < w && maxy >= 0.0 && miny < h))
+        return false;
+    *x0 = (int)fmax(floor(minx), 0.0);
+    *y0 = (int)fmax(floor(miny), 0.0);
+    *x1 = (int)fmin(floor(maxx), w - 1.0);
+    *y1 = (int)fmin(floor(maxy), h - 1.0);
+    return true;
 }
 
 static void raster_centres(raster_ctx *r, const double *v[3], uint32_t id, uint32_t slot_index)
 {
     int x0, y0, x1, y1;
-    bbox(v, 0, r, &x0, &y0, &x1, &y1);
+    if (!bbox(v, 0, r, &x0, &y0, &x1, &y1))
+        return;
     const double strict_eps = 1e-6;
     for (int y = y0; y <= y1; y++)
         for (int x = x0; x <= x1; x++) {
@@ -173,7 +180,8 @@ static void raster_centres(raster_ctx *r, const double *v[3], uint32_t id, uint3
 static void raster_borders(raster_ctx *r, const double *v[3], uint32_t id)
 {
     int x0, y0, x1, y1;
-    bbox(v, 1, r, &x0, &y0, &x1, &y1);
+    if (!bbox(v, 1, r, &x0, &y0, &x1, &y1))
+        return;
     for (int y = y0; y <= y1; y++)
         for (int x = x0; x <= x1; x++) {
             size_t p = (size_t)y * r->width + x;
@@ -222,17 +230,18 @@ static int size_from_density(const lx_scene *scene, const lx_node *node, const s
     if (!(uv_area > 0))
         return 4;
     double r = desc->texel_density * sqrt(world_area / uv_area);
-    int size = (int)(ceil(r / 4.0) * 4.0);
-    if (size < 4)
-        size = 4;
-    if (size > desc->max_resolution) {
+    /* compare in double: a huge (or infinite) size must cap, not wrap */
+    if (!(r <= desc->max_resolution)) {
         if (warn)
             lx_log(LX_LOG_WARN,
                    "%s: node '%s': %.0f texels per side needed for %.3g texels/m; capped at %d",
                    scene->path, node->name, r, desc->texel_density, desc->max_resolution);
-        size = desc->max_resolution;
+        return desc->max_resolution;
     }
-    return size;
+    int size = (int)(ceil(r / 4.0) * 4.0);
+    if (size > desc->max_resolution)
+        size = desc->max_resolution;
+    return size < 4 ? 4 : size;
 }
 
 static lx_status check_uv_triangles(const lx_scene *scene, const slot *s, const lx_node *node,

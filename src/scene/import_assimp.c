@@ -185,7 +185,8 @@ static lx_status import_materials(import_ctx *c)
         if (aiGetMaterialTexture(am, aiTextureType_NORMALS, 0, &tex, NULL, &uv, NULL, NULL, NULL,
                                  NULL) == aiReturn_SUCCESS) {
             load_texture(c, &tex, true, "normal", name_buf, &m.normal_map, &m.normal_map_path);
-            m.normal_uv_set = (int)uv;
+            /* checked unsigned: a huge texCoord must not wrap to -1 */
+            m.normal_uv_set = uv < LX_MAX_UV_SETS ? (int)uv : LX_MAX_UV_SETS;
             /* glTF normalTexture.scale scales the map's x and y */
             ai_real scale = 1;
             if (aiGetMaterialFloatArray(am, AI_MATKEY_GLTF_TEXTURE_SCALE(aiTextureType_NORMALS, 0),
@@ -199,7 +200,7 @@ static lx_status import_materials(import_ctx *c)
             aiGetMaterialTexture(am, aiTextureType_DIFFUSE, 0, &tex, NULL, &uv, NULL, NULL, NULL,
                                  NULL) == aiReturn_SUCCESS) {
             load_texture(c, &tex, false, "base colour", name_buf, &m.base_color_map, NULL);
-            m.base_color_uv_set = (int)uv;
+            m.base_color_uv_set = uv < LX_MAX_UV_SETS ? (int)uv : LX_MAX_UV_SETS;
         }
         if (m.normal_uv_set >= LX_MAX_UV_SETS || m.base_color_uv_set >= LX_MAX_UV_SETS) {
             lx_log(LX_LOG_WARN,

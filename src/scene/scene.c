@@ -100,6 +100,31 @@ static void compute_normals(lx_mesh *m)
         m->normals[v] = lx_normalize(m->normals[v]);
 }
 
+/* Renormalizes the file's normals; a zero one takes the face normals around
+ * its vertex, the others are kept (hard edges stay hard). */
+static void repair_normals(lx_mesh *m)
+{
+    bool any_zero = false;
+    for (uint32_t v = 0; v < m->vertex_count; v++) {
+        float len = lx_length(m->normals[v]);
+        if (len > 1e-12f)
+            m->normals[v] = lx_scale(m->normals[v], 1.0f / len);
+        else
+            any_zero = true;
+    }
+    if (!any_zero)
+        return;
+    lx_vec3 *kept = malloc(sizeof(lx_vec3) * m->vertex_count);
+    if (!kept)
+        return; /* zero normals then fall back to geometric ones in the bake */
+    memcpy(kept, m->normals, sizeof(lx_vec3) * m->vertex_count);
+    compute_normals(m);
+    for (uint32_t v = 0; v < m->vertex_count; v++)
+        if (lx_length(kept[v]) > 0.0f)
+            m->normals[v] = kept[v];
+    free(kept);
+}
+
 /* A triangle is degenerate in space when its area is negligible next to
  * its edges: its geometric normal cannot be trusted. */
 bool lx_triangle_degenerate(lx_vec3 a, lx_vec3 b, lx_vec3 c)
@@ -184,15 +209,7 @@ lx_status lx_scene_add_mesh(lx_scene *s, const lx_mesh *src, uint32_t *index)
     if (!src->normals)
         compute_normals(&m);
     else
-        for (size_t v = 0; v < nv; v++) {
-            /* renormalize; a zero normal falls back to the face normals */
-            float len = lx_length(m.normals[v]);
-            if (!(len > 1e-12f)) {
-                compute_normals(&m);
-                break;
-            }
-            m.normals[v] = lx_scale(m.normals[v], 1.0f / len);
-        }
+        repair_normals(&m);
     if (index)
         *index = s->mesh_count;
     s->meshes[s->mesh_count++] = m;
