@@ -11,7 +11,9 @@
 #include <stdlib.h>
 #include <string.h>
 #include <strings.h>
+#include <signal.h>
 #include <sys/stat.h>
+#include <unistd.h>
 
 static const char *bake_usage =
     "usage: luxel bake SCENE [options]\n"
@@ -325,6 +327,145 @@ static lx_status write_text(const char *path, const char *text)
     return lx_out_commit(&f);
 }
 
+/* ---- staged output ------------------------------------------------------ */
+
+typedef struct staging {
+    char *dir;     /* DIR/.luxel-XXXXXX */
+    char **names;  /* files written into it */
+    uint32_t count;
+} staging;
+
+static char *make_staging(const char *output)
+{
+    char *dir = lx_path_join(output, ".luxel-XXXXXX");
+    if (dir && !mkdtemp(dir)) {
+        free(dir);
+        return NULL;
+    }
+    return dir;
+}
+
+/* Reports an error from a staged write under the final folder's name. */
+static void stage_error(const staging *st, const char *output)
+{
+    const char *msg = lx_last_error();
+    size_t n = strlen(st->dir);
+    if (strncmp(msg, st->dir, n) == 0)
+        cli_error("%s%s", output, msg + n);
+    else
+        cli_error("%s", msg);
+}
+
+static bool stage_add(staging *st, const char *name)
+{
+    char **names = realloc(st->names, sizeof(char *) * (st->count + 1));
+    if (!names)
+        return false;
+    st->names = names;
+    st->names[st->count] = lx_strdup(name);
+    if (!st->names[st->count])
+        return false;
+    char *path = lx_path_join(st->dir, name);
+    if (path)
+        cli_track_output(path);
+    free(path);
+    st->count++;
+    return true;
+}
+
+static bool stage_image(staging *st, const char *output, const char *name, const lx_image *img,
+                        const lx_image_write_desc *desc)
+{
+    char *path = lx_path_join(st->dir, name);
+    if (!path) {
+        cli_error("out of memory");
+        return false;
+    }
+    lx_status s = lx_image_write(path, img, desc);
+    free(path);
+    if (s != LX_OK) {
+        stage_error(st, output);
+        return false;
+    }
+    return stage_add(st, name);
+}
+
+static bool stage_text(staging *st, const char *output, const char *name, const char *text)
+{
+    char *path = lx_path_join(st->dir, name);
+    if (!path) {
+        cli_error("out of memory");
+        return false;
+    }
+    lx_status s = write_text(path, text);
+    free(path);
+    if (s != LX_OK) {
+        stage_error(st, output);
+        return false;
+    }
+    return stage_add(st, name);
+}
+
+/* Moves every staged file into the output folder, with interrupts held
+ * off so the move is not cut in half. */
+static bool publish(staging *st, const char *output)
+{
+    sigset_t block, old;
+    sigemptyset(&block);
+    sigaddset(&block, SIGINT);
+    sigaddset(&block, SIGTERM);
+    sigprocmask(SIG_BLOCK, &block, &old);
+    bool ok = true;
+    /* anything but a file in the way would fail its rename half-way through */
+    for (uint32_t i = 0; i < st->count && ok; i++) {
+        char *to = lx_path_join(output, st->names[i]);
+        struct stat sb;
+        if (!to || (lstat(to, &sb) == 0 && !S_ISREG(sb.st_mode))) {
+            cli_error("%s: cannot write: something that is not a file is in the way",
+                      to ? to : output);
+            ok = false;
+        }
+        free(to);
+    }
+    uint32_t moved = 0;
+    for (uint32_t i = 0; i < st->count && ok; i++) {
+        char *from = lx_path_join(st->dir, st->names[i]);
+        char *to = lx_path_join(output, st->names[i]);
+        if (!from || !to || rename(from, to) != 0) {
+            cli_error("%s: cannot move into place: %s", to ? to : output, strerror(errno));
+            ok = false;
+        }
+        free(from);
+        free(to);
+        moved += ok;
+    }
+    /* a rename that failed anyway: this run's files do not stay half-published */
+    for (uint32_t i = 0; i < moved && !ok; i++) {
+        char *to = lx_path_join(output, st->names[i]);
+        if (to)
+            unlink(to);
+        free(to);
+    }
+    if (ok)
+        cli_forget_outputs(); /* they are results now, not temporaries */
+    sigprocmask(SIG_SETMASK, &old, NULL);
+    return ok;
+}
+
+/* Removes whatever is still staged and the staging folder. */
+static void stage_clear(staging *st)
+{
+    cli_remove_tracked_outputs();
+    if (st->dir)
+        rmdir(st->dir);
+    cli_track_dir(NULL);
+    for (uint32_t i = 0; i < st->count; i++)
+        free(st->names[i]);
+    free(st->names);
+    free(st->dir);
+    memset(st, 0, sizeof *st);
+}
+
 int cmd_bake(int argc, char **argv)
 {
     bake_args a;
@@ -337,6 +478,7 @@ int cmd_bake(int argc, char **argv)
     lx_image *images = NULL;
     char **stems = NULL;
     uint32_t maps = 0;
+    staging stage = {0};
     int status = EXIT_FAILED;
     double t0 = cli_now();
 
@@ -375,8 +517,10 @@ int cmd_bake(int argc, char **argv)
     }
     lx_status st = lx_baker_bake(baker);
     /* a scene's dynamic lights are part of its look: evaluate them once too */
-    if (st == LX_OK)
+    if (st == LX_OK) {
+        cli_progress_init(&progress, "dynamic lights", a.quiet);
         st = lx_baker_update(baker);
+    }
     cli_progress_finish(&progress);
     if (st != LX_OK) {
         cli_error("%s", st == LX_ERR_CANCELLED ? "interrupted; nothing written" : lx_last_error());
@@ -402,11 +546,25 @@ int cmd_bake(int argc, char **argv)
     double ev = a.has_exposure ? a.exposure_ev100 : auto_ev100(baker, images, &a);
     float exposure = lx_exposure_from_ev100((float)ev) * preview_scale(&a);
 
+    if (cli_interrupted()) {
+        cli_error("interrupted; nothing written");
+        goto done;
+    }
     if (!make_dirs(a.output)) {
         cli_error("%s: cannot create the output folder: %s", a.output, strerror(errno));
         goto done;
     }
+    /* Everything goes to a staging folder inside the output folder first and
+     * is moved into place only when every file is written: a failure leaves
+     * the folder as it was, old lightmaps included. */
     cli_set_writing(true);
+    stage.dir = make_staging(a.output);
+    if (!stage.dir) {
+        cli_error("%s: cannot write into the output folder: %s", a.output, strerror(errno));
+        cli_set_writing(false);
+        goto done;
+    }
+    cli_track_dir(stage.dir);
     cJSON *manifest = cJSON_CreateObject();
     cJSON_AddStringToObject(manifest, "scene", a.scene);
     cJSON_AddStringToObject(manifest, "quantity",
@@ -422,45 +580,31 @@ int cmd_bake(int argc, char **argv)
         char file[300], preview[300];
         snprintf(file, sizeof file, "%s.%s", stems[m], lx_image_format_extension(a.format));
         snprintf(preview, sizeof preview, "%s.png", stems[m]);
-        char *path = lx_path_join(a.output, file);
         lx_image_write_desc wd = {.format = a.format,
                                   .half = a.half,
                                   .exposure = a.format == LX_IMAGE_PNG ? exposure : 1.0f};
-        if (!path || lx_image_write(path, &images[m], &wd) != LX_OK) {
-            cli_error("%s", path ? lx_last_error() : "out of memory");
-            failed = true;
-        } else {
-            cli_track_output(path);
-        }
-        free(path);
+        failed = !stage_image(&stage, a.output, file, &images[m], &wd);
         bool want_preview = a.format != LX_IMAGE_PNG;
         if (!failed && want_preview) {
-            path = lx_path_join(a.output, preview);
             lx_image_write_desc pd = {.format = LX_IMAGE_PNG, .exposure = exposure};
-            if (!path || lx_image_write(path, &images[m], &pd) != LX_OK) {
-                cli_error("%s", path ? lx_last_error() : "out of memory");
-                failed = true;
-            } else {
-                cli_track_output(path);
-            }
-            free(path);
+            failed = !stage_image(&stage, a.output, preview, &images[m], &pd);
         }
         cJSON_AddItemToArray(list, manifest_entry(scene, info, file, want_preview ? preview : NULL,
                                                   a.desc.quantity));
     }
     if (!failed) {
         char *text = cJSON_Print(manifest);
-        char *path = lx_path_join(a.output, "manifest.json");
-        if (!text || !path || write_text(path, text) != LX_OK) {
-            cli_error("%s", text && path ? lx_last_error() : "out of memory");
-            failed = true;
-        }
+        failed = !text || !stage_text(&stage, a.output, "manifest.json", text);
+        if (!text)
+            cli_error("out of memory");
         free(text);
-        free(path);
     }
     cJSON_Delete(manifest);
+    if (!failed && !publish(&stage, a.output)) {
+        failed = true;
+    }
+    stage_clear(&stage);
     if (failed) {
-        cli_remove_tracked_outputs();
         cli_set_writing(false);
         goto done;
     }

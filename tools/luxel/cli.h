@@ -45,6 +45,10 @@ bool cli_interrupted(void);
 /* Registers a completed output so an interrupt can remove it. */
 void cli_track_output(const char *path);
 void cli_remove_tracked_outputs(void);
+/* Stops tracking outputs without removing them (they were published). */
+void cli_forget_outputs(void);
+/* A folder an interrupt removes after the tracked files (NULL: none). */
+void cli_track_dir(const char *dir);
 void cli_set_writing(bool writing);
 
 /* Monotonic seconds. */

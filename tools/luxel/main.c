@@ -109,6 +109,7 @@ static volatile sig_atomic_t interrupted;
 static volatile sig_atomic_t writing;
 static char *tracked[MAX_TRACKED];
 static volatile sig_atomic_t tracked_count;
+static char *tracked_dir;
 
 static void on_signal(int sig)
 {
@@ -117,6 +118,8 @@ static void on_signal(int sig)
         lx_out_abort_all_signal_safe();
         for (sig_atomic_t i = 0; i < tracked_count; i++)
             unlink(tracked[i]);
+        if (tracked_dir)
+            rmdir(tracked_dir);
         static const char msg[] = "\nluxel: error: interrupted; outputs removed\n";
         ssize_t unused = write(2, msg, sizeof msg - 1);
         (void)unused;
@@ -154,6 +157,19 @@ void cli_remove_tracked_outputs(void)
         free(tracked[i]);
     }
     tracked_count = 0;
+}
+
+void cli_forget_outputs(void)
+{
+    for (sig_atomic_t i = 0; i < tracked_count; i++)
+        free(tracked[i]);
+    tracked_count = 0;
+}
+
+void cli_track_dir(const char *dir)
+{
+    free(tracked_dir);
+    tracked_dir = dir ? lx_strdup(dir) : NULL;
 }
 
 void cli_set_writing(bool w)
