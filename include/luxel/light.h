@@ -219,6 +219,65 @@ const char *lx_ies_keyword(const lx_ies_profile *profile, int index, const char 
 /* "rotational", "quadrant", "bilateral 0-180", "bilateral 90-270", "full". */
 const char *lx_ies_symmetry_name(lx_ies_symmetry symmetry);
 
+/* ---- area lights ----------------------------------------------------------- */
+
+/* Unshadowed illuminance in lux at a point p with normal n from a uniform
+ * Lambertian area light of luminance L (nits), exact for lights partly
+ * below p's horizon (the plane through p with normal n): only the part of
+ * the light above that plane counts. Nothing occludes the light but its own
+ * body. Inputs must be finite (lights are validated when they are made);
+ * normals need not be exactly unit length (they are normalized here, a zero
+ * normal gives 0). A radius or luminance that is not above 0 gives 0. */
+
+/* A sphere of the given radius around centre: pi L sin^2(a) cos(t) while
+ * the sphere is wholly above the horizon (sin a = r/d, t the angle between
+ * n and the direction to the centre), Snyder's exact formula while it is
+ * partly below, 0 when it is wholly below. A point on or inside the sphere
+ * sees light over its whole hemisphere: the result is then pi L. */
+float lx_sphere_light_illuminance(lx_vec3 centre, float radius, float luminance, lx_vec3 p,
+                                  lx_vec3 n);
+
+/* A one-sided disk emitting toward normal (its emitting side): 0 for points
+ * behind it or in its plane. Exact in closed form for any orientation and
+ * for disks partly below the horizon (Stokes' contour integral along the
+ * circle, integrated analytically). */
+float lx_disk_light_illuminance(lx_vec3 centre, lx_vec3 normal, float radius, float luminance,
+                                lx_vec3 p, lx_vec3 n);
+
+/* A one-sided planar polygon of count >= 3 vertices, counter-clockwise seen
+ * from its emitting side: Lambert's exact form factor after clipping the
+ * polygon to p's upper half-space. 0 for points behind it (side taken from
+ * the polygon's Newell normal and its vertex centroid) or in its plane, for
+ * count < 3 or vertices NULL. The polygon must be simple (convex or not) and
+ * planar; vertices are read, not kept. */
+float lx_polygon_light_illuminance(const lx_vec3 *vertices, int count, float luminance, lx_vec3 p,
+                                   lx_vec3 n);
+
+/* A one-sided rectangle (any planar quadrilateral) given by its 4 corners,
+ * counter-clockwise seen from its emitting side: the polygon form factor. */
+float lx_rect_light_illuminance(const lx_vec3 corners[4], float luminance, lx_vec3 p, lx_vec3 n);
+
+typedef enum lx_area_shape {
+    LX_AREA_SPHERE = 0, /* radius */
+    LX_AREA_DISK,       /* radius; emits from one side */
+    LX_AREA_RECT,       /* width x height; emits from one side */
+    LX_AREA_TUBE        /* a cylinder of radius and length with hemispherical caps */
+} lx_area_shape;
+
+/* Luminance (nits) of an area light emitting power_lm lumens from its whole
+ * surface (Lambertian, exitance pi L): sphere L = P / (4 pi^2 r^2), disk
+ * P / (pi^2 r^2), rect P / (pi W H), tube P / (pi (2 pi r length + 4 pi
+ * r^2)). Only the sizes of the shape are read: radius (sphere, disk, tube),
+ * length (tube), width and height (rect). Fails with LX_ERR_INVALID when
+ * power_lm is negative or not finite, when a size it reads is not finite
+ * or not above 0 (a tube's length may be 0: it is then a sphere; a linear
+ * tube, radius 0, has no finite luminance), when the shape is unknown, or
+ * when the luminance overflows a float. *luminance is written only on
+ * success. */
+lx_status lx_area_light_luminance_from_power(lx_area_shape shape, float power_lm, float radius,
+                                             float length, float width, float height,
+                                             float *luminance);
+
 /* ---- exposure ------------------------------------------------------------ */
 
 /* Photometric exposure multiplier for an EV100: 1 / (1.2 * 2^ev100). */

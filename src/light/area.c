@@ -1,0 +1,343 @@
+/* Unshadowed illuminance from uniform Lambertian area lights in closed form,
+ * and area-light luminance from luminous power.
+ *
+ * - Sphere: E = pi L sin^2(a) cos(t) while the sphere is above the horizon;
+ *   partly below it, Snyder's exact formula (J. Snyder, "Area light sources
+ *   for real-time graphics", Microsoft Research MSR-TR-96-11, 1996) as
+ *   written in S. Lagarde and C. de Rousiers, "Moving Frostbite to
+ *   Physically Based Rendering", SIGGRAPH 2014 course notes, section 4.7.2,
+ *   listing "illuminanceSphereOrDisk".
+ * - Polygon and rect: Lambert's formula for the form factor of a polygon
+ *   (J. H. Lambert, Photometria, 1760; J. Arvo, "Applications of irradiance
+ *   tensors to the simulation of non-Lambertian phenomena", SIGGRAPH 1995,
+ *   eq. 2): E = L/2 sum_i angle(v_i, v_i+1) n_i . n over the edges, after
+ *   Sutherland-Hodgman clipping of the polygon to the receiver's upper
+ *   half-space so that lights crossing the horizon stay exact.
+ * - Disk: the same contour integral (Stokes' theorem, the limit of
+ *   Lambert's formula for a smooth boundary: E = L/2 closed-integral
+ *   (R' x R) . n / |R|^2 dt) along the visible arc of the circle, done
+ *   analytically: the integrand is (A + B cos t + C sin t) / (a + b cos t +
+ *   c sin t), whose antiderivative is elementary; the chord cut by the
+ *   horizon is one more Lambert edge.
+ * - Luminance from power: Filament's area-light conversions (seed 001;
+ *   Frostbite 2014 section 4.7.1), L = P / (pi A) with A the emitting area.
+ * Everything is computed in double and returned as float. */
+#include "luxel/light.h"
+
+#include <math.h>
+
+/* pi in double: M_PI is not part of C11. */
+#define LX_PI_D 3.14159265358979323846
+
+typedef struct dvec3 {
+    double x, y, z;
+} dvec3;
+
+static dvec3 dv(double x, double y, double z)
+{
+    dvec3 r = {x, y, z};
+    return r;
+}
+/* a - b of float vectors, exact in double. */
+static dvec3 dsub(lx_vec3 a, lx_vec3 b)
+{
+    return dv((double)a.x - b.x, (double)a.y - b.y, (double)a.z - b.z);
+}
+static dvec3 dfrom(lx_vec3 a)
+{
+    return dv(a.x, a.y, a.z);
+}
+static double ddot(dvec3 a, dvec3 b)
+{
+    return a.x * b.x + a.y * b.y + a.z * b.z;
+}
+static dvec3 dcross(dvec3 a, dvec3 b)
+{
+    return dv(a.y * b.z - a.z * b.y, a.z * b.x - a.x * b.z, a.x * b.y - a.y * b.x);
+}
+static dvec3 dmadd(dvec3 a, dvec3 b, double s)
+{
+    return dv(a.x + b.x * s, a.y + b.y * s, a.z + b.z * s);
+}
+static dvec3 dscale(dvec3 a, double s)
+{
+    return dv(a.x * s, a.y * s, a.z * s);
+}
+/* a / |a|, or the zero vector when a is zero. */
+static dvec3 dnormalize(dvec3 a)
+{
+    double len = sqrt(ddot(a, a));
+    return len > 0.0 ? dscale(a, 1.0 / len) : dv(0.0, 0.0, 0.0);
+}
+
+/* ---- sphere --------------------------------------------------------------- */
+
+float lx_sphere_light_illuminance(lx_vec3 centre, float radius, float luminance, lx_vec3 p,
+                                  lx_vec3 n)
+{
+    if (!(radius > 0.0f) || !(luminance > 0.0f))
+        return 0.0f;
+    dvec3 w = dsub(centre, p);
+    double d2 = ddot(w, w);
+    double r = radius, r2 = r * r;
+    if (d2 <= r2)
+        return (float)(LX_PI_D * luminance);
+    dvec3 nn = dnormalize(dfrom(n));
+    if (ddot(nn, nn) == 0.0)
+        return 0.0f;
+    double d = sqrt(d2);
+    double cos_t = ddot(w, nn) / d;
+    cos_t = cos_t < -1.0 ? -1.0 : (cos_t > 1.0 ? 1.0 : cos_t);
+    double sin2a = r2 / d2;
+    double e;
+    if (cos_t * cos_t >= sin2a) {
+        /* wholly above (cos_t > sin a) or wholly below the horizon */
+        e = cos_t > 0.0 ? LX_PI_D * sin2a * cos_t : 0.0;
+    } else {
+        /* Snyder 1996 / Frostbite 2014 listing: x = cot a, y = -x cot t */
+        double sin_t = sqrt(1.0 - cos_t * cos_t);
+        double x = sqrt(d2 - r2) / r;
+        double y = -x * cos_t / sin_t;
+        y = y < -1.0 ? -1.0 : (y > 1.0 ? 1.0 : y);
+        double s = sin_t * sqrt(1.0 - y * y);
+        e = (cos_t * acos(y) - x * s) * sin2a + atan(s / x);
+    }
+    return e > 0.0 ? (float)(luminance * e) : 0.0f;
+}
+
+/* ---- polygon -------------------------------------------------------------- */
+
+/* Lambert's term of the edge a -> b seen from the origin: the angle between
+ * a and b times the cosine between n and the normal of the plane through
+ * the origin and the edge, oriented b x a (counter-clockwise polygons seen
+ * from their emitting side then give positive sums). */
+static double lambert_edge(dvec3 a, dvec3 b, dvec3 n)
+{
+    dvec3 c = dcross(b, a);
+    double s = sqrt(ddot(c, c));
+    if (!(s > 0.0))
+        return 0.0; /* a zero-length edge (or one through the origin, excluded by the caller) */
+    return atan2(s, ddot(a, b)) * ddot(c, n) / s;
+}
+
+/* Running sum of Lambert terms over the vertices a clipper emits. */
+typedef struct edge_sum {
+    dvec3 first, prev;
+    int count;
+    double sum;
+    dvec3 n;
+} edge_sum;
+
+static void emit(edge_sum *es, dvec3 v)
+{
+    if (es->count == 0)
+        es->first = v;
+    else
+        es->sum += lambert_edge(es->prev, v, es->n);
+    es->prev = v;
+    es->count++;
+}
+
+float lx_polygon_light_illuminance(const lx_vec3 *vertices, int count, float luminance, lx_vec3 p,
+                                   lx_vec3 n)
+{
+    if (!vertices || count < 3 || !(luminance > 0.0f))
+        return 0.0f;
+    dvec3 nn = dnormalize(dfrom(n));
+    if (ddot(nn, nn) == 0.0)
+        return 0.0f;
+
+    /* One-sidedness: the Newell normal of a polygon counter-clockwise seen
+     * from its emitting side points to that side. Vertices relative to p. */
+    dvec3 newell = dv(0.0, 0.0, 0.0), centroid = dv(0.0, 0.0, 0.0);
+    for (int i = 0; i < count; i++) {
+        dvec3 a = dsub(vertices[i], p);
+        dvec3 b = dsub(vertices[i + 1 < count ? i + 1 : 0], p);
+        newell = dmadd(newell, dcross(a, b), 1.0);
+        centroid = dmadd(centroid, a, 1.0);
+    }
+    if (ddot(centroid, newell) >= 0.0)
+        return 0.0f; /* p behind the light or in its plane */
+
+    /* Sutherland-Hodgman against the half-space h = v . n >= 0, streamed
+     * into the edge sum: no storage, any vertex count. */
+    edge_sum es = {.count = 0, .sum = 0.0, .n = nn};
+    for (int i = 0; i < count; i++) {
+        dvec3 a = dsub(vertices[i], p);
+        dvec3 b = dsub(vertices[i + 1 < count ? i + 1 : 0], p);
+        double ha = ddot(a, nn), hb = ddot(b, nn);
+        if (ha >= 0.0)
+            emit(&es, a);
+        if ((ha >= 0.0) != (hb >= 0.0))
+            emit(&es, dmadd(a, dv(b.x - a.x, b.y - a.y, b.z - a.z), ha / (ha - hb)));
+    }
+    if (es.count < 3)
+        return 0.0f; /* wholly below the horizon (or touching it) */
+    es.sum += lambert_edge(es.prev, es.first, nn);
+    double e = 0.5 * luminance * es.sum;
+    return e > 0.0 ? (float)e : 0.0f;
+}
+
+float lx_rect_light_illuminance(const lx_vec3 corners[4], float luminance, lx_vec3 p, lx_vec3 n)
+{
+    return lx_polygon_light_illuminance(corners, 4, luminance, p, n);
+}
+
+/* ---- disk ----------------------------------------------------------------- */
+
+/* The integral over t in [t0, t1] of (A + B cos t + C sin t) / (a + b cos t
+ * + c sin t), for a > sqrt(b^2 + c^2) (the receiver is off the rim).
+ * With b cos t + c sin t = rho cos s (s = t - phi) the numerator becomes
+ * A + P cos s + Q sin s, and
+ *   int ds / (a + rho cos s)     = (s + 2 T(s)) / k,  k = sqrt(a^2 - rho^2),
+ *   T(s) = atan2((m - 1) sin s, (1 + m) + (1 - m) cos s),
+ *          m = sqrt((a - rho) / (a + rho)),
+ * which is 2/k atan(m tan(s/2)) unwrapped (the atan2's second argument is
+ * >= 2m > 0, so T is continuous for every s);
+ *   int cos s ds / (a + rho cos s) = (s - a int ds / (a + rho cos s)) / rho,
+ *   int sin s ds / (a + rho cos s) = -ln(a + rho cos s) / rho,
+ * both rearranged below so that nothing cancels when rho is small. */
+static double arc_integral(double A, double B, double C, double a, double b, double c, double t0,
+                           double t1)
+{
+    double rho = sqrt(b * b + c * c);
+    if (rho <= 1e-12 * a) /* the denominator is constant to 1e-12 */
+        return (A * (t1 - t0) + B * (sin(t1) - sin(t0)) - C * (cos(t1) - cos(t0))) / a;
+    double phi = atan2(c, b);
+    double P = B * cos(phi) + C * sin(phi);
+    double Q = C * cos(phi) - B * sin(phi);
+    double s0 = t0 - phi, s1 = t1 - phi;
+    double sp = sqrt(a + rho), sm = sqrt(a - rho);
+    double k = sp * sm;
+    double m1 = -2.0 * rho / ((sm + sp) * sp); /* m - 1 without cancellation */
+    double T0 = atan2(m1 * sin(s0), 2.0 + m1 - m1 * cos(s0));
+    double T1 = atan2(m1 * sin(s1), 2.0 + m1 - m1 * cos(s1));
+    double ds = s1 - s0, dT = T1 - T0;
+    double i_one = (ds + 2.0 * dT) / k;
+    /* (ds - a i_one) / rho = -ds rho / (k (a + k)) - 2 a dT / (k rho) */
+    double i_cos = -ds * rho / (k * (a + k)) - 2.0 * a * dT / (k * rho);
+    double i_sin = -log1p(rho * (cos(s1) - cos(s0)) / (a + rho * cos(s0))) / rho;
+    return A * i_one + P * i_cos + Q * i_sin;
+}
+
+float lx_disk_light_illuminance(lx_vec3 centre, lx_vec3 normal, float radius, float luminance,
+                                lx_vec3 p, lx_vec3 n)
+{
+    if (!(radius > 0.0f) || !(luminance > 0.0f))
+        return 0.0f;
+    dvec3 N = dnormalize(dfrom(normal));
+    dvec3 nn = dnormalize(dfrom(n));
+    if (ddot(N, N) == 0.0 || ddot(nn, nn) == 0.0)
+        return 0.0f;
+    dvec3 w = dsub(centre, p); /* from p to the centre */
+    if (ddot(w, N) >= 0.0)
+        return 0.0f; /* p behind the disk or in its plane */
+
+    /* Frame with e1 x e2 = N: t increasing runs counter-clockwise seen from
+     * the emitting side. The circle is R(t) = w + r (cos t e1 + sin t e2). */
+    dvec3 e1 = fabs(N.x) < 0.9 ? dv(1.0, 0.0, 0.0) : dv(0.0, 1.0, 0.0);
+    e1 = dnormalize(dcross(N, e1));
+    dvec3 e2 = dcross(N, e1);
+    double r = radius;
+
+    /* Height above the horizon: h(t) = h0 + r (s1 cos t + s2 sin t). */
+    double h0 = ddot(w, nn);
+    double s1 = ddot(e1, nn), s2 = ddot(e2, nn);
+    double sigma = sqrt(s1 * s1 + s2 * s2);
+    double t0, t1;
+    bool clipped = false;
+    if (h0 - r * sigma >= 0.0) {
+        t0 = 0.0;
+        t1 = 2.0 * LX_PI_D;
+    } else if (h0 + r * sigma <= 0.0) {
+        return 0.0f;
+    } else {
+        /* visible where cos(t - psi) > -h0 / (r sigma) = cos(beta) */
+        double psi = atan2(s2, s1);
+        double cb = -h0 / (r * sigma);
+        double beta = acos(cb < -1.0 ? -1.0 : (cb > 1.0 ? 1.0 : cb));
+        t0 = psi - beta;
+        t1 = psi + beta;
+        clipped = true;
+    }
+
+    /* (R' x R) . n = A + B cos t + C sin t, |R|^2 = a + b cos t + c sin t */
+    double A = -r * r * ddot(N, nn);
+    double B = r * ddot(dcross(e2, w), nn);
+    double C = -r * ddot(dcross(e1, w), nn);
+    double a = ddot(w, w) + r * r;
+    double b = 2.0 * r * ddot(w, e1);
+    double c = 2.0 * r * ddot(w, e2);
+    double sum = arc_integral(A, B, C, a, b, c, t0, t1);
+    if (clipped) {
+        /* the chord along the horizon, from the arc's end back to its start */
+        dvec3 x1 = dmadd(dmadd(w, e1, r * cos(t1)), e2, r * sin(t1));
+        dvec3 x0 = dmadd(dmadd(w, e1, r * cos(t0)), e2, r * sin(t0));
+        sum += lambert_edge(x1, x0, nn);
+    }
+    double e = 0.5 * luminance * sum;
+    return e > 0.0 ? (float)e : 0.0f;
+}
+
+/* ---- luminance from power --------------------------------------------------- */
+
+static lx_status check_size(const char *shape, const char *what, float v, bool zero_ok)
+{
+    if (!isfinite(v))
+        return lx_fail(LX_ERR_INVALID, "%s light: %s is not finite", shape, what);
+    if (v < 0.0f || (!zero_ok && v == 0.0f))
+        return lx_fail(LX_ERR_INVALID, "%s light: %s %g is not above 0", shape, what, v);
+    return LX_OK;
+}
+
+lx_status lx_area_light_luminance_from_power(lx_area_shape shape, float power_lm, float radius,
+                                             float length, float width, float height,
+                                             float *luminance)
+{
+    static const char *names[] = {"sphere", "disk", "rect", "tube"};
+    if (!luminance)
+        return lx_fail(LX_ERR_INVALID, "area light: NULL luminance pointer");
+    if ((unsigned)shape > (unsigned)LX_AREA_TUBE)
+        return lx_fail(LX_ERR_INVALID, "area light: shape %d is not an area-light shape",
+                       (int)shape);
+    const char *name = names[shape];
+    if (!isfinite(power_lm))
+        return lx_fail(LX_ERR_INVALID, "%s light: power is not finite", name);
+    if (power_lm < 0.0f)
+        return lx_fail(LX_ERR_INVALID, "%s light: power %g lm is negative", name, power_lm);
+
+    lx_status st = LX_OK;
+    double area = 0.0; /* emitting area in m^2 */
+    double r = radius;
+    switch (shape) {
+    case LX_AREA_SPHERE:
+        st = check_size(name, "radius", radius, false);
+        area = 4.0 * LX_PI_D * r * r;
+        break;
+    case LX_AREA_DISK:
+        st = check_size(name, "radius", radius, false);
+        area = LX_PI_D * r * r;
+        break;
+    case LX_AREA_RECT:
+        if ((st = check_size(name, "width", width, false)) == LX_OK)
+            st = check_size(name, "height", height, false);
+        area = (double)width * height;
+        break;
+    case LX_AREA_TUBE:
+        if (isfinite(radius) && radius == 0.0f)
+            return lx_fail(LX_ERR_INVALID,
+                           "tube light: radius 0 (a linear tube) has no finite luminance");
+        if ((st = check_size(name, "radius", radius, false)) == LX_OK)
+            st = check_size(name, "length", length, true);
+        area = 2.0 * LX_PI_D * r * length + 4.0 * LX_PI_D * r * r;
+        break;
+    }
+    if (st != LX_OK)
+        return st;
+    double l = (double)power_lm / (LX_PI_D * area);
+    if (!(l <= 3.4028234663852886e38))
+        return lx_fail(LX_ERR_INVALID, "%s light: luminance %g nt from %g lm overflows a float",
+                       name, l, power_lm);
+    *luminance = (float)l;
+    return LX_OK;
+}
