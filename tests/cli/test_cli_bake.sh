@@ -280,4 +280,23 @@ for n in tall_box short_box; do
         <(paste "$WORK/irr_$n.txt" "$WORK/rad_$n.txt")
 done
 
+
+# --pre-expose: every value times 1/(1.2 * 2^EV100) (seed 001); at EV100 0
+# that is exactly 1/1.2 = 0.833333.
+run "$LUXEL" bake "$ROOM" --resolution 32 --format pfm -q -o "$WORK/pre" \
+    --pre-expose --exposure 0
+expect_rc 0 "--pre-expose --exposure 0"
+check "manifest: pre_exposure 1/1.2" grep -Eq '"pre_exposure":[[:space:]]*0\.8333' \
+    "$WORK/pre/manifest.json"
+run "$LUXEL" bake "$ROOM" --resolution 32 --format pfm -q -o "$WORK/unexposed"
+pfm_floats "$WORK/unexposed/room.pfm" >"$WORK/unexposed.txt"
+pfm_floats "$WORK/pre/room.pfm" >"$WORK/pre.txt"
+check "pre-exposed values = values / 1.2 on every texel" \
+    awk '{ e = $1 + 0; p = $2 + 0
+           if (e > 1e-3) { lit++; if (p < e / 1.2 * 0.99999 || p > e / 1.2 * 1.00001) bad++ } }
+         END { if (bad || lit < 100) { printf "        %d bad of %d lit\n", bad, lit; exit 1 } }' \
+    <(paste "$WORK/unexposed.txt" "$WORK/pre.txt")
+run "$LUXEL" bake "$ROOM" --resolution 32 -q -o "$WORK/pre_bad" --pre-expose
+expect_rc 2 "--pre-expose without --exposure"
+
 finish

@@ -33,6 +33,9 @@ static const char *bake_usage =
     "                          scene's (docs/lights-json.md)\n"
     "  --format F              exr (default), hdr, pfm or png\n"
     "  --half                  EXR with 16-bit half floats\n"
+    "  --pre-expose            store values times the exposure of --exposure\n"
+    "                          (seed 001's pre-exposure: sun-lit scenes fit in\n"
+    "                          half floats); the manifest records the factor\n"
     "  --quantity Q            irradiance (lux, default) or radiance (nits:\n"
     "                          irradiance x base colour / pi)\n"
     "  --ambient R,G,B         constant ambient illuminance in lux\n"
@@ -51,6 +54,7 @@ enum {
     OPT_LIGHTS,
     OPT_FORMAT,
     OPT_HALF,
+    OPT_PRE_EXPOSE,
     OPT_QUANTITY,
     OPT_AMBIENT,
     OPT_EXPOSURE,
@@ -65,6 +69,7 @@ typedef struct bake_args {
     const char *lights;
     lx_image_format format;
     bool half;
+    bool pre_expose;
     bool has_ambient;
     lx_vec3 ambient;
     bool has_exposure;
@@ -83,6 +88,7 @@ static int parse_args(int argc, char **argv, bake_args *a)
         {"lights", required_argument, NULL, OPT_LIGHTS},
         {"format", required_argument, NULL, OPT_FORMAT},
         {"half", no_argument, NULL, OPT_HALF},
+        {"pre-expose", no_argument, NULL, OPT_PRE_EXPOSE},
         {"quantity", required_argument, NULL, OPT_QUANTITY},
         {"ambient", required_argument, NULL, OPT_AMBIENT},
         {"exposure", required_argument, NULL, OPT_EXPOSURE},
@@ -140,6 +146,9 @@ static int parse_args(int argc, char **argv, bake_args *a)
             else
                 return cli_usage_error("bake", "--format must be exr, hdr, pfm or png, not '%s'",
                                        optarg);
+            break;
+        case OPT_PRE_EXPOSE:
+            a->pre_expose = true;
             break;
         case OPT_HALF:
             a->half = true;
@@ -204,6 +213,10 @@ static int parse_args(int argc, char **argv, bake_args *a)
     a->scene = argv[optind];
     if (a->half && a->format != LX_IMAGE_EXR)
         return cli_usage_error("bake", "--half applies to --format exr only");
+    if (a->pre_expose && !a->has_exposure)
+        return cli_usage_error("bake", "--pre-expose needs --exposure EV100");
+    if (a->pre_expose && a->format == LX_IMAGE_PNG)
+        return cli_usage_error("bake", "--pre-expose applies to float formats, not png");
     return 0;
 }
 
@@ -545,6 +558,8 @@ int cmd_bake(int argc, char **argv)
     }
     double ev = a.has_exposure ? a.exposure_ev100 : auto_ev100(baker, images, &a);
     float exposure = lx_exposure_from_ev100((float)ev) * preview_scale(&a);
+    /* seed 001: pre-exposed values are the quantity times 1/(1.2 * 2^EV100) */
+    float pre_exposure = lx_exposure_from_ev100((float)ev);
 
     if (cli_interrupted()) {
         cli_error("interrupted; nothing written");
@@ -573,6 +588,8 @@ int cmd_bake(int argc, char **argv)
                             a.desc.quantity == LX_QUANTITY_RADIANCE ? "nt" : "lx");
     cJSON_AddStringToObject(manifest, "format", lx_image_format_extension(a.format));
     cJSON_AddNumberToObject(manifest, "preview_ev100", ev);
+    /* values in the files are (quantity) x pre_exposure */
+    cJSON_AddNumberToObject(manifest, "pre_exposure", a.pre_expose ? pre_exposure : 1.0);
     cJSON *list = cJSON_AddArrayToObject(manifest, "lightmaps");
     bool failed = false;
     for (uint32_t m = 0; m < maps && !failed; m++) {
@@ -582,7 +599,9 @@ int cmd_bake(int argc, char **argv)
         snprintf(preview, sizeof preview, "%s.png", stems[m]);
         lx_image_write_desc wd = {.format = a.format,
                                   .half = a.half,
-                                  .exposure = a.format == LX_IMAGE_PNG ? exposure : 1.0f};
+                                  .exposure = a.format == LX_IMAGE_PNG ? exposure
+                                              : a.pre_expose   ? pre_exposure
+                                                               : 1.0f};
         failed = !stage_image(&stage, a.output, file, &images[m], &wd);
         bool want_preview = a.format != LX_IMAGE_PNG;
         if (!failed && want_preview) {
