@@ -42,13 +42,17 @@ extern "C" {
 typedef enum lx_light_type {
     LX_LIGHT_POINT = 0,
     LX_LIGHT_SPOT,
-    LX_LIGHT_DIRECTIONAL
+    LX_LIGHT_DIRECTIONAL,
+    LX_LIGHT_SPHERE, /* area lights: intensity is luminance in nits */
+    LX_LIGHT_DISK,
+    LX_LIGHT_RECT
 } lx_light_type;
 
 typedef enum lx_shadow_mode {
     LX_SHADOW_HARD = 0, /* one occlusion ray per texel and light */
     LX_SHADOW_NONE,     /* lit only: nothing blocks the light */
-    LX_SHADOW_BLUR      /* the seed's dynamic blur from the nearest occluder */
+    LX_SHADOW_BLUR,     /* the seed's dynamic blur from the nearest occluder */
+    LX_SHADOW_SOFT      /* area lights: rays to `samples` points on the light */
 } lx_shadow_mode;
 
 typedef enum lx_falloff_model {
@@ -61,7 +65,8 @@ typedef enum lx_light_unit {
     LX_UNIT_CANDELA,
     LX_UNIT_LUMEN,
     LX_UNIT_WATT,
-    LX_UNIT_LUX
+    LX_UNIT_LUX,
+    LX_UNIT_NIT /* cd/m^2: area-light luminance */
 } lx_light_unit;
 
 /* How a spot light's luminous power becomes intensity. */
@@ -88,7 +93,24 @@ typedef struct lx_light {
     float blur_multiplier; /* seed's blur scale, default 1 */
     lx_vec3 ambient;       /* lux added everywhere in range, falling off with range */
     bool dynamic;          /* re-evaluated by lx_baker_update instead of baked */
+    /* area lights (sphere, disk, rect); direction is the emitting side */
+    float radius;          /* metres: sphere, disk */
+    float width, height;   /* metres: rect, width along cross(up, direction) */
+    lx_vec3 up;            /* rect: fixes its rotation about direction */
+    uint32_t samples;      /* soft shadows: points on the light per texel, 0 = 16 */
 } lx_light;
+
+#define LX_MAX_LIGHT_SAMPLES 1024u
+
+/* True for the area light types (sphere, disk, rect). */
+bool lx_light_is_area(const lx_light *light);
+
+/* A point on an area light's surface from two numbers in [0,1) (uniform
+ * in area), with the surface normal there; for soft shadows. */
+lx_vec3 lx_area_light_point(const lx_light *light, float u, float v, lx_vec3 *normal);
+
+/* The rect's four corners, counter-clockwise seen from the emitting side. */
+void lx_rect_light_corners(const lx_light *light, lx_vec3 corners[4]);
 
 /* A light of the given type with every default filled in: white, intensity
  * 1, unlimited range, cone 0..pi/4, hard shadows, blur power/multiplier 1,

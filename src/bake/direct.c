@@ -33,9 +33,62 @@ static lx_ray shadow_ray(const lx_baker *b, lx_vec3 p, lx_vec3 ng, const lx_ligh
     return r;
 }
 
-static void light_tile(const lx_baker *b, const lx_lightmap *map, uint32_t first, uint32_t count,
-                       const lx_light *light, lx_vec3 *accum)
+/* Soft shadows from an area light: rays to stratified points on its
+ * surface (jittered by a hash of map, texel, sample and light, so any
+ * thread count gives the same points). The exact unshadowed illuminance is
+ * scaled by the visible share of the points, each weighted by what it
+ * contributes (cos at the texel x cos at the light / d^2): unoccluded, the
+ * result is exactly the closed form. */
+static float soft_visibility(const lx_baker *b, uint32_t map_index, const lx_lightmap *map,
+                             uint32_t texel, uint32_t light_index, const lx_light *light)
 {
+    uint32_t want = light->samples ? light->samples : 16u;
+    uint32_t sx = (uint32_t)sqrtf((float)want);
+    sx = sx ? sx : 1u;
+    uint32_t sy = (want + sx - 1) / sx;
+    lx_vec3 p = map->world_position[texel], n = map->world_normal[texel];
+    lx_vec3 ng = map->world_geometric_normal[texel];
+    uint32_t pixel = map->texels[texel].pixel;
+    enum { BATCH = 64 };
+    lx_ray rays[BATCH];
+    float weight[BATCH];
+    uint8_t occluded[BATCH];
+    double total = 0.0, visible = 0.0;
+    uint32_t k = 0, cells = sx * sy;
+    while (k < cells) {
+        uint32_t m = 0;
+        for (; m < BATCH && k < cells; k++) {
+            float u = ((float)(k % sx) + lx_random(map_index, pixel, k, 2 * light_index)) / sx;
+            float v = ((float)(k / sx) + lx_random(map_index, pixel, k, 2 * light_index + 1)) / sy;
+            lx_vec3 nq;
+            lx_vec3 q = lx_area_light_point(light, u, v, &nq);
+            lx_vec3 d = lx_sub(q, p);
+            float d2 = lx_dot(d, d);
+            float w = fmaxf(lx_dot(n, d), 0.0f) * fmaxf(-lx_dot(nq, d), 0.0f) / (d2 * d2);
+            if (!(w > 0.0f) || !isfinite(w))
+                continue;
+            float dist = sqrtf(d2);
+            lx_light_eval e = {.to_light = lx_scale(d, 1.0f / dist), .distance = dist};
+            rays[m] = shadow_ray(b, p, ng, &e);
+            weight[m] = w;
+            m++;
+        }
+        if (m == 0)
+            continue;
+        lx_tracer_occluded_batch(b->tracer, rays, m, true, occluded);
+        for (uint32_t j = 0; j < m; j++) {
+            total += weight[j];
+            if (!occluded[j])
+                visible += weight[j];
+        }
+    }
+    return total > 0.0 ? (float)(visible / total) : 0.0f;
+}
+
+static void light_tile(const lx_baker *b, uint32_t map_index, const lx_lightmap *map,
+                       uint32_t first, uint32_t count, uint32_t light_index, lx_vec3 *accum)
+{
+    const lx_light *light = &b->lights[light_index];
     lx_ray rays[LX_TILE * LX_TILE];
     pending_ray pending[LX_TILE * LX_TILE];
     uint8_t occluded[LX_TILE * LX_TILE];
@@ -49,6 +102,11 @@ static void light_tile(const lx_baker *b, const lx_lightmap *map, uint32_t first
             continue;
         if (light->shadow == LX_SHADOW_NONE) {
             accum[k] = lx_add(accum[k], e.illuminance);
+            continue;
+        }
+        if (light->shadow == LX_SHADOW_SOFT) {
+            float vis = soft_visibility(b, map_index, map, i, light_index, light);
+            accum[k] = lx_add(accum[k], lx_scale(e.illuminance, vis));
             continue;
         }
         rays[n] = shadow_ray(b, map->world_position[i], map->world_geometric_normal[i], &e);
@@ -115,7 +173,7 @@ lx_status lx_bake_lights(lx_baker *b, const uint32_t *lights, uint32_t light_cou
             for (uint32_t k = 0; k < count; k++)
                 accum[k] = ambient;
             for (uint32_t l = 0; l < light_count; l++)
-                light_tile(b, map, first, count, &b->lights[lights[l]], accum);
+                light_tile(b, m, map, first, count, lights[l], accum);
             /* every texel belongs to one tile: plain stores, no clearing */
             for (uint32_t k = 0; k < count; k++) {
                 float *px = target + (size_t)map->texels[first + k].pixel * 3;

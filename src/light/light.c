@@ -38,7 +38,88 @@ lx_light lx_light_defaults(lx_light_type type)
     l.blur_multiplier = 1.0f;
     l.ambient = lx_v3(0.0f, 0.0f, 0.0f);
     l.dynamic = false;
+    /* area lights: 10 cm, facing down with up = +Z */
+    l.radius = type == LX_LIGHT_SPHERE || type == LX_LIGHT_DISK ? 0.1f : 0.0f;
+    l.width = l.height = type == LX_LIGHT_RECT ? 0.1f : 0.0f;
+    l.up = lx_v3(0.0f, 0.0f, 1.0f);
+    l.samples = 0;
     return l;
+}
+
+bool lx_light_is_area(const lx_light *light)
+{
+    return light->type == LX_LIGHT_SPHERE || light->type == LX_LIGHT_DISK ||
+           light->type == LX_LIGHT_RECT;
+}
+
+/* The rect's axes: x along its width, y along its height, x cross y = the
+ * emitting direction, so corners in (x, y) order are counter-clockwise
+ * seen from the front. */
+static void rect_axes(const lx_light *light, lx_vec3 *x, lx_vec3 *y)
+{
+    *x = lx_normalize(lx_cross(light->up, light->direction));
+    *y = lx_cross(light->direction, *x);
+}
+
+void lx_rect_light_corners(const lx_light *light, lx_vec3 corners[4])
+{
+    lx_vec3 x, y;
+    rect_axes(light, &x, &y);
+    lx_vec3 hx = lx_scale(x, 0.5f * light->width), hy = lx_scale(y, 0.5f * light->height);
+    corners[0] = lx_sub(lx_sub(light->position, hx), hy);
+    corners[1] = lx_sub(lx_add(light->position, hx), hy);
+    corners[2] = lx_add(lx_add(light->position, hx), hy);
+    corners[3] = lx_add(lx_sub(light->position, hx), hy);
+}
+
+lx_vec3 lx_area_light_point(const lx_light *light, float u, float v, lx_vec3 *normal)
+{
+    float phi = 2.0f * LX_PI * v;
+    if (light->type == LX_LIGHT_SPHERE) {
+        float z = 1.0f - 2.0f * u, r = sqrtf(fmaxf(0.0f, 1.0f - z * z));
+        lx_vec3 d = lx_v3(r * cosf(phi), r * sinf(phi), z);
+        *normal = d;
+        return lx_madd(light->position, d, light->radius);
+    }
+    *normal = light->direction;
+    if (light->type == LX_LIGHT_DISK) {
+        lx_vec3 t = lx_perpendicular(light->direction), b = lx_cross(light->direction, t);
+        float r = light->radius * sqrtf(u);
+        return lx_madd(lx_madd(light->position, t, r * cosf(phi)), b, r * sinf(phi));
+    }
+    lx_vec3 x, y;
+    rect_axes(light, &x, &y);
+    return lx_madd(lx_madd(light->position, x, (u - 0.5f) * light->width), y,
+                   (v - 0.5f) * light->height);
+}
+
+/* Area lights: the exact unshadowed illuminance (area.c), with the range
+ * window on the distance to the light's centre. */
+static bool evaluate_area(const lx_light *light, lx_vec3 p, lx_vec3 n, lx_light_eval *out)
+{
+    lx_vec3 to_light = lx_sub(light->position, p);
+    float dist_sq = lx_dot(to_light, to_light);
+    float dist = sqrtf(dist_sq);
+    float window = lx_light_range_window(dist_sq, light->range);
+    out->ambient = lx_scale(light->ambient, window);
+    out->distance = dist;
+    out->to_light = dist > 0.0f ? lx_scale(to_light, 1.0f / dist) : n;
+    float e;
+    if (light->type == LX_LIGHT_SPHERE) {
+        e = lx_sphere_light_illuminance(light->position, light->radius, light->intensity, p, n);
+    } else if (light->type == LX_LIGHT_DISK) {
+        e = lx_disk_light_illuminance(light->position, light->direction, light->radius,
+                                      light->intensity, p, n);
+    } else {
+        lx_vec3 corners[4];
+        lx_rect_light_corners(light, corners);
+        e = lx_rect_light_illuminance(corners, light->intensity, p, n);
+    }
+    e *= window;
+    if (!(e > 0.0f))
+        return false;
+    out->illuminance = lx_scale(light->color, e);
+    return true;
 }
 
 /* The light's name for messages; names are not guaranteed NUL-terminated
@@ -86,6 +167,34 @@ static lx_status check_non_negative(const lx_light *light, const char *field, fl
     return LX_OK;
 }
 
+/* The area-light fields: sizes, the rect's up vector, soft shadows. */
+static lx_status validate_area(const lx_light *light)
+{
+    char msg[200];
+    if (light->samples > LX_MAX_LIGHT_SAMPLES) {
+        snprintf(msg, sizeof msg, "samples %u is above %u", light->samples, LX_MAX_LIGHT_SAMPLES);
+        return invalid(light, msg);
+    }
+    if (!lx_light_is_area(light)) {
+        if (light->shadow == LX_SHADOW_SOFT)
+            return invalid(light, "soft shadows need an area light (sphere, disk or rect)");
+        return LX_OK;
+    }
+    if (light->model == LX_MODEL_CLASSIC)
+        return invalid(light, "area lights use the physical model");
+    if (light->type == LX_LIGHT_RECT) {
+        if (!(light->width > 0.0f && isfinite(light->width)) ||
+            !(light->height > 0.0f && isfinite(light->height)))
+            return invalid(light, "a rect light needs a finite width and height above 0");
+        lx_vec3 side = lx_cross(light->up, light->direction);
+        if (!lx_vec3_finite(light->up) || !(lx_length(side) > 1e-6f))
+            return invalid(light, "a rect light's up must be finite and not along its direction");
+    } else if (!(light->radius > 0.0f && isfinite(light->radius))) {
+        return invalid(light, "a sphere or disk light needs a finite radius above 0");
+    }
+    return LX_OK;
+}
+
 lx_status lx_light_validate(const lx_light *light)
 {
     char msg[200];
@@ -94,7 +203,7 @@ lx_status lx_light_validate(const lx_light *light)
         return lx_fail(LX_ERR_INVALID, "light: NULL pointer");
     if (!memchr(light->name, '\0', sizeof light->name))
         return invalid(light, "name is not NUL-terminated within LX_LIGHT_NAME_MAX bytes");
-    if ((unsigned)light->type > (unsigned)LX_LIGHT_DIRECTIONAL) {
+    if ((unsigned)light->type > (unsigned)LX_LIGHT_RECT) {
         snprintf(msg, sizeof msg, "type %d is not a light type", (int)light->type);
         return invalid(light, msg);
     }
@@ -102,7 +211,7 @@ lx_status lx_light_validate(const lx_light *light)
         snprintf(msg, sizeof msg, "model %d is not a falloff model", (int)light->model);
         return invalid(light, msg);
     }
-    if ((unsigned)light->shadow > (unsigned)LX_SHADOW_BLUR) {
+    if ((unsigned)light->shadow > (unsigned)LX_SHADOW_SOFT) {
         snprintf(msg, sizeof msg, "shadow %d is not a shadow mode", (int)light->shadow);
         return invalid(light, msg);
     }
@@ -158,7 +267,7 @@ lx_status lx_light_validate(const lx_light *light)
         return st;
     if ((st = check_vec(light, "ambient", light->ambient, true)) != LX_OK)
         return st;
-    return LX_OK;
+    return validate_area(light);
 }
 
 float lx_light_range_window(float distance_sq, float range)
@@ -213,6 +322,8 @@ bool lx_light_evaluate(const lx_light *light, lx_vec3 p, lx_vec3 n, lx_light_eva
     out->illuminance = lx_v3(0.0f, 0.0f, 0.0f);
     if (light->type == LX_LIGHT_DIRECTIONAL)
         return evaluate_directional(light, n, out);
+    if (lx_light_is_area(light))
+        return evaluate_area(light, p, n, out);
 
     lx_vec3 to_light = lx_sub(light->position, p);
     float dist_sq = lx_dot(to_light, to_light);

@@ -24,6 +24,39 @@ static void light_label(const lx_light *light, char *buf, size_t size)
         snprintf(buf, size, "light '%.*s'", n, light->name);
 }
 
+/* Area lights carry luminance (nits): power goes through the emitting
+ * area (issue 3's formulas, lx_area_light_luminance_from_power), candela
+ * through the area seen along the axis. */
+static lx_status area_to_native(const lx_light *light, const char *who, float value,
+                                lx_light_unit unit, float *native)
+{
+    if (unit == LX_UNIT_DEFAULT || unit == LX_UNIT_NIT) {
+        *native = value;
+        return LX_OK;
+    }
+    if (unit == LX_UNIT_LUX)
+        return lx_fail(LX_ERR_INVALID, "%s: %s lights take nt, cd, lm or W, not lx", who,
+                       lx_light_type_name(light->type));
+    lx_area_shape shape = light->type == LX_LIGHT_SPHERE ? LX_AREA_SPHERE
+                          : light->type == LX_LIGHT_DISK ? LX_AREA_DISK
+                                                         : LX_AREA_RECT;
+    if (unit == LX_UNIT_CANDELA) {
+        double projected = light->type == LX_LIGHT_RECT
+                               ? (double)light->width * light->height
+                               : LX_PI_D * light->radius * light->radius;
+        if (!(projected > 0.0) || !isfinite(projected))
+            return lx_fail(LX_ERR_INVALID, "%s: candela needs the light's size first", who);
+        *native = (float)(value / projected);
+        return LX_OK;
+    }
+    float lumens = unit == LX_UNIT_WATT ? value * LX_LUMENS_PER_WATT : value;
+    lx_status st = lx_area_light_luminance_from_power(shape, lumens, light->radius, 0.0f,
+                                                      light->width, light->height, native);
+    if (st != LX_OK)
+        lx_error_prefix(who);
+    return st;
+}
+
 lx_status lx_light_intensity_to_native(const lx_light *light, float value, lx_light_unit unit,
                                        lx_spot_conversion spot_conversion, float *native)
 {
@@ -35,7 +68,7 @@ lx_status lx_light_intensity_to_native(const lx_light *light, float value, lx_li
         return lx_fail(LX_ERR_INVALID, "%s: intensity is not finite", who);
     if (value < 0.0f)
         return lx_fail(LX_ERR_INVALID, "%s: intensity %g is negative", who, value);
-    if ((unsigned)unit > (unsigned)LX_UNIT_LUX)
+    if ((unsigned)unit > (unsigned)LX_UNIT_NIT)
         return lx_fail(LX_ERR_INVALID, "%s: unit %d is not a light unit", who, (int)unit);
 
     if (light->type == LX_LIGHT_DIRECTIONAL) {
@@ -45,8 +78,13 @@ lx_status lx_light_intensity_to_native(const lx_light *light, float value, lx_li
         *native = value;
         return LX_OK;
     }
+    if (lx_light_is_area(light))
+        return area_to_native(light, who, value, unit, native);
     if (light->type != LX_LIGHT_POINT && light->type != LX_LIGHT_SPOT)
         return lx_fail(LX_ERR_INVALID, "%s: type %d is not a light type", who, (int)light->type);
+    if (unit == LX_UNIT_NIT)
+        return lx_fail(LX_ERR_INVALID, "%s: %s lights take cd, lm or W, not nt", who,
+                       lx_light_type_name(light->type));
     if (unit == LX_UNIT_LUX)
         return lx_fail(LX_ERR_INVALID, "%s: %s lights take cd, lm or W, not lx", who,
                        lx_light_type_name(light->type));
@@ -105,6 +143,7 @@ lx_light_unit lx_light_unit_from_string(const char *s)
         {"lm", LX_UNIT_LUMEN},   {"lumen", LX_UNIT_LUMEN},     {"lumens", LX_UNIT_LUMEN},
         {"W", LX_UNIT_WATT},     {"watt", LX_UNIT_WATT},       {"watts", LX_UNIT_WATT},
         {"lx", LX_UNIT_LUX},     {"lux", LX_UNIT_LUX},
+        {"nt", LX_UNIT_NIT},     {"nit", LX_UNIT_NIT},         {"nits", LX_UNIT_NIT},
     };
     if (!s)
         return LX_UNIT_DEFAULT;
@@ -127,6 +166,8 @@ const char *lx_light_unit_symbol(lx_light_unit unit)
         return "W";
     case LX_UNIT_LUX:
         return "lx";
+    case LX_UNIT_NIT:
+        return "nt";
     }
     return "unknown";
 }
@@ -140,6 +181,12 @@ const char *lx_light_type_name(lx_light_type type)
         return "spot";
     case LX_LIGHT_DIRECTIONAL:
         return "directional";
+    case LX_LIGHT_SPHERE:
+        return "sphere";
+    case LX_LIGHT_DISK:
+        return "disk";
+    case LX_LIGHT_RECT:
+        return "rect";
     }
     return "unknown";
 }
@@ -153,6 +200,8 @@ const char *lx_shadow_mode_name(lx_shadow_mode mode)
         return "none";
     case LX_SHADOW_BLUR:
         return "blur";
+    case LX_SHADOW_SOFT:
+        return "soft";
     }
     return "unknown";
 }
