@@ -23,7 +23,9 @@ wait_for() {
     done
     return 1
 }
-has_files() { [ -d "$1" ] && [ "$(ls -A "$1" | wc -l)" -ge "$2" ]; }
+# files written so far, staged ones included (the CLI writes into a hidden
+# staging folder inside the output folder and moves them out at the end)
+has_files() { [ -d "$1" ] && [ "$(find "$1" -type f | wc -l)" -ge "$2" ]; }
 alive() { kill -0 "$1" 2>/dev/null; }
 
 # interrupted LABEL OUTDIR: checks after an interrupted run.

@@ -462,8 +462,11 @@ static bool publish(staging *st, const char *output)
             unlink(to);
         free(to);
     }
-    if (ok)
-        cli_forget_outputs(); /* they are results now, not temporaries */
+    if (ok) {
+        /* the run is complete: a signal held off until now must not undo it */
+        cli_forget_outputs();
+        cli_set_writing(false);
+    }
     sigprocmask(SIG_SETMASK, &old, NULL);
     return ok;
 }
