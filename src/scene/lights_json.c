@@ -1,8 +1,10 @@
 /* The luxel lights JSON (docs/lights-json.md): scene ambient plus a list of
  * lights in Filament's physical units (seed 001) or the seed-000 classic
- * model, with the seed's shadow modes and per-light ambient. Parsed with
- * cJSON; every key, type, length and value is checked, and nothing changes
- * in the scene unless the whole file is valid. */
+ * model, with the seed's shadow modes and per-light ambient, and the area
+ * lights of issue 3 (sphere, disk, rect; a point light with a radius is a
+ * sphere, as in seed 001). Parsed with cJSON; every key, type, length and
+ * value is checked, and nothing changes in the scene unless the whole file
+ * is valid. */
 #include "luxel/scene.h"
 
 #include "json_text.h"
@@ -71,6 +73,25 @@ static lx_status get_vec3(const ctx *c, const cJSON *item, const char *field, lx
             return st;
     }
     *out = lx_v3(v[0], v[1], v[2]);
+    return LX_OK;
+}
+
+/* A direction-like vector of any non-zero length, normalized; *raw keeps
+ * the values as given (for messages). */
+static lx_status get_unit_vec3(const ctx *c, const cJSON *item, const char *field, lx_vec3 *out,
+                               lx_vec3 *raw)
+{
+    lx_vec3 d;
+    lx_status st = get_vec3(c, item, field, &d);
+    if (st != LX_OK)
+        return st;
+    /* The length in float can overflow even for finite components. */
+    double len = sqrt((double)d.x * d.x + (double)d.y * d.y + (double)d.z * d.z);
+    if (!(len > 1e-20))
+        return fail(c, LX_ERR_INVALID, "%s [%g, %g, %g] has zero length", field, d.x, d.y, d.z);
+    *out = lx_v3((float)(d.x / len), (float)(d.y / len), (float)(d.z / len));
+    if (raw)
+        *raw = d;
     return LX_OK;
 }
 
@@ -197,9 +218,12 @@ static const char *const light_keys[] = {"name",        "type",
                                          "blur_power",  "blur_multiplier",
                                          "model",       "ambient",
                                          "dynamic",     "srgb",
-                                         "temperature"};
-static const char *const type_names[] = {"point", "spot", "directional"};
-static const char *const shadow_names[] = {"hard", "none", "blur"};
+                                         "temperature", "radius",
+                                         "width",       "height",
+                                         "up",          "samples"};
+/* Indexed by lx_light_type and lx_shadow_mode. */
+static const char *const type_names[] = {"point", "spot", "directional", "sphere", "disk", "rect"};
+static const char *const shadow_names[] = {"hard", "none", "blur", "soft"};
 static const char *const model_names[] = {"physical", "classic"};
 static const char *const conversion_names[] = {"pi", "cone"};
 
@@ -220,6 +244,150 @@ static lx_status restate(const ctx *c, lx_status st, const lx_light *l)
     return fail(c, st, "%s", msg);
 }
 
+/* ---- area lights ---------------------------------------------------------- */
+
+static bool is_area_type(lx_light_type t)
+{
+    return t == LX_LIGHT_SPHERE || t == LX_LIGHT_DISK || t == LX_LIGHT_RECT;
+}
+
+static bool has_radius(lx_light_type t)
+{
+    return t == LX_LIGHT_SPHERE || t == LX_LIGHT_DISK;
+}
+
+/* The unit intensity is kept in: candela, lux or nits. */
+static lx_light_unit native_unit(lx_light_type t)
+{
+    return t == LX_LIGHT_DIRECTIONAL ? LX_UNIT_LUX
+           : is_area_type(t)         ? LX_UNIT_NIT
+                                     : LX_UNIT_CANDELA;
+}
+
+/* Changes l's type; the sizes the new type uses and the old one did not
+ * (or does not share) come from the new type's defaults. */
+static void change_type(lx_light *l, lx_light_type type)
+{
+    lx_light d = lx_light_defaults(type);
+    if (!(has_radius(l->type) && has_radius(type)))
+        l->radius = d.radius;
+    if (!(l->type == LX_LIGHT_RECT && type == LX_LIGHT_RECT)) {
+        l->width = d.width;
+        l->height = d.height;
+        l->up = d.up;
+    }
+    l->type = type;
+}
+
+/* Unit vectors a and b are (anti)parallel, too close to fix a rect's
+ * rotation. */
+static bool parallel(lx_vec3 a, lx_vec3 b)
+{
+    return !(lx_length(lx_cross(a, b)) > 1e-4f);
+}
+
+/* A rect's up when the file gives none: +Y, or +Z for a rect facing
+ * straight up or down. */
+static lx_vec3 default_up(lx_vec3 direction)
+{
+    lx_vec3 y = lx_v3(0.0f, 1.0f, 0.0f);
+    return parallel(y, direction) ? lx_v3(0.0f, 0.0f, 1.0f) : y;
+}
+
+/* The keys of area lights: radius (a point light given one becomes a
+ * sphere), width, height, up, samples. new_shape: the light is new or
+ * its type changed in this entry, so a rect gets the default up. */
+static lx_status read_area(const ctx *c, const cJSON *obj, bool new_shape, lx_light *l)
+{
+    lx_status st;
+    const cJSON *it;
+    if ((it = cJSON_GetObjectItemCaseSensitive(obj, "radius"))) {
+        float r;
+        if ((st = get_non_negative(c, it, "radius", &r)) != LX_OK)
+            return st;
+        if (l->type == LX_LIGHT_POINT && r > 0.0f) {
+            change_type(l, LX_LIGHT_SPHERE); /* a point light is a sphere of radius 0 */
+            new_shape = true;
+        }
+        if (l->type != LX_LIGHT_POINT && !has_radius(l->type))
+            return fail(c, LX_ERR_INVALID,
+                        "radius is for sphere, disk and point lights, not a %s light",
+                        lx_light_type_name(l->type));
+        if (has_radius(l->type) && !(r > 0.0f))
+            return fail(c, LX_ERR_INVALID, "radius %g must be above 0 for a %s light", r,
+                        lx_light_type_name(l->type));
+        if (has_radius(l->type))
+            l->radius = r;
+    }
+    static const char *const sizes[] = {"width", "height"};
+    for (int i = 0; i < 2; i++) {
+        if (!(it = cJSON_GetObjectItemCaseSensitive(obj, sizes[i])))
+            continue;
+        if (l->type != LX_LIGHT_RECT)
+            return fail(c, LX_ERR_INVALID, "%s is for rect lights, not a %s light", sizes[i],
+                        lx_light_type_name(l->type));
+        float v;
+        if ((st = get_float(c, it, sizes[i], &v)) != LX_OK)
+            return st;
+        if (!(v > 0.0f))
+            return fail(c, LX_ERR_INVALID, "%s %g must be above 0", sizes[i], v);
+        *(i == 0 ? &l->width : &l->height) = v;
+    }
+    if ((it = cJSON_GetObjectItemCaseSensitive(obj, "up"))) {
+        if (l->type != LX_LIGHT_RECT)
+            return fail(c, LX_ERR_INVALID, "up is for rect lights, not a %s light",
+                        lx_light_type_name(l->type));
+        lx_vec3 up, raw;
+        if ((st = get_unit_vec3(c, it, "up", &up, &raw)) != LX_OK)
+            return st;
+        if (parallel(up, l->direction))
+            return fail(c, LX_ERR_INVALID, "up [%g, %g, %g] is parallel to direction [%g, %g, %g]",
+                        raw.x, raw.y, raw.z, l->direction.x, l->direction.y, l->direction.z);
+        l->up = up;
+    } else if (l->type == LX_LIGHT_RECT && (new_shape || parallel(l->up, l->direction))) {
+        /* An override that turns the rect toward its old up picks the
+         * default again rather than failing. */
+        l->up = default_up(l->direction);
+    }
+    if ((it = cJSON_GetObjectItemCaseSensitive(obj, "samples"))) {
+        if (!is_area_type(l->type))
+            return fail(c, LX_ERR_INVALID,
+                        "samples is for area lights (sphere, disk, rect), not a %s light",
+                        lx_light_type_name(l->type));
+        if (!cJSON_IsNumber(it))
+            return fail(c, LX_ERR_FORMAT, "samples must be a whole number");
+        double v = it->valuedouble;
+        if (!isfinite(v) || v != floor(v))
+            return fail(c, LX_ERR_FORMAT, "samples %g is not a whole number", v);
+        if (v < 1.0 || v > (double)LX_MAX_LIGHT_SAMPLES)
+            return fail(c, LX_ERR_INVALID, "samples %g is outside 1..%u", v, LX_MAX_LIGHT_SAMPLES);
+        l->samples = (uint32_t)v;
+    }
+    return LX_OK;
+}
+
+/* The intensity of a light whose type changed between punctual (cd) and
+ * area (nt) without a new "intensity": the same candela along the axis,
+ * through the area the light shows there (pi r^2, W H). */
+static lx_status carry_intensity(const ctx *c, const lx_light *before, lx_light *l)
+{
+    lx_light_unit from = native_unit(before->type), to = native_unit(l->type);
+    if (from == to || from == LX_UNIT_LUX || to == LX_UNIT_LUX)
+        return LX_OK;
+    if (to == LX_UNIT_NIT) {
+        lx_status st = lx_light_intensity_to_native(l, before->intensity, LX_UNIT_CANDELA,
+                                                    LX_SPOT_POWER_PI, &l->intensity);
+        return st == LX_OK ? LX_OK : restate(c, st, l);
+    }
+    double area = before->type == LX_LIGHT_RECT ? (double)before->width * before->height
+                                                : LX_PI * (double)before->radius * before->radius;
+    float cd = (float)(before->intensity * area);
+    if (!isfinite(cd))
+        return fail(c, LX_ERR_INVALID, "intensity %g nt overflows as candela", before->intensity);
+    l->intensity = cd;
+    return LX_OK;
+}
+
 /* Fills out from obj; a light named like one in names (earlier in the file
  * or already in the scene) starts from that light. */
 static lx_status read_light(ctx *c, const cJSON *obj, const name_table *names,
@@ -237,6 +405,10 @@ static lx_status read_light(ctx *c, const cJSON *obj, const name_table *names,
         size_t len = strlen(c->where);
         snprintf(c->where + len, sizeof c->where - len, " ('%s')", name);
     }
+    const cJSON *type_item = cJSON_GetObjectItemCaseSensitive(obj, "type");
+    if (cJSON_IsString(type_item) && type_item->valuestring &&
+        strcmp(type_item->valuestring, "tube") == 0)
+        return fail(c, LX_ERR_UNSUPPORTED, "tube lights are not supported yet");
     if ((st = check_keys(c, obj, light_keys, COUNT(light_keys))) != LX_OK)
         return st;
 
@@ -244,21 +416,31 @@ static lx_status read_light(ctx *c, const cJSON *obj, const name_table *names,
      * the file gives change. */
     int32_t found = 0;
     bool is_override = name[0] && table_get(names, name, &found);
-    const cJSON *type_item = cJSON_GetObjectItemCaseSensitive(obj, "type");
     int type = 0;
-    if (type_item && (st = get_enum(c, type_item, "type", type_names, 3, &type)) != LX_OK)
+    if (type_item &&
+        (st = get_enum(c, type_item, "type", type_names, COUNT(type_names), &type)) != LX_OK)
         return st;
     lx_light l;
+    bool new_shape = !is_override; /* a rect then gets the default up */
     if (is_override) {
         l = found >= 0 ? pending[found] : scene->lights[-(found + 1)];
-        if (type_item)
-            l.type = (lx_light_type)type;
     } else {
         if (!type_item)
-            return fail(c, LX_ERR_FORMAT, "missing 'type' (point, spot or directional)");
+            return fail(c, LX_ERR_FORMAT,
+                        "missing 'type' (point, spot, directional, sphere, disk or rect)");
         l = lx_light_defaults((lx_light_type)type);
         memcpy(l.name, name, strlen(name) + 1);
     }
+    /* The light as it was (or a new light's defaults), for an intensity
+     * that has to follow a change between candela and nits. */
+    const lx_light before = l;
+    if (is_override && type_item && l.type != (lx_light_type)type) {
+        change_type(&l, (lx_light_type)type);
+        new_shape = true;
+    }
+    /* The type as written decides the default unit: a point light given a
+     * radius becomes a sphere below but still counts in candela. */
+    const lx_light_type written_type = l.type;
 
     const cJSON *it;
     if ((it = cJSON_GetObjectItemCaseSensitive(obj, "position"))) {
@@ -269,15 +451,9 @@ static lx_status read_light(ctx *c, const cJSON *obj, const name_table *names,
                     lx_light_type_name(l.type));
     }
     if ((it = cJSON_GetObjectItemCaseSensitive(obj, "direction"))) {
-        lx_vec3 d;
-        if ((st = get_vec3(c, it, "direction", &d)) != LX_OK)
+        if ((st = get_unit_vec3(c, it, "direction", &l.direction, NULL)) != LX_OK)
             return st;
-        /* The length in float can overflow even for finite components. */
-        double len = sqrt((double)d.x * d.x + (double)d.y * d.y + (double)d.z * d.z);
-        if (!(len > 1e-20))
-            return fail(c, LX_ERR_INVALID, "direction [%g, %g, %g] has zero length", d.x, d.y, d.z);
-        l.direction = lx_v3((float)(d.x / len), (float)(d.y / len), (float)(d.z / len));
-    } else if (!is_override && l.type != LX_LIGHT_POINT) {
+    } else if (!is_override && l.type != LX_LIGHT_POINT && l.type != LX_LIGHT_SPHERE) {
         return fail(c, LX_ERR_FORMAT, "missing 'direction' for a %s light",
                     lx_light_type_name(l.type));
     }
@@ -325,12 +501,12 @@ static lx_status read_light(ctx *c, const cJSON *obj, const name_table *names,
     }
     int e = 0;
     if ((it = cJSON_GetObjectItemCaseSensitive(obj, "shadow"))) {
-        if ((st = get_enum(c, it, "shadow", shadow_names, 3, &e)) != LX_OK)
+        if ((st = get_enum(c, it, "shadow", shadow_names, COUNT(shadow_names), &e)) != LX_OK)
             return st;
         l.shadow = (lx_shadow_mode)e;
     }
     if ((it = cJSON_GetObjectItemCaseSensitive(obj, "model"))) {
-        if ((st = get_enum(c, it, "model", model_names, 2, &e)) != LX_OK)
+        if ((st = get_enum(c, it, "model", model_names, COUNT(model_names), &e)) != LX_OK)
             return st;
         l.model = (lx_falloff_model)e;
     }
@@ -346,10 +522,23 @@ static lx_status read_light(ctx *c, const cJSON *obj, const name_table *names,
         l.dynamic = cJSON_IsTrue(it);
     }
 
-    /* Units last: lumens over a spot's cone need the final outer angle. */
+    /* Sizes before units: they need them (and a radius can make a point
+     * light a sphere). */
+    if ((st = read_area(c, obj, new_shape, &l)) != LX_OK)
+        return st;
+    bool area = is_area_type(l.type);
+    if (l.shadow == LX_SHADOW_SOFT && !area)
+        return fail(c, LX_ERR_INVALID,
+                    "shadow 'soft' needs an area light (sphere, disk, rect, or a point light with "
+                    "a radius), not a %s light",
+                    lx_light_type_name(l.type));
+
+    /* Units last: lumens over a spot's cone need the final outer angle, an
+     * area light's lumens or candela its final size. */
     lx_spot_conversion conv = LX_SPOT_POWER_PI;
     if ((it = cJSON_GetObjectItemCaseSensitive(obj, "spot_conversion"))) {
-        if ((st = get_enum(c, it, "spot_conversion", conversion_names, 2, &e)) != LX_OK)
+        if ((st = get_enum(c, it, "spot_conversion", conversion_names, COUNT(conversion_names),
+                           &e)) != LX_OK)
             return st;
         conv = (lx_spot_conversion)e;
     }
@@ -361,22 +550,28 @@ static lx_status read_light(ctx *c, const cJSON *obj, const name_table *names,
             return st;
         unit = lx_light_unit_from_string(s);
         if (unit == LX_UNIT_DEFAULT)
-            return fail(c, LX_ERR_FORMAT, "unknown unit '%.40s' (expected cd, lm, W or lx)", s);
+            return fail(c, LX_ERR_FORMAT, "unknown unit '%.40s' (expected cd, lm, W, lx or nt)", s);
     }
     if ((it = cJSON_GetObjectItemCaseSensitive(obj, "intensity"))) {
         float value;
         if ((st = get_non_negative(c, it, "intensity", &value)) != LX_OK)
             return st;
-        if (unit == LX_UNIT_LUX && l.type != LX_LIGHT_DIRECTIONAL)
-            return fail(c, LX_ERR_INVALID, "unit: %s lights take cd, lm or W, not lx",
-                        lx_light_type_name(l.type));
+        if ((unit == LX_UNIT_LUX || (unit == LX_UNIT_NIT && !area)) &&
+            l.type != LX_LIGHT_DIRECTIONAL)
+            return fail(c, LX_ERR_INVALID, "unit: %s lights take %s, not %s",
+                        lx_light_type_name(l.type), area ? "nt, cd, lm or W" : "cd, lm or W",
+                        lx_light_unit_symbol(unit));
         if (unit != LX_UNIT_DEFAULT && unit != LX_UNIT_LUX && l.type == LX_LIGHT_DIRECTIONAL)
             return fail(c, LX_ERR_INVALID, "unit: directional lights take lux, not %s",
                         lx_light_unit_symbol(unit));
+        if (unit == LX_UNIT_DEFAULT)
+            unit = native_unit(written_type);
         if ((st = lx_light_intensity_to_native(&l, value, unit, conv, &l.intensity)) != LX_OK)
             return restate(c, st, &l);
     } else if (unit_item) {
         return fail(c, LX_ERR_FORMAT, "'unit' is given without 'intensity'");
+    } else if ((st = carry_intensity(c, &before, &l)) != LX_OK) {
+        return st;
     }
 
     if ((st = lx_light_validate(&l)) != LX_OK)

@@ -1,7 +1,9 @@
 /* Tests of the lights JSON reader (src/scene/lights_json.c, the schema of
  * docs/lights-json.md): the documented example with its unit and angle
- * conversions worked out here, overrides by name, and every malformed
- * input failing with a message that names the file, light and field. */
+ * conversions worked out here, issue 3's area lights with their luminance
+ * computed here from the issue's formulas, overrides by name, and every
+ * malformed input failing with a message that names the file, light and
+ * field. */
 #define _POSIX_C_SOURCE 200809L
 #include <stdarg.h>
 #include <stddef.h>
@@ -198,7 +200,7 @@ static const bad_case bad_cases[] = {
      LX_ERR_FORMAT, "lights.json: lights[2]: unknown key 'intesity'"},
     {"{\"light\": []}", LX_ERR_FORMAT, "lights.json: unknown key 'light'"},
     {"{\"lights\": [{\"type\": \"area\", \"position\": [0,0,0]}]}", LX_ERR_FORMAT,
-     "lights[0]: unknown type 'area'"},
+     "lights[0]: unknown type 'area' (expected point, spot, directional, sphere, disk, rect)"},
     {"{\"lights\": [{\"type\": \"point\", \"position\": [0,0,0], \"intensity\": 1e999}]}",
      LX_ERR_FORMAT, "lights[0]: intensity is not a finite number"},
     {"{\"lights\": [{\"type\": \"point\", \"position\": [0,-1e999,0]}]}", LX_ERR_FORMAT,
@@ -239,9 +241,9 @@ static const bad_case bad_cases[] = {
     {"{\"ambient\": [0, -0.1, 0]}", LX_ERR_INVALID, "ambient [0, -0.1, 0]"},
     {"{\"lights\": [{\"type\": \"point\", \"position\": [0,0,0], \"intensity\": 1, "
      "\"unit\": \"kW\"}]}",
-     LX_ERR_FORMAT, "unknown unit 'kW'"},
-    {"{\"lights\": [{\"type\": \"point\", \"position\": [0,0,0], \"shadow\": \"soft\"}]}",
-     LX_ERR_FORMAT, "unknown shadow 'soft' (expected hard, none, blur)"},
+     LX_ERR_FORMAT, "unknown unit 'kW' (expected cd, lm, W, lx or nt)"},
+    {"{\"lights\": [{\"type\": \"point\", \"position\": [0,0,0], \"shadow\": \"sharp\"}]}",
+     LX_ERR_FORMAT, "unknown shadow 'sharp' (expected hard, none, blur, soft)"},
     {"{\"lights\": [{\"type\": \"point\", \"position\": [0,0,0], \"model\": \"fancy\"}]}",
      LX_ERR_FORMAT, "unknown model 'fancy'"},
     {"{\"lights\": [{\"type\": \"spot\", \"position\": [0,0,0], \"direction\": [0,-1,0], "
@@ -278,6 +280,82 @@ static const bad_case bad_cases[] = {
     {"{\"lights\": [{\"name\": \"0123456789012345678901234567890123456789012345678901234567890"
      "123456789\", \"type\": \"point\", \"position\": [0,0,0]}]}",
      LX_ERR_INVALID, "is longer than 63 bytes"},
+    /* area lights (issue 3) */
+    {"{\"lights\": [{\"type\": \"tube\", \"position\": [0, 2, 0], \"direction\": [1, 0, 0], "
+     "\"length\": 1.2, \"radius\": 0.02, \"intensity\": 3000, \"unit\": \"lm\"}]}",
+     LX_ERR_UNSUPPORTED, "lights.json: lights[0]: tube lights are not supported yet"},
+    {"{\"lights\": [{\"name\": \"ball\", \"type\": \"sphere\", \"position\": [0,0,0], "
+     "\"radius\": -0.1}]}",
+     LX_ERR_INVALID, "lights.json: lights[0] ('ball'): radius -0.1 is negative"},
+    {"{\"lights\": [{\"type\": \"point\", \"position\": [0,0,0], \"radius\": -1}]}", LX_ERR_INVALID,
+     "lights[0]: radius -1 is negative"},
+    {"{\"lights\": [{\"type\": \"disk\", \"position\": [0,0,0], \"direction\": [0,-1,0], "
+     "\"radius\": 0}]}",
+     LX_ERR_INVALID, "lights[0]: radius 0 must be above 0 for a disk light"},
+    {"{\"lights\": [{\"type\": \"sphere\", \"position\": [0,0,0], \"radius\": 1e999}]}",
+     LX_ERR_FORMAT, "lights[0]: radius is not a finite number"},
+    {"{\"lights\": [{\"type\": \"sphere\", \"position\": [0,0,0], \"radius\": \"big\"}]}",
+     LX_ERR_FORMAT, "lights[0]: radius must be a number"},
+    {"{\"lights\": [{\"type\": \"rect\", \"position\": [0,0,0], \"direction\": [0,-1,0], "
+     "\"width\": 0, \"height\": 1}]}",
+     LX_ERR_INVALID, "lights[0]: width 0 must be above 0"},
+    {"{\"lights\": [{\"type\": \"rect\", \"position\": [0,0,0], \"direction\": [0,-1,0], "
+     "\"width\": 1, \"height\": -0.5}]}",
+     LX_ERR_INVALID, "lights[0]: height -0.5 must be above 0"},
+    {"{\"lights\": [{\"name\": \"panel\", \"type\": \"rect\", \"position\": [0,0,0], "
+     "\"direction\": [0,-1,0], \"up\": [0,2,0]}]}",
+     LX_ERR_INVALID, "lights[0] ('panel'): up [0, 2, 0] is parallel to direction [0, -1, 0]"},
+    {"{\"lights\": [{\"type\": \"rect\", \"position\": [0,0,0], \"direction\": [0,-1,0], "
+     "\"up\": [0,0,0]}]}",
+     LX_ERR_INVALID, "lights[0]: up [0, 0, 0] has zero length"},
+    {"{\"lights\": [{\"type\": \"rect\", \"position\": [0,0,0], \"direction\": [0,-1,0], "
+     "\"up\": [0,1]}]}",
+     LX_ERR_FORMAT, "lights[0]: up must be an array of 3 numbers, not 2"},
+    {"{\"lights\": [{\"type\": \"sphere\", \"position\": [0,0,0], \"samples\": 0}]}",
+     LX_ERR_INVALID, "lights[0]: samples 0 is outside 1..1024"},
+    {"{\"lights\": [{\"type\": \"sphere\", \"position\": [0,0,0], \"samples\": 5000}]}",
+     LX_ERR_INVALID, "lights[0]: samples 5000 is outside 1..1024"},
+    {"{\"lights\": [{\"type\": \"sphere\", \"position\": [0,0,0], \"samples\": 2.5}]}",
+     LX_ERR_FORMAT, "lights[0]: samples 2.5 is not a whole number"},
+    {"{\"lights\": [{\"type\": \"sphere\", \"position\": [0,0,0], \"samples\": \"16\"}]}",
+     LX_ERR_FORMAT, "lights[0]: samples must be a whole number"},
+    {"{\"lights\": [{\"name\": \"bulb\", \"type\": \"point\", \"position\": [0,0,0], "
+     "\"shadow\": \"soft\"}]}",
+     LX_ERR_INVALID, "lights[0] ('bulb'): shadow 'soft' needs an area light"},
+    {"{\"lights\": [{\"type\": \"spot\", \"position\": [0,0,0], \"direction\": [0,-1,0], "
+     "\"shadow\": \"soft\"}]}",
+     LX_ERR_INVALID, "not a spot light"},
+    {"{\"lights\": [{\"type\": \"point\", \"position\": [0,0,0], \"radius\": 0, "
+     "\"shadow\": \"soft\"}]}",
+     LX_ERR_INVALID, "shadow 'soft' needs an area light"},
+    {"{\"lights\": [{\"type\": \"spot\", \"position\": [0,0,0], \"direction\": [0,-1,0], "
+     "\"radius\": 0.1}]}",
+     LX_ERR_INVALID, "lights[0]: radius is for sphere, disk and point lights, not a spot light"},
+    {"{\"lights\": [{\"type\": \"rect\", \"position\": [0,0,0], \"direction\": [0,-1,0], "
+     "\"radius\": 0.1}]}",
+     LX_ERR_INVALID, "radius is for sphere, disk and point lights, not a rect light"},
+    {"{\"lights\": [{\"type\": \"disk\", \"position\": [0,0,0], \"direction\": [0,-1,0], "
+     "\"width\": 1}]}",
+     LX_ERR_INVALID, "lights[0]: width is for rect lights, not a disk light"},
+    {"{\"lights\": [{\"type\": \"sphere\", \"position\": [0,0,0], \"up\": [0,1,0]}]}",
+     LX_ERR_INVALID, "lights[0]: up is for rect lights, not a sphere light"},
+    {"{\"lights\": [{\"type\": \"point\", \"position\": [0,0,0], \"samples\": 8}]}", LX_ERR_INVALID,
+     "samples is for area lights (sphere, disk, rect), not a point light"},
+    {"{\"lights\": [{\"type\": \"disk\", \"position\": [0,0,0], \"radius\": 0.1}]}", LX_ERR_FORMAT,
+     "lights[0]: missing 'direction' for a disk light"},
+    {"{\"lights\": [{\"type\": \"rect\", \"direction\": [0,-1,0]}]}", LX_ERR_FORMAT,
+     "lights[0]: missing 'position' for a rect light"},
+    {"{\"lights\": [{\"type\": \"sphere\", \"position\": [0,0,0], \"intensity\": 5, "
+     "\"unit\": \"lx\"}]}",
+     LX_ERR_INVALID, "lights[0]: unit: sphere lights take nt, cd, lm or W, not lx"},
+    {"{\"lights\": [{\"type\": \"point\", \"position\": [0,0,0], \"intensity\": 5, "
+     "\"unit\": \"nt\"}]}",
+     LX_ERR_INVALID, "lights[0]: unit: point lights take cd, lm or W, not nt"},
+    {"{\"lights\": [{\"type\": \"directional\", \"direction\": [0,-1,0], \"intensity\": 5, "
+     "\"unit\": \"nits\"}]}",
+     LX_ERR_INVALID, "lights[0]: unit: directional lights take lux, not nt"},
+    {"{\"lights\": [{\"type\": \"sphere\", \"position\": [0,0,0], \"intensity\": -5}]}",
+     LX_ERR_INVALID, "lights[0]: intensity -5 is negative"},
 };
 
 static void test_bad_input(void **state)
@@ -375,6 +453,192 @@ static void test_colour_forms(void **state)
     }
 }
 
+/* Issue 3's area lights: luminance from lumens and watts by the issue's
+ * formulas (sphere P / (4 pi^2 r^2), disk P / (pi^2 r^2), rect P / (pi W
+ * H), 683 lm/W), from candela through the area facing the axis, nits as
+ * is. */
+static void test_area_lights(void **state)
+{
+    (void)state;
+    lx_scene *s = new_scene();
+    assert_int_equal(
+        apply(s, "{\"lights\": ["
+                 "{\"type\": \"sphere\", \"position\": [1, 1, 0], \"radius\": 0.1, "
+                 "\"intensity\": 1000, \"unit\": \"lm\", \"shadow\": \"soft\", \"samples\": 64},"
+                 "{\"type\": \"disk\", \"position\": [0, 3, 0], \"direction\": [0, -1, 0], "
+                 "\"radius\": 0.3, \"intensity\": 2000, \"unit\": \"lm\"},"
+                 "{\"type\": \"rect\", \"position\": [0, 2.5, 0], \"direction\": [0, -1, 0], "
+                 "\"up\": [0, 0, 1], \"width\": 1.0, \"height\": 0.5, \"intensity\": 40, "
+                 "\"unit\": \"W\"}]}"),
+        LX_OK);
+    assert_int_equal(s->light_count, 3);
+    const lx_light *sp = &s->lights[0];
+    assert_int_equal(sp->type, LX_LIGHT_SPHERE);
+    assert_vec(sp->position, 1, 1, 0);
+    assert_true(sp->radius == 0.1f);
+    assert_rel(sp->intensity, 1000.0 / (4.0 * PI_D * PI_D * 0.01), 1e-5);
+    assert_int_equal(sp->shadow, LX_SHADOW_SOFT);
+    assert_int_equal(sp->samples, 64);
+
+    const lx_light *d = &s->lights[1];
+    assert_int_equal(d->type, LX_LIGHT_DISK);
+    assert_vec(d->position, 0, 3, 0);
+    assert_vec(d->direction, 0, -1, 0);
+    assert_true(d->radius == 0.3f);
+    assert_rel(d->intensity, 2000.0 / (PI_D * PI_D * 0.09), 1e-5);
+    assert_int_equal(d->shadow, LX_SHADOW_HARD); /* the default: one ray to the centre */
+    assert_int_equal(d->samples, 0);
+
+    const lx_light *r = &s->lights[2];
+    assert_int_equal(r->type, LX_LIGHT_RECT);
+    assert_vec(r->position, 0, 2.5, 0);
+    assert_vec(r->direction, 0, -1, 0);
+    assert_vec(r->up, 0, 0, 1);
+    assert_true(r->width == 1.0f && r->height == 0.5f);
+    assert_rel(r->intensity, 40.0 * 683.0 / (PI_D * 0.5), 1e-5);
+    lx_scene_destroy(s);
+
+    /* Nits by default and by name; candela over pi r^2 and W H; the rect's
+     * default up (+Y, or +Z when it faces straight up or down) and a
+     * given up normalized; a sphere needs no direction; sizes default to
+     * 10 cm. */
+    s = new_scene();
+    assert_int_equal(
+        apply(s, "{\"lights\": ["
+                 "{\"type\": \"sphere\", \"position\": [0, 1, 0], \"radius\": 0.2, "
+                 "\"intensity\": 5000},"
+                 "{\"type\": \"disk\", \"position\": [0, 1, 0], \"direction\": [0, -1, 0], "
+                 "\"radius\": 0.5, \"intensity\": 5000, \"unit\": \"nits\"},"
+                 "{\"type\": \"disk\", \"position\": [0, 1, 0], \"direction\": [1, 0, 0], "
+                 "\"radius\": 0.5, \"intensity\": 100, \"unit\": \"cd\"},"
+                 "{\"type\": \"rect\", \"position\": [0, 1, 0], \"direction\": [0, 0, -2], "
+                 "\"width\": 2, \"height\": 0.5, \"intensity\": 10, \"unit\": \"cd\"},"
+                 "{\"type\": \"rect\", \"position\": [0, 1, 0], \"direction\": [0, 2, 0]},"
+                 "{\"type\": \"rect\", \"position\": [0, 1, 0], \"direction\": [1, 0, 0], "
+                 "\"up\": [0, 0, 3], \"width\": 1, \"height\": 1, \"intensity\": 10, "
+                 "\"unit\": \"lm\"},"
+                 "{\"type\": \"sphere\", \"position\": [0, 1, 0], \"shadow\": \"soft\"}]}"),
+        LX_OK);
+    assert_int_equal(s->light_count, 7);
+    assert_true(s->lights[0].intensity == 5000.0f);
+    assert_true(s->lights[1].intensity == 5000.0f);
+    assert_rel(s->lights[2].intensity, 100.0 / (PI_D * 0.25), 1e-5);
+    assert_vec(s->lights[3].direction, 0, 0, -1);
+    assert_vec(s->lights[3].up, 0, 1, 0);
+    assert_rel(s->lights[3].intensity, 10.0 / (2.0 * 0.5), 1e-6);
+    assert_vec(s->lights[4].up, 0, 0, 1);
+    assert_true(s->lights[4].width == 0.1f && s->lights[4].height == 0.1f);
+    assert_true(s->lights[4].intensity == 1.0f);
+    assert_vec(s->lights[5].up, 0, 0, 1);
+    assert_rel(s->lights[5].intensity, 10.0 / PI_D, 1e-6);
+    assert_int_equal(s->lights[6].type, LX_LIGHT_SPHERE);
+    assert_true(s->lights[6].radius == 0.1f);
+    assert_int_equal(s->lights[6].shadow, LX_SHADOW_SOFT);
+    assert_int_equal(s->lights[6].samples, 0); /* 0: the library's default count */
+    lx_scene_destroy(s);
+}
+
+/* A point light is a sphere of radius 0 (seed 001): given a radius above 0
+ * it becomes a sphere whose intensity keeps the point light's units (cd
+ * by default: luminance I / (pi r^2); lumens: P / (4 pi^2 r^2)); a radius
+ * of 0 leaves it a point light. */
+static void test_point_with_radius(void **state)
+{
+    (void)state;
+    lx_scene *s = new_scene();
+    assert_int_equal(apply(s, "{\"lights\": ["
+                              "{\"type\": \"point\", \"position\": [0, 2, 0], \"radius\": 0.05, "
+                              "\"intensity\": 800, \"shadow\": \"soft\", \"samples\": 8},"
+                              "{\"type\": \"point\", \"position\": [0, 2, 0], \"radius\": 0.1, "
+                              "\"intensity\": 1000, \"unit\": \"lm\"},"
+                              "{\"type\": \"point\", \"position\": [0, 2, 0], \"radius\": 0, "
+                              "\"intensity\": 800},"
+                              "{\"type\": \"point\", \"position\": [0, 2, 0], \"radius\": 0.5}]}"),
+                     LX_OK);
+    assert_int_equal(s->light_count, 4);
+    assert_int_equal(s->lights[0].type, LX_LIGHT_SPHERE);
+    assert_vec(s->lights[0].position, 0, 2, 0);
+    assert_true(s->lights[0].radius == 0.05f);
+    assert_rel(s->lights[0].intensity, 800.0 / (PI_D * 0.0025), 1e-5);
+    assert_int_equal(s->lights[0].shadow, LX_SHADOW_SOFT);
+    assert_int_equal(s->lights[0].samples, 8);
+    assert_int_equal(s->lights[1].type, LX_LIGHT_SPHERE);
+    assert_rel(s->lights[1].intensity, 1000.0 / (4.0 * PI_D * PI_D * 0.01), 1e-5);
+    assert_int_equal(s->lights[2].type, LX_LIGHT_POINT);
+    assert_true(s->lights[2].intensity == 800.0f);
+    /* no intensity: the point light's default 1 cd */
+    assert_int_equal(s->lights[3].type, LX_LIGHT_SPHERE);
+    assert_rel(s->lights[3].intensity, 1.0 / (PI_D * 0.25), 1e-5);
+    lx_scene_destroy(s);
+}
+
+/* Overrides by name on area lights: a scene's point light given a radius
+ * becomes a sphere with the same candela (luminance I / (pi r^2)); only the
+ * given keys change; back to a point light, the candela is L pi r^2; a
+ * rect turned toward its old up takes the default up. */
+static void test_area_override(void **state)
+{
+    (void)state;
+    lx_scene *s = new_scene();
+    lx_light lamp = lx_light_defaults(LX_LIGHT_POINT);
+    strcpy(lamp.name, "lamp");
+    lamp.position = lx_v3(1, 2, 3);
+    lamp.intensity = 800.0f;
+    assert_int_equal(lx_scene_add_light(s, &lamp), LX_OK);
+
+    assert_int_equal(apply(s, "{\"lights\": [{\"name\": \"lamp\", \"radius\": 0.05, "
+                              "\"shadow\": \"soft\", \"samples\": 32}]}"),
+                     LX_OK);
+    assert_int_equal(s->light_count, 1);
+    const lx_light *l = &s->lights[0];
+    assert_int_equal(l->type, LX_LIGHT_SPHERE);
+    assert_vec(l->position, 1, 2, 3);
+    assert_true(l->radius == 0.05f);
+    double nits = 800.0 / (PI_D * 0.0025);
+    assert_rel(l->intensity, nits, 1e-5);
+    assert_int_equal(l->shadow, LX_SHADOW_SOFT);
+    assert_int_equal(l->samples, 32);
+
+    /* A new radius keeps the luminance. */
+    assert_int_equal(apply(s, "{\"lights\": [{\"name\": \"lamp\", \"radius\": 0.1}]}"), LX_OK);
+    assert_true(l->radius == 0.1f);
+    assert_rel(l->intensity, nits, 1e-5);
+    assert_int_equal(l->samples, 32);
+
+    /* Back to a point light: soft shadows must go too. */
+    assert_int_equal(apply(s, "{\"lights\": [{\"name\": \"lamp\", \"type\": \"point\"}]}"),
+                     LX_ERR_INVALID);
+    assert_non_null(
+        strstr(lx_last_error(), "lights[0] ('lamp'): shadow 'soft' needs an area light"));
+    assert_int_equal(l->type, LX_LIGHT_SPHERE);
+    assert_int_equal(apply(s, "{\"lights\": [{\"name\": \"lamp\", \"type\": \"point\", "
+                              "\"shadow\": \"hard\"}]}"),
+                     LX_OK);
+    assert_int_equal(l->type, LX_LIGHT_POINT);
+    assert_true(l->radius == 0.0f);
+    assert_rel(l->intensity, nits * PI_D * 0.01, 1e-5); /* 3200 cd */
+
+    /* A rect turned to face along its old up. */
+    assert_int_equal(apply(s, "{\"lights\": [{\"name\": \"panel\", \"type\": \"rect\", "
+                              "\"position\": [0, 2, 0], \"direction\": [0, -1, 0], "
+                              "\"width\": 2, \"height\": 1, \"intensity\": 100}]}"),
+                     LX_OK);
+    const lx_light *r = &s->lights[1];
+    assert_vec(r->up, 0, 0, 1);
+    assert_int_equal(apply(s, "{\"lights\": [{\"name\": \"panel\", \"width\": 3}]}"), LX_OK);
+    assert_true(r->width == 3.0f && r->height == 1.0f && r->intensity == 100.0f);
+    assert_vec(r->up, 0, 0, 1);
+    assert_int_equal(apply(s, "{\"lights\": [{\"name\": \"panel\", \"direction\": [0, 0, 1]}]}"),
+                     LX_OK);
+    assert_vec(r->direction, 0, 0, 1);
+    assert_vec(r->up, 0, 1, 0);
+    assert_int_equal(apply(s, "{\"lights\": [{\"name\": \"panel\", \"up\": [0, 0, -1]}]}"),
+                     LX_ERR_INVALID);
+    assert_non_null(strstr(lx_last_error(), "('panel'): up [0, 0, -1] is parallel to direction"));
+    assert_vec(r->up, 0, 1, 0);
+    lx_scene_destroy(s);
+}
+
 static const char *tmp_dir(void)
 {
     const char *dir = getenv("LX_TEST_TMP");
@@ -422,10 +686,12 @@ static void test_file(void **state)
 int main(void)
 {
     const struct CMUnitTest tests[] = {
-        cmocka_unit_test(test_example),   cmocka_unit_test(test_units),
-        cmocka_unit_test(test_override),  cmocka_unit_test(test_bad_input),
-        cmocka_unit_test(test_bad_bytes), cmocka_unit_test(test_all_or_nothing),
-        cmocka_unit_test(test_file),      cmocka_unit_test(test_colour_forms),
+        cmocka_unit_test(test_example),       cmocka_unit_test(test_units),
+        cmocka_unit_test(test_override),      cmocka_unit_test(test_bad_input),
+        cmocka_unit_test(test_bad_bytes),     cmocka_unit_test(test_all_or_nothing),
+        cmocka_unit_test(test_file),          cmocka_unit_test(test_colour_forms),
+        cmocka_unit_test(test_area_lights),   cmocka_unit_test(test_point_with_radius),
+        cmocka_unit_test(test_area_override),
     };
     return cmocka_run_group_tests(tests, NULL, NULL);
 }
