@@ -696,3 +696,51 @@ lx_status lx_gltf_lights_load(lx_scene *scene, const char *path)
     free(json);
     return st;
 }
+
+lx_status lx_glb_check_file(const char *path)
+{
+    FILE *fp = fopen(path, "rb");
+    if (!fp)
+        return failf(path, LX_ERR_IO, "cannot open: %s", strerror(errno));
+    uint8_t head[12];
+    size_t got = fread(head, 1, sizeof head, fp);
+    lx_status st = LX_OK;
+    if (fseek(fp, 0, SEEK_END) != 0) {
+        fclose(fp);
+        return failf(path, LX_ERR_IO, "cannot seek");
+    }
+    long total = ftell(fp);
+    if (got < sizeof head || total < (long)sizeof head) {
+        fclose(fp);
+        return failf(path, LX_ERR_FORMAT, "truncated GLB: %ld bytes, the header needs 12",
+                     total < 0 ? 0L : total);
+    }
+    if (le32(head) != LX_GLB_MAGIC)
+        st = failf(path, LX_ERR_FORMAT, "not a GLB file (bad magic)");
+    else if (le32(head + 4) != 2)
+        st = failf(path, LX_ERR_UNSUPPORTED, "GLB version %u (only version 2 is supported)",
+                   le32(head + 4));
+    else if ((uint64_t)le32(head + 8) > (uint64_t)total)
+        st = failf(path, LX_ERR_FORMAT, "truncated GLB: the header says %u bytes, the file has %ld",
+                   le32(head + 8), total);
+    /* walk the chunks: each length must fit in what the header declares */
+    uint64_t length = le32(head + 8), pos = LX_GLB_HEADER;
+    for (int chunk = 0; st == LX_OK && pos < length; chunk++) {
+        uint8_t ch[LX_GLB_CHUNK_HEADER];
+        if (length - pos < LX_GLB_CHUNK_HEADER || fseek(fp, (long)pos, SEEK_SET) != 0 ||
+            fread(ch, 1, sizeof ch, fp) != sizeof ch) {
+            st = failf(path, LX_ERR_FORMAT, "truncated GLB: chunk %d header is cut", chunk);
+            break;
+        }
+        uint64_t len = le32(ch);
+        if (len > length - pos - LX_GLB_CHUNK_HEADER) {
+            st = failf(path, LX_ERR_FORMAT,
+                       "truncated GLB: chunk %d of %llu bytes runs past the end (%llu bytes)",
+                       chunk, (unsigned long long)len, (unsigned long long)length);
+            break;
+        }
+        pos += LX_GLB_CHUNK_HEADER + len;
+    }
+    fclose(fp);
+    return st;
+}

@@ -5,6 +5,8 @@
  * drops their units and range. */
 #include "luxel/scene.h"
 
+#include "json_text.h"
+
 #include <assimp/cimport.h>
 #include <assimp/GltfMaterial.h>
 #include <assimp/config.h>
@@ -437,6 +439,11 @@ lx_status lx_scene_load(const char *path, const lx_scene_load_desc *desc, lx_sce
 
     if (has_extension(path, ".obj")) {
         lx_status st = check_obj_numbers(path);
+        if (st != LX_OK)
+            return st;
+    }
+    if (has_extension(path, ".glb")) {
+        lx_status st = lx_glb_check_file(path);
         if (st != LX_OK)
             return st;
     }

@@ -21,4 +21,9 @@ lx_status lx_json_fail(lx_status status, const char *file, const char *where, co
 #endif
     ;
 
+/* Checks a .glb file's container before anything parses it: the 12-byte
+ * header (magic, version 2, a length that fits the file) and every chunk's
+ * length, so no reader allocates what a forged header claims. */
+lx_status lx_glb_check_file(const char *path);
+
 #endif

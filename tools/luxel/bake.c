@@ -381,10 +381,6 @@ static bool stage_add(staging *st, const char *name)
     st->names[st->count] = lx_strdup(name);
     if (!st->names[st->count])
         return false;
-    char *path = lx_path_join(st->dir, name);
-    if (path)
-        cli_track_output(path);
-    free(path);
     st->count++;
     return true;
 }
@@ -397,6 +393,9 @@ static bool stage_image(staging *st, const char *output, const char *name, const
         cli_error("out of memory");
         return false;
     }
+    /* tracked before it exists: an interrupt right after the rename that
+     * completes the file still finds it */
+    cli_track_output(path);
     lx_status s = lx_image_write(path, img, desc);
     free(path);
     if (s != LX_OK) {
@@ -413,6 +412,7 @@ static bool stage_text(staging *st, const char *output, const char *name, const 
         cli_error("out of memory");
         return false;
     }
+    cli_track_output(path);
     lx_status s = write_text(path, text);
     free(path);
     if (s != LX_OK) {
