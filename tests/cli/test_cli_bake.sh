@@ -299,4 +299,26 @@ check "pre-exposed values = values / 1.2 on every texel" \
 run "$LUXEL" bake "$ROOM" --resolution 32 -q -o "$WORK/pre_bad" --pre-expose
 expect_rc 2 "--pre-expose without --exposure"
 
+
+# Area lights end to end: a soft-shadowed rect replaces the ceiling lamp by
+# name; 40 W over 1 m x 0.5 m is 40 * 683 / (pi * 0.5) = 17392.5 nt.
+cat >"$WORK/soft.json" <<'JSON'
+{"lights": [
+  {"name": "ceiling_lamp", "type": "rect", "position": [0, 2.95, 0], "direction": [0, -1, 0],
+   "up": [0, 0, 1], "width": 1.0, "height": 0.5, "intensity": 40, "unit": "W",
+   "shadow": "soft", "samples": 16},
+  {"type": "sphere", "position": [1, 1, 0], "radius": 0.1, "intensity": 1000, "unit": "lm",
+   "shadow": "soft", "samples": 16}]}
+JSON
+run "$LUXEL" info "$ROOM" --lights "$WORK/soft.json"
+expect_rc 0 "info with area lights"
+expect_stdout_has "info: the rect in nits" 'rect +ceiling_lamp +17392.5 nt'
+expect_stdout_has "info: the sphere" 'sphere'
+run "$LUXEL" bake "$ROOM" --resolution 32 --format pfm -q -o "$WORK/soft" --lights "$WORK/soft.json"
+expect_rc 0 "bake with soft area lights"
+check "soft bake: every lightmap written" test -s "$WORK/soft/room.pfm" -a -s "$WORK/soft/tall_box.pfm"
+run "$LUXEL" bake "$ROOM" --resolution 32 --format pfm -q -o "$WORK/soft2" --threads 1 \
+    --lights "$WORK/soft.json"
+check "soft bake: the same bytes with 1 thread" cmp -s "$WORK/soft/room.pfm" "$WORK/soft2/room.pfm"
+
 finish
