@@ -94,10 +94,17 @@ typedef struct lx_light {
     lx_vec3 ambient;       /* lux added everywhere in range, falling off with range */
     bool dynamic;          /* re-evaluated by lx_baker_update instead of baked */
     /* area lights (sphere, disk, rect); direction is the emitting side */
-    float radius;          /* metres: sphere, disk */
-    float width, height;   /* metres: rect, width along cross(up, direction) */
-    lx_vec3 up;            /* rect: fixes its rotation about direction */
-    uint32_t samples;      /* soft shadows: points on the light per texel, 0 = 16 */
+    float radius;        /* metres: sphere, disk */
+    float width, height; /* metres: rect, width along cross(up, direction) */
+    lx_vec3 up;          /* rect: fixes its rotation about direction */
+    uint32_t samples;    /* soft shadows: points on the light per texel, 0 = 16 */
+    /* photometric profile (point and spot): candela toward a direction is
+     * the profile's value times profile_scale; its 0 deg vertical angle
+     * points along direction, its 0 deg horizontal plane toward up (and
+     * 90 deg toward cross(direction, up)). Borrowed: whoever sets it keeps
+     * the profile alive (lx_ies_retain) while the light is used. */
+    const struct lx_ies_profile *profile;
+    float profile_scale;
 } lx_light;
 
 #define LX_MAX_LIGHT_SAMPLES 1024u
@@ -187,7 +194,10 @@ typedef struct lx_ies_profile lx_ies_profile;
 lx_status lx_ies_load(const char *path, lx_ies_profile **out);
 /* Same from text in memory; name is used in messages. */
 lx_status lx_ies_parse(const char *text, size_t size, const char *name, lx_ies_profile **out);
+/* Drops one reference; the profile is freed with the last. */
 void lx_ies_free(lx_ies_profile *profile);
+/* Adds a reference (for a second owner, such as a baker); returns profile. */
+lx_ies_profile *lx_ies_retain(const lx_ies_profile *profile);
 
 /* Candela toward (vertical, horizontal) in degrees, interpolated between
  * the file's angles and extended by its horizontal symmetry. */

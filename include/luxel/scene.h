@@ -79,9 +79,11 @@ typedef struct lx_scene {
     uint32_t node_count;
     lx_light *lights;
     uint32_t light_count;
-    lx_vec3 ambient; /* constant scene ambient (lux) */
+    lx_vec3 ambient;           /* constant scene ambient (lux) */
+    lx_ies_profile **profiles; /* photometric profiles the lights point to */
+    uint32_t profile_count;
     /* internal bookkeeping for growth; do not touch */
-    uint32_t mesh_capacity, material_capacity, node_capacity, light_capacity;
+    uint32_t mesh_capacity, material_capacity, node_capacity, light_capacity, profile_capacity;
 } lx_scene;
 
 typedef struct lx_scene_load_desc {
@@ -106,6 +108,9 @@ lx_status lx_scene_add_material(lx_scene *scene, const lx_material *material, ui
 /* Adds a node placing meshes with world; name must be unique. */
 lx_status lx_scene_add_node(lx_scene *scene, const char *name, const lx_mat4 *world,
                             const uint32_t *meshes, uint32_t mesh_count, uint32_t *index);
+/* The scene takes over one reference to profile (freed with the scene), so
+ * its lights may point to it. */
+lx_status lx_scene_adopt_profile(lx_scene *scene, lx_ies_profile *profile);
 /* Adds a copy of light after validating it; a light whose name matches an
  * existing light's replaces it. */
 lx_status lx_scene_add_light(lx_scene *scene, const lx_light *light);

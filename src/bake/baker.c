@@ -73,6 +73,9 @@ lx_status lx_baker_create(const lx_scene *scene, const lx_bake_desc *in, lx_bake
     }
     if (scene->light_count)
         memcpy(b->lights, scene->lights, sizeof(lx_light) * scene->light_count);
+    /* the baker outlives the scene: it keeps its own hold on profiles */
+    for (uint32_t l = 0; l < b->light_count; l++)
+        lx_ies_retain(b->lights[l].profile);
 
     lx_vec3 lo, hi;
     b->scene_diagonal = lx_scene_bounds(scene, &lo, &hi) ? lx_length(lx_sub(hi, lo)) : 1.0f;
@@ -139,6 +142,8 @@ void lx_baker_destroy(lx_baker *b)
     free(b->maps);
     free(b->node_map);
     free(b->node_world);
+    for (uint32_t l = 0; b->lights && l < b->light_count; l++)
+        lx_ies_free((lx_ies_profile *)b->lights[l].profile);
     free(b->lights);
     free(b);
 }
@@ -175,6 +180,8 @@ lx_status lx_baker_set_light(lx_baker *b, uint32_t light, const lx_light *value)
     lx_status st = lx_light_validate(value);
     if (st != LX_OK)
         return st;
+    lx_ies_retain(value->profile);
+    lx_ies_free((lx_ies_profile *)b->lights[light].profile);
     b->lights[light] = *value;
     return LX_OK;
 }

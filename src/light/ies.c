@@ -48,6 +48,7 @@ struct lx_ies_profile {
     float *cd;    /* nh planes of nv values, scaled */
     lx_ies_symmetry symmetry;
     float peak;
+    int refs; /* owners: lx_ies_retain adds one, lx_ies_free drops one */
 };
 
 /* ---- the number stream --------------------------------------------------- */
@@ -447,6 +448,8 @@ lx_status lx_ies_parse(const char *text, size_t size, const char *name, lx_ies_p
         return lx_fail(LX_ERR_FORMAT, "%s: %zu bytes, more than the %u allowed for an IES file",
                        name, size, IES_MAX_FILE_SIZE);
     lx_ies_profile *p = calloc(1, sizeof *p);
+    if (p)
+        p->refs = 1;
     if (!p)
         return lx_fail(LX_ERR_NOMEM, "%s: out of memory", name);
     ies_reader r = {.p = text, .end = text + size, .name = name, .line = 1, .tok_line = 1};
@@ -474,9 +477,19 @@ lx_status lx_ies_load(const char *path, lx_ies_profile **out)
     return st;
 }
 
+lx_ies_profile *lx_ies_retain(const lx_ies_profile *profile)
+{
+    lx_ies_profile *p = (lx_ies_profile *)profile;
+    if (p)
+        __atomic_add_fetch(&p->refs, 1, __ATOMIC_RELAXED);
+    return p;
+}
+
 void lx_ies_free(lx_ies_profile *p)
 {
     if (!p)
+        return;
+    if (__atomic_sub_fetch(&p->refs, 1, __ATOMIC_ACQ_REL) > 0)
         return;
     free(p->keywords);
     free(p->vert);

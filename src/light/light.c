@@ -93,6 +93,23 @@ lx_vec3 lx_area_light_point(const lx_light *light, float u, float v, lx_vec3 *no
                    (v - 0.5f) * light->height);
 }
 
+/* Candela toward the point (along -to_light) from the light's photometric
+ * profile (seed 001's photometric lights): the vertical angle from the
+ * light's direction, the horizontal angle around it from up. */
+static float profile_intensity(const lx_light *light, lx_vec3 to_light)
+{
+    lx_vec3 v = lx_neg(to_light), d = light->direction;
+    float cos_v = lx_clampf(lx_dot(v, d), -1.0f, 1.0f);
+    lx_vec3 h0 = lx_sub(light->up, lx_scale(d, lx_dot(light->up, d)));
+    h0 = lx_length(h0) > 1e-6f ? lx_normalize(h0) : lx_perpendicular(d);
+    lx_vec3 h90 = lx_cross(d, h0);
+    float phi = LX_RAD2DEG(atan2f(lx_dot(v, h90), lx_dot(v, h0)));
+    if (phi < 0.0f)
+        phi += 360.0f;
+    float cd = lx_ies_candela(light->profile, LX_RAD2DEG(acosf(cos_v)), phi);
+    return cd * light->profile_scale;
+}
+
 /* Area lights: the exact unshadowed illuminance (area.c), with the range
  * window on the distance to the light's centre. */
 static bool evaluate_area(const lx_light *light, lx_vec3 p, lx_vec3 n, lx_light_eval *out)
@@ -267,6 +284,12 @@ lx_status lx_light_validate(const lx_light *light)
         return st;
     if ((st = check_vec(light, "ambient", light->ambient, true)) != LX_OK)
         return st;
+    if (light->profile) {
+        if (light->type != LX_LIGHT_POINT && light->type != LX_LIGHT_SPOT)
+            return invalid(light, "photometric profiles go on point and spot lights");
+        if (!(light->profile_scale >= 0.0f) || !isfinite(light->profile_scale))
+            return invalid(light, "profile_scale must be finite and >= 0");
+    }
     return validate_area(light);
 }
 
@@ -344,16 +367,17 @@ bool lx_light_evaluate(const lx_light *light, lx_vec3 p, lx_vec3 n, lx_light_eva
     if (!(spot > 0.0f))
         return false;
 
+    float intensity = light->profile ? profile_intensity(light, out->to_light) : light->intensity;
     float e;
     if (light->model == LX_MODEL_CLASSIC) {
         if (!(dist < light->range))
             return false;
         float v = (1.0f - dist / light->range) * ndotl;
-        e = v * v * light->intensity * spot;
+        e = v * v * intensity * spot;
     } else {
         float window = lx_light_range_window(dist_sq, light->range);
         float d2 = dist_sq > LX_MIN_DISTANCE_SQ ? dist_sq : LX_MIN_DISTANCE_SQ;
-        e = light->intensity * window * spot * ndotl / d2;
+        e = intensity * window * spot * ndotl / d2;
     }
     if (!(e > 0.0f))
         return false;

@@ -17,8 +17,10 @@
 #define LX_LIGHTS_JSON_MAX ((size_t)64 << 20)
 
 typedef struct ctx {
-    const char *file; /* name used in messages */
-    char where[128];  /* "lights[2] ('key')" or "" at the root */
+    const char *file;          /* name used in messages */
+    char where[128];           /* "lights[2] ('key')" or "" at the root */
+    lx_ies_profile **profiles; /* loaded by this file: the scene adopts them */
+    uint32_t profile_count;
 } ctx;
 
 #define fail(c, st, ...) lx_json_fail(st, (c)->file, (c)->where, __VA_ARGS__)
@@ -220,7 +222,9 @@ static const char *const light_keys[] = {"name",        "type",
                                          "dynamic",     "srgb",
                                          "temperature", "radius",
                                          "width",       "height",
-                                         "up",          "samples"};
+                                         "up",          "samples",
+                                         "ies",         "masked",
+                                         "multiplier"};
 /* Indexed by lx_light_type and lx_shadow_mode. */
 static const char *const type_names[] = {"point", "spot", "directional", "sphere", "disk", "rect"};
 static const char *const shadow_names[] = {"hard", "none", "blur", "soft"};
@@ -334,8 +338,12 @@ static lx_status read_area(const ctx *c, const cJSON *obj, bool new_shape, lx_li
         *(i == 0 ? &l->width : &l->height) = v;
     }
     if ((it = cJSON_GetObjectItemCaseSensitive(obj, "up"))) {
-        if (l->type != LX_LIGHT_RECT)
-            return fail(c, LX_ERR_INVALID, "up is for rect lights, not a %s light",
+        /* a rect's rotation, or the 0 deg plane of a point or spot's profile */
+        bool profiled = cJSON_GetObjectItemCaseSensitive(obj, "ies") || l->profile;
+        if (l->type != LX_LIGHT_RECT &&
+            !(profiled && (l->type == LX_LIGHT_POINT || l->type == LX_LIGHT_SPOT)))
+            return fail(c, LX_ERR_INVALID,
+                        "up is for rect lights and lights with an ies profile, not a %s light",
                         lx_light_type_name(l->type));
         lx_vec3 up, raw;
         if ((st = get_unit_vec3(c, it, "up", &up, &raw)) != LX_OK)
@@ -390,6 +398,73 @@ static lx_status carry_intensity(const ctx *c, const lx_light *before, lx_light 
 
 /* Fills out from obj; a light named like one in names (earlier in the file
  * or already in the scene) starts from that light. */
+/* "ies" (a path relative to this file), "masked" and "multiplier": seed
+ * 001's photometric lights. A masked profile keeps its shape and takes the
+ * light's intensity as its average (lumens / 4 pi); an unmasked one keeps
+ * its own candela times the multiplier. Runs after the intensity is known. */
+static lx_status read_profile(ctx *c, const cJSON *obj, lx_light *l)
+{
+    lx_status st;
+    const cJSON *ies = cJSON_GetObjectItemCaseSensitive(obj, "ies");
+    const cJSON *masked_item = cJSON_GetObjectItemCaseSensitive(obj, "masked");
+    const cJSON *mult_item = cJSON_GetObjectItemCaseSensitive(obj, "multiplier");
+    if (!ies) {
+        if ((masked_item || mult_item) && !l->profile)
+            return fail(c, LX_ERR_FORMAT, "'masked' and 'multiplier' need an 'ies' profile");
+        if (!masked_item && !mult_item)
+            return LX_OK;
+    }
+    if (l->type != LX_LIGHT_POINT && l->type != LX_LIGHT_SPOT)
+        return fail(c, LX_ERR_INVALID, "ies profiles go on point and spot lights, not a %s light",
+                    lx_light_type_name(l->type));
+    if (ies) {
+        const char *rel = NULL;
+        if ((st = get_string(c, ies, "ies", &rel)) != LX_OK)
+            return st;
+        char *dir = lx_path_dirname(c->file);
+        char *path = dir ? lx_path_join(dir, rel) : NULL;
+        free(dir);
+        if (!path)
+            return fail(c, LX_ERR_NOMEM, "out of memory");
+        lx_ies_profile *profile = NULL;
+        st = lx_ies_load(path, &profile);
+        free(path);
+        if (st != LX_OK) {
+            char where[300];
+            snprintf(where, sizeof where, "%s: %s: ies", c->file, c->where);
+            lx_error_prefix(where);
+            return st;
+        }
+        lx_ies_profile **list =
+            realloc(c->profiles, sizeof(lx_ies_profile *) * (c->profile_count + 1));
+        if (!list) {
+            lx_ies_free(profile);
+            return fail(c, LX_ERR_NOMEM, "out of memory");
+        }
+        c->profiles = list;
+        c->profiles[c->profile_count++] = profile;
+        l->profile = profile;
+    }
+    bool masked = false;
+    if (masked_item) {
+        if (!cJSON_IsBool(masked_item))
+            return fail(c, LX_ERR_FORMAT, "masked must be true or false");
+        masked = cJSON_IsTrue(masked_item);
+    }
+    if (masked) {
+        double lumens = lx_ies_total_lumens(l->profile);
+        if (!(lumens > 0.0))
+            return fail(c, LX_ERR_INVALID, "a masked ies profile needs some light (it has 0 lm)");
+        l->profile_scale = (float)(l->intensity / (lumens / (4.0 * 3.14159265358979323846)));
+    } else {
+        float multiplier = 1.0f;
+        if (mult_item && (st = get_non_negative(c, mult_item, "multiplier", &multiplier)) != LX_OK)
+            return st;
+        l->profile_scale = multiplier;
+    }
+    return LX_OK;
+}
+
 static lx_status read_light(ctx *c, const cJSON *obj, const name_table *names,
                             const lx_light *pending, const lx_scene *scene, lx_light *out)
 {
@@ -574,6 +649,8 @@ static lx_status read_light(ctx *c, const cJSON *obj, const name_table *names,
         return st;
     }
 
+    if ((st = read_profile(c, obj, &l)) != LX_OK)
+        return st;
     if ((st = lx_light_validate(&l)) != LX_OK)
         return restate(c, st, &l);
     *out = l;
@@ -629,6 +706,11 @@ static lx_status apply_root(lx_scene *scene, const cJSON *root, const char *file
             table_put(&names, pending[i].name, (int32_t)i);
     }
     table_free(&names);
+    /* profiles belong to the scene once the file is valid, else go */
+    for (uint32_t k = 0; k < c.profile_count; k++)
+        if (st != LX_OK || lx_scene_adopt_profile(scene, c.profiles[k]) != LX_OK)
+            lx_ies_free(c.profiles[k]);
+    free(c.profiles);
     if (st == LX_OK) {
         /* The whole file is valid: only now does the scene change. */
         scene->ambient = ambient;

@@ -70,6 +70,9 @@ void lx_scene_destroy(lx_scene *s)
     free(s->meshes);
     free(s->materials);
     free(s->nodes);
+    for (uint32_t i = 0; i < s->profile_count; i++)
+        lx_ies_free(s->profiles[i]);
+    free(s->profiles);
     free(s->lights);
     free(s->path);
     free(s);
@@ -303,6 +306,16 @@ lx_status lx_scene_add_light(lx_scene *s, const lx_light *light)
     if (st != LX_OK)
         return st;
     s->lights[s->light_count++] = *light;
+    return LX_OK;
+}
+
+lx_status lx_scene_adopt_profile(lx_scene *s, lx_ies_profile *profile)
+{
+    lx_status st = grow((void **)&s->profiles, &s->profile_capacity, s->profile_count,
+                        sizeof(lx_ies_profile *), "photometric profiles");
+    if (st != LX_OK)
+        return st;
+    s->profiles[s->profile_count++] = profile;
     return LX_OK;
 }
 

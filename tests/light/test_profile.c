@@ -1,0 +1,155 @@
+/* Photometric profiles on lights (seed 001): an isotropic profile equals a
+ * plain point light, a masked one takes the light's intensity as its
+ * average, the profile's planes follow the light's direction and up, the
+ * lights JSON loads them relative to its own folder, and a baker keeps its
+ * profiles alive after the scene is gone. */
+#include <setjmp.h>
+#include <stdarg.h>
+#include <stddef.h>
+#include <stdint.h>
+
+#include <cmocka.h>
+
+#include "helpers.h"
+
+#include <math.h>
+#include <stdio.h>
+#include <stdlib.h>
+#include <string.h>
+
+#define LX_PI_D 3.14159265358979323846
+
+/* 100 cd in every direction. */
+static const char *isotropic = "IESNA:LM-63-2002\nTILT=NONE\n"
+                               "1 -1 1 3 1 1 2 0 0 0\n1 1 0\n0 90 180\n0\n100 100 100\n";
+/* Lower hemisphere only: 100 cd in the C0/C180 planes, 10 cd in C90. */
+static const char *bilateral = "IESNA:LM-63-2002\nTILT=NONE\n"
+                               "1 -1 1 2 3 1 2 0 0 0\n1 1 0\n0 90\n0 90 180\n"
+                               "100 100\n10 10\n100 100\n";
+
+static lx_ies_profile *parse(const char *text)
+{
+    lx_ies_profile *p = NULL;
+    assert_int_equal(lx_ies_parse(text, strlen(text), "test.ies", &p), LX_OK);
+    return p;
+}
+
+/* Intensity toward q: E at q with the normal facing the light, times d^2. */
+static double intensity_toward(const lx_light *l, lx_vec3 q)
+{
+    lx_vec3 to = lx_sub(l->position, q);
+    double d2 = lx_dot(to, to);
+    lx_light_eval e;
+    if (!lx_light_evaluate(l, q, lx_normalize(to), &e))
+        return 0.0;
+    return e.illuminance.x * d2;
+}
+
+static void isotropic_equals_point(void **state)
+{
+    (void)state;
+    lx_ies_profile *p = parse(isotropic);
+    lx_light plain = lx_light_defaults(LX_LIGHT_POINT);
+    plain.intensity = 100.0f;
+    lx_light prof = plain;
+    prof.intensity = 7.0f; /* ignored without masking */
+    prof.profile = p;
+    prof.profile_scale = 1.0f;
+    assert_int_equal(lx_light_validate(&prof), LX_OK);
+    const lx_vec3 qs[3] = {{0, -2, 0}, {1, 1, 1}, {-3, 0.5f, 2}};
+    for (int i = 0; i < 3; i++)
+        assert_true(fabs(intensity_toward(&prof, qs[i]) - intensity_toward(&plain, qs[i])) < 1e-3);
+    /* masked: the light's 50 cd becomes the average of the profile */
+    prof.intensity = 50.0f;
+    prof.profile_scale = (float)(50.0 / (lx_ies_total_lumens(p) / (4.0 * LX_PI_D)));
+    assert_true(fabs(intensity_toward(&prof, qs[1]) - 50.0) < 0.05);
+    lx_ies_free(p);
+}
+
+static void planes_follow_direction_and_up(void **state)
+{
+    (void)state;
+    lx_ies_profile *p = parse(bilateral);
+    lx_light l = lx_light_defaults(LX_LIGHT_POINT);
+    l.direction = lx_v3(0, -1, 0);
+    l.up = lx_v3(1, 0, 0); /* C0 toward +x, C90 toward direction x up = +z */
+    l.profile = p;
+    l.profile_scale = 1.0f;
+    assert_true(fabs(intensity_toward(&l, lx_v3(1, -1, 0)) - 100.0) < 1e-3);
+    assert_true(fabs(intensity_toward(&l, lx_v3(0, -1, 1)) - 10.0) < 1e-3);
+    assert_true(fabs(intensity_toward(&l, lx_v3(-1, -1, 0)) - 100.0) < 1e-3);
+    assert_true(intensity_toward(&l, lx_v3(0, 1, 0)) == 0.0); /* upper hemisphere: dark */
+    /* turned: C0 toward +z now */
+    l.up = lx_v3(0, 0, 1);
+    assert_true(fabs(intensity_toward(&l, lx_v3(0, -1, 1)) - 100.0) < 1e-3);
+    lx_ies_free(p);
+}
+
+static void lights_json_loads_relative_profiles(void **state)
+{
+    (void)state;
+    const char *dir = lx_test_dir("test_profile");
+    char path[1024];
+    snprintf(path, sizeof path, "%s/fixture.ies", dir);
+    FILE *fp = fopen(path, "wb");
+    assert_non_null(fp);
+    fputs(isotropic, fp);
+    fclose(fp);
+    snprintf(path, sizeof path, "%s/lights.json", dir);
+    fp = fopen(path, "wb");
+    assert_non_null(fp);
+    fputs("{\"lights\": [{\"name\": \"fixture\", \"type\": \"point\", \"position\": [0, 3, 0],"
+          " \"direction\": [0, -1, 0], \"ies\": \"fixture.ies\", \"masked\": true,"
+          " \"intensity\": 1500, \"unit\": \"lm\"}]}",
+          fp);
+    fclose(fp);
+    lx_scene *scene;
+    assert_int_equal(lx_scene_create("profiles", &scene), LX_OK);
+    assert_int_equal(lx_lights_json_apply(scene, path), LX_OK);
+    assert_int_equal(scene->light_count, 1);
+    assert_non_null(scene->lights[0].profile);
+    /* 1500 lm masked onto an isotropic profile: 1500 / 4 pi cd everywhere */
+    double want = 1500.0 / (4.0 * LX_PI_D);
+    assert_true(fabs(intensity_toward(&scene->lights[0], lx_v3(2, 0, 1)) - want) < 1e-3 * want);
+
+    /* a baker keeps the profile when the scene is gone */
+    lx_mesh floor = lx_test_plane("floor", 2.0f, 0.0f, 0.0f, 0.0f, 1);
+    lx_test_add(scene, &floor);
+    lx_test_mesh_free(&floor);
+    lx_bake_desc desc = {.resolution = 4, .padding = LX_PADDING_NONE};
+    lx_baker *baker;
+    assert_int_equal(lx_baker_create(scene, &desc, &baker), LX_OK);
+    lx_scene_destroy(scene);
+    assert_int_equal(lx_baker_bake(baker), LX_OK);
+    lx_image img;
+    assert_int_equal(lx_baker_apply_alloc(baker, 0, &img), LX_OK);
+    lx_texel_sample s;
+    assert_true(lx_baker_texel(baker, 0, 1, 1, &s));
+    lx_vec3 to = lx_sub(lx_v3(0, 3, 0), s.position);
+    double e = want * (to.y / lx_length(to)) / lx_dot(to, to);
+    assert_true(fabs(img.data[3 * (1 * 4 + 1)] - e) < 1e-3 * e);
+    lx_image_free(&img);
+    lx_baker_destroy(baker);
+
+    /* a missing profile names the light and the file */
+    fp = fopen(path, "wb");
+    fputs("{\"lights\": [{\"type\": \"point\", \"position\": [0, 3, 0], \"ies\": \"nope.ies\"}]}",
+          fp);
+    fclose(fp);
+    assert_int_equal(lx_scene_create("profiles", &scene), LX_OK);
+    assert_int_not_equal(lx_lights_json_apply(scene, path), LX_OK);
+    assert_non_null(strstr(lx_last_error(), "nope.ies"));
+    assert_non_null(strstr(lx_last_error(), "lights[0]"));
+    assert_int_equal(scene->light_count, 0);
+    lx_scene_destroy(scene);
+}
+
+int main(void)
+{
+    const struct CMUnitTest tests[] = {
+        cmocka_unit_test(isotropic_equals_point),
+        cmocka_unit_test(planes_follow_direction_and_up),
+        cmocka_unit_test(lights_json_loads_relative_profiles),
+    };
+    return cmocka_run_group_tests(tests, NULL, NULL);
+}
