@@ -115,15 +115,6 @@ static lx_baker *bake(const lx_scene *s, int resolution, int padding, lx_quantit
     return b;
 }
 
-static uint32_t map_of(const lx_baker *b, uint32_t node)
-{
-    for (uint32_t m = 0; m < lx_baker_lightmap_count(b); m++)
-        if (lx_baker_lightmap_info(b, m)->node == node)
-            return m;
-    fail_msg("no lightmap for node %u", node);
-    return UINT32_MAX;
-}
-
 static lx_image apply(const lx_baker *b, uint32_t map)
 {
     lx_image img;
@@ -168,7 +159,7 @@ static int check_plane_light(lx_light light, irradiance_fn fn, double rel, doubl
     uint32_t node = add_plane(s, "ground", size, height, cx, cz, 4);
     add_light(s, light);
     lx_baker *b = bake(s, res, LX_PADDING_NONE, LX_QUANTITY_IRRADIANCE);
-    uint32_t map = map_of(b, node);
+    uint32_t map = lx_test_map_of(b, node);
     const lx_lightmap_info *info = lx_baker_lightmap_info(b, map);
     assert_int_equal(info->width, res);
     assert_int_equal(info->height, res);
@@ -257,7 +248,7 @@ static void test_spot_light_cone(void **state)
     uint32_t node = add_plane(s, "ground", 4.0f, 0.0f, 0.25f, -0.5f, 4);
     add_light(s, l);
     lx_baker *b = bake(s, 64, LX_PADDING_NONE, LX_QUANTITY_IRRADIANCE);
-    uint32_t map = map_of(b, node);
+    uint32_t map = lx_test_map_of(b, node);
     lx_image img = apply(b, map);
     int inside = 0, outside = 0;
     for (int y = 0; y < 64; y++)
@@ -320,7 +311,7 @@ static void test_occluder_projection(void **state)
     double z0 = l.position.z + (ocz - occ / 2.0 - l.position.z) * k;
     double z1 = l.position.z + (ocz + occ / 2.0 - l.position.z) * k;
 
-    uint32_t map = map_of(b, ground);
+    uint32_t map = lx_test_map_of(b, ground);
     lx_image img = apply(b, map);
     int shadowed = 0, lit = 0, edge = 0;
     for (int y = 0; y < res; y++)
@@ -349,7 +340,7 @@ static void test_occluder_projection(void **state)
     lx_image_free(&img);
 
     /* the occluder's own top is fully lit */
-    map = map_of(b, occluder);
+    map = lx_test_map_of(b, occluder);
     img = apply(b, map);
     int n = 0;
     for (int y = 0; y < res; y++)
@@ -392,7 +383,7 @@ static void test_closed_room_dark(void **state)
     add_light(s, point_light("side", lx_v3(3.0f, 0.1f, -0.4f), 100.0f, 0.0f));
     add_light(s, dir_light("sun", lx_v3(0.5f, -0.7f, 0.3f), 10.0f));
     lx_baker *b = bake(s, 64, 0, LX_QUANTITY_IRRADIANCE);
-    assert_all_zero(b, map_of(b, 0), "inside the room");
+    assert_all_zero(b, lx_test_map_of(b, 0), "inside the room");
     lx_baker_destroy(b);
     lx_scene_destroy(s);
 }
@@ -408,9 +399,9 @@ static void test_plane_inside_box_dark(void **state)
     add_light(s, point_light("above", lx_v3(0.3f, 4.0f, 0.2f), 100.0f, 0.0f));
     add_light(s, dir_light("sun", lx_v3(-0.4f, -0.8f, 0.2f), 10.0f));
     lx_baker *b = bake(s, 64, 0, LX_QUANTITY_IRRADIANCE);
-    assert_all_zero(b, map_of(b, plane), "plane inside the box");
+    assert_all_zero(b, lx_test_map_of(b, plane), "plane inside the box");
     /* the box's outside is lit: the lights are really there */
-    lx_image img = apply(b, map_of(b, 0));
+    lx_image img = apply(b, lx_test_map_of(b, 0));
     double sum = 0;
     for (int i = 0; i < img.width * img.height * 3; i++)
         sum += img.data[i];
@@ -434,7 +425,7 @@ static void grazing_case(float size, float cx, float cz, int n, float elevation_
     double want = lux * -(double)l->direction.y; /* lux * sin(elevation) */
     assert_true(fabs(want - lux * sin(e)) <= 1e-4 * want);
     lx_baker *b = bake(s, 64, LX_PADDING_NONE, LX_QUANTITY_IRRADIANCE);
-    uint32_t map = map_of(b, node);
+    uint32_t map = lx_test_map_of(b, node);
     lx_image img = apply(b, map);
     for (int y = 0; y < 64; y++)
         for (int x = 0; x < 64; x++) {
@@ -470,7 +461,7 @@ static void test_scene_ambient_adds(void **state)
     uint32_t node = add_plane(s, "ground", 4.0f, 0.0f, 0.0f, 0.0f, 4);
     s->ambient = amb;
     lx_baker *b = bake(s, 32, LX_PADDING_NONE, LX_QUANTITY_IRRADIANCE);
-    uint32_t map = map_of(b, node);
+    uint32_t map = lx_test_map_of(b, node);
     lx_image img = apply(b, map);
     for (int i = 0; i < 32 * 32; i++) {
         assert_true(img.data[3 * i] == amb.x);
@@ -513,7 +504,7 @@ static void test_light_ambient_falloff_and_blend(void **state)
     add_light(s, red);
     add_light(s, blue);
     lx_baker *b = bake(s, 64, LX_PADDING_NONE, LX_QUANTITY_IRRADIANCE);
-    uint32_t map = map_of(b, node);
+    uint32_t map = lx_test_map_of(b, node);
     lx_image img = apply(b, map);
     int only_red = 0, only_blue = 0, both = 0, neither = 0;
     for (int y = 0; y < 64; y++)
@@ -559,7 +550,7 @@ static void test_radiance_quantity(void **state)
     add_light(s, p);
     add_light(s, d);
     lx_baker *b = bake(s, 32, LX_PADDING_NONE, LX_QUANTITY_RADIANCE);
-    uint32_t map = map_of(b, node);
+    uint32_t map = lx_test_map_of(b, node);
     lx_image img = apply(b, map);
     const double albedo[3] = {0.5, 0.25, 0.8};
     for (int y = 0; y < 32; y++)
@@ -606,7 +597,7 @@ static void test_dilation(void **state)
     for (int pass = 0; pass < 2; pass++) {
         int padding = pass == 0 ? 2 : LX_PADDING_NONE;
         lx_baker *b = bake(s, res, padding, LX_QUANTITY_IRRADIANCE);
-        uint32_t map = map_of(b, node);
+        uint32_t map = lx_test_map_of(b, node);
         const uint8_t *mask = lx_baker_mask(b, map);
         /* covered: every texel whose square overlaps the chart, columns and
          * rows 8..24 (24 only partly: pass 2 of the texel map) */

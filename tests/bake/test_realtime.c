@@ -70,21 +70,12 @@ static lx_image apply(const lx_baker *b, uint32_t map)
     return img;
 }
 
-static uint32_t map_of(const lx_baker *b, uint32_t node)
-{
-    for (uint32_t m = 0; m < lx_baker_lightmap_count(b); m++)
-        if (lx_baker_lightmap_info(b, m)->node == node)
-            return m;
-    fail_msg("no lightmap for node %u", node);
-    return 0;
-}
-
 /* Bakes scene s (static lights only) and returns the applied map of node. */
 static lx_image bake_alone(const lx_scene *s, uint32_t node, int res)
 {
     lx_baker *b = make_baker(s, res, 0, 0);
     assert_int_equal(lx_baker_bake(b), LX_OK);
-    lx_image img = apply(b, map_of(b, node));
+    lx_image img = apply(b, lx_test_map_of(b, node));
     lx_baker_destroy(b);
     return img;
 }
@@ -135,7 +126,7 @@ static void test_apply_is_baked_plus_dynamic(void **state)
     lx_baker *b = make_baker(both, res, 0, 0);
     assert_int_equal(lx_baker_bake(b), LX_OK);
     for (uint32_t node = 0; node < 2; node++) {
-        uint32_t map = map_of(b, node);
+        uint32_t map = lx_test_map_of(b, node);
         /* before any update: exactly the static bake */
         lx_image before = apply(b, map);
         lx_image s_img = bake_alone(only_static, node, res);
@@ -151,7 +142,7 @@ static void test_apply_is_baked_plus_dynamic(void **state)
     d2.dynamic = false;
     add_light(only_dyn, d2);
     for (uint32_t node = 0; node < 2; node++) {
-        lx_image got = apply(b, map_of(b, node));
+        lx_image got = apply(b, lx_test_map_of(b, node));
         lx_image s_img = bake_alone(only_static, node, res);
         lx_image d_img = bake_alone(only_dyn, node, res);
         assert_sum(&got, &s_img, &d_img, node == 0 ? "ground: baked + dynamic" : "plate");
@@ -230,7 +221,7 @@ static void test_apply_is_baked_plus_dynamic(void **state)
 static void check_projected_shadow(const lx_baker *b, lx_vec3 L, lx_vec3 offset, const char *what)
 {
     const double plate = 0.8, h = 1.0 + offset.y, cx = 0.2 + offset.x, cz = 0.1 + offset.z;
-    uint32_t map = map_of(b, 0);
+    uint32_t map = lx_test_map_of(b, 0);
     const lx_lightmap_info *info = lx_baker_lightmap_info(b, map);
     const double texel = 4.0 / info->width;
     double k = L.y / (L.y - h);
@@ -279,7 +270,7 @@ static void test_moving_occluder_moves_shadow(void **state)
 
     /* the plate's own texels moved with it */
     lx_texel_sample ts;
-    uint32_t pm = map_of(b, 1);
+    uint32_t pm = lx_test_map_of(b, 1);
     assert_true(lx_baker_texel(b, pm, 0, 0, &ts));
     assert_true(fabsf(ts.position.y - 1.4f) < 1e-5f);
 
@@ -312,7 +303,7 @@ static void test_moving_lit_node_moves_texels(void **state)
     add_light(s, lamp);
     const int res = 32;
     lx_baker *b = make_baker(s, res, LX_PADDING_NONE, 0);
-    uint32_t map = map_of(b, 0);
+    uint32_t map = lx_test_map_of(b, 0);
     lx_texel_sample *before = calloc(res * res, sizeof *before);
     for (int i = 0; i < res * res; i++)
         assert_true(lx_baker_texel(b, map, i % res, i / res, &before[i]));

@@ -2,6 +2,12 @@
 #define _POSIX_C_SOURCE 200809L
 #include "helpers.h"
 
+#include <setjmp.h>
+#include <stdarg.h>
+#include <stddef.h>
+
+#include <cmocka.h>
+
 #include <dirent.h>
 #include <signal.h>
 #include <stdio.h>
@@ -188,4 +194,27 @@ void lx_test_watchdog(unsigned seconds)
     sa.sa_handler = watchdog_fired;
     sigaction(SIGALRM, &sa, NULL);
     alarm(seconds);
+}
+
+lx_scene *lx_test_new_scene(const char *name)
+{
+    lx_scene *s = NULL;
+    if (lx_scene_create(name, &s) != LX_OK)
+        fail_msg("lx_scene_create: %s", lx_last_error());
+    return s;
+}
+
+void lx_test_assert_vec3(lx_vec3 v, double x, double y, double z)
+{
+    if (!(fabs(v.x - x) < 1e-5 && fabs(v.y - y) < 1e-5 && fabs(v.z - z) < 1e-5))
+        fail_msg("got [%g, %g, %g], want [%g, %g, %g]", v.x, v.y, v.z, x, y, z);
+}
+
+uint32_t lx_test_map_of(const lx_baker *b, uint32_t node)
+{
+    for (uint32_t m = 0; m < lx_baker_lightmap_count(b); m++)
+        if (lx_baker_lightmap_info(b, m)->node == node)
+            return m;
+    fail_msg("no lightmap for node %u", node);
+    return UINT32_MAX;
 }

@@ -23,6 +23,15 @@ lx_mesh lx_test_box(const char *name, lx_vec3 lo, lx_vec3 hi, bool inward);
 
 void lx_test_mesh_free(lx_mesh *m);
 
+/* An empty scene named name; fails the test if it cannot be made. */
+lx_scene *lx_test_new_scene(const char *name);
+
+/* Fails the test unless v equals (x, y, z) to 1e-5 in each component. */
+void lx_test_assert_vec3(lx_vec3 v, double x, double y, double z);
+
+/* The lightmap index of scene node `node`; fails the test if it has none. */
+uint32_t lx_test_map_of(const lx_baker *baker, uint32_t node);
+
 /* Adds mesh as its own node named like the mesh with an identity transform
  * (and a default material when the scene has none). */
 void lx_test_add(lx_scene *scene, lx_mesh *mesh);

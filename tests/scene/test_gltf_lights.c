@@ -17,23 +17,11 @@
 #include <sys/stat.h>
 #include <unistd.h>
 
+#include "helpers.h"
 #include "luxel/scene.h"
 
 #define PI_D 3.14159265358979323846
 #define S45 "0.7071067811865476" /* sin 45 deg = cos 45 deg */
-
-static void assert_vec(lx_vec3 v, double x, double y, double z)
-{
-    if (!(fabs(v.x - x) < 1e-5 && fabs(v.y - y) < 1e-5 && fabs(v.z - z) < 1e-5))
-        fail_msg("got [%g, %g, %g], want [%g, %g, %g]", v.x, v.y, v.z, x, y, z);
-}
-
-static lx_scene *new_scene(void)
-{
-    lx_scene *s;
-    assert_int_equal(lx_scene_create("test", &s), LX_OK);
-    return s;
-}
 
 static void tmp_path(char *out, size_t size, const char *name)
 {
@@ -59,7 +47,7 @@ static lx_status load_text(lx_scene *s, const char *json)
 
 static void expect_fail(const char *json, lx_status want, const char *needle)
 {
-    lx_scene *s = new_scene();
+    lx_scene *s = lx_test_new_scene("test");
     lx_status st = load_text(s, json);
     if (st != want || !strstr(lx_last_error(), needle))
         fail_msg("%s '%s', want %s with '%s'", lx_status_name(st), lx_last_error(),
@@ -110,9 +98,9 @@ static void check_nested(const lx_scene *s)
     const lx_light *spot = &s->lights[0];
     assert_string_equal(spot->name, "Spot");
     assert_int_equal(spot->type, LX_LIGHT_SPOT);
-    assert_vec(spot->position, 3, 2, 3);
-    assert_vec(spot->direction, 0, 1, 0);
-    assert_vec(spot->color, 1, 0.5, 0.5);
+    lx_test_assert_vec3(spot->position, 3, 2, 3);
+    lx_test_assert_vec3(spot->direction, 0, 1, 0);
+    lx_test_assert_vec3(spot->color, 1, 0.5, 0.5);
     assert_true(spot->intensity == 10.0f && spot->range == 20.0f);
     assert_true(spot->inner_angle == 0.3f && spot->outer_angle == 0.6f);
     assert_int_equal(spot->shadow, LX_SHADOW_HARD);
@@ -120,25 +108,25 @@ static void check_nested(const lx_scene *s)
     const lx_light *sun = &s->lights[1];
     assert_string_equal(sun->name, "Sun");
     assert_int_equal(sun->type, LX_LIGHT_DIRECTIONAL);
-    assert_vec(sun->direction, 0, -1, 0);
+    lx_test_assert_vec3(sun->direction, 0, -1, 0);
     assert_true(sun->intensity == 3.0f);
 
     const lx_light *bulb = &s->lights[2];
     assert_string_equal(bulb->name, "bulb");
     assert_int_equal(bulb->type, LX_LIGHT_POINT);
-    assert_vec(bulb->position, 5, 0, -1);
-    assert_vec(bulb->color, 1, 1, 1); /* spec defaults */
+    lx_test_assert_vec3(bulb->position, 5, 0, -1);
+    lx_test_assert_vec3(bulb->color, 1, 1, 1); /* spec defaults */
     assert_true(bulb->intensity == 1.0f && bulb->range == 0.0f);
 
     assert_string_equal(s->lights[3].name, "Spot_2");
-    assert_vec(s->lights[3].position, 0, 0, 0);
-    assert_vec(s->lights[3].direction, 0, 0, -1);
+    lx_test_assert_vec3(s->lights[3].position, 0, 0, 0);
+    lx_test_assert_vec3(s->lights[3].direction, 0, 0, -1);
 }
 
 static void test_nested_nodes(void **state)
 {
     (void)state;
-    lx_scene *s = new_scene();
+    lx_scene *s = lx_test_new_scene("test");
     assert_int_equal(load_text(s, nested), LX_OK);
     check_nested(s);
     lx_scene_destroy(s);
@@ -146,7 +134,7 @@ static void test_nested_nodes(void **state)
     char path[512];
     tmp_path(path, sizeof path, "nested.gltf");
     write_file(path, nested, strlen(nested));
-    s = new_scene();
+    s = lx_test_new_scene("test");
     assert_int_equal(lx_gltf_lights_load(s, path), LX_OK);
     check_nested(s);
     lx_scene_destroy(s);
@@ -184,7 +172,7 @@ static void test_glb(void **state)
     (void)state;
     size_t size;
     uint8_t *glb = make_glb(nested, &size);
-    lx_scene *s = new_scene();
+    lx_scene *s = lx_test_new_scene("test");
     assert_int_equal(lx_gltf_lights_load_memory(s, glb, size, "t.glb"), LX_OK);
     check_nested(s);
     lx_scene_destroy(s);
@@ -192,7 +180,7 @@ static void test_glb(void **state)
     char path[512];
     tmp_path(path, sizeof path, "nested.glb");
     write_file(path, glb, size);
-    s = new_scene();
+    s = lx_test_new_scene("test");
     assert_int_equal(lx_gltf_lights_load(s, path), LX_OK);
     check_nested(s);
 
@@ -245,7 +233,7 @@ static void test_glb(void **state)
 static void test_blender_cone_and_defaults(void **state)
 {
     (void)state;
-    lx_scene *s = new_scene();
+    lx_scene *s = lx_test_new_scene("test");
     assert_int_equal(
         load_text(s, "{\"extensions\": {\"KHR_lights_punctual\": {\"lights\": ["
                      "{\"type\": \"spot\", \"name\": \"Blender\", \"intensity\": 50,"
@@ -261,7 +249,7 @@ static void test_blender_cone_and_defaults(void **state)
     const lx_light *l = &s->lights[0];
     assert_true(l->inner_angle == 0.5f && l->outer_angle == 0.5f);
     /* R_x(-90) turns -Z into -Y: the spot looks down from 3 m. */
-    assert_vec(l->direction, 0, -1, 0);
+    lx_test_assert_vec3(l->direction, 0, -1, 0);
     lx_light_eval ev;
     float x_in = 3.0f * tanf(0.49f), x_out = 3.0f * tanf(0.51f);
     assert_true(lx_light_evaluate(l, lx_v3(x_in, 0, 0), lx_v3(0, 1, 0), &ev));
@@ -280,7 +268,7 @@ static void test_blender_cone_and_defaults(void **state)
 static void test_no_extension(void **state)
 {
     (void)state;
-    lx_scene *s = new_scene();
+    lx_scene *s = lx_test_new_scene("test");
     assert_int_equal(load_text(s, "{\"asset\": {\"version\": \"2.0\"}, \"nodes\": [{}]}"), LX_OK);
     assert_int_equal(load_text(s, "{\"extensions\": {\"OTHER\": {}}}"), LX_OK);
     assert_int_equal(s->light_count, 0);
@@ -290,7 +278,7 @@ static void test_no_extension(void **state)
 static void test_scene_choice_and_names(void **state)
 {
     (void)state;
-    lx_scene *s = new_scene();
+    lx_scene *s = lx_test_new_scene("test");
     /* "scene": 1 picks the second scene only; names collide into _2, _2_2. */
     assert_int_equal(load_text(s, "{\"extensions\": {\"KHR_lights_punctual\": {\"lights\": ["
                                   "{\"type\": \"point\", \"name\": \"L\"},"
@@ -310,7 +298,7 @@ static void test_scene_choice_and_names(void **state)
     lx_scene_destroy(s);
 
     /* No scenes: every parentless node is a root. A 70-byte name is cut. */
-    s = new_scene();
+    s = lx_test_new_scene("test");
     assert_int_equal(
         load_text(s,
                   "{\"extensions\": {\"KHR_lights_punctual\": {\"lights\": ["
@@ -323,7 +311,7 @@ static void test_scene_choice_and_names(void **state)
         LX_OK);
     assert_int_equal(s->light_count, 2);
     assert_int_equal(strlen(s->lights[0].name), LX_LIGHT_NAME_MAX - 1);
-    assert_vec(s->lights[0].position, 0, 2, 0);
+    lx_test_assert_vec3(s->lights[0].position, 0, 2, 0);
     assert_int_equal(strlen(s->lights[1].name), LX_LIGHT_NAME_MAX - 1);
     assert_non_null(strstr(s->lights[1].name, "_2"));
     assert_string_not_equal(s->lights[0].name, s->lights[1].name);
@@ -408,7 +396,7 @@ static void test_bad_lights(void **state)
 static void test_io_errors(void **state)
 {
     (void)state;
-    lx_scene *s = new_scene();
+    lx_scene *s = lx_test_new_scene("test");
     assert_int_equal(lx_gltf_lights_load(s, "/nonexistent/dir/x.gltf"), LX_ERR_IO);
     assert_non_null(strstr(lx_last_error(), "/nonexistent/dir/x.gltf"));
     lx_scene_destroy(s);

@@ -18,6 +18,7 @@
 #include <sys/stat.h>
 #include <unistd.h>
 
+#include "helpers.h"
 #include "luxel/scene.h"
 
 #define PI_D 3.14159265358979323846
@@ -27,19 +28,6 @@ static void assert_rel(double got, double want, double tol)
     double scale = fabs(want) > 1e-30 ? fabs(want) : 1.0;
     if (!(fabs(got - want) <= tol * scale))
         fail_msg("got %.9g, want %.9g", got, want);
-}
-
-static void assert_vec(lx_vec3 v, double x, double y, double z)
-{
-    if (!(fabs(v.x - x) < 1e-5 && fabs(v.y - y) < 1e-5 && fabs(v.z - z) < 1e-5))
-        fail_msg("got [%g, %g, %g], want [%g, %g, %g]", v.x, v.y, v.z, x, y, z);
-}
-
-static lx_scene *new_scene(void)
-{
-    lx_scene *s;
-    assert_int_equal(lx_scene_create("test", &s), LX_OK);
-    return s;
 }
 
 static lx_status apply(lx_scene *s, const char *text)
@@ -65,16 +53,16 @@ static const char *example =
 static void test_example(void **state)
 {
     (void)state;
-    lx_scene *s = new_scene();
+    lx_scene *s = lx_test_new_scene("test");
     assert_int_equal(apply(s, example), LX_OK);
     assert_int_equal(s->light_count, 4);
-    assert_vec(s->ambient, 0.02, 0.02, 0.02);
+    lx_test_assert_vec3(s->ambient, 0.02, 0.02, 0.02);
 
     const lx_light *k = &s->lights[0];
     assert_string_equal(k->name, "key");
     assert_int_equal(k->type, LX_LIGHT_POINT);
-    assert_vec(k->position, 0, 2, 0);
-    assert_vec(k->color, 1, 1, 1);
+    lx_test_assert_vec3(k->position, 0, 2, 0);
+    lx_test_assert_vec3(k->color, 1, 1, 1);
     assert_true(k->intensity == 800.0f && k->range == 10.0f);
     assert_int_equal(k->shadow, LX_SHADOW_HARD);
     assert_int_equal(k->model, LX_MODEL_PHYSICAL);
@@ -83,7 +71,7 @@ static void test_example(void **state)
     const lx_light *sp = &s->lights[1];
     assert_string_equal(sp->name, "");
     assert_int_equal(sp->type, LX_LIGHT_SPOT);
-    assert_vec(sp->direction, 0, -1, 0);
+    lx_test_assert_vec3(sp->direction, 0, -1, 0);
     assert_rel(sp->inner_angle, 20.0 * PI_D / 180.0, 1e-6);
     assert_rel(sp->outer_angle, 30.0 * PI_D / 180.0, 1e-6);
     assert_true(sp->intensity == 1200.0f);
@@ -93,12 +81,12 @@ static void test_example(void **state)
     const lx_light *d = &s->lights[2];
     double len = sqrt(0.09 + 1.0 + 0.04);
     assert_int_equal(d->type, LX_LIGHT_DIRECTIONAL);
-    assert_vec(d->direction, 0.3 / len, -1.0 / len, 0.2 / len);
+    lx_test_assert_vec3(d->direction, 0.3 / len, -1.0 / len, 0.2 / len);
     assert_true(d->intensity == 100000.0f);
 
     const lx_light *c = &s->lights[3];
     assert_int_equal(c->model, LX_MODEL_CLASSIC);
-    assert_vec(c->ambient, 0.1, 0, 0);
+    lx_test_assert_vec3(c->ambient, 0.1, 0, 0);
     assert_true(c->range == 5.0f && c->intensity == 1.0f);
     assert_int_equal(c->shadow, LX_SHADOW_HARD); /* default */
     lx_scene_destroy(s);
@@ -107,7 +95,7 @@ static void test_example(void **state)
 static void test_units(void **state)
 {
     (void)state;
-    lx_scene *s = new_scene();
+    lx_scene *s = lx_test_new_scene("test");
     assert_int_equal(apply(s,
                            "{\"lights\": ["
                            "{\"name\": \"a\", \"type\": \"point\", \"position\": [0,0,0], "
@@ -129,9 +117,9 @@ static void test_units(void **state)
     assert_rel(s->lights[2].intensity, 1000.0 / PI_D, 1e-6);
     assert_rel(s->lights[3].intensity, 1000.0 / (2 * PI_D * (1 - cos(PI_D / 6))), 1e-5);
     assert_true(s->lights[4].intensity == 5.0f);
-    assert_vec(s->lights[4].direction, 0, -1, 0);
+    lx_test_assert_vec3(s->lights[4].direction, 0, -1, 0);
     /* Defaults of a new light. */
-    assert_vec(s->lights[0].color, 1, 1, 1);
+    lx_test_assert_vec3(s->lights[0].color, 1, 1, 1);
     assert_true(s->lights[0].range == 0.0f);
     assert_rel(s->lights[0].outer_angle, PI_D / 4, 1e-6);
     lx_scene_destroy(s);
@@ -140,7 +128,7 @@ static void test_units(void **state)
 static void test_override(void **state)
 {
     (void)state;
-    lx_scene *s = new_scene();
+    lx_scene *s = lx_test_new_scene("test");
     lx_light lamp = lx_light_defaults(LX_LIGHT_SPOT);
     strcpy(lamp.name, "lamp");
     lamp.position = lx_v3(1, 2, 3);
@@ -159,13 +147,13 @@ static void test_override(void **state)
     assert_int_equal(s->light_count, 1);
     const lx_light *l = &s->lights[0];
     assert_int_equal(l->type, LX_LIGHT_SPOT);
-    assert_vec(l->position, 1, 2, 3);
-    assert_vec(l->direction, 0, 0, -1);
+    lx_test_assert_vec3(l->position, 1, 2, 3);
+    lx_test_assert_vec3(l->direction, 0, 0, -1);
     assert_true(l->intensity == 100.0f && l->range == 7.0f);
     assert_true(l->inner_angle == 0.2f && l->outer_angle == 0.5f);
     assert_int_equal(l->shadow, LX_SHADOW_NONE);
     assert_true(l->dynamic);
-    assert_vec(s->ambient, 0.5, 0.5, 0.5); /* no "ambient": unchanged */
+    lx_test_assert_vec3(s->ambient, 0.5, 0.5, 0.5); /* no "ambient": unchanged */
 
     /* A later entry of the same file overrides an earlier one the same way. */
     assert_int_equal(apply(s, "{\"lights\": ["
@@ -175,8 +163,8 @@ static void test_override(void **state)
                      LX_OK);
     assert_int_equal(s->light_count, 2);
     assert_string_equal(s->lights[1].name, "new");
-    assert_vec(s->lights[1].position, 4, 5, 6);
-    assert_vec(s->lights[1].color, 1, 0, 0);
+    lx_test_assert_vec3(s->lights[1].position, 4, 5, 6);
+    lx_test_assert_vec3(s->lights[1].color, 1, 0, 0);
     assert_true(s->lights[1].intensity == 3.0f);
 
     /* Lumens over an overridden spot use its (possibly new) cone. */
@@ -363,7 +351,7 @@ static void test_bad_input(void **state)
 {
     (void)state;
     for (size_t i = 0; i < sizeof bad_cases / sizeof bad_cases[0]; i++) {
-        lx_scene *s = new_scene();
+        lx_scene *s = lx_test_new_scene("test");
         lx_status st = apply(s, bad_cases[i].json);
         if (st != bad_cases[i].status || !strstr(lx_last_error(), bad_cases[i].message))
             fail_msg("case %zu: %s '%s', want %s with '%s'", i, lx_status_name(st), lx_last_error(),
@@ -376,7 +364,7 @@ static void test_bad_input(void **state)
 static void test_bad_bytes(void **state)
 {
     (void)state;
-    lx_scene *s = new_scene();
+    lx_scene *s = lx_test_new_scene("test");
     const char with_nul[] = "{\"lights\": []}\0{}";
     assert_int_equal(lx_lights_json_apply_text(s, with_nul, sizeof with_nul - 1, "x.json"),
                      LX_ERR_FORMAT);
@@ -387,7 +375,7 @@ static void test_bad_bytes(void **state)
     /* A UTF-8 byte order mark is fine. */
     const char bom[] = "\xEF\xBB\xBF{\"ambient\": [1, 2, 3]}";
     assert_int_equal(lx_lights_json_apply_text(s, bom, strlen(bom), "x.json"), LX_OK);
-    assert_vec(s->ambient, 1, 2, 3);
+    lx_test_assert_vec3(s->ambient, 1, 2, 3);
     /* More than 64 MiB is refused before parsing. */
     size_t big = ((size_t)64 << 20) + 1;
     char *text = malloc(big);
@@ -403,7 +391,7 @@ static void test_bad_bytes(void **state)
 static void test_all_or_nothing(void **state)
 {
     (void)state;
-    lx_scene *s = new_scene();
+    lx_scene *s = lx_test_new_scene("test");
     assert_int_equal(apply(s, "{\"lights\": [{\"name\": \"a\", \"type\": \"point\", "
                               "\"position\": [0,0,0], \"intensity\": 2}]}"),
                      LX_OK);
@@ -416,7 +404,7 @@ static void test_all_or_nothing(void **state)
     assert_non_null(strstr(lx_last_error(), "lights[2] ('c'): intensity -1 is negative"));
     assert_int_equal(s->light_count, 1);
     assert_true(s->lights[0].intensity == 2.0f);
-    assert_vec(s->ambient, 0, 0, 0);
+    lx_test_assert_vec3(s->ambient, 0, 0, 0);
     lx_scene_destroy(s);
 }
 
@@ -426,17 +414,17 @@ static void test_all_or_nothing(void **state)
 static void test_colour_forms(void **state)
 {
     (void)state;
-    lx_scene *s = new_scene();
+    lx_scene *s = lx_test_new_scene("test");
     assert_int_equal(apply(s,
                            "{\"lights\": ["
                            "{\"type\": \"point\", \"position\": [0,1,0], \"srgb\": [0.5, 1, 0]},"
                            "{\"type\": \"point\", \"position\": [0,1,0], \"temperature\": 2700}]}"),
                      LX_OK);
     assert_int_equal(s->light_count, 2);
-    assert_vec(s->lights[0].color, 0.214041, 1.0, 0.0);
+    lx_test_assert_vec3(s->lights[0].color, 0.214041, 1.0, 0.0);
     lx_vec3 warm;
     assert_int_equal(lx_temperature_to_rgb(2700.0f, &warm), LX_OK);
-    assert_vec(s->lights[1].color, warm.x, warm.y, warm.z);
+    lx_test_assert_vec3(s->lights[1].color, warm.x, warm.y, warm.z);
     lx_scene_destroy(s);
 
     const char *bad[] = {
@@ -446,7 +434,7 @@ static void test_colour_forms(void **state)
         "\"color\": [1, 1, 1]}]}"};
     const char *say[] = {"srgb", "temperature", "not several"};
     for (int i = 0; i < 3; i++) {
-        s = new_scene();
+        s = lx_test_new_scene("test");
         assert_int_not_equal(apply(s, bad[i]), LX_OK);
         assert_non_null(strstr(lx_last_error(), say[i]));
         assert_int_equal(s->light_count, 0);
@@ -461,7 +449,7 @@ static void test_colour_forms(void **state)
 static void test_area_lights(void **state)
 {
     (void)state;
-    lx_scene *s = new_scene();
+    lx_scene *s = lx_test_new_scene("test");
     assert_int_equal(
         apply(s, "{\"lights\": ["
                  "{\"type\": \"sphere\", \"position\": [1, 1, 0], \"radius\": 0.1, "
@@ -475,7 +463,7 @@ static void test_area_lights(void **state)
     assert_int_equal(s->light_count, 3);
     const lx_light *sp = &s->lights[0];
     assert_int_equal(sp->type, LX_LIGHT_SPHERE);
-    assert_vec(sp->position, 1, 1, 0);
+    lx_test_assert_vec3(sp->position, 1, 1, 0);
     assert_true(sp->radius == 0.1f);
     assert_rel(sp->intensity, 1000.0 / (4.0 * PI_D * PI_D * 0.01), 1e-5);
     assert_int_equal(sp->shadow, LX_SHADOW_SOFT);
@@ -483,8 +471,8 @@ static void test_area_lights(void **state)
 
     const lx_light *d = &s->lights[1];
     assert_int_equal(d->type, LX_LIGHT_DISK);
-    assert_vec(d->position, 0, 3, 0);
-    assert_vec(d->direction, 0, -1, 0);
+    lx_test_assert_vec3(d->position, 0, 3, 0);
+    lx_test_assert_vec3(d->direction, 0, -1, 0);
     assert_true(d->radius == 0.3f);
     assert_rel(d->intensity, 2000.0 / (PI_D * PI_D * 0.09), 1e-5);
     assert_int_equal(d->shadow, LX_SHADOW_HARD); /* the default: one ray to the centre */
@@ -492,9 +480,9 @@ static void test_area_lights(void **state)
 
     const lx_light *r = &s->lights[2];
     assert_int_equal(r->type, LX_LIGHT_RECT);
-    assert_vec(r->position, 0, 2.5, 0);
-    assert_vec(r->direction, 0, -1, 0);
-    assert_vec(r->up, 0, 0, 1);
+    lx_test_assert_vec3(r->position, 0, 2.5, 0);
+    lx_test_assert_vec3(r->direction, 0, -1, 0);
+    lx_test_assert_vec3(r->up, 0, 0, 1);
     assert_true(r->width == 1.0f && r->height == 0.5f);
     assert_rel(r->intensity, 40.0 * 683.0 / (PI_D * 0.5), 1e-5);
     lx_scene_destroy(s);
@@ -503,7 +491,7 @@ static void test_area_lights(void **state)
      * default up (+Y, or +Z when it faces straight up or down) and a
      * given up normalized; a sphere needs no direction; sizes default to
      * 10 cm. */
-    s = new_scene();
+    s = lx_test_new_scene("test");
     assert_int_equal(
         apply(s, "{\"lights\": ["
                  "{\"type\": \"sphere\", \"position\": [0, 1, 0], \"radius\": 0.2, "
@@ -524,13 +512,13 @@ static void test_area_lights(void **state)
     assert_true(s->lights[0].intensity == 5000.0f);
     assert_true(s->lights[1].intensity == 5000.0f);
     assert_rel(s->lights[2].intensity, 100.0 / (PI_D * 0.25), 1e-5);
-    assert_vec(s->lights[3].direction, 0, 0, -1);
-    assert_vec(s->lights[3].up, 0, 1, 0);
+    lx_test_assert_vec3(s->lights[3].direction, 0, 0, -1);
+    lx_test_assert_vec3(s->lights[3].up, 0, 1, 0);
     assert_rel(s->lights[3].intensity, 10.0 / (2.0 * 0.5), 1e-6);
-    assert_vec(s->lights[4].up, 0, 0, 1);
+    lx_test_assert_vec3(s->lights[4].up, 0, 0, 1);
     assert_true(s->lights[4].width == 0.1f && s->lights[4].height == 0.1f);
     assert_true(s->lights[4].intensity == 1.0f);
-    assert_vec(s->lights[5].up, 0, 0, 1);
+    lx_test_assert_vec3(s->lights[5].up, 0, 0, 1);
     assert_rel(s->lights[5].intensity, 10.0 / PI_D, 1e-6);
     assert_int_equal(s->lights[6].type, LX_LIGHT_SPHERE);
     assert_true(s->lights[6].radius == 0.1f);
@@ -546,7 +534,7 @@ static void test_area_lights(void **state)
 static void test_point_with_radius(void **state)
 {
     (void)state;
-    lx_scene *s = new_scene();
+    lx_scene *s = lx_test_new_scene("test");
     assert_int_equal(apply(s, "{\"lights\": ["
                               "{\"type\": \"point\", \"position\": [0, 2, 0], \"radius\": 0.05, "
                               "\"intensity\": 800, \"shadow\": \"soft\", \"samples\": 8},"
@@ -558,7 +546,7 @@ static void test_point_with_radius(void **state)
                      LX_OK);
     assert_int_equal(s->light_count, 4);
     assert_int_equal(s->lights[0].type, LX_LIGHT_SPHERE);
-    assert_vec(s->lights[0].position, 0, 2, 0);
+    lx_test_assert_vec3(s->lights[0].position, 0, 2, 0);
     assert_true(s->lights[0].radius == 0.05f);
     assert_rel(s->lights[0].intensity, 800.0 / (PI_D * 0.0025), 1e-5);
     assert_int_equal(s->lights[0].shadow, LX_SHADOW_SOFT);
@@ -580,7 +568,7 @@ static void test_point_with_radius(void **state)
 static void test_area_override(void **state)
 {
     (void)state;
-    lx_scene *s = new_scene();
+    lx_scene *s = lx_test_new_scene("test");
     lx_light lamp = lx_light_defaults(LX_LIGHT_POINT);
     strcpy(lamp.name, "lamp");
     lamp.position = lx_v3(1, 2, 3);
@@ -593,7 +581,7 @@ static void test_area_override(void **state)
     assert_int_equal(s->light_count, 1);
     const lx_light *l = &s->lights[0];
     assert_int_equal(l->type, LX_LIGHT_SPHERE);
-    assert_vec(l->position, 1, 2, 3);
+    lx_test_assert_vec3(l->position, 1, 2, 3);
     assert_true(l->radius == 0.05f);
     double nits = 800.0 / (PI_D * 0.0025);
     assert_rel(l->intensity, nits, 1e-5);
@@ -625,18 +613,18 @@ static void test_area_override(void **state)
                               "\"width\": 2, \"height\": 1, \"intensity\": 100}]}"),
                      LX_OK);
     const lx_light *r = &s->lights[1];
-    assert_vec(r->up, 0, 0, 1);
+    lx_test_assert_vec3(r->up, 0, 0, 1);
     assert_int_equal(apply(s, "{\"lights\": [{\"name\": \"panel\", \"width\": 3}]}"), LX_OK);
     assert_true(r->width == 3.0f && r->height == 1.0f && r->intensity == 100.0f);
-    assert_vec(r->up, 0, 0, 1);
+    lx_test_assert_vec3(r->up, 0, 0, 1);
     assert_int_equal(apply(s, "{\"lights\": [{\"name\": \"panel\", \"direction\": [0, 0, 1]}]}"),
                      LX_OK);
-    assert_vec(r->direction, 0, 0, 1);
-    assert_vec(r->up, 0, 1, 0);
+    lx_test_assert_vec3(r->direction, 0, 0, 1);
+    lx_test_assert_vec3(r->up, 0, 1, 0);
     assert_int_equal(apply(s, "{\"lights\": [{\"name\": \"panel\", \"up\": [0, 0, -1]}]}"),
                      LX_ERR_INVALID);
     assert_non_null(strstr(lx_last_error(), "('panel'): up [0, 0, -1] is parallel to direction"));
-    assert_vec(r->up, 0, 1, 0);
+    lx_test_assert_vec3(r->up, 0, 1, 0);
     lx_scene_destroy(s);
 }
 
@@ -658,7 +646,7 @@ static void test_file(void **state)
     assert_non_null(fp);
     fputs(example, fp);
     fclose(fp);
-    lx_scene *s = new_scene();
+    lx_scene *s = lx_test_new_scene("test");
     assert_int_equal(lx_lights_json_apply(s, path), LX_OK);
     assert_int_equal(s->light_count, 4);
 
