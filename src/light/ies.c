@@ -12,44 +12,15 @@
  * lumens per lamp, candela multiplier, vertical and horizontal counts,
  * photometric type, units, width, length, height, ballast factor, ballast-
  * lamp factor ("future use" since 1995), input watts, the vertical angles,
- * the horizontal angles and the candela values, one plane after another. */
-#include "luxel/light.h"
+ * the horizontal angles and the candela values, one plane after another.
+ *
+ * Photometric types A and B are resampled onto a type C grid when loaded
+ * (ies_types.c). */
+#include "ies_internal.h"
 
 #include <math.h>
 #include <stdlib.h>
 #include <string.h>
-
-#define IES_MAX_FILE_SIZE (16u << 20)
-#define IES_MAX_ANGLES 100000
-#define IES_MAX_VALUES 4194304 /* vertical x horizontal */
-#define IES_MAX_KEYWORDS 10000
-#define IES_KEY_MAX 64
-#define IES_VALUE_MAX 256
-#define IES_ANGLE_EPS 1e-4
-#define IES_PI 3.14159265358979323846
-
-typedef struct ies_keyword {
-    char key[IES_KEY_MAX];
-    char value[IES_VALUE_MAX];
-} ies_keyword;
-
-struct lx_ies_profile {
-    char version[32];
-    ies_keyword *keywords;
-    int keyword_count;
-    bool tilt_included;
-    int lamp_count;
-    double lumens_per_lamp, multiplier, ballast_factor, ballast_lamp_factor, input_watts;
-    int photometric_type, units;
-    double width, length, height;
-    int nv, nh;
-    float *vert;  /* nv degrees, strictly increasing */
-    float *horiz; /* nh degrees, strictly increasing */
-    float *cd;    /* nh planes of nv values, scaled */
-    lx_ies_symmetry symmetry;
-    float peak;
-    int refs; /* owners: lx_ies_retain adds one, lx_ies_free drops one */
-};
 
 /* ---- the number stream --------------------------------------------------- */
 
@@ -132,9 +103,9 @@ static lx_status read_int(ies_reader *r, const char *what, long lo, long hi, int
     return LX_OK;
 }
 
-/* n strictly increasing angles in [lo, hi]. */
+/* n strictly increasing angles in [lo, hi]; note ends the range message. */
 static lx_status read_angles(ies_reader *r, const char *what, int n, double lo, double hi,
-                             float *out)
+                             const char *note, float *out)
 {
     for (int i = 0; i < n; i++) {
         double v;
@@ -142,8 +113,8 @@ static lx_status read_angles(ies_reader *r, const char *what, int n, double lo, 
         if (st != LX_OK)
             return st;
         if (v < lo || v > hi)
-            return lx_fail(LX_ERR_FORMAT, "%s: line %d: %s %d is %s, outside %g..%g", r->name,
-                           r->tok_line, what, i + 1, r->tok, lo, hi);
+            return lx_fail(LX_ERR_FORMAT, "%s: line %d: %s %d is %s, outside %g..%g%s", r->name,
+                           r->tok_line, what, i + 1, r->tok, lo, hi, note);
         if (i > 0 && !((float)v > out[i - 1]))
             return lx_fail(LX_ERR_FORMAT,
                            "%s: line %d: %s out of order: %s follows %g (angles must increase)",
@@ -271,7 +242,7 @@ static lx_status read_tilt(ies_reader *r)
     float *angles = malloc((size_t)count * sizeof *angles);
     if (!angles)
         return lx_fail(LX_ERR_NOMEM, "%s: out of memory for %d tilt angles", r->name, count);
-    st = read_angles(r, "tilt angles", count, 0.0, 180.0, angles);
+    st = read_angles(r, "tilt angles", count, 0.0, 180.0, "", angles);
     free(angles);
     for (int i = 0; st == LX_OK && i < count; i++) {
         double f;
@@ -285,29 +256,29 @@ static lx_status read_tilt(ies_reader *r)
 
 /* ---- symmetry ------------------------------------------------------------- */
 
-static bool near(float a, double b)
+bool ies_near(float a, double b)
 {
     return fabs((double)a - b) <= IES_ANGLE_EPS;
 }
 
-static lx_status classify(lx_ies_profile *p, const char *name, int vline, int hline)
+lx_status ies_classify(lx_ies_profile *p, const char *name, int vline, int hline)
 {
     double v0 = p->vert[0], v1 = p->vert[p->nv - 1];
-    if (p->nv < 2 || !((near(p->vert[0], 0) || near(p->vert[0], 90)) &&
-                       (near(p->vert[p->nv - 1], 90) || near(p->vert[p->nv - 1], 180))))
+    if (p->nv < 2 || !((ies_near(p->vert[0], 0) || ies_near(p->vert[0], 90)) &&
+                       (ies_near(p->vert[p->nv - 1], 90) || ies_near(p->vert[p->nv - 1], 180))))
         return lx_fail(LX_ERR_FORMAT,
                        "%s: line %d: vertical angles %g..%g are not 0-90, 90-180 or 0-180", name,
                        vline, v0, v1);
     double h0 = p->horiz[0], h1 = p->horiz[p->nh - 1];
-    if (p->nh == 1 && near(p->horiz[0], 0))
+    if (p->nh == 1 && ies_near(p->horiz[0], 0))
         p->symmetry = LX_IES_ROTATIONAL;
-    else if (p->nh > 1 && near(p->horiz[0], 0) && near(p->horiz[p->nh - 1], 90))
+    else if (p->nh > 1 && ies_near(p->horiz[0], 0) && ies_near(p->horiz[p->nh - 1], 90))
         p->symmetry = LX_IES_QUADRANT;
-    else if (p->nh > 1 && near(p->horiz[0], 0) && near(p->horiz[p->nh - 1], 180))
+    else if (p->nh > 1 && ies_near(p->horiz[0], 0) && ies_near(p->horiz[p->nh - 1], 180))
         p->symmetry = LX_IES_BILATERAL;
-    else if (p->nh > 1 && near(p->horiz[0], 90) && near(p->horiz[p->nh - 1], 270))
+    else if (p->nh > 1 && ies_near(p->horiz[0], 90) && ies_near(p->horiz[p->nh - 1], 270))
         p->symmetry = LX_IES_BILATERAL_90;
-    else if (p->nh > 1 && near(p->horiz[0], 0) && h1 > 180 && h1 <= 360 + IES_ANGLE_EPS)
+    else if (p->nh > 1 && ies_near(p->horiz[0], 0) && h1 > 180 && h1 <= 360 + IES_ANGLE_EPS)
         p->symmetry = LX_IES_FULL;
     else
         return lx_fail(LX_ERR_FORMAT,
@@ -372,7 +343,6 @@ static lx_status parse(lx_ies_profile *p, ies_reader *r)
                        IES_MAX_VALUES);
     if ((st = read_int(r, "photometric type", 1, 3, &p->photometric_type)) != LX_OK)
         return st;
-    int type_line = r->tok_line;
     if ((st = read_int(r, "units type", 1, 2, &p->units)) != LX_OK)
         return st;
     if ((st = read_number(r, "width", &p->width, 0, 0, NULL)) != LX_OK ||
@@ -393,10 +363,6 @@ static lx_status parse(lx_ies_profile *p, ies_reader *r)
     if ((st = read_number(r, "input watts", &d, 0, 0, NULL)) != LX_OK)
         return st;
     p->input_watts = d;
-    if (p->photometric_type != 1)
-        return lx_fail(LX_ERR_UNSUPPORTED,
-                       "%s: line %d: photometric type %s is not supported (only type C, 1)",
-                       r->name, type_line, p->photometric_type == 2 ? "B (2)" : "A (3)");
 
     p->vert = malloc((size_t)p->nv * sizeof *p->vert);
     p->horiz = malloc((size_t)p->nh * sizeof *p->horiz);
@@ -404,10 +370,18 @@ static lx_status parse(lx_ies_profile *p, ies_reader *r)
     if (!p->vert || !p->horiz || !p->cd)
         return lx_fail(LX_ERR_NOMEM, "%s: out of memory for %llu candela values", r->name,
                        (unsigned long long)total);
-    if ((st = read_angles(r, "vertical angles", p->nv, 0.0, 180.0, p->vert)) != LX_OK)
+    /* type C: vertical 0..180 from the nadir, horizontal 0..360 around it;
+     * types A and B: both -90..90 from the beam axis */
+    bool type_c = p->photometric_type == 1;
+    const char *note =
+        type_c ? ""
+               : (p->photometric_type == 2 ? " for photometric type B" : " for photometric type A");
+    if ((st = read_angles(r, "vertical angles", p->nv, type_c ? 0.0 : -90.0, type_c ? 180.0 : 90.0,
+                          note, p->vert)) != LX_OK)
         return st;
     int vline = r->tok_line;
-    if ((st = read_angles(r, "horizontal angles", p->nh, 0.0, 360.0, p->horiz)) != LX_OK)
+    if ((st = read_angles(r, "horizontal angles", p->nh, type_c ? 0.0 : -90.0,
+                          type_c ? 360.0 : 90.0, note, p->horiz)) != LX_OK)
         return st;
     int hline = r->tok_line;
     double scale = p->multiplier * p->ballast_factor * p->ballast_lamp_factor;
@@ -432,7 +406,9 @@ static lx_status parse(lx_ies_profile *p, ies_reader *r)
         return lx_fail(LX_ERR_FORMAT,
                        "%s: line %d: unexpected '%.20s' after the %llu candela values", r->name,
                        r->tok_line, r->tok, (unsigned long long)total);
-    return classify(p, r->name, vline, hline);
+    if (!type_c)
+        return ies_convert_ab(p, r->name, vline, hline);
+    return ies_classify(p, r->name, vline, hline);
 }
 
 lx_status lx_ies_parse(const char *text, size_t size, const char *name, lx_ies_profile **out)
@@ -495,13 +471,15 @@ void lx_ies_free(lx_ies_profile *p)
     free(p->vert);
     free(p->horiz);
     free(p->cd);
+    free(p->file_vert);
+    free(p->file_horiz);
     free(p);
 }
 
 /* ---- evaluation ----------------------------------------------------------- */
 
 /* Index i and weight t with a[i] <= x <= a[i+1] (n >= 2, a[0] <= x <= a[n-1]). */
-static void bracket(const float *a, int n, float x, int *i, float *t)
+void ies_bracket(const float *a, int n, float x, int *i, float *t)
 {
     int lo = 0, hi = n - 1;
     while (hi - lo > 1) {
@@ -555,14 +533,9 @@ static void horizontal_weights(const lx_ies_profile *p, float h, int *h0, int *h
     float lo = p->horiz[0], hi = p->horiz[p->nh - 1];
     h = h < lo ? lo : (h > hi ? hi : h);
     int i;
-    bracket(p->horiz, p->nh, h, &i, t);
+    ies_bracket(p->horiz, p->nh, h, &i, t);
     *h0 = i;
     *h1 = i + 1;
-}
-
-static float lerp(float a, float b, float t)
-{
-    return a + (b - a) * t;
 }
 
 static float candela_at(const lx_ies_profile *p, float v, int h0, int h1, float th)
@@ -571,12 +544,12 @@ static float candela_at(const lx_ies_profile *p, float v, int h0, int h1, float 
         return 0.0f;
     int i;
     float tv;
-    bracket(p->vert, p->nv, v, &i, &tv);
+    ies_bracket(p->vert, p->nv, v, &i, &tv);
     const float *a = p->cd + (size_t)h0 * (size_t)p->nv;
     const float *b = p->cd + (size_t)h1 * (size_t)p->nv;
-    float ca = lerp(a[i], a[i + 1], tv);
-    float cb = lerp(b[i], b[i + 1], tv);
-    return lerp(ca, cb, th);
+    float ca = ies_lerp(a[i], a[i + 1], tv);
+    float cb = ies_lerp(b[i], b[i + 1], tv);
+    return ies_lerp(ca, cb, th);
 }
 
 float lx_ies_candela(const lx_ies_profile *p, float vertical_deg, float horizontal_deg)
@@ -654,10 +627,10 @@ void lx_ies_get_info(const lx_ies_profile *p, lx_ies_info *out)
     out->width = p->width;
     out->length = p->length;
     out->height = p->height;
-    out->vertical_count = p->nv;
-    out->horizontal_count = p->nh;
-    out->vertical_angles = p->vert;
-    out->horizontal_angles = p->horiz;
+    out->vertical_count = p->file_vert ? p->file_nv : p->nv;
+    out->horizontal_count = p->file_vert ? p->file_nh : p->nh;
+    out->vertical_angles = p->file_vert ? p->file_vert : p->vert;
+    out->horizontal_angles = p->file_vert ? p->file_horiz : p->horiz;
     out->symmetry = p->symmetry;
 }
 

@@ -4,7 +4,8 @@
  * values worked out by hand, total lumens against closed forms (isotropic
  * 4 pi I, cosine pi I0, hemisphere 2 pi I, a linear ramp 200 pi - 400), the
  * multiplier and ballast factors, and every malformed case with its status
- * and the line its message names. */
+ * and the line its message names. Photometric types A and B:
+ * test_ies_types.c. */
 #include <stdarg.h>
 #include <stddef.h>
 #include <setjmp.h>
@@ -476,14 +477,6 @@ static void test_bad_counts(void **state)
                 "number of tilt angles");
 }
 
-static void test_types_a_b(void **state)
-{
-    parse_fails(HEAD "1 -1 1 2 1 2 2 0 0 0\n1 1 0\n-90 90\n0\n1 2\n", LX_ERR_UNSUPPORTED, "line 4",
-                "photometric type B");
-    parse_fails(HEAD "1 -1 1 2 1 3 2 0 0 0\n1 1 0\n-90 90\n0\n1 2\n", LX_ERR_UNSUPPORTED, "line 4",
-                "photometric type A");
-}
-
 static void test_garbage(void **state)
 {
     parse_fails("", LX_ERR_FORMAT, "no TILT= line", NULL);
@@ -533,7 +526,6 @@ int main(void)
         cmocka_unit_test(test_bad_symmetry),
         cmocka_unit_test(test_tilt),
         cmocka_unit_test(test_bad_counts),
-        cmocka_unit_test(test_types_a_b),
         cmocka_unit_test(test_garbage),
     };
     return cmocka_run_group_tests(tests, NULL, NULL);

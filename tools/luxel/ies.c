@@ -3,7 +3,9 @@
  * planes) and, with --plot, the polar candela curve of the C0-C180 and
  * C90-C270 planes. Beam angle: the full angle between the two directions of
  * a plane where the intensity is 50% of that plane's maximum (IES/CIE
- * beam spread). */
+ * beam spread). Type A and B files are shown as the library converts them
+ * to type C (docs/ies.md): their C0-C180 plane holds the vertical angles,
+ * C90-C270 the horizontal ones. */
 #define _POSIX_C_SOURCE 200809L
 #include "cli.h"
 
@@ -229,7 +231,10 @@ int cmd_ies(int argc, char **argv)
            in.units == 1 ? "ft" : "m");
     print_angles("vertical angles", in.vertical_count, in.vertical_angles);
     print_angles("horizontal angles", in.horizontal_count, in.horizontal_angles);
-    printf("symmetry: %s\n", lx_ies_symmetry_name(in.symmetry));
+    /* a type A or B file is converted to type C on loading: its symmetry is
+     * the converted distribution's */
+    printf("symmetry: %s%s\n", lx_ies_symmetry_name(in.symmetry),
+           in.photometric_type == 1 ? "" : " (after conversion to type C)");
     printf("total lumens: %.6g lm (integrated)\n", lx_ies_total_lumens(p));
     printf("peak candela: %.6g cd\n", lx_ies_peak_candela(p));
     print_beam("C0-C180", beam_angle(p, 0.0f));
