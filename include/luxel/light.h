@@ -45,7 +45,9 @@ typedef enum lx_light_type {
     LX_LIGHT_DIRECTIONAL,
     LX_LIGHT_SPHERE, /* area lights: intensity is luminance in nits */
     LX_LIGHT_DISK,
-    LX_LIGHT_RECT
+    LX_LIGHT_RECT,
+    LX_LIGHT_TUBE /* a capsule along direction; radius 0: a linear light, intensity
+                     in cd per metre across its axis */
 } lx_light_type;
 
 typedef enum lx_shadow_mode {
@@ -93,8 +95,10 @@ typedef struct lx_light {
     float blur_multiplier; /* seed's blur scale, default 1 */
     lx_vec3 ambient;       /* lux added everywhere in range, falling off with range */
     bool dynamic;          /* re-evaluated by lx_baker_update instead of baked */
-    /* area lights (sphere, disk, rect); direction is the emitting side */
-    float radius;        /* metres: sphere, disk */
+    /* area lights (sphere, disk, rect, tube); direction is the emitting side
+     * (a tube's axis) */
+    float radius;        /* metres: sphere, disk, tube (0: a linear tube) */
+    float length;        /* metres: tube, between its cap centres */
     float width, height; /* metres: rect, width along cross(up, direction) */
     lx_vec3 up;          /* rect: fixes its rotation about direction */
     uint32_t samples;    /* soft shadows: points on the light per texel, 0 = 16 */
@@ -109,12 +113,18 @@ typedef struct lx_light {
 
 #define LX_MAX_LIGHT_SAMPLES 1024u
 
-/* True for the area light types (sphere, disk, rect). */
+/* True for the area light types (sphere, disk, rect, tube). */
 bool lx_light_is_area(const lx_light *light);
 
 /* A point on an area light's surface from two numbers in [0,1) (uniform
- * in area), with the surface normal there; for soft shadows. */
+ * in area), with the surface normal there; for soft shadows. A linear tube
+ * (radius 0) gives a point uniform along its segment and a zero normal. */
 lx_vec3 lx_area_light_point(const lx_light *light, float u, float v, lx_vec3 *normal);
+
+/* The area an area light shows along its axis (a tube: across it), in m^2:
+ * candela = luminance * this. pi r^2 for a sphere or disk, W H for a rect,
+ * 2 r length + pi r^2 for a tube (0 for a linear tube and other types). */
+double lx_area_light_projected_area(const lx_light *light);
 
 /* The rect's four corners, counter-clockwise seen from the emitting side. */
 void lx_rect_light_corners(const lx_light *light, lx_vec3 corners[4]);
@@ -186,8 +196,9 @@ lx_vec3 lx_srgb_color_to_linear(lx_vec3 srgb);
 /* A luminaire's candela distribution read from an IES LM-63 file (1986,
  * 1991, 1995 and 2002 variants), in photometric type C: vertical angle 0 is
  * straight down the luminaire's axis (nadir), horizontal angles go around
- * it. Candela values already include the candela multiplier and the
- * ballast factors. */
+ * it. Type A and B files are resampled to type C when read, their beam
+ * axis on the nadir (docs/ies.md). Candela values already include the
+ * candela multiplier and the ballast factors. */
 typedef struct lx_ies_profile lx_ies_profile;
 
 /* Reads an IES file; errors name the file and line. */
@@ -237,7 +248,7 @@ typedef struct lx_ies_info {
     int vertical_count, horizontal_count;
     const float *vertical_angles;   /* degrees, increasing; borrowed until lx_ies_free */
     const float *horizontal_angles; /* degrees, increasing; borrowed until lx_ies_free */
-    lx_ies_symmetry symmetry;
+    lx_ies_symmetry symmetry;       /* types A and B: of the converted type C distribution */
 } lx_ies_info;
 
 /* Fills out with the profile's header; pointers are borrowed until
@@ -288,6 +299,31 @@ float lx_polygon_light_illuminance(const lx_vec3 *vertices, int count, float lum
 /* A one-sided rectangle (any planar quadrilateral) given by its 4 corners,
  * counter-clockwise seen from its emitting side: the polygon form factor. */
 float lx_rect_light_illuminance(const lx_vec3 corners[4], float luminance, lx_vec3 p, lx_vec3 n);
+
+/* A linear light: the segment a..b, every metre of it a Lambertian line
+ * element of intensity_per_metre candela across the segment (and
+ * intensity_per_metre sin(alpha) at an angle alpha from it). Exact in
+ * closed form, over the part of the segment above p's horizon; 0 for points
+ * on the segment's line. */
+float lx_line_light_illuminance(lx_vec3 a, lx_vec3 b, float intensity_per_metre, lx_vec3 p,
+                                lx_vec3 n);
+
+/* A tube: a cylinder of radius and length along the unit axis, centred on
+ * centre, with hemispherical caps, of luminance L. Its intensity toward a
+ * direction at alpha from the axis is L (2 r length sin(alpha) + pi r^2):
+ * the cylinder is a line of 2 r L candela per metre, shifted along the
+ * axis by r cot(alpha) at each end as the end circles' ellipses shift the
+ * side's visible band, and each cap a sphere light at its end weighted by
+ * the share of its disk it shows, (1 + cos beta) / 2 at beta from its
+ * pole. Exact for length 0 (a sphere), on the axis beyond an end, and as
+ * radius / distance goes to 0. Against a quadrature of the capsule's
+ * surface (tests/light/test_area.c): within 1.5% at 5 radii and more from
+ * the tube; seen nearly end-on from just off the axis line, where the near
+ * cap hides most of the side, within 8%. A receiver whose horizon passes
+ * through the tube misses the grazing sliver of side above it (about 1% of
+ * what the point would get facing the tube). */
+float lx_tube_light_illuminance(lx_vec3 centre, lx_vec3 axis, float length, float radius,
+                                float luminance, lx_vec3 p, lx_vec3 n);
 
 typedef enum lx_area_shape {
     LX_AREA_SPHERE = 0, /* radius */

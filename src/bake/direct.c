@@ -64,7 +64,12 @@ static float soft_visibility(const lx_baker *b, uint32_t map_index, const lx_lig
             lx_vec3 q = lx_area_light_point(light, u, v, &nq);
             lx_vec3 d = lx_sub(q, p);
             float d2 = lx_dot(d, d);
-            float w = fmaxf(lx_dot(n, d), 0.0f) * fmaxf(-lx_dot(nq, d), 0.0f) / (d2 * d2);
+            /* cos at the texel times cos at the light over d^2 (d is not
+             * unit); a linear tube's zero normal stands for its element's
+             * sin(alpha), |axis x d| / |d| */
+            float facing = lx_dot(nq, nq) > 0.0f ? fmaxf(-lx_dot(nq, d), 0.0f)
+                                                 : lx_length(lx_cross(light->direction, d));
+            float w = fmaxf(lx_dot(n, d), 0.0f) * facing / (d2 * d2);
             if (!(w > 0.0f) || !isfinite(w))
                 continue;
             float dist = sqrtf(d2);

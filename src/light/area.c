@@ -19,6 +19,13 @@
  *   analytically: the integrand is (A + B cos t + C sin t) / (a + b cos t +
  *   c sin t), whose antiderivative is elementary; the chord cut by the
  *   horizon is one more Lambert edge.
+ * - Line: the inverse-square, cosine-weighted integral of a Lambertian line
+ *   element (intensity I sin(alpha)) along the segment, which has an
+ *   elementary antiderivative; the horizon clips the segment at one point.
+ *   A tube is that line with 2 r L per metre (the cylinder's projected
+ *   width) plus a sphere light at each end weighted by the share of its
+ *   disk the cap shows, (1 + cos beta) / 2 (Frostbite 2014 section 4.7.4
+ *   also builds tubes from a cylinder and a sphere).
  * - Luminance from power: Filament's area-light conversions (seed 001;
  *   Frostbite 2014 section 4.7.1), L = P / (pi A) with A the emitting area.
  * Everything is computed in double and returned as float. */
@@ -277,6 +284,106 @@ float lx_disk_light_illuminance(lx_vec3 centre, lx_vec3 normal, float radius, fl
     }
     double e = 0.5 * luminance * sum;
     return e > 0.0 ? (float)e : 0.0f;
+}
+
+/* ---- line and tube ---------------------------------------------------------- */
+
+/* Along the line q(s) = p + D_perp + s w (s measured from the foot of the
+ * perpendicular from p, h = |D_perp|), an element of intensity I sin(alpha)
+ * gives I sin(alpha) cos(theta_n) / d^2 = I h (A + B s) / (s^2 + h^2)^2
+ * with A = n . D_perp and B = n . w (sin(alpha) = h / d, and A + B s is the
+ * element's height above the receiver's plane). The antiderivative of that
+ * over I, times h. */
+static double line_integral(double A, double B, double h, double s)
+{
+    double q = s * s + h * h;
+    return A * (s / (2.0 * h * q) + atan(s / h) / (2.0 * h * h)) - h * B / (2.0 * q);
+}
+
+float lx_line_light_illuminance(lx_vec3 a, lx_vec3 b, float intensity_per_metre, lx_vec3 p,
+                                lx_vec3 n)
+{
+    if (!(intensity_per_metre > 0.0f))
+        return 0.0f;
+    dvec3 seg = dsub(b, a);
+    double len = sqrt(ddot(seg, seg));
+    dvec3 nn = dnormalize(dfrom(n));
+    if (!(len > 0.0) || ddot(nn, nn) == 0.0)
+        return 0.0f;
+    dvec3 w = dscale(seg, 1.0 / len);
+    dvec3 D = dsub(a, p);
+    double along = ddot(w, D); /* s of the segment's start */
+    dvec3 perp = dmadd(D, w, -along);
+    double h = sqrt(ddot(perp, perp));
+    /* on the line itself every element is seen edge-on */
+    if (!(h > 1e-9 * (len + sqrt(ddot(D, D)))))
+        return 0.0f;
+    double A = ddot(nn, perp), B = ddot(nn, w);
+    /* the part above the horizon: A + B s > 0 for s in [s0, s1] */
+    double s0 = along, s1 = along + len;
+    if (B > 0.0) {
+        s0 = fmax(s0, -A / B);
+    } else if (B < 0.0) {
+        s1 = fmin(s1, -A / B);
+    } else if (!(A > 0.0)) {
+        return 0.0f;
+    }
+    if (!(s1 > s0))
+        return 0.0f;
+    double e = line_integral(A, B, h, s1) - line_integral(A, B, h, s0);
+    return e > 0.0 ? (float)(intensity_per_metre * e) : 0.0f;
+}
+
+float lx_tube_light_illuminance(lx_vec3 centre, lx_vec3 axis, float length, float radius,
+                                float luminance, lx_vec3 p, lx_vec3 n)
+{
+    if (!(radius > 0.0f) || !(luminance > 0.0f) || !(length >= 0.0f))
+        return 0.0f;
+    lx_vec3 w = lx_normalize(axis);
+    lx_vec3 half = lx_scale(w, 0.5f * length);
+    lx_vec3 ends[2] = {lx_sub(centre, half), lx_add(centre, half)};
+    /* Each cap is a hemisphere; seen at beta from its pole it shows
+     * pi r^2 (1 + cos beta) / 2 outside the cylinder's band, so it is a
+     * sphere light at its end weighted by that share: half each across the
+     * axis, all of the near cap end-on (and the power stays exact). */
+    double caps = 0.0, cos_beta[2];
+    for (int i = 0; i < 2; i++) {
+        lx_vec3 to_p = lx_sub(p, ends[i]);
+        float d = lx_length(to_p);
+        cos_beta[i] = d > 0.0f ? (double)((i ? 1.0f : -1.0f) * lx_dot(to_p, w) / d) : 1.0;
+        caps += 0.5 * (1.0 + cos_beta[i]) *
+                (double)lx_sphere_light_illuminance(ends[i], radius, luminance, p, n);
+    }
+    if (!(length > 0.0f))
+        return (float)caps;
+    /* The side: a line of 2 r L per metre, seen only from outside its
+     * infinite extension. Seen at alpha from the axis, each end circle
+     * shows as an ellipse that shifts the side's visible band away from the
+     * viewer by r cot(alpha) along the axis: under the near cap at the near
+     * end, past the far cap at the far end. The line is shifted the same
+     * way at each end, which changes nothing far away and removes the side
+     * behind the near cap when seen end-on. */
+    lx_vec3 rel = lx_sub(p, centre);
+    float along = lx_dot(rel, w);
+    float h2 = lx_dot(rel, rel) - along * along;
+    if (!(h2 > radius * radius))
+        return (float)caps;
+    double h = sqrt(h2), shifted[2];
+    for (int i = 0; i < 2; i++) {
+        double t = (i ? 0.5 : -0.5) * length; /* the end along the axis */
+        double cot = (t - along) / h;         /* at that end, signed away from p */
+        shifted[i] = t + radius * cot;
+    }
+    if (!(shifted[1] > shifted[0]))
+        return (float)caps;
+    /* A receiver whose horizon cuts through the tube sees the side's upper
+     * part; the line, on the axis, gives it only when the axis is above. It
+     * is a grazing sliver: about 1% of what the same point gets facing the
+     * tube (tests/light/test_area.c). */
+    double side = lx_line_light_illuminance(lx_madd(centre, w, (float)shifted[0]),
+                                            lx_madd(centre, w, (float)shifted[1]),
+                                            2.0f * radius * luminance, p, n);
+    return (float)(caps + side);
 }
 
 /* ---- luminance from power --------------------------------------------------- */

@@ -39,7 +39,10 @@ lx_light lx_light_defaults(lx_light_type type)
     l.ambient = lx_v3(0.0f, 0.0f, 0.0f);
     l.dynamic = false;
     /* area lights: 10 cm, facing down with up = +Z */
-    l.radius = type == LX_LIGHT_SPHERE || type == LX_LIGHT_DISK ? 0.1f : 0.0f;
+    l.radius = type == LX_LIGHT_SPHERE || type == LX_LIGHT_DISK ? 0.1f
+               : type == LX_LIGHT_TUBE                          ? 0.02f
+                                                                : 0.0f;
+    l.length = type == LX_LIGHT_TUBE ? 1.0f : 0.0f;
     l.width = l.height = type == LX_LIGHT_RECT ? 0.1f : 0.0f;
     l.up = lx_v3(0.0f, 0.0f, 1.0f);
     l.samples = 0;
@@ -49,7 +52,7 @@ lx_light lx_light_defaults(lx_light_type type)
 bool lx_light_is_area(const lx_light *light)
 {
     return light->type == LX_LIGHT_SPHERE || light->type == LX_LIGHT_DISK ||
-           light->type == LX_LIGHT_RECT;
+           light->type == LX_LIGHT_RECT || light->type == LX_LIGHT_TUBE;
 }
 
 /* The rect's axes: x along its width, y along its height, x cross y = the
@@ -72,15 +75,51 @@ void lx_rect_light_corners(const lx_light *light, lx_vec3 corners[4])
     corners[3] = lx_add(lx_sub(light->position, hx), hy);
 }
 
+/* A unit vector uniform on the sphere from u, v in [0,1). */
+static lx_vec3 sphere_direction(float u, float v)
+{
+    float phi = 2.0f * LX_PI * v;
+    float z = 1.0f - 2.0f * u, r = sqrtf(fmaxf(0.0f, 1.0f - z * z));
+    return lx_v3(r * cosf(phi), r * sinf(phi), z);
+}
+
+/* A tube's surface, uniform in area: u first picks the cylinder (its share
+ * of the area, 2 pi r L / (2 pi r L + 4 pi r^2)) or a cap, then places the
+ * point within it, so stratification in u carries over. */
+static lx_vec3 tube_point(const lx_light *light, float u, float v, lx_vec3 *normal)
+{
+    lx_vec3 axis = light->direction;
+    float half = 0.5f * light->length, r = light->radius;
+    if (!(r > 0.0f)) {
+        *normal = lx_v3(0.0f, 0.0f, 0.0f);
+        return lx_madd(light->position, axis, (2.0f * u - 1.0f) * half);
+    }
+    float side = light->length / (light->length + 2.0f * r);
+    if (u < side) {
+        lx_vec3 t = lx_perpendicular(axis), b = lx_cross(axis, t);
+        float phi = 2.0f * LX_PI * v;
+        *normal = lx_add(lx_scale(t, cosf(phi)), lx_scale(b, sinf(phi)));
+        lx_vec3 centre = lx_madd(light->position, axis, (2.0f * u / side - 1.0f) * half);
+        return lx_madd(centre, *normal, r);
+    }
+    /* caps: the rest of u covers the whole sphere; each hemisphere sits on
+     * the end it faces */
+    lx_vec3 d = sphere_direction((u - side) / (1.0f - side), v);
+    *normal = d;
+    float end = lx_dot(d, axis) >= 0.0f ? half : -half;
+    return lx_madd(lx_madd(light->position, axis, end), d, r);
+}
+
 lx_vec3 lx_area_light_point(const lx_light *light, float u, float v, lx_vec3 *normal)
 {
     float phi = 2.0f * LX_PI * v;
     if (light->type == LX_LIGHT_SPHERE) {
-        float z = 1.0f - 2.0f * u, r = sqrtf(fmaxf(0.0f, 1.0f - z * z));
-        lx_vec3 d = lx_v3(r * cosf(phi), r * sinf(phi), z);
+        lx_vec3 d = sphere_direction(u, v);
         *normal = d;
         return lx_madd(light->position, d, light->radius);
     }
+    if (light->type == LX_LIGHT_TUBE)
+        return tube_point(light, u, v, normal);
     *normal = light->direction;
     if (light->type == LX_LIGHT_DISK) {
         lx_vec3 t = lx_perpendicular(light->direction), b = lx_cross(light->direction, t);
@@ -126,6 +165,14 @@ static bool evaluate_area(const lx_light *light, lx_vec3 p, lx_vec3 n, lx_light_
         e = lx_sphere_light_illuminance(light->position, light->radius, light->intensity, p, n);
     } else if (light->type == LX_LIGHT_DISK) {
         e = lx_disk_light_illuminance(light->position, light->direction, light->radius,
+                                      light->intensity, p, n);
+    } else if (light->type == LX_LIGHT_TUBE && light->radius > 0.0f) {
+        e = lx_tube_light_illuminance(light->position, light->direction, light->length,
+                                      light->radius, light->intensity, p, n);
+    } else if (light->type == LX_LIGHT_TUBE) {
+        /* linear: intensity is candela per metre across the axis */
+        lx_vec3 half = lx_scale(light->direction, 0.5f * light->length);
+        e = lx_line_light_illuminance(lx_sub(light->position, half), lx_add(light->position, half),
                                       light->intensity, p, n);
     } else {
         lx_vec3 corners[4];
@@ -194,7 +241,7 @@ static lx_status validate_area(const lx_light *light)
     }
     if (!lx_light_is_area(light)) {
         if (light->shadow == LX_SHADOW_SOFT)
-            return invalid(light, "soft shadows need an area light (sphere, disk or rect)");
+            return invalid(light, "soft shadows need an area light (sphere, disk, rect or tube)");
         return LX_OK;
     }
     if (light->model == LX_MODEL_CLASSIC)
@@ -206,6 +253,13 @@ static lx_status validate_area(const lx_light *light)
         lx_vec3 side = lx_cross(light->up, light->direction);
         if (!lx_vec3_finite(light->up) || !(lx_length(side) > 1e-6f))
             return invalid(light, "a rect light's up must be finite and not along its direction");
+    } else if (light->type == LX_LIGHT_TUBE) {
+        if (!(light->radius >= 0.0f && isfinite(light->radius)))
+            return invalid(light, "a tube light needs a finite radius of 0 or more");
+        if (!(light->length >= 0.0f && isfinite(light->length)))
+            return invalid(light, "a tube light needs a finite length of 0 or more");
+        if (!(light->radius > 0.0f) && !(light->length > 0.0f))
+            return invalid(light, "a linear tube light (radius 0) needs a length above 0");
     } else if (!(light->radius > 0.0f && isfinite(light->radius))) {
         return invalid(light, "a sphere or disk light needs a finite radius above 0");
     }
@@ -220,7 +274,7 @@ lx_status lx_light_validate(const lx_light *light)
         return lx_fail(LX_ERR_INVALID, "light: NULL pointer");
     if (!memchr(light->name, '\0', sizeof light->name))
         return invalid(light, "name is not NUL-terminated within LX_LIGHT_NAME_MAX bytes");
-    if ((unsigned)light->type > (unsigned)LX_LIGHT_RECT) {
+    if ((unsigned)light->type > (unsigned)LX_LIGHT_TUBE) {
         snprintf(msg, sizeof msg, "type %d is not a light type", (int)light->type);
         return invalid(light, msg);
     }

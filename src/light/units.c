@@ -24,12 +24,56 @@ static void light_label(const lx_light *light, char *buf, size_t size)
         snprintf(buf, size, "light '%.*s'", n, light->name);
 }
 
+/* A linear tube (radius 0) carries candela per metre across its axis,
+ * I_l: its intensity at alpha from the axis is I_l L sin(alpha), so its
+ * power is I_l L pi^2 (the integral of sin(alpha) over the sphere). Candela
+ * is the whole tube's intensity across the axis. */
+static lx_status linear_to_native(const lx_light *light, const char *who, float value,
+                                  lx_light_unit unit, float *native)
+{
+    if (unit == LX_UNIT_NIT)
+        return lx_fail(LX_ERR_INVALID,
+                       "%s: a linear tube (radius 0) has no area for nt; give cd, lm or W", who);
+    if (!(light->length > 0.0f) || !isfinite(light->length))
+        return lx_fail(LX_ERR_INVALID, "%s: a linear tube needs its length first", who);
+    double per_metre;
+    if (unit == LX_UNIT_DEFAULT || unit == LX_UNIT_CANDELA) {
+        per_metre = (double)value / light->length;
+    } else {
+        double lumens = unit == LX_UNIT_WATT ? (double)value * LX_LUMENS_PER_WATT : (double)value;
+        per_metre = lumens / (LX_PI_D * LX_PI_D * light->length);
+    }
+    if (!(per_metre <= 3.4028234663852886e38))
+        return lx_fail(LX_ERR_INVALID, "%s: intensity %g %s overflows as cd per metre", who, value,
+                       lx_light_unit_symbol(unit));
+    *native = (float)per_metre;
+    return LX_OK;
+}
+
+double lx_area_light_projected_area(const lx_light *light)
+{
+    double r = light->radius;
+    switch (light->type) {
+    case LX_LIGHT_RECT:
+        return (double)light->width * light->height;
+    case LX_LIGHT_TUBE:
+        return 2.0 * r * light->length + LX_PI_D * r * r;
+    case LX_LIGHT_SPHERE:
+    case LX_LIGHT_DISK:
+        return LX_PI_D * r * r;
+    default:
+        return 0.0;
+    }
+}
+
 /* Area lights carry luminance (nits): power goes through the emitting
  * area (issue 3's formulas, lx_area_light_luminance_from_power), candela
  * through the area seen along the axis. */
 static lx_status area_to_native(const lx_light *light, const char *who, float value,
                                 lx_light_unit unit, float *native)
 {
+    if (light->type == LX_LIGHT_TUBE && !(light->radius > 0.0f))
+        return linear_to_native(light, who, value, unit, native);
     if (unit == LX_UNIT_DEFAULT || unit == LX_UNIT_NIT) {
         *native = value;
         return LX_OK;
@@ -39,18 +83,17 @@ static lx_status area_to_native(const lx_light *light, const char *who, float va
                        lx_light_type_name(light->type));
     lx_area_shape shape = light->type == LX_LIGHT_SPHERE ? LX_AREA_SPHERE
                           : light->type == LX_LIGHT_DISK ? LX_AREA_DISK
+                          : light->type == LX_LIGHT_TUBE ? LX_AREA_TUBE
                                                          : LX_AREA_RECT;
     if (unit == LX_UNIT_CANDELA) {
-        double projected = light->type == LX_LIGHT_RECT
-                               ? (double)light->width * light->height
-                               : LX_PI_D * light->radius * light->radius;
+        double projected = lx_area_light_projected_area(light);
         if (!(projected > 0.0) || !isfinite(projected))
             return lx_fail(LX_ERR_INVALID, "%s: candela needs the light's size first", who);
         *native = (float)(value / projected);
         return LX_OK;
     }
     float lumens = unit == LX_UNIT_WATT ? value * LX_LUMENS_PER_WATT : value;
-    lx_status st = lx_area_light_luminance_from_power(shape, lumens, light->radius, 0.0f,
+    lx_status st = lx_area_light_luminance_from_power(shape, lumens, light->radius, light->length,
                                                       light->width, light->height, native);
     if (st != LX_OK)
         lx_error_prefix(who);
@@ -142,8 +185,8 @@ lx_light_unit lx_light_unit_from_string(const char *s)
         {"cd", LX_UNIT_CANDELA}, {"candela", LX_UNIT_CANDELA}, {"candelas", LX_UNIT_CANDELA},
         {"lm", LX_UNIT_LUMEN},   {"lumen", LX_UNIT_LUMEN},     {"lumens", LX_UNIT_LUMEN},
         {"W", LX_UNIT_WATT},     {"watt", LX_UNIT_WATT},       {"watts", LX_UNIT_WATT},
-        {"lx", LX_UNIT_LUX},     {"lux", LX_UNIT_LUX},
-        {"nt", LX_UNIT_NIT},     {"nit", LX_UNIT_NIT},         {"nits", LX_UNIT_NIT},
+        {"lx", LX_UNIT_LUX},     {"lux", LX_UNIT_LUX},         {"nt", LX_UNIT_NIT},
+        {"nit", LX_UNIT_NIT},    {"nits", LX_UNIT_NIT},
     };
     if (!s)
         return LX_UNIT_DEFAULT;
@@ -187,6 +230,8 @@ const char *lx_light_type_name(lx_light_type type)
         return "disk";
     case LX_LIGHT_RECT:
         return "rect";
+    case LX_LIGHT_TUBE:
+        return "tube";
     }
     return "unknown";
 }

@@ -224,9 +224,10 @@ static const char *const light_keys[] = {"name",        "type",
                                          "width",       "height",
                                          "up",          "samples",
                                          "ies",         "masked",
-                                         "multiplier"};
+                                         "length",      "multiplier"};
 /* Indexed by lx_light_type and lx_shadow_mode. */
-static const char *const type_names[] = {"point", "spot", "directional", "sphere", "disk", "rect"};
+static const char *const type_names[] = {"point", "spot", "directional", "sphere",
+                                         "disk",  "rect", "tube"};
 static const char *const shadow_names[] = {"hard", "none", "blur", "soft"};
 static const char *const model_names[] = {"physical", "classic"};
 static const char *const conversion_names[] = {"pi", "cone"};
@@ -252,20 +253,36 @@ static lx_status restate(const ctx *c, lx_status st, const lx_light *l)
 
 static bool is_area_type(lx_light_type t)
 {
-    return t == LX_LIGHT_SPHERE || t == LX_LIGHT_DISK || t == LX_LIGHT_RECT;
+    return t == LX_LIGHT_SPHERE || t == LX_LIGHT_DISK || t == LX_LIGHT_RECT || t == LX_LIGHT_TUBE;
 }
 
 static bool has_radius(lx_light_type t)
 {
-    return t == LX_LIGHT_SPHERE || t == LX_LIGHT_DISK;
+    return t == LX_LIGHT_SPHERE || t == LX_LIGHT_DISK || t == LX_LIGHT_TUBE;
 }
 
-/* The unit intensity is kept in: candela, lux or nits. */
+/* The unit a value without "unit" is in: candela, lux or nits; a tube's
+ * depends on its radius (nits, or candela when linear), so it is left to
+ * lx_light_intensity_to_native. */
 static lx_light_unit native_unit(lx_light_type t)
 {
     return t == LX_LIGHT_DIRECTIONAL ? LX_UNIT_LUX
+           : t == LX_LIGHT_TUBE      ? LX_UNIT_DEFAULT
            : is_area_type(t)         ? LX_UNIT_NIT
                                      : LX_UNIT_CANDELA;
+}
+
+/* What an lx_light's intensity means: lux, candela, nits or, for a linear
+ * tube, candela per metre. */
+typedef enum { KIND_LUX, KIND_CANDELA, KIND_NIT, KIND_CANDELA_PER_METRE } intensity_kind;
+
+static intensity_kind kind_of(const lx_light *l)
+{
+    if (l->type == LX_LIGHT_DIRECTIONAL)
+        return KIND_LUX;
+    if (l->type == LX_LIGHT_TUBE && !(l->radius > 0.0f))
+        return KIND_CANDELA_PER_METRE;
+    return is_area_type(l->type) ? KIND_NIT : KIND_CANDELA;
 }
 
 /* Changes l's type; the sizes the new type uses and the old one did not
@@ -275,6 +292,10 @@ static void change_type(lx_light *l, lx_light_type type)
     lx_light d = lx_light_defaults(type);
     if (!(has_radius(l->type) && has_radius(type)))
         l->radius = d.radius;
+    if (type != LX_LIGHT_TUBE)
+        l->length = 0.0f;
+    else if (l->type != LX_LIGHT_TUBE)
+        l->length = d.length;
     if (!(l->type == LX_LIGHT_RECT && type == LX_LIGHT_RECT)) {
         l->width = d.width;
         l->height = d.height;
@@ -315,14 +336,24 @@ static lx_status read_area(const ctx *c, const cJSON *obj, bool new_shape, lx_li
         }
         if (l->type != LX_LIGHT_POINT && !has_radius(l->type))
             return fail(c, LX_ERR_INVALID,
-                        "radius is for sphere, disk and point lights, not a %s light",
+                        "radius is for sphere, disk, tube and point lights, not a %s light",
                         lx_light_type_name(l->type));
-        if (has_radius(l->type) && !(r > 0.0f))
+        if (has_radius(l->type) && l->type != LX_LIGHT_TUBE && !(r > 0.0f))
             return fail(c, LX_ERR_INVALID, "radius %g must be above 0 for a %s light", r,
                         lx_light_type_name(l->type));
         if (has_radius(l->type))
             l->radius = r;
     }
+    if ((it = cJSON_GetObjectItemCaseSensitive(obj, "length"))) {
+        if (l->type != LX_LIGHT_TUBE)
+            return fail(c, LX_ERR_INVALID, "length is for tube lights, not a %s light",
+                        lx_light_type_name(l->type));
+        if ((st = get_non_negative(c, it, "length", &l->length)) != LX_OK)
+            return st;
+    }
+    if (l->type == LX_LIGHT_TUBE && !(l->radius > 0.0f) && !(l->length > 0.0f))
+        return fail(c, LX_ERR_INVALID,
+                    "a tube with radius 0 (a linear light) needs a length above 0");
     static const char *const sizes[] = {"width", "height"};
     for (int i = 0; i < 2; i++) {
         if (!(it = cJSON_GetObjectItemCaseSensitive(obj, sizes[i])))
@@ -360,7 +391,7 @@ static lx_status read_area(const ctx *c, const cJSON *obj, bool new_shape, lx_li
     if ((it = cJSON_GetObjectItemCaseSensitive(obj, "samples"))) {
         if (!is_area_type(l->type))
             return fail(c, LX_ERR_INVALID,
-                        "samples is for area lights (sphere, disk, rect), not a %s light",
+                        "samples is for area lights (sphere, disk, rect, tube), not a %s light",
                         lx_light_type_name(l->type));
         if (!cJSON_IsNumber(it))
             return fail(c, LX_ERR_FORMAT, "samples must be a whole number");
@@ -374,26 +405,29 @@ static lx_status read_area(const ctx *c, const cJSON *obj, bool new_shape, lx_li
     return LX_OK;
 }
 
-/* The intensity of a light whose type changed between punctual (cd) and
- * area (nt) without a new "intensity": the same candela along the axis,
- * through the area the light shows there (pi r^2, W H). */
+/* The intensity of a light whose type changed between punctual (cd), area
+ * (nt) and linear (cd/m) without a new "intensity": the same candela along
+ * the axis (a tube: across it), through the area the light shows there
+ * (lx_area_light_projected_area) or along a linear tube's length. */
 static lx_status carry_intensity(const ctx *c, const lx_light *before, lx_light *l)
 {
-    lx_light_unit from = native_unit(before->type), to = native_unit(l->type);
-    if (from == to || from == LX_UNIT_LUX || to == LX_UNIT_LUX)
+    intensity_kind from = kind_of(before), to = kind_of(l);
+    if (from == to || from == KIND_LUX || to == KIND_LUX)
         return LX_OK;
-    if (to == LX_UNIT_NIT) {
-        lx_status st = lx_light_intensity_to_native(l, before->intensity, LX_UNIT_CANDELA,
-                                                    LX_SPOT_POWER_PI, &l->intensity);
-        return st == LX_OK ? LX_OK : restate(c, st, l);
+    double cd = before->intensity;
+    if (from == KIND_NIT)
+        cd *= lx_area_light_projected_area(before);
+    else if (from == KIND_CANDELA_PER_METRE)
+        cd *= before->length;
+    if (!((float)cd <= 3.4028234663852886e38f))
+        return fail(c, LX_ERR_INVALID, "intensity %g overflows as candela", before->intensity);
+    if (to == KIND_CANDELA) {
+        l->intensity = (float)cd;
+        return LX_OK;
     }
-    double area = before->type == LX_LIGHT_RECT ? (double)before->width * before->height
-                                                : LX_PI * (double)before->radius * before->radius;
-    float cd = (float)(before->intensity * area);
-    if (!isfinite(cd))
-        return fail(c, LX_ERR_INVALID, "intensity %g nt overflows as candela", before->intensity);
-    l->intensity = cd;
-    return LX_OK;
+    lx_status st = lx_light_intensity_to_native(l, (float)cd, LX_UNIT_CANDELA, LX_SPOT_POWER_PI,
+                                                &l->intensity);
+    return st == LX_OK ? LX_OK : restate(c, st, l);
 }
 
 /* Fills out from obj; a light named like one in names (earlier in the file
@@ -481,9 +515,6 @@ static lx_status read_light(ctx *c, const cJSON *obj, const name_table *names,
         snprintf(c->where + len, sizeof c->where - len, " ('%s')", name);
     }
     const cJSON *type_item = cJSON_GetObjectItemCaseSensitive(obj, "type");
-    if (cJSON_IsString(type_item) && type_item->valuestring &&
-        strcmp(type_item->valuestring, "tube") == 0)
-        return fail(c, LX_ERR_UNSUPPORTED, "tube lights are not supported yet");
     if ((st = check_keys(c, obj, light_keys, COUNT(light_keys))) != LX_OK)
         return st;
 
@@ -502,7 +533,7 @@ static lx_status read_light(ctx *c, const cJSON *obj, const name_table *names,
     } else {
         if (!type_item)
             return fail(c, LX_ERR_FORMAT,
-                        "missing 'type' (point, spot, directional, sphere, disk or rect)");
+                        "missing 'type' (point, spot, directional, sphere, disk, rect or tube)");
         l = lx_light_defaults((lx_light_type)type);
         memcpy(l.name, name, strlen(name) + 1);
     }
@@ -604,8 +635,8 @@ static lx_status read_light(ctx *c, const cJSON *obj, const name_table *names,
     bool area = is_area_type(l.type);
     if (l.shadow == LX_SHADOW_SOFT && !area)
         return fail(c, LX_ERR_INVALID,
-                    "shadow 'soft' needs an area light (sphere, disk, rect, or a point light with "
-                    "a radius), not a %s light",
+                    "shadow 'soft' needs an area light (sphere, disk, rect, tube, or a point "
+                    "light with a radius), not a %s light",
                     lx_light_type_name(l.type));
 
     /* Units last: lumens over a spot's cone need the final outer angle, an

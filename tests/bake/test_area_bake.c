@@ -1,8 +1,8 @@
 /* Area lights in the baker: soft shadows with nothing in the way equal the
  * unshadowed bake (an invariant of the weighted visible fraction), a rect
  * light half hidden behind an occluder's edge matches an independent
- * quadrature of its visible part, and soft shadows are the same bytes for
- * any thread count. */
+ * quadrature of its visible part (and so does a linear tube's), and soft
+ * shadows are the same bytes for any thread count. */
 #include <setjmp.h>
 #include <stdarg.h>
 #include <stddef.h>
@@ -58,11 +58,19 @@ static lx_baker *bake(lx_light light, bool occluder, int threads, lx_image *out)
 static void soft_unoccluded_equals_unshadowed(void **state)
 {
     (void)state;
-    const lx_light_type types[3] = {LX_LIGHT_SPHERE, LX_LIGHT_DISK, LX_LIGHT_RECT};
-    for (int t = 0; t < 3; t++) {
+    /* the last two: a tube along x, and a linear one */
+    const lx_light_type types[5] = {LX_LIGHT_SPHERE, LX_LIGHT_DISK, LX_LIGHT_RECT, LX_LIGHT_TUBE,
+                                    LX_LIGHT_TUBE};
+    for (int t = 0; t < 5; t++) {
+        lx_light soft_light = area_light(types[t], LX_SHADOW_SOFT, 16);
+        lx_light none_light = area_light(types[t], LX_SHADOW_NONE, 0);
+        if (types[t] == LX_LIGHT_TUBE) {
+            soft_light.direction = none_light.direction = lx_v3(1.0f, 0.0f, 0.0f);
+            soft_light.radius = none_light.radius = t == 4 ? 0.0f : 0.05f;
+        }
         lx_image soft, none;
-        lx_baker *a = bake(area_light(types[t], LX_SHADOW_SOFT, 16), false, 2, &soft);
-        lx_baker *b = bake(area_light(types[t], LX_SHADOW_NONE, 0), false, 2, &none);
+        lx_baker *a = bake(soft_light, false, 2, &soft);
+        lx_baker *b = bake(none_light, false, 2, &none);
         for (int p = 0; p < 64 * 3; p++) {
             assert_true(none.data[p] > 0.0f);
             assert_true(fabsf(soft.data[p] - none.data[p]) <= 1e-5f * none.data[p]);
@@ -118,6 +126,49 @@ static void half_hidden_rect_matches_quadrature(void **state)
     lx_baker_destroy(baker);
 }
 
+/* Illuminance at p (normal +Y) from the part of a linear light along x
+ * at height 2, x in [-0.5, 0.5], with x > x_min: I sin(alpha) cos(t) / d^2
+ * summed along it. */
+static double visible_line_quadrature(lx_vec3 p, double x_min, double per_metre)
+{
+    const int n = 20000;
+    double sum = 0.0, dl = 1.0 / n;
+    for (int i = 0; i < n; i++) {
+        double qx = -0.5 + (i + 0.5) * dl;
+        if (qx < x_min)
+            continue;
+        double dx = qx - p.x, dy = 2.0 - p.y, dz = -p.z;
+        double d2 = dx * dx + dy * dy + dz * dz, d = sqrt(d2);
+        double sin_a = sqrt(dy * dy + dz * dz) / d;
+        sum += per_metre * sin_a * (dy / d) / d2 * dl;
+    }
+    return sum;
+}
+
+static void half_hidden_linear_tube_matches_quadrature(void **state)
+{
+    (void)state;
+    lx_light tube = area_light(LX_LIGHT_TUBE, LX_SHADOW_SOFT, 1024);
+    tube.direction = lx_v3(1.0f, 0.0f, 0.0f);
+    tube.radius = 0.0f;
+    tube.intensity = 200.0f; /* cd per metre */
+    lx_image img;
+    lx_baker *baker = bake(tube, true, 2, &img);
+    for (int y = 0; y < 8; y++)
+        for (int x = 0; x < 8; x++) {
+            lx_texel_sample s;
+            assert_true(lx_baker_texel(baker, 0, x, y, &s));
+            double x_min = s.position.x * (1.0 - 2.0 / 1.9);
+            double want = visible_line_quadrature(s.position, x_min, 200.0);
+            double full = visible_line_quadrature(s.position, -1.0, 200.0);
+            double got = img.data[3 * (y * 8 + x)];
+            assert_true(want > 0.3 * full && want < 0.7 * full);
+            assert_true(fabs(got - want) <= 0.02 * full);
+        }
+    lx_image_free(&img);
+    lx_baker_destroy(baker);
+}
+
 static void soft_shadows_are_deterministic(void **state)
 {
     (void)state;
@@ -153,6 +204,7 @@ int main(void)
     const struct CMUnitTest tests[] = {
         cmocka_unit_test(soft_unoccluded_equals_unshadowed),
         cmocka_unit_test(half_hidden_rect_matches_quadrature),
+        cmocka_unit_test(half_hidden_linear_tube_matches_quadrature),
         cmocka_unit_test(soft_shadows_are_deterministic),
         cmocka_unit_test(soft_shadows_need_an_area_light),
     };

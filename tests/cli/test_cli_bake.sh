@@ -308,12 +308,20 @@ cat >"$WORK/soft.json" <<'JSON'
    "up": [0, 0, 1], "width": 1.0, "height": 0.5, "intensity": 40, "unit": "W",
    "shadow": "soft", "samples": 16},
   {"type": "sphere", "position": [1, 1, 0], "radius": 0.1, "intensity": 1000, "unit": "lm",
-   "shadow": "soft", "samples": 16}]}
+   "shadow": "soft", "samples": 16},
+  {"name": "bar", "type": "tube", "position": [0, 2, 0], "direction": [1, 0, 0], "length": 1.2,
+   "radius": 0.02, "intensity": 3000, "unit": "lm", "shadow": "soft", "samples": 16},
+  {"name": "strip", "type": "tube", "position": [0, 2.5, 1], "direction": [0, 0, 1], "length": 2,
+   "radius": 0, "intensity": 3000, "unit": "lm", "shadow": "soft", "samples": 16}]}
 JSON
 run "$LUXEL" info "$ROOM" --lights "$WORK/soft.json"
 expect_rc 0 "info with area lights"
 expect_stdout_has "info: the rect in nits" 'rect +ceiling_lamp +17392.5 nt'
 expect_stdout_has "info: the sphere" 'sphere'
+# 3000 lm over the capsule: 3000 / (pi (2 pi 0.02 1.2 + 4 pi 0.02^2)) = 6128.3 nt;
+# linear: 3000 / (pi^2 2) = 151.982 cd per metre
+expect_stdout_has "info: the tube in nits" 'tube +bar +6128.3 nt .*axis \(1, 0, 0\)  length 1.2 m  radius 0.02 m'
+expect_stdout_has "info: the linear tube in cd/m" 'tube +strip +151.982 cd/m .*\(linear\)'
 run "$LUXEL" bake "$ROOM" --resolution 32 --format pfm -q -o "$WORK/soft" --lights "$WORK/soft.json"
 expect_rc 0 "bake with soft area lights"
 check "soft bake: every lightmap written" test -s "$WORK/soft/room.pfm" -a -s "$WORK/soft/tall_box.pfm"

@@ -11,6 +11,11 @@
 #   a = 20 deg, b = 40 deg (the linear ramp integrated against sin).
 # quad.ies has the same C0 plane and a C90 plane 1000 at 0 falling to 0 at
 # 20 degrees: 50% at 10 degrees, a 20 degree beam across C90-C270.
+# flood.ies is photometric type B, 1000 cd a(V) b(H): a flat to |V| = 20
+# falling to 0 at 40, b flat to |H| = 10 falling to 0 at 20 (horizontal
+# angles 0..90: mirrored). Converted to type C its C0-C180 plane is V and its
+# C90-C270 plane H (docs/ies.md): beams of 60 and 30 degrees. Its flux,
+# with dOmega = cos H dH dV, is 1000 (60 deg) 2 (cos 10 - cos 20) / (10 deg).
 #
 # usage: bash test_cli_ies.sh LUXEL GEN_SCENES WORKDIR
 set -u
@@ -38,6 +43,20 @@ TILT=NONE
 1000 1000 0 0
 1000 500 0 0
 1000 0 0 0
+EOF
+
+cat >flood.ies <<'EOF'
+IESNA:LM-63-2002
+[TEST] luxel cli test, type B
+TILT=NONE
+1 -1 1 7 4 2 2 0 0 0
+1 1 150
+-90 -40 -20 0 20 40 90
+0 10 20 90
+0 0 1000 1000 1000 0 0
+0 0 1000 1000 1000 0 0
+0 0 0 0 0 0 0
+0 0 0 0 0 0 0
 EOF
 
 # a number printed on a stdout line "LABEL: <number> ..."
@@ -79,6 +98,22 @@ check "beam angle C0-C180 $got ~ 60" near "$got" 60 0.002
 got=$(value_of "beam angle C90-C270")
 check "beam angle C90-C270 $got ~ 60" near "$got" 60 0.002
 
+# luxel info shows a light's profile: a masked 1500 lm point light scales
+# the profile by 1500 / its flux.
+"$GEN" "$WORK/scenes" >/dev/null || { echo "gen_scenes failed"; exit 1; }
+cat >profiled.json <<'EOF'
+{"lights": [{"name": "downlight", "type": "point", "position": [0, 2.9, 0],
+  "direction": [0, -1, 0], "ies": "spot.ies", "masked": true, "intensity": 1500, "unit": "lm"}]}
+EOF
+run "$LUXEL" info "$WORK/scenes/room.glb" --lights profiled.json
+expect_rc 0 "info with a profiled light"
+expect_stdout_has "info: the profile" 'downlight .* profile LM-63-2002 rotational, '
+flux=$(awk 'BEGIN { pi = atan2(0, -1); a = 20 * pi / 180; b = 40 * pi / 180;
+    printf "%.6f", 2 * pi * 1000 * ((1 - cos(a)) + cos(a) - (sin(b) - sin(a)) / (b - a)) }')
+got=$(sed -n 's/.*profile LM-63-2002 rotational, [0-9.e+]* lm x \([0-9.e+-]*\).*/\1/p' "$OUT")
+want=$(awk -v f="$flux" 'BEGIN { printf "%.6f", 1500 / f }')
+check "info: profile scale $got ~ 1500 / flux = $want" near "$got" "$want" 0.003
+
 run "$LUXEL" ies quad.ies
 expect_rc 0 "ies quad.ies"
 expect_stdout_has "version 1995" '^version: LM-63-1995$'
@@ -87,6 +122,28 @@ got=$(value_of "beam angle C0-C180")
 check "quad: beam angle C0-C180 $got ~ 60" near "$got" 60 0.002
 got=$(value_of "beam angle C90-C270")
 check "quad: beam angle C90-C270 $got ~ 20" near "$got" 20 0.002
+
+run "$LUXEL" ies flood.ies
+expect_rc 0 "ies flood.ies (type B)"
+check "ies flood.ies: nothing on stderr" test ! -s "$ERR"
+expect_stdout_has "photometric type B" '^photometric type: B$'
+expect_stdout_has "type B: the file's angles" '^vertical angles: 7 \(-90\.\.90 deg\)$'
+expect_stdout_has "type B: symmetry after conversion" \
+    '^symmetry: bilateral 0-180 \(after conversion to type C\)$'
+want=$(awk 'BEGIN { r = atan2(0, -1) / 180;
+    printf "%.6f", 1000 * 60 * r * 2 * (cos(10 * r) - cos(20 * r)) / (10 * r) }')
+got=$(value_of "total lumens")
+check "type B: total lumens $got ~ $want (0.2%)" near "$got" "$want" 0.002
+got=$(value_of "peak candela")
+check "type B: peak candela $got = 1000" near "$got" 1000 1e-6
+got=$(value_of "beam angle C0-C180")
+check "type B: beam angle C0-C180 $got ~ 60" near "$got" 60 0.002
+got=$(value_of "beam angle C90-C270")
+check "type B: beam angle C90-C270 $got ~ 30" near "$got" 30 0.002
+sed 's/^1 -1 1 7 4 2 2 /1 -1 1 7 4 3 2 /' flood.ies >flood_a.ies
+run "$LUXEL" ies flood_a.ies
+expect_rc 0 "ies flood_a.ies (type A)"
+expect_stdout_has "photometric type A" '^photometric type: A$'
 
 # ---- --plot ---------------------------------------------------------------------
 
@@ -123,6 +180,12 @@ sed 's/^TILT=NONE$/TILT=lamp.tlt/' spot.ies >tilt.ies
 run "$LUXEL" ies tilt.ies --plot plots/bad.png
 expect_rc 1 "TILT=<file>"
 expect_error "TILT=<file>" "tilt.ies" "line 4" "not supported"
+
+sed 's/^-90 -40 -20 0 20 40 90$/-90 -40 -20 0 20 40 95/' flood.ies >steep.ies
+run "$LUXEL" ies steep.ies --plot plots/bad.png
+expect_rc 1 "type B vertical angle above 90"
+expect_error "type B vertical angle above 90" "steep.ies" "line 6" "outside -90..90"
+check "type B vertical angle above 90: no plot" test ! -e plots/bad.png
 
 printf 'just some text\n' >garbage.ies
 run "$LUXEL" ies garbage.ies

@@ -188,7 +188,8 @@ static const bad_case bad_cases[] = {
      LX_ERR_FORMAT, "lights.json: lights[2]: unknown key 'intesity'"},
     {"{\"light\": []}", LX_ERR_FORMAT, "lights.json: unknown key 'light'"},
     {"{\"lights\": [{\"type\": \"area\", \"position\": [0,0,0]}]}", LX_ERR_FORMAT,
-     "lights[0]: unknown type 'area' (expected point, spot, directional, sphere, disk, rect)"},
+     "lights[0]: unknown type 'area' (expected point, spot, directional, sphere, disk, rect, "
+     "tube)"},
     {"{\"lights\": [{\"type\": \"point\", \"position\": [0,0,0], \"intensity\": 1e999}]}",
      LX_ERR_FORMAT, "lights[0]: intensity is not a finite number"},
     {"{\"lights\": [{\"type\": \"point\", \"position\": [0,-1e999,0]}]}", LX_ERR_FORMAT,
@@ -270,8 +271,22 @@ static const bad_case bad_cases[] = {
      LX_ERR_INVALID, "is longer than 63 bytes"},
     /* area lights (issue 3) */
     {"{\"lights\": [{\"type\": \"tube\", \"position\": [0, 2, 0], \"direction\": [1, 0, 0], "
-     "\"length\": 1.2, \"radius\": 0.02, \"intensity\": 3000, \"unit\": \"lm\"}]}",
-     LX_ERR_UNSUPPORTED, "lights.json: lights[0]: tube lights are not supported yet"},
+     "\"length\": -1.2}]}",
+     LX_ERR_INVALID, "lights.json: lights[0]: length -1.2 is negative"},
+    {"{\"lights\": [{\"type\": \"tube\", \"position\": [0, 2, 0], \"direction\": [1, 0, 0], "
+     "\"length\": 0, \"radius\": 0}]}",
+     LX_ERR_INVALID, "lights[0]: a tube with radius 0 (a linear light) needs a length above 0"},
+    {"{\"lights\": [{\"type\": \"tube\", \"position\": [0, 2, 0], \"direction\": [1, 0, 0], "
+     "\"radius\": 0, \"intensity\": 5, \"unit\": \"nt\"}]}",
+     LX_ERR_INVALID, "lights[0]: a linear tube (radius 0) has no area for nt"},
+    {"{\"lights\": [{\"type\": \"tube\", \"position\": [0, 2, 0]}]}", LX_ERR_FORMAT,
+     "lights[0]: missing 'direction' for a tube light"},
+    {"{\"lights\": [{\"type\": \"disk\", \"position\": [0, 2, 0], \"direction\": [1, 0, 0], "
+     "\"length\": 1}]}",
+     LX_ERR_INVALID, "lights[0]: length is for tube lights, not a disk light"},
+    {"{\"lights\": [{\"type\": \"tube\", \"position\": [0, 2, 0], \"direction\": [1, 0, 0], "
+     "\"length\": \"long\"}]}",
+     LX_ERR_FORMAT, "lights[0]: length must be a number"},
     {"{\"lights\": [{\"name\": \"ball\", \"type\": \"sphere\", \"position\": [0,0,0], "
      "\"radius\": -0.1}]}",
      LX_ERR_INVALID, "lights.json: lights[0] ('ball'): radius -0.1 is negative"},
@@ -318,10 +333,11 @@ static const bad_case bad_cases[] = {
      LX_ERR_INVALID, "shadow 'soft' needs an area light"},
     {"{\"lights\": [{\"type\": \"spot\", \"position\": [0,0,0], \"direction\": [0,-1,0], "
      "\"radius\": 0.1}]}",
-     LX_ERR_INVALID, "lights[0]: radius is for sphere, disk and point lights, not a spot light"},
+     LX_ERR_INVALID,
+     "lights[0]: radius is for sphere, disk, tube and point lights, not a spot light"},
     {"{\"lights\": [{\"type\": \"rect\", \"position\": [0,0,0], \"direction\": [0,-1,0], "
      "\"radius\": 0.1}]}",
-     LX_ERR_INVALID, "radius is for sphere, disk and point lights, not a rect light"},
+     LX_ERR_INVALID, "radius is for sphere, disk, tube and point lights, not a rect light"},
     {"{\"lights\": [{\"type\": \"disk\", \"position\": [0,0,0], \"direction\": [0,-1,0], "
      "\"width\": 1}]}",
      LX_ERR_INVALID, "lights[0]: width is for rect lights, not a disk light"},
@@ -329,7 +345,7 @@ static const bad_case bad_cases[] = {
      LX_ERR_INVALID,
      "lights[0]: up is for rect lights and lights with an ies profile, not a sphere light"},
     {"{\"lights\": [{\"type\": \"point\", \"position\": [0,0,0], \"samples\": 8}]}", LX_ERR_INVALID,
-     "samples is for area lights (sphere, disk, rect), not a point light"},
+     "samples is for area lights (sphere, disk, rect, tube), not a point light"},
     {"{\"lights\": [{\"type\": \"disk\", \"position\": [0,0,0], \"radius\": 0.1}]}", LX_ERR_FORMAT,
      "lights[0]: missing 'direction' for a disk light"},
     {"{\"lights\": [{\"type\": \"rect\", \"direction\": [0,-1,0]}]}", LX_ERR_FORMAT,
@@ -527,6 +543,68 @@ static void test_area_lights(void **state)
     lx_scene_destroy(s);
 }
 
+/* Tubes (issue 3's example): lumens through the capsule's area,
+ * L = P / (pi (2 pi r len + 4 pi r^2)); candela across the axis through
+ * 2 r len + pi r^2; a linear tube (radius 0) in candela per metre, P /
+ * (pi^2 len) or I / len; the defaults (1 m, 2 cm) and soft shadows. */
+static void test_tube_lights(void **state)
+{
+    (void)state;
+    lx_scene *s = lx_test_new_scene("test");
+    assert_int_equal(
+        apply(s, "{\"lights\": ["
+                 "{\"type\": \"tube\", \"position\": [0, 2, 0], \"direction\": [1, 0, 0], "
+                 "\"length\": 1.2, \"radius\": 0.02, \"intensity\": 3000, \"unit\": \"lm\"},"
+                 "{\"type\": \"tube\", \"position\": [0, 2, 0], \"direction\": [0, 0, 2], "
+                 "\"length\": 2, \"radius\": 0, \"intensity\": 3000, \"unit\": \"lm\", "
+                 "\"shadow\": \"soft\", \"samples\": 32},"
+                 "{\"type\": \"tube\", \"position\": [0, 2, 0], \"direction\": [1, 0, 0], "
+                 "\"length\": 0.5, \"radius\": 0, \"intensity\": 100, \"unit\": \"cd\"},"
+                 "{\"type\": \"tube\", \"position\": [0, 2, 0], \"direction\": [1, 0, 0], "
+                 "\"intensity\": 100, \"unit\": \"cd\"},"
+                 "{\"type\": \"tube\", \"position\": [0, 2, 0], \"direction\": [1, 0, 0], "
+                 "\"intensity\": 2500}]}"),
+        LX_OK);
+    assert_int_equal(s->light_count, 5);
+    const lx_light *t = &s->lights[0];
+    assert_int_equal(t->type, LX_LIGHT_TUBE);
+    lx_test_assert_vec3(t->direction, 1, 0, 0);
+    assert_true(t->length == 1.2f && t->radius == 0.02f);
+    assert_rel(t->intensity, 3000.0 / (PI_D * (2.0 * PI_D * 0.02 * 1.2 + 4.0 * PI_D * 0.02 * 0.02)),
+               1e-5);
+    const lx_light *lin = &s->lights[1];
+    lx_test_assert_vec3(lin->direction, 0, 0, 1);
+    assert_true(lin->radius == 0.0f);
+    assert_rel(lin->intensity, 3000.0 / (PI_D * PI_D * 2.0), 1e-5);
+    assert_int_equal(lin->shadow, LX_SHADOW_SOFT);
+    assert_int_equal(lin->samples, 32);
+    assert_rel(s->lights[2].intensity, 100.0 / 0.5, 1e-6);
+    /* defaults: 1 m long, 2 cm radius */
+    assert_true(s->lights[3].length == 1.0f && s->lights[3].radius == 0.02f);
+    assert_rel(s->lights[3].intensity, 100.0 / (2.0 * 0.02 * 1.0 + PI_D * 0.02 * 0.02), 1e-5);
+    assert_true(s->lights[4].intensity == 2500.0f); /* nits by default */
+    lx_scene_destroy(s);
+
+    /* A point light turned into a tube by an override keeps its candela
+     * across the axis; a tube turned linear keeps it too. */
+    s = lx_test_new_scene("test");
+    assert_int_equal(apply(s, "{\"lights\": [{\"name\": \"a\", \"type\": \"point\", "
+                              "\"position\": [0, 2, 0], \"intensity\": 300},"
+                              "{\"name\": \"a\", \"type\": \"tube\", \"direction\": [1, 0, 0], "
+                              "\"length\": 0.6, \"radius\": 0.05},"
+                              "{\"name\": \"b\", \"type\": \"tube\", \"position\": [0, 2, 0], "
+                              "\"direction\": [1, 0, 0], \"length\": 0.6, \"radius\": 0.05, "
+                              "\"intensity\": 300, \"unit\": \"cd\"},"
+                              "{\"name\": \"b\", \"radius\": 0}]}"),
+                     LX_OK);
+    assert_int_equal(s->light_count, 2);
+    double across = 2.0 * 0.05 * 0.6 + PI_D * 0.05 * 0.05;
+    assert_int_equal(s->lights[0].type, LX_LIGHT_TUBE);
+    assert_rel(s->lights[0].intensity * across, 300.0, 1e-5);
+    assert_rel(s->lights[1].intensity * 0.6, 300.0, 1e-5);
+    lx_scene_destroy(s);
+}
+
 /* A point light is a sphere of radius 0 (seed 001): given a radius above 0
  * it becomes a sphere whose intensity keeps the point light's units (cd
  * by default: luminance I / (pi r^2); lumens: P / (4 pi^2 r^2)); a radius
@@ -675,12 +753,12 @@ static void test_file(void **state)
 int main(void)
 {
     const struct CMUnitTest tests[] = {
-        cmocka_unit_test(test_example),       cmocka_unit_test(test_units),
-        cmocka_unit_test(test_override),      cmocka_unit_test(test_bad_input),
-        cmocka_unit_test(test_bad_bytes),     cmocka_unit_test(test_all_or_nothing),
-        cmocka_unit_test(test_file),          cmocka_unit_test(test_colour_forms),
-        cmocka_unit_test(test_area_lights),   cmocka_unit_test(test_point_with_radius),
-        cmocka_unit_test(test_area_override),
+        cmocka_unit_test(test_example),     cmocka_unit_test(test_units),
+        cmocka_unit_test(test_override),    cmocka_unit_test(test_bad_input),
+        cmocka_unit_test(test_bad_bytes),   cmocka_unit_test(test_all_or_nothing),
+        cmocka_unit_test(test_file),        cmocka_unit_test(test_colour_forms),
+        cmocka_unit_test(test_area_lights), cmocka_unit_test(test_point_with_radius),
+        cmocka_unit_test(test_tube_lights), cmocka_unit_test(test_area_override),
     };
     return cmocka_run_group_tests(tests, NULL, NULL);
 }

@@ -21,18 +21,26 @@ static const char *info_usage =
 static void print_light(const lx_light *l)
 {
     bool area = lx_light_is_area(l);
-    const char *unit = l->type == LX_LIGHT_DIRECTIONAL ? "lx" : area ? "nt" : "cd";
+    bool linear = l->type == LX_LIGHT_TUBE && !(l->radius > 0.0f);
+    const char *unit = l->type == LX_LIGHT_DIRECTIONAL ? "lx"
+                       : linear                        ? "cd/m"
+                       : area                          ? "nt"
+                                                       : "cd";
     printf("  %-12s %-16s %10.6g %s", lx_light_type_name(l->type), l->name[0] ? l->name : "-",
            l->intensity, l->model == LX_MODEL_CLASSIC ? "(classic units)" : unit);
     printf("  colour (%.3g, %.3g, %.3g)", l->color.x, l->color.y, l->color.z);
     if (l->type != LX_LIGHT_DIRECTIONAL)
         printf("  at (%.3g, %.3g, %.3g)", l->position.x, l->position.y, l->position.z);
-    if (l->type != LX_LIGHT_POINT && l->type != LX_LIGHT_SPHERE)
+    if (l->type == LX_LIGHT_TUBE)
+        printf("  axis (%.3g, %.3g, %.3g)", l->direction.x, l->direction.y, l->direction.z);
+    else if (l->type != LX_LIGHT_POINT && l->type != LX_LIGHT_SPHERE)
         printf("  toward (%.3g, %.3g, %.3g)", l->direction.x, l->direction.y, l->direction.z);
     if (l->type == LX_LIGHT_SPOT)
         printf("  cone %.1f..%.1f deg", LX_RAD2DEG(l->inner_angle), LX_RAD2DEG(l->outer_angle));
     if (l->type == LX_LIGHT_SPHERE || l->type == LX_LIGHT_DISK)
         printf("  radius %.3g m", l->radius);
+    if (l->type == LX_LIGHT_TUBE)
+        printf("  length %.3g m  radius %.3g m%s", l->length, l->radius, linear ? " (linear)" : "");
     if (l->type == LX_LIGHT_RECT)
         printf("  %.3g x %.3g m  up (%.3g, %.3g, %.3g)", l->width, l->height, l->up.x, l->up.y,
                l->up.z);
@@ -40,6 +48,12 @@ static void print_light(const lx_light *l)
         printf("  range %.3g m", l->range);
     else if (l->type != LX_LIGHT_DIRECTIONAL)
         printf("  range unlimited");
+    if (l->profile) {
+        lx_ies_info ies;
+        lx_ies_get_info(l->profile, &ies);
+        printf("  profile %s %s, %.4g lm x %.4g", ies.version, lx_ies_symmetry_name(ies.symmetry),
+               lx_ies_total_lumens(l->profile), l->profile_scale);
+    }
     printf("  shadow %s", lx_shadow_mode_name(l->shadow));
     if (l->shadow == LX_SHADOW_SOFT)
         printf(" (%u samples)", l->samples ? l->samples : 16u);
