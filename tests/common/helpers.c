@@ -9,6 +9,7 @@
 #include <cmocka.h>
 
 #include <dirent.h>
+#include <math.h>
 #include <signal.h>
 #include <stdio.h>
 #include <stdlib.h>
@@ -217,4 +218,21 @@ uint32_t lx_test_map_of(const lx_baker *b, uint32_t node)
             return m;
     fail_msg("no lightmap for node %u", node);
     return UINT32_MAX;
+}
+
+void lx_test_assert_rel(double got, double want, double tol)
+{
+    double scale = fabs(want) > 1e-30 ? fabs(want) : 1.0;
+    if (!(fabs(got - want) <= tol * scale))
+        fail_msg("got %.9g, want %.9g (relative tolerance %g)", got, want, tol);
+}
+
+lx_ies_profile *lx_test_parse_ies(const char *text)
+{
+    lx_ies_profile *p = NULL;
+    lx_status st = lx_ies_parse(text, strlen(text), "t.ies", &p);
+    if (st != LX_OK)
+        fail_msg("parse failed: %s: %s", lx_status_name(st), lx_last_error());
+    assert_non_null(p);
+    return p;
 }

@@ -26,6 +26,13 @@ void lx_test_mesh_free(lx_mesh *m);
 /* An empty scene named name; fails the test if it cannot be made. */
 lx_scene *lx_test_new_scene(const char *name);
 
+/* Fails the test unless got is within tol of want, relative to |want| (or
+ * absolute when want is 0). */
+void lx_test_assert_rel(double got, double want, double tol);
+
+/* Parses IES text named "t.ies"; fails the test if it does not parse. */
+lx_ies_profile *lx_test_parse_ies(const char *text);
+
 /* Fails the test unless v equals (x, y, z) to 1e-5 in each component. */
 void lx_test_assert_vec3(lx_vec3 v, double x, double y, double z);
 

@@ -22,23 +22,6 @@
 
 #define PI_D 3.14159265358979323846
 
-static void assert_rel(double got, double want, double tol)
-{
-    double scale = fabs(want) > 1e-30 ? fabs(want) : 1.0;
-    if (!(fabs(got - want) <= tol * scale))
-        fail_msg("got %.9g, want %.9g (relative tolerance %g)", got, want, tol);
-}
-
-static lx_ies_profile *parse_ok(const char *text)
-{
-    lx_ies_profile *p = NULL;
-    lx_status st = lx_ies_parse(text, strlen(text), "t.ies", &p);
-    if (st != LX_OK)
-        fail_msg("parse failed: %s: %s", lx_status_name(st), lx_last_error());
-    assert_non_null(p);
-    return p;
-}
-
 /* Parsing fails with `want` and a message holding every needle. */
 static void parse_fails(const char *text, lx_status want, const char *n1, const char *n2)
 {
@@ -78,7 +61,7 @@ static const char *ies_1986 = "ACME LIGHTING 1986\n"
 
 static void test_version_1986(void **state)
 {
-    lx_ies_profile *p = parse_ok(ies_1986);
+    lx_ies_profile *p = lx_test_parse_ies(ies_1986);
     lx_ies_info info;
     lx_ies_get_info(p, &info);
     assert_string_equal(info.version, "LM-63-1986");
@@ -89,16 +72,16 @@ static void test_version_1986(void **state)
     assert_null(lx_ies_keyword(p, 2, &value));
     assert_false(info.tilt_included);
     assert_int_equal(info.lamp_count, 1);
-    assert_rel(info.lumens_per_lamp, 1000, 0);
+    lx_test_assert_rel(info.lumens_per_lamp, 1000, 0);
     assert_int_equal(info.photometric_type, 1);
     assert_int_equal(info.units, 1);
-    assert_rel(info.input_watts, 60, 0);
+    lx_test_assert_rel(info.input_watts, 60, 0);
     assert_int_equal(info.symmetry, LX_IES_ROTATIONAL);
     assert_cd(p, 0, 0, 100);
     assert_cd(p, 37, 123, 100);
     assert_cd(p, 180, 300, 100);
-    assert_rel(lx_ies_peak_candela(p), 100, 0);
-    assert_rel(lx_ies_total_lumens(p), 4 * PI_D * 100, 1e-3);
+    lx_test_assert_rel(lx_ies_peak_candela(p), 100, 0);
+    lx_test_assert_rel(lx_ies_total_lumens(p), 4 * PI_D * 100, 1e-3);
     lx_ies_free(p);
 }
 
@@ -124,7 +107,7 @@ static const char *ies_1991 = "IESNA91\n"
 
 static void test_version_1991_quadrant(void **state)
 {
-    lx_ies_profile *p = parse_ok(ies_1991);
+    lx_ies_profile *p = lx_test_parse_ies(ies_1991);
     lx_ies_info info;
     lx_ies_get_info(p, &info);
     assert_string_equal(info.version, "LM-63-1991");
@@ -135,12 +118,12 @@ static void test_version_1991_quadrant(void **state)
     assert_string_equal(value, "Acme");
     assert_int_equal(info.lamp_count, 2);
     assert_int_equal(info.units, 2);
-    assert_rel(info.width, 0.5, 0);
-    assert_rel(info.length, 0.6, 0);
-    assert_rel(info.height, 0.1, 1e-7);
+    lx_test_assert_rel(info.width, 0.5, 0);
+    lx_test_assert_rel(info.length, 0.6, 0);
+    lx_test_assert_rel(info.height, 0.1, 1e-7);
     assert_int_equal(info.vertical_count, 4);
     assert_int_equal(info.horizontal_count, 3);
-    assert_rel(info.horizontal_angles[2], 90, 0);
+    lx_test_assert_rel(info.horizontal_angles[2], 90, 0);
     assert_int_equal(info.symmetry, LX_IES_QUADRANT);
     /* given angles */
     assert_cd(p, 0, 0, 100);
@@ -162,7 +145,7 @@ static void test_version_1991_quadrant(void **state)
     /* above the last vertical angle: dark */
     assert_cd(p, 95, 0, 0);
     assert_cd(p, 180, 0, 0);
-    assert_rel(lx_ies_peak_candela(p), 100, 0);
+    lx_test_assert_rel(lx_ies_peak_candela(p), 100, 0);
     lx_ies_free(p);
 }
 
@@ -183,12 +166,12 @@ static const char *ies_1995 = "IESNA:LM-63-1995\n"
 
 static void test_version_1995_bilateral(void **state)
 {
-    lx_ies_profile *p = parse_ok(ies_1995);
+    lx_ies_profile *p = lx_test_parse_ies(ies_1995);
     lx_ies_info info;
     lx_ies_get_info(p, &info);
     assert_string_equal(info.version, "LM-63-1995");
     assert_int_equal(info.keyword_count, 3);
-    assert_rel(info.lumens_per_lamp, -1, 0);
+    lx_test_assert_rel(info.lumens_per_lamp, -1, 0);
     assert_int_equal(info.symmetry, LX_IES_BILATERAL);
     assert_cd(p, 0, 90, 30);
     assert_cd(p, 45, 0, 15);
@@ -224,7 +207,7 @@ static const char *ies_2002 = "IESNA:LM-63-2002\n"
 
 static void test_version_2002_full(void **state)
 {
-    lx_ies_profile *p = parse_ok(ies_2002);
+    lx_ies_profile *p = lx_test_parse_ies(ies_2002);
     lx_ies_info info;
     lx_ies_get_info(p, &info);
     assert_string_equal(info.version, "LM-63-2002");
@@ -240,14 +223,14 @@ static void test_version_2002_full(void **state)
     /* past the zenith: the opposite plane */
     assert_cd(p, 200, 0, 30);
     /* the azimuthal mean of the piecewise-linear ring is 25: 4 pi 25 */
-    assert_rel(lx_ies_total_lumens(p), 4 * PI_D * 25, 1e-3);
+    lx_test_assert_rel(lx_ies_total_lumens(p), 4 * PI_D * 25, 1e-3);
     lx_ies_free(p);
 }
 
 /* 0-360 written out with the duplicate 360 plane. */
 static void test_full_360(void **state)
 {
-    lx_ies_profile *p = parse_ok("IESNA:LM-63-2002\nTILT=NONE\n1 1000 1 2 4 1 2 0 0 0\n1 1 0\n"
+    lx_ies_profile *p = lx_test_parse_ies("IESNA:LM-63-2002\nTILT=NONE\n1 1000 1 2 4 1 2 0 0 0\n1 1 0\n"
                                  "0 90\n0 120 240 360\n10 10 40 40 70 70 10 10\n");
     assert_cd(p, 0, 300, 40);
     assert_cd(p, 45, 60, 25);
@@ -258,7 +241,7 @@ static void test_full_360(void **state)
 /* 90-270: mirrored about the 90-270 plane, I(h) = I(180 - h). */
 static void test_bilateral_90_270(void **state)
 {
-    lx_ies_profile *p = parse_ok("IESNA:LM-63-1995\nTILT=NONE\n1 1000 1 2 3 1 2 0 0 0\n1 1 0\n"
+    lx_ies_profile *p = lx_test_parse_ies("IESNA:LM-63-1995\nTILT=NONE\n1 1000 1 2 3 1 2 0 0 0\n1 1 0\n"
                                  "0 90\n90 180 270\n10 20\n30 40\n50 60\n");
     lx_ies_info info;
     lx_ies_get_info(p, &info);
@@ -277,13 +260,13 @@ static void test_bilateral_90_270(void **state)
  * = 400 (pi/2 - 1) = 200 pi - 400. */
 static void test_vertical_90_180(void **state)
 {
-    lx_ies_profile *p = parse_ok("IESNA:LM-63-1995\nTILT=NONE\n1 1000 1 3 1 1 2 0 0 0\n1 1 0\n"
+    lx_ies_profile *p = lx_test_parse_ies("IESNA:LM-63-1995\nTILT=NONE\n1 1000 1 3 1 1 2 0 0 0\n1 1 0\n"
                                  "90 135 180\n0\n0 50 100\n");
     assert_cd(p, 45, 0, 0);
     assert_cd(p, 89, 0, 0);
     assert_cd(p, 90, 0, 0);
     assert_cd(p, 157.5f, 77, 75);
-    assert_rel(lx_ies_total_lumens(p), 200 * PI_D - 400, 1e-3);
+    lx_test_assert_rel(lx_ies_total_lumens(p), 200 * PI_D - 400, 1e-3);
     lx_ies_free(p);
 }
 
@@ -300,8 +283,8 @@ static void test_lumens_cosine(void **state)
     for (int i = 0; i <= 90; i++)
         n += snprintf(text + n, 8192 - n, "%.6f%s", 1000 * cos(i * PI_D / 180),
                       i % 8 == 7 ? "\n" : " ");
-    lx_ies_profile *p = parse_ok(text);
-    assert_rel(lx_ies_total_lumens(p), PI_D * 1000, 1e-3);
+    lx_ies_profile *p = lx_test_parse_ies(text);
+    lx_test_assert_rel(lx_ies_total_lumens(p), PI_D * 1000, 1e-3);
     assert_cd(p, 60, 0, 500);
     lx_ies_free(p);
     free(text);
@@ -310,14 +293,14 @@ static void test_lumens_cosine(void **state)
 static void test_lumens_hemisphere(void **state)
 {
     /* constant 250 cd on 0..90, nothing above: 2 pi 250 */
-    lx_ies_profile *p = parse_ok("IESNA:LM-63-2002\nTILT=NONE\n1 -1 1 3 1 1 2 0 0 0\n1 1 0\n"
+    lx_ies_profile *p = lx_test_parse_ies("IESNA:LM-63-2002\nTILT=NONE\n1 -1 1 3 1 1 2 0 0 0\n1 1 0\n"
                                  "0 45 90\n0\n250 250 250\n");
-    assert_rel(lx_ies_total_lumens(p), 2 * PI_D * 250, 1e-3);
+    lx_test_assert_rel(lx_ies_total_lumens(p), 2 * PI_D * 250, 1e-3);
     lx_ies_free(p);
     /* the same as a quadrant file with planes 0, 45, 90 */
-    p = parse_ok("IESNA:LM-63-2002\nTILT=NONE\n1 -1 1 2 3 1 2 0 0 0\n1 1 0\n"
+    p = lx_test_parse_ies("IESNA:LM-63-2002\nTILT=NONE\n1 -1 1 2 3 1 2 0 0 0\n1 1 0\n"
                  "0 90\n0 45 90\n250 250 250 250 250 250\n");
-    assert_rel(lx_ies_total_lumens(p), 2 * PI_D * 250, 1e-3);
+    lx_test_assert_rel(lx_ies_total_lumens(p), 2 * PI_D * 250, 1e-3);
     lx_ies_free(p);
 }
 
@@ -325,9 +308,9 @@ static void test_lumens_bilateral_varying(void **state)
 {
     /* bilateral, constant in theta over 0..180: planes 0, 90, 180 at 10, 30,
      * 50; mirrored ring 10-30-50-30-10: mean 30, flux 4 pi 30 */
-    lx_ies_profile *p = parse_ok("IESNA:LM-63-1995\nTILT=NONE\n1 -1 1 2 3 1 2 0 0 0\n1 1 0\n"
+    lx_ies_profile *p = lx_test_parse_ies("IESNA:LM-63-1995\nTILT=NONE\n1 -1 1 2 3 1 2 0 0 0\n1 1 0\n"
                                  "0 180\n0 90 180\n10 10 30 30 50 50\n");
-    assert_rel(lx_ies_total_lumens(p), 4 * PI_D * 30, 1e-3);
+    lx_test_assert_rel(lx_ies_total_lumens(p), 4 * PI_D * 30, 1e-3);
     lx_ies_free(p);
 }
 
@@ -336,16 +319,16 @@ static void test_lumens_bilateral_varying(void **state)
 static void test_multiplier_and_ballast(void **state)
 {
     /* 100 cd x multiplier 2 x ballast 0.5 x ballast-lamp factor 0.9 = 90 */
-    lx_ies_profile *p = parse_ok("IESNA:LM-63-2002\nTILT=NONE\n1 1000 2 2 1 1 2 0 0 0\n"
+    lx_ies_profile *p = lx_test_parse_ies("IESNA:LM-63-2002\nTILT=NONE\n1 1000 2 2 1 1 2 0 0 0\n"
                                  "0.5 0.9 0\n0 180\n0\n100 100\n");
     lx_ies_info info;
     lx_ies_get_info(p, &info);
-    assert_rel(info.multiplier, 2, 0);
-    assert_rel(info.ballast_factor, 0.5, 0);
-    assert_rel(info.ballast_lamp_factor, 0.9, 0);
+    lx_test_assert_rel(info.multiplier, 2, 0);
+    lx_test_assert_rel(info.ballast_factor, 0.5, 0);
+    lx_test_assert_rel(info.ballast_lamp_factor, 0.9, 0);
     assert_cd(p, 30, 0, 90);
-    assert_rel(lx_ies_peak_candela(p), 90, 1e-6);
-    assert_rel(lx_ies_total_lumens(p), 4 * PI_D * 90, 1e-3);
+    lx_test_assert_rel(lx_ies_peak_candela(p), 90, 1e-6);
+    lx_test_assert_rel(lx_ies_total_lumens(p), 4 * PI_D * 90, 1e-3);
     lx_ies_free(p);
 }
 

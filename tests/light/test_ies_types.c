@@ -38,23 +38,6 @@
 #define PI_D 3.14159265358979323846
 #define RAD (PI_D / 180.0)
 
-static void assert_rel(double got, double want, double tol)
-{
-    double scale = fabs(want) > 1e-30 ? fabs(want) : 1.0;
-    if (!(fabs(got - want) <= tol * scale))
-        fail_msg("got %.9g, want %.9g (relative tolerance %g)", got, want, tol);
-}
-
-static lx_ies_profile *parse_ok(const char *text)
-{
-    lx_ies_profile *p = NULL;
-    lx_status st = lx_ies_parse(text, strlen(text), "t.ies", &p);
-    if (st != LX_OK)
-        fail_msg("parse failed: %s: %s", lx_status_name(st), lx_last_error());
-    assert_non_null(p);
-    return p;
-}
-
 /* Parsing fails with LX_ERR_FORMAT and a message holding every needle. */
 static void parse_fails(const char *text, const char *n1, const char *n2)
 {
@@ -138,7 +121,7 @@ static lx_ies_profile *ab_profile(int type, double vlo, double vhi, double hlo, 
     double va[512], ha[512];
     int nv = steps(va, vlo, vhi, step), nh = steps(ha, hlo, hhi, step);
     char *text = ab_file(type, va, nv, ha, nh, f);
-    lx_ies_profile *p = parse_ok(text);
+    lx_ies_profile *p = lx_test_parse_ies(text);
     free(text);
     return p;
 }
@@ -211,7 +194,7 @@ static void check_linear(int type)
     assert_cd(p, 90.5, 0, 0, 0);
     assert_cd(p, 120, 45, 0, 0);
     assert_cd(p, 180, 0, 0, 0);
-    assert_rel(lx_ies_peak_candela(p), 200 + 90 + 45, 0);
+    lx_test_assert_rel(lx_ies_peak_candela(p), 200 + 90 + 45, 0);
     lx_ies_free(p);
 }
 
@@ -243,7 +226,7 @@ static void test_cosine(void **state)
         lx_ies_profile *p = ab_profile(type, -90, 90, -90, 90, 1, cosine_fn);
         for (size_t k = 0; k < sizeof dirs / sizeof dirs[0]; k++)
             assert_cd(p, dirs[k][0], dirs[k][1], 100 * cos(dirs[k][0] * RAD), 0.02);
-        assert_rel(lx_ies_total_lumens(p), 100 * PI_D, 1e-3);
+        lx_test_assert_rel(lx_ies_total_lumens(p), 100 * PI_D, 1e-3);
         lx_ies_free(p);
     }
 }
@@ -255,13 +238,13 @@ static void test_lumens_uniform(void **state)
     for (int type = 2; type <= 3; type++) {
         /* the whole measured half space: 2 pi I */
         lx_ies_profile *p = ab_profile(type, -90, 90, -90, 90, 15, uniform_fn);
-        assert_rel(lx_ies_total_lumens(p), 2 * PI_D * 40, 1e-3);
+        lx_test_assert_rel(lx_ies_total_lumens(p), 2 * PI_D * 40, 1e-3);
         assert_cd(p, 89.9f, 90, 40, 1e-3);
         assert_cd(p, 90.2f, 90, 0, 0);
         lx_ies_free(p);
         /* symmetric halves mirrored: the same half space */
         p = ab_profile(type, 0, 90, 0, 90, 15, uniform_fn);
-        assert_rel(lx_ies_total_lumens(p), 2 * PI_D * 40, 1e-3);
+        lx_test_assert_rel(lx_ies_total_lumens(p), 2 * PI_D * 40, 1e-3);
         lx_ies_free(p);
         /* measured on one side of the axis only (V <= 0 or H <= 0): a
          * quarter of the sphere, pi I, dark on the other side. The type C
@@ -269,12 +252,12 @@ static void test_lumens_uniform(void **state)
          * range: half a step on each of the two edge half-planes adds
          * 40 x 2 x 0.5 deg = 0.70 lm to the 125.7, 0.56% */
         p = ab_profile(type, -90, 0, -90, 90, 15, uniform_fn);
-        assert_rel(lx_ies_total_lumens(p), PI_D * 40 + 40 * 2 * 0.5 * RAD, 1e-3);
+        lx_test_assert_rel(lx_ies_total_lumens(p), PI_D * 40 + 40 * 2 * 0.5 * RAD, 1e-3);
         assert_cd(p, 30, 180, 40, 1e-3); /* x < 0 */
         assert_cd(p, 30, 0, 0, 0);       /* x > 0 */
         lx_ies_free(p);
         p = ab_profile(type, -90, 90, -90, 0, 15, uniform_fn);
-        assert_rel(lx_ies_total_lumens(p), PI_D * 40 + 40 * 2 * 0.5 * RAD, 1e-3);
+        lx_test_assert_rel(lx_ies_total_lumens(p), PI_D * 40 + 40 * 2 * 0.5 * RAD, 1e-3);
         assert_cd(p, 30, 270, 40, 1e-3); /* y < 0 */
         assert_cd(p, 30, 90, 0, 0);      /* y > 0 */
         lx_ies_free(p);
@@ -294,13 +277,13 @@ static void test_flood(void **state)
     double a_cos = 2 * (cos(a20) - cos(a40)) / (a40 - a20);
     for (int type = 2; type <= 3; type++) {
         char *text = ab_file(type, va, 7, ha, 4, flood_fn);
-        lx_ies_profile *p = parse_ok(text);
+        lx_ies_profile *p = lx_test_parse_ies(text);
         free(text);
         lx_ies_info info;
         lx_ies_get_info(p, &info);
         assert_int_equal(info.symmetry, LX_IES_BILATERAL); /* horizontal 0..90 */
         double want = type == 2 ? 1000 * (60 * RAD) * b_cos : 1000 * (30 * RAD) * a_cos;
-        assert_rel(lx_ies_total_lumens(p), want, 2e-3);
+        lx_test_assert_rel(lx_ies_total_lumens(p), want, 2e-3);
         /* the C0 plane is V = gamma: 50% at 30 deg; C90 is H = gamma: 50% at 15 */
         assert_cd(p, 30, 0, 500, 0.5);
         assert_cd(p, 30, 180, 500, 0.5);
@@ -323,8 +306,8 @@ static void assert_same(const lx_ies_profile *a, const lx_ies_profile *b)
             if (!(fabs(x - y) <= 1e-4 * (1 + fabs(y))))
                 fail_msg("at (%g, %g): half-range file %.7g, mirrored file %.7g", g, c, x, y);
         }
-    assert_rel(lx_ies_total_lumens(a), lx_ies_total_lumens(b), 1e-5);
-    assert_rel(lx_ies_peak_candela(a), lx_ies_peak_candela(b), 0);
+    lx_test_assert_rel(lx_ies_total_lumens(a), lx_ies_total_lumens(b), 1e-5);
+    lx_test_assert_rel(lx_ies_peak_candela(a), lx_ies_peak_candela(b), 0);
 }
 
 static void test_symmetric_halves(void **state)
@@ -359,7 +342,7 @@ static void test_symmetric_halves(void **state)
 
 static void test_info(void **state)
 {
-    lx_ies_profile *p = parse_ok("IESNA:LM-63-1995\n[TEST] b\nTILT=NONE\n"
+    lx_ies_profile *p = lx_test_parse_ies("IESNA:LM-63-1995\n[TEST] b\nTILT=NONE\n"
                                  "1 -1 2 3 2 2 1 0 0 0\n1 1 50\n"
                                  "-90 0 90\n0 90\n"
                                  "1 5 2\n3 4 3\n");
@@ -368,12 +351,12 @@ static void test_info(void **state)
     assert_int_equal(info.photometric_type, 2);
     assert_int_equal(info.vertical_count, 3);
     assert_int_equal(info.horizontal_count, 2);
-    assert_rel(info.vertical_angles[0], -90, 0);
-    assert_rel(info.vertical_angles[2], 90, 0);
-    assert_rel(info.horizontal_angles[1], 90, 0);
+    lx_test_assert_rel(info.vertical_angles[0], -90, 0);
+    lx_test_assert_rel(info.vertical_angles[2], 90, 0);
+    lx_test_assert_rel(info.horizontal_angles[1], 90, 0);
     assert_int_equal(info.symmetry, LX_IES_BILATERAL);
     /* the largest value times the multiplier 2 */
-    assert_rel(lx_ies_peak_candela(p), 10, 0);
+    lx_test_assert_rel(lx_ies_peak_candela(p), 10, 0);
     /* the beam axis and the principal planes: V = 0, H = 0 is 5 x 2; C0 at
      * 45 deg is V = 45 (between 5 and 2: 3.5 x 2); C90 at 90 is H = 90 (4 x 2) */
     assert_cd(p, 0, 0, 10, 1e-4);
@@ -384,13 +367,13 @@ static void test_info(void **state)
     assert_cd(p, 45, 270, 9, 1e-3);
     lx_ies_free(p);
     /* type A */
-    p = parse_ok("IESNA:LM-63-2002\nTILT=NONE\n1 -1 1 2 2 3 2 0 0 0\n1 1 0\n0 90\n-90 90\n"
+    p = lx_test_parse_ies("IESNA:LM-63-2002\nTILT=NONE\n1 -1 1 2 2 3 2 0 0 0\n1 1 0\n0 90\n-90 90\n"
                  "7 7\n7 7\n");
     lx_ies_get_info(p, &info);
     assert_int_equal(info.photometric_type, 3);
     assert_int_equal(info.symmetry, LX_IES_BILATERAL_90);
     assert_cd(p, 60, 300, 7, 1e-4);
-    assert_rel(lx_ies_total_lumens(p), 2 * PI_D * 7, 1e-3);
+    lx_test_assert_rel(lx_ies_total_lumens(p), 2 * PI_D * 7, 1e-3);
     lx_ies_free(p);
 }
 

@@ -11,16 +11,9 @@
 #include <math.h>
 #include <string.h>
 
-#include "luxel/light.h"
+#include "helpers.h"
 
 #define PI_D 3.14159265358979323846
-
-static void assert_rel(double got, double want, double tol)
-{
-    double scale = fabs(want) > 1e-30 ? fabs(want) : 1.0;
-    if (!(fabs(got - want) <= tol * scale))
-        fail_msg("got %.9g, want %.9g (relative tolerance %g)", got, want, tol);
-}
 
 static void assert_fails(lx_status st, lx_status want, const char *needle)
 {
@@ -55,7 +48,7 @@ static void test_defaults(void **state)
     assert_true(l.color.x == 1.0f && l.color.y == 1.0f && l.color.z == 1.0f);
     assert_true(l.intensity == 1.0f && l.range == 0.0f);
     assert_true(l.inner_angle == 0.0f);
-    assert_rel(l.outer_angle, PI_D / 4.0, 1e-6);
+    lx_test_assert_rel(l.outer_angle, PI_D / 4.0, 1e-6);
     assert_int_equal(l.shadow, LX_SHADOW_HARD);
     assert_int_equal(l.model, LX_MODEL_PHYSICAL);
     assert_true(l.blur_power == 1.0f && l.blur_multiplier == 1.0f);
@@ -70,10 +63,10 @@ static void test_range_window(void **state)
     (void)state;
     assert_true(lx_light_range_window(0.0f, 4.0f) == 1.0f);
     assert_true(lx_light_range_window(16.0f, 4.0f) == 0.0f);
-    assert_rel(lx_light_range_window(4.0f, 4.0f), (1.0 - 1.0 / 16.0) * (1.0 - 1.0 / 16.0), 1e-6);
+    lx_test_assert_rel(lx_light_range_window(4.0f, 4.0f), (1.0 - 1.0 / 16.0) * (1.0 - 1.0 / 16.0), 1e-6);
     assert_true(lx_light_range_window(25.0f, 4.0f) == 0.0f);
     assert_true(lx_light_range_window(1e6f, 0.0f) == 1.0f);
-    assert_rel(lx_light_range_window(9.0f, 5.0f), window_ref(3.0, 5.0), 1e-6);
+    lx_test_assert_rel(lx_light_range_window(9.0f, 5.0f), window_ref(3.0, 5.0), 1e-6);
 }
 
 static void test_point_inverse_square(void **state)
@@ -95,11 +88,11 @@ static void test_point_inverse_square(void **state)
         double e = 800.0 * cos_t / (d * d) * window_ref(d, 10.0);
         lx_light_eval ev;
         assert_true(lx_light_evaluate(&l, p, n, &ev));
-        assert_rel(ev.illuminance.x, e, 1e-5);
-        assert_rel(ev.illuminance.y, 0.5 * e, 1e-5);
-        assert_rel(ev.illuminance.z, 0.25 * e, 1e-5);
-        assert_rel(ev.distance, d, 1e-6);
-        assert_rel(ev.to_light.y, ly / d, 1e-5);
+        lx_test_assert_rel(ev.illuminance.x, e, 1e-5);
+        lx_test_assert_rel(ev.illuminance.y, 0.5 * e, 1e-5);
+        lx_test_assert_rel(ev.illuminance.z, 0.25 * e, 1e-5);
+        lx_test_assert_rel(ev.distance, d, 1e-6);
+        lx_test_assert_rel(ev.to_light.y, ly / d, 1e-5);
     }
     /* Behind the surface and out of range: no direct light. */
     lx_light_eval ev;
@@ -109,7 +102,7 @@ static void test_point_inverse_square(void **state)
     /* Unlimited range: the pure inverse square law. */
     l.range = 0.0f;
     assert_true(lx_light_evaluate(&l, lx_v3(0.5f, -98.0f, -1.0f), lx_v3(0, 1, 0), &ev));
-    assert_rel(ev.illuminance.x, 800.0 / (100.0 * 100.0), 1e-5);
+    lx_test_assert_rel(ev.illuminance.x, 800.0 / (100.0 * 100.0), 1e-5);
 }
 
 /* A spot 3 m above the floor pointing down; the floor point at angle deg. */
@@ -146,13 +139,13 @@ static void test_spot(void **state)
         bool lit;
         lx_light_eval ev = spot_at(&l, angles[i], &lit);
         assert_true(lit);
-        assert_rel(ev.illuminance.x, spot_ref(angles[i], 20, 30, 1200), 1e-4);
+        lx_test_assert_rel(ev.illuminance.x, spot_ref(angles[i], 20, 30, 1200), 1e-4);
     }
     /* Inside the inner cone the spot factor is exactly 1. */
     bool lit;
     lx_light_eval ev = spot_at(&l, 10.0, &lit);
     double c = cos(10.0 * PI_D / 180.0);
-    assert_rel(ev.illuminance.x, 1200.0 * c * c * c / 9.0, 1e-5);
+    lx_test_assert_rel(ev.illuminance.x, 1200.0 * c * c * c / 9.0, 1e-5);
     spot_at(&l, 31.0, &lit);
     assert_false(lit);
     spot_at(&l, 60.0, &lit);
@@ -160,7 +153,7 @@ static void test_spot(void **state)
     /* The attenuation function itself, penumbra midpoint. */
     double ci = cos(20 * PI_D / 180), co = cos(30 * PI_D / 180);
     double t = ((ci + co) / 2 - co) / (ci - co);
-    assert_rel(lx_light_spot_attenuation(&l, (float)((ci + co) / 2)), t * t, 1e-3);
+    lx_test_assert_rel(lx_light_spot_attenuation(&l, (float)((ci + co) / 2)), t * t, 1e-3);
     /* Point lights have no cone. */
     lx_light p = lx_light_defaults(LX_LIGHT_POINT);
     assert_true(lx_light_spot_attenuation(&p, -1.0f) == 1.0f);
@@ -179,10 +172,10 @@ static void test_spot_hard_edge(void **state)
     lx_light_eval ev = spot_at(&l, 29.8, &lit);
     assert_true(lit);
     double c = cos(29.8 * PI_D / 180.0);
-    assert_rel(ev.illuminance.x, 100.0 * c * c * c / 9.0, 1e-5);
+    lx_test_assert_rel(ev.illuminance.x, 100.0 * c * c * c / 9.0, 1e-5);
     ev = spot_at(&l, 0.0, &lit);
     assert_true(lit);
-    assert_rel(ev.illuminance.x, 100.0 / 9.0, 1e-5);
+    lx_test_assert_rel(ev.illuminance.x, 100.0 / 9.0, 1e-5);
     spot_at(&l, 30.2, &lit);
     assert_false(lit);
     assert_true(lx_light_spot_attenuation(&l, cosf(LX_DEG2RAD(29.9f))) == 1.0f);
@@ -204,15 +197,15 @@ static void test_directional(void **state)
     lx_light_eval ev;
     assert_true(lx_light_evaluate(&l, lx_v3(100, -5, 3), lx_v3(0, 1, 0), &ev));
     double cos_t = -dy / len;
-    assert_rel(ev.illuminance.x, 100000.0 * cos_t, 1e-5);
-    assert_rel(ev.illuminance.y, 90000.0 * cos_t, 1e-5);
+    lx_test_assert_rel(ev.illuminance.x, 100000.0 * cos_t, 1e-5);
+    lx_test_assert_rel(ev.illuminance.y, 90000.0 * cos_t, 1e-5);
     assert_true(isinf(ev.distance));
-    assert_rel(ev.to_light.x, -dx / len, 1e-6);
-    assert_rel(ev.to_light.y, -dy / len, 1e-6);
+    lx_test_assert_rel(ev.to_light.x, -dx / len, 1e-6);
+    lx_test_assert_rel(ev.to_light.y, -dy / len, 1e-6);
     /* A wall facing +X gets cos = -dx/len < 0: dark. */
     assert_false(lx_light_evaluate(&l, lx_v3(0, 0, 0), lx_v3(1, 0, 0), &ev));
     assert_true(lx_light_evaluate(&l, lx_v3(0, 0, 0), lx_v3(-1, 0, 0), &ev));
-    assert_rel(ev.illuminance.x, 100000.0 * dx / len, 1e-5);
+    lx_test_assert_rel(ev.illuminance.x, 100000.0 * dx / len, 1e-5);
 }
 
 static void test_classic(void **state)
@@ -236,8 +229,8 @@ static void test_classic(void **state)
         lx_light_eval ev;
         assert_true(
             lx_light_evaluate(&l, lx_v3(pts[i][0], pts[i][1], pts[i][2]), lx_v3(0, 1, 0), &ev));
-        assert_rel(ev.illuminance.x, val * val * 1.5, 1e-5);
-        assert_rel(ev.illuminance.y, val * val * 0.75, 1e-5);
+        lx_test_assert_rel(ev.illuminance.x, val * val * 1.5, 1e-5);
+        lx_test_assert_rel(ev.illuminance.y, val * val * 0.75, 1e-5);
         assert_true(ev.illuminance.z == 0.0f);
     }
     lx_light_eval ev;
@@ -261,9 +254,9 @@ static void test_ambient(void **state)
     lx_light_eval a, b;
     lx_light_evaluate(&red, p, lx_v3(0, -1, 0), &a); /* facing away: ambient all the same */
     lx_light_evaluate(&blue, p, lx_v3(0, 1, 0), &b);
-    assert_rel(a.ambient.x, 0.1 * window_ref(2.5, 5.0), 1e-5);
+    lx_test_assert_rel(a.ambient.x, 0.1 * window_ref(2.5, 5.0), 1e-5);
     double db = sqrt(1.0 + 6.25);
-    assert_rel(b.ambient.z, 0.2 * window_ref(db, 6.0), 1e-5);
+    lx_test_assert_rel(b.ambient.z, 0.2 * window_ref(db, 6.0), 1e-5);
     lx_vec3 sum = lx_add(a.ambient, b.ambient); /* red + blue = purple */
     assert_true(sum.x > 0.0f && sum.z > 0.0f && sum.y == 0.0f);
     /* Out of reach: no ambient. */
@@ -272,11 +265,11 @@ static void test_ambient(void **state)
     /* Unlimited range and directional lights: ambient everywhere. */
     red.range = 0.0f;
     lx_light_evaluate(&red, lx_v3(0, 700, 0), lx_v3(0, 1, 0), &a);
-    assert_rel(a.ambient.x, 0.1, 1e-6);
+    lx_test_assert_rel(a.ambient.x, 0.1, 1e-6);
     lx_light sun = named(LX_LIGHT_DIRECTIONAL, "sun");
     sun.ambient = lx_v3(0.3f, 0.2f, 0.1f);
     lx_light_evaluate(&sun, p, lx_v3(0, -1, 0), &a);
-    assert_rel(a.ambient.y, 0.2, 1e-6);
+    lx_test_assert_rel(a.ambient.y, 0.2, 1e-6);
 }
 
 static void test_blur(void **state)
@@ -284,11 +277,11 @@ static void test_blur(void **state)
     (void)state;
     lx_light l = named(LX_LIGHT_POINT, "b");
     l.shadow = LX_SHADOW_BLUR;
-    assert_rel(lx_light_blur_visibility(&l, 1.0f, 4.0f), 0.25, 1e-6);
+    lx_test_assert_rel(lx_light_blur_visibility(&l, 1.0f, 4.0f), 0.25, 1e-6);
     l.blur_power = 2.0f;
-    assert_rel(lx_light_blur_visibility(&l, 1.0f, 4.0f), 1.0 / 16.0, 1e-6);
+    lx_test_assert_rel(lx_light_blur_visibility(&l, 1.0f, 4.0f), 1.0 / 16.0, 1e-6);
     l.blur_multiplier = 3.0f;
-    assert_rel(lx_light_blur_visibility(&l, 1.0f, 4.0f), 3.0 / 16.0, 1e-6);
+    lx_test_assert_rel(lx_light_blur_visibility(&l, 1.0f, 4.0f), 3.0 / 16.0, 1e-6);
     l.blur_multiplier = 100.0f;
     assert_true(lx_light_blur_visibility(&l, 1.0f, 4.0f) == 1.0f);
     assert_true(lx_light_blur_visibility(&l, 0.0f, 4.0f) == 0.0f);
@@ -301,9 +294,9 @@ static void test_conversions(void **state)
     lx_light p = named(LX_LIGHT_POINT, "p");
     float v;
     assert_int_equal(lx_light_intensity_to_native(&p, 1000, LX_UNIT_LUMEN, 0, &v), LX_OK);
-    assert_rel(v, 1000.0 / (4.0 * PI_D), 1e-6);
+    lx_test_assert_rel(v, 1000.0 / (4.0 * PI_D), 1e-6);
     assert_int_equal(lx_light_intensity_to_native(&p, 10, LX_UNIT_WATT, 0, &v), LX_OK);
-    assert_rel(v, 6830.0 / (4.0 * PI_D), 1e-6); /* 10 W = 6830 lm */
+    lx_test_assert_rel(v, 6830.0 / (4.0 * PI_D), 1e-6); /* 10 W = 6830 lm */
     assert_int_equal(lx_light_intensity_to_native(&p, 42, LX_UNIT_CANDELA, 0, &v), LX_OK);
     assert_true(v == 42.0f);
     assert_int_equal(lx_light_intensity_to_native(&p, 42, LX_UNIT_DEFAULT, 0, &v), LX_OK);
@@ -315,13 +308,13 @@ static void test_conversions(void **state)
     s.outer_angle = LX_DEG2RAD(30.0f);
     assert_int_equal(lx_light_intensity_to_native(&s, 1000, LX_UNIT_LUMEN, LX_SPOT_POWER_PI, &v),
                      LX_OK);
-    assert_rel(v, 1000.0 / PI_D, 1e-6);
+    lx_test_assert_rel(v, 1000.0 / PI_D, 1e-6);
     assert_int_equal(lx_light_intensity_to_native(&s, 1000, LX_UNIT_LUMEN, LX_SPOT_POWER_CONE, &v),
                      LX_OK);
-    assert_rel(v, 1000.0 / (2.0 * PI_D * (1.0 - cos(30.0 * PI_D / 180.0))), 1e-5);
+    lx_test_assert_rel(v, 1000.0 / (2.0 * PI_D * (1.0 - cos(30.0 * PI_D / 180.0))), 1e-5);
     assert_int_equal(lx_light_intensity_to_native(&s, 2, LX_UNIT_WATT, LX_SPOT_POWER_CONE, &v),
                      LX_OK);
-    assert_rel(v, 1366.0 / (2.0 * PI_D * (1.0 - cos(30.0 * PI_D / 180.0))), 1e-5);
+    lx_test_assert_rel(v, 1366.0 / (2.0 * PI_D * (1.0 - cos(30.0 * PI_D / 180.0))), 1e-5);
 
     lx_light d = named(LX_LIGHT_DIRECTIONAL, "sun");
     assert_int_equal(lx_light_intensity_to_native(&d, 1e5f, LX_UNIT_LUX, 0, &v), LX_OK);
@@ -364,13 +357,13 @@ static void test_unit_names(void **state)
 static void test_exposure(void **state)
 {
     (void)state;
-    assert_rel(lx_exposure_from_ev100(0.0f), 1.0 / 1.2, 1e-6);
-    assert_rel(lx_exposure_from_ev100(1.0f), 1.0 / 2.4, 1e-6);
-    assert_rel(lx_exposure_from_ev100(15.0f), 1.0 / (1.2 * 32768.0), 1e-6);
+    lx_test_assert_rel(lx_exposure_from_ev100(0.0f), 1.0 / 1.2, 1e-6);
+    lx_test_assert_rel(lx_exposure_from_ev100(1.0f), 1.0 / 2.4, 1e-6);
+    lx_test_assert_rel(lx_exposure_from_ev100(15.0f), 1.0 / (1.2 * 32768.0), 1e-6);
     /* EV100 = log2(L * 100 / 12.5): 0.125 nits -> 0, 12.5 nits -> log2(100). */
     assert_true(fabsf(lx_ev100_from_luminance(0.125)) < 1e-6f);
-    assert_rel(lx_ev100_from_luminance(12.5), log2(100.0), 1e-6);
-    assert_rel(lx_ev100_from_luminance(0.25), 1.0, 1e-6);
+    lx_test_assert_rel(lx_ev100_from_luminance(12.5), log2(100.0), 1e-6);
+    lx_test_assert_rel(lx_ev100_from_luminance(0.25), 1.0, 1e-6);
     assert_true(lx_ev100_from_luminance(0.0) == 0.0f);
     assert_true(lx_ev100_from_luminance(-3.0) == 0.0f);
 }
