@@ -132,6 +132,9 @@ void lx_image_free(lx_image *img);
 typedef struct lx_image_load_desc {
     bool raw_8bit; /* 8-bit data is mapped to [0,1] without sRGB decoding */
     int channels;  /* wanted channel count, 0 = as stored */
+    bool keep_nonfinite; /* keep NaN and infinite values (the caller checks
+                            them, e.g. to count them); default: fail on the
+                            first one */
 } lx_image_load_desc;
 
 /* Loads PNG/JPEG/TGA/HDR (stb_image), PFM and EXR. desc may be NULL.

@@ -12,5 +12,6 @@
 #include "luxel/trace.h"
 #include "luxel/maps.h"
 #include "luxel/bake.h"
+#include "luxel/ibl.h"
 
 #endif

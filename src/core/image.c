@@ -284,7 +284,7 @@ lx_status lx_image_load_memory(const void *bytes, size_t size, const char *name,
         s = lx_img_load_stb(data, size, name, format == LX_IMAGE_TGA, d.raw_8bit, out);
         break;
     }
-    if (s == LX_OK)
+    if (s == LX_OK && !d.keep_nonfinite)
         s = check_finite(out, name);
     if (s == LX_OK)
         s = convert_channels(out, d.channels, name);

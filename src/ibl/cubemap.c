@@ -1,0 +1,155 @@
+/* Cube map geometry and storage: the OpenGL cube face table (OpenGL 4.6
+ * specification, section 8.13 "Cube Map Texture Selection"), exact texel
+ * solid angles from the solid angle of a face rectangle seen from the cube
+ * centre, F(a, b) = atan(a b / sqrt(a^2 + b^2 + 1)), and bilinear sampling
+ * that takes its taps across face edges. */
+#include "ibl_internal.h"
+
+#include <math.h>
+#include <stdlib.h>
+#include <string.h>
+
+const char *lx_cube_face_name(int face)
+{
+    static const char *names[6] = {"px", "nx", "py", "ny", "pz", "nz"};
+    return face >= 0 && face < 6 ? names[face] : "?";
+}
+
+/* Direction (not normalised) through face coordinates sc, tc in [-1, 1]. */
+lx_vec3 lx_ibl_face_vector(int face, float sc, float tc)
+{
+    switch (face) {
+    case LX_FACE_PX:
+        return lx_v3(1.0f, -tc, -sc);
+    case LX_FACE_NX:
+        return lx_v3(-1.0f, -tc, sc);
+    case LX_FACE_PY:
+        return lx_v3(sc, 1.0f, tc);
+    case LX_FACE_NY:
+        return lx_v3(sc, -1.0f, -tc);
+    case LX_FACE_PZ:
+        return lx_v3(sc, -tc, 1.0f);
+    default:
+        return lx_v3(-sc, -tc, -1.0f);
+    }
+}
+
+lx_vec3 lx_cube_direction(int face, float s, float t)
+{
+    return lx_normalize(lx_ibl_face_vector(face, 2.0f * s - 1.0f, 2.0f * t - 1.0f));
+}
+
+void lx_cube_face_coords(lx_vec3 d, int *face, float *s, float *t)
+{
+    lx_ibl_face_st(d, face, s, t);
+}
+
+/* Solid angle of the face rectangle [0, a] x [0, b] (face at distance 1). */
+static double corner_solid_angle(double a, double b)
+{
+    return atan2(a * b, sqrt(a * a + b * b + 1.0));
+}
+
+double lx_cube_texel_solid_angle(int size, int x, int y)
+{
+    double inv = 2.0 / size;
+    double x0 = x * inv - 1.0, x1 = (x + 1) * inv - 1.0;
+    double y0 = y * inv - 1.0, y1 = (y + 1) * inv - 1.0;
+    return corner_solid_angle(x0, y0) - corner_solid_angle(x0, y1) -
+           corner_solid_angle(x1, y0) + corner_solid_angle(x1, y1);
+}
+
+lx_vec3 lx_equirect_direction(float u, float v)
+{
+    float phi = 2.0f * (float)LX_PI * (u - 0.5f), theta = (float)LX_PI * v;
+    float st = sinf(theta);
+    return lx_v3(st * sinf(phi), cosf(theta), -st * cosf(phi));
+}
+
+void lx_equirect_coords(lx_vec3 d, float *u, float *v)
+{
+    d = lx_normalize(d);
+    float phi = atan2f(d.x, -d.z);
+    *u = phi / (2.0f * (float)LX_PI) + 0.5f;
+    if (*u >= 1.0f)
+        *u -= 1.0f;
+    *v = acosf(lx_clampf(d.y, -1.0f, 1.0f)) / (float)LX_PI;
+}
+
+int lx_cube_mip_count(int size)
+{
+    int n = 1;
+    while (size > 1) {
+        size /= 2;
+        n++;
+    }
+    return n;
+}
+
+lx_status lx_cubemap_alloc(lx_cubemap *c, int size)
+{
+    memset(c, 0, sizeof *c);
+    if (size < 1 || size > LX_MAX_CUBE_SIZE)
+        return lx_fail(LX_ERR_INVALID, "cube map size %d is outside 1..%d", size,
+                       LX_MAX_CUBE_SIZE);
+    uint64_t count = 6ull * (uint64_t)size * (uint64_t)size * 3ull;
+    lx_status st = lx_check_memory(count * sizeof(float), "cube map");
+    if (st != LX_OK)
+        return st;
+    c->data = calloc((size_t)count, sizeof(float));
+    if (!c->data)
+        return lx_fail(LX_ERR_NOMEM, "out of memory for a %d x %d cube map", size, size);
+    c->size = size;
+    return LX_OK;
+}
+
+void lx_cubemap_free(lx_cubemap *c)
+{
+    if (!c)
+        return;
+    free(c->data);
+    c->data = NULL;
+    c->size = 0;
+}
+
+lx_image lx_cubemap_face_image(const lx_cubemap *c, int face)
+{
+    lx_image img = {c->size, c->size, 3, lx_cubemap_texel(c, face, 0, 0)};
+    return img;
+}
+
+/* Texel (x, y) of a face where x or y may be one step off the face: the
+ * texel whose centre is nearest the extrapolated direction. */
+static const float *texel_across(const lx_cubemap *c, int face, int x, int y)
+{
+    int n = c->size;
+    if (x >= 0 && x < n && y >= 0 && y < n)
+        return lx_cubemap_texel(c, face, x, y);
+    float sc = 2.0f * ((float)x + 0.5f) / (float)n - 1.0f;
+    float tc = 2.0f * ((float)y + 0.5f) / (float)n - 1.0f;
+    int f;
+    float s, t;
+    lx_cube_face_coords(lx_ibl_face_vector(face, sc, tc), &f, &s, &t);
+    int nx = (int)(s * (float)n), ny = (int)(t * (float)n);
+    nx = nx < 0 ? 0 : nx >= n ? n - 1 : nx;
+    ny = ny < 0 ? 0 : ny >= n ? n - 1 : ny;
+    return lx_cubemap_texel(c, f, nx, ny);
+}
+
+void lx_cubemap_sample(const lx_cubemap *c, lx_vec3 dir, float out[3])
+{
+    int face;
+    float s, t;
+    lx_cube_face_coords(dir, &face, &s, &t);
+    float fx = s * (float)c->size - 0.5f, fy = t * (float)c->size - 0.5f;
+    float x0f = floorf(fx), y0f = floorf(fy);
+    float wx = fx - x0f, wy = fy - y0f;
+    int x0 = (int)x0f, y0 = (int)y0f;
+    const float *a = texel_across(c, face, x0, y0), *b = texel_across(c, face, x0 + 1, y0);
+    const float *d = texel_across(c, face, x0, y0 + 1), *e = texel_across(c, face, x0 + 1, y0 + 1);
+    for (int k = 0; k < 3; k++) {
+        float top = a[k] + (b[k] - a[k]) * wx;
+        float bottom = d[k] + (e[k] - d[k]) * wx;
+        out[k] = top + (bottom - top) * wy;
+    }
+}

@@ -1,0 +1,267 @@
+/* Brute-force diffuse irradiance, seed 004 (Wikibooks, "Cg Programming/
+ * Unity/Many Light Sources", computeFilteredCubemap): every texel of the
+ * source cube map is a directional light and the irradiance of a normal is
+ * the sum of them all, weighted by the cosine. Differences from the seed,
+ * all toward the exact integral E(n) = sum over texels of
+ * L * integral over the texel of max(0, n.w) dw:
+ *  - each texel is weighted by its exact solid angle (the seed uses none);
+ *  - a texel wholly above the horizon of n contributes L (n . Phi), where
+ *    Phi = integral of w dw over the texel is its irradiance vector, exact
+ *    from Lambert's formula for a spherical polygon, 1/2 sum_e theta_e u_e
+ *    (J. Arvo, "Applications of Irradiance Tensors...", SIGGRAPH 1995);
+ *  - a texel the horizon cuts is split into k x k sub-texels, each a
+ *    directional light at its centre with its exact solid angle (k brings
+ *    the split grid to 128 per face side, at most 32).
+ * A constant environment L then gives pi L to ~2e-5 from a 32^2 source.
+ * The source is first downsampled (solid-angle weighted 2x2) to at most
+ * source_size per side, so a 512^2 input stays practical. */
+#include "ibl_internal.h"
+
+#include <math.h>
+#include <stdlib.h>
+#include <string.h>
+
+typedef struct lights {
+    int count, sub;           /* texels, sub-texels per texel (k * k) */
+    float *cx, *cy, *cz;      /* centre direction */
+    float *px, *py, *pz;      /* irradiance vector Phi */
+    float *horizon;           /* sin of the texel's angular radius */
+    float *r, *g, *b;         /* radiance */
+    float *sx, *sy, *sz, *sw; /* sub-texel directions and solid angles, sub per texel */
+} lights;
+
+static void lights_free(lights *l)
+{
+    free(l->cx);
+    free(l->sx);
+    memset(l, 0, sizeof *l);
+}
+
+static lx_vec3 unit_corner(int face, int n, double x, double y)
+{
+    return lx_normalize(
+        lx_ibl_face_vector(face, (float)(2.0 * x / n - 1.0), (float)(2.0 * y / n - 1.0)));
+}
+
+/* ibl.h's face table in double. */
+static void face_vector_d(int face, double sc, double tc, double a[3])
+{
+    switch (face) {
+    case LX_FACE_PX:
+        a[0] = 1, a[1] = -tc, a[2] = -sc;
+        break;
+    case LX_FACE_NX:
+        a[0] = -1, a[1] = -tc, a[2] = sc;
+        break;
+    case LX_FACE_PY:
+        a[0] = sc, a[1] = 1, a[2] = tc;
+        break;
+    case LX_FACE_NY:
+        a[0] = sc, a[1] = -1, a[2] = -tc;
+        break;
+    case LX_FACE_PZ:
+        a[0] = sc, a[1] = -tc, a[2] = 1;
+        break;
+    default:
+        a[0] = -sc, a[1] = -tc, a[2] = -1;
+        break;
+    }
+}
+
+/* Phi of face texel (x, y): Lambert's formula over its four edges. */
+static void irradiance_vector(int face, int n, int x, int y, lx_vec3 centre, double phi[3])
+{
+    double v[4][3];
+    const int cx[4] = {0, 1, 1, 0}, cy[4] = {0, 0, 1, 1};
+    for (int k = 0; k < 4; k++) {
+        /* corner directions in double: the edges of small texels are short */
+        double sc = 2.0 * (x + cx[k]) / n - 1.0, tc = 2.0 * (y + cy[k]) / n - 1.0;
+        double a[3];
+        face_vector_d(face, sc, tc, a);
+        double len = sqrt(a[0] * a[0] + a[1] * a[1] + a[2] * a[2]);
+        for (int c = 0; c < 3; c++)
+            v[k][c] = a[c] / len;
+    }
+    phi[0] = phi[1] = phi[2] = 0.0;
+    for (int e = 0; e < 4; e++) {
+        const double *a = v[e], *b = v[(e + 1) & 3];
+        double w[3] = {a[1] * b[2] - a[2] * b[1], a[2] * b[0] - a[0] * b[2],
+                       a[0] * b[1] - a[1] * b[0]};
+        double s = sqrt(w[0] * w[0] + w[1] * w[1] + w[2] * w[2]);
+        double theta = atan2(s, a[0] * b[0] + a[1] * b[1] + a[2] * b[2]);
+        for (int c = 0; c < 3; c++)
+            phi[c] += 0.5 * theta * w[c] / s;
+    }
+    /* the corner order's orientation decides the sign: Phi points outward */
+    if (phi[0] * centre.x + phi[1] * centre.y + phi[2] * centre.z < 0.0)
+        for (int c = 0; c < 3; c++)
+            phi[c] = -phi[c];
+}
+
+static lx_status lights_build(const lx_cubemap *s, lights *l)
+{
+    memset(l, 0, sizeof *l);
+    int n = s->size;
+    int k = n >= 128 ? 1 : 128 / n;
+    k = k > 32 ? 32 : k;
+    size_t count = (size_t)6 * n * n, sub = (size_t)k * k;
+    l->count = (int)count;
+    l->sub = (int)sub;
+    l->cx = malloc(sizeof(float) * count * 10);
+    l->sx = malloc(sizeof(float) * count * sub * 4);
+    double *omega = lx_ibl_solid_angles(n * k);
+    if (!l->cx || !l->sx || !omega) {
+        free(omega);
+        lights_free(l);
+        return lx_fail(LX_ERR_NOMEM, "out of memory for %zu source texels", count);
+    }
+    l->cy = l->cx + count, l->cz = l->cy + count;
+    l->px = l->cz + count, l->py = l->px + count, l->pz = l->py + count;
+    l->horizon = l->pz + count;
+    l->r = l->horizon + count, l->g = l->r + count, l->b = l->g + count;
+    l->sy = l->sx + count * sub, l->sz = l->sy + count * sub, l->sw = l->sz + count * sub;
+    for (int face = 0; face < 6; face++)
+        for (int y = 0; y < n; y++)
+            for (int x = 0; x < n; x++) {
+                size_t t = ((size_t)face * n + y) * n + x;
+                lx_vec3 c = unit_corner(face, n, x + 0.5, y + 0.5);
+                double phi[3];
+                irradiance_vector(face, n, x, y, c, phi);
+                float lowest = 1.0f; /* cos of the angular radius */
+                for (int j = 0; j < 2; j++)
+                    for (int i = 0; i < 2; i++) {
+                        float cc = lx_dot(c, unit_corner(face, n, x + i, y + j));
+                        lowest = cc < lowest ? cc : lowest;
+                    }
+                lowest = lx_clampf(lowest, -1.0f, 1.0f);
+                const float *p = lx_cubemap_texel(s, face, x, y);
+                l->cx[t] = c.x, l->cy[t] = c.y, l->cz[t] = c.z;
+                l->px[t] = (float)phi[0], l->py[t] = (float)phi[1], l->pz[t] = (float)phi[2];
+                /* sin(radius), rounded up a little so float error cannot
+                 * call a cut texel whole */
+                l->horizon[t] = sqrtf(1.0f - lowest * lowest) * 1.0001f + 1e-6f;
+                l->r[t] = p[0], l->g[t] = p[1], l->b[t] = p[2];
+                for (int j = 0; j < k; j++)
+                    for (int i = 0; i < k; i++) {
+                        size_t u = t * sub + (size_t)j * k + i;
+                        int X = x * k + i, Y = y * k + j;
+                        lx_vec3 d = unit_corner(face, n * k, X + 0.5, Y + 0.5);
+                        l->sx[u] = d.x, l->sy[u] = d.y, l->sz[u] = d.z;
+                        l->sw[u] = (float)lx_ibl_omega(omega, n * k, X, Y);
+                    }
+            }
+    free(omega);
+    return LX_OK;
+}
+
+static void irradiance_at(const lights *l, lx_vec3 nrm, float out[3])
+{
+    double e[3] = {0, 0, 0};
+    for (int t = 0; t < l->count; t++) {
+        float c = nrm.x * l->cx[t] + nrm.y * l->cy[t] + nrm.z * l->cz[t];
+        float h = l->horizon[t];
+        if (c <= -h)
+            continue;
+        double w;
+        if (c >= h) {
+            w = (double)(nrm.x * l->px[t] + nrm.y * l->py[t] + nrm.z * l->pz[t]);
+        } else {
+            w = 0.0;
+            size_t u0 = (size_t)t * l->sub;
+            for (int s = 0; s < l->sub; s++) {
+                size_t u = u0 + s;
+                float cs = nrm.x * l->sx[u] + nrm.y * l->sy[u] + nrm.z * l->sz[u];
+                if (cs > 0.0f)
+                    w += (double)(cs * l->sw[u]);
+            }
+        }
+        e[0] += w * l->r[t];
+        e[1] += w * l->g[t];
+        e[2] += w * l->b[t];
+    }
+    for (int k = 0; k < 3; k++)
+        out[k] = (float)e[k];
+}
+
+lx_ibl_desc lx_ibl_desc_defaults(const lx_ibl_desc *desc)
+{
+    lx_ibl_desc d = {0};
+    if (desc)
+        d = *desc;
+    return d;
+}
+
+lx_status lx_irradiance_brute(const lx_cubemap *src, int size, int source_size,
+                              const lx_ibl_desc *in, lx_cubemap *out)
+{
+    if (!out)
+        return lx_fail(LX_ERR_INVALID, "irradiance: no output cube map (NULL)");
+    memset(out, 0, sizeof *out);
+    lx_ibl_desc desc = lx_ibl_desc_defaults(in);
+    size = size ? size : 32;
+    source_size = source_size ? source_size : 32;
+    if (size < 1 || size > LX_MAX_CUBE_SIZE)
+        return lx_fail(LX_ERR_INVALID, "irradiance: face size %d is outside 1..%d", size,
+                       LX_MAX_CUBE_SIZE);
+    if (source_size < 1 || source_size > LX_MAX_CUBE_SIZE)
+        return lx_fail(LX_ERR_INVALID, "irradiance: source size %d is outside 1..%d", source_size,
+                       LX_MAX_CUBE_SIZE);
+    lx_status st = lx_ibl_check_threads(desc.threads);
+    if (st != LX_OK)
+        return st;
+    if ((st = lx_ibl_check_cubemap(src, "irradiance: source cube map", true)) != LX_OK)
+        return st;
+    int threads = lx_thread_count(desc.threads);
+
+    /* the source, halved until it fits source_size */
+    lx_cubemap small = *src, tmp;
+    bool owned = false;
+    while (small.size > source_size) {
+        if ((st = lx_ibl_downsample(&small, &tmp, threads)) != LX_OK) {
+            if (owned)
+                lx_cubemap_free(&small);
+            return st;
+        }
+        if (owned)
+            lx_cubemap_free(&small);
+        small = tmp;
+        owned = true;
+    }
+    lights l;
+    st = lights_build(&small, &l);
+    if (owned)
+        lx_cubemap_free(&small);
+    if (st != LX_OK)
+        return st;
+    if ((st = lx_cubemap_alloc(out, size)) != LX_OK) {
+        lights_free(&l);
+        return st;
+    }
+
+    int tiles_side = (size + LX_IBL_TILE - 1) / LX_IBL_TILE;
+    int tiles = 6 * tiles_side * tiles_side;
+    lx_ibl_progress prog;
+    lx_ibl_progress_init(&prog, desc.progress, desc.progress_user, (double)6 * size * size, 0.0f,
+                         1.0f);
+#pragma omp parallel for schedule(dynamic, 1) num_threads(threads)
+    for (int tile = 0; tile < tiles; tile++) {
+        if (prog.cancelled)
+            continue;
+        int face = tile / (tiles_side * tiles_side), rest = tile % (tiles_side * tiles_side);
+        int x0 = (rest % tiles_side) * LX_IBL_TILE, y0 = (rest / tiles_side) * LX_IBL_TILE;
+        int x1 = x0 + LX_IBL_TILE < size ? x0 + LX_IBL_TILE : size;
+        int y1 = y0 + LX_IBL_TILE < size ? y0 + LX_IBL_TILE : size;
+        for (int y = y0; y < y1; y++)
+            for (int x = x0; x < x1; x++) {
+                lx_vec3 nrm = lx_cube_direction(face, (x + 0.5f) / size, (y + 0.5f) / size);
+                irradiance_at(&l, nrm, lx_cubemap_texel(out, face, x, y));
+            }
+        lx_ibl_progress_add(&prog, (double)(x1 - x0) * (y1 - y0));
+    }
+    lights_free(&l);
+    if (!lx_ibl_progress_end(&prog)) {
+        lx_cubemap_free(out);
+        return lx_fail(LX_ERR_CANCELLED, "irradiance cancelled");
+    }
+    return LX_OK;
+}
