@@ -17,13 +17,17 @@ deps:
 configure: deps
 	@test -f $(BUILD)/CMakeCache.txt || cmake -S . -B $(BUILD) -DCMAKE_BUILD_TYPE=Release $(CMAKE_FLAGS)
 
-# Generate the example scenes, bake the room, write lightmaps and previews.
+# Generate the example scenes and sky, bake the room and the courtyard by
+# night and by day (sky light), and filter the sky for image-based lighting.
 demo: all
 	$(BUILD)/bin/gen_scenes examples/scenes
 	$(BUILD)/bin/luxel bake examples/scenes/room.glb -o lightmaps/room
 	$(BUILD)/bin/luxel bake examples/scenes/retro.glb --texel-density 8 \
 		--lights examples/retro-night.json -o lightmaps/retro
-	@echo "demo: lightmaps, PNG previews and manifest.json are in lightmaps/room/ and lightmaps/retro/"
+	$(BUILD)/bin/luxel bake examples/scenes/retro.glb --texel-density 8 \
+		--lights examples/retro-day.json -o lightmaps/retro-day
+	$(BUILD)/bin/luxel ibl examples/scenes/sky.pfm -o ibl/sky
+	@echo "demo: lightmaps, PNG previews and manifest.json are in lightmaps/room/, lightmaps/retro/ and lightmaps/retro-day/; the sky's irradiance, SH, specular mips and DFG table in ibl/sky/"
 
 check: all
 	cd $(BUILD) && ctest --output-on-failure -j $(JOBS)
@@ -36,6 +40,7 @@ check-asan: deps
 bench: all
 	$(BUILD)/bin/bench_bake
 	$(BUILD)/bin/bench_realtime
+	$(BUILD)/bin/bench_ibl
 
 fuzz: all
 	@test -f $(BUILD_FUZZ)/CMakeCache.txt || CC=clang cmake -S . -B $(BUILD_FUZZ) -DCMAKE_BUILD_TYPE=Debug -DLX_FUZZ=ON

@@ -1,10 +1,12 @@
 /*
  * gen_scenes.c - example scene generator: writes two binary glTF 2.0 (.glb)
- * scenes for trying out and testing luxel's lightmap baker.
+ * scenes for trying out and testing luxel's lightmap baker, and a clear-sky
+ * environment for its image-based lighting.
  *
  * Usage: gen_scenes OUTDIR
- *   writes OUTDIR/room.glb and OUTDIR/retro.glb, creating OUTDIR if needed. Each
- *   file is written to a temporary file in OUTDIR and renamed when complete.
+ *   writes OUTDIR/room.glb, OUTDIR/retro.glb and OUTDIR/sky.pfm, creating
+ *   OUTDIR if needed. Each file is written to a temporary file in OUTDIR and
+ *   renamed when complete.
  *
  * Standalone on purpose (libc + libm only, no libluxel) so the test inputs
  * come from code that shares nothing with the code under test.
@@ -57,6 +59,22 @@
  *                     40 degrees above the horizon.
  *   "torch_a", "torch_b"  point lights, colour (1,0.6,0.25), 60 cd, range
  *                     8 m, 2.5 m up beside pillars 3 and 0.
+ *
+ * sky.pfm - a clear day as a 1024 x 512 equirectangular PFM (radiance in
+ * nits, linear Rec.709; luxel's convention: +Y up, the centre column looks
+ * down -Z, docs/ibl.md). A deliberately simple model, not a measured sky:
+ *   sky       L = Lz (1.6 - 0.6 sin e) at elevation e, a blue tint of
+ *             luminance 1, Lz = 15000 / (1.2 pi) nits so the sky alone gives
+ *             15000 lux on a horizontal surface (the integral of
+ *             (1.6 - 0.6 mu) mu over the upper hemisphere is 1.2 pi);
+ *   sun       a disk of 1.5 degrees radius (wider than the real 0.27 so it
+ *             spans a few pixels) where the retro scene's sun is, 40 degrees
+ *             up, of luminance 80000 / (pi sin^2 1.5 deg):
+ *             80000 lux at normal incidence, a warm white;
+ *   ground    below the horizon, a Lambertian ground of albedo 0.2 under the
+ *             sun and sky: 0.2 (80000 sin 40 deg + 15000) / pi nits.
+ * Each pixel averages 4 x 4 sub-pixel samples, so the sun's edge is
+ * antialiased.
  */
 #define _POSIX_C_SOURCE 200809L
 
@@ -223,6 +241,67 @@ static void put_f32(bytes *b, float f)
     uint32_t u;
     memcpy(&u, &f, 4);
     put_u32(b, u);
+}
+
+/* ---- the sky --------------------------------------------------------------- */
+
+#define SKY_W 1024
+#define SKY_H 512
+
+/* Radiance (nits, RGB) toward unit direction d of the sky described at the
+ * top of this file. */
+static void sky_radiance(const double d[3], const double sun[3], double out[3])
+{
+    const double sky_tint[3] = {0.62, 0.79, 1.18};   /* luminance 1 */
+    const double sun_tint[3] = {1.04, 1.0, 0.9};     /* luminance ~1 */
+    const double ground_tint[3] = {1.08, 1.0, 0.82}; /* luminance ~1 */
+    const double sun_radius = 1.5 * PI / 180.0;
+    const double sun_lux = 80000.0, sky_lux = 15000.0;
+    double e = asin(d[1] < -1 ? -1 : d[1] > 1 ? 1 : d[1]);
+    double cos_sun = d[0] * sun[0] + d[1] * sun[1] + d[2] * sun[2];
+    if (e < 0.0) {
+        double l = 0.2 * (sun_lux * sin(40.0 * PI / 180.0) + sky_lux) / PI;
+        for (int k = 0; k < 3; k++)
+            out[k] = l * ground_tint[k];
+        return;
+    }
+    if (cos_sun >= cos(sun_radius)) {
+        double l = sun_lux / (PI * sin(sun_radius) * sin(sun_radius));
+        for (int k = 0; k < 3; k++)
+            out[k] = l * sun_tint[k];
+        return;
+    }
+    double lz = sky_lux / (1.2 * PI);
+    double l = lz * (1.6 - 0.6 * sin(e));
+    for (int k = 0; k < 3; k++)
+        out[k] = l * sky_tint[k];
+}
+
+/* The equirect as a PFM: header, then rows bottom to top, little-endian
+ * floats (the PFM convention). */
+static void make_sky(bytes *out)
+{
+    /* toward the retro scene's sun (its light travels the other way) */
+    double el = 40.0 * PI / 180.0, az = 30.0 * PI / 180.0;
+    double sun[3] = {-cos(el) * sin(az), sin(el), cos(el) * cos(az)};
+    bytes_printf(out, "PF\n%d %d\n-1.0\n", SKY_W, SKY_H);
+    for (int row = SKY_H - 1; row >= 0; row--)
+        for (int col = 0; col < SKY_W; col++) {
+            double sum[3] = {0, 0, 0};
+            for (int sy = 0; sy < 4; sy++)
+                for (int sx = 0; sx < 4; sx++) {
+                    double u = (col + (sx + 0.5) / 4.0) / SKY_W;
+                    double v = (row + (sy + 0.5) / 4.0) / SKY_H;
+                    double phi = 2.0 * PI * (u - 0.5), theta = PI * v;
+                    double d[3] = {sin(theta) * sin(phi), cos(theta), -sin(theta) * cos(phi)};
+                    double l[3];
+                    sky_radiance(d, sun, l);
+                    for (int k = 0; k < 3; k++)
+                        sum[k] += l[k] / 16.0;
+                }
+            for (int k = 0; k < 3; k++)
+                put_f32(out, (float)sum[k]);
+        }
 }
 
 /* Shortest decimal that reads back as the same float (0.95, not
@@ -1080,14 +1159,16 @@ int main(int argc, char **argv)
     static scene room, retro;
     build_room(&room);
     build_retro(&retro);
-    bytes room_glb = {0}, retro_glb = {0};
+    bytes room_glb = {0}, retro_glb = {0}, sky = {0};
+    make_sky(&sky);
     int rc = 1;
     if (make_glb(&room, "room.glb", &room_glb) == 0 &&
         make_glb(&retro, "retro.glb", &retro_glb) == 0 && make_dirs(dir) == 0 &&
         write_atomic(dir, "room.glb", &room_glb) == 0 &&
-        write_atomic(dir, "retro.glb", &retro_glb) == 0)
+        write_atomic(dir, "retro.glb", &retro_glb) == 0 && write_atomic(dir, "sky.pfm", &sky) == 0)
         rc = 0;
     free(room_glb.data);
     free(retro_glb.data);
+    free(sky.data);
     return rc;
 }

@@ -34,6 +34,7 @@
 #define LUXEL_BAKE_H
 
 #include "luxel/core.h"
+#include "luxel/ibl.h"
 #include "luxel/light.h"
 #include "luxel/math.h"
 #include "luxel/scene.h"
@@ -52,6 +53,18 @@ typedef enum lx_quantity {
 #define LX_PADDING_NONE (-1)
 #define LX_MAX_LIGHTMAP_SIZE 16384
 
+/* Sky light: every texel lit by an environment (radiance in nits, luxel's
+ * IBL conventions, ibl.h). Unshadowed, the irradiance of its order-2
+ * spherical harmonics at the texel's normal; with shadows, the mean of
+ * cosine-weighted rays over the texel's hemisphere that escape the scene,
+ * each bringing the environment it sees (pi / N sum L). */
+typedef struct lx_sky_desc {
+    const lx_cubemap *environment; /* NULL = no sky; read by lx_baker_create only */
+    float intensity;               /* multiplier, 0 = 1 */
+    bool shadows;                  /* rays through the scene: sky visibility */
+    uint32_t samples;              /* rays per texel with shadows, 0 = 64 */
+} lx_sky_desc;
+
 typedef struct lx_bake_desc {
     int resolution;      /* texels per side for every lightmap, 0 = 256 */
     float texel_density; /* texels per metre; > 0 sizes each lightmap from its
@@ -62,6 +75,7 @@ typedef struct lx_bake_desc {
     int threads;          /* 0 = all cores */
     bool skip_degenerate; /* zero-UV-area triangles: warn and skip, not fail */
     float shadow_bias;    /* ray origin offset in metres, 0 = scale-aware auto */
+    lx_sky_desc sky;      /* baked with the static lights */
     lx_progress_fn progress;
     void *progress_user;
 } lx_bake_desc;
@@ -91,7 +105,7 @@ const lx_lightmap_info *lx_baker_lightmap_info(const lx_baker *baker, uint32_t m
 /* width*height bytes, 1 where a texel is covered. Borrowed. */
 const uint8_t *lx_baker_mask(const lx_baker *baker, uint32_t map);
 
-/* Bakes the static (non-dynamic) lights and ambient. LX_ERR_CANCELLED when
+/* Bakes the static (non-dynamic) lights, ambient and sky. LX_ERR_CANCELLED when
  * the progress callback asks to stop. */
 lx_status lx_baker_bake(lx_baker *baker);
 

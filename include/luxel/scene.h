@@ -69,6 +69,17 @@ typedef struct lx_node {
     uint32_t mesh_count;
 } lx_node;
 
+#define LX_MAX_SKY_SAMPLES 65536u
+
+/* The sky a lights JSON asks for ("sky" key): the environment file is
+ * named, not loaded (lx_env_load in ibl.h reads it). */
+typedef struct lx_scene_sky {
+    char *environment; /* path resolved against the JSON's folder; NULL = none */
+    float intensity;   /* multiplier, default 1 */
+    bool shadows;
+    uint32_t samples; /* 1..LX_MAX_SKY_SAMPLES, 0 = the baker's default */
+} lx_scene_sky;
+
 typedef struct lx_scene {
     char *path; /* file the scene came from, or a given name */
     lx_mesh *meshes;
@@ -80,6 +91,7 @@ typedef struct lx_scene {
     lx_light *lights;
     uint32_t light_count;
     lx_vec3 ambient;           /* constant scene ambient (lux) */
+    lx_scene_sky sky;          /* from the lights JSON; loading it is the caller's */
     lx_ies_profile **profiles; /* photometric profiles the lights point to */
     uint32_t profile_count;
     /* internal bookkeeping for growth; do not touch */

@@ -48,6 +48,14 @@ struct lx_baker {
     bool tracer_dirty;
     float scene_diagonal;
     float bias; /* shadow ray origin offset, metres */
+    /* sky light (sky.c) */
+    bool has_sky, sky_shadows;
+    uint32_t sky_samples;
+    lx_sh9 sky_sh;         /* scaled by the sky's intensity */
+    lx_cubemap sky_lookup; /* with shadows: the filtered, scaled environment
+                              less its peak */
+    float *sky_peak;       /* NULL, or the bright part per texel (RGB) */
+    double *sky_peak_cdf;  /* cumulative luminance x solid angle of the peak */
 };
 
 /* Bytes a lightmap needs per texel at most: raster scratch, mask, baked and
@@ -72,6 +80,18 @@ void lx_texel_map_transform(lx_lightmap *map, const lx_mat4 *world);
  * (width*height*3 floats per map), plus `ambient` at every texel
  * (direct.c). progress_base/progress_span place this pass in the whole
  * operation's progress. */
+/* Shadow ray from texel position p with geometric normal ng toward e's
+ * light (direct.c). */
+lx_ray lx_shadow_ray(const lx_baker *b, lx_vec3 p, lx_vec3 ng, const lx_light_eval *e);
+
+/* Takes what the baker needs of a sky (SH, the lookup for rays); nothing
+ * when sky->environment is NULL (sky.c). */
+lx_status lx_sky_prepare(lx_baker *b, const lx_sky_desc *sky);
+void lx_sky_free(lx_baker *b);
+/* Adds the sky's irradiance to accum for count texels from first. */
+void lx_sky_tile(const lx_baker *b, uint32_t map_index, const lx_lightmap *map, uint32_t first,
+                 uint32_t count, lx_vec3 *accum);
+
 lx_status lx_bake_lights(lx_baker *baker, const uint32_t *lights, uint32_t light_count,
                          lx_vec3 ambient, bool to_realtime, float progress_base,
                          float progress_span);

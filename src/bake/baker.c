@@ -76,6 +76,13 @@ lx_status lx_baker_create(const lx_scene *scene, const lx_bake_desc *in, lx_bake
     /* the baker outlives the scene: it keeps its own hold on profiles */
     for (uint32_t l = 0; l < b->light_count; l++)
         lx_ies_retain(b->lights[l].profile);
+    /* the sky's environment is borrowed for this call only */
+    st = lx_sky_prepare(b, &desc.sky);
+    b->desc.sky.environment = NULL;
+    if (st != LX_OK) {
+        lx_baker_destroy(b);
+        return st;
+    }
 
     lx_vec3 lo, hi;
     b->scene_diagonal = lx_scene_bounds(scene, &lo, &hi) ? lx_length(lx_sub(hi, lo)) : 1.0f;
@@ -139,6 +146,7 @@ void lx_baker_destroy(lx_baker *b)
     for (uint32_t m = 0; m < b->map_count; m++)
         lx_texel_map_free(&b->maps[m]);
     lx_tracer_destroy(b->tracer);
+    lx_sky_free(b);
     free(b->maps);
     free(b->node_map);
     free(b->node_world);

@@ -19,7 +19,7 @@ typedef struct pending_ray {
  * the surface along the geometric normal, on the light's side, by a
  * scale-aware bias, so the ray neither re-hits its own triangle (acne) nor
  * starts behind a wall it touches (leaks). */
-static lx_ray shadow_ray(const lx_baker *b, lx_vec3 p, lx_vec3 ng, const lx_light_eval *e)
+lx_ray lx_shadow_ray(const lx_baker *b, lx_vec3 p, lx_vec3 ng, const lx_light_eval *e)
 {
     lx_vec3 side = lx_dot(ng, e->to_light) >= 0.0f ? ng : lx_neg(ng);
     float bias = b->bias + 4e-6f * lx_max_abs_component(p);
@@ -74,7 +74,7 @@ static float soft_visibility(const lx_baker *b, uint32_t map_index, const lx_lig
                 continue;
             float dist = sqrtf(d2);
             lx_light_eval e = {.to_light = lx_scale(d, 1.0f / dist), .distance = dist};
-            rays[m] = shadow_ray(b, p, ng, &e);
+            rays[m] = lx_shadow_ray(b, p, ng, &e);
             weight[m] = w;
             m++;
         }
@@ -114,7 +114,7 @@ static void light_tile(const lx_baker *b, uint32_t map_index, const lx_lightmap 
             accum[k] = lx_add(accum[k], lx_scale(e.illuminance, vis));
             continue;
         }
-        rays[n] = shadow_ray(b, map->world_position[i], map->world_geometric_normal[i], &e);
+        rays[n] = lx_shadow_ray(b, map->world_position[i], map->world_geometric_normal[i], &e);
         pending[n] = (pending_ray){k, e.illuminance};
         if (light->shadow == LX_SHADOW_BLUR) {
             /* seed 000: blur = nearest occluder distance / light distance */
@@ -179,6 +179,8 @@ lx_status lx_bake_lights(lx_baker *b, const uint32_t *lights, uint32_t light_cou
                 accum[k] = ambient;
             for (uint32_t l = 0; l < light_count; l++)
                 light_tile(b, m, map, first, count, lights[l], accum);
+            if (!to_realtime && b->has_sky)
+                lx_sky_tile(b, m, map, first, count, accum);
             /* every texel belongs to one tile: plain stores, no clearing */
             for (uint32_t k = 0; k < count; k++) {
                 float *px = target + (size_t)map->texels[first + k].pixel * 3;

@@ -432,6 +432,15 @@ static lx_status carry_intensity(const ctx *c, const lx_light *before, lx_light 
 
 /* Fills out from obj; a light named like one in names (earlier in the file
  * or already in the scene) starts from that light. */
+/* A path the file gives, relative to the file's folder (malloc'd). */
+static char *relative_to_file(const ctx *c, const char *rel)
+{
+    char *dir = lx_path_dirname(c->file);
+    char *path = dir ? lx_path_join(dir, rel) : NULL;
+    free(dir);
+    return path;
+}
+
 /* "ies" (a path relative to this file), "masked" and "multiplier": seed
  * 001's photometric lights. A masked profile keeps its shape and takes the
  * light's intensity as its average (lumens / 4 pi); an unmasked one keeps
@@ -455,9 +464,7 @@ static lx_status read_profile(ctx *c, const cJSON *obj, lx_light *l)
         const char *rel = NULL;
         if ((st = get_string(c, ies, "ies", &rel)) != LX_OK)
             return st;
-        char *dir = lx_path_dirname(c->file);
-        char *path = dir ? lx_path_join(dir, rel) : NULL;
-        free(dir);
+        char *path = relative_to_file(c, rel);
         if (!path)
             return fail(c, LX_ERR_NOMEM, "out of memory");
         lx_ies_profile *profile = NULL;
@@ -690,7 +697,54 @@ static lx_status read_light(ctx *c, const cJSON *obj, const name_table *names,
 
 /* ---- the file ----------------------------------------------------------- */
 
-static const char *const root_keys[] = {"ambient", "lights"};
+static const char *const root_keys[] = {"ambient", "lights", "sky"};
+static const char *const sky_keys[] = {"environment", "intensity", "shadows", "samples"};
+
+/* "sky": {"environment": path relative to the file, "intensity",
+ * "shadows", "samples"}; the environment is named here, loaded by whoever
+ * bakes. */
+static lx_status read_sky(ctx *c, const cJSON *obj, lx_scene_sky *sky)
+{
+    snprintf(c->where, sizeof c->where, "sky");
+    if (!cJSON_IsObject(obj))
+        return fail(c, LX_ERR_FORMAT, "must be an object with \"environment\"");
+    lx_status st = check_keys(c, obj, sky_keys, COUNT(sky_keys));
+    if (st != LX_OK)
+        return st;
+    const cJSON *it = cJSON_GetObjectItemCaseSensitive(obj, "environment");
+    const char *rel = NULL;
+    if (!it)
+        return fail(c, LX_ERR_FORMAT, "missing 'environment' (an image file)");
+    if ((st = get_string(c, it, "environment", &rel)) != LX_OK)
+        return st;
+    if (!rel[0])
+        return fail(c, LX_ERR_FORMAT, "environment is an empty path");
+    sky->intensity = 1.0f;
+    if ((it = cJSON_GetObjectItemCaseSensitive(obj, "intensity"))) {
+        if ((st = get_non_negative(c, it, "intensity", &sky->intensity)) != LX_OK)
+            return st;
+        if (!(sky->intensity > 0.0f))
+            return fail(c, LX_ERR_INVALID,
+                        "intensity must be above 0 (leave \"sky\" out for none)");
+    }
+    if ((it = cJSON_GetObjectItemCaseSensitive(obj, "shadows"))) {
+        if (!cJSON_IsBool(it))
+            return fail(c, LX_ERR_FORMAT, "shadows must be true or false");
+        sky->shadows = cJSON_IsTrue(it);
+    }
+    if ((it = cJSON_GetObjectItemCaseSensitive(obj, "samples"))) {
+        double v = cJSON_IsNumber(it) ? it->valuedouble : NAN;
+        if (!isfinite(v) || v != floor(v))
+            return fail(c, LX_ERR_FORMAT, "samples must be a whole number");
+        if (v < 1.0 || v > (double)LX_MAX_SKY_SAMPLES)
+            return fail(c, LX_ERR_INVALID, "samples %g is outside 1..%u", v, LX_MAX_SKY_SAMPLES);
+        sky->samples = (uint32_t)v;
+    }
+    sky->environment = relative_to_file(c, rel);
+    if (!sky->environment)
+        return fail(c, LX_ERR_NOMEM, "out of memory");
+    return LX_OK;
+}
 
 static lx_status apply_root(lx_scene *scene, const cJSON *root, const char *file)
 {
@@ -704,6 +758,13 @@ static lx_status apply_root(lx_scene *scene, const cJSON *root, const char *file
     lx_vec3 ambient = scene->ambient;
     if (amb && (st = get_color(&c, amb, "ambient", &ambient)) != LX_OK)
         return st;
+    const cJSON *sky_item = cJSON_GetObjectItemCaseSensitive(root, "sky");
+    lx_scene_sky sky = {0};
+    if (sky_item && (st = read_sky(&c, sky_item, &sky)) != LX_OK) {
+        free(sky.environment);
+        return st;
+    }
+    c.where[0] = '\0';
 
     const cJSON *list = cJSON_GetObjectItemCaseSensitive(root, "lights");
     size_t count = 0;
@@ -713,13 +774,16 @@ static lx_status apply_root(lx_scene *scene, const cJSON *root, const char *file
         for (const cJSON *e = list->child; e; e = e->next)
             count++;
     }
-    if (count > INT32_MAX / 4)
+    if (count > INT32_MAX / 4) {
+        free(sky.environment);
         return fail(&c, LX_ERR_INVALID, "%zu lights are too many", count);
+    }
     lx_light *pending = malloc((count ? count : 1) * sizeof *pending);
     name_table names = {0};
     if (!pending || table_init(&names, count + scene->light_count) != LX_OK) {
         free(pending);
         table_free(&names);
+        free(sky.environment);
         return fail(&c, LX_ERR_NOMEM, "out of memory for %zu lights", count);
     }
     for (uint32_t i = 0; i < scene->light_count; i++)
@@ -745,6 +809,11 @@ static lx_status apply_root(lx_scene *scene, const cJSON *root, const char *file
     if (st == LX_OK) {
         /* The whole file is valid: only now does the scene change. */
         scene->ambient = ambient;
+        if (sky_item) {
+            free(scene->sky.environment);
+            scene->sky = sky;
+            sky.environment = NULL;
+        }
         for (i = 0; i < count && st == LX_OK; i++)
             if ((st = lx_scene_add_light(scene, &pending[i])) != LX_OK) {
                 char where[160];
@@ -753,6 +822,7 @@ static lx_status apply_root(lx_scene *scene, const cJSON *root, const char *file
             }
     }
     free(pending);
+    free(sky.environment);
     return st;
 }
 

@@ -74,6 +74,7 @@ void lx_scene_destroy(lx_scene *s)
         lx_ies_free(s->profiles[i]);
     free(s->profiles);
     free(s->lights);
+    free(s->sky.environment);
     free(s->path);
     free(s);
 }

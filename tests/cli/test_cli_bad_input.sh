@@ -409,5 +409,28 @@ bad "missing lights JSON" 1 "no_lights.json" bake "$ROOM" --lights "$IN/no_light
 mkdir "$IN/folder.json"
 bad "a folder as lights JSON" 1 "folder.json" bake "$ROOM" --lights "$IN/folder.json"
 
+# ---- the sky (issue 4) --------------------------------------------------------
+
+bad "--sky: missing environment" 1 "no_sky.hdr" bake "$ROOM" --sky "$IN/no_sky.hdr"
+printf 'PF\n4 2\n-1.0\n' >"$IN/short.pfm"
+head -c 40 /dev/zero >>"$IN/short.pfm"
+bad "--sky: truncated PFM" 1 "short.pfm" bake "$ROOM" --sky "$IN/short.pfm"
+# a 4 x 2 equirect with one NaN texel (0x7fc00000 little-endian)
+{ printf 'PF\n4 2\n-1.0\n'; head -c 84 /dev/zero; printf '\000\000\300\177'; head -c 8 /dev/zero; } \
+    >"$IN/nan_sky.pfm"
+bad "--sky: NaN texel" 1 "nan_sky.pfm|NaN" bake "$ROOM" --sky "$IN/nan_sky.pfm"
+printf 'PF\n6 2\n-1.0\n' >"$IN/wide.pfm"
+head -c 144 /dev/zero >>"$IN/wide.pfm"
+bad "--sky: 3:1 image" 1 "wide.pfm" bake "$ROOM" --sky "$IN/wide.pfm"
+bad "--sky: bad constant" 2 "const:" bake "$ROOM" --sky const:bright
+bad "--sky-shadows without a sky" 2 "--sky" bake "$ROOM" --sky-shadows
+bad "--sky-samples 0" 2 "--sky-samples" bake "$ROOM" --sky const:1 --sky-shadows --sky-samples 0
+bad "--sky-intensity -1" 2 "--sky-intensity" bake "$ROOM" --sky const:1 --sky-intensity -1
+printf '{"sky": {"environment": "nowhere.hdr"}}\n' >"$IN/sky_missing.json"
+bad "lights JSON: sky file missing" 1 "nowhere.hdr" bake "$ROOM" --lights "$IN/sky_missing.json"
+printf '{"sky": {"environment": "x.hdr", "samples": -3}}\n' >"$IN/sky_samples.json"
+bad "lights JSON: sky samples" 1 "sky_samples.json|sky|samples" \
+    bake "$ROOM" --lights "$IN/sky_samples.json"
+
 check "no failing run wrote anything in the working folder" test -z "$(ls -A "$WORK/cwd")"
 finish

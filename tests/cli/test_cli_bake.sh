@@ -329,4 +329,29 @@ run "$LUXEL" bake "$ROOM" --resolution 32 --format pfm -q -o "$WORK/soft2" --thr
     --lights "$WORK/soft.json"
 check "soft bake: the same bytes with 1 thread" cmp -s "$WORK/soft/room.pfm" "$WORK/soft2/room.pfm"
 
+# Sky light (issue 4): gen_scenes' sky through a lights JSON in another
+# folder (the path is relative to the JSON), with sky shadows; the manifest
+# records it; 1 and 2 threads give the same bytes; --sky on the command line
+# wins over the file's.
+mkdir -p "$WORK/skycfg"
+cat >"$WORK/skycfg/day.json" <<'JSON'
+{"sky": {"environment": "../scenes/sky.pfm", "shadows": true, "samples": 16},
+ "lights": [{"name": "sun", "intensity": 0}]}
+JSON
+run "$LUXEL" bake "$RETRO" --texel-density 4 --format pfm -q -o "$WORK/sky1" --lights "$WORK/skycfg/day.json"
+expect_rc 0 "bake with a sky from the lights JSON"
+check "sky bake: manifest names the environment" grep -q '"environment":.*scenes/sky.pfm' "$WORK/sky1/manifest.json"
+sky_block=$(grep -A4 '"sky"' "$WORK/sky1/manifest.json")
+check "sky bake: manifest says shadows" grep -q '"shadows":.*true' <<<"$sky_block"
+check "sky bake: manifest says 16 samples" grep -q '"samples":.*16' <<<"$sky_block"
+run "$LUXEL" info "$RETRO" --lights "$WORK/skycfg/day.json"
+expect_stdout_has "info: the sky" '^sky: .*scenes/sky.pfm x 1, shadows \(16 samples\)$'
+run "$LUXEL" bake "$RETRO" --texel-density 4 --format pfm -q -o "$WORK/sky2" --threads 1 \
+    --lights "$WORK/skycfg/day.json"
+check "sky bake: the same bytes with 1 thread" cmp -s "$WORK/sky1/ground.pfm" "$WORK/sky2/ground.pfm"
+run "$LUXEL" bake "$RETRO" --texel-density 4 --format pfm -q -o "$WORK/sky3" \
+    --lights "$WORK/skycfg/day.json" --sky const:100 --sky-samples 4
+expect_rc 0 "bake with --sky over the file's sky"
+check "sky bake: --sky wins" grep -q '"environment":.*const:100' "$WORK/sky3/manifest.json"
+
 finish

@@ -23,13 +23,6 @@
 
 #define PI_D 3.14159265358979323846
 
-static void assert_rel(double got, double want, double tol)
-{
-    double scale = fabs(want) > 1e-30 ? fabs(want) : 1.0;
-    if (!(fabs(got - want) <= tol * scale))
-        fail_msg("got %.9g, want %.9g", got, want);
-}
-
 static lx_status apply(lx_scene *s, const char *text)
 {
     return lx_lights_json_apply_text(s, text, strlen(text), "lights.json");
@@ -72,8 +65,8 @@ static void test_example(void **state)
     assert_string_equal(sp->name, "");
     assert_int_equal(sp->type, LX_LIGHT_SPOT);
     lx_test_assert_vec3(sp->direction, 0, -1, 0);
-    assert_rel(sp->inner_angle, 20.0 * PI_D / 180.0, 1e-6);
-    assert_rel(sp->outer_angle, 30.0 * PI_D / 180.0, 1e-6);
+    lx_test_assert_rel(sp->inner_angle, 20.0 * PI_D / 180.0, 1e-6);
+    lx_test_assert_rel(sp->outer_angle, 30.0 * PI_D / 180.0, 1e-6);
     assert_true(sp->intensity == 1200.0f);
     assert_int_equal(sp->shadow, LX_SHADOW_BLUR);
     assert_true(sp->blur_power == 1.0f && sp->blur_multiplier == 1.0f);
@@ -112,16 +105,16 @@ static void test_units(void **state)
                            "\"intensity\": 5}]}"),
                      LX_OK);
     assert_int_equal(s->light_count, 5);
-    assert_rel(s->lights[0].intensity, 1000.0 / (4 * PI_D), 1e-6);
-    assert_rel(s->lights[1].intensity, 6830.0 / (4 * PI_D), 1e-6);
-    assert_rel(s->lights[2].intensity, 1000.0 / PI_D, 1e-6);
-    assert_rel(s->lights[3].intensity, 1000.0 / (2 * PI_D * (1 - cos(PI_D / 6))), 1e-5);
+    lx_test_assert_rel(s->lights[0].intensity, 1000.0 / (4 * PI_D), 1e-6);
+    lx_test_assert_rel(s->lights[1].intensity, 6830.0 / (4 * PI_D), 1e-6);
+    lx_test_assert_rel(s->lights[2].intensity, 1000.0 / PI_D, 1e-6);
+    lx_test_assert_rel(s->lights[3].intensity, 1000.0 / (2 * PI_D * (1 - cos(PI_D / 6))), 1e-5);
     assert_true(s->lights[4].intensity == 5.0f);
     lx_test_assert_vec3(s->lights[4].direction, 0, -1, 0);
     /* Defaults of a new light. */
     lx_test_assert_vec3(s->lights[0].color, 1, 1, 1);
     assert_true(s->lights[0].range == 0.0f);
-    assert_rel(s->lights[0].outer_angle, PI_D / 4, 1e-6);
+    lx_test_assert_rel(s->lights[0].outer_angle, PI_D / 4, 1e-6);
     lx_scene_destroy(s);
 }
 
@@ -172,7 +165,7 @@ static void test_override(void **state)
                               "\"intensity\": 100, \"unit\": \"lm\", "
                               "\"spot_conversion\": \"cone\"}]}"),
                      LX_OK);
-    assert_rel(s->lights[0].intensity, 100.0 / (2 * PI_D * 0.5), 1e-5);
+    lx_test_assert_rel(s->lights[0].intensity, 100.0 / (2 * PI_D * 0.5), 1e-5);
     lx_scene_destroy(s);
 }
 
@@ -361,7 +354,45 @@ static const bad_case bad_cases[] = {
      LX_ERR_INVALID, "lights[0]: unit: directional lights take lux, not nt"},
     {"{\"lights\": [{\"type\": \"sphere\", \"position\": [0,0,0], \"intensity\": -5}]}",
      LX_ERR_INVALID, "lights[0]: intensity -5 is negative"},
+    /* the sky (issue 4) */
+    {"{\"sky\": {\"intensity\": 2}}", LX_ERR_FORMAT, "sky: missing 'environment'"},
+    {"{\"sky\": \"sky.hdr\"}", LX_ERR_FORMAT, "sky: must be an object"},
+    {"{\"sky\": {\"environment\": \"\"}}", LX_ERR_FORMAT, "sky: environment is an empty path"},
+    {"{\"sky\": {\"environment\": \"s.hdr\", \"samples\": 0}}", LX_ERR_INVALID,
+     "sky: samples 0 is outside 1..65536"},
+    {"{\"sky\": {\"environment\": \"s.hdr\", \"samples\": 2.5}}", LX_ERR_FORMAT,
+     "sky: samples must be a whole number"},
+    {"{\"sky\": {\"environment\": \"s.hdr\", \"shadows\": \"yes\"}}", LX_ERR_FORMAT,
+     "sky: shadows must be true or false"},
+    {"{\"sky\": {\"environment\": \"s.hdr\", \"intensity\": -1}}", LX_ERR_INVALID,
+     "sky: intensity -1 is negative"},
+    {"{\"sky\": {\"environment\": \"s.hdr\", \"intensity\": 0}}", LX_ERR_INVALID,
+     "sky: intensity must be above 0"},
+    {"{\"sky\": {\"environment\": \"s.hdr\", \"exposure\": 1}}", LX_ERR_FORMAT,
+     "sky: unknown key 'exposure'"},
 };
+
+/* "sky" names an environment relative to the JSON file; intensity,
+ * shadows and samples are kept for the baker; a bad file leaves the
+ * scene's sky as it was. */
+static void test_sky(void **state)
+{
+    (void)state;
+    lx_scene *s = lx_test_new_scene("test");
+    const char *text = "{\"sky\": {\"environment\": \"env/sky.hdr\", \"intensity\": 0.5, "
+                       "\"shadows\": true, \"samples\": 128}}";
+    assert_int_equal(lx_lights_json_apply_text(s, text, strlen(text), "scenes/night.json"), LX_OK);
+    assert_string_equal(s->sky.environment, "scenes/env/sky.hdr");
+    assert_true(s->sky.intensity == 0.5f && s->sky.shadows && s->sky.samples == 128);
+    text = "{\"sky\": {\"environment\": \"/abs/day.exr\"}}";
+    assert_int_equal(lx_lights_json_apply_text(s, text, strlen(text), "x.json"), LX_OK);
+    assert_string_equal(s->sky.environment, "/abs/day.exr");
+    assert_true(s->sky.intensity == 1.0f && !s->sky.shadows && s->sky.samples == 0);
+    text = "{\"sky\": {\"environment\": \"other.hdr\"}, \"lights\": [{\"type\": \"nope\"}]}";
+    assert_int_not_equal(lx_lights_json_apply_text(s, text, strlen(text), "x.json"), LX_OK);
+    assert_string_equal(s->sky.environment, "/abs/day.exr");
+    lx_scene_destroy(s);
+}
 
 static void test_bad_input(void **state)
 {
@@ -481,7 +512,7 @@ static void test_area_lights(void **state)
     assert_int_equal(sp->type, LX_LIGHT_SPHERE);
     lx_test_assert_vec3(sp->position, 1, 1, 0);
     assert_true(sp->radius == 0.1f);
-    assert_rel(sp->intensity, 1000.0 / (4.0 * PI_D * PI_D * 0.01), 1e-5);
+    lx_test_assert_rel(sp->intensity, 1000.0 / (4.0 * PI_D * PI_D * 0.01), 1e-5);
     assert_int_equal(sp->shadow, LX_SHADOW_SOFT);
     assert_int_equal(sp->samples, 64);
 
@@ -490,7 +521,7 @@ static void test_area_lights(void **state)
     lx_test_assert_vec3(d->position, 0, 3, 0);
     lx_test_assert_vec3(d->direction, 0, -1, 0);
     assert_true(d->radius == 0.3f);
-    assert_rel(d->intensity, 2000.0 / (PI_D * PI_D * 0.09), 1e-5);
+    lx_test_assert_rel(d->intensity, 2000.0 / (PI_D * PI_D * 0.09), 1e-5);
     assert_int_equal(d->shadow, LX_SHADOW_HARD); /* the default: one ray to the centre */
     assert_int_equal(d->samples, 0);
 
@@ -500,7 +531,7 @@ static void test_area_lights(void **state)
     lx_test_assert_vec3(r->direction, 0, -1, 0);
     lx_test_assert_vec3(r->up, 0, 0, 1);
     assert_true(r->width == 1.0f && r->height == 0.5f);
-    assert_rel(r->intensity, 40.0 * 683.0 / (PI_D * 0.5), 1e-5);
+    lx_test_assert_rel(r->intensity, 40.0 * 683.0 / (PI_D * 0.5), 1e-5);
     lx_scene_destroy(s);
 
     /* Nits by default and by name; candela over pi r^2 and W H; the rect's
@@ -527,15 +558,15 @@ static void test_area_lights(void **state)
     assert_int_equal(s->light_count, 7);
     assert_true(s->lights[0].intensity == 5000.0f);
     assert_true(s->lights[1].intensity == 5000.0f);
-    assert_rel(s->lights[2].intensity, 100.0 / (PI_D * 0.25), 1e-5);
+    lx_test_assert_rel(s->lights[2].intensity, 100.0 / (PI_D * 0.25), 1e-5);
     lx_test_assert_vec3(s->lights[3].direction, 0, 0, -1);
     lx_test_assert_vec3(s->lights[3].up, 0, 1, 0);
-    assert_rel(s->lights[3].intensity, 10.0 / (2.0 * 0.5), 1e-6);
+    lx_test_assert_rel(s->lights[3].intensity, 10.0 / (2.0 * 0.5), 1e-6);
     lx_test_assert_vec3(s->lights[4].up, 0, 0, 1);
     assert_true(s->lights[4].width == 0.1f && s->lights[4].height == 0.1f);
     assert_true(s->lights[4].intensity == 1.0f);
     lx_test_assert_vec3(s->lights[5].up, 0, 0, 1);
-    assert_rel(s->lights[5].intensity, 10.0 / PI_D, 1e-6);
+    lx_test_assert_rel(s->lights[5].intensity, 10.0 / PI_D, 1e-6);
     assert_int_equal(s->lights[6].type, LX_LIGHT_SPHERE);
     assert_true(s->lights[6].radius == 0.1f);
     assert_int_equal(s->lights[6].shadow, LX_SHADOW_SOFT);
@@ -570,18 +601,18 @@ static void test_tube_lights(void **state)
     assert_int_equal(t->type, LX_LIGHT_TUBE);
     lx_test_assert_vec3(t->direction, 1, 0, 0);
     assert_true(t->length == 1.2f && t->radius == 0.02f);
-    assert_rel(t->intensity, 3000.0 / (PI_D * (2.0 * PI_D * 0.02 * 1.2 + 4.0 * PI_D * 0.02 * 0.02)),
+    lx_test_assert_rel(t->intensity, 3000.0 / (PI_D * (2.0 * PI_D * 0.02 * 1.2 + 4.0 * PI_D * 0.02 * 0.02)),
                1e-5);
     const lx_light *lin = &s->lights[1];
     lx_test_assert_vec3(lin->direction, 0, 0, 1);
     assert_true(lin->radius == 0.0f);
-    assert_rel(lin->intensity, 3000.0 / (PI_D * PI_D * 2.0), 1e-5);
+    lx_test_assert_rel(lin->intensity, 3000.0 / (PI_D * PI_D * 2.0), 1e-5);
     assert_int_equal(lin->shadow, LX_SHADOW_SOFT);
     assert_int_equal(lin->samples, 32);
-    assert_rel(s->lights[2].intensity, 100.0 / 0.5, 1e-6);
+    lx_test_assert_rel(s->lights[2].intensity, 100.0 / 0.5, 1e-6);
     /* defaults: 1 m long, 2 cm radius */
     assert_true(s->lights[3].length == 1.0f && s->lights[3].radius == 0.02f);
-    assert_rel(s->lights[3].intensity, 100.0 / (2.0 * 0.02 * 1.0 + PI_D * 0.02 * 0.02), 1e-5);
+    lx_test_assert_rel(s->lights[3].intensity, 100.0 / (2.0 * 0.02 * 1.0 + PI_D * 0.02 * 0.02), 1e-5);
     assert_true(s->lights[4].intensity == 2500.0f); /* nits by default */
     lx_scene_destroy(s);
 
@@ -600,8 +631,8 @@ static void test_tube_lights(void **state)
     assert_int_equal(s->light_count, 2);
     double across = 2.0 * 0.05 * 0.6 + PI_D * 0.05 * 0.05;
     assert_int_equal(s->lights[0].type, LX_LIGHT_TUBE);
-    assert_rel(s->lights[0].intensity * across, 300.0, 1e-5);
-    assert_rel(s->lights[1].intensity * 0.6, 300.0, 1e-5);
+    lx_test_assert_rel(s->lights[0].intensity * across, 300.0, 1e-5);
+    lx_test_assert_rel(s->lights[1].intensity * 0.6, 300.0, 1e-5);
     lx_scene_destroy(s);
 }
 
@@ -626,16 +657,16 @@ static void test_point_with_radius(void **state)
     assert_int_equal(s->lights[0].type, LX_LIGHT_SPHERE);
     lx_test_assert_vec3(s->lights[0].position, 0, 2, 0);
     assert_true(s->lights[0].radius == 0.05f);
-    assert_rel(s->lights[0].intensity, 800.0 / (PI_D * 0.0025), 1e-5);
+    lx_test_assert_rel(s->lights[0].intensity, 800.0 / (PI_D * 0.0025), 1e-5);
     assert_int_equal(s->lights[0].shadow, LX_SHADOW_SOFT);
     assert_int_equal(s->lights[0].samples, 8);
     assert_int_equal(s->lights[1].type, LX_LIGHT_SPHERE);
-    assert_rel(s->lights[1].intensity, 1000.0 / (4.0 * PI_D * PI_D * 0.01), 1e-5);
+    lx_test_assert_rel(s->lights[1].intensity, 1000.0 / (4.0 * PI_D * PI_D * 0.01), 1e-5);
     assert_int_equal(s->lights[2].type, LX_LIGHT_POINT);
     assert_true(s->lights[2].intensity == 800.0f);
     /* no intensity: the point light's default 1 cd */
     assert_int_equal(s->lights[3].type, LX_LIGHT_SPHERE);
-    assert_rel(s->lights[3].intensity, 1.0 / (PI_D * 0.25), 1e-5);
+    lx_test_assert_rel(s->lights[3].intensity, 1.0 / (PI_D * 0.25), 1e-5);
     lx_scene_destroy(s);
 }
 
@@ -662,14 +693,14 @@ static void test_area_override(void **state)
     lx_test_assert_vec3(l->position, 1, 2, 3);
     assert_true(l->radius == 0.05f);
     double nits = 800.0 / (PI_D * 0.0025);
-    assert_rel(l->intensity, nits, 1e-5);
+    lx_test_assert_rel(l->intensity, nits, 1e-5);
     assert_int_equal(l->shadow, LX_SHADOW_SOFT);
     assert_int_equal(l->samples, 32);
 
     /* A new radius keeps the luminance. */
     assert_int_equal(apply(s, "{\"lights\": [{\"name\": \"lamp\", \"radius\": 0.1}]}"), LX_OK);
     assert_true(l->radius == 0.1f);
-    assert_rel(l->intensity, nits, 1e-5);
+    lx_test_assert_rel(l->intensity, nits, 1e-5);
     assert_int_equal(l->samples, 32);
 
     /* Back to a point light: soft shadows must go too. */
@@ -683,7 +714,7 @@ static void test_area_override(void **state)
                      LX_OK);
     assert_int_equal(l->type, LX_LIGHT_POINT);
     assert_true(l->radius == 0.0f);
-    assert_rel(l->intensity, nits * PI_D * 0.01, 1e-5); /* 3200 cd */
+    lx_test_assert_rel(l->intensity, nits * PI_D * 0.01, 1e-5); /* 3200 cd */
 
     /* A rect turned to face along its old up. */
     assert_int_equal(apply(s, "{\"lights\": [{\"name\": \"panel\", \"type\": \"rect\", "
@@ -753,12 +784,13 @@ static void test_file(void **state)
 int main(void)
 {
     const struct CMUnitTest tests[] = {
-        cmocka_unit_test(test_example),     cmocka_unit_test(test_units),
-        cmocka_unit_test(test_override),    cmocka_unit_test(test_bad_input),
-        cmocka_unit_test(test_bad_bytes),   cmocka_unit_test(test_all_or_nothing),
-        cmocka_unit_test(test_file),        cmocka_unit_test(test_colour_forms),
-        cmocka_unit_test(test_area_lights), cmocka_unit_test(test_point_with_radius),
-        cmocka_unit_test(test_tube_lights), cmocka_unit_test(test_area_override),
+        cmocka_unit_test(test_example),       cmocka_unit_test(test_units),
+        cmocka_unit_test(test_override),      cmocka_unit_test(test_bad_input),
+        cmocka_unit_test(test_bad_bytes),     cmocka_unit_test(test_all_or_nothing),
+        cmocka_unit_test(test_file),          cmocka_unit_test(test_colour_forms),
+        cmocka_unit_test(test_area_lights),   cmocka_unit_test(test_point_with_radius),
+        cmocka_unit_test(test_tube_lights),   cmocka_unit_test(test_sky),
+        cmocka_unit_test(test_area_override),
     };
     return cmocka_run_group_tests(tests, NULL, NULL);
 }

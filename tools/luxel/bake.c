@@ -5,15 +5,14 @@
 #include "cli.h"
 
 #include <cjson/cJSON.h>
-#include <errno.h>
 #include <getopt.h>
 #include <stdio.h>
 #include <stdlib.h>
 #include <string.h>
 #include <strings.h>
-#include <signal.h>
-#include <sys/stat.h>
-#include <unistd.h>
+
+/* Face size the sky is loaded at: enough for its SH and ray lookup. */
+#define LX_SKY_LOAD_SIZE 256
 
 static const char *bake_usage =
     "usage: luxel bake SCENE [options]\n"
@@ -39,6 +38,14 @@ static const char *bake_usage =
     "  --quantity Q            irradiance (lux, default) or radiance (nits:\n"
     "                          irradiance x base colour / pi)\n"
     "  --ambient R,G,B         constant ambient illuminance in lux\n"
+    "  --sky ENV               light by an environment (equirect, cross or\n"
+    "                          <name>_px.<ext> faces, radiance in nits, or\n"
+    "                          const:R,G,B; see docs/ibl.md), unshadowed through\n"
+    "                          its spherical harmonics\n"
+    "  --sky-intensity X       multiplier on the sky, above 0 (default 1)\n"
+    "  --sky-shadows           sky visibility: cosine-weighted rays that escape\n"
+    "                          the scene bring the environment they see\n"
+    "  --sky-samples N         rays per texel with --sky-shadows (default 64)\n"
     "  --exposure EV100        exposure of the PNG preview (default: automatic)\n"
     "  --padding N             texels of dilation around charts (default 2)\n"
     "  --threads N             worker threads (default: all cores)\n"
@@ -60,7 +67,11 @@ enum {
     OPT_EXPOSURE,
     OPT_PADDING,
     OPT_THREADS,
-    OPT_SKIP_DEGENERATE
+    OPT_SKIP_DEGENERATE,
+    OPT_SKY,
+    OPT_SKY_INTENSITY,
+    OPT_SKY_SHADOWS,
+    OPT_SKY_SAMPLES
 };
 
 typedef struct bake_args {
@@ -75,6 +86,10 @@ typedef struct bake_args {
     bool has_exposure;
     double exposure_ev100;
     bool quiet;
+    const char *sky;      /* --sky, else the lights JSON's */
+    double sky_intensity; /* < 0: not given */
+    bool sky_shadows;
+    long sky_samples; /* 0: not given */
     lx_bake_desc desc;
 } bake_args;
 
@@ -95,12 +110,17 @@ static int parse_args(int argc, char **argv, bake_args *a)
         {"padding", required_argument, NULL, OPT_PADDING},
         {"threads", required_argument, NULL, OPT_THREADS},
         {"skip-degenerate", no_argument, NULL, OPT_SKIP_DEGENERATE},
+        {"sky", required_argument, NULL, OPT_SKY},
+        {"sky-intensity", required_argument, NULL, OPT_SKY_INTENSITY},
+        {"sky-shadows", no_argument, NULL, OPT_SKY_SHADOWS},
+        {"sky-samples", required_argument, NULL, OPT_SKY_SAMPLES},
         {"quiet", no_argument, NULL, 'q'},
         {"help", no_argument, NULL, 'h'},
         {NULL, 0, NULL, 0}};
     memset(a, 0, sizeof *a);
     a->output = "lightmaps";
     a->format = LX_IMAGE_EXR;
+    a->sky_intensity = -1.0;
     opterr = 0;
     optind = 1;
     int c;
@@ -194,6 +214,25 @@ static int parse_args(int argc, char **argv, bake_args *a)
         case OPT_SKIP_DEGENERATE:
             a->desc.skip_degenerate = true;
             break;
+        case OPT_SKY:
+            a->sky = optarg;
+            break;
+        case OPT_SKY_INTENSITY:
+            if (!cli_parse_float(optarg, 1e-30, 1e30, &f))
+                return cli_usage_error("bake", "--sky-intensity must be a number above 0, not '%s'",
+                                       optarg);
+            a->sky_intensity = f;
+            break;
+        case OPT_SKY_SHADOWS:
+            a->sky_shadows = true;
+            break;
+        case OPT_SKY_SAMPLES:
+            if (!cli_parse_int(optarg, 1, (long)LX_MAX_SKY_SAMPLES, &n))
+                return cli_usage_error("bake",
+                                       "--sky-samples must be an integer in 1..%u, not '%s'",
+                                       LX_MAX_SKY_SAMPLES, optarg);
+            a->sky_samples = n;
+            break;
         case 'q':
             a->quiet = true;
             break;
@@ -218,28 +257,6 @@ static int parse_args(int argc, char **argv, bake_args *a)
     if (a->pre_expose && a->format == LX_IMAGE_PNG)
         return cli_usage_error("bake", "--pre-expose applies to float formats, not png");
     return 0;
-}
-
-/* Creates dir and its parents. */
-static bool make_dirs(const char *dir)
-{
-    char *p = lx_strdup(dir);
-    if (!p)
-        return false;
-    for (char *s = p + 1; *s; s++)
-        if (*s == '/') {
-            *s = '\0';
-            if (mkdir(p, 0777) != 0 && errno != EEXIST) {
-                free(p);
-                return false;
-            }
-            *s = '/';
-        }
-    bool ok = mkdir(p, 0777) == 0 || errno == EEXIST;
-    struct stat st;
-    ok = ok && stat(p, &st) == 0 && S_ISDIR(st.st_mode);
-    free(p);
-    return ok;
 }
 
 /* A file name from a node name: path separators and control characters
@@ -330,161 +347,6 @@ static cJSON *manifest_entry(const lx_scene *scene, const lx_lightmap_info *info
     return e;
 }
 
-static lx_status write_text(const char *path, const char *text)
-{
-    lx_out_file f;
-    lx_status st = lx_out_open(&f, path);
-    if (st != LX_OK)
-        return st;
-    fputs(text, (FILE *)f.fp);
-    return lx_out_commit(&f);
-}
-
-/* ---- staged output ------------------------------------------------------ */
-
-typedef struct staging {
-    char *dir;     /* DIR/.luxel- and six random characters (mkdtemp) */
-    char **names;  /* files written into it */
-    uint32_t count;
-} staging;
-
-static char *make_staging(const char *output)
-{
-    /* mkdtemp's template: six X at the end that it replaces */
-    char name[16] = ".luxel-";
-    memset(name + 7, 'X', 6);
-    char *dir = lx_path_join(output, name);
-    if (dir && !mkdtemp(dir)) {
-        free(dir);
-        return NULL;
-    }
-    return dir;
-}
-
-/* Reports an error from a staged write under the final folder's name. */
-static void stage_error(const staging *st, const char *output)
-{
-    const char *msg = lx_last_error();
-    size_t n = strlen(st->dir);
-    if (strncmp(msg, st->dir, n) == 0)
-        cli_error("%s%s", output, msg + n);
-    else
-        cli_error("%s", msg);
-}
-
-static bool stage_add(staging *st, const char *name)
-{
-    char **names = realloc(st->names, sizeof(char *) * (st->count + 1));
-    if (!names)
-        return false;
-    st->names = names;
-    st->names[st->count] = lx_strdup(name);
-    if (!st->names[st->count])
-        return false;
-    st->count++;
-    return true;
-}
-
-static bool stage_image(staging *st, const char *output, const char *name, const lx_image *img,
-                        const lx_image_write_desc *desc)
-{
-    char *path = lx_path_join(st->dir, name);
-    if (!path) {
-        cli_error("out of memory");
-        return false;
-    }
-    /* tracked before it exists: an interrupt right after the rename that
-     * completes the file still finds it */
-    cli_track_output(path);
-    lx_status s = lx_image_write(path, img, desc);
-    free(path);
-    if (s != LX_OK) {
-        stage_error(st, output);
-        return false;
-    }
-    return stage_add(st, name);
-}
-
-static bool stage_text(staging *st, const char *output, const char *name, const char *text)
-{
-    char *path = lx_path_join(st->dir, name);
-    if (!path) {
-        cli_error("out of memory");
-        return false;
-    }
-    cli_track_output(path);
-    lx_status s = write_text(path, text);
-    free(path);
-    if (s != LX_OK) {
-        stage_error(st, output);
-        return false;
-    }
-    return stage_add(st, name);
-}
-
-/* Moves every staged file into the output folder, with interrupts held
- * off so the move is not cut in half. */
-static bool publish(staging *st, const char *output)
-{
-    sigset_t block, old;
-    sigemptyset(&block);
-    sigaddset(&block, SIGINT);
-    sigaddset(&block, SIGTERM);
-    sigprocmask(SIG_BLOCK, &block, &old);
-    bool ok = true;
-    /* anything but a file in the way would fail its rename half-way through */
-    for (uint32_t i = 0; i < st->count && ok; i++) {
-        char *to = lx_path_join(output, st->names[i]);
-        struct stat sb;
-        if (!to || (lstat(to, &sb) == 0 && !S_ISREG(sb.st_mode))) {
-            cli_error("%s: cannot write: something that is not a file is in the way",
-                      to ? to : output);
-            ok = false;
-        }
-        free(to);
-    }
-    uint32_t moved = 0;
-    for (uint32_t i = 0; i < st->count && ok; i++) {
-        char *from = lx_path_join(st->dir, st->names[i]);
-        char *to = lx_path_join(output, st->names[i]);
-        if (!from || !to || rename(from, to) != 0) {
-            cli_error("%s: cannot move into place: %s", to ? to : output, strerror(errno));
-            ok = false;
-        }
-        free(from);
-        free(to);
-        moved += ok;
-    }
-    /* a rename that failed anyway: this run's files do not stay half-published */
-    for (uint32_t i = 0; i < moved && !ok; i++) {
-        char *to = lx_path_join(output, st->names[i]);
-        if (to)
-            unlink(to);
-        free(to);
-    }
-    if (ok) {
-        /* the run is complete: a signal held off until now must not undo it */
-        cli_forget_outputs();
-        cli_set_writing(false);
-    }
-    sigprocmask(SIG_SETMASK, &old, NULL);
-    return ok;
-}
-
-/* Removes whatever is still staged and the staging folder. */
-static void stage_clear(staging *st)
-{
-    cli_remove_tracked_outputs();
-    if (st->dir)
-        rmdir(st->dir);
-    cli_track_dir(NULL);
-    for (uint32_t i = 0; i < st->count; i++)
-        free(st->names[i]);
-    free(st->names);
-    free(st->dir);
-    memset(st, 0, sizeof *st);
-}
-
 int cmd_bake(int argc, char **argv)
 {
     bake_args a;
@@ -497,7 +359,8 @@ int cmd_bake(int argc, char **argv)
     lx_image *images = NULL;
     char **stems = NULL;
     uint32_t maps = 0;
-    staging stage = {0};
+    cli_stage stage = {0};
+    lx_cubemap sky_env = {0};
     int status = EXIT_FAILED;
     double t0 = cli_now();
 
@@ -516,6 +379,30 @@ int cmd_bake(int argc, char **argv)
         cli_error("%s: the scene has no meshes to bake", a.scene);
         goto done;
     }
+    /* the sky: --sky and its options over the lights JSON's "sky" */
+    lx_scene_sky sky = scene->sky;
+    if (a.sky)
+        sky.environment = (char *)a.sky;
+    if (!sky.environment && (a.sky_shadows || a.sky_intensity >= 0.0 || a.sky_samples)) {
+        status = cli_usage_error("bake", "--sky-intensity, --sky-shadows and --sky-samples need "
+                                         "--sky ENV (or a \"sky\" in --lights)");
+        goto done;
+    }
+    if (sky.environment) {
+        if (a.sky_intensity >= 0.0)
+            sky.intensity = (float)a.sky_intensity;
+        sky.shadows = sky.shadows || a.sky_shadows;
+        if (a.sky_samples)
+            sky.samples = (uint32_t)a.sky_samples;
+        /* the SH need no more than 256 texels a side, sky shadows 64 */
+        int loaded =
+            cli_load_environment("bake", sky.environment, 1.0f, LX_SKY_LOAD_SIZE, &sky_env);
+        if (loaded != EXIT_OK) {
+            status = loaded;
+            goto done;
+        }
+        a.desc.sky = (lx_sky_desc){&sky_env, sky.intensity, sky.shadows, sky.samples};
+    }
 
     cli_progress progress;
     cli_progress_init(&progress, "texel maps", a.quiet);
@@ -523,9 +410,10 @@ int cmd_bake(int argc, char **argv)
     a.desc.progress_user = &progress;
     lx_status created = lx_baker_create(scene, &a.desc, &baker);
     cli_progress_finish(&progress);
+    lx_cubemap_free(&sky_env);
     if (created != LX_OK) {
-        cli_error("%s", created == LX_ERR_CANCELLED ? "interrupted; nothing written"
-                                                    : lx_last_error());
+        cli_error("%s",
+                  created == LX_ERR_CANCELLED ? "interrupted; nothing written" : lx_last_error());
         goto done;
     }
     cli_progress_init(&progress, "bake", a.quiet);
@@ -571,21 +459,11 @@ int cmd_bake(int argc, char **argv)
         cli_error("interrupted; nothing written");
         goto done;
     }
-    if (!make_dirs(a.output)) {
-        cli_error("%s: cannot create the output folder: %s", a.output, strerror(errno));
-        goto done;
-    }
     /* Everything goes to a staging folder inside the output folder first and
      * is moved into place only when every file is written: a failure leaves
      * the folder as it was, old lightmaps included. */
-    cli_set_writing(true);
-    stage.dir = make_staging(a.output);
-    if (!stage.dir) {
-        cli_error("%s: cannot write into the output folder: %s", a.output, strerror(errno));
-        cli_set_writing(false);
+    if (!cli_stage_begin(&stage, a.output))
         goto done;
-    }
-    cli_track_dir(stage.dir);
     cJSON *manifest = cJSON_CreateObject();
     cJSON_AddStringToObject(manifest, "scene", a.scene);
     cJSON_AddStringToObject(manifest, "quantity",
@@ -596,6 +474,14 @@ int cmd_bake(int argc, char **argv)
     cJSON_AddNumberToObject(manifest, "preview_ev100", ev);
     /* values in the files are (quantity) x pre_exposure */
     cJSON_AddNumberToObject(manifest, "pre_exposure", a.pre_expose ? pre_exposure : 1.0);
+    if (sky.environment) {
+        cJSON *sk = cJSON_AddObjectToObject(manifest, "sky");
+        cJSON_AddStringToObject(sk, "environment", sky.environment);
+        cJSON_AddNumberToObject(sk, "intensity", sky.intensity > 0.0f ? sky.intensity : 1.0);
+        cJSON_AddBoolToObject(sk, "shadows", sky.shadows);
+        if (sky.shadows)
+            cJSON_AddNumberToObject(sk, "samples", sky.samples ? sky.samples : 64);
+    }
     cJSON *list = cJSON_AddArrayToObject(manifest, "lightmaps");
     bool failed = false;
     for (uint32_t m = 0; m < maps && !failed; m++) {
@@ -606,29 +492,29 @@ int cmd_bake(int argc, char **argv)
         lx_image_write_desc wd = {.format = a.format,
                                   .half = a.half,
                                   .exposure = a.format == LX_IMAGE_PNG ? exposure
-                                              : a.pre_expose   ? pre_exposure
-                                                               : 1.0f};
-        failed = !stage_image(&stage, a.output, file, &images[m], &wd);
+                                              : a.pre_expose           ? pre_exposure
+                                                                       : 1.0f};
+        failed = !cli_stage_image(&stage, file, &images[m], &wd);
         bool want_preview = a.format != LX_IMAGE_PNG;
         if (!failed && want_preview) {
             lx_image_write_desc pd = {.format = LX_IMAGE_PNG, .exposure = exposure};
-            failed = !stage_image(&stage, a.output, preview, &images[m], &pd);
+            failed = !cli_stage_image(&stage, preview, &images[m], &pd);
         }
         cJSON_AddItemToArray(list, manifest_entry(scene, info, file, want_preview ? preview : NULL,
                                                   a.desc.quantity));
     }
     if (!failed) {
         char *text = cJSON_Print(manifest);
-        failed = !text || !stage_text(&stage, a.output, "manifest.json", text);
+        failed = !text || !cli_stage_text(&stage, "manifest.json", text);
         if (!text)
             cli_error("out of memory");
         free(text);
     }
     cJSON_Delete(manifest);
-    if (!failed && !publish(&stage, a.output)) {
+    if (!failed && !cli_stage_publish(&stage)) {
         failed = true;
     }
-    stage_clear(&stage);
+    cli_stage_clear(&stage);
     if (failed) {
         cli_set_writing(false);
         goto done;
@@ -656,6 +542,7 @@ done:
     free(images);
     free(stems);
     lx_baker_destroy(baker);
+    lx_cubemap_free(&sky_env);
     lx_scene_destroy(scene);
     return status;
 }

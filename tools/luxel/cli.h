@@ -12,6 +12,7 @@ enum { EXIT_OK = 0, EXIT_FAILED = 1, EXIT_USAGE = 2 };
 int cmd_bake(int argc, char **argv);
 int cmd_info(int argc, char **argv);
 int cmd_ies(int argc, char **argv);
+int cmd_ibl(int argc, char **argv);
 
 /* "luxel: error: <message>" on stderr. */
 void cli_error(const char *fmt, ...) __attribute__((format(printf, 1, 2)));
@@ -24,6 +25,14 @@ bool cli_parse_int(const char *s, long lo, long hi, long *out);
 bool cli_parse_float(const char *s, double lo, double hi, double *out);
 /* "R,G,B" with finite components >= 0. */
 bool cli_parse_rgb(const char *s, lx_vec3 *out);
+
+/* Loads the environment argument ENV of `command` (ibl, bake --sky): an
+ * image (lx_env_load, at face size `size`, 0 = the input's) or a constant
+ * colour const:R,G,B / const:L in nits, times intensity. Prints the error
+ * and returns EXIT_FAILED (a bad file) or EXIT_USAGE (a bad const:); *out
+ * is zeroed on failure. */
+int cli_load_environment(const char *command, const char *env, float intensity, int size,
+                         lx_cubemap *out);
 
 /* Progress bar on stderr: drawn only when stderr is a terminal, not quiet,
  * and the work has run for more than a second. Returns false after SIGINT. */
@@ -53,5 +62,41 @@ void cli_set_writing(bool writing);
 
 /* Monotonic seconds. */
 double cli_now(void);
+
+/* ---- staged output (stage.c) ---------------------------------------------
+ * Files go to OUTPUT/.luxel-XXXXXX and are moved into OUTPUT together by
+ * cli_stage_publish once all are written; interrupts remove them. Every
+ * function prints its own "luxel: error:" line and returns false on
+ * failure. Usage:
+ *   cli_stage st;
+ *   if (!cli_stage_begin(&st, dir)) return EXIT_FAILED;
+ *   bool ok = cli_stage_image(&st, "a.exr", &img, NULL) && cli_stage_publish(&st);
+ *   cli_stage_clear(&st); cli_set_writing(false);
+ */
+typedef struct cli_stage {
+    char *output; /* the final folder */
+    char *dir;    /* OUTPUT/.luxel- and six random characters (mkdtemp) */
+    char **names; /* files written into it */
+    uint32_t count;
+} cli_stage;
+
+/* Creates dir and its parents. */
+bool cli_make_dirs(const char *dir);
+/* Creates the output folder and the staging folder inside it, and enters
+ * the writing state (an interrupt removes this run's files). */
+bool cli_stage_begin(cli_stage *st, const char *output);
+/* The path of a new staged file (malloc'd; tracked so an interrupt removes
+ * it), for writers other than images and text; end with cli_stage_finish
+ * and the writer's status. NULL when out of memory. */
+char *cli_stage_path(cli_stage *st, const char *name);
+bool cli_stage_finish(cli_stage *st, const char *name, lx_status status);
+bool cli_stage_image(cli_stage *st, const char *name, const lx_image *img,
+                     const lx_image_write_desc *desc);
+bool cli_stage_text(cli_stage *st, const char *name, const char *text);
+/* Moves every staged file into the output folder, with interrupts held
+ * off; on a failed rename the ones already moved are removed again. */
+bool cli_stage_publish(cli_stage *st);
+/* Removes whatever is still staged and the staging folder. */
+void cli_stage_clear(cli_stage *st);
 
 #endif

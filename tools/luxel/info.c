@@ -12,7 +12,7 @@ static const char *info_usage =
     "usage: luxel info SCENE [options]\n"
     "\n"
     "Lists the meshes (triangles, UV sets), materials, nodes, lights (type and\n"
-    "physical units) and bounds of a glTF 2.0 or OBJ scene.\n"
+    "physical units), the sky and bounds of a glTF 2.0 or OBJ scene.\n"
     "\n"
     "options:\n"
     "  --lights FILE.json   apply a lights file first (docs/lights-json.md)\n"
@@ -133,6 +133,13 @@ int cmd_info(int argc, char **argv)
         print_light(&s->lights[i]);
     if (s->ambient.x > 0 || s->ambient.y > 0 || s->ambient.z > 0)
         printf("ambient: (%.3g, %.3g, %.3g) lx\n", s->ambient.x, s->ambient.y, s->ambient.z);
+    if (s->sky.environment) {
+        printf("sky: %s x %.4g, %s", s->sky.environment, s->sky.intensity,
+               s->sky.shadows ? "shadows" : "unshadowed (spherical harmonics)");
+        if (s->sky.shadows)
+            printf(" (%u samples)", s->sky.samples ? s->sky.samples : 64u);
+        printf("\n");
+    }
     lx_vec3 lo, hi;
     if (lx_scene_bounds(s, &lo, &hi))
         printf("bounds: (%.4g, %.4g, %.4g) .. (%.4g, %.4g, %.4g) m, %llu triangles\n", lo.x, lo.y,

@@ -18,12 +18,14 @@ static const char *main_usage =
     "usage: luxel <command> [options] inputs...\n"
     "\n"
     "luxel is a lighting toolkit: per-texel lightmaps with physically based\n"
-    "lights and shadows.\n"
+    "lights and shadows, and image-based lighting from environment maps.\n"
     "\n"
     "commands:\n"
     "  bake SCENE    bake lightmaps for a glTF 2.0 (.gltf/.glb) or OBJ scene\n"
     "  info SCENE    list a scene's meshes, materials, lights and bounds\n"
     "  ies FILE      show an IES photometric file: header, lumens, beam; --plot\n"
+    "  ibl ENV       image-based lighting from an environment map: irradiance,\n"
+    "                SH, prefiltered specular mips, DFG table; faces/cross/KTX\n"
     "\n"
     "options:\n"
     "  -h, --help    show this help (luxel <command> --help for a command)\n"
@@ -253,6 +255,8 @@ int main(int argc, char **argv)
         return cmd_info(argc - 1, argv + 1);
     if (strcmp(cmd, "ies") == 0)
         return cmd_ies(argc - 1, argv + 1);
+    if (strcmp(cmd, "ibl") == 0)
+        return cmd_ibl(argc - 1, argv + 1);
     if (cmd[0] == '-')
         return cli_usage_error(NULL, "unknown option '%s'", cmd);
     return cli_usage_error(NULL, "unknown command '%s'", cmd);

@@ -1,0 +1,315 @@
+/* Sky light in the baker (issue 4): the environment's irradiance at each
+ * texel, either unshadowed from its order-2 spherical harmonics
+ * (Ramamoorthi & Hanrahan 2001, ibl/sh.c) or with sky visibility, by rays
+ * that escape the scene bringing the environment they see.
+ *
+ * With rays the environment is box-filtered to at most LX_SKY_LOOKUP_SIZE
+ * texels a side and split in two, L = base + peak, where peak is what
+ * exceeds LX_SKY_PEAK_RATIO times the mean luminance (a sun, a window):
+ * - base by stratified cosine-weighted rays over the texel's hemisphere
+ *   (Malley's method: points uniform on the unit disk lifted onto the
+ *   hemisphere), E = pi / N sum base(w);
+ * - peak by rays toward its texels, each chosen with probability
+ *   proportional to its peak luminance times solid angle (the seed's "every
+ *   texel a directional light", sampled by importance), jittered within the
+ *   texel: E = P / M sum cos(w) over the rays that escape, P the peak's
+ *   total. A sun then casts clean shadows with a few dozen rays, where
+ *   cosine rays alone would almost never find it. */
+#include "bake_internal.h"
+
+#include <math.h>
+#include <stdlib.h>
+#include <string.h>
+
+#define LX_SKY_LOOKUP_SIZE 64
+#define LX_SKY_DEFAULT_SAMPLES 64u
+#define LX_SKY_PEAK_RATIO 8.0
+
+static float luminance(const float *rgb)
+{
+    return 0.2126f * rgb[0] + 0.7152f * rgb[1] + 0.0722f * rgb[2];
+}
+
+/* Splits the lookup into base (kept in b->sky_lookup) and peak
+ * (b->sky_peak), and builds the peak's sampling table. */
+static lx_status split_peak(lx_baker *b)
+{
+    lx_cubemap *base = &b->sky_lookup;
+    int n = base->size;
+    size_t texels = (size_t)6 * n * n;
+    double sum = 0.0;
+    for (size_t i = 0; i < texels; i++) {
+        int y = (int)(i / (size_t)n % (size_t)n), x = (int)(i % (size_t)n);
+        sum += luminance(base->data + 3 * i) * lx_cube_texel_solid_angle(n, x, y);
+    }
+    double threshold = LX_SKY_PEAK_RATIO * sum / (4.0 * LX_PI);
+    double *cdf = malloc(sizeof(double) * (texels + 1));
+    float *peak = calloc(texels * 3, sizeof(float));
+    if (!cdf || !peak) {
+        free(cdf);
+        free(peak);
+        return lx_fail(LX_ERR_NOMEM, "sky: out of memory");
+    }
+    cdf[0] = 0.0;
+    for (size_t i = 0; i < texels; i++) {
+        int y = (int)(i / (size_t)n % (size_t)n), x = (int)(i % (size_t)n);
+        float *t = base->data + 3 * i;
+        float lum = luminance(t);
+        double share = 0.0;
+        if (lum > threshold) {
+            /* the part above the threshold, in the texel's colour */
+            float f = (float)(1.0 - threshold / lum);
+            for (int k = 0; k < 3; k++) {
+                peak[3 * i + k] = t[k] * f;
+                t[k] -= peak[3 * i + k];
+            }
+            share = luminance(peak + 3 * i) * lx_cube_texel_solid_angle(n, x, y);
+        }
+        cdf[i + 1] = cdf[i] + share;
+    }
+    if (!(cdf[texels] > 0.0)) {
+        free(cdf);
+        free(peak);
+        return LX_OK; /* nothing stands out: cosine rays suffice */
+    }
+    b->sky_peak = peak;
+    b->sky_peak_cdf = cdf;
+    return LX_OK;
+}
+
+/* Lowest SH irradiance over a spread of normals (a Fibonacci sphere). */
+static float sh_minimum(const lx_sh9 *sh)
+{
+    const int n = 2048;
+    float lowest = INFINITY;
+    for (int i = 0; i < n; i++) {
+        float y = 1.0f - 2.0f * ((float)i + 0.5f) / (float)n;
+        float r = sqrtf(fmaxf(0.0f, 1.0f - y * y));
+        float phi = (float)i * 2.39996323f; /* the golden angle */
+        float e[3];
+        lx_sh_irradiance(sh, lx_v3(r * cosf(phi), y, r * sinf(phi)), e);
+        for (int k = 0; k < 3; k++)
+            lowest = fminf(lowest, e[k]);
+    }
+    return lowest;
+}
+
+lx_status lx_sky_prepare(lx_baker *b, const lx_sky_desc *sky)
+{
+    if (!sky->environment)
+        return LX_OK;
+    const lx_cubemap *env = sky->environment;
+    if (!env->data || env->size < 1)
+        return lx_fail(LX_ERR_INVALID, "sky: the environment cube map is empty");
+    if (!(sky->intensity >= 0.0f) || !isfinite(sky->intensity))
+        return lx_fail(LX_ERR_INVALID, "sky: intensity must be finite and >= 0");
+    if (sky->samples > LX_MAX_SKY_SAMPLES)
+        return lx_fail(LX_ERR_INVALID, "sky: samples %u is above %u", sky->samples,
+                       LX_MAX_SKY_SAMPLES);
+    float scale = sky->intensity > 0.0f ? sky->intensity : 1.0f;
+    lx_status st = lx_sh_project(env, &b->sky_sh);
+    if (st != LX_OK) {
+        lx_error_prefix("sky");
+        return st;
+    }
+    for (int i = 0; i < 9; i++)
+        for (int k = 0; k < 3; k++)
+            b->sky_sh.c[i][k] *= scale;
+    b->sky_samples = sky->samples ? sky->samples : LX_SKY_DEFAULT_SAMPLES;
+    b->sky_shadows = sky->shadows;
+    b->has_sky = true;
+    if (!sky->shadows) {
+        float lowest = sh_minimum(&b->sky_sh);
+        if (lowest < 0.0f)
+            lx_log(LX_LOG_WARN,
+                   "sky: its spherical-harmonic irradiance dips to %g lx for some normals "
+                   "(ringing around a small, bright source); those texels get 0. Sky shadows "
+                   "sample the environment itself",
+                   (double)lowest);
+        return LX_OK;
+    }
+    /* the lookup for escaping rays: box-filtered, scaled */
+    lx_cubemap level = {0};
+    const lx_cubemap *from = env;
+    while (from->size > LX_SKY_LOOKUP_SIZE) {
+        lx_cubemap half;
+        st = lx_cubemap_downsample(from, &half);
+        lx_cubemap_free(&level);
+        if (st != LX_OK)
+            return st;
+        level = half;
+        from = &level;
+    }
+    if (from == env) {
+        if ((st = lx_cubemap_alloc(&level, env->size)) != LX_OK)
+            return st;
+        memcpy(level.data, env->data, (size_t)env->size * env->size * 18 * sizeof(float));
+    }
+    size_t n = (size_t)level.size * level.size * 18;
+    for (size_t i = 0; i < n; i++)
+        level.data[i] *= scale;
+    b->sky_lookup = level;
+    return split_peak(b);
+}
+
+void lx_sky_free(lx_baker *b)
+{
+    lx_cubemap_free(&b->sky_lookup);
+    free(b->sky_peak);
+    free(b->sky_peak_cdf);
+    b->sky_peak = NULL;
+    b->sky_peak_cdf = NULL;
+    b->has_sky = false;
+}
+
+/* The texel of a cube map face-major texel index. */
+static void texel_of(int n, size_t i, int *face, int *x, int *y)
+{
+    size_t per_face = (size_t)n * (size_t)n;
+    *face = (int)(i / per_face);
+    *y = (int)(i % per_face / (size_t)n);
+    *x = (int)(i % (size_t)n);
+}
+
+/* The texel index a direction falls in (nearest: the lookup is already
+ * filtered, and the base must match the texels the peak was cut from). */
+static size_t texel_index(int n, lx_vec3 d)
+{
+    int face;
+    float s, t;
+    lx_cube_face_coords(d, &face, &s, &t);
+    int x = (int)(s * (float)n), y = (int)(t * (float)n);
+    x = x < 0 ? 0 : x >= n ? n - 1 : x;
+    y = y < 0 ? 0 : y >= n ? n - 1 : y;
+    return ((size_t)face * (size_t)n + (size_t)y) * (size_t)n + (size_t)x;
+}
+
+/* The first texel whose cumulative share exceeds u * total. */
+static size_t pick_texel(const double *cdf, size_t count, double u)
+{
+    double target = u * cdf[count];
+    size_t lo = 0, hi = count - 1;
+    while (lo < hi) {
+        size_t mid = lo + (hi - lo) / 2;
+        if (cdf[mid + 1] <= target)
+            lo = mid + 1;
+        else
+            hi = mid;
+    }
+    return lo;
+}
+
+/* Casts m rays (directions in rays[], weights per channel in w[]) and adds
+ * the weights of those that escape to sum. */
+static void cast(const lx_baker *b, lx_ray *rays, const lx_vec3 *w, uint32_t m, double sum[3])
+{
+    uint8_t occluded[64];
+    lx_tracer_occluded_batch(b->tracer, rays, m, false, occluded);
+    for (uint32_t j = 0; j < m; j++)
+        if (!occluded[j]) {
+            sum[0] += w[j].x;
+            sum[1] += w[j].y;
+            sum[2] += w[j].z;
+        }
+}
+
+/* Sky visibility of one texel (see the top of this file). Samples are
+ * stratified and jittered by map, texel and sample, so any thread count
+ * gives the same rays; directions below the geometric surface are blocked
+ * by it. */
+static lx_vec3 sky_visible(const lx_baker *b, uint32_t map_index, const lx_lightmap *map,
+                           uint32_t texel)
+{
+    const lx_cubemap *lookup = &b->sky_lookup;
+    int n = lookup->size;
+    lx_vec3 p = map->world_position[texel], nrm = map->world_normal[texel];
+    lx_vec3 ng = map->world_geometric_normal[texel];
+    lx_vec3 t = lx_perpendicular(nrm), bt = lx_cross(nrm, t);
+    uint32_t pixel = map->texels[texel].pixel;
+    const uint32_t key = 0x5eedu; /* dimensions apart from the lights' */
+    enum { BATCH = 64 };
+    lx_ray rays[BATCH];
+    lx_vec3 w[BATCH];
+    lx_vec3 result = lx_v3(0.0f, 0.0f, 0.0f);
+
+    /* base: stratified cosine-weighted directions, pi / N sum base(w) */
+    uint32_t want = b->sky_samples;
+    uint32_t sx = (uint32_t)sqrtf((float)want);
+    sx = sx ? sx : 1u;
+    uint32_t sy = (want + sx - 1) / sx, cells = sx * sy;
+    double sum[3] = {0.0, 0.0, 0.0};
+    uint32_t m = 0;
+    for (uint32_t k = 0; k < cells; k++) {
+        float u = ((float)(k % sx) + lx_random(map_index, pixel, k, key)) / (float)sx;
+        float v = ((float)(k / sx) + lx_random(map_index, pixel, k, key + 1)) / (float)sy;
+        float r = sqrtf(u), phi = 2.0f * LX_PI * v;
+        lx_vec3 d = lx_add(lx_add(lx_scale(t, r * cosf(phi)), lx_scale(bt, r * sinf(phi))),
+                           lx_scale(nrm, sqrtf(fmaxf(0.0f, 1.0f - u))));
+        if (!(lx_dot(d, ng) > 0.0f))
+            continue;
+        const float *l = lookup->data + 3 * texel_index(n, d);
+        lx_light_eval e = {.to_light = d, .distance = INFINITY};
+        rays[m] = lx_shadow_ray(b, p, ng, &e);
+        w[m++] = lx_v3(l[0], l[1], l[2]);
+        if (m == BATCH) {
+            cast(b, rays, w, m, sum);
+            m = 0;
+        }
+    }
+    if (m)
+        cast(b, rays, w, m, sum);
+    double scale = LX_PI / (double)cells;
+    result = lx_v3((float)(sum[0] * scale), (float)(sum[1] * scale), (float)(sum[2] * scale));
+    if (!b->sky_peak)
+        return result;
+
+    /* peak: texels by importance, P / M sum chroma cos over escaping rays */
+    size_t texels = (size_t)6 * n * n;
+    uint32_t peaks = (want + 1) / 2;
+    double total = b->sky_peak_cdf[texels];
+    sum[0] = sum[1] = sum[2] = 0.0;
+    m = 0;
+    for (uint32_t k = 0; k < peaks; k++) {
+        double u = ((double)k + lx_random(map_index, pixel, k, key + 2)) / (double)peaks;
+        size_t i = pick_texel(b->sky_peak_cdf, texels, u);
+        int face, x, y;
+        texel_of(n, i, &face, &x, &y);
+        float s = ((float)x + lx_random(map_index, pixel, k, key + 3)) / (float)n;
+        float tt = ((float)y + lx_random(map_index, pixel, k, key + 4)) / (float)n;
+        lx_vec3 d = lx_cube_direction(face, s, tt);
+        float cos_n = lx_dot(d, nrm);
+        if (!(cos_n > 0.0f) || !(lx_dot(d, ng) > 0.0f))
+            continue;
+        const float *l = b->sky_peak + 3 * i;
+        float chroma = cos_n / luminance(l);
+        lx_light_eval e = {.to_light = d, .distance = INFINITY};
+        rays[m] = lx_shadow_ray(b, p, ng, &e);
+        w[m++] = lx_v3(l[0] * chroma, l[1] * chroma, l[2] * chroma);
+        if (m == BATCH) {
+            cast(b, rays, w, m, sum);
+            m = 0;
+        }
+    }
+    if (m)
+        cast(b, rays, w, m, sum);
+    scale = total / (double)peaks;
+    return lx_add(result,
+                  lx_v3((float)(sum[0] * scale), (float)(sum[1] * scale), (float)(sum[2] * scale)));
+}
+
+void lx_sky_tile(const lx_baker *b, uint32_t map_index, const lx_lightmap *map, uint32_t first,
+                 uint32_t count, lx_vec3 *accum)
+{
+    for (uint32_t k = 0; k < count; k++) {
+        uint32_t i = first + k;
+        lx_vec3 e;
+        if (b->sky_shadows) {
+            e = sky_visible(b, map_index, map, i);
+        } else {
+            float sh[3];
+            lx_sh_irradiance(&b->sky_sh, map->world_normal[i], sh);
+            e = lx_v3(fmaxf(sh[0], 0.0f), fmaxf(sh[1], 0.0f), fmaxf(sh[2], 0.0f));
+        }
+        accum[k] = lx_add(accum[k], e);
+    }
+}

@@ -1,0 +1,282 @@
+/* Sky light in the baker against closed forms: a constant environment L
+ * gives pi L on an open floor, unshadowed (SH) and with sky shadows (every
+ * ray escapes); L = 1 + y gives pi + 2 pi / 3 facing up and pi - 2 pi / 3
+ * facing down (the cosine integrals of 1 and y over a hemisphere); under a
+ * square roof sky shadows take away the roof's form factor, pi L F (Lambert's
+ * polygon formula); a single bright texel lights like a directional light of
+ * L Omega and is shadowed by a roof; inside a closed box they give exactly 0;
+ * the bytes are the same for any thread count; bad sky settings fail with a
+ * message. */
+#include <setjmp.h>
+#include <stdarg.h>
+#include <stddef.h>
+#include <stdint.h>
+
+#include <cmocka.h>
+
+#include "helpers.h"
+
+#include <math.h>
+#include <stdlib.h>
+#include <string.h>
+
+#define PI_D 3.14159265358979323846
+
+/* A cube map whose every texel centre holds f(direction). */
+static lx_cubemap make_env(int size, double (*f)(lx_vec3))
+{
+    lx_cubemap c;
+    assert_int_equal(lx_cubemap_alloc(&c, size), LX_OK);
+    for (int face = 0; face < 6; face++)
+        for (int y = 0; y < size; y++)
+            for (int x = 0; x < size; x++) {
+                lx_vec3 d = lx_cube_direction(face, (x + 0.5f) / size, (y + 0.5f) / size);
+                float *t = lx_cubemap_texel(&c, face, x, y);
+                t[0] = t[1] = t[2] = (float)f(d);
+            }
+    return c;
+}
+
+static double constant_env(lx_vec3 d)
+{
+    (void)d;
+    return 2.0;
+}
+
+static double linear_env(lx_vec3 d)
+{
+    return 1.0 + d.y;
+}
+
+/* Bakes an 8x8 map of a 1 m floor (node 0; facing down when `down`) with
+ * optional extra meshes, lit by the sky alone. */
+static lx_baker *bake_sky(const lx_cubemap *env, bool shadows, uint32_t samples, bool down,
+                          lx_mesh *extra, int extra_count, int threads, lx_image *out)
+{
+    lx_scene *scene = lx_test_new_scene("sky");
+    lx_mesh floor = lx_test_plane("floor", 1.0f, 0.0f, 0.0f, 0.0f, 1);
+    if (down)
+        for (uint32_t v = 0; v < floor.vertex_count; v++)
+            floor.normals[v] = lx_v3(0.0f, -1.0f, 0.0f);
+    if (down)
+        for (uint32_t t = 0; t < 3 * floor.triangle_count; t += 3) {
+            uint32_t k = floor.indices[t + 1];
+            floor.indices[t + 1] = floor.indices[t + 2];
+            floor.indices[t + 2] = k;
+        }
+    lx_test_add(scene, &floor);
+    lx_test_mesh_free(&floor);
+    for (int i = 0; i < extra_count; i++)
+        lx_test_add(scene, &extra[i]);
+    lx_bake_desc desc = {.resolution = 8, .padding = LX_PADDING_NONE, .threads = threads};
+    desc.sky.environment = env;
+    desc.sky.shadows = shadows;
+    desc.sky.samples = samples;
+    lx_baker *baker;
+    assert_int_equal(lx_baker_create(scene, &desc, &baker), LX_OK);
+    lx_scene_destroy(scene);
+    assert_int_equal(lx_baker_bake(baker), LX_OK);
+    assert_int_equal(lx_baker_apply_alloc(baker, lx_test_map_of(baker, 0), out), LX_OK);
+    return baker;
+}
+
+static void check_all(const lx_image *img, double want, double rel_tol, const char *what)
+{
+    for (int i = 0; i < img->width * img->height * 3; i++)
+        if (!(fabs(img->data[i] - want) <= rel_tol * want))
+            fail_msg("%s: texel value %d is %.7g, want %.7g (tolerance %g)", what, i / 3,
+                     (double)img->data[i], want, rel_tol);
+}
+
+static void constant_sky_is_pi_l(void **state)
+{
+    (void)state;
+    lx_cubemap env = make_env(16, constant_env);
+    for (int shadows = 0; shadows <= 1; shadows++) {
+        lx_image img;
+        lx_baker *b = bake_sky(&env, shadows, 16, false, NULL, 0, 2, &img);
+        check_all(&img, 2.0 * PI_D, 1e-4, shadows ? "open floor, sky shadows" : "open floor");
+        lx_image_free(&img);
+        lx_baker_destroy(b);
+    }
+    lx_cubemap_free(&env);
+}
+
+static void linear_sky_matches_cosine_integrals(void **state)
+{
+    (void)state;
+    lx_cubemap env = make_env(32, linear_env);
+    /* up: int (1 + cos t) cos t dw = pi + 2 pi / 3; down: pi - 2 pi / 3 */
+    const double up = PI_D + 2.0 * PI_D / 3.0, down = PI_D - 2.0 * PI_D / 3.0;
+    lx_image img;
+    lx_baker *b = bake_sky(&env, false, 0, false, NULL, 0, 2, &img);
+    check_all(&img, up, 2e-3, "unshadowed, facing up");
+    lx_image_free(&img);
+    lx_baker_destroy(b);
+    b = bake_sky(&env, false, 0, true, NULL, 0, 2, &img);
+    check_all(&img, down, 5e-3, "unshadowed, facing down");
+    lx_image_free(&img);
+    lx_baker_destroy(b);
+    /* rays: stratified over 1024 strata, the box-filtered lookup */
+    b = bake_sky(&env, true, 1024, false, NULL, 0, 2, &img);
+    check_all(&img, up, 5e-3, "sky shadows, facing up");
+    lx_image_free(&img);
+    lx_baker_destroy(b);
+    lx_cubemap_free(&env);
+}
+
+static void roof_takes_its_form_factor(void **state)
+{
+    (void)state;
+    lx_cubemap env = make_env(16, constant_env);
+    /* a 1 m roof 0.5 m above the floor's centre */
+    lx_mesh roof = lx_test_plane("roof", 1.0f, 0.5f, 0.0f, 0.0f, 1);
+    lx_image img;
+    lx_baker *b = bake_sky(&env, true, 1024, false, &roof, 1, 2, &img);
+    lx_test_mesh_free(&roof);
+    /* the roof as a rect light of luminance 2 seen from below: pi L F */
+    lx_vec3 corners[4] = {lx_v3(-0.5f, 0.5f, -0.5f), lx_v3(0.5f, 0.5f, -0.5f),
+                          lx_v3(0.5f, 0.5f, 0.5f), lx_v3(-0.5f, 0.5f, 0.5f)};
+    int checked = 0;
+    for (int y = 0; y < 8; y++)
+        for (int x = 0; x < 8; x++) {
+            lx_texel_sample s;
+            assert_true(lx_baker_texel(b, 0, x, y, &s));
+            double blocked = lx_rect_light_illuminance(corners, 2.0f, s.position, s.normal);
+            double want = 2.0 * PI_D - blocked;
+            double got = img.data[3 * (y * 8 + x)];
+            assert_true(blocked > 0.2 * 2.0 * PI_D); /* the roof matters */
+            if (!(fabs(got - want) <= 0.01 * 2.0 * PI_D))
+                fail_msg("texel (%d, %d): %.5g, want %.5g", x, y, got, want);
+            checked++;
+        }
+    assert_int_equal(checked, 64);
+    lx_image_free(&img);
+    lx_baker_destroy(b);
+    lx_cubemap_free(&env);
+}
+
+/* A dim sky of 100 nits with a "sun": one texel of 1e7 nits on the +Y
+ * face, looking up and a little toward +x. On an open floor the texel is a
+ * directional light of L Omega (the seed's view of a texel): E = pi 100 +
+ * L Omega cos(t). Under a roof that hides it, only the dim sky's visible
+ * part is left, pi 100 - (the roof's form factor as a rect light of 100). */
+static lx_cubemap sun_env(int *sun_x, int *sun_y)
+{
+    lx_cubemap env = make_env(16, constant_env);
+    for (size_t i = 0; i < (size_t)6 * 16 * 16 * 3; i++)
+        env.data[i] = 100.0f;
+    *sun_x = 9;
+    *sun_y = 8;
+    float *t = lx_cubemap_texel(&env, LX_FACE_PY, *sun_x, *sun_y);
+    t[0] = t[1] = t[2] = 1e7f;
+    return env;
+}
+
+static void sun_texel_lights_like_a_directional_light(void **state)
+{
+    (void)state;
+    int sx, sy;
+    lx_cubemap env = sun_env(&sx, &sy);
+    lx_vec3 d = lx_cube_direction(LX_FACE_PY, (sx + 0.5f) / 16, (sy + 0.5f) / 16);
+    double omega = lx_cube_texel_solid_angle(16, sx, sy);
+    double want = PI_D * 100.0 + 1e7 * omega * d.y;
+    lx_image img;
+    lx_baker *b = bake_sky(&env, true, 256, false, NULL, 0, 2, &img);
+    check_all(&img, want, 0.015, "open floor under a sun texel");
+    lx_image_free(&img);
+    lx_baker_destroy(b);
+
+    lx_mesh roof = lx_test_plane("roof", 4.0f, 0.5f, 0.0f, 0.0f, 1);
+    b = bake_sky(&env, true, 256, false, &roof, 1, 2, &img);
+    lx_test_mesh_free(&roof);
+    lx_vec3 corners[4] = {lx_v3(-2.0f, 0.5f, -2.0f), lx_v3(2.0f, 0.5f, -2.0f),
+                          lx_v3(2.0f, 0.5f, 2.0f), lx_v3(-2.0f, 0.5f, 2.0f)};
+    for (int y = 0; y < 8; y++)
+        for (int x = 0; x < 8; x++) {
+            lx_texel_sample ts;
+            assert_true(lx_baker_texel(b, 0, x, y, &ts));
+            double shaded =
+                PI_D * 100.0 - lx_rect_light_illuminance(corners, 100.0f, ts.position, ts.normal);
+            double got = img.data[3 * (y * 8 + x)];
+            if (!(fabs(got - shaded) <= 0.02 * PI_D * 100.0))
+                fail_msg("texel (%d, %d) under the roof: %.5g, want %.5g", x, y, got, shaded);
+        }
+    lx_image_free(&img);
+    lx_baker_destroy(b);
+    lx_cubemap_free(&env);
+}
+
+static void closed_box_is_dark(void **state)
+{
+    (void)state;
+    lx_cubemap env = make_env(8, constant_env);
+    lx_mesh box = lx_test_box("box", lx_v3(-2, -1, -2), lx_v3(2, 2, 2), true);
+    lx_image img;
+    lx_baker *b = bake_sky(&env, true, 64, false, &box, 1, 2, &img);
+    lx_test_mesh_free(&box);
+    for (int i = 0; i < 64 * 3; i++)
+        assert_true(img.data[i] == 0.0f);
+    lx_image_free(&img);
+    lx_baker_destroy(b);
+    lx_cubemap_free(&env);
+}
+
+static void same_bytes_for_any_thread_count(void **state)
+{
+    (void)state;
+    lx_cubemap env = make_env(16, linear_env);
+    lx_mesh roof = lx_test_plane("roof", 0.6f, 0.4f, 0.2f, 0.1f, 1);
+    lx_image one, three;
+    lx_baker *a = bake_sky(&env, true, 37, false, &roof, 1, 1, &one);
+    lx_baker *b = bake_sky(&env, true, 37, false, &roof, 1, 3, &three);
+    assert_memory_equal(one.data, three.data, sizeof(float) * 64 * 3);
+    lx_test_mesh_free(&roof);
+    lx_image_free(&one);
+    lx_image_free(&three);
+    lx_baker_destroy(a);
+    lx_baker_destroy(b);
+    lx_cubemap_free(&env);
+}
+
+static void bad_sky_settings(void **state)
+{
+    (void)state;
+    lx_cubemap env = make_env(4, constant_env);
+    lx_scene *scene = lx_test_new_scene("sky");
+    lx_mesh floor = lx_test_plane("floor", 1.0f, 0.0f, 0.0f, 0.0f, 1);
+    lx_test_add(scene, &floor);
+    lx_test_mesh_free(&floor);
+    lx_bake_desc desc = {.resolution = 8};
+    desc.sky.environment = &env;
+    lx_baker *b = (lx_baker *)&desc;
+    desc.sky.intensity = NAN;
+    assert_int_equal(lx_baker_create(scene, &desc, &b), LX_ERR_INVALID);
+    assert_non_null(strstr(lx_last_error(), "sky: intensity must be finite"));
+    assert_null(b);
+    desc.sky.intensity = 1.0f;
+    desc.sky.samples = LX_MAX_SKY_SAMPLES + 1;
+    assert_int_equal(lx_baker_create(scene, &desc, &b), LX_ERR_INVALID);
+    assert_non_null(strstr(lx_last_error(), "sky: samples"));
+    desc.sky.samples = 0;
+    env.data[5] = NAN;
+    assert_int_equal(lx_baker_create(scene, &desc, &b), LX_ERR_INVALID);
+    assert_non_null(strstr(lx_last_error(), "sky"));
+    lx_scene_destroy(scene);
+    lx_cubemap_free(&env);
+}
+
+int main(void)
+{
+    lx_test_watchdog(120);
+    const struct CMUnitTest tests[] = {
+        cmocka_unit_test(constant_sky_is_pi_l),
+        cmocka_unit_test(linear_sky_matches_cosine_integrals),
+        cmocka_unit_test(roof_takes_its_form_factor),
+        cmocka_unit_test(sun_texel_lights_like_a_directional_light),
+        cmocka_unit_test(closed_box_is_dark),
+        cmocka_unit_test(same_bytes_for_any_thread_count),
+        cmocka_unit_test(bad_sky_settings),
+    };
+    return cmocka_run_group_tests(tests, NULL, NULL);
+}

@@ -1,0 +1,576 @@
+/* luxel ibl: image-based lighting from an environment map: the diffuse
+ * irradiance cube (brute force or from spherical harmonics), the nine SH
+ * coefficients as JSON, the prefiltered specular mip chain (GGX or Phong)
+ * and the split-sum DFG table, in the layouts engines read (six faces, a
+ * cross, an equirect or one KTX 1.1 file). Everything is computed before
+ * the first file is written; files are staged and moved into place
+ * together (stage.c). */
+#define _POSIX_C_SOURCE 200809L
+#include "cli.h"
+
+#include <cjson/cJSON.h>
+#include <errno.h>
+#include <getopt.h>
+#include <math.h>
+#include <stdio.h>
+#include <stdlib.h>
+#include <string.h>
+
+static const char *ibl_usage =
+    "usage: luxel ibl ENV [options]\n"
+    "\n"
+    "Image-based lighting from the environment ENV (radiance in nits): an\n"
+    "equirect (2:1), a horizontal (4:3) or vertical (3:4) cross, six faces\n"
+    "NAME_px.EXT ... NAME_nz.EXT (give the _px file), in .hdr, .exr, .pfm or\n"
+    ".png/.jpg (sRGB decoded), or a constant colour const:R,G,B (const:L for\n"
+    "grey). Writes to DIR:\n"
+    "  irradiance.*     diffuse irradiance cube in lux (--irradiance)\n"
+    "  sh.json          order-2 spherical harmonics of the radiance (--sh)\n"
+    "  specular_mL.*    prefiltered specular mip L = 0, 1, ... (--specular),\n"
+    "                   or specular.ktx holding them all\n"
+    "  dfg_lut.*        split-sum GGX table, 128x128: R scale, G bias (--lut)\n"
+    "  environment.*    the environment itself in the output layout (--environment)\n"
+    "With none of --irradiance, --sh, --specular, --lut, --environment, the\n"
+    "first four are written. Cube faces are in the OpenGL/KTX order and\n"
+    "orientation, +Y up (docs/ibl.md).\n"
+    "\n"
+    "options:\n"
+    "  -o, --output DIR         output folder (default ./ibl)\n"
+    "  --irradiance[=METHOD]    irradiance cube, 32x32 faces: brute (default; every\n"
+    "                           source texel a light) or sh (from the 9 SH terms)\n"
+    "  --sh                     write sh.json\n"
+    "  --specular FILTER        ggx (default) or phong\n"
+    "  --mips N                 specular levels (default: down to 1x1)\n"
+    "  --phong-exponents A,B,.. Phong exponent per level (default 2048/4^level)\n"
+    "  --samples N              GGX importance samples per texel of the specular\n"
+    "                           levels and the DFG table (default 256 and 1024)\n"
+    "  --lut                    write the DFG table\n"
+    "  --environment            write the environment in the output layout\n"
+    "  --size N                 face size the environment is resampled to, and of\n"
+    "                           specular level 0 (default: the input's, specular at\n"
+    "                           most 256; a constant: 64)\n"
+    "  --layout L               faces (default: NAME_px.EXT ... NAME_nz.EXT), cross,\n"
+    "                           vcross (vertical cross), equirect (4N x 2N) or ktx\n"
+    "                           (one KTX 1.1 file per cube, mips included)\n"
+    "  --format F               exr (default), hdr, pfm or png (png clamps to 0..1)\n"
+    "  --half                   16-bit floats: EXR half, KTX RGBA16F (else RGBA32F)\n"
+    "  --no-seam-fix            keep cube edges as filtered (for engines that sample\n"
+    "                           cube maps seamlessly); by default edge texels are\n"
+    "                           averaged across faces (the seed's seam fix)\n"
+    "  --intensity X            multiply the environment by X (default 1)\n"
+    "  --threads N              worker threads (default: all cores)\n"
+    "  -q, --quiet              no progress bar, no list of files\n"
+    "  -h, --help               show this help\n";
+
+enum {
+    OPT_IRRADIANCE = 256,
+    OPT_SH,
+    OPT_SPECULAR,
+    OPT_MIPS,
+    OPT_PHONG,
+    OPT_SAMPLES,
+    OPT_LUT,
+    OPT_ENVIRONMENT,
+    OPT_SIZE,
+    OPT_LAYOUT,
+    OPT_FORMAT,
+    OPT_HALF,
+    OPT_NO_SEAM_FIX,
+    OPT_INTENSITY,
+    OPT_THREADS
+};
+
+typedef enum { LAYOUT_FACES, LAYOUT_CROSS, LAYOUT_VCROSS, LAYOUT_EQUIRECT, LAYOUT_KTX } layout;
+
+#define LUT_SIZE 128
+#define IRRADIANCE_SIZE 32
+#define MAX_SAMPLES 65536
+
+typedef struct ibl_args {
+    const char *env;
+    const char *output;
+    bool irradiance, irradiance_sh, sh, specular, lut, environment;
+    lx_specular_filter filter;
+    bool filter_given;
+    int mips;
+    float phong[LX_MAX_CUBE_MIPS];
+    int phong_count;
+    int samples;
+    int size;
+    layout layout;
+    lx_image_format format;
+    bool half;
+    bool seam_fix;
+    float intensity;
+    int threads;
+    bool quiet;
+} ibl_args;
+
+static bool parse_exponents(const char *s, ibl_args *a)
+{
+    a->phong_count = 0;
+    const char *p = s;
+    for (;;) {
+        char *end;
+        errno = 0;
+        double v = strtod(p, &end);
+        if (errno || end == p || !isfinite(v) || v <= 0.0 || v > 1e6 ||
+            a->phong_count == LX_MAX_CUBE_MIPS)
+            return false;
+        a->phong[a->phong_count++] = (float)v;
+        p = end;
+        if (*p == '\0')
+            return true;
+        if (*p != ',')
+            return false;
+        p++;
+    }
+}
+
+static int parse_args(int argc, char **argv, ibl_args *a)
+{
+    static const struct option options[] = {{"output", required_argument, NULL, 'o'},
+                                            {"irradiance", optional_argument, NULL, OPT_IRRADIANCE},
+                                            {"sh", no_argument, NULL, OPT_SH},
+                                            {"specular", required_argument, NULL, OPT_SPECULAR},
+                                            {"mips", required_argument, NULL, OPT_MIPS},
+                                            {"phong-exponents", required_argument, NULL, OPT_PHONG},
+                                            {"samples", required_argument, NULL, OPT_SAMPLES},
+                                            {"lut", no_argument, NULL, OPT_LUT},
+                                            {"environment", no_argument, NULL, OPT_ENVIRONMENT},
+                                            {"size", required_argument, NULL, OPT_SIZE},
+                                            {"layout", required_argument, NULL, OPT_LAYOUT},
+                                            {"format", required_argument, NULL, OPT_FORMAT},
+                                            {"half", no_argument, NULL, OPT_HALF},
+                                            {"no-seam-fix", no_argument, NULL, OPT_NO_SEAM_FIX},
+                                            {"intensity", required_argument, NULL, OPT_INTENSITY},
+                                            {"threads", required_argument, NULL, OPT_THREADS},
+                                            {"quiet", no_argument, NULL, 'q'},
+                                            {"help", no_argument, NULL, 'h'},
+                                            {NULL, 0, NULL, 0}};
+    memset(a, 0, sizeof *a);
+    a->output = "ibl";
+    a->format = LX_IMAGE_EXR;
+    a->seam_fix = true;
+    a->intensity = 1.0f;
+    opterr = 0;
+    optind = 1;
+    int c;
+    long n;
+    double f;
+    while ((c = getopt_long(argc, argv, ":o:qh", options, NULL)) != -1) {
+        switch (c) {
+        case 'o':
+            if (!*optarg)
+                return cli_usage_error("ibl", "-o needs a folder name");
+            a->output = optarg;
+            break;
+        case OPT_IRRADIANCE:
+            a->irradiance = true;
+            if (!optarg || strcmp(optarg, "brute") == 0)
+                a->irradiance_sh = false;
+            else if (strcmp(optarg, "sh") == 0)
+                a->irradiance_sh = true;
+            else
+                return cli_usage_error("ibl", "--irradiance takes brute or sh, not '%s'", optarg);
+            break;
+        case OPT_SH:
+            a->sh = true;
+            break;
+        case OPT_SPECULAR:
+            a->specular = true;
+            a->filter_given = true;
+            if (strcmp(optarg, "ggx") == 0)
+                a->filter = LX_SPECULAR_GGX;
+            else if (strcmp(optarg, "phong") == 0)
+                a->filter = LX_SPECULAR_PHONG;
+            else
+                return cli_usage_error("ibl", "--specular must be ggx or phong, not '%s'", optarg);
+            break;
+        case OPT_MIPS:
+            if (!cli_parse_int(optarg, 1, LX_MAX_CUBE_MIPS, &n))
+                return cli_usage_error("ibl", "--mips must be an integer in 1..%d, not '%s'",
+                                       LX_MAX_CUBE_MIPS, optarg);
+            a->mips = (int)n;
+            break;
+        case OPT_PHONG:
+            if (!parse_exponents(optarg, a))
+                return cli_usage_error("ibl",
+                                       "--phong-exponents must be 1..%d comma-separated numbers "
+                                       "in (0, 1e6], not '%s'",
+                                       LX_MAX_CUBE_MIPS, optarg);
+            break;
+        case OPT_SAMPLES:
+            if (!cli_parse_int(optarg, 1, MAX_SAMPLES, &n))
+                return cli_usage_error("ibl", "--samples must be an integer in 1..%d, not '%s'",
+                                       MAX_SAMPLES, optarg);
+            a->samples = (int)n;
+            break;
+        case OPT_LUT:
+            a->lut = true;
+            break;
+        case OPT_ENVIRONMENT:
+            a->environment = true;
+            break;
+        case OPT_SIZE:
+            if (!cli_parse_int(optarg, 1, LX_MAX_CUBE_SIZE, &n))
+                return cli_usage_error("ibl", "--size must be an integer in 1..%d, not '%s'",
+                                       LX_MAX_CUBE_SIZE, optarg);
+            a->size = (int)n;
+            break;
+        case OPT_LAYOUT:
+            if (strcmp(optarg, "faces") == 0)
+                a->layout = LAYOUT_FACES;
+            else if (strcmp(optarg, "cross") == 0)
+                a->layout = LAYOUT_CROSS;
+            else if (strcmp(optarg, "vcross") == 0)
+                a->layout = LAYOUT_VCROSS;
+            else if (strcmp(optarg, "equirect") == 0)
+                a->layout = LAYOUT_EQUIRECT;
+            else if (strcmp(optarg, "ktx") == 0)
+                a->layout = LAYOUT_KTX;
+            else
+                return cli_usage_error(
+                    "ibl", "--layout must be faces, cross, vcross, equirect or ktx, not '%s'",
+                    optarg);
+            break;
+        case OPT_FORMAT:
+            if (strcmp(optarg, "exr") == 0)
+                a->format = LX_IMAGE_EXR;
+            else if (strcmp(optarg, "hdr") == 0)
+                a->format = LX_IMAGE_HDR;
+            else if (strcmp(optarg, "pfm") == 0)
+                a->format = LX_IMAGE_PFM;
+            else if (strcmp(optarg, "png") == 0)
+                a->format = LX_IMAGE_PNG;
+            else
+                return cli_usage_error("ibl", "--format must be exr, hdr, pfm or png, not '%s'",
+                                       optarg);
+            break;
+        case OPT_HALF:
+            a->half = true;
+            break;
+        case OPT_NO_SEAM_FIX:
+            a->seam_fix = false;
+            break;
+        case OPT_INTENSITY:
+            if (!cli_parse_float(optarg, 0.0, 1e30, &f) || f <= 0.0)
+                return cli_usage_error("ibl", "--intensity must be a finite number > 0, not '%s'",
+                                       optarg);
+            a->intensity = (float)f;
+            break;
+        case OPT_THREADS:
+            if (!cli_parse_int(optarg, 1, 1024, &n))
+                return cli_usage_error("ibl", "--threads must be an integer in 1..1024, not '%s'",
+                                       optarg);
+            a->threads = (int)n;
+            break;
+        case 'q':
+            a->quiet = true;
+            break;
+        case 'h':
+            fputs(ibl_usage, stdout);
+            return -1;
+        case ':':
+            return cli_usage_error("ibl", "option '%s' needs a value", argv[optind - 1]);
+        default:
+            return cli_usage_error("ibl", "unknown option '%s'", argv[optind - 1]);
+        }
+    }
+    if (optind >= argc)
+        return cli_usage_error("ibl", "no environment given");
+    if (optind + 1 < argc)
+        return cli_usage_error("ibl", "one environment at a time ('%s' is extra)",
+                               argv[optind + 1]);
+    a->env = argv[optind];
+    if (!a->irradiance && !a->sh && !a->specular && !a->lut && !a->environment)
+        a->irradiance = a->sh = a->specular = a->lut = true;
+    if (!a->specular && (a->mips || a->phong_count))
+        return cli_usage_error("ibl", "--mips and --phong-exponents apply to the specular "
+                                      "chain: add --specular");
+    if (!a->specular && !a->lut && a->samples)
+        return cli_usage_error("ibl", "--samples applies to --specular and --lut");
+    if (a->phong_count && a->filter != LX_SPECULAR_PHONG)
+        return cli_usage_error("ibl", "--phong-exponents needs --specular phong");
+    if (a->phong_count && a->mips && a->mips != a->phong_count)
+        return cli_usage_error("ibl", "--mips %d but %d Phong exponents", a->mips, a->phong_count);
+    if (a->phong_count)
+        a->mips = a->phong_count;
+    if (a->half && a->format != LX_IMAGE_EXR && a->layout != LAYOUT_KTX)
+        return cli_usage_error("ibl", "--half applies to --format exr and --layout ktx only");
+    return 0;
+}
+
+/* ---- writing ------------------------------------------------------------- */
+
+typedef struct writer {
+    cli_stage stage;
+    const ibl_args *a;
+    char **written; /* names, for the list on stdout */
+    int written_count;
+} writer;
+
+static bool note(writer *w, const char *name)
+{
+    char **n = realloc(w->written, sizeof(char *) * (size_t)(w->written_count + 1));
+    if (!n) {
+        cli_error("out of memory");
+        return false;
+    }
+    w->written = n;
+    w->written[w->written_count] = lx_strdup(name);
+    if (!w->written[w->written_count]) {
+        cli_error("out of memory");
+        return false;
+    }
+    w->written_count++;
+    return true;
+}
+
+static bool put_image(writer *w, const char *name, const lx_image *img)
+{
+    lx_image_write_desc wd = {.format = w->a->format, .half = w->a->half};
+    return cli_stage_image(&w->stage, name, img, &wd) && note(w, name);
+}
+
+/* One cube map (and its mips) in the chosen layout: STEM.ktx, or per level
+ * STEM[_mL]_<face>.EXT (faces) / STEM[_mL].EXT (cross, equirect). */
+static bool put_cube(writer *w, const char *stem, const lx_cubemap *levels, int count,
+                     bool level_names)
+{
+    const ibl_args *a = w->a;
+    const char *ext = lx_image_format_extension(a->format);
+    char name[256];
+    if (a->layout == LAYOUT_KTX) {
+        snprintf(name, sizeof name, "%s.ktx", stem);
+        char *path = cli_stage_path(&w->stage, name);
+        if (!path)
+            return false;
+        lx_status s = lx_ktx_write_cubemap(path, levels, count, a->half);
+        free(path);
+        return cli_stage_finish(&w->stage, name, s) && note(w, name);
+    }
+    for (int l = 0; l < count; l++) {
+        char base[200];
+        if (level_names)
+            snprintf(base, sizeof base, "%s_m%d", stem, l);
+        else
+            snprintf(base, sizeof base, "%s", stem);
+        const lx_cubemap *c = &levels[l];
+        if (a->layout == LAYOUT_FACES) {
+            for (int f = 0; f < 6; f++) {
+                snprintf(name, sizeof name, "%s_%s.%s", base, lx_cube_face_name(f), ext);
+                lx_image face = lx_cubemap_face_image(c, f);
+                if (!put_image(w, name, &face))
+                    return false;
+            }
+            continue;
+        }
+        lx_image img;
+        lx_status s = a->layout == LAYOUT_EQUIRECT
+                          ? lx_cubemap_to_equirect(c, 4 * c->size, &img)
+                          : lx_cubemap_to_cross(c, a->layout == LAYOUT_VCROSS, &img);
+        if (s != LX_OK) {
+            cli_error("%s: %s", stem, lx_last_error());
+            return false;
+        }
+        snprintf(name, sizeof name, "%s.%s", base, ext);
+        bool ok = put_image(w, name, &img);
+        lx_image_free(&img);
+        if (!ok)
+            return false;
+    }
+    return true;
+}
+
+/* A JSON number with the fewest digits that read back as the same float. */
+static cJSON *float_number(float f)
+{
+    char buf[32];
+    for (int digits = 6; digits <= 9; digits++) {
+        snprintf(buf, sizeof buf, "%.*g", digits, (double)f);
+        if ((float)strtod(buf, NULL) == f)
+            break;
+    }
+    return cJSON_CreateNumber(strtod(buf, NULL));
+}
+
+static char *sh_json(const lx_sh9 *sh)
+{
+    cJSON *root = cJSON_CreateObject();
+    cJSON_AddNumberToObject(root, "order", 2);
+    cJSON *coeffs = cJSON_AddArrayToObject(root, "coefficients");
+    for (int i = 0; i < 9; i++) {
+        cJSON *rgb = cJSON_CreateArray();
+        for (int k = 0; k < 3; k++)
+            cJSON_AddItemToArray(rgb, float_number(sh->c[i][k]));
+        cJSON_AddItemToArray(coeffs, rgb);
+    }
+    cJSON *consts = cJSON_AddArrayToObject(root, "irradiance_constants");
+    for (int i = 0; i < 5; i++)
+        cJSON_AddItemToArray(consts, float_number(lx_sh_irradiance_constants[i]));
+    cJSON_AddStringToObject(
+        root, "convention",
+        "Ramamoorthi & Hanrahan 2001: radiance coefficients L_lm in nits, order L00, L1-1, L10, "
+        "L11, L2-2, L2-1, L20, L21, L22 with Y1-1 = 0.488603 y, Y10 = 0.488603 z, "
+        "Y11 = 0.488603 x in luxel's axes (right-handed, +Y up); irradiance in lux at unit "
+        "normal n is the paper's equation 13 with c1..c5 = irradiance_constants");
+    char *text = cJSON_Print(root);
+    cJSON_Delete(root);
+    return text;
+}
+
+/* ---- the command ----------------------------------------------------------- */
+
+static bool cancelled_or_failed(lx_status s, const char *what)
+{
+    if (s == LX_OK)
+        return false;
+    if (s == LX_ERR_CANCELLED)
+        cli_error("interrupted; nothing written");
+    else
+        cli_error("%s: %s", what, lx_last_error());
+    return true;
+}
+
+int cmd_ibl(int argc, char **argv)
+{
+    ibl_args a;
+    int rc = parse_args(argc, argv, &a);
+    if (rc != 0)
+        return rc < 0 ? EXIT_OK : rc;
+
+    int status = EXIT_FAILED;
+    lx_cubemap env = {0}, irr = {0};
+    lx_cubemap spec[LX_MAX_CUBE_MIPS];
+    memset(spec, 0, sizeof spec);
+    int spec_count = 0;
+    lx_sh9 sh;
+    lx_image lut = {0}, lut_rgb = {0};
+    writer w;
+    memset(&w, 0, sizeof w);
+    w.a = &a;
+    double t0 = cli_now();
+
+    /* the environment */
+    int loaded = cli_load_environment("ibl", a.env, a.intensity, a.size, &env);
+    if (loaded != EXIT_OK) {
+        status = loaded;
+        goto done;
+    }
+
+    /* the specular chain's size and levels */
+    int spec_size = a.size ? a.size : (env.size < 256 ? env.size : 256);
+    if (a.specular && a.mips > lx_cube_mip_count(spec_size)) {
+        status = cli_usage_error("ibl", "--mips %d: a specular cube of size %d has only %d levels",
+                                 a.mips, spec_size, lx_cube_mip_count(spec_size));
+        goto done;
+    }
+
+    cli_progress progress;
+    if (a.irradiance || a.sh) {
+        if (cancelled_or_failed(lx_sh_project(&env, &sh), a.env))
+            goto done;
+    }
+    if (a.irradiance) {
+        int irr_size = env.size < IRRADIANCE_SIZE ? env.size : IRRADIANCE_SIZE;
+        lx_status s;
+        if (a.irradiance_sh) {
+            s = lx_sh_irradiance_cube(&sh, irr_size, &irr);
+        } else {
+            cli_progress_init(&progress, "irradiance", a.quiet);
+            lx_ibl_desc d = {
+                .threads = a.threads, .progress = cli_progress_update, .progress_user = &progress};
+            s = lx_irradiance_brute(&env, irr_size, 0, &d, &irr);
+            cli_progress_finish(&progress);
+        }
+        if (cancelled_or_failed(s, a.env))
+            goto done;
+        if (a.seam_fix)
+            lx_cubemap_fix_seams(&irr);
+    }
+    if (a.specular) {
+        cli_progress_init(&progress, "specular", a.quiet);
+        lx_prefilter_desc d = {.filter = a.filter,
+                               .size = spec_size,
+                               .mips = a.mips,
+                               .samples = a.samples,
+                               .phong_exponents = a.phong_count ? a.phong : NULL,
+                               .threads = a.threads,
+                               .progress = cli_progress_update,
+                               .progress_user = &progress};
+        lx_status s = lx_prefilter(&env, &d, spec, &spec_count);
+        cli_progress_finish(&progress);
+        if (cancelled_or_failed(s, a.env))
+            goto done;
+        if (a.seam_fix)
+            for (int l = 0; l < spec_count; l++)
+                lx_cubemap_fix_seams(&spec[l]);
+    }
+    if (a.lut) {
+        if (cancelled_or_failed(lx_dfg_lut(LUT_SIZE, a.samples, &lut), "DFG table"))
+            goto done;
+        /* RG in an RGB image (B = 0): every format here stores RGB */
+        if (lx_image_alloc(&lut_rgb, lut.width, lut.height, 3) != LX_OK) {
+            cli_error("%s", lx_last_error());
+            goto done;
+        }
+        for (size_t i = 0; i < (size_t)lut.width * lut.height; i++) {
+            lut_rgb.data[3 * i] = lut.data[i * lut.channels];
+            lut_rgb.data[3 * i + 1] = lut.data[i * lut.channels + 1];
+        }
+    }
+    double t_compute = cli_now() - t0;
+    if (cli_interrupted()) {
+        cli_error("interrupted; nothing written");
+        goto done;
+    }
+
+    /* everything is computed: stage the files, then move them into place */
+    if (!cli_stage_begin(&w.stage, a.output))
+        goto done;
+    bool ok = true;
+    if (ok && a.irradiance)
+        ok = put_cube(&w, "irradiance", &irr, 1, false);
+    if (ok && a.sh) {
+        char *text = sh_json(&sh);
+        ok = text && cli_stage_text(&w.stage, "sh.json", text) && note(&w, "sh.json");
+        if (!text)
+            cli_error("out of memory");
+        free(text);
+    }
+    if (ok && a.specular)
+        ok = put_cube(&w, "specular", spec, spec_count, true);
+    if (ok && a.lut) {
+        char name[32];
+        snprintf(name, sizeof name, "dfg_lut.%s", lx_image_format_extension(a.format));
+        lx_image_write_desc wd = {.format = a.format, .half = a.half && a.format == LX_IMAGE_EXR};
+        ok = cli_stage_image(&w.stage, name, &lut_rgb, &wd) && note(&w, name);
+    }
+    if (ok && a.environment)
+        ok = put_cube(&w, "environment", &env, 1, false);
+    if (ok)
+        ok = cli_stage_publish(&w.stage);
+    cli_stage_clear(&w.stage);
+    cli_set_writing(false);
+    if (!ok)
+        goto done;
+    if (!a.quiet) {
+        fprintf(stderr, "luxel: %d file%s from a %d x %d environment in %.2f s\n", w.written_count,
+                w.written_count == 1 ? "" : "s", env.size, env.size, t_compute);
+        for (int i = 0; i < w.written_count; i++)
+            printf("%s/%s\n", a.output, w.written[i]);
+    }
+    status = EXIT_OK;
+done:
+    lx_cubemap_free(&env);
+    lx_cubemap_free(&irr);
+    for (int l = 0; l < LX_MAX_CUBE_MIPS; l++)
+        lx_cubemap_free(&spec[l]);
+    lx_image_free(&lut);
+    lx_image_free(&lut_rgb);
+    for (int i = 0; i < w.written_count; i++)
+        free(w.written[i]);
+    free(w.written);
+    return status;
+}
