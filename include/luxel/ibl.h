@@ -93,7 +93,8 @@ void lx_cubemap_free(lx_cubemap *c);
 /* The 3 floats of texel (x, y) on a face. */
 static inline float *lx_cubemap_texel(const lx_cubemap *c, int face, int x, int y)
 {
-    return c->data + (((size_t)face * (size_t)c->size + (size_t)y) * (size_t)c->size + (size_t)x) * 3;
+    return c->data +
+           (((size_t)face * (size_t)c->size + (size_t)y) * (size_t)c->size + (size_t)x) * 3;
 }
 
 /* A face as an image that borrows the cube map's memory (do not free). */
@@ -118,12 +119,12 @@ void lx_cubemap_fix_seams(lx_cubemap *c);
 /* ---- environments in and out ---------------------------------------- */
 
 typedef enum lx_env_layout {
-    LX_ENV_AUTO = 0,  /* from the shape: 2:1 equirect, 4:3 or 3:4 cross,
-                         a name ending in _px.<ext> for six faces */
+    LX_ENV_AUTO = 0, /* from the shape: 2:1 equirect, 4:3 or 3:4 cross,
+                        a name ending in _px.<ext> for six faces */
     LX_ENV_EQUIRECT,
-    LX_ENV_CROSS,     /* horizontal (4:3) or vertical (3:4) */
-    LX_ENV_FACES,     /* path names the +X face: <name>_px.<ext> */
-    LX_ENV_KTX        /* output only: one KTX 1.1 file */
+    LX_ENV_CROSS, /* horizontal (4:3) or vertical (3:4) */
+    LX_ENV_FACES, /* path names the +X face: <name>_px.<ext> */
+    LX_ENV_KTX    /* output only: one KTX 1.1 file */
 } lx_env_layout;
 
 typedef struct lx_env_load_desc {
@@ -137,6 +138,12 @@ typedef struct lx_env_load_desc {
  * wrong proportions, faces of unequal sizes, and NaN, infinite or negative
  * texels (the message gives their count). desc may be NULL. */
 lx_status lx_env_load(const char *path, const lx_env_load_desc *desc, lx_cubemap *out);
+
+/* The same for an image already in memory (1 to 4 channels; grey is
+ * grey, alpha ignored): an equirect or a cross, as desc->layout says or
+ * from its shape; name is used in messages. Six faces need files. */
+lx_status lx_env_from_image(const lx_image *img, const char *name, const lx_env_load_desc *desc,
+                            lx_cubemap *out);
 
 /* A constant environment of radiance L (nits) per channel. */
 lx_status lx_env_constant(lx_vec3 radiance, int size, lx_cubemap *out);
@@ -157,8 +164,8 @@ lx_status lx_ktx_write_cubemap(const char *path, const lx_cubemap *levels, int c
 /* ---- diffuse irradiance --------------------------------------------- */
 
 typedef struct lx_ibl_desc {
-    int threads;                 /* 0 = all cores */
-    lx_progress_fn progress;     /* may be NULL; returning false cancels */
+    int threads;             /* 0 = all cores */
+    lx_progress_fn progress; /* may be NULL; returning false cancels */
     void *progress_user;
 } lx_ibl_desc;
 
@@ -215,12 +222,12 @@ typedef enum lx_specular_filter { LX_SPECULAR_GGX = 0, LX_SPECULAR_PHONG } lx_sp
 
 typedef struct lx_prefilter_desc {
     lx_specular_filter filter;
-    int size;       /* level 0 face size, 0 = the source's (at most 256) */
-    int mips;       /* levels, 0 = down to 1x1; at most log2(size) + 1 */
-    int samples;    /* GGX importance samples per texel (1..65536), 0 = 256 */
+    int size;                     /* level 0 face size, 0 = the source's (at most 256) */
+    int mips;                     /* levels, 0 = down to 1x1; at most log2(size) + 1 */
+    int samples;                  /* GGX importance samples per texel (1..65536), 0 = 256 */
     const float *phong_exponents; /* PHONG: one per level, each in (0, 1e6];
                                      NULL = lx_phong_level_exponent */
-    int threads;    /* 0 = all cores */
+    int threads;                  /* 0 = all cores */
     lx_progress_fn progress;
     void *progress_user;
 } lx_prefilter_desc;

@@ -392,18 +392,17 @@ static lx_status resample_cube(const lx_cubemap *c, int size, lx_cubemap *out)
     return cube_by_grid(size, grid_for((double)c->size / (double)size), cube_lookup, c, out);
 }
 
-static lx_status load_image_layout(const char *path, lx_env_layout layout, int size,
-                                   lx_cubemap *out)
+/* An equirect or a cross image (layout AUTO, EQUIRECT or CROSS) as a cube
+ * map; name is for messages. */
+static lx_status image_layout(const lx_image *img, const char *path, lx_env_layout layout, int size,
+                              lx_cubemap *out)
 {
-    lx_image img;
-    lx_status st = load_rgb(path, &img);
-    if (st != LX_OK)
-        return st;
+    lx_status st = LX_OK;
     int cross_size;
     bool vertical;
-    bool is_cross = cross_shape(img.width, img.height, &cross_size, &vertical);
+    bool is_cross = cross_shape(img->width, img->height, &cross_size, &vertical);
     if (layout == LX_ENV_AUTO) {
-        if (img.width == 2 * img.height)
+        if (img->width == 2 * img->height)
             layout = LX_ENV_EQUIRECT;
         else if (is_cross)
             layout = LX_ENV_CROSS;
@@ -411,31 +410,36 @@ static lx_status load_image_layout(const char *path, lx_env_layout layout, int s
             st = lx_fail(LX_ERR_FORMAT,
                          "%s: cannot tell the layout of a %dx%d image: an equirect is 2:1, a "
                          "cross 4:3 or 3:4, six faces are named <name>_px.<ext> ...",
-                         path, img.width, img.height);
+                         path, img->width, img->height);
             goto done;
         }
     }
     if (layout == LX_ENV_EQUIRECT) {
-        if (img.width != 2 * img.height) {
+        if (img->width != 2 * img->height) {
             st = lx_fail(LX_ERR_FORMAT,
                          "%s: an equirect must be exactly twice as wide as it is tall, not %dx%d",
-                         path, img.width, img.height);
+                         path, img->width, img->height);
             goto done;
         }
-        st = check_image_values(&img, path);
+        st = check_image_values(img, path);
         if (st != LX_OK)
             goto done;
         if (size == 0)
-            size = img.width / 4 > 0 ? img.width / 4 : 1;
-        if (size > LX_MAX_CUBE_SIZE)
-            size = LX_MAX_CUBE_SIZE;
-        st = lx_cubemap_from_equirect(&img, size, out);
+            size = img->width / 4 > 0 ? img->width / 4 : 1;
+        if (size > LX_MAX_CUBE_SIZE) {
+            st = lx_fail(LX_ERR_INVALID,
+                         "%s: a %dx%d equirect makes %d x %d faces, more than %d; ask for a "
+                         "smaller size",
+                         path, img->width, img->height, size, size, LX_MAX_CUBE_SIZE);
+            goto done;
+        }
+        st = lx_cubemap_from_equirect(img, size, out);
     } else {
         if (!is_cross) {
             st = lx_fail(LX_ERR_FORMAT,
                          "%s: a cross must be 4:3 (horizontal) or 3:4 (vertical) with square "
                          "faces, not %dx%d",
-                         path, img.width, img.height);
+                         path, img->width, img->height);
             goto done;
         }
         if (cross_size > LX_MAX_CUBE_SIZE) {
@@ -443,54 +447,49 @@ static lx_status load_image_layout(const char *path, lx_env_layout layout, int s
                          LX_MAX_CUBE_SIZE);
             goto done;
         }
-        st = lx_cubemap_from_cross(&img, out);
+        st = lx_cubemap_from_cross(img, out);
         if (st == LX_OK)
             st = check_cube_values(out, path);
     }
     if (st != LX_OK && strncmp(lx_last_error(), path, strlen(path)) != 0)
         lx_error_prefix(path);
 done:
-    lx_image_free(&img);
     if (st != LX_OK)
         lx_cubemap_free(out);
     return st;
 }
 
-lx_status lx_env_load(const char *path, const lx_env_load_desc *desc, lx_cubemap *out)
+/* Checks desc (NULL: defaults) into *d and the intensity multiplier. */
+static lx_status check_desc(const char *name, const lx_env_load_desc *desc, lx_env_load_desc *d,
+                            float *intensity)
 {
-    if (out)
-        memset(out, 0, sizeof *out);
-    if (!path || !out)
-        return lx_fail(LX_ERR_INVALID, "lx_env_load: path and out must not be NULL");
-    lx_env_load_desc d = {0};
-    if (desc)
-        d = *desc;
-    float intensity = d.intensity == 0.0f ? 1.0f : d.intensity;
-    if (!isfinite(intensity) || intensity < 0.0f)
-        return lx_fail(LX_ERR_INVALID, "%s: intensity %g must be a finite number > 0", path,
-                       (double)d.intensity);
-    if (d.size < 0 || d.size > LX_MAX_CUBE_SIZE)
-        return lx_fail(LX_ERR_INVALID, "%s: cube size %d is outside 1..%d", path, d.size,
+    *d = desc ? *desc : (lx_env_load_desc){0};
+    *intensity = d->intensity == 0.0f ? 1.0f : d->intensity;
+    if (!isfinite(*intensity) || *intensity < 0.0f)
+        return lx_fail(LX_ERR_INVALID, "%s: intensity %g must be a finite number > 0", name,
+                       (double)d->intensity);
+    if (d->size < 0 || d->size > LX_MAX_CUBE_SIZE)
+        return lx_fail(LX_ERR_INVALID, "%s: cube size %d is outside 1..%d", name, d->size,
                        LX_MAX_CUBE_SIZE);
-    lx_env_layout layout = d.layout;
-    if (layout == LX_ENV_KTX)
+    if (d->layout == LX_ENV_KTX)
         return lx_fail(LX_ERR_UNSUPPORTED, "%s: KTX is an output layout; luxel does not read it",
-                       path);
-    if (layout < LX_ENV_AUTO || layout > LX_ENV_KTX)
-        return lx_fail(LX_ERR_INVALID, "%s: unknown layout %d", path, (int)layout);
-    if (layout == LX_ENV_AUTO && px_suffix(path) >= 0)
-        layout = LX_ENV_FACES;
+                       name);
+    if (d->layout < LX_ENV_AUTO || d->layout > LX_ENV_KTX)
+        return lx_fail(LX_ERR_INVALID, "%s: unknown layout %d", name, (int)d->layout);
+    return LX_OK;
+}
 
-    lx_status st = layout == LX_ENV_FACES ? load_faces(path, out)
-                                          : load_image_layout(path, layout, d.size, out);
-    if (st != LX_OK)
-        return st;
-    if (d.size != 0 && d.size != out->size) {
+/* The asked size and intensity applied to a loaded cube map. */
+static lx_status finish(const char *name, const lx_env_load_desc *d, float intensity,
+                        lx_cubemap *out)
+{
+    lx_status st;
+    if (d->size != 0 && d->size != out->size) {
         lx_cubemap resized;
-        st = resample_cube(out, d.size, &resized);
+        st = resample_cube(out, d->size, &resized);
         lx_cubemap_free(out);
         if (st != LX_OK) {
-            lx_error_prefix(path);
+            lx_error_prefix(name);
             return st;
         }
         *out = resized;
@@ -504,10 +503,52 @@ lx_status lx_env_load(const char *path, const lx_env_load_desc *desc, lx_cubemap
         if (overflow) {
             lx_cubemap_free(out);
             return lx_fail(LX_ERR_INVALID, "%s: intensity %g makes %zu values overflow to infinity",
-                           path, (double)intensity, overflow);
+                           name, (double)intensity, overflow);
         }
     }
     return LX_OK;
+}
+
+lx_status lx_env_load(const char *path, const lx_env_load_desc *desc, lx_cubemap *out)
+{
+    if (out)
+        memset(out, 0, sizeof *out);
+    if (!path || !out)
+        return lx_fail(LX_ERR_INVALID, "lx_env_load: path and out must not be NULL");
+    lx_env_load_desc d;
+    float intensity;
+    lx_status st = check_desc(path, desc, &d, &intensity);
+    if (st != LX_OK)
+        return st;
+    if (d.layout == LX_ENV_FACES || (d.layout == LX_ENV_AUTO && px_suffix(path) >= 0)) {
+        st = load_faces(path, out);
+    } else {
+        lx_image img;
+        if ((st = load_rgb(path, &img)) != LX_OK)
+            return st;
+        st = image_layout(&img, path, d.layout, d.size, out);
+        lx_image_free(&img);
+    }
+    return st == LX_OK ? finish(path, &d, intensity, out) : st;
+}
+
+lx_status lx_env_from_image(const lx_image *img, const char *name, const lx_env_load_desc *desc,
+                            lx_cubemap *out)
+{
+    if (out)
+        memset(out, 0, sizeof *out);
+    name = name ? name : "environment";
+    if (!out || !image_ok(img))
+        return lx_fail(LX_ERR_INVALID, "%s: no image, or an image without pixels", name);
+    lx_env_load_desc d;
+    float intensity;
+    lx_status st = check_desc(name, desc, &d, &intensity);
+    if (st != LX_OK)
+        return st;
+    if (d.layout == LX_ENV_FACES)
+        return lx_fail(LX_ERR_INVALID, "%s: six faces come from files (lx_env_load)", name);
+    st = image_layout(img, name, d.layout, d.size, out);
+    return st == LX_OK ? finish(name, &d, intensity, out) : st;
 }
 
 lx_status lx_env_constant(lx_vec3 radiance, int size, lx_cubemap *out)
