@@ -262,10 +262,11 @@ static lx_status check_values(const float *data, size_t count, int stride, int w
 {
     size_t nonfinite = 0, negative = 0, first = 0;
     bool found = false;
+    int colours = stride < 3 ? stride : 3; /* grey, or RGB without alpha */
     for (size_t i = 0; i < count; i++) {
         const float *p = data + i * (size_t)stride;
         bool bad_nf = false, bad_neg = false;
-        for (int k = 0; k < 3; k++) {
+        for (int k = 0; k < colours; k++) {
             if (!isfinite(p[k]))
                 bad_nf = true;
             else if (p[k] < 0.0f)

@@ -92,6 +92,11 @@ static void bad_images(void **state)
     img.data[20] = -1.0f;
     expect_error(&img, NULL, "NaN");
     lx_image_free(&img);
+    /* grey: one value per pixel is all that is read */
+    assert_int_equal(lx_image_alloc(&img, 8, 4, 1), LX_OK);
+    img.data[31] = INFINITY;
+    expect_error(&img, NULL, "1 texel is NaN or infinite (the first at pixel (7, 3))");
+    lx_image_free(&img);
     lx_cubemap c;
     assert_int_equal(lx_env_from_image(NULL, "none", NULL, &c), LX_ERR_INVALID);
 }
