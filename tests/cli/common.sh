@@ -126,12 +126,21 @@ expect_stdout_has() {
     fi
 }
 
-# expect_no_output DESCRIPTION DIR: DIR is missing or empty.
+# expect_no_output DESCRIPTION DIR [existed]: DIR is missing; when the test
+# made it beforehand ("existed"), it is there and empty.
 expect_no_output() {
     if [ ! -e "$2" ]; then
-        pass "$1: no output folder"
+        if [ -n "${3:-}" ]; then
+            fail "$1: the output folder that was there is gone"
+        else
+            pass "$1: no output folder"
+        fi
     elif [ -d "$2" ] && [ -z "$(ls -A "$2")" ]; then
-        pass "$1: output folder left empty"
+        if [ -n "${3:-}" ]; then
+            pass "$1: output folder left empty"
+        else
+            fail "$1: an empty output folder $2 was left behind"
+        fi
     else
         fail "$1: files left in $2" "$(ls -A "$2" | tr '\n' ' ')"
     fi

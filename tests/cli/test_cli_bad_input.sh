@@ -24,7 +24,7 @@ cd "$WORK/cwd" || exit 1 # the default output folder (./lightmaps) would land he
 CASE=0
 # bad LABEL STATUS "NEEDLE|NEEDLE..." ARGS...: `luxel ARGS -o DIR` must exit
 # with STATUS, print one error line holding every needle and leave DIR
-# missing or empty.
+# missing (or empty when PRECREATE made it first).
 bad() {
     local label=$1 status=$2 needles=$3
     shift 3
@@ -36,7 +36,7 @@ bad() {
     local list=()
     IFS='|' read -ra list <<<"$needles"
     expect_error "$label" "${list[@]}"
-    expect_no_output "$label" "$out"
+    expect_no_output "$label" "$out" ${PRECREATE:+existed}
 }
 
 # bad_info LABEL "NEEDLE|..." SCENE: `luxel info` fails with status 1, one

@@ -52,7 +52,7 @@ all_near() { # all_near WANT TOL < values
 CASE=0
 # bad LABEL STATUS "NEEDLE|NEEDLE..." ARGS...: `luxel ibl ARGS -o DIR` must
 # exit with STATUS, print one error line holding every needle and leave DIR
-# missing or empty.
+# missing.
 bad() {
     local label=$1 status=$2 needles=$3
     shift 3

@@ -2,7 +2,7 @@
 # error or Ctrl-C never leaves a partial or corrupt file"): SIGINT while the
 # lightmaps are computed, SIGINT and SIGTERM while the files are written.
 # Each interrupted run must exit non-zero, say so on stderr, and leave the
-# output folder missing or empty (no finished files, no temporary files).
+# output folder missing (no finished files, no temporary files, no folder).
 #
 # usage: bash test_cli_interrupt.sh LUXEL GEN_SCENES WORKDIR
 set -u

@@ -56,8 +56,10 @@ void cli_track_output(const char *path);
 void cli_remove_tracked_outputs(void);
 /* Stops tracking outputs without removing them (they were published). */
 void cli_forget_outputs(void);
-/* A folder an interrupt removes after the tracked files (NULL: none). */
-void cli_track_dir(const char *dir);
+/* Folders an interrupt removes after the tracked files, if empty: the
+ * staging folder, then the output folder when this run created it (NULL:
+ * none). */
+void cli_track_dir(const char *dir, const char *created_parent);
 void cli_set_writing(bool writing);
 
 /* Monotonic seconds. */
@@ -78,6 +80,7 @@ typedef struct cli_stage {
     char *dir;    /* OUTPUT/.luxel- and six random characters (mkdtemp) */
     char **names; /* files written into it */
     uint32_t count;
+    bool created; /* the output folder is this run's and nothing is published yet */
 } cli_stage;
 
 /* Creates dir and its parents. */

@@ -111,7 +111,7 @@ static volatile sig_atomic_t interrupted;
 static volatile sig_atomic_t writing;
 static char *tracked[MAX_TRACKED];
 static volatile sig_atomic_t tracked_count;
-static char *tracked_dir;
+static char *tracked_dir, *tracked_parent;
 
 static void on_signal(int sig)
 {
@@ -122,6 +122,8 @@ static void on_signal(int sig)
             unlink(tracked[i]);
         if (tracked_dir)
             rmdir(tracked_dir);
+        if (tracked_parent)
+            rmdir(tracked_parent);
         static const char msg[] = "\nluxel: error: interrupted; outputs removed\n";
         ssize_t unused = write(2, msg, sizeof msg - 1);
         (void)unused;
@@ -168,10 +170,12 @@ void cli_forget_outputs(void)
     tracked_count = 0;
 }
 
-void cli_track_dir(const char *dir)
+void cli_track_dir(const char *dir, const char *created_parent)
 {
     free(tracked_dir);
+    free(tracked_parent);
     tracked_dir = dir ? lx_strdup(dir) : NULL;
+    tracked_parent = created_parent ? lx_strdup(created_parent) : NULL;
 }
 
 void cli_set_writing(bool w)

@@ -50,6 +50,8 @@ static char *make_staging(const char *output)
 bool cli_stage_begin(cli_stage *st, const char *output)
 {
     memset(st, 0, sizeof *st);
+    struct stat sb;
+    bool existed = stat(output, &sb) == 0;
     if (!cli_make_dirs(output)) {
         cli_error("%s: cannot create the output folder: %s", output, strerror(errno));
         return false;
@@ -68,7 +70,9 @@ bool cli_stage_begin(cli_stage *st, const char *output)
         st->output = NULL;
         return false;
     }
-    cli_track_dir(st->dir);
+    /* a folder this run made goes again if the run writes nothing */
+    st->created = !existed;
+    cli_track_dir(st->dir, st->created ? output : NULL);
     return true;
 }
 
@@ -191,6 +195,7 @@ bool cli_stage_publish(cli_stage *st)
         /* the run is complete: a signal held off until now must not undo it */
         cli_forget_outputs();
         cli_set_writing(false);
+        st->created = false;
     }
     sigprocmask(SIG_SETMASK, &old, NULL);
     return ok;
@@ -201,7 +206,9 @@ void cli_stage_clear(cli_stage *st)
     cli_remove_tracked_outputs();
     if (st->dir)
         rmdir(st->dir);
-    cli_track_dir(NULL);
+    if (st->created && st->output)
+        rmdir(st->output);
+    cli_track_dir(NULL, NULL);
     for (uint32_t i = 0; i < st->count; i++)
         free(st->names[i]);
     free(st->names);
