@@ -1,6 +1,6 @@
 /* libFuzzer harness for luxel's own environment code (src/ibl/envmap.c):
- * an image decoded from the input (PFM or Radiance HDR, picked by the first
- * byte) goes through layout detection, the equirect and cross conversions
+ * an image decoded from the input after its first byte (PFM or Radiance
+ * HDR, picked by that byte with the options) goes through layout detection, the equirect and cross conversions
  * and the texel checks of lx_env_from_image, at a small cube size so each
  * run stays fast. The decoders themselves are fuzzed by fuzz_image.c.
  *
@@ -19,11 +19,12 @@ const char *__asan_default_options(void)
 int LLVMFuzzerTestOneInput(const uint8_t *data, size_t size);
 int LLVMFuzzerTestOneInput(const uint8_t *data, size_t size)
 {
-    if (size < 1)
+    if (size < 2)
         return 0;
+    /* the first byte picks the decoder and the options; the rest is the file */
     const char *name = data[0] & 1 ? "f.hdr" : "f.pfm";
     lx_image img;
-    if (lx_image_load_memory(data, size, name, NULL, &img) != LX_OK)
+    if (lx_image_load_memory(data + 1, size - 1, name, NULL, &img) != LX_OK)
         return 0;
     /* layout from the shape, or forced; a small size bounds the work */
     lx_env_load_desc d = {.layout = (lx_env_layout)(data[0] >> 1) % 3,
