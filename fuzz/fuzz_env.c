@@ -1,8 +1,9 @@
 /* libFuzzer harness for luxel's own environment code (src/ibl/envmap.c):
  * an image decoded from the input after its first byte (PFM or Radiance
- * HDR, picked by that byte with the options) goes through layout detection, the equirect and cross conversions
- * and the texel checks of lx_env_from_image, at a small cube size so each
- * run stays fast. The decoders themselves are fuzzed by fuzz_image.c.
+ * HDR, picked by that byte with the options) goes through layout
+ * detection, the equirect and cross conversions and the texel checks of
+ * lx_env_from_image, at a small cube size so each run stays fast. The
+ * decoders themselves are fuzzed by fuzz_image.c.
  *
  *   make fuzz   (or: clang -fsanitize=fuzzer,address ... ; ./fuzz_env corpus/) */
 #include "luxel/ibl.h"
