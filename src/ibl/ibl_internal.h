@@ -1,7 +1,9 @@
 /* Private to src/ibl: the face table (cubemap.c) and, for the filters
- * (mips.c, irradiance.c, sh.c, prefilter*.c, dfg.c), exact texel solid-angle tables, argument checks, the progress and
- * cancel bookkeeping of the tiled OpenMP loops, the source mip chain, a
- * bilinear cube sampler and Hammersley points. */
+ * (mips.c, irradiance.c, sh.c, prefilter*.c, dfg.c), exact texel
+ * solid-angle tables, argument checks, the progress and cancel bookkeeping
+ * of the tiled OpenMP loops, the source mip chain, a bilinear cube sampler
+ * and Hammersley points; the specular levels' plans (direct convolution
+ * with a lobe, GGX importance sampling). */
 #ifndef LX_IBL_INTERNAL_H
 #define LX_IBL_INTERNAL_H
 
@@ -160,26 +162,52 @@ static inline void lx_ibl_frame(lx_vec3 n, lx_vec3 *t, lx_vec3 *b)
 
 /* ---- specular prefiltering (prefilter.c drives, one file per lobe) ---- */
 
-/* The work of one level of lx_prefilter: tile() fills texels
- * [x0,x1) x [y0,y1) of one face of out; cost is the work per texel (for
- * progress and nothing else). */
+/* A lobe w(r.l) of the angle between the output direction r and the light
+ * direction l, for the direct convolution of prefilter_conv.c. */
+typedef enum lx_lobe_kind { LX_LOBE_PHONG, LX_LOBE_GGX } lx_lobe_kind;
+
+typedef struct lx_lobe {
+    lx_lobe_kind kind;
+    float param;       /* PHONG: the exponent n; GGX: alpha^2 */
+    float cos_cut;     /* r.l below it is left out (PHONG: each light; GGX: whole nodes) */
+    double half_width; /* angle (radians) where the lobe falls to half its peak */
+    double texels;     /* the source mip's mean texel angle is at most half_width / texels */
+    double far;        /* 0, or: a node at least far x its radius away from r is one light */
+} lx_lobe;
+
+/* Phong's pow(max(0, r.l), n) (prefilter_phong.c). */
+lx_lobe lx_phong_lobe(float exponent);
+/* GGX's D(h) (n.l) with N = V = R (prefilter_ggx.c). */
+lx_lobe lx_ggx_lobe(float roughness);
+
+/* The work of one level of lx_prefilter by direct convolution with a
+ * lobe: lx_conv_tile fills texels [x0,x1) x [y0,y1) of one face of out
+ * (returns false when out of memory). out_size: the face size of the level
+ * it fills (bounds the tile test). The cost is the nodes and lights a
+ * texel tests, measured on the tree before the lights are made: above
+ * max_cost the build stops there and *out is NULL (with LX_OK). */
+typedef struct lx_conv_plan lx_conv_plan;
+lx_status lx_conv_plan_build(const lx_ibl_chain *chain, const lx_lobe *lobe, int out_size,
+                             double max_cost, lx_conv_plan **out);
+double lx_conv_plan_cost(const lx_conv_plan *p);
+bool lx_conv_tile(const lx_conv_plan *p, lx_cubemap *out, int face, int x0, int y0, int x1, int y1);
+void lx_conv_plan_free(lx_conv_plan *p);
+
+/* GGX by importance sampling (prefilter_ggx.c): lx_ggx_tile fills a tile
+ * like lx_conv_tile; pads: the chain's levels, padded (lx_ibl_pad). The
+ * cost is the samples per texel. */
 typedef struct lx_ggx_plan lx_ggx_plan;
 lx_status lx_ggx_plan_build(const lx_ibl_chain *chain, float roughness, int samples,
                             lx_ggx_plan **out);
 double lx_ggx_plan_cost(const lx_ggx_plan *p);
-/* pads: the chain's levels, padded (lx_ibl_pad). */
 void lx_ggx_tile(const lx_ggx_plan *p, const lx_ibl_padded *pads, lx_cubemap *out, int face, int x0,
                  int y0, int x1, int y1);
 void lx_ggx_plan_free(lx_ggx_plan *p);
 
-typedef struct lx_phong_plan lx_phong_plan;
-/* out_size: the face size of the level it fills (bounds the tile test). */
-lx_status lx_phong_plan_build(const lx_ibl_chain *chain, float exponent, int out_size,
-                              lx_phong_plan **out);
-double lx_phong_plan_cost(const lx_phong_plan *p);
-/* Returns false when out of memory. */
-bool lx_phong_tile(const lx_phong_plan *p, lx_cubemap *out, int face, int x0, int y0, int x1,
-                   int y1);
-void lx_phong_plan_free(lx_phong_plan *p);
+/* One GGX level: a direct convolution (*conv) where it costs at most what
+ * samples importance samples per texel do, else importance sampling
+ * (*is); the other is NULL. *cost: per texel, in importance samples. */
+lx_status lx_ggx_level_build(const lx_ibl_chain *chain, float roughness, int samples, int out_size,
+                             lx_conv_plan **conv, lx_ggx_plan **is, double *cost);
 
 #endif

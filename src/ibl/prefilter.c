@@ -1,8 +1,11 @@
 /* lx_prefilter: the specular mip chain of an environment, one level per
- * roughness (GGX, prefilter_ggx.c) or Phong exponent (prefilter_phong.c).
- * Builds the source's solid-angle weighted mip chain once, then fills every
- * tile of every level in one OpenMP loop; each texel is computed alone from
- * read-only inputs, so the output is the same for any thread count. */
+ * roughness (GGX, prefilter_ggx.c: a direct convolution, or importance
+ * sampling where that costs less) or Phong exponent (prefilter_phong.c),
+ * the direct convolutions by prefilter_conv.c. Builds the source's
+ * solid-angle weighted mip chain and every level's plan once, then fills
+ * every tile of every level in one OpenMP loop; each texel is computed
+ * alone from read-only inputs, so the output is the same for any thread
+ * count. */
 #include "ibl_internal.h"
 
 #include <math.h>
@@ -128,11 +131,9 @@ lx_status lx_prefilter(const lx_cubemap *src, const lx_prefilter_desc *in,
     if ((st = lx_ibl_chain_build(src, 1, threads, &chain)) != LX_OK)
         return st;
     lx_ibl_padded pads[LX_MAX_CUBE_MIPS + 1] = {{0}};
-    if (d.filter == LX_SPECULAR_GGX && mips > 1)
-        for (int i = 0; i < chain.count && st == LX_OK; i++)
-            st = lx_ibl_pad(&chain.level[i], &pads[i]);
     lx_ggx_plan *ggx[LX_MAX_CUBE_MIPS] = {0};
-    lx_phong_plan *phong[LX_MAX_CUBE_MIPS] = {0};
+    lx_conv_plan *conv[LX_MAX_CUBE_MIPS] = {0};
+    bool sampled = false;
     const lx_cubemap *mirror = NULL;
     bool mirror_exact = false;
     double cost[LX_MAX_CUBE_MIPS];
@@ -143,20 +144,26 @@ lx_status lx_prefilter(const lx_cubemap *src, const lx_prefilter_desc *in,
         st = lx_cubemap_alloc(&levels[l], size);
         if (st != LX_OK)
             break;
+        cost[l] = 1.0;
         if (d.filter == LX_SPECULAR_PHONG) {
             float e = d.phong_exponents ? d.phong_exponents[l] : lx_phong_level_exponent(l);
-            st = lx_phong_plan_build(&chain, e, size, &phong[l]);
-            cost[l] = st == LX_OK ? lx_phong_plan_cost(phong[l]) : 0.0;
+            lx_lobe lobe = lx_phong_lobe(e);
+            st = lx_conv_plan_build(&chain, &lobe, size, HUGE_VAL, &conv[l]);
+            if (st == LX_OK)
+                cost[l] = lx_conv_plan_cost(conv[l]);
         } else if (l == 0) {
             mirror = mirror_source(&chain, size, &mirror_exact);
-            cost[l] = 1.0;
         } else {
-            st = lx_ggx_plan_build(&chain, lx_ggx_level_roughness(l, mips), d.samples, &ggx[l]);
-            cost[l] = st == LX_OK ? lx_ggx_plan_cost(ggx[l]) : 0.0;
+            st = lx_ggx_level_build(&chain, lx_ggx_level_roughness(l, mips), d.samples, size,
+                                    &conv[l], &ggx[l], &cost[l]);
+            sampled = sampled || ggx[l];
         }
         int side = (size + LX_IBL_TILE - 1) / LX_IBL_TILE;
         ntiles += 6 * side * side;
     }
+    /* importance samples read the chain's levels through a border */
+    for (int i = 0; sampled && i < chain.count && st == LX_OK; i++)
+        st = lx_ibl_pad(&chain.level[i], &pads[i]);
     if (st == LX_OK && !(tiles = malloc(sizeof(tile) * (size_t)ntiles)))
         st = lx_fail(LX_ERR_NOMEM, "out of memory");
     double total = 0.0;
@@ -187,10 +194,10 @@ lx_status lx_prefilter(const lx_cubemap *src, const lx_prefilter_desc *in,
                 continue;
             const tile *t = &tiles[i];
             lx_cubemap *out = &levels[t->level];
-            if (d.filter == LX_SPECULAR_PHONG) {
-                if (!lx_phong_tile(phong[t->level], out, t->face, t->x0, t->y0, t->x1, t->y1))
+            if (conv[t->level]) {
+                if (!lx_conv_tile(conv[t->level], out, t->face, t->x0, t->y0, t->x1, t->y1))
                     nomem = 1;
-            } else if (t->level == 0) {
+            } else if (!ggx[t->level]) {
                 mirror_tile(mirror, mirror_exact, out, t->face, t->x0, t->y0, t->x1, t->y1);
             } else {
                 lx_ggx_tile(ggx[t->level], pads, out, t->face, t->x0, t->y0, t->x1, t->y1);
@@ -206,7 +213,7 @@ lx_status lx_prefilter(const lx_cubemap *src, const lx_prefilter_desc *in,
     free(tiles);
     for (int l = 0; l < mips; l++) {
         lx_ggx_plan_free(ggx[l]);
-        lx_phong_plan_free(phong[l]);
+        lx_conv_plan_free(conv[l]);
     }
     for (int i = 0; i < chain.count; i++)
         lx_ibl_padded_free(&pads[i]);

@@ -14,6 +14,7 @@
 
 #include <cmocka.h>
 
+#include "cube_reference.h"
 #include "helpers.h"
 
 #include <math.h>
@@ -22,30 +23,17 @@
 
 #define PI_D 3.14159265358979323846
 
-/* A cube map whose every texel centre holds f(direction). */
-static lx_cubemap make_env(int size, double (*f)(lx_vec3))
+/* Environments for lx_test_make_env (cube_reference.h), grey. */
+static void constant_env(double x, double y, double z, float out[3])
 {
-    lx_cubemap c;
-    assert_int_equal(lx_cubemap_alloc(&c, size), LX_OK);
-    for (int face = 0; face < 6; face++)
-        for (int y = 0; y < size; y++)
-            for (int x = 0; x < size; x++) {
-                lx_vec3 d = lx_cube_direction(face, (x + 0.5f) / size, (y + 0.5f) / size);
-                float *t = lx_cubemap_texel(&c, face, x, y);
-                t[0] = t[1] = t[2] = (float)f(d);
-            }
-    return c;
+    (void)x, (void)y, (void)z;
+    out[0] = out[1] = out[2] = 2.0f;
 }
 
-static double constant_env(lx_vec3 d)
+static void linear_env(double x, double y, double z, float out[3])
 {
-    (void)d;
-    return 2.0;
-}
-
-static double linear_env(lx_vec3 d)
-{
-    return 1.0 + d.y;
+    (void)x, (void)z;
+    out[0] = out[1] = out[2] = (float)(1.0 + y);
 }
 
 /* Bakes an 8x8 map of a 1 m floor (node 0; facing down when `down`) with
@@ -91,7 +79,7 @@ static void check_all(const lx_image *img, double want, double rel_tol, const ch
 static void constant_sky_is_pi_l(void **state)
 {
     (void)state;
-    lx_cubemap env = make_env(16, constant_env);
+    lx_cubemap env = lx_test_make_env(16, constant_env);
     for (int shadows = 0; shadows <= 1; shadows++) {
         lx_image img;
         lx_baker *b = bake_sky(&env, shadows, 16, false, NULL, 0, 2, &img);
@@ -105,7 +93,7 @@ static void constant_sky_is_pi_l(void **state)
 static void linear_sky_matches_cosine_integrals(void **state)
 {
     (void)state;
-    lx_cubemap env = make_env(32, linear_env);
+    lx_cubemap env = lx_test_make_env(32, linear_env);
     /* up: int (1 + cos t) cos t dw = pi + 2 pi / 3; down: pi - 2 pi / 3 */
     const double up = PI_D + 2.0 * PI_D / 3.0, down = PI_D - 2.0 * PI_D / 3.0;
     lx_image img;
@@ -128,7 +116,7 @@ static void linear_sky_matches_cosine_integrals(void **state)
 static void roof_takes_its_form_factor(void **state)
 {
     (void)state;
-    lx_cubemap env = make_env(16, constant_env);
+    lx_cubemap env = lx_test_make_env(16, constant_env);
     /* a 1 m roof 0.5 m above the floor's centre */
     lx_mesh roof = lx_test_plane("roof", 1.0f, 0.5f, 0.0f, 0.0f, 1);
     lx_image img;
@@ -163,7 +151,7 @@ static void roof_takes_its_form_factor(void **state)
  * part is left, pi 100 - (the roof's form factor as a rect light of 100). */
 static lx_cubemap sun_env(int *sun_x, int *sun_y)
 {
-    lx_cubemap env = make_env(16, constant_env);
+    lx_cubemap env = lx_test_make_env(16, constant_env);
     for (size_t i = 0; i < (size_t)6 * 16 * 16 * 3; i++)
         env.data[i] = 100.0f;
     *sun_x = 9;
@@ -210,7 +198,7 @@ static void sun_texel_lights_like_a_directional_light(void **state)
 static void closed_box_is_dark(void **state)
 {
     (void)state;
-    lx_cubemap env = make_env(8, constant_env);
+    lx_cubemap env = lx_test_make_env(8, constant_env);
     lx_mesh box = lx_test_box("box", lx_v3(-2, -1, -2), lx_v3(2, 2, 2), true);
     lx_image img;
     lx_baker *b = bake_sky(&env, true, 64, false, &box, 1, 2, &img);
@@ -225,7 +213,7 @@ static void closed_box_is_dark(void **state)
 static void same_bytes_for_any_thread_count(void **state)
 {
     (void)state;
-    lx_cubemap env = make_env(16, linear_env);
+    lx_cubemap env = lx_test_make_env(16, linear_env);
     lx_mesh roof = lx_test_plane("roof", 0.6f, 0.4f, 0.2f, 0.1f, 1);
     lx_image one, three;
     lx_baker *a = bake_sky(&env, true, 37, false, &roof, 1, 1, &one);
@@ -242,7 +230,7 @@ static void same_bytes_for_any_thread_count(void **state)
 static void bad_sky_settings(void **state)
 {
     (void)state;
-    lx_cubemap env = make_env(4, constant_env);
+    lx_cubemap env = lx_test_make_env(4, constant_env);
     lx_scene *scene = lx_test_new_scene("sky");
     lx_mesh floor = lx_test_plane("floor", 1.0f, 0.0f, 0.0f, 0.0f, 1);
     lx_test_add(scene, &floor);

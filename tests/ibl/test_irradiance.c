@@ -16,35 +16,11 @@
 #include <stdlib.h>
 #include <string.h>
 
+#include "cube_reference.h"
 #include "helpers.h"
 #include "luxel/ibl.h"
 
 #define PI_D 3.14159265358979323846
-
-/* ibl.h's face table, written out again (not normalised). */
-static void face_vec(int face, double sc, double tc, double v[3])
-{
-    switch (face) {
-    case 0:
-        v[0] = 1, v[1] = -tc, v[2] = -sc;
-        break;
-    case 1:
-        v[0] = -1, v[1] = -tc, v[2] = sc;
-        break;
-    case 2:
-        v[0] = sc, v[1] = 1, v[2] = tc;
-        break;
-    case 3:
-        v[0] = sc, v[1] = -1, v[2] = -tc;
-        break;
-    case 4:
-        v[0] = sc, v[1] = -tc, v[2] = 1;
-        break;
-    default:
-        v[0] = -sc, v[1] = -tc, v[2] = -1;
-        break;
-    }
-}
 
 static lx_cubemap constant_env(int size, float r, float g, float b)
 {
@@ -89,7 +65,7 @@ static double texel_cosine_integral(int face, int n, int x, int y, const double 
         for (int i = 0; i < m; i++) {
             double a = -1.0 + 2.0 * x / n + (i + 0.5) * h, b = -1.0 + 2.0 * y / n + (j + 0.5) * h;
             double v[3];
-            face_vec(face, a, b, v);
+            lx_test_face_vec(face, a, b, v);
             double len2 = 1.0 + a * a + b * b, len = sqrt(len2);
             double c = (nrm[0] * v[0] + nrm[1] * v[1] + nrm[2] * v[2]) / len;
             if (c > 0.0)
@@ -109,10 +85,7 @@ static void single_texel_follows_cosine_law(void **state)
     assert_int_equal(lx_irradiance_brute(&env, out_size, n, NULL, &irr), LX_OK);
 
     double c[3];
-    face_vec(face, 2.0 * (tx + 0.5) / n - 1.0, 2.0 * (ty + 0.5) / n - 1.0, c);
-    double cl = sqrt(c[0] * c[0] + c[1] * c[1] + c[2] * c[2]);
-    for (int k = 0; k < 3; k++)
-        c[k] /= cl;
+    lx_test_texel_dir(face, n, tx, ty, c);
     const double up[3] = {c[0], c[1], c[2]};
     double peak = L * texel_cosine_integral(face, n, tx, ty, up, 64);
     int lit = 0;
@@ -120,10 +93,7 @@ static void single_texel_follows_cosine_law(void **state)
         for (int y = 0; y < out_size; y++)
             for (int x = 0; x < out_size; x++) {
                 double nv[3];
-                face_vec(f, 2.0 * (x + 0.5) / out_size - 1.0, 2.0 * (y + 0.5) / out_size - 1.0, nv);
-                double l = sqrt(nv[0] * nv[0] + nv[1] * nv[1] + nv[2] * nv[2]);
-                for (int k = 0; k < 3; k++)
-                    nv[k] /= l;
+                lx_test_texel_dir(f, out_size, x, y, nv);
                 double want = L * texel_cosine_integral(face, n, tx, ty, nv, 64);
                 const float *e = lx_cubemap_texel(&irr, f, x, y);
                 if (fabs(e[1] - want) > 1e-3 * peak)

@@ -17,57 +17,11 @@
 #include <stdlib.h>
 #include <string.h>
 
+#include "cube_reference.h"
 #include "helpers.h"
 #include "luxel/ibl.h"
 
 #define PI_D 3.14159265358979323846
-
-typedef void (*env_fn)(double x, double y, double z, float out[3]);
-
-/* ibl.h's face table, written out again: the unit direction of face
- * coordinates sc, tc in [-1, 1]. */
-static void face_dir(int face, double sc, double tc, double d[3])
-{
-    double v[3];
-    switch (face) {
-    case 0:
-        v[0] = 1, v[1] = -tc, v[2] = -sc;
-        break;
-    case 1:
-        v[0] = -1, v[1] = -tc, v[2] = sc;
-        break;
-    case 2:
-        v[0] = sc, v[1] = 1, v[2] = tc;
-        break;
-    case 3:
-        v[0] = sc, v[1] = -1, v[2] = -tc;
-        break;
-    case 4:
-        v[0] = sc, v[1] = -tc, v[2] = 1;
-        break;
-    default:
-        v[0] = -sc, v[1] = -tc, v[2] = -1;
-        break;
-    }
-    double n = sqrt(v[0] * v[0] + v[1] * v[1] + v[2] * v[2]);
-    for (int k = 0; k < 3; k++)
-        d[k] = v[k] / n;
-}
-
-/* A cube map whose texels hold fn at their centres. */
-static lx_cubemap make_env(int size, env_fn fn)
-{
-    lx_cubemap c;
-    assert_int_equal(lx_cubemap_alloc(&c, size), LX_OK);
-    for (int f = 0; f < 6; f++)
-        for (int y = 0; y < size; y++)
-            for (int x = 0; x < size; x++) {
-                double d[3];
-                face_dir(f, 2.0 * (x + 0.5) / size - 1.0, 2.0 * (y + 0.5) / size - 1.0, d);
-                fn(d[0], d[1], d[2], lx_cubemap_texel(&c, f, x, y));
-            }
-    return c;
-}
 
 /* A set of unit directions spread over the sphere (golden spiral). */
 static lx_vec3 spiral(int i, int n)
@@ -96,7 +50,7 @@ static void env_poly(double x, double y, double z, float out[3])
 static void constant_environment_gives_pi_l(void **state)
 {
     (void)state;
-    lx_cubemap env = make_env(16, env_constant);
+    lx_cubemap env = lx_test_make_env(16, env_constant);
     lx_sh9 sh;
     assert_int_equal(lx_sh_project(&env, &sh), LX_OK);
     const double L[3] = {0.5, 1.0, 2.0};
@@ -134,7 +88,7 @@ static void polynomial_environment_coefficients(void **state)
     want[2][2] = 0.5 * 0.488603 * m2;
     want[7][2] = 1.092548 * m22;
 
-    lx_cubemap env = make_env(64, env_poly);
+    lx_cubemap env = lx_test_make_env(64, env_poly);
     lx_sh9 sh;
     assert_int_equal(lx_sh_project(&env, &sh), LX_OK);
     for (int k = 0; k < 9; k++)
@@ -153,7 +107,7 @@ static void polynomial_environment_coefficients(void **state)
 static void band_limited_irradiance_closed_form(void **state)
 {
     (void)state;
-    lx_cubemap env = make_env(64, env_poly);
+    lx_cubemap env = lx_test_make_env(64, env_poly);
     lx_sh9 sh;
     assert_int_equal(lx_sh_project(&env, &sh), LX_OK);
     for (int i = 0; i < 300; i++) {
@@ -183,7 +137,7 @@ static void basis_is_orthonormal(void **state)
             for (int x = 0; x < n; x++) {
                 double a = 2.0 * (x + 0.5) / n - 1.0, b = 2.0 * (y + 0.5) / n - 1.0, d[3];
                 double w = (2.0 / n) * (2.0 / n) / pow(1.0 + a * a + b * b, 1.5);
-                face_dir(f, a, b, d);
+                lx_test_face_dir(f, a, b, d);
                 float yv[9];
                 lx_sh9_basis(lx_v3((float)d[0], (float)d[1], (float)d[2]), yv);
                 for (int i = 0; i < 9; i++)
@@ -218,7 +172,7 @@ static void env_smooth(double x, double y, double z, float out[3])
 static void reconstruction_matches_brute_force(void **state)
 {
     (void)state;
-    lx_cubemap env = make_env(32, env_smooth), brute;
+    lx_cubemap env = lx_test_make_env(32, env_smooth), brute;
     lx_sh9 sh;
     assert_int_equal(lx_sh_project(&env, &sh), LX_OK);
     assert_int_equal(lx_irradiance_brute(&env, 8, 32, NULL, &brute), LX_OK);
@@ -283,15 +237,8 @@ static void ringing_is_kept_and_reported(void **state)
         double want = 0.0;
         for (int k = 0; k < 4; k++) {
             int x = 3 + k % 2, y = 3 + k / 2;
-            double c[3], w = 0.0;
-            face_dir(LX_FACE_PY, 2.0 * (x + 0.5) / n - 1.0, 2.0 * (y + 0.5) / n - 1.0, c);
-            /* the texel's solid angle by a midpoint rule */
-            for (int j = 0; j < 16; j++)
-                for (int q = 0; q < 16; q++) {
-                    double a = -1.0 + 2.0 * (x + (q + 0.5) / 16) / n;
-                    double b = -1.0 + 2.0 * (y + (j + 0.5) / 16) / n;
-                    w += pow(1.0 + a * a + b * b, -1.5) * (2.0 / n / 16) * (2.0 / n / 16);
-                }
+            double c[3], w = lx_test_texel_omega(n, x, y, 16);
+            lx_test_texel_dir(LX_FACE_PY, n, x, y, c);
             want += 1e4 * w * point_light_sh(nrm.x * c[0] + nrm.y * c[1] + nrm.z * c[2]);
         }
         float e[3];

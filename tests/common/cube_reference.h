@@ -1,0 +1,34 @@
+/* ibl.h's cube map conventions written out again for the tests, so that
+ * the inputs and expected values of the IBL and sky tests do not come from
+ * the code under test: the face table (OpenGL's, ibl.h: face coordinates
+ * sc, tc in [-1, 1] to a direction), texel centres, texel solid angles by a
+ * midpoint rule of dA / (1 + a^2 + b^2)^(3/2), and environments built from
+ * a function of the direction at every texel centre. */
+#ifndef LX_TEST_CUBE_REFERENCE_H
+#define LX_TEST_CUBE_REFERENCE_H
+
+#include "luxel/ibl.h"
+
+/* The direction through face coordinates sc, tc of face (0..5 = +X -X +Y
+ * -Y +Z -Z), not normalised: the point on the cube of half-size 1. */
+void lx_test_face_vec(int face, double sc, double tc, double v[3]);
+
+/* The same direction, normalised. */
+void lx_test_face_dir(int face, double sc, double tc, double d[3]);
+
+/* The unit direction through the centre of texel (x, y), row 0 at the top,
+ * of a size x size face. */
+void lx_test_texel_dir(int face, int size, int x, int y, double d[3]);
+
+/* The solid angle of texel (x, y) of a size x size face by an m x m
+ * midpoint rule. */
+double lx_test_texel_omega(int size, int x, int y, int m);
+
+/* Radiance (3 channels) at unit direction (x, y, z). */
+typedef void (*lx_test_env_fn)(double x, double y, double z, float out[3]);
+
+/* A cube map whose every texel holds fn at its centre's direction; fails
+ * the test when it cannot be allocated. Free with lx_cubemap_free. */
+lx_cubemap lx_test_make_env(int size, lx_test_env_fn fn);
+
+#endif
