@@ -155,15 +155,7 @@ static int parse_args(int argc, char **argv, bake_args *a)
             a->lights = optarg;
             break;
         case OPT_FORMAT:
-            if (strcmp(optarg, "exr") == 0)
-                a->format = LX_IMAGE_EXR;
-            else if (strcmp(optarg, "hdr") == 0)
-                a->format = LX_IMAGE_HDR;
-            else if (strcmp(optarg, "pfm") == 0)
-                a->format = LX_IMAGE_PFM;
-            else if (strcmp(optarg, "png") == 0)
-                a->format = LX_IMAGE_PNG;
-            else
+            if (!cli_parse_format(optarg, &a->format))
                 return cli_usage_error("bake", "--format must be exr, hdr, pfm or png, not '%s'",
                                        optarg);
             break;

@@ -23,6 +23,8 @@ int cli_usage_error(const char *command, const char *fmt, ...)
 /* Strict number parsing: the whole string, finite, within [lo, hi]. */
 bool cli_parse_int(const char *s, long lo, long hi, long *out);
 bool cli_parse_float(const char *s, double lo, double hi, double *out);
+/* The float image formats and PNG: "exr", "hdr", "pfm" or "png". */
+bool cli_parse_format(const char *s, lx_image_format *out);
 /* "R,G,B" with finite components >= 0. */
 bool cli_parse_rgb(const char *s, lx_vec3 *out);
 

@@ -74,6 +74,21 @@ bool cli_parse_float(const char *s, double lo, double hi, double *out)
     return true;
 }
 
+bool cli_parse_format(const char *s, lx_image_format *out)
+{
+    static const struct {
+        const char *name;
+        lx_image_format format;
+    } formats[] = {
+        {"exr", LX_IMAGE_EXR}, {"hdr", LX_IMAGE_HDR}, {"pfm", LX_IMAGE_PFM}, {"png", LX_IMAGE_PNG}};
+    for (size_t i = 0; i < sizeof formats / sizeof formats[0]; i++)
+        if (strcmp(s, formats[i].name) == 0) {
+            *out = formats[i].format;
+            return true;
+        }
+    return false;
+}
+
 bool cli_parse_rgb(const char *s, lx_vec3 *out)
 {
     double c[3];
