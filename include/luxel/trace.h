@@ -49,6 +49,9 @@ typedef struct lx_hit {
 
 /* Builds the ray structures for every node of scene. */
 lx_status lx_tracer_create(const lx_scene *scene, lx_tracer **out);
+/* The same with Embree's own build threads held to `threads` (0 = all
+ * cores), for callers that bound their thread count. */
+lx_status lx_tracer_create_threads(const lx_scene *scene, int threads, lx_tracer **out);
 void lx_tracer_destroy(lx_tracer *tracer);
 
 /* Moves a node; takes effect at the next lx_tracer_commit. */

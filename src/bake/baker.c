@@ -130,7 +130,7 @@ lx_status lx_baker_create(const lx_scene *scene, const lx_bake_desc *in, lx_bake
             return lx_fail(LX_ERR_CANCELLED, "bake cancelled");
         }
     }
-    st = lx_tracer_create(scene, &b->tracer);
+    st = lx_tracer_create_threads(scene, desc.threads, &b->tracer);
     if (st != LX_OK) {
         lx_baker_destroy(b);
         return st;

@@ -79,12 +79,23 @@ static RTCGeometry new_geometry(RTCDevice dev, const lx_mesh *m, const lx_mat4 *
 
 lx_status lx_tracer_create(const lx_scene *scene, lx_tracer **out)
 {
+    return lx_tracer_create_threads(scene, 0, out);
+}
+
+lx_status lx_tracer_create_threads(const lx_scene *scene, int threads, lx_tracer **out)
+{
     *out = NULL;
     embree_error[0] = '\0';
+    if (threads < 0)
+        return lx_fail(LX_ERR_INVALID, "tracer: thread count %d is negative", threads);
     lx_tracer *tr = calloc(1, sizeof *tr);
     if (!tr)
         return lx_fail(LX_ERR_NOMEM, "out of memory creating a tracer");
-    tr->device = rtcNewDevice(NULL);
+    /* Embree builds the BVH on its own threads: hold them to the count */
+    char config[32] = "";
+    if (threads > 0)
+        snprintf(config, sizeof config, "threads=%d", threads);
+    tr->device = rtcNewDevice(threads > 0 ? config : NULL);
     if (!tr->device) {
         free(tr);
         return lx_fail(LX_ERR_UNSUPPORTED, "Embree: cannot create a device (error %d)",
