@@ -758,14 +758,6 @@ static lx_status apply_root(lx_scene *scene, const cJSON *root, const char *file
     lx_vec3 ambient = scene->ambient;
     if (amb && (st = get_color(&c, amb, "ambient", &ambient)) != LX_OK)
         return st;
-    const cJSON *sky_item = cJSON_GetObjectItemCaseSensitive(root, "sky");
-    lx_scene_sky sky = {0};
-    if (sky_item && (st = read_sky(&c, sky_item, &sky)) != LX_OK) {
-        free(sky.environment);
-        return st;
-    }
-    c.where[0] = '\0';
-
     const cJSON *list = cJSON_GetObjectItemCaseSensitive(root, "lights");
     size_t count = 0;
     if (list) {
@@ -774,10 +766,16 @@ static lx_status apply_root(lx_scene *scene, const cJSON *root, const char *file
         for (const cJSON *e = list->child; e; e = e->next)
             count++;
     }
-    if (count > INT32_MAX / 4) {
-        free(sky.environment);
+    if (count > INT32_MAX / 4)
         return fail(&c, LX_ERR_INVALID, "%zu lights are too many", count);
+    /* the sky last before the lights: from here on every exit frees it */
+    const cJSON *sky_item = cJSON_GetObjectItemCaseSensitive(root, "sky");
+    lx_scene_sky sky = {0};
+    if (sky_item && (st = read_sky(&c, sky_item, &sky)) != LX_OK) {
+        free(sky.environment);
+        return st;
     }
+    c.where[0] = '\0';
     lx_light *pending = malloc((count ? count : 1) * sizeof *pending);
     name_table names = {0};
     if (!pending || table_init(&names, count + scene->light_count) != LX_OK) {

@@ -368,6 +368,9 @@ static const bad_case bad_cases[] = {
      "sky: intensity -1 is negative"},
     {"{\"sky\": {\"environment\": \"s.hdr\", \"intensity\": 0}}", LX_ERR_INVALID,
      "sky: intensity must be above 0"},
+    /* a valid sky in a file that fails later (fuzzing: the sky's path leaked) */
+    {"{\"sky\": {\"environment\": \"cn\", \"samples\": 7}, \"lights\": {\"lights\": []}}",
+     LX_ERR_FORMAT, "lights must be an array of objects"},
     {"{\"sky\": {\"environment\": \"s.hdr\", \"exposure\": 1}}", LX_ERR_FORMAT,
      "sky: unknown key 'exposure'"},
 };
