@@ -57,7 +57,9 @@ typedef enum lx_quantity {
  * IBL conventions, ibl.h). Unshadowed, the irradiance of its order-2
  * spherical harmonics at the texel's normal; with shadows, the mean of
  * cosine-weighted rays over the texel's hemisphere that escape the scene,
- * each bringing the environment it sees (pi / N sum L). */
+ * each bringing the environment it sees (pi / N sum L). lx_baker_create
+ * rejects an environment with NaN, infinite or negative texels, or whose
+ * brightest texel times intensity exceeds 1e36 nits. */
 typedef struct lx_sky_desc {
     const lx_cubemap *environment; /* NULL = no sky; read by lx_baker_create only */
     float intensity;               /* multiplier, 0 = 1 */

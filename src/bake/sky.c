@@ -24,6 +24,11 @@
 #define LX_SKY_LOOKUP_SIZE 64
 #define LX_SKY_DEFAULT_SAMPLES 64u
 #define LX_SKY_PEAK_RATIO 8.0
+/* Brightest sky texel (nits, intensity applied) the baker takes: its SH
+ * coefficients (up to 2 sqrt(pi) L), irradiance (pi L, plus ringing) and
+ * peak estimates (at most 4 pi L / 0.0722 for a pure blue sun) then stay
+ * well inside a float. */
+#define LX_SKY_MAX_RADIANCE 1e36
 
 static float luminance(const float *rgb)
 {
@@ -112,6 +117,24 @@ lx_status lx_sky_prepare(lx_baker *b, const lx_sky_desc *sky)
         lx_error_prefix("sky");
         return st;
     }
+    /* finite now (the projection checked): negative radiance has no
+     * meaning, and too bright a sky overflows once scaled */
+    size_t values = (size_t)env->size * (size_t)env->size * 18, negative = 0;
+    float brightest = 0.0f;
+    for (size_t i = 0; i < values; i++) {
+        negative += env->data[i] < 0.0f;
+        brightest = fmaxf(brightest, env->data[i]);
+    }
+    if (negative)
+        return lx_fail(LX_ERR_INVALID,
+                       "sky: %zu environment values are negative; an environment needs "
+                       "radiance >= 0",
+                       negative);
+    if (!((double)brightest * scale <= LX_SKY_MAX_RADIANCE))
+        return lx_fail(LX_ERR_INVALID,
+                       "sky: intensity %g times the brightest texel (%g nt) would overflow; "
+                       "the sky may reach %g nt",
+                       (double)scale, (double)brightest, LX_SKY_MAX_RADIANCE);
     for (int i = 0; i < 9; i++)
         for (int k = 0; k < 3; k++)
             b->sky_sh.c[i][k] *= scale;

@@ -262,7 +262,7 @@ static lx_status check_values(const float *data, size_t count, int stride, int w
 {
     size_t nonfinite = 0, negative = 0, first = 0;
     bool found = false;
-    int colours = stride < 3 ? stride : 3; /* grey, or RGB without alpha */
+    int colours = stride < 3 ? 1 : 3; /* grey (alpha ignored), or RGB without alpha */
     for (size_t i = 0; i < count; i++) {
         const float *p = data + i * (size_t)stride;
         bool bad_nf = false, bad_neg = false;

@@ -34,6 +34,8 @@ static lx_status linear_to_native(const lx_light *light, const char *who, float 
     if (unit == LX_UNIT_NIT)
         return lx_fail(LX_ERR_INVALID,
                        "%s: a linear tube (radius 0) has no area for nt; give cd, lm or W", who);
+    if (unit == LX_UNIT_LUX)
+        return lx_fail(LX_ERR_INVALID, "%s: tube lights take cd, lm or W, not lx", who);
     if (!(light->length > 0.0f) || !isfinite(light->length))
         return lx_fail(LX_ERR_INVALID, "%s: a linear tube needs its length first", who);
     double per_metre;

@@ -129,6 +129,8 @@ static int parse_args(int argc, char **argv, bake_args *a)
     while ((c = getopt_long(argc, argv, ":o:qh", options, NULL)) != -1) {
         switch (c) {
         case 'o':
+            if (!*optarg)
+                return cli_usage_error("bake", "-o needs a folder name");
             a->output = optarg;
             break;
         case OPT_RESOLUTION:

@@ -53,15 +53,16 @@ void cli_progress_finish(cli_progress *p);
  * remove this run's files and exit. */
 void cli_install_signal_handlers(void);
 bool cli_interrupted(void);
-/* Registers a completed output so an interrupt can remove it. */
-void cli_track_output(const char *path);
+/* Registers a completed output so an interrupt can remove it; false when
+ * out of memory (the caller must not write it then). */
+bool cli_track_output(const char *path);
 void cli_remove_tracked_outputs(void);
 /* Stops tracking outputs without removing them (they were published). */
 void cli_forget_outputs(void);
 /* Folders an interrupt removes after the tracked files, if empty: the
- * staging folder, then the output folder when this run created it (NULL:
- * none). */
-void cli_track_dir(const char *dir, const char *created_parent);
+ * staging folder, then the `count` folders this run created, deepest first
+ * (the output folder and its parents that were missing). */
+void cli_track_dir(const char *dir, const char *const *created, uint32_t count);
 void cli_set_writing(bool writing);
 
 /* Monotonic seconds. */
@@ -83,6 +84,8 @@ typedef struct cli_stage {
     char **names; /* files written into it */
     uint32_t count;
     bool created; /* the output folder is this run's and nothing is published yet */
+    char **made;  /* the folders this run created, deepest first */
+    uint32_t made_count;
 } cli_stage;
 
 /* Creates dir and its parents. */

@@ -414,6 +414,45 @@ static char *sh_json(const lx_sh9 *sh)
 
 /* ---- the command ----------------------------------------------------------- */
 
+/* Bytes the run holds at its peak with an environment of env_size and a
+ * specular chain of spec_size (a bound: a 2048^2 environment filtered at
+ * that size peaks at 0.8x it): the environment E = 72 size^2, and the
+ * largest of what each step adds while it runs - irradiance its first
+ * half-size copy (E / 4); the specular chain the source's mips (E / 3),
+ * their padded copies (4 E / 3) and the convolutions' lights (E) besides
+ * its levels (4/3 of 72 spec^2); writing a cross or an equirect one image
+ * of 4/3 of the largest cube besides the levels. */
+static double peak_bytes(const ibl_args *a, int env_size, int spec_size)
+{
+    double e = 72.0 * env_size * env_size;
+    double levels = a->specular ? 96.0 * spec_size * spec_size : 0.0;
+    double work = 0.0;
+    if (a->irradiance && !a->irradiance_sh)
+        work = 0.25 * e;
+    double chain = e / 3.0 + 4.0 * e / 3.0 + e;
+    if (a->specular && work < chain + levels)
+        work = chain + levels;
+    if (a->layout == LAYOUT_CROSS || a->layout == LAYOUT_VCROSS || a->layout == LAYOUT_EQUIRECT) {
+        int largest = a->environment ? env_size : a->specular ? spec_size : IRRADIANCE_SIZE;
+        double image = levels + 96.0 * largest * largest;
+        work = image > work ? image : work;
+    }
+    return e + work;
+}
+
+/* All of the run at once must fit in memory, not each allocation alone:
+ * false with the error printed when it does not. */
+static bool fits(const ibl_args *a, int env_size)
+{
+    int spec_size = a->size ? a->size : (env_size < 256 ? env_size : 256);
+    char what[300];
+    snprintf(what, sizeof what, "%s: filtering a %d x %d environment", a->env, env_size, env_size);
+    if (lx_check_memory((uint64_t)peak_bytes(a, env_size, spec_size), what) == LX_OK)
+        return true;
+    cli_error("%s", lx_last_error());
+    return false;
+}
+
 static bool cancelled_or_failed(lx_status s, const char *what)
 {
     if (s == LX_OK)
@@ -444,7 +483,9 @@ int cmd_ibl(int argc, char **argv)
     w.a = &a;
     double t0 = cli_now();
 
-    /* the environment */
+    /* the environment; with --size its size is known before it is made */
+    if (a.size && !fits(&a, a.size))
+        goto done;
     int loaded = cli_load_environment("ibl", a.env, a.intensity, a.size, &env);
     if (loaded != EXIT_OK) {
         status = loaded;
@@ -458,6 +499,8 @@ int cmd_ibl(int argc, char **argv)
                                  a.mips, spec_size, lx_cube_mip_count(spec_size));
         goto done;
     }
+    if (!fits(&a, env.size))
+        goto done;
 
     cli_progress progress;
     if (a.irradiance || a.sh) {

@@ -5,6 +5,7 @@
 #include "cli.h"
 
 #include <errno.h>
+#include <limits.h>
 #include <math.h>
 #include <signal.h>
 #include <stdarg.h>
@@ -121,12 +122,16 @@ double cli_now(void)
 
 /* ---- interrupts ---------------------------------------------------------- */
 
-#define MAX_TRACKED 4096
 static volatile sig_atomic_t interrupted;
 static volatile sig_atomic_t writing;
-static char *tracked[MAX_TRACKED];
+/* This run's outputs: grown by copying, so the handler always sees a
+ * complete array and a count of entries already in it. */
+static char **volatile tracked;
 static volatile sig_atomic_t tracked_count;
-static char *tracked_dir, *tracked_parent;
+static size_t tracked_capacity;
+static char *tracked_dir;
+static char **tracked_made; /* folders this run created, deepest first */
+static volatile sig_atomic_t tracked_made_count;
 
 static void on_signal(int sig)
 {
@@ -137,8 +142,8 @@ static void on_signal(int sig)
             unlink(tracked[i]);
         if (tracked_dir)
             rmdir(tracked_dir);
-        if (tracked_parent)
-            rmdir(tracked_parent);
+        for (sig_atomic_t i = 0; i < tracked_made_count; i++)
+            rmdir(tracked_made[i]);
         static const char msg[] = "\nluxel: error: interrupted; outputs removed\n";
         ssize_t unused = write(2, msg, sizeof msg - 1);
         (void)unused;
@@ -161,36 +166,67 @@ bool cli_interrupted(void)
     return interrupted != 0;
 }
 
-void cli_track_output(const char *path)
+bool cli_track_output(const char *path)
 {
-    if (tracked_count < MAX_TRACKED) {
-        tracked[tracked_count] = lx_strdup(path);
-        tracked_count = tracked_count + 1;
+    char *copy = lx_strdup(path);
+    if (!copy)
+        return false;
+    size_t count = (size_t)tracked_count;
+    if (count == tracked_capacity) {
+        size_t capacity = tracked_capacity ? 2 * tracked_capacity : 64;
+        char **grown = count < INT_MAX / 2 ? malloc(sizeof(char *) * capacity) : NULL;
+        if (!grown) {
+            free(copy);
+            return false;
+        }
+        if (count)
+            memcpy(grown, tracked, sizeof(char *) * count);
+        char **old = tracked;
+        tracked = grown;
+        tracked_capacity = capacity;
+        free(old);
     }
+    tracked[count] = copy;
+    tracked_count = (sig_atomic_t)(count + 1);
+    return true;
 }
 
 void cli_remove_tracked_outputs(void)
 {
-    for (sig_atomic_t i = 0; i < tracked_count; i++) {
+    sig_atomic_t count = tracked_count;
+    for (sig_atomic_t i = 0; i < count; i++)
         unlink(tracked[i]);
-        free(tracked[i]);
-    }
     tracked_count = 0;
+    for (sig_atomic_t i = 0; i < count; i++)
+        free(tracked[i]);
 }
 
 void cli_forget_outputs(void)
 {
-    for (sig_atomic_t i = 0; i < tracked_count; i++)
-        free(tracked[i]);
+    sig_atomic_t count = tracked_count;
     tracked_count = 0;
+    for (sig_atomic_t i = 0; i < count; i++)
+        free(tracked[i]);
 }
 
-void cli_track_dir(const char *dir, const char *created_parent)
+void cli_track_dir(const char *dir, const char *const *created, uint32_t count)
 {
+    /* the handler sees no folders while the lists change */
+    sig_atomic_t old_count = tracked_made_count;
+    tracked_made_count = 0;
+    for (sig_atomic_t i = 0; i < old_count; i++)
+        free(tracked_made[i]);
+    free(tracked_made);
+    tracked_made = NULL;
     free(tracked_dir);
-    free(tracked_parent);
     tracked_dir = dir ? lx_strdup(dir) : NULL;
-    tracked_parent = created_parent ? lx_strdup(created_parent) : NULL;
+    char **made = count ? calloc(count, sizeof *made) : NULL;
+    uint32_t n = 0;
+    for (; made && n < count; n++)
+        if (!(made[n] = lx_strdup(created[n])))
+            break;
+    tracked_made = made;
+    tracked_made_count = (sig_atomic_t)n;
 }
 
 void cli_set_writing(bool w)

@@ -15,6 +15,10 @@
 
 bool cli_make_dirs(const char *dir)
 {
+    if (!dir[0]) {
+        errno = ENOENT;
+        return false;
+    }
     char *p = lx_strdup(dir);
     if (!p)
         return false;
@@ -47,18 +51,65 @@ static char *make_staging(const char *output)
     return dir;
 }
 
+/* The folders among path and its parents that do not exist yet, deepest
+ * first (malloc'd, *count of them): the ones cli_make_dirs will create.
+ * NULL with *count 0 when there are none or memory ran out. */
+static char **missing_dirs(const char *path, uint32_t *count)
+{
+    *count = 0;
+    char *p = lx_strdup(path);
+    char **list = NULL;
+    struct stat sb;
+    while (p && p[0] && stat(p, &sb) != 0) {
+        char **grown = realloc(list, sizeof(char *) * (*count + 1));
+        char *copy = grown ? lx_strdup(p) : NULL;
+        if (grown)
+            list = grown;
+        if (!copy)
+            break;
+        list[(*count)++] = copy;
+        char *slash = strrchr(p, '/');
+        if (!slash || slash == p)
+            break;
+        *slash = '\0';
+    }
+    free(p);
+    return list;
+}
+
+/* Removes the folders a run made (deepest first; only empty ones go). */
+static void remove_made(cli_stage *st)
+{
+    for (uint32_t i = 0; i < st->made_count; i++)
+        rmdir(st->made[i]);
+}
+
+static void free_made(cli_stage *st)
+{
+    for (uint32_t i = 0; i < st->made_count; i++)
+        free(st->made[i]);
+    free(st->made);
+    st->made = NULL;
+    st->made_count = 0;
+}
+
 bool cli_stage_begin(cli_stage *st, const char *output)
 {
     memset(st, 0, sizeof *st);
-    struct stat sb;
-    bool existed = stat(output, &sb) == 0;
+    /* the folders this run makes (the output folder and any missing
+     * parents) go again if the run writes nothing */
+    st->made = missing_dirs(output, &st->made_count);
     if (!cli_make_dirs(output)) {
         cli_error("%s: cannot create the output folder: %s", output, strerror(errno));
+        remove_made(st);
+        free_made(st);
         return false;
     }
     st->output = lx_strdup(output);
     if (!st->output) {
         cli_error("out of memory");
+        remove_made(st);
+        free_made(st);
         return false;
     }
     cli_set_writing(true);
@@ -66,13 +117,14 @@ bool cli_stage_begin(cli_stage *st, const char *output)
     if (!st->dir) {
         cli_error("%s: cannot write into the output folder: %s", output, strerror(errno));
         cli_set_writing(false);
+        remove_made(st);
+        free_made(st);
         free(st->output);
         st->output = NULL;
         return false;
     }
-    /* a folder this run made goes again if the run writes nothing */
-    st->created = !existed;
-    cli_track_dir(st->dir, st->created ? output : NULL);
+    st->created = st->made_count > 0;
+    cli_track_dir(st->dir, (const char *const *)st->made, st->made_count);
     return true;
 }
 
@@ -96,7 +148,11 @@ char *cli_stage_path(cli_stage *st, const char *name)
     }
     /* tracked before it exists: an interrupt right after the rename that
      * completes the file still finds it */
-    cli_track_output(path);
+    if (!cli_track_output(path)) {
+        free(path);
+        cli_error("out of memory");
+        return NULL;
+    }
     return path;
 }
 
@@ -206,9 +262,10 @@ void cli_stage_clear(cli_stage *st)
     cli_remove_tracked_outputs();
     if (st->dir)
         rmdir(st->dir);
-    if (st->created && st->output)
-        rmdir(st->output);
-    cli_track_dir(NULL, NULL);
+    if (st->created)
+        remove_made(st);
+    cli_track_dir(NULL, NULL, 0);
+    free_made(st);
     for (uint32_t i = 0; i < st->count; i++)
         free(st->names[i]);
     free(st->names);
