@@ -78,11 +78,12 @@ static bool image_ok(const lx_image *img)
 }
 
 /* Fills a cube map of size texels a side, each texel the mean of an n x n
- * grid of lookup(source, direction) over the texel. */
+ * grid of lookup(source, direction) over the texel, n from the ratio of the
+ * source's resolution to the cube's (grid_for). */
 typedef void (*direction_lookup)(const void *source, lx_vec3 dir, float rgb[3]);
 
-static lx_status cube_by_grid(int size, int n, direction_lookup lookup, const void *source,
-                              lx_cubemap *out)
+static lx_status cube_by_grid(int size, double ratio, bool equirect_source, direction_lookup lookup,
+                              const void *source, lx_cubemap *out)
 {
     lx_status st = lx_cubemap_alloc(out, size);
     if (st != LX_OK)
@@ -92,6 +93,16 @@ static lx_status cube_by_grid(int size, int n, direction_lookup lookup, const vo
     for (int row = 0; row < rows; row++) {
         int face = row / size, y = row % size;
         for (int x = 0; x < size; x++) {
+            /* An equirect's columns crowd together toward the poles, 1 /
+             * sin(theta) more of them across a texel: the grid grows with
+             * them so a small sun there is not missed between samples. */
+            int n = grid_for(ratio);
+            if (equirect_source) {
+                lx_vec3 c = lx_cube_direction(face, ((float)x + 0.5f) / (float)size,
+                                              ((float)y + 0.5f) / (float)size);
+                double sin_theta = sqrt(fmax(0.0, 1.0 - (double)c.y * c.y));
+                n = grid_for(ratio / fmax(sin_theta, 1.0 / MAX_GRID));
+            }
             double sum[3] = {0, 0, 0};
             for (int j = 0; j < n; j++)
                 for (int i = 0; i < n; i++) {
@@ -134,7 +145,7 @@ lx_status lx_cubemap_from_equirect(const lx_image *eq, int size, lx_cubemap *out
                        "equirect is %dx%d; an equirect must be exactly twice as wide as it is "
                        "tall",
                        eq->width, eq->height);
-    return cube_by_grid(size, grid_for((double)eq->width / (4.0 * size)), equirect_lookup, eq, out);
+    return cube_by_grid(size, (double)eq->width / (4.0 * size), true, equirect_lookup, eq, out);
 }
 
 lx_status lx_cubemap_to_equirect(const lx_cubemap *c, int width, lx_image *out)
@@ -390,7 +401,7 @@ static lx_status load_faces(const char *path, lx_cubemap *out)
 /* A cube map of another size: each texel the box-filtered mean of c. */
 static lx_status resample_cube(const lx_cubemap *c, int size, lx_cubemap *out)
 {
-    return cube_by_grid(size, grid_for((double)c->size / (double)size), cube_lookup, c, out);
+    return cube_by_grid(size, (double)c->size / (double)size, false, cube_lookup, c, out);
 }
 
 /* An equirect or a cross image (layout AUTO, EQUIRECT or CROSS) as a cube
