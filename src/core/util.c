@@ -6,6 +6,7 @@
 #include <errno.h>
 #include <omp.h>
 #include <pthread.h>
+#include <signal.h>
 #include <stdio.h>
 #include <stdlib.h>
 #include <string.h>
@@ -110,7 +111,17 @@ lx_status lx_out_open(lx_out_file *f, const char *path)
     memcpy(f->tmp_path + len, ".tmp.", 5);
     memset(f->tmp_path + len + 5, 'X', 6);
     f->tmp_path[len + 11] = '\0';
+    /* SIGINT/SIGTERM wait until the file is registered, so an interrupt
+     * handler calling lx_out_abort_all_signal_safe always knows it */
+    sigset_t block, old;
+    sigemptyset(&block);
+    sigaddset(&block, SIGINT);
+    sigaddset(&block, SIGTERM);
+    pthread_sigmask(SIG_BLOCK, &block, &old);
     int fd = mkstemp(f->tmp_path);
+    if (fd >= 0)
+        register_tmp(f->tmp_path);
+    pthread_sigmask(SIG_SETMASK, &old, NULL);
     if (fd < 0) {
         int err = errno;
         free(f->path);
@@ -122,7 +133,6 @@ lx_status lx_out_open(lx_out_file *f, const char *path)
     mode_t mask = umask(0);
     umask(mask);
     fchmod(fd, 0666 & ~mask);
-    register_tmp(f->tmp_path);
     f->fp = fdopen(fd, "wb");
     if (!f->fp) {
         int err = errno;

@@ -7,6 +7,7 @@
 #include <errno.h>
 #include <limits.h>
 #include <math.h>
+#include <pthread.h>
 #include <signal.h>
 #include <stdarg.h>
 #include <stdio.h>
@@ -133,8 +134,17 @@ static char *tracked_dir;
 static char **tracked_made; /* folders this run created, deepest first */
 static volatile sig_atomic_t tracked_made_count;
 
+static pthread_t main_thread;
+
 static void on_signal(int sig)
 {
+    /* Only the main thread writes files: a signal that lands on an OpenMP
+     * or Embree worker goes to it, so the cleanup below never races a file
+     * the main thread is creating. */
+    if (!pthread_equal(pthread_self(), main_thread)) {
+        pthread_kill(main_thread, sig);
+        return;
+    }
     interrupted = 1;
     if (writing) {
         lx_out_abort_all_signal_safe();
@@ -153,6 +163,7 @@ static void on_signal(int sig)
 
 void cli_install_signal_handlers(void)
 {
+    main_thread = pthread_self();
     struct sigaction sa;
     memset(&sa, 0, sizeof sa);
     sa.sa_handler = on_signal;

@@ -93,7 +93,23 @@ static void free_made(cli_stage *st)
     st->made_count = 0;
 }
 
+static bool stage_begin(cli_stage *st, const char *output);
+
 bool cli_stage_begin(cli_stage *st, const char *output)
+{
+    /* Ctrl-C waits until the folders exist and are tracked: a signal in
+     * between would leave a staging folder the handler does not know. */
+    sigset_t block, old;
+    sigemptyset(&block);
+    sigaddset(&block, SIGINT);
+    sigaddset(&block, SIGTERM);
+    sigprocmask(SIG_BLOCK, &block, &old);
+    bool ok = stage_begin(st, output);
+    sigprocmask(SIG_SETMASK, &old, NULL);
+    return ok;
+}
+
+static bool stage_begin(cli_stage *st, const char *output)
 {
     memset(st, 0, sizeof *st);
     /* the folders this run makes (the output folder and any missing
