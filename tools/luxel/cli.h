@@ -69,8 +69,8 @@ void cli_set_writing(bool writing);
 double cli_now(void);
 
 /* ---- staged output (stage.c) ---------------------------------------------
- * Files go to OUTPUT/.luxel-XXXXXX and are moved into OUTPUT together by
- * cli_stage_publish once all are written; interrupts remove them. Every
+ * Files go to OUTPUT/.luxel-<6 random characters> and are moved into
+ * OUTPUT together by cli_stage_publish once all are written; interrupts remove them. Every
  * function prints its own "luxel: error:" line and returns false on
  * failure. Usage:
  *   cli_stage st;

@@ -1,7 +1,7 @@
 /* Staged output for the commands that write several files (bake, ibl):
- * every file goes to DIR/.luxel-XXXXXX first and is moved into DIR only
- * when all of them are written, so a failure or an interrupt leaves DIR as
- * it was. */
+ * every file goes to DIR/.luxel-<6 random characters> first and is moved
+ * into DIR only when all of them are written, so a failure or an interrupt
+ * leaves DIR as it was. */
 #define _POSIX_C_SOURCE 200809L
 #include "cli.h"
 
