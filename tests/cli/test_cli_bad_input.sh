@@ -425,6 +425,10 @@ bad "--sky: 3:1 image" 1 "wide.pfm" bake "$ROOM" --sky "$IN/wide.pfm"
 bad "--sky: bad constant" 2 "const:" bake "$ROOM" --sky const:bright
 bad "--sky-shadows without a sky" 2 "--sky" bake "$ROOM" --sky-shadows
 bad "--sky-samples 0" 2 "--sky-samples" bake "$ROOM" --sky const:1 --sky-shadows --sky-samples 0
+bad "--sky-samples without sky shadows" 2 "--sky-samples needs sky shadows" \
+    bake "$ROOM" --sky const:1 --sky-samples 8
+bad "--sky-shadows and --no-sky-shadows" 2 "contradict" \
+    bake "$ROOM" --sky const:1 --sky-shadows --no-sky-shadows
 bad "--sky-intensity -1" 2 "--sky-intensity" bake "$ROOM" --sky const:1 --sky-intensity -1
 printf '{"sky": {"environment": "nowhere.hdr"}}\n' >"$IN/sky_missing.json"
 bad "lights JSON: sky file missing" 1 "nowhere.hdr" bake "$ROOM" --lights "$IN/sky_missing.json"

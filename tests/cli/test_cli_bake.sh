@@ -353,5 +353,9 @@ run "$LUXEL" bake "$RETRO" --texel-density 4 --format pfm -q -o "$WORK/sky3" \
     --lights "$WORK/skycfg/day.json" --sky const:100 --sky-samples 4
 expect_rc 0 "bake with --sky over the file's sky"
 check "sky bake: --sky wins" grep -q '"environment":.*const:100' "$WORK/sky3/manifest.json"
+run "$LUXEL" bake "$RETRO" --texel-density 4 --format pfm -q -o "$WORK/sky4" \
+    --lights "$WORK/skycfg/day.json" --no-sky-shadows
+expect_rc 0 "bake with --no-sky-shadows over the file's shadows"
+check "sky bake: --no-sky-shadows wins" grep -q '"shadows":.*false' "$WORK/sky4/manifest.json"
 
 finish

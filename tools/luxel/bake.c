@@ -45,7 +45,9 @@ static const char *bake_usage =
     "  --sky-intensity X       multiplier on the sky, above 0 (default 1)\n"
     "  --sky-shadows           sky visibility: cosine-weighted rays that escape\n"
     "                          the scene bring the environment they see\n"
-    "  --sky-samples N         rays per texel with --sky-shadows (default 64)\n"
+    "  --no-sky-shadows        unshadowed sky even when the lights file asks\n"
+    "                          for shadows\n"
+    "  --sky-samples N         rays per texel with sky shadows (default 64)\n"
     "  --exposure EV100        exposure of the PNG preview (default: automatic)\n"
     "  --padding N             texels of dilation around charts (default 2)\n"
     "  --threads N             worker threads (default: all cores)\n"
@@ -71,6 +73,7 @@ enum {
     OPT_SKY,
     OPT_SKY_INTENSITY,
     OPT_SKY_SHADOWS,
+    OPT_NO_SKY_SHADOWS,
     OPT_SKY_SAMPLES
 };
 
@@ -88,8 +91,8 @@ typedef struct bake_args {
     bool quiet;
     const char *sky;      /* --sky, else the lights JSON's */
     double sky_intensity; /* < 0: not given */
-    bool sky_shadows;
-    long sky_samples; /* 0: not given */
+    int sky_shadows;      /* 1 on, 0 off, -1 not given */
+    long sky_samples;     /* 0: not given */
     lx_bake_desc desc;
 } bake_args;
 
@@ -113,6 +116,7 @@ static int parse_args(int argc, char **argv, bake_args *a)
         {"sky", required_argument, NULL, OPT_SKY},
         {"sky-intensity", required_argument, NULL, OPT_SKY_INTENSITY},
         {"sky-shadows", no_argument, NULL, OPT_SKY_SHADOWS},
+        {"no-sky-shadows", no_argument, NULL, OPT_NO_SKY_SHADOWS},
         {"sky-samples", required_argument, NULL, OPT_SKY_SAMPLES},
         {"quiet", no_argument, NULL, 'q'},
         {"help", no_argument, NULL, 'h'},
@@ -121,6 +125,7 @@ static int parse_args(int argc, char **argv, bake_args *a)
     a->output = "lightmaps";
     a->format = LX_IMAGE_EXR;
     a->sky_intensity = -1.0;
+    a->sky_shadows = -1;
     opterr = 0;
     optind = 1;
     int c;
@@ -218,7 +223,10 @@ static int parse_args(int argc, char **argv, bake_args *a)
             a->sky_intensity = f;
             break;
         case OPT_SKY_SHADOWS:
-            a->sky_shadows = true;
+        case OPT_NO_SKY_SHADOWS:
+            if (a->sky_shadows >= 0 && a->sky_shadows != (c == OPT_SKY_SHADOWS))
+                return cli_usage_error("bake", "--sky-shadows and --no-sky-shadows contradict");
+            a->sky_shadows = c == OPT_SKY_SHADOWS;
             break;
         case OPT_SKY_SAMPLES:
             if (!cli_parse_int(optarg, 1, (long)LX_MAX_SKY_SAMPLES, &n))
@@ -377,15 +385,22 @@ int cmd_bake(int argc, char **argv)
     lx_scene_sky sky = scene->sky;
     if (a.sky)
         sky.environment = (char *)a.sky;
-    if (!sky.environment && (a.sky_shadows || a.sky_intensity >= 0.0 || a.sky_samples)) {
-        status = cli_usage_error("bake", "--sky-intensity, --sky-shadows and --sky-samples need "
-                                         "--sky ENV (or a \"sky\" in --lights)");
+    if (!sky.environment && (a.sky_shadows >= 0 || a.sky_intensity >= 0.0 || a.sky_samples)) {
+        status = cli_usage_error("bake", "--sky-intensity, --sky-shadows, --no-sky-shadows and "
+                                         "--sky-samples need --sky ENV (or a \"sky\" in --lights)");
         goto done;
     }
     if (sky.environment) {
         if (a.sky_intensity >= 0.0)
             sky.intensity = (float)a.sky_intensity;
-        sky.shadows = sky.shadows || a.sky_shadows;
+        if (a.sky_shadows >= 0)
+            sky.shadows = a.sky_shadows;
+        if (a.sky_samples && !sky.shadows) {
+            /* rays are only cast with shadows: the count would do nothing */
+            status = cli_usage_error("bake", "--sky-samples needs sky shadows (--sky-shadows, or "
+                                             "\"shadows\": true in the lights file)");
+            goto done;
+        }
         if (a.sky_samples)
             sky.samples = (uint32_t)a.sky_samples;
         /* the SH need no more than 256 texels a side, sky shadows 64 */
