@@ -29,6 +29,7 @@
  */
 #define _POSIX_C_SOURCE 200809L
 #include "helpers.h"
+#include "core/internal.h"
 #include "reference.h"
 #include "scenes.h"
 

@@ -25,6 +25,7 @@
  */
 #define _POSIX_C_SOURCE 200809L
 #include "helpers.h"
+#include "core/internal.h"
 #include "scenes.h"
 
 #include "luxel/ibl.h"

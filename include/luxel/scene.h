@@ -94,8 +94,6 @@ typedef struct lx_scene {
     lx_scene_sky sky;          /* from the lights JSON; loading it is the caller's */
     lx_ies_profile **profiles; /* photometric profiles the lights point to */
     uint32_t profile_count;
-    /* internal bookkeeping for growth; do not touch */
-    uint32_t mesh_capacity, material_capacity, node_capacity, light_capacity, profile_capacity;
 } lx_scene;
 
 typedef struct lx_scene_load_desc {

@@ -2,6 +2,7 @@
  * static lights, re-evaluates dynamic lights per update and combines the
  * two (seed 000's initial frame / update frame / Apply kernel). */
 #include "bake_internal.h"
+#include "core/internal.h"
 
 #include <stdio.h>
 #include <stdlib.h>

@@ -5,6 +5,7 @@
  * Work is split into fixed tiles, so the sums are the same for any number
  * of threads. */
 #include "bake_internal.h"
+#include "core/internal.h"
 
 #include <omp.h>
 #include <stdlib.h>

@@ -16,6 +16,7 @@
  *   total. A sun then casts clean shadows with a few dozen rays, where
  *   cosine rays alone would almost never find it. */
 #include "bake_internal.h"
+#include "core/internal.h"
 
 #include <math.h>
 #include <stdlib.h>

@@ -5,6 +5,7 @@
  * triangle only partly covers (chart borders) the triangle's closest point
  * to the texel centre, so chart edges get real samples and do not go dark. */
 #include "bake_internal.h"
+#include "core/internal.h"
 
 #include "luxel/maps.h"
 

@@ -1,6 +1,8 @@
 /* Thread-local error messages and the process-wide log callback. */
-#include "luxel/core.h"
+#define _XOPEN_SOURCE 700
+#include "internal.h"
 
+#include <pthread.h>
 #include <stdarg.h>
 #include <stdio.h>
 #include <string.h>
@@ -9,8 +11,24 @@
 
 static _Thread_local char error_message[LX_ERROR_MAX];
 
+/* One lock guards the callback and its user pointer together and is held
+ * while the callback runs: calls never overlap, a line never goes to one
+ * callback with the other's user pointer, and lx_set_log_callback returns
+ * only once no call to the old callback is in flight. It is recursive so a
+ * callback that logs anyway does not deadlock. */
+static pthread_mutex_t log_lock;
+static pthread_once_t log_once = PTHREAD_ONCE_INIT;
 static lx_log_fn log_fn;
 static void *log_user;
+
+static void log_lock_init(void)
+{
+    pthread_mutexattr_t attr;
+    pthread_mutexattr_init(&attr);
+    pthread_mutexattr_settype(&attr, PTHREAD_MUTEX_RECURSIVE);
+    pthread_mutex_init(&log_lock, &attr);
+    pthread_mutexattr_destroy(&attr);
+}
 
 const char *lx_version(void)
 {
@@ -66,18 +84,23 @@ void lx_error_prefix(const char *prefix)
 
 void lx_set_log_callback(lx_log_fn fn, void *user)
 {
+    pthread_once(&log_once, log_lock_init);
+    pthread_mutex_lock(&log_lock);
     log_fn = fn;
     log_user = user;
+    pthread_mutex_unlock(&log_lock);
 }
 
 void lx_log(lx_log_level level, const char *fmt, ...)
 {
-    if (!log_fn)
-        return;
     char line[LX_ERROR_MAX];
     va_list ap;
     va_start(ap, fmt);
     vsnprintf(line, sizeof line, fmt, ap);
     va_end(ap);
-    log_fn(log_user, level, line);
+    pthread_once(&log_once, log_lock_init);
+    pthread_mutex_lock(&log_lock);
+    if (log_fn)
+        log_fn(log_user, level, line);
+    pthread_mutex_unlock(&log_lock);
 }

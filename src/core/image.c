@@ -239,6 +239,14 @@ static lx_status convert_channels(lx_image *img, int want, const char *name)
     return LX_OK;
 }
 
+lx_image_load_desc lx_image_load_desc_defaults(const lx_image_load_desc *desc)
+{
+    lx_image_load_desc d = {0};
+    if (desc)
+        d = *desc;
+    return d; /* every field's zero is its default: as stored, sRGB-decoded, finite */
+}
+
 lx_status lx_image_load_memory(const void *bytes, size_t size, const char *name,
                                const lx_image_load_desc *desc, lx_image *out)
 {
@@ -247,9 +255,7 @@ lx_status lx_image_load_memory(const void *bytes, size_t size, const char *name,
     memset(out, 0, sizeof *out);
     if (!name)
         name = "<memory>";
-    lx_image_load_desc d = {0};
-    if (desc)
-        d = *desc;
+    lx_image_load_desc d = lx_image_load_desc_defaults(desc);
     if (d.channels < 0 || d.channels > 4)
         return lx_fail(LX_ERR_INVALID, "%s: requested %d channels (expected 0..4)", name,
                        d.channels);
@@ -348,18 +354,28 @@ static lx_status check_writable(const char *path, const lx_image *img, lx_image_
     return LX_OK;
 }
 
+lx_image_write_desc lx_image_write_desc_defaults(const lx_image_write_desc *desc)
+{
+    lx_image_write_desc d = {0};
+    if (desc)
+        d = *desc;
+    if (d.exposure == 0.0f)
+        d.exposure = 1.0f;
+    return d;
+}
+
 lx_status lx_image_write(const char *path, const lx_image *img, const lx_image_write_desc *desc)
 {
     if (!path || !img)
         return lx_fail(LX_ERR_INVALID, "lx_image_write: path and img must not be NULL");
-    lx_image_write_desc d = {0};
-    if (desc)
-        d = *desc;
+    lx_image_write_desc d = lx_image_write_desc_defaults(desc);
     size_t count;
     if (!img->data || img->width < 1 || img->height < 1 || img->channels < 1 || img->channels > 4 ||
         !lx_size_mul((size_t)img->width, (size_t)img->height, (size_t)img->channels, &count))
         return lx_fail(LX_ERR_INVALID, "%s: invalid image (%dx%d, %d channels, data %s)", path,
                        img->width, img->height, img->channels, img->data ? "set" : "NULL");
+    if (d.threads < 0)
+        return lx_fail(LX_ERR_INVALID, "%s: thread count %d is negative", path, d.threads);
     if (d.format != LX_IMAGE_AUTO && !lx_image_format_extension(d.format))
         return lx_fail(LX_ERR_INVALID, "%s: unknown image format %d in lx_image_write_desc", path,
                        (int)d.format);
@@ -369,7 +385,7 @@ lx_status lx_image_write(const char *path, const lx_image *img, const lx_image_w
                        "%s: cannot tell the image format from the name (use .exr, .hdr, .pfm, "
                        ".png, .jpg or .tga)",
                        path);
-    float exposure = d.exposure == 0.0f ? 1.0f : d.exposure;
+    float exposure = d.exposure;
     if (!isfinite(exposure) || exposure < 0.0f)
         return lx_fail(LX_ERR_INVALID, "%s: exposure %g must be a finite value >= 0", path,
                        (double)d.exposure);

@@ -318,33 +318,6 @@ lx_status lx_img_load_exr(const unsigned char *data, size_t size, const char *na
 
 /* ---- writing ------------------------------------------------------------- */
 
-/* binary16 from binary32, round to nearest even. The caller has checked
- * |f| <= 65504, so the result is finite. */
-static uint16_t float_to_half(float f)
-{
-    uint32_t x;
-    memcpy(&x, &f, sizeof x);
-    uint16_t sign = (uint16_t)((x >> 16) & 0x8000u);
-    uint32_t ax = x & 0x7fffffffu;
-    if (ax >= 0x47800000u) /* >= 2^16: out of range (not reached) */
-        return sign | 0x7c00u;
-    if (ax < 0x38800000u) {   /* below 2^-14: subnormal half or zero */
-        if (ax < 0x33000000u) /* below 2^-25: rounds to zero */
-            return sign;
-        uint32_t e = ax >> 23, m = (ax & 0x7fffffu) | 0x800000u;
-        uint32_t shift = 126 - e; /* 14..24 */
-        uint32_t h = m >> shift, rem = m & ((1u << shift) - 1), halfway = 1u << (shift - 1);
-        if (rem > halfway || (rem == halfway && (h & 1u)))
-            h++;
-        return sign | (uint16_t)h;
-    }
-    uint32_t r = ax - 0x38000000u; /* rebias the exponent from 127 to 15 */
-    uint32_t h = r >> 13, rem = r & 0x1fffu;
-    if (rem > 0x1000u || (rem == 0x1000u && (h & 1u)))
-        h++;
-    return sign | (uint16_t)h;
-}
-
 typedef struct exr_out {
     FILE *fp;
     bool failed;
@@ -464,7 +437,7 @@ lx_status lx_img_write_exr(FILE *fp, const char *path, const lx_image *img, floa
         if (half) {
             uint16_t *dst = (uint16_t *)pixels + (size_t)k * plane;
             for (size_t i = 0; i < plane; i++, src += nc)
-                dst[i] = float_to_half(*src * e);
+                dst[i] = lx_float_to_half(*src * e);
         } else {
             float *dst = (float *)pixels + (size_t)k * plane;
             for (size_t i = 0; i < plane; i++, src += nc)

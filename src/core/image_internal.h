@@ -3,7 +3,7 @@
 #ifndef LX_CORE_IMAGE_INTERNAL_H
 #define LX_CORE_IMAGE_INTERNAL_H
 
-#include "luxel/core.h"
+#include "internal.h"
 
 #include <stdio.h>
 
@@ -34,9 +34,8 @@ LX_IMG_HIDDEN lx_status lx_img_write_pfm(FILE *fp, const char *path, const lx_im
 LX_IMG_HIDDEN lx_status lx_img_write_exr(FILE *fp, const char *path, const lx_image *img,
                                          float exposure, bool half);
 
-/* Largest finite IEEE half, and the bound below which stb's RGBE encoder
- * keeps its exponent byte in range (2^127). */
-#define LX_HALF_MAX 65504.0f
+/* The bound below which stb's RGBE encoder keeps its exponent byte in
+ * range (2^127). */
 #define LX_RGBE_LIMIT 0x1p127f
 
 #endif

@@ -1,16 +1,17 @@
 /* Sizes and memory checks, thread counts, atomic output files, counter-based
- * hashing, whole-file reads and path helpers. */
+ * hashing, whole-file reads and path helpers (declared in internal.h). */
 #define _POSIX_C_SOURCE 200809L
-#include "luxel/core.h"
+#include "internal.h"
 
 #include <errno.h>
+#include <fcntl.h>
 #include <omp.h>
-#include <pthread.h>
-#include <signal.h>
+#include <stdatomic.h>
 #include <stdio.h>
 #include <stdlib.h>
 #include <string.h>
 #include <sys/stat.h>
+#include <time.h>
 #include <unistd.h>
 
 bool lx_size_mul(size_t a, size_t b, size_t c, size_t *out)
@@ -31,7 +32,7 @@ uint64_t lx_physical_memory(void)
     return (uint64_t)pages * (uint64_t)page_size;
 }
 
-static void format_bytes(uint64_t bytes, char *buf, size_t size)
+void lx_format_bytes(uint64_t bytes, char *buf, size_t size)
 {
     const double gib = 1024.0 * 1024.0 * 1024.0;
     if (bytes >= (uint64_t)gib / 4)
@@ -46,8 +47,8 @@ lx_status lx_check_memory(uint64_t bytes, const char *what)
     if (have == 0 || bytes <= have)
         return LX_OK;
     char need_s[32], have_s[32];
-    format_bytes(bytes, need_s, sizeof need_s);
-    format_bytes(have, have_s, sizeof have_s);
+    lx_format_bytes(bytes, need_s, sizeof need_s);
+    lx_format_bytes(have, have_s, sizeof have_s);
     return lx_fail(LX_ERR_NOMEM, "%s needs %s of memory, the machine has %s", what, need_s, have_s);
 }
 
@@ -61,38 +62,20 @@ int lx_thread_count(int requested)
 
 /* ---- atomic output files ------------------------------------------------ */
 
-/* Temp files still open, so a signal handler can remove them. */
-#define LX_MAX_OPEN_OUT 64
-static char *volatile open_tmp_paths[LX_MAX_OPEN_OUT];
-static pthread_mutex_t open_tmp_lock = PTHREAD_MUTEX_INITIALIZER;
-
-static void register_tmp(char *path)
+/* A name no other writer picks: the process id, a per-process counter and
+ * the clock, hashed; O_EXCL catches the rare clash and we try again. */
+static void temp_suffix(char out[7])
 {
-    pthread_mutex_lock(&open_tmp_lock);
-    for (int i = 0; i < LX_MAX_OPEN_OUT; i++)
-        if (!open_tmp_paths[i]) {
-            open_tmp_paths[i] = path;
-            break;
-        }
-    pthread_mutex_unlock(&open_tmp_lock);
-}
-
-static void unregister_tmp(char *path)
-{
-    pthread_mutex_lock(&open_tmp_lock);
-    for (int i = 0; i < LX_MAX_OPEN_OUT; i++)
-        if (open_tmp_paths[i] == path)
-            open_tmp_paths[i] = NULL;
-    pthread_mutex_unlock(&open_tmp_lock);
-}
-
-void lx_out_abort_all_signal_safe(void)
-{
-    for (int i = 0; i < LX_MAX_OPEN_OUT; i++) {
-        char *p = open_tmp_paths[i];
-        if (p)
-            unlink(p);
+    static _Atomic uint32_t counter;
+    static const char digits[] = "abcdefghijklmnopqrstuvwxyz0123456789";
+    struct timespec ts;
+    clock_gettime(CLOCK_REALTIME, &ts);
+    uint32_t h = lx_hash4((uint32_t)getpid(), counter++, (uint32_t)ts.tv_nsec, (uint32_t)ts.tv_sec);
+    for (int i = 0; i < 6; i++) {
+        out[i] = digits[h % 36u];
+        h /= 36u;
     }
+    out[6] = '\0';
 }
 
 lx_status lx_out_open(lx_out_file *f, const char *path)
@@ -104,38 +87,29 @@ lx_status lx_out_open(lx_out_file *f, const char *path)
     if (!f->path || !f->tmp_path) {
         free(f->path);
         free(f->tmp_path);
+        memset(f, 0, sizeof *f);
         return lx_fail(LX_ERR_NOMEM, "%s: out of memory", path);
     }
-    memcpy(f->tmp_path, path, len);
-    /* mkstemp's template: ".tmp." then six X that it replaces */
-    memcpy(f->tmp_path + len, ".tmp.", 5);
-    memset(f->tmp_path + len + 5, 'X', 6);
-    f->tmp_path[len + 11] = '\0';
-    /* SIGINT/SIGTERM wait until the file is registered, so an interrupt
-     * handler calling lx_out_abort_all_signal_safe always knows it */
-    sigset_t block, old;
-    sigemptyset(&block);
-    sigaddset(&block, SIGINT);
-    sigaddset(&block, SIGTERM);
-    pthread_sigmask(SIG_BLOCK, &block, &old);
-    int fd = mkstemp(f->tmp_path);
-    if (fd >= 0)
-        register_tmp(f->tmp_path);
-    pthread_sigmask(SIG_SETMASK, &old, NULL);
+    int fd = -1, err = 0;
+    for (int attempt = 0; attempt < 100 && fd < 0; attempt++) {
+        char suffix[7];
+        temp_suffix(suffix);
+        snprintf(f->tmp_path, len + 16, "%s.tmp.%s", path, suffix);
+        /* 0666 less the umask, as any new file: the kernel applies it */
+        fd = open(f->tmp_path, O_WRONLY | O_CREAT | O_EXCL | O_CLOEXEC, 0666);
+        err = errno;
+        if (fd < 0 && err != EEXIST)
+            break;
+    }
     if (fd < 0) {
-        int err = errno;
         free(f->path);
         free(f->tmp_path);
         memset(f, 0, sizeof *f);
         return lx_fail(LX_ERR_IO, "%s: cannot create: %s", path, strerror(err));
     }
-    /* mkstemp makes 0600; outputs are ordinary files */
-    mode_t mask = umask(0);
-    umask(mask);
-    fchmod(fd, 0666 & ~mask);
     f->fp = fdopen(fd, "wb");
     if (!f->fp) {
-        int err = errno;
+        err = errno;
         close(fd);
         lx_out_abort(f);
         return lx_fail(LX_ERR_IO, "%s: cannot open: %s", path, strerror(err));
@@ -149,26 +123,25 @@ lx_status lx_out_commit(lx_out_file *f)
     f->fp = NULL;
     /* on disk before the rename, so a crash never leaves an empty target */
     int failed = fflush(fp) != 0 || ferror(fp) || fsync(fileno(fp)) != 0;
-    if (fclose(fp) != 0)
+    int err = errno;
+    if (fclose(fp) != 0 && !failed) {
         failed = 1;
+        err = errno;
+    }
+    const char *what = "write failed";
+    if (!failed && rename(f->tmp_path, f->path) != 0) {
+        failed = 1;
+        err = errno;
+        what = "cannot rename temporary file";
+    }
     if (failed) {
-        int err = errno;
-        char *path = lx_strdup(f->path);
+        char *path = f->path;
+        f->path = NULL;
         lx_out_abort(f);
-        lx_status s = lx_fail(LX_ERR_IO, "%s: write failed: %s", path ? path : "?", strerror(err));
+        lx_status s = lx_fail(LX_ERR_IO, "%s: %s: %s", path ? path : "?", what, strerror(err));
         free(path);
         return s;
     }
-    if (rename(f->tmp_path, f->path) != 0) {
-        int err = errno;
-        char *path = lx_strdup(f->path);
-        lx_out_abort(f);
-        lx_status s = lx_fail(LX_ERR_IO, "%s: cannot rename temporary file: %s", path ? path : "?",
-                              strerror(err));
-        free(path);
-        return s;
-    }
-    unregister_tmp(f->tmp_path);
     free(f->tmp_path);
     free(f->path);
     memset(f, 0, sizeof *f);
@@ -179,10 +152,8 @@ void lx_out_abort(lx_out_file *f)
 {
     if (f->fp)
         fclose(f->fp);
-    if (f->tmp_path) {
+    if (f->tmp_path)
         unlink(f->tmp_path);
-        unregister_tmp(f->tmp_path);
-    }
     free(f->tmp_path);
     free(f->path);
     memset(f, 0, sizeof *f);

@@ -4,6 +4,7 @@
  * centre, F(a, b) = atan(a b / sqrt(a^2 + b^2 + 1)), and bilinear sampling
  * that takes its taps across face edges. */
 #include "ibl_internal.h"
+#include "core/internal.h"
 
 #include <math.h>
 #include <stdlib.h>
@@ -55,8 +56,8 @@ double lx_cube_texel_solid_angle(int size, int x, int y)
     double inv = 2.0 / size;
     double x0 = x * inv - 1.0, x1 = (x + 1) * inv - 1.0;
     double y0 = y * inv - 1.0, y1 = (y + 1) * inv - 1.0;
-    return corner_solid_angle(x0, y0) - corner_solid_angle(x0, y1) -
-           corner_solid_angle(x1, y0) + corner_solid_angle(x1, y1);
+    return corner_solid_angle(x0, y0) - corner_solid_angle(x0, y1) - corner_solid_angle(x1, y0) +
+           corner_solid_angle(x1, y1);
 }
 
 lx_vec3 lx_equirect_direction(float u, float v)
@@ -90,8 +91,7 @@ lx_status lx_cubemap_alloc(lx_cubemap *c, int size)
 {
     memset(c, 0, sizeof *c);
     if (size < 1 || size > LX_MAX_CUBE_SIZE)
-        return lx_fail(LX_ERR_INVALID, "cube map size %d is outside 1..%d", size,
-                       LX_MAX_CUBE_SIZE);
+        return lx_fail(LX_ERR_INVALID, "cube map size %d is outside 1..%d", size, LX_MAX_CUBE_SIZE);
     uint64_t count = 6ull * (uint64_t)size * (uint64_t)size * 3ull;
     lx_status st = lx_check_memory(count * sizeof(float), "cube map");
     if (st != LX_OK)

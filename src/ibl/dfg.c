@@ -10,6 +10,7 @@
  * the Masking-Shadowing Function in Microfacet-Based BRDFs", JCGT 2014),
  * alpha = roughness^2 (perceptual roughness, as in glTF). Sums in double. */
 #include "ibl_internal.h"
+#include "core/internal.h"
 
 #include <math.h>
 #include <stdlib.h>

@@ -10,6 +10,7 @@
  * the OpenGL orientation, +Z in the middle, and in the vertical cross -Z
  * below -Y turned by 180 degrees, so neighbouring faces meet edge to edge. */
 #include "luxel/ibl.h"
+#include "core/internal.h"
 
 #include <math.h>
 #include <stdio.h>

@@ -3,6 +3,7 @@
  * cubemap.c), argument checks, progress and cancellation of the tiled
  * OpenMP loops, and a bilinear sampler with a fast path inside a face. */
 #include "ibl_internal.h"
+#include "core/internal.h"
 
 #include <math.h>
 #include <omp.h>

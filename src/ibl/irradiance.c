@@ -16,6 +16,7 @@
  * The source is first downsampled (solid-angle weighted 2x2) to at most
  * source_size per side, so a 512^2 input stays practical. */
 #include "ibl_internal.h"
+#include "core/internal.h"
 
 #include <math.h>
 #include <stdlib.h>

@@ -13,6 +13,8 @@
  * rather than clamped. */
 #include "luxel/ibl.h"
 
+#include "core/internal.h"
+
 #include <errno.h>
 #include <math.h>
 #include <stdio.h>
@@ -24,40 +26,9 @@
 #define GL_RGBA 0x1908
 #define GL_RGBA16F 0x881A
 #define GL_RGBA32F 0x8814
-#define HALF_MAX 65504.0f
 
 static const unsigned char ktx_identifier[12] = {0xAB, 0x4B, 0x54, 0x58, 0x20, 0x31,
                                                  0x31, 0xBB, 0x0D, 0x0A, 0x1A, 0x0A};
-
-/* binary32 -> binary16, round to nearest even. |f| <= 65504 or not finite. */
-static uint16_t half_from_float(float f)
-{
-    uint32_t x;
-    memcpy(&x, &f, sizeof x);
-    uint16_t sign = (uint16_t)((x >> 16) & 0x8000u);
-    uint32_t ax = x & 0x7fffffffu;
-    if (ax > 0x7f800000u)
-        return sign | 0x7e00u; /* NaN (never written: rejected before) */
-    if (ax >= 0x477ff000u)
-        return sign | 0x7c00u; /* rounds to infinity (rejected before) */
-    if (ax < 0x33000000u)
-        return sign; /* below half the smallest subnormal: zero */
-    if (ax < 0x38800000u) {
-        /* subnormal half: the value in units of 2^-24, rounded */
-        uint32_t e = ax >> 23, m = (ax & 0x7fffffu) | 0x800000u;
-        uint32_t shift = 126u - e; /* 14..24 */
-        uint32_t q = m >> shift, rem = m & ((1u << shift) - 1u), halfway = 1u << (shift - 1u);
-        if (rem > halfway || (rem == halfway && (q & 1u)))
-            q++;
-        return sign | (uint16_t)q;
-    }
-    /* normal: rebias the exponent (127 - 15 = 112), keep 10 mantissa bits;
-     * a carry out of the mantissa correctly bumps the exponent */
-    uint32_t h = (ax - 0x38000000u) >> 13, rem = ax & 0x1fffu;
-    if (rem > 0x1000u || (rem == 0x1000u && (h & 1u)))
-        h++;
-    return sign | (uint16_t)h;
-}
 
 static void put_u32(unsigned char *p, uint32_t v)
 {
@@ -91,7 +62,7 @@ static lx_status check_levels(const char *path, const lx_cubemap *levels, int co
             const char *problem = NULL;
             if (!isfinite(v))
                 problem = isnan(v) ? "is NaN" : "is infinite";
-            else if (half && fabsf(v) > HALF_MAX)
+            else if (half && fabsf(v) > LX_HALF_MAX)
                 problem = "is outside the half-float range (|v| <= 65504); write RGBA32F instead";
             if (problem) {
                 size_t texel = i / 3, per_face = (size_t)c->size * (size_t)c->size;
@@ -180,7 +151,7 @@ lx_status lx_ktx_write_cubemap(const char *path, const lx_cubemap *levels, int c
                     float rgba[4] = {src[3 * x], src[3 * x + 1], src[3 * x + 2], 1.0f};
                     for (int k = 0; k < 4; k++) {
                         if (half) {
-                            uint16_t h = half_from_float(rgba[k]);
+                            uint16_t h = lx_float_to_half(rgba[k]);
                             *p++ = (unsigned char)h;
                             *p++ = (unsigned char)(h >> 8);
                         } else {

@@ -5,6 +5,7 @@
  * texels per side, each covering a fractional 2.x texels, weighted by the
  * covered fraction of each source texel. */
 #include "ibl_internal.h"
+#include "core/internal.h"
 
 #include <stdlib.h>
 #include <string.h>

@@ -7,6 +7,7 @@
  * alone from read-only inputs, so the output is the same for any thread
  * count. */
 #include "ibl_internal.h"
+#include "core/internal.h"
 
 #include <math.h>
 #include <stdlib.h>

@@ -38,6 +38,7 @@
  *    texels in their hemisphere).
  * Each texel's sums run over the tree in one fixed order, in double. */
 #include "ibl_internal.h"
+#include "core/internal.h"
 
 #include <math.h>
 #include <stdlib.h>

@@ -39,6 +39,7 @@
  *    solid-angle weighted mip chain and bilinear across face edges (the
  *    taps lx_cubemap_sample takes), so the levels have no seams. */
 #include "ibl_internal.h"
+#include "core/internal.h"
 
 #include <math.h>
 #include <stdlib.h>

@@ -6,6 +6,7 @@
  * with x, y, z luxel's axes (+Y up): the irradiance formula holds in any
  * orthonormal frame, only the names of the coefficients follow the axes. */
 #include "ibl_internal.h"
+#include "core/internal.h"
 
 #include <math.h>
 #include <stdlib.h>

@@ -30,6 +30,7 @@
  *   Frostbite 2014 section 4.7.1), L = P / (pi A) with A the emitting area.
  * Everything is computed in double and returned as float. */
 #include "luxel/light.h"
+#include "core/internal.h"
 
 #include <math.h>
 

@@ -5,6 +5,7 @@
  * CIE 1931 xy, to XYZ at Y = 1, to linear sRGB with the IEC 61966-2-1
  * matrix, normalized to a largest channel of 1. */
 #include "luxel/light.h"
+#include "core/internal.h"
 
 lx_status lx_temperature_to_xy(float kelvin, float *x, float *y)
 {

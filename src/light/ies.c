@@ -17,6 +17,7 @@
  * Photometric types A and B are resampled onto a type C grid when loaded
  * (ies_types.c). */
 #include "ies_internal.h"
+#include "core/internal.h"
 
 #include <math.h>
 #include <stdlib.h>

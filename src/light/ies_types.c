@@ -10,6 +10,7 @@
  * and the nadir, type B reads sin H = y, tan V = x / z (polar axis C90-C270)
  * and type A sin V = x, tan H = y / z (polar axis C0-C180). */
 #include "ies_internal.h"
+#include "core/internal.h"
 
 #include <math.h>
 #include <stdlib.h>

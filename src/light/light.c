@@ -6,6 +6,7 @@
  * the seed's dynamic blur shadow factor and its ambient wish list item
  * (ambient that falls off with the light's reach and adds across lights). */
 #include "luxel/light.h"
+#include "core/internal.h"
 
 #include <math.h>
 #include <stdio.h>

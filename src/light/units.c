@@ -5,6 +5,7 @@
  * 2^EV100)) and EV100 from average luminance with K = 12.5; unit and enum
  * names. */
 #include "luxel/light.h"
+#include "core/internal.h"
 
 #include <math.h>
 #include <stdio.h>

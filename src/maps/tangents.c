@@ -3,6 +3,7 @@
  * bitangent are summed at its vertices, the tangent is made orthogonal to
  * the normal and the bitangent's side is kept as a handedness sign. */
 #include "luxel/maps.h"
+#include "core/internal.h"
 
 #include <stdlib.h>
 

@@ -6,6 +6,7 @@
  * (JSON) chunk per the glTF 2.0 binary container spec. Node world matrices
  * are T * R * S (or "matrix"), parent times child, column-major. */
 #include "luxel/scene.h"
+#include "core/internal.h"
 
 #include "json_text.h"
 

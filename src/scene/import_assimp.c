@@ -4,6 +4,7 @@
  * lights are read from the file's own JSON (gltf_lights.c) because assimp
  * drops their units and range. */
 #include "luxel/scene.h"
+#include "core/internal.h"
 
 #include "json_text.h"
 

@@ -1,6 +1,7 @@
 /* JSON text to a cJSON tree for the scene module's readers (lights JSON,
  * glTF), reporting syntax errors by line and column. */
 #include "json_text.h"
+#include "core/internal.h"
 
 #include <stdarg.h>
 #include <stdio.h>

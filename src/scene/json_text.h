@@ -4,6 +4,7 @@
 #define LX_JSON_TEXT_H
 
 #include "luxel/core.h"
+#include "core/internal.h"
 
 #include <cjson/cJSON.h>
 

@@ -6,6 +6,7 @@
  * value is checked, and nothing changes in the scene unless the whole file
  * is valid. */
 #include "luxel/scene.h"
+#include "core/internal.h"
 
 #include "json_text.h"
 

@@ -1,10 +1,24 @@
 /* The scene container: meshes, materials, nodes and lights, their
  * validation and programmatic construction. */
 #include "luxel/scene.h"
+#include "core/internal.h"
 
+#include <stddef.h>
 #include <stdio.h>
 #include <stdlib.h>
 #include <string.h>
+
+/* A scene with the capacities of its growing arrays, which users never see:
+ * lx_scene_create hands out &store->scene. */
+typedef struct scene_store {
+    lx_scene scene;
+    uint32_t mesh_capacity, material_capacity, node_capacity, light_capacity, profile_capacity;
+} scene_store;
+
+static scene_store *store_of(lx_scene *s)
+{
+    return (scene_store *)((char *)s - offsetof(scene_store, scene));
+}
 
 /* Grows *array (of elem bytes, *capacity entries) to hold count + 1. */
 static lx_status grow(void **array, uint32_t *capacity, uint32_t count, size_t elem,
@@ -27,12 +41,12 @@ static lx_status grow(void **array, uint32_t *capacity, uint32_t count, size_t e
 lx_status lx_scene_create(const char *name, lx_scene **out)
 {
     *out = NULL;
-    lx_scene *s = calloc(1, sizeof *s);
-    if (!s || !(s->path = lx_strdup(name ? name : "scene"))) {
-        free(s);
+    scene_store *store = calloc(1, sizeof *store);
+    if (!store || !(store->scene.path = lx_strdup(name ? name : "scene"))) {
+        free(store);
         return lx_fail(LX_ERR_NOMEM, "out of memory creating a scene");
     }
-    *out = s;
+    *out = &store->scene;
     return LX_OK;
 }
 
@@ -76,7 +90,7 @@ void lx_scene_destroy(lx_scene *s)
     free(s->lights);
     free(s->sky.environment);
     free(s->path);
-    free(s);
+    free(store_of(s));
 }
 
 static void *dup_array(const void *src, size_t count, size_t elem)
@@ -187,7 +201,8 @@ lx_status lx_scene_add_mesh(lx_scene *s, const lx_mesh *src, uint32_t *index)
     lx_status st = validate_mesh(s, src, name);
     if (st != LX_OK)
         return st;
-    st = grow((void **)&s->meshes, &s->mesh_capacity, s->mesh_count, sizeof(lx_mesh), "meshes");
+    st = grow((void **)&s->meshes, &store_of(s)->mesh_capacity, s->mesh_count, sizeof(lx_mesh),
+              "meshes");
     if (st != LX_OK)
         return st;
     lx_mesh m = *src;
@@ -222,7 +237,7 @@ lx_status lx_scene_add_mesh(lx_scene *s, const lx_mesh *src, uint32_t *index)
 
 lx_status lx_scene_add_material(lx_scene *s, const lx_material *src, uint32_t *index)
 {
-    lx_status st = grow((void **)&s->materials, &s->material_capacity, s->material_count,
+    lx_status st = grow((void **)&s->materials, &store_of(s)->material_capacity, s->material_count,
                         sizeof(lx_material), "materials");
     if (st != LX_OK)
         return st;
@@ -270,8 +285,8 @@ lx_status lx_scene_add_node(lx_scene *s, const char *name, const lx_mat4 *world,
         if (meshes[i] >= s->mesh_count)
             return lx_fail(LX_ERR_INVALID, "%s: node '%s': mesh %u out of range (count %u)",
                            s->path, name, meshes[i], s->mesh_count);
-    lx_status st =
-        grow((void **)&s->nodes, &s->node_capacity, s->node_count, sizeof(lx_node), "nodes");
+    lx_status st = grow((void **)&s->nodes, &store_of(s)->node_capacity, s->node_count,
+                        sizeof(lx_node), "nodes");
     if (st != LX_OK)
         return st;
     lx_node n = {0};
@@ -303,7 +318,8 @@ lx_status lx_scene_add_light(lx_scene *s, const lx_light *light)
                 s->lights[i] = *light;
                 return LX_OK;
             }
-    st = grow((void **)&s->lights, &s->light_capacity, s->light_count, sizeof(lx_light), "lights");
+    st = grow((void **)&s->lights, &store_of(s)->light_capacity, s->light_count, sizeof(lx_light),
+              "lights");
     if (st != LX_OK)
         return st;
     s->lights[s->light_count++] = *light;
@@ -312,7 +328,7 @@ lx_status lx_scene_add_light(lx_scene *s, const lx_light *light)
 
 lx_status lx_scene_adopt_profile(lx_scene *s, lx_ies_profile *profile)
 {
-    lx_status st = grow((void **)&s->profiles, &s->profile_capacity, s->profile_count,
+    lx_status st = grow((void **)&s->profiles, &store_of(s)->profile_capacity, s->profile_count,
                         sizeof(lx_ies_profile *), "photometric profiles");
     if (st != LX_OK)
         return st;

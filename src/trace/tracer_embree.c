@@ -5,6 +5,7 @@
  * moves gets its vertices rewritten and the scene is rebuilt at the next
  * commit. */
 #include "luxel/trace.h"
+#include "core/internal.h"
 
 #include <embree3/rtcore.h>
 #include <stdio.h>

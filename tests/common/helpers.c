@@ -1,6 +1,7 @@
 /* Helpers shared by luxel's tests. */
 #define _POSIX_C_SOURCE 200809L
 #include "helpers.h"
+#include "core/internal.h"
 
 #include <setjmp.h>
 #include <stdarg.h>

@@ -2,6 +2,7 @@
  * machine report (see scenes.h). */
 #define _POSIX_C_SOURCE 200809L
 #include "scenes.h"
+#include "core/internal.h"
 #include "helpers.h"
 
 #include <embree3/rtcore.h>

@@ -8,6 +8,7 @@
 #include <cmocka.h>
 
 #include "luxel/core.h"
+#include "core/internal.h"
 
 #include <dirent.h>
 #include <math.h>

@@ -18,6 +18,7 @@
 #include <string.h>
 
 #include "luxel/ibl.h"
+#include "core/internal.h"
 
 #define PI_D 3.14159265358979323846
 

@@ -23,6 +23,7 @@
 #include <stb/stb_image_write.h>
 
 #include "helpers.h"
+#include "core/internal.h"
 #include "luxel/ibl.h"
 
 typedef struct v3d {

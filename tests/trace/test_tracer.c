@@ -17,6 +17,7 @@
 #include <string.h>
 
 #include "helpers.h"
+#include "core/internal.h"
 #include "reference.h"
 
 #define RAYS 1000

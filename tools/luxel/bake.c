@@ -413,6 +413,10 @@ int cmd_bake(int argc, char **argv)
         a.desc.sky = (lx_sky_desc){&sky_env, sky.intensity, sky.shadows, sky.samples};
     }
 
+    /* the output folder is checked (and made) before the long work */
+    if (!cli_stage_begin(&stage, a.output))
+        goto done;
+
     cli_progress progress;
     cli_progress_init(&progress, "texel maps", a.quiet);
     a.desc.progress = cli_progress_update;
@@ -421,16 +425,43 @@ int cmd_bake(int argc, char **argv)
     cli_progress_finish(&progress);
     lx_cubemap_free(&sky_env);
     if (created != LX_OK) {
-        cli_error("%s",
-                  created == LX_ERR_CANCELLED ? "interrupted; nothing written" : lx_last_error());
+        if (created == LX_ERR_CANCELLED)
+            cli_report_interrupt(false);
+        else
+            cli_error("%s", lx_last_error());
         goto done;
     }
-    cli_progress_init(&progress, "bake", a.quiet);
     maps = lx_baker_lightmap_count(baker);
     if (maps == 0) {
         cli_error("%s: no mesh has UVs to bake a lightmap on", a.scene);
         goto done;
     }
+    /* every output's name, checked before the bake: a folder in the way of
+     * one fails now, not after minutes of work */
+    images = calloc(maps, sizeof *images);
+    stems = calloc(maps, sizeof *stems);
+    if (!images || !stems) {
+        cli_error("out of memory");
+        goto done;
+    }
+    for (uint32_t m = 0; m < maps; m++) {
+        char stem[256], name[300];
+        file_stem(lx_baker_lightmap_info(baker, m)->name, stems, m, stem, sizeof stem);
+        if (!(stems[m] = cli_strdup(stem))) {
+            cli_error("out of memory");
+            goto done;
+        }
+        snprintf(name, sizeof name, "%s.%s", stem, lx_image_format_extension(a.format));
+        if (!cli_stage_check(&stage, name))
+            goto done;
+        snprintf(name, sizeof name, "%s.png", stem);
+        if (a.format != LX_IMAGE_PNG && !cli_stage_check(&stage, name))
+            goto done;
+    }
+    if (!cli_stage_check(&stage, "manifest.json"))
+        goto done;
+
+    cli_progress_init(&progress, "bake", a.quiet);
     lx_status st = lx_baker_bake(baker);
     /* a scene's dynamic lights are part of its look: evaluate them once too */
     if (st == LX_OK) {
@@ -439,25 +470,19 @@ int cmd_bake(int argc, char **argv)
     }
     cli_progress_finish(&progress);
     if (st != LX_OK) {
-        cli_error("%s", st == LX_ERR_CANCELLED ? "interrupted; nothing written" : lx_last_error());
+        if (st == LX_ERR_CANCELLED)
+            cli_report_interrupt(false);
+        else
+            cli_error("%s", lx_last_error());
         goto done;
     }
     double t_bake = cli_now() - t0;
 
-    images = calloc(maps, sizeof *images);
-    stems = calloc(maps, sizeof *stems);
-    if (!images || !stems) {
-        cli_error("out of memory");
-        goto done;
-    }
     for (uint32_t m = 0; m < maps; m++) {
         if (lx_baker_apply_alloc(baker, m, &images[m]) != LX_OK) {
             cli_error("%s", lx_last_error());
             goto done;
         }
-        char stem[256];
-        file_stem(lx_baker_lightmap_info(baker, m)->name, stems, m, stem, sizeof stem);
-        stems[m] = lx_strdup(stem);
     }
     double ev = a.has_exposure ? a.exposure_ev100 : auto_ev100(baker, images, &a);
     float exposure = lx_exposure_from_ev100((float)ev) * preview_scale(&a);
@@ -465,14 +490,12 @@ int cmd_bake(int argc, char **argv)
     float pre_exposure = lx_exposure_from_ev100((float)ev);
 
     if (cli_interrupted()) {
-        cli_error("interrupted; nothing written");
+        cli_report_interrupt(false);
         goto done;
     }
-    /* Everything goes to a staging folder inside the output folder first and
-     * is moved into place only when every file is written: a failure leaves
-     * the folder as it was, old lightmaps included. */
-    if (!cli_stage_begin(&stage, a.output))
-        goto done;
+    /* Everything goes to the staging folder first and is moved into place
+     * only when every file is written: a failure leaves the folder as it
+     * was, old lightmaps included. */
     cJSON *manifest = cJSON_CreateObject();
     cJSON_AddStringToObject(manifest, "scene", a.scene);
     cJSON_AddStringToObject(manifest, "quantity",
@@ -520,15 +543,10 @@ int cmd_bake(int argc, char **argv)
         free(text);
     }
     cJSON_Delete(manifest);
-    if (!failed && !cli_stage_publish(&stage)) {
+    if (!failed && !cli_stage_publish(&stage))
         failed = true;
-    }
-    cli_stage_clear(&stage);
-    if (failed) {
-        cli_set_writing(false);
+    if (failed)
         goto done;
-    }
-    cli_set_writing(false);
     if (!a.quiet) {
         uint64_t texels = 0;
         for (uint32_t m = 0; m < maps; m++)
@@ -542,6 +560,7 @@ int cmd_bake(int argc, char **argv)
     }
     status = EXIT_OK;
 done:
+    cli_stage_clear(&stage);
     if (images)
         for (uint32_t m = 0; m < maps; m++)
             lx_image_free(&images[m]);

@@ -37,9 +37,10 @@ int cli_load_environment(const char *command, const char *env, float intensity, 
                          lx_cubemap *out);
 
 /* Progress bar on stderr: drawn only when stderr is a terminal, not quiet,
- * and the work has run for more than a second. Returns false after SIGINT. */
+ * and the work has run for more than a second. Returns false once the run
+ * is interrupted, which cancels the library call it reports for. */
 typedef struct cli_progress {
-    const char *label;
+    const char *label; /* also the phase name of LUXEL_TEST_PAUSE */
     bool enabled;
     bool drawn;
     double start;
@@ -49,62 +50,82 @@ void cli_progress_init(cli_progress *p, const char *label, bool quiet);
 bool cli_progress_update(void *user, float fraction);
 void cli_progress_finish(cli_progress *p);
 
-/* SIGINT/SIGTERM: cancel the running work; while outputs are being written,
- * remove this run's files and exit. */
-void cli_install_signal_handlers(void);
+/* ---- interrupts (main.c) -------------------------------------------------
+ * SIGINT, SIGTERM and SIGHUP are blocked in every thread from the first
+ * line of main (threads made later inherit the mask), so no handler ever
+ * runs: a signal waits, pending, until cli_interrupted() takes it, and the
+ * command then winds down through its ordinary error path, removing what
+ * it staged. main ends an interrupted run by re-raising the signal. */
+void cli_block_signals(void);
+/* True once a signal has come (takes a pending one). Any thread. */
 bool cli_interrupted(void);
-/* Registers a completed output so an interrupt can remove it; false when
- * out of memory (the caller must not write it then). */
-bool cli_track_output(const char *path);
-void cli_remove_tracked_outputs(void);
-/* Stops tracking outputs without removing them (they were published). */
-void cli_forget_outputs(void);
-/* Folders an interrupt removes after the tracked files, if empty: the
- * staging folder, then the `count` folders this run created, deepest first
- * (the output folder and its parents that were missing). */
-void cli_track_dir(const char *dir, const char *const *created, uint32_t count);
-void cli_set_writing(bool writing);
+/* The signal that interrupted the run, 0 when none. */
+int cli_interrupt_signal(void);
+/* Prints the one error line of an interrupted run. */
+void cli_report_interrupt(bool removed_outputs);
+
+/* Test hooks, read from the environment (never set outside tests):
+ * LUXEL_TEST_PAUSE=PHASE stops the run the first time it reaches PHASE (a
+ * progress label such as "bake", or "write" once the first output file is
+ * staged), says "luxel: test: paused at PHASE" on stderr and waits up to a
+ * minute for a signal, so a test can interrupt a run at a known point. */
+void cli_test_pause(const char *phase);
+/* LUXEL_TEST_FAIL_RENAME=N: true for the Nth rename cli_stage_publish
+ * makes (1 = the first), which then fails as if the disk had. */
+bool cli_test_fail_rename(void);
 
 /* Monotonic seconds. */
 double cli_now(void);
 
+/* strdup and a/b joined, malloc'd; NULL when out of memory. */
+char *cli_strdup(const char *s);
+char *cli_path_join(const char *a, const char *b);
+
 /* ---- staged output (stage.c) ---------------------------------------------
- * Files go to OUTPUT/.luxel-<6 random characters> and are moved into
- * OUTPUT together by cli_stage_publish once all are written; interrupts remove them. Every
- * function prints its own "luxel: error:" line and returns false on
- * failure. Usage:
+ * The commands that write several files (bake, ibl) stage them in
+ * OUTPUT/.luxel-XXXXXX and move them into OUTPUT together once all are
+ * written. cli_stage_begin runs before the long work, so a folder that
+ * cannot be written is reported before anything is computed; a failed or
+ * interrupted run leaves OUTPUT as it was (and removes it, and any parent,
+ * when the run created them). Publishing keeps a hard link (or the file
+ * itself) of every output it replaces until all are in place, and puts the
+ * old files back if a rename fails half-way. Every function prints its own
+ * "luxel: error:" line and returns false on failure. Usage:
  *   cli_stage st;
  *   if (!cli_stage_begin(&st, dir)) return EXIT_FAILED;
+ *   ... compute ...
  *   bool ok = cli_stage_image(&st, "a.exr", &img, NULL) && cli_stage_publish(&st);
- *   cli_stage_clear(&st); cli_set_writing(false);
+ *   cli_stage_clear(&st);
  */
 typedef struct cli_stage {
     char *output; /* the final folder */
-    char *dir;    /* OUTPUT/.luxel- and six random characters (mkdtemp) */
-    char **names; /* files written into it */
-    uint32_t count;
-    bool created; /* the output folder is this run's and nothing is published yet */
-    char **made;  /* the folders this run created, deepest first */
+    char *dir;    /* OUTPUT/.luxel-XXXXXX (mkdtemp) */
+    char **names; /* files staged in dir, in the order they were named */
+    uint32_t count, capacity;
+    char **made; /* folders this run created, deepest first */
     uint32_t made_count;
+    bool published; /* the outputs are in place: nothing is undone */
 } cli_stage;
 
 /* Creates dir and its parents. */
 bool cli_make_dirs(const char *dir);
-/* Creates the output folder and the staging folder inside it, and enters
- * the writing state (an interrupt removes this run's files). */
+/* Creates the output folder (and parents) and the staging folder in it. */
 bool cli_stage_begin(cli_stage *st, const char *output);
-/* The path of a new staged file (malloc'd; tracked so an interrupt removes
- * it), for writers other than images and text; end with cli_stage_finish
- * and the writer's status. NULL when out of memory. */
+/* Checks that OUTPUT/name can be replaced: nothing but a regular file (or
+ * nothing) is in the way. For checking every name before the long work. */
+bool cli_stage_check(const cli_stage *st, const char *name);
+/* The staging path of output `name` (malloc'd) for writers other than
+ * images and text; end with cli_stage_finish and the writer's status.
+ * NULL (error printed) when out of memory or interrupted. */
 char *cli_stage_path(cli_stage *st, const char *name);
 bool cli_stage_finish(cli_stage *st, const char *name, lx_status status);
 bool cli_stage_image(cli_stage *st, const char *name, const lx_image *img,
                      const lx_image_write_desc *desc);
 bool cli_stage_text(cli_stage *st, const char *name, const char *text);
-/* Moves every staged file into the output folder, with interrupts held
- * off; on a failed rename the ones already moved are removed again. */
+/* Moves every staged file into the output folder (see above). */
 bool cli_stage_publish(cli_stage *st);
-/* Removes whatever is still staged and the staging folder. */
+/* Removes whatever is still staged, the staging folder, and, unless the
+ * outputs were published, the folders the run created. */
 void cli_stage_clear(cli_stage *st);
 
 #endif

@@ -15,6 +15,7 @@
 #include <stdio.h>
 #include <stdlib.h>
 #include <string.h>
+#include <unistd.h>
 
 static const char *ibl_usage =
     "usage: luxel ibl ENV [options]\n"
@@ -310,7 +311,7 @@ static bool note(writer *w, const char *name)
         return false;
     }
     w->written = n;
-    w->written[w->written_count] = lx_strdup(name);
+    w->written[w->written_count] = cli_strdup(name);
     if (!w->written[w->written_count]) {
         cli_error("out of memory");
         return false;
@@ -445,11 +446,15 @@ static double peak_bytes(const ibl_args *a, int env_size, int spec_size)
 static bool fits(const ibl_args *a, int env_size)
 {
     int spec_size = a->size ? a->size : (env_size < 256 ? env_size : 256);
-    char what[300];
-    snprintf(what, sizeof what, "%s: filtering a %d x %d environment", a->env, env_size, env_size);
-    if (lx_check_memory((uint64_t)peak_bytes(a, env_size, spec_size), what) == LX_OK)
+    double need = peak_bytes(a, env_size, spec_size);
+    long pages = sysconf(_SC_PHYS_PAGES), page_size = sysconf(_SC_PAGESIZE);
+    double have = pages > 0 && page_size > 0 ? (double)pages * (double)page_size : 0.0;
+    if (have == 0.0 || need <= have)
         return true;
-    cli_error("%s", lx_last_error());
+    const double gib = 1024.0 * 1024.0 * 1024.0;
+    cli_error("%s: filtering a %d x %d environment needs %.1f GiB of memory, the machine has "
+              "%.1f GiB",
+              a->env, env_size, env_size, need / gib, have / gib);
     return false;
 }
 
@@ -458,7 +463,7 @@ static bool cancelled_or_failed(lx_status s, const char *what)
     if (s == LX_OK)
         return false;
     if (s == LX_ERR_CANCELLED)
-        cli_error("interrupted; nothing written");
+        cli_report_interrupt(false);
     else
         cli_error("%s: %s", what, lx_last_error());
     return true;
@@ -485,6 +490,9 @@ int cmd_ibl(int argc, char **argv)
 
     /* the environment; with --size its size is known before it is made */
     if (a.size && !fits(&a, a.size))
+        goto done;
+    /* the output folder is checked (and made) before the long work */
+    if (!cli_stage_begin(&w.stage, a.output))
         goto done;
     int loaded = cli_load_environment("ibl", a.env, a.intensity, a.size, &env);
     if (loaded != EXIT_OK) {
@@ -557,13 +565,11 @@ int cmd_ibl(int argc, char **argv)
     }
     double t_compute = cli_now() - t0;
     if (cli_interrupted()) {
-        cli_error("interrupted; nothing written");
+        cli_report_interrupt(false);
         goto done;
     }
 
     /* everything is computed: stage the files, then move them into place */
-    if (!cli_stage_begin(&w.stage, a.output))
-        goto done;
     bool ok = true;
     if (ok && a.irradiance)
         ok = put_cube(&w, "irradiance", &irr, 1, false);
@@ -586,8 +592,6 @@ int cmd_ibl(int argc, char **argv)
         ok = put_cube(&w, "environment", &env, 1, false);
     if (ok)
         ok = cli_stage_publish(&w.stage);
-    cli_stage_clear(&w.stage);
-    cli_set_writing(false);
     if (!ok)
         goto done;
     if (!a.quiet) {
@@ -598,6 +602,7 @@ int cmd_ibl(int argc, char **argv)
     }
     status = EXIT_OK;
 done:
+    cli_stage_clear(&w.stage);
     lx_cubemap_free(&env);
     lx_cubemap_free(&irr);
     for (int l = 0; l < LX_MAX_CUBE_MIPS; l++)

@@ -241,14 +241,11 @@ int cmd_ies(int argc, char **argv)
     print_beam("C90-C270", beam_angle(p, 90.0f));
     int rc = EXIT_OK;
     if (plot_path) {
-        cli_set_writing(true);
+        /* one file, written under a temporary name and renamed */
         if (plot(p, plot_path) != LX_OK) {
             cli_error("%s", lx_last_error());
             rc = EXIT_FAILED;
-        } else {
-            cli_track_output(plot_path);
         }
-        cli_set_writing(false);
     }
     lx_ies_free(p);
     return rc;

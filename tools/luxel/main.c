@@ -1,14 +1,15 @@
 /* luxel: the command-line tool. Dispatches to one file per subcommand and
  * holds the pieces they share: error printing, strict number parsing, the
- * progress bar and interrupt handling. */
+ * progress bar, interrupts (blocked signals polled as a flag) and the test
+ * hooks. */
 #define _POSIX_C_SOURCE 200809L
 #include "cli.h"
 
 #include <errno.h>
-#include <limits.h>
 #include <math.h>
 #include <pthread.h>
 #include <signal.h>
+#include <stdatomic.h>
 #include <stdarg.h>
 #include <stdio.h>
 #include <stdlib.h>
@@ -121,128 +122,120 @@ double cli_now(void)
     return (double)ts.tv_sec + (double)ts.tv_nsec * 1e-9;
 }
 
-/* ---- interrupts ---------------------------------------------------------- */
-
-static volatile sig_atomic_t interrupted;
-static volatile sig_atomic_t writing;
-/* This run's outputs: grown by copying, so the handler always sees a
- * complete array and a count of entries already in it. */
-static char **volatile tracked;
-static volatile sig_atomic_t tracked_count;
-static size_t tracked_capacity;
-static char *tracked_dir;
-static char **tracked_made; /* folders this run created, deepest first */
-static volatile sig_atomic_t tracked_made_count;
-
-static pthread_t main_thread;
-
-static void on_signal(int sig)
+char *cli_strdup(const char *s)
 {
-    /* Only the main thread writes files: a signal that lands on an OpenMP
-     * or Embree worker goes to it, so the cleanup below never races a file
-     * the main thread is creating. */
-    if (!pthread_equal(pthread_self(), main_thread)) {
-        pthread_kill(main_thread, sig);
-        return;
-    }
-    interrupted = 1;
-    if (writing) {
-        lx_out_abort_all_signal_safe();
-        for (sig_atomic_t i = 0; i < tracked_count; i++)
-            unlink(tracked[i]);
-        if (tracked_dir)
-            rmdir(tracked_dir);
-        for (sig_atomic_t i = 0; i < tracked_made_count; i++)
-            rmdir(tracked_made[i]);
-        static const char msg[] = "\nluxel: error: interrupted; outputs removed\n";
-        ssize_t unused = write(2, msg, sizeof msg - 1);
-        (void)unused;
-        _exit(128 + sig);
-    }
+    return strdup(s);
 }
 
-void cli_install_signal_handlers(void)
+char *cli_path_join(const char *a, const char *b)
 {
-    main_thread = pthread_self();
-    struct sigaction sa;
-    memset(&sa, 0, sizeof sa);
-    sa.sa_handler = on_signal;
-    sigemptyset(&sa.sa_mask);
-    sigaction(SIGINT, &sa, NULL);
-    sigaction(SIGTERM, &sa, NULL);
+    if (b[0] == '/' || !a[0])
+        return strdup(b);
+    size_t na = strlen(a), nb = strlen(b);
+    bool slash = a[na - 1] != '/';
+    char *r = malloc(na + nb + 2);
+    if (!r)
+        return NULL;
+    memcpy(r, a, na);
+    if (slash)
+        r[na++] = '/';
+    memcpy(r + na, b, nb + 1);
+    return r;
+}
+
+/* ---- interrupts ---------------------------------------------------------- */
+
+static _Atomic int interrupt_signal;
+
+static void interrupt_set(sigset_t *set)
+{
+    sigemptyset(set);
+    sigaddset(set, SIGINT);
+    sigaddset(set, SIGTERM);
+    sigaddset(set, SIGHUP);
+}
+
+void cli_block_signals(void)
+{
+    sigset_t set;
+    interrupt_set(&set);
+    pthread_sigmask(SIG_BLOCK, &set, NULL);
+}
+
+/* Takes a pending signal, waiting up to `seconds`; 0 when none came. */
+static int take_signal(double seconds)
+{
+    sigset_t set;
+    interrupt_set(&set);
+    struct timespec wait = {(time_t)seconds, (long)((seconds - (double)(time_t)seconds) * 1e9)};
+    int sig;
+    do
+        sig = sigtimedwait(&set, NULL, &wait);
+    while (sig < 0 && errno == EINTR);
+    return sig > 0 ? sig : 0;
 }
 
 bool cli_interrupted(void)
 {
-    return interrupted != 0;
-}
-
-bool cli_track_output(const char *path)
-{
-    char *copy = lx_strdup(path);
-    if (!copy)
+    if (atomic_load(&interrupt_signal))
+        return true;
+    sigset_t pending;
+    if (sigpending(&pending) != 0 ||
+        !(sigismember(&pending, SIGINT) || sigismember(&pending, SIGTERM) ||
+          sigismember(&pending, SIGHUP)))
         return false;
-    size_t count = (size_t)tracked_count;
-    if (count == tracked_capacity) {
-        size_t capacity = tracked_capacity ? 2 * tracked_capacity : 64;
-        char **grown = count < INT_MAX / 2 ? malloc(sizeof(char *) * capacity) : NULL;
-        if (!grown) {
-            free(copy);
-            return false;
-        }
-        if (count)
-            memcpy(grown, tracked, sizeof(char *) * count);
-        char **old = tracked;
-        tracked = grown;
-        tracked_capacity = capacity;
-        free(old);
+    int sig = take_signal(0.0);
+    if (sig) {
+        int none = 0;
+        atomic_compare_exchange_strong(&interrupt_signal, &none, sig);
     }
-    tracked[count] = copy;
-    tracked_count = (sig_atomic_t)(count + 1);
-    return true;
+    return atomic_load(&interrupt_signal) != 0;
 }
 
-void cli_remove_tracked_outputs(void)
+int cli_interrupt_signal(void)
 {
-    sig_atomic_t count = tracked_count;
-    for (sig_atomic_t i = 0; i < count; i++)
-        unlink(tracked[i]);
-    tracked_count = 0;
-    for (sig_atomic_t i = 0; i < count; i++)
-        free(tracked[i]);
+    return atomic_load(&interrupt_signal);
 }
 
-void cli_forget_outputs(void)
+void cli_report_interrupt(bool removed_outputs)
 {
-    sig_atomic_t count = tracked_count;
-    tracked_count = 0;
-    for (sig_atomic_t i = 0; i < count; i++)
-        free(tracked[i]);
+    cli_error("interrupted; %s", removed_outputs ? "outputs removed" : "nothing written");
 }
 
-void cli_track_dir(const char *dir, const char *const *created, uint32_t count)
+/* Ends an interrupted run the way the signal would have: default action,
+ * unblocked, raised. Returns only if the signal does not end the process. */
+static int end_interrupted(int sig)
 {
-    /* the handler sees no folders while the lists change */
-    sig_atomic_t old_count = tracked_made_count;
-    tracked_made_count = 0;
-    for (sig_atomic_t i = 0; i < old_count; i++)
-        free(tracked_made[i]);
-    free(tracked_made);
-    tracked_made = NULL;
-    free(tracked_dir);
-    tracked_dir = dir ? lx_strdup(dir) : NULL;
-    char **made = count ? calloc(count, sizeof *made) : NULL;
-    uint32_t n = 0;
-    for (; made && n < count; n++)
-        if (!(made[n] = lx_strdup(created[n])))
-            break;
-    tracked_made = made;
-    tracked_made_count = (sig_atomic_t)n;
+    fflush(stdout);
+    signal(sig, SIG_DFL);
+    sigset_t set;
+    sigemptyset(&set);
+    sigaddset(&set, sig);
+    raise(sig);
+    pthread_sigmask(SIG_UNBLOCK, &set, NULL);
+    return 128 + sig;
 }
 
-void cli_set_writing(bool w)
+void cli_test_pause(const char *phase)
 {
-    writing = w;
+    static _Atomic bool paused;
+    const char *want = getenv("LUXEL_TEST_PAUSE");
+    if (!want || strcmp(want, phase) != 0 || atomic_exchange(&paused, true))
+        return;
+    fprintf(stderr, "luxel: test: paused at %s\n", phase);
+    fflush(stderr);
+    int sig = take_signal(60.0);
+    if (sig) {
+        int none = 0;
+        atomic_compare_exchange_strong(&interrupt_signal, &none, sig);
+    }
+}
+
+bool cli_test_fail_rename(void)
+{
+    static _Atomic long renames;
+    const char *nth = getenv("LUXEL_TEST_FAIL_RENAME");
+    return nth && atol(nth) == ++renames;
 }
 
 /* ---- progress bar -------------------------------------------------------- */
@@ -259,7 +252,8 @@ void cli_progress_init(cli_progress *p, const char *label, bool quiet)
 bool cli_progress_update(void *user, float fraction)
 {
     cli_progress *p = user;
-    if (interrupted)
+    cli_test_pause(p->label);
+    if (cli_interrupted())
         return false;
     if (!p->enabled)
         return true;
@@ -300,6 +294,8 @@ static void print_log(void *user, lx_log_level level, const char *message)
 
 int main(int argc, char **argv)
 {
+    /* before any thread exists, so every thread inherits the mask */
+    cli_block_signals();
     if (argc < 2) {
         fputs(main_usage, stderr);
         return EXIT_USAGE;
@@ -313,16 +309,20 @@ int main(int argc, char **argv)
         printf("luxel %s\n", lx_version());
         return EXIT_OK;
     }
-    lx_set_log_callback(print_log, NULL);
-    cli_install_signal_handlers();
-    if (strcmp(cmd, "bake") == 0)
-        return cmd_bake(argc - 1, argv + 1);
-    if (strcmp(cmd, "info") == 0)
-        return cmd_info(argc - 1, argv + 1);
-    if (strcmp(cmd, "ies") == 0)
-        return cmd_ies(argc - 1, argv + 1);
-    if (strcmp(cmd, "ibl") == 0)
-        return cmd_ibl(argc - 1, argv + 1);
+    static const struct {
+        const char *name;
+        int (*run)(int argc, char **argv);
+    } commands[] = {{"bake", cmd_bake}, {"info", cmd_info}, {"ies", cmd_ies}, {"ibl", cmd_ibl}};
+    for (size_t i = 0; i < sizeof commands / sizeof commands[0]; i++)
+        if (strcmp(cmd, commands[i].name) == 0) {
+            lx_set_log_callback(print_log, NULL);
+            int status = commands[i].run(argc - 1, argv + 1);
+            /* a run that finished anyway (the signal came while its outputs
+             * were moved into place) keeps its status */
+            if (status != EXIT_OK && cli_interrupt_signal())
+                return end_interrupted(cli_interrupt_signal());
+            return status;
+        }
     if (cmd[0] == '-')
         return cli_usage_error(NULL, "unknown option '%s'", cmd);
     return cli_usage_error(NULL, "unknown command '%s'", cmd);

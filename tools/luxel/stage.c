@@ -1,17 +1,21 @@
 /* Staged output for the commands that write several files (bake, ibl):
- * every file goes to DIR/.luxel-<6 random characters> first and is moved
- * into DIR only when all of them are written, so a failure or an interrupt
- * leaves DIR as it was. */
+ * every file goes to DIR/.luxel-XXXXXX first and is moved into DIR only
+ * when all of them are written, so a failure or an interrupt leaves DIR as
+ * it was. Publishing keeps what it replaces until the last rename is done
+ * and restores it if one fails. */
 #define _POSIX_C_SOURCE 200809L
 #include "cli.h"
 
 #include <errno.h>
-#include <signal.h>
 #include <stdio.h>
 #include <stdlib.h>
 #include <string.h>
 #include <sys/stat.h>
 #include <unistd.h>
+
+/* The folder inside the staging folder that holds the replaced outputs
+ * while publishing (staged names never start with a dot). */
+#define PREVIOUS ".previous"
 
 bool cli_make_dirs(const char *dir)
 {
@@ -19,7 +23,7 @@ bool cli_make_dirs(const char *dir)
         errno = ENOENT;
         return false;
     }
-    char *p = lx_strdup(dir);
+    char *p = cli_strdup(dir);
     if (!p)
         return false;
     for (char *s = p + 1; *s; s++)
@@ -33,163 +37,158 @@ bool cli_make_dirs(const char *dir)
         }
     bool ok = mkdir(p, 0777) == 0 || errno == EEXIST;
     struct stat st;
-    ok = ok && stat(p, &st) == 0 && S_ISDIR(st.st_mode);
+    if (ok && (stat(p, &st) != 0 || !S_ISDIR(st.st_mode))) {
+        ok = false;
+        errno = ENOTDIR;
+    }
     free(p);
     return ok;
 }
 
-static char *make_staging(const char *output)
-{
-    /* mkdtemp's template: six X at the end that it replaces */
-    char name[16] = ".luxel-";
-    memset(name + 7, 'X', 6);
-    char *dir = lx_path_join(output, name);
-    if (dir && !mkdtemp(dir)) {
-        free(dir);
-        return NULL;
-    }
-    return dir;
-}
-
 /* The folders among path and its parents that do not exist yet, deepest
- * first (malloc'd, *count of them): the ones cli_make_dirs will create.
- * NULL with *count 0 when there are none or memory ran out. */
-static char **missing_dirs(const char *path, uint32_t *count)
+ * first: the ones cli_make_dirs will create. false when out of memory. */
+static bool find_missing_dirs(cli_stage *st, const char *path)
 {
-    *count = 0;
-    char *p = lx_strdup(path);
-    char **list = NULL;
+    char *p = cli_strdup(path);
+    if (!p)
+        return false;
     struct stat sb;
-    while (p && p[0] && stat(p, &sb) != 0) {
-        char **grown = realloc(list, sizeof(char *) * (*count + 1));
-        char *copy = grown ? lx_strdup(p) : NULL;
+    bool ok = true;
+    while (p[0] && lstat(p, &sb) != 0) {
+        char **grown = realloc(st->made, sizeof(char *) * (st->made_count + 1));
+        char *copy = grown ? cli_strdup(p) : NULL;
         if (grown)
-            list = grown;
-        if (!copy)
+            st->made = grown;
+        if (!copy) {
+            ok = false;
             break;
-        list[(*count)++] = copy;
+        }
+        st->made[st->made_count++] = copy;
         char *slash = strrchr(p, '/');
         if (!slash || slash == p)
             break;
         *slash = '\0';
     }
     free(p);
-    return list;
+    return ok;
 }
 
-/* Removes the folders a run made (deepest first; only empty ones go). */
-static void remove_made(cli_stage *st)
+/* Removes the folders the run made, deepest first (only empty ones go). */
+static void remove_made(const cli_stage *st)
 {
     for (uint32_t i = 0; i < st->made_count; i++)
         rmdir(st->made[i]);
 }
 
-static void free_made(cli_stage *st)
+static void stage_free(cli_stage *st)
 {
     for (uint32_t i = 0; i < st->made_count; i++)
         free(st->made[i]);
+    for (uint32_t i = 0; i < st->count; i++)
+        free(st->names[i]);
     free(st->made);
-    st->made = NULL;
-    st->made_count = 0;
+    free(st->names);
+    free(st->dir);
+    free(st->output);
+    memset(st, 0, sizeof *st);
 }
-
-static bool stage_begin(cli_stage *st, const char *output);
 
 bool cli_stage_begin(cli_stage *st, const char *output)
 {
-    /* Ctrl-C waits until the folders exist and are tracked: a signal in
-     * between would leave a staging folder the handler does not know. */
-    sigset_t block, old;
-    sigemptyset(&block);
-    sigaddset(&block, SIGINT);
-    sigaddset(&block, SIGTERM);
-    sigprocmask(SIG_BLOCK, &block, &old);
-    bool ok = stage_begin(st, output);
-    sigprocmask(SIG_SETMASK, &old, NULL);
-    return ok;
-}
-
-static bool stage_begin(cli_stage *st, const char *output)
-{
     memset(st, 0, sizeof *st);
-    /* the folders this run makes (the output folder and any missing
-     * parents) go again if the run writes nothing */
-    st->made = missing_dirs(output, &st->made_count);
-    if (!cli_make_dirs(output)) {
-        cli_error("%s: cannot create the output folder: %s", output, strerror(errno));
-        remove_made(st);
-        free_made(st);
-        return false;
-    }
-    st->output = lx_strdup(output);
-    if (!st->output) {
+    st->output = cli_strdup(output);
+    if (!st->output || !find_missing_dirs(st, output)) {
         cli_error("out of memory");
-        remove_made(st);
-        free_made(st);
+        stage_free(st);
         return false;
     }
-    cli_set_writing(true);
-    st->dir = make_staging(output);
-    if (!st->dir) {
-        cli_error("%s: cannot write into the output folder: %s", output, strerror(errno));
-        cli_set_writing(false);
+    if (!cli_make_dirs(output)) {
+        int err = errno;
+        cli_error("%s: cannot create the output folder: %s", output,
+                  err == ENOTDIR || err == EEXIST ? "something that is not a folder is in the way"
+                                                  : strerror(err));
         remove_made(st);
-        free_made(st);
-        free(st->output);
-        st->output = NULL;
+        stage_free(st);
         return false;
     }
-    st->created = st->made_count > 0;
-    cli_track_dir(st->dir, (const char *const *)st->made, st->made_count);
+    /* mkdtemp's template: six X at the end that it replaces */
+    st->dir = cli_path_join(output, ".luxel-XXXXXX");
+    if (!st->dir || !mkdtemp(st->dir)) {
+        int err = errno;
+        if (st->dir)
+            cli_error("%s: cannot write into the output folder: %s", output, strerror(err));
+        else
+            cli_error("out of memory");
+        free(st->dir);
+        st->dir = NULL;
+        remove_made(st);
+        stage_free(st);
+        return false;
+    }
     return true;
 }
 
-/* Reports an error from a staged write under the final folder's name. */
-static void stage_error(const cli_stage *st)
+bool cli_stage_check(const cli_stage *st, const char *name)
 {
-    const char *msg = lx_last_error();
-    size_t n = strlen(st->dir);
-    if (strncmp(msg, st->dir, n) == 0)
-        cli_error("%s%s", st->output, msg + n);
-    else
-        cli_error("%s", msg);
+    char *to = cli_path_join(st->output, name);
+    if (!to) {
+        cli_error("out of memory");
+        return false;
+    }
+    struct stat sb;
+    bool ok = lstat(to, &sb) != 0 || S_ISREG(sb.st_mode);
+    if (!ok)
+        cli_error("%s: cannot write: something that is not a file is in the way", to);
+    free(to);
+    return ok;
 }
 
 char *cli_stage_path(cli_stage *st, const char *name)
 {
-    char *path = lx_path_join(st->dir, name);
-    if (!path) {
-        cli_error("out of memory");
+    if (cli_interrupted()) {
+        cli_report_interrupt(true);
         return NULL;
     }
-    /* tracked before it exists: an interrupt right after the rename that
-     * completes the file still finds it */
-    if (!cli_track_output(path)) {
+    if (!cli_stage_check(st, name))
+        return NULL;
+    /* named before it exists, so cli_stage_clear removes whatever the
+     * writer leaves behind */
+    if (st->count == st->capacity) {
+        uint32_t capacity = st->capacity ? 2 * st->capacity : 16;
+        char **grown = realloc(st->names, sizeof(char *) * capacity);
+        if (!grown) {
+            cli_error("out of memory");
+            return NULL;
+        }
+        st->names = grown;
+        st->capacity = capacity;
+    }
+    char *copy = cli_strdup(name);
+    char *path = cli_path_join(st->dir, name);
+    if (!copy || !path) {
+        free(copy);
         free(path);
         cli_error("out of memory");
         return NULL;
     }
+    st->names[st->count++] = copy;
     return path;
 }
 
 bool cli_stage_finish(cli_stage *st, const char *name, lx_status s)
 {
     if (s != LX_OK) {
-        stage_error(st);
+        /* the writer's message names the staging path: show the final one */
+        const char *msg = lx_last_error();
+        size_t n = strlen(st->dir);
+        if (strncmp(msg, st->dir, n) == 0)
+            cli_error("%s%s", st->output, msg + n);
+        else
+            cli_error("%s: %s", name, msg);
         return false;
     }
-    char **names = realloc(st->names, sizeof(char *) * (st->count + 1));
-    if (!names) {
-        cli_error("out of memory");
-        return false;
-    }
-    st->names = names;
-    st->names[st->count] = lx_strdup(name);
-    if (!st->names[st->count]) {
-        cli_error("out of memory");
-        return false;
-    }
-    st->count++;
+    if (st->count == 1)
+        cli_test_pause("write");
     return true;
 }
 
@@ -204,88 +203,132 @@ bool cli_stage_image(cli_stage *st, const char *name, const lx_image *img,
     return cli_stage_finish(st, name, s);
 }
 
-static lx_status write_text(const char *path, const char *text)
-{
-    lx_out_file f;
-    lx_status st = lx_out_open(&f, path);
-    if (st != LX_OK)
-        return st;
-    fputs(text, (FILE *)f.fp);
-    return lx_out_commit(&f);
-}
-
 bool cli_stage_text(cli_stage *st, const char *name, const char *text)
 {
     char *path = cli_stage_path(st, name);
     if (!path)
         return false;
-    lx_status s = write_text(path, text);
+    /* the staging folder is this run's alone: no temporary name needed */
+    FILE *fp = fopen(path, "wb");
+    bool ok = fp && fputs(text, fp) >= 0;
+    ok = fp && fclose(fp) == 0 && ok;
+    if (!ok)
+        cli_error("%s/%s: cannot write: %s", st->output, name, strerror(errno));
     free(path);
-    return cli_stage_finish(st, name, s);
+    return ok && cli_stage_finish(st, name, LX_OK);
+}
+
+/* What publishing did to one output: whether an old file was there, and
+ * whether the new one is in its place yet. */
+typedef struct published {
+    bool had_old;  /* OUTPUT/name existed: a copy of it is in PREVIOUS */
+    bool old_gone; /* the old file was moved, not linked: OUTPUT/name is missing */
+    bool placed;   /* the new file is OUTPUT/name */
+} published;
+
+/* Puts back what publishing the first n outputs changed, last first. */
+static void restore(const cli_stage *st, const published *done, uint32_t n, const char *previous)
+{
+    for (uint32_t i = n; i-- > 0;) {
+        char *to = cli_path_join(st->output, st->names[i]);
+        char *kept = cli_path_join(previous, st->names[i]);
+        if (to && kept) {
+            if (done[i].had_old && (done[i].placed || done[i].old_gone)) {
+                if (rename(kept, to) != 0)
+                    cli_error("%s: could not put the previous file back (it is in %s): %s", to,
+                              kept, strerror(errno));
+            } else if (done[i].placed) {
+                unlink(to);
+            }
+        }
+        free(to);
+        free(kept);
+    }
 }
 
 bool cli_stage_publish(cli_stage *st)
 {
-    const char *output = st->output;
-    sigset_t block, old;
-    sigemptyset(&block);
-    sigaddset(&block, SIGINT);
-    sigaddset(&block, SIGTERM);
-    sigprocmask(SIG_BLOCK, &block, &old);
-    bool ok = true;
-    /* anything but a file in the way would fail its rename half-way through */
-    for (uint32_t i = 0; i < st->count && ok; i++) {
-        char *to = lx_path_join(output, st->names[i]);
-        struct stat sb;
-        if (!to || (lstat(to, &sb) == 0 && !S_ISREG(sb.st_mode))) {
-            cli_error("%s: cannot write: something that is not a file is in the way",
-                      to ? to : output);
-            ok = false;
-        }
-        free(to);
+    /* anything but a file in the way would fail its rename half-way */
+    for (uint32_t i = 0; i < st->count; i++)
+        if (!cli_stage_check(st, st->names[i]))
+            return false;
+    char *previous = cli_path_join(st->dir, PREVIOUS);
+    published *done = calloc(st->count + 1, sizeof *done);
+    if (!previous || !done || mkdir(previous, 0700) != 0) {
+        cli_error("%s: cannot publish: %s", st->output,
+                  previous && done ? strerror(errno) : "out of memory");
+        free(previous);
+        free(done);
+        return false;
     }
-    uint32_t moved = 0;
-    for (uint32_t i = 0; i < st->count && ok; i++) {
-        char *from = lx_path_join(st->dir, st->names[i]);
-        char *to = lx_path_join(output, st->names[i]);
-        if (!from || !to || rename(from, to) != 0) {
-            cli_error("%s: cannot move into place: %s", to ? to : output, strerror(errno));
-            ok = false;
+    bool ok = true;
+    uint32_t i = 0;
+    for (; i < st->count && ok; i++) {
+        char *from = cli_path_join(st->dir, st->names[i]);
+        char *to = cli_path_join(st->output, st->names[i]);
+        char *kept = cli_path_join(previous, st->names[i]);
+        ok = from && to && kept;
+        if (!ok)
+            cli_error("out of memory");
+        struct stat sb;
+        if (ok && lstat(to, &sb) == 0) {
+            /* keep the old file: a second name for it (the output stays in
+             * place meanwhile), or the file itself where links are refused */
+            done[i].had_old = true;
+            if (link(to, kept) != 0) {
+                done[i].old_gone = rename(to, kept) == 0;
+                if (!done[i].old_gone) {
+                    cli_error("%s: cannot set the previous file aside: %s", to, strerror(errno));
+                    done[i].had_old = false;
+                    ok = false;
+                }
+            }
+        }
+        if (ok) {
+            errno = EIO; /* what an injected failure reports */
+            if (cli_test_fail_rename() || rename(from, to) != 0) {
+                cli_error("%s: cannot move into place: %s", to, strerror(errno));
+                ok = false;
+            } else {
+                done[i].placed = true;
+            }
         }
         free(from);
         free(to);
-        moved += ok;
+        free(kept);
     }
-    /* a rename that failed anyway: this run's files do not stay half-published */
-    for (uint32_t i = 0; i < moved && !ok; i++) {
-        char *to = lx_path_join(output, st->names[i]);
-        if (to)
-            unlink(to);
-        free(to);
+    if (!ok)
+        restore(st, done, i, previous);
+    /* What is left in PREVIOUS: after success, the replaced files; after a
+     * failure, only second links to old files that never left their place
+     * (restore moved the others back, and one it could not move is the
+     * only copy: it stays). */
+    for (uint32_t k = 0; k < i; k++) {
+        bool spare = ok || (done[k].had_old && !done[k].old_gone && !done[k].placed);
+        char *kept = spare ? cli_path_join(previous, st->names[k]) : NULL;
+        if (kept)
+            unlink(kept);
+        free(kept);
     }
-    if (ok) {
-        /* the run is complete: a signal held off until now must not undo it */
-        cli_forget_outputs();
-        cli_set_writing(false);
-        st->created = false;
-    }
-    sigprocmask(SIG_SETMASK, &old, NULL);
+    rmdir(previous);
+    free(previous);
+    free(done);
+    st->published = ok;
     return ok;
 }
 
 void cli_stage_clear(cli_stage *st)
 {
-    cli_remove_tracked_outputs();
-    if (st->dir)
+    if (st->dir) {
+        for (uint32_t i = 0; i < st->count; i++) {
+            char *path = cli_path_join(st->dir, st->names[i]);
+            if (path)
+                unlink(path);
+            free(path);
+        }
         rmdir(st->dir);
-    if (st->created)
+    }
+    if (!st->published)
         remove_made(st);
-    cli_track_dir(NULL, NULL, 0);
-    free_made(st);
-    for (uint32_t i = 0; i < st->count; i++)
-        free(st->names[i]);
-    free(st->names);
-    free(st->dir);
-    free(st->output);
-    memset(st, 0, sizeof *st);
+    stage_free(st);
 }
