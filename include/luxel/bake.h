@@ -50,7 +50,10 @@ typedef enum lx_quantity {
     LX_QUANTITY_RADIANCE        /* nits, irradiance * base colour / pi */
 } lx_quantity;
 
-#define LX_PADDING_NONE (-1)
+/* Dilation around the charts: none (the library's default), or the texels
+ * `luxel bake` uses unless told otherwise. */
+#define LX_PADDING_NONE 0
+#define LX_PADDING_RECOMMENDED 2
 #define LX_MAX_LIGHTMAP_SIZE 16384
 
 /* Sky light: every texel lit by an environment (radiance in nits, luxel's
@@ -67,13 +70,18 @@ typedef struct lx_sky_desc {
     uint32_t samples;              /* rays per texel with shadows, 0 = 64 */
 } lx_sky_desc;
 
+/* A copy of desc (or of zeros when NULL) with every default filled in. */
+lx_sky_desc lx_sky_desc_defaults(const lx_sky_desc *desc);
+
 typedef struct lx_bake_desc {
     int resolution;      /* texels per side for every lightmap, 0 = 256 */
     float texel_density; /* texels per metre; > 0 sizes each lightmap from its
                             world and UV areas, rounded to a multiple of 4 */
     int max_resolution;  /* cap for texel_density sizes, 0 = 4096 */
     lx_quantity quantity;
-    int padding;          /* texels of dilation, 0 = 2, LX_PADDING_NONE = none */
+    int padding;          /* texels of dilation around the charts, 0..64; 0 = none
+                             (the one field whose zero is a value, not a default;
+                             luxel bake uses LX_PADDING_RECOMMENDED) */
     int threads;          /* 0 = all cores */
     bool skip_degenerate; /* zero-UV-area triangles: warn and skip, not fail */
     float shadow_bias;    /* ray origin offset in metres, 0 = scale-aware auto */
@@ -82,7 +90,8 @@ typedef struct lx_bake_desc {
     void *progress_user;
 } lx_bake_desc;
 
-/* A copy of desc (or of zeros when NULL) with every default filled in. */
+/* A copy of desc (or of zeros when NULL) with every default filled in,
+ * the sky's included (lx_sky_desc_defaults). */
 lx_bake_desc lx_bake_desc_defaults(const lx_bake_desc *desc);
 
 typedef struct lx_lightmap_info {
@@ -147,6 +156,13 @@ typedef struct lx_texel_sample {
 
 /* The world-space sample of texel (x, y); false when it is not covered. */
 bool lx_baker_texel(const lx_baker *baker, uint32_t map, int x, int y, lx_texel_sample *out);
+
+/* The EV100 that exposes the mean luminance of every covered texel of
+ * every lightmap (baked + real-time, in the desc's quantity; irradiance
+ * metered as a white Lambertian surface, E / pi) to middle grey
+ * (lx_ev100_from_luminance). *lit gets false, and *ev100 0, when that mean
+ * is 0: every lightmap is black. */
+void lx_baker_meter_ev100(const lx_baker *baker, float *ev100, bool *lit);
 
 /* Fills unused texels (mask 0) from used neighbours, one ring per pass, so
  * bilinear sampling and mips do not bleed black. mask is updated.

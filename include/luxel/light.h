@@ -319,9 +319,9 @@ float lx_line_light_illuminance(lx_vec3 a, lx_vec3 b, float intensity_per_metre,
  * radius / distance goes to 0. Against a quadrature of the capsule's
  * surface (tests/light/test_area.c): within 1.5% alongside the tube at 5
  * radii and more, 3.5% beyond its ends; seen nearly end-on from just off
- * the axis line, where the near cap hides most of the side, within 8%. A receiver whose horizon passes
- * through the tube misses the grazing sliver of side above it (about 1% of
- * what the point would get facing the tube). */
+ * the axis line, where the near cap hides most of the side, within 8%. A receiver whose horizon
+ * passes through the tube misses the grazing sliver of side above it (about 1% of what the point
+ * would get facing the tube). */
 float lx_tube_light_illuminance(lx_vec3 centre, lx_vec3 axis, float length, float radius,
                                 float luminance, lx_vec3 p, lx_vec3 n);
 

@@ -120,6 +120,13 @@ static inline float lx_saturate(float x)
     return lx_clampf(x, 0.0f, 1.0f);
 }
 
+/* Luminance (Y) of linear Rec.709/sRGB primaries, ITU-R BT.709's weights;
+ * in double, for the sums that accumulate it. */
+static inline double lx_luminance(const float rgb[3])
+{
+    return 0.2126 * (double)rgb[0] + 0.7152 * (double)rgb[1] + 0.0722 * (double)rgb[2];
+}
+
 /* Any unit vector perpendicular to n (n must be unit length). */
 static inline lx_vec3 lx_perpendicular(lx_vec3 n)
 {

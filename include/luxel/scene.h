@@ -56,10 +56,11 @@ typedef struct lx_material {
     lx_vec4 base_color;      /* linear RGBA factor */
     lx_image base_color_map; /* linear RGBA (sRGB-decoded), width 0 if none */
     int base_color_uv_set;
-    lx_image normal_map;   /* raw tangent-space normals in [0,1], width 0 if none */
-    float normal_scale;    /* glTF normalTexture.scale, 1 by default */
-    int normal_uv_set;     /* UV set the normal map uses */
-    char *normal_map_path; /* where it came from (for messages), or NULL */
+    char *base_color_map_path; /* where it came from (for messages), or NULL */
+    lx_image normal_map;       /* raw tangent-space normals in [0,1], width 0 if none */
+    float normal_scale;        /* glTF normalTexture.scale, 1 by default */
+    int normal_uv_set;         /* UV set the normal map uses */
+    char *normal_map_path;     /* where it came from (for messages), or NULL */
 } lx_material;
 
 typedef struct lx_node {
@@ -98,7 +99,12 @@ typedef struct lx_scene {
 
 typedef struct lx_scene_load_desc {
     bool skip_degenerate; /* warn and drop zero-area triangles instead of failing */
+    bool skip_textures;   /* name textures (the *_map_path fields) without
+                             decoding them: the maps stay empty (luxel info) */
 } lx_scene_load_desc;
+
+/* A copy of desc (or of zeros when NULL) with every default filled in. */
+lx_scene_load_desc lx_scene_load_desc_defaults(const lx_scene_load_desc *desc);
 
 /* Imports a scene file through assimp (glTF 2.0, OBJ, FBX, ...), plus the
  * KHR_lights_punctual lights of glTF files. desc may be NULL. Triangles of

@@ -8,6 +8,18 @@
 #include <stdlib.h>
 #include <string.h>
 
+lx_sky_desc lx_sky_desc_defaults(const lx_sky_desc *desc)
+{
+    lx_sky_desc d = {0};
+    if (desc)
+        d = *desc;
+    if (d.intensity == 0.0f)
+        d.intensity = 1.0f;
+    if (d.samples == 0)
+        d.samples = 64;
+    return d;
+}
+
 lx_bake_desc lx_bake_desc_defaults(const lx_bake_desc *desc)
 {
     lx_bake_desc d = {0};
@@ -17,8 +29,7 @@ lx_bake_desc lx_bake_desc_defaults(const lx_bake_desc *desc)
         d.resolution = 256;
     if (d.max_resolution == 0)
         d.max_resolution = 4096;
-    if (d.padding == 0)
-        d.padding = 2;
+    d.sky = lx_sky_desc_defaults(&d.sky);
     return d;
 }
 
@@ -32,7 +43,7 @@ static lx_status validate_desc(const lx_bake_desc *d)
                        LX_MAX_LIGHTMAP_SIZE);
     if (!(d->texel_density >= 0.0f) || !isfinite(d->texel_density))
         return lx_fail(LX_ERR_INVALID, "texel density must be a finite positive number");
-    if (d->padding < LX_PADDING_NONE || d->padding > 64)
+    if (d->padding < 0 || d->padding > 64)
         return lx_fail(LX_ERR_INVALID, "padding %d is outside 0..64", d->padding);
     if (d->threads < 0 || d->threads > 1024)
         return lx_fail(LX_ERR_INVALID, "thread count %d is outside 0..1024", d->threads);
@@ -322,6 +333,35 @@ lx_status lx_baker_apply_rgba8(const lx_baker *b, uint32_t map, float exposure, 
     }
     lx_image_free(&img);
     return LX_OK;
+}
+
+void lx_baker_meter_ev100(const lx_baker *b, float *ev100, bool *lit)
+{
+    /* what a preview shows: radiance E * albedo / pi, or for irradiance
+     * the radiance of a white Lambertian surface, E / pi */
+    const double scale = 1.0 / LX_PI;
+    double sum = 0.0;
+    uint64_t n = 0;
+    for (uint32_t m = 0; m < b->map_count; m++) {
+        const lx_lightmap *map = &b->maps[m];
+        for (uint32_t i = 0; i < map->info.used_texels; i++) {
+            const lx_texel *t = &map->texels[i];
+            size_t p = (size_t)t->pixel * 3;
+            float e[3] = {map->baked[p] + map->realtime[p],
+                          map->baked[p + 1] + map->realtime[p + 1],
+                          map->baked[p + 2] + map->realtime[p + 2]};
+            if (b->desc.quantity == LX_QUANTITY_RADIANCE) {
+                e[0] *= t->albedo.x;
+                e[1] *= t->albedo.y;
+                e[2] *= t->albedo.z;
+            }
+            sum += lx_luminance(e) * scale;
+            n++;
+        }
+    }
+    double mean = n ? sum / (double)n : 0.0;
+    *lit = mean > 0.0 && isfinite(mean);
+    *ev100 = *lit ? lx_ev100_from_luminance(mean) : 0.0f;
 }
 
 bool lx_baker_texel(const lx_baker *b, uint32_t map_index, int x, int y, lx_texel_sample *out)

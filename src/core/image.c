@@ -3,6 +3,7 @@
  * reader and writer. The codecs live in image_io.c (stb), image_pfm.c and
  * image_exr.c. */
 #include "image_internal.h"
+#include "luxel/math.h"
 
 #include <ctype.h>
 #include <math.h>
@@ -223,7 +224,7 @@ static lx_status convert_channels(lx_image *img, int want, const char *name)
         }
         float a = have_alpha ? p[have - 1] : 1.0f;
         if (want <= 2) {
-            q[0] = have >= 3 ? (float)(0.2126 * r + 0.7152 * g + 0.0722 * b) : r;
+            q[0] = have >= 3 ? (float)lx_luminance((const float[3]){r, g, b}) : r;
             if (want == 2)
                 q[1] = a;
         } else {

@@ -114,11 +114,16 @@ static bool has_extension(const char *path, const char *ext)
 
 /* Loads a texture named by a material: "*N" is embedded in the file, other
  * paths are relative to the scene's folder. Failures are warnings: the
- * material then goes without the map. */
+ * material then goes without the map. With skip_textures only the name is
+ * kept. */
 static void load_texture(import_ctx *c, const struct aiString *tex_path, bool raw, const char *what,
                          const char *material, lx_image *out, char **out_path)
 {
     const char *p = tex_path->data;
+    if (c->desc->skip_textures) {
+        *out_path = p[0] == '*' ? lx_strdup(p) : lx_path_join(c->folder, p);
+        return;
+    }
     lx_image_load_desc ld = {.raw_8bit = raw, .channels = raw ? 3 : 4};
     lx_status st;
     char *full = NULL;
@@ -154,10 +159,7 @@ static void load_texture(import_ctx *c, const struct aiString *tex_path, bool ra
         free(full);
         return;
     }
-    if (out_path)
-        *out_path = full ? full : lx_strdup(p);
-    else
-        free(full);
+    *out_path = full ? full : lx_strdup(p);
 }
 
 static lx_status import_materials(import_ctx *c)
@@ -202,7 +204,8 @@ static lx_status import_materials(import_ctx *c)
                                  NULL) == aiReturn_SUCCESS ||
             aiGetMaterialTexture(am, aiTextureType_DIFFUSE, 0, &tex, NULL, &uv, NULL, NULL, NULL,
                                  NULL) == aiReturn_SUCCESS) {
-            load_texture(c, &tex, false, "base colour", name_buf, &m.base_color_map, NULL);
+            load_texture(c, &tex, false, "base colour", name_buf, &m.base_color_map,
+                         &m.base_color_map_path);
             m.base_color_uv_set = uv < LX_MAX_UV_SETS ? (int)uv : LX_MAX_UV_SETS;
         }
         if (m.normal_uv_set >= LX_MAX_UV_SETS || m.base_color_uv_set >= LX_MAX_UV_SETS) {
@@ -225,6 +228,7 @@ static lx_status import_materials(import_ctx *c)
         lx_image_free(&m.normal_map);
         lx_image_free(&m.base_color_map);
         free(m.normal_map_path);
+        free(m.base_color_map_path);
         if (st != LX_OK)
             return st;
     }
@@ -422,12 +426,19 @@ static lx_status import_node(import_ctx *c, const struct aiNode *node, const lx_
     return LX_OK;
 }
 
-lx_status lx_scene_load(const char *path, const lx_scene_load_desc *desc, lx_scene **out)
+lx_scene_load_desc lx_scene_load_desc_defaults(const lx_scene_load_desc *desc)
+{
+    lx_scene_load_desc d = {0};
+    if (desc)
+        d = *desc;
+    return d; /* every field's zero is its default */
+}
+
+lx_status lx_scene_load(const char *path, const lx_scene_load_desc *in, lx_scene **out)
 {
     *out = NULL;
-    lx_scene_load_desc defaults = {0};
-    if (!desc)
-        desc = &defaults;
+    lx_scene_load_desc defaults = lx_scene_load_desc_defaults(in);
+    const lx_scene_load_desc *desc = &defaults;
     struct stat st_buf;
     if (stat(path, &st_buf) != 0)
         return lx_fail(LX_ERR_IO, "%s: cannot open: no such file", path);

@@ -24,10 +24,10 @@ static const char *bake_usage =
     "\n"
     "options:\n"
     "  -o, --output DIR        output folder (default ./lightmaps)\n"
-    "  --resolution N          texels per side of every lightmap (default 256)\n"
+    "  --resolution N          texels per side of every lightmap (default %d)\n"
     "  --texel-density T       texels per metre instead: each lightmap sized from\n"
     "                          its world and UV areas, a multiple of 4\n"
-    "  --max-resolution N      cap for --texel-density sizes (default 4096)\n"
+    "  --max-resolution N      cap for --texel-density sizes (default %d)\n"
     "  --lights FILE.json      lights and settings added to or overriding the\n"
     "                          scene's (docs/lights-json.md)\n"
     "  --format F              exr (default), hdr, pfm or png\n"
@@ -42,14 +42,15 @@ static const char *bake_usage =
     "                          <name>_px.<ext> faces, radiance in nits, or\n"
     "                          const:R,G,B; see docs/ibl.md), unshadowed through\n"
     "                          its spherical harmonics\n"
-    "  --sky-intensity X       multiplier on the sky, above 0 (default 1)\n"
+    "  --sky-intensity X       multiplier on the sky, above 0 (default %g)\n"
     "  --sky-shadows           sky visibility: cosine-weighted rays that escape\n"
     "                          the scene bring the environment they see\n"
     "  --no-sky-shadows        unshadowed sky even when the lights file asks\n"
     "                          for shadows\n"
-    "  --sky-samples N         rays per texel with sky shadows (default 64)\n"
+    "  --sky-samples N         rays per texel with sky shadows (default %u)\n"
     "  --exposure EV100        exposure of the PNG preview (default: automatic)\n"
-    "  --padding N             texels of dilation around charts (default 2)\n"
+    "  --padding N             texels of dilation around charts, 0 for none\n"
+    "                          (default %d)\n"
     "  --threads N             worker threads (default: all cores)\n"
     "  --skip-degenerate       skip zero-area triangles with a warning instead of\n"
     "                          failing\n"
@@ -122,6 +123,8 @@ static int parse_args(int argc, char **argv, bake_args *a)
         {"help", no_argument, NULL, 'h'},
         {NULL, 0, NULL, 0}};
     memset(a, 0, sizeof *a);
+    a->desc = lx_bake_desc_defaults(NULL);
+    a->desc.padding = LX_PADDING_RECOMMENDED;
     a->output = "lightmaps";
     a->format = LX_IMAGE_EXR;
     a->sky_intensity = -1.0;
@@ -202,7 +205,7 @@ static int parse_args(int argc, char **argv, bake_args *a)
             if (!cli_parse_int(optarg, 0, 64, &n))
                 return cli_usage_error("bake", "--padding must be an integer in 0..64, not '%s'",
                                        optarg);
-            a->desc.padding = n == 0 ? LX_PADDING_NONE : (int)n;
+            a->desc.padding = (int)n;
             break;
         case OPT_THREADS:
             if (!cli_parse_int(optarg, 1, 1024, &n))
@@ -238,9 +241,13 @@ static int parse_args(int argc, char **argv, bake_args *a)
         case 'q':
             a->quiet = true;
             break;
-        case 'h':
-            fputs(bake_usage, stdout);
+        case 'h': {
+            /* the defaults shown are the library's */
+            lx_bake_desc d = lx_bake_desc_defaults(NULL);
+            printf(bake_usage, d.resolution, d.max_resolution, (double)d.sky.intensity,
+                   d.sky.samples, LX_PADDING_RECOMMENDED);
             return -1;
+        }
         case ':':
             return cli_usage_error("bake", "option '%s' needs a value", argv[optind - 1]);
         default:
@@ -290,34 +297,11 @@ static void file_stem(const char *name, char **taken, uint32_t taken_count, char
     }
 }
 
-/* Luminance of a linear Rec.709 colour. */
-static double luminance(const float *rgb)
-{
-    return 0.2126 * rgb[0] + 0.7152 * rgb[1] + 0.0722 * rgb[2];
-}
-
 /* The preview shows luminance: radiance as is, irradiance as the radiance of
- * a white Lambertian surface (E / pi). Auto exposure meters the average of
- * covered texels to middle grey. */
+ * a white Lambertian surface (E / pi). */
 static float preview_scale(const bake_args *a)
 {
     return a->desc.quantity == LX_QUANTITY_RADIANCE ? 1.0f : 1.0f / LX_PI;
-}
-
-static double auto_ev100(const lx_baker *b, const lx_image *images, const bake_args *a)
-{
-    double sum = 0;
-    uint64_t n = 0;
-    for (uint32_t m = 0; m < lx_baker_lightmap_count(b); m++) {
-        const uint8_t *mask = lx_baker_mask(b, m);
-        const lx_image *img = &images[m];
-        for (size_t p = 0; p < (size_t)img->width * img->height; p++)
-            if (mask[p]) {
-                sum += luminance(&img->data[3 * p]) * preview_scale(a);
-                n++;
-            }
-    }
-    return n ? lx_ev100_from_luminance(sum / (double)n) : 0.0;
 }
 
 static cJSON *manifest_entry(const lx_scene *scene, const lx_lightmap_info *info, const char *file,
@@ -410,7 +394,8 @@ int cmd_bake(int argc, char **argv)
             status = loaded;
             goto done;
         }
-        a.desc.sky = (lx_sky_desc){&sky_env, sky.intensity, sky.shadows, sky.samples};
+        lx_sky_desc given = {&sky_env, sky.intensity, sky.shadows, sky.samples};
+        a.desc.sky = lx_sky_desc_defaults(&given);
     }
 
     /* the output folder is checked (and made) before the long work */
@@ -484,7 +469,13 @@ int cmd_bake(int argc, char **argv)
             goto done;
         }
     }
-    double ev = a.has_exposure ? a.exposure_ev100 : auto_ev100(baker, images, &a);
+    float metered;
+    bool lit;
+    lx_baker_meter_ev100(baker, &metered, &lit);
+    if (!lit)
+        lx_log(LX_LOG_WARN, "%s: every lightmap is black: nothing lights the scene%s", a.scene,
+               scene->light_count ? " where it has texels" : " (it has no lights)");
+    double ev = a.has_exposure ? a.exposure_ev100 : metered;
     float exposure = lx_exposure_from_ev100((float)ev) * preview_scale(&a);
     /* seed 001: pre-exposed values are the quantity times 1/(1.2 * 2^EV100) */
     float pre_exposure = lx_exposure_from_ev100((float)ev);
@@ -509,10 +500,10 @@ int cmd_bake(int argc, char **argv)
     if (sky.environment) {
         cJSON *sk = cJSON_AddObjectToObject(manifest, "sky");
         cJSON_AddStringToObject(sk, "environment", sky.environment);
-        cJSON_AddNumberToObject(sk, "intensity", sky.intensity > 0.0f ? sky.intensity : 1.0);
+        cJSON_AddNumberToObject(sk, "intensity", a.desc.sky.intensity);
         cJSON_AddBoolToObject(sk, "shadows", sky.shadows);
         if (sky.shadows)
-            cJSON_AddNumberToObject(sk, "samples", sky.samples ? sky.samples : 64);
+            cJSON_AddNumberToObject(sk, "samples", a.desc.sky.samples);
     }
     cJSON *list = cJSON_AddArrayToObject(manifest, "lightmaps");
     bool failed = false;

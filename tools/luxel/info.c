@@ -89,7 +89,9 @@ int cmd_info(int argc, char **argv)
         return cli_usage_error("info", "one scene at a time ('%s' is extra)", argv[optind + 1]);
     const char *path = argv[optind];
     lx_scene *s;
-    if (lx_scene_load(path, NULL, &s) != LX_OK) {
+    /* listing needs the textures' names, not their pixels */
+    lx_scene_load_desc ld = {.skip_textures = true};
+    if (lx_scene_load(path, &ld, &s) != LX_OK) {
         cli_error("%s", lx_last_error());
         return EXIT_FAILED;
     }
@@ -119,8 +121,8 @@ int cmd_info(int argc, char **argv)
     for (uint32_t i = 0; i < s->material_count; i++) {
         const lx_material *m = &s->materials[i];
         printf("  %-24s base colour (%.3g, %.3g, %.3g)%s%s\n", m->name, m->base_color.x,
-               m->base_color.y, m->base_color.z, m->base_color_map.width ? " + texture" : "",
-               m->normal_map.width ? "  normal map" : "");
+               m->base_color.y, m->base_color.z, m->base_color_map_path ? " + texture" : "",
+               m->normal_map_path ? "  normal map" : "");
     }
     printf("nodes: %u\n", s->node_count);
     for (uint32_t i = 0; i < s->node_count; i++) {
@@ -137,7 +139,8 @@ int cmd_info(int argc, char **argv)
         printf("sky: %s x %.4g, %s", s->sky.environment, s->sky.intensity,
                s->sky.shadows ? "shadows" : "unshadowed (spherical harmonics)");
         if (s->sky.shadows)
-            printf(" (%u samples)", s->sky.samples ? s->sky.samples : 64u);
+            printf(" (%u samples)",
+                   s->sky.samples ? s->sky.samples : lx_sky_desc_defaults(NULL).samples);
         printf("\n");
     }
     lx_vec3 lo, hi;
