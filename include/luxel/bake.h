@@ -23,11 +23,20 @@
  *   for any thread count.
  *
  * USAGE
- *   lx_bake_desc d = {.resolution = 512};
+ *   lx_scene *scene;
  *   lx_baker *b;
- *   lx_baker_create(scene, &d, &b);
- *   lx_baker_bake(b);                                    // static lights
- *   lx_image img; lx_baker_apply_alloc(b, 0, &img);      // baked + real-time
+ *   if (lx_scene_load("room.glb", NULL, &scene) != LX_OK) return 1;
+ *   lx_bake_desc d = lx_bake_desc_defaults(NULL);
+ *   d.resolution = 64;
+ *   d.padding = LX_PADDING_RECOMMENDED;
+ *   lx_status st = lx_baker_create(scene, &d, &b);
+ *   lx_scene_destroy(scene);                              // the baker keeps a copy
+ *   if (st != LX_OK) return 1;
+ *   lx_image img;
+ *   if (lx_baker_bake(b) == LX_OK && lx_baker_apply_alloc(b, 0, &img) == LX_OK) {
+ *       lx_image_write("room.exr", &img, NULL);           // irradiance in lux
+ *       lx_image_free(&img);
+ *   }
  *   lx_baker_destroy(b);
  */
 #ifndef LUXEL_BAKE_H

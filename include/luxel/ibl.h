@@ -28,10 +28,11 @@
  *
  * USAGE
  *   lx_cubemap env, irr;
- *   lx_env_load("sky.hdr", NULL, &env);
- *   lx_sh9 sh; lx_sh_project(&env, &sh);
- *   lx_sh_irradiance_cube(&sh, 32, &irr);
- *   lx_cubemap_free(&env); lx_cubemap_free(&irr);
+ *   if (lx_env_load("sky.hdr", NULL, &env) != LX_OK) return 1;
+ *   lx_sh9 sh;
+ *   if (lx_sh_project(&env, &sh) == LX_OK && lx_sh_irradiance_cube(&sh, 32, &irr) == LX_OK)
+ *       lx_cubemap_free(&irr);
+ *   lx_cubemap_free(&env);
  */
 #ifndef LUXEL_IBL_H
 #define LUXEL_IBL_H

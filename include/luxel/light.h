@@ -22,9 +22,10 @@
  * USAGE
  *   lx_light l = lx_light_defaults(LX_LIGHT_POINT);
  *   l.position = lx_v3(0, 2, 0);
- *   l.intensity = 800.0f;                      // candela
+ *   l.intensity = 800.0f;                                  // candela
  *   lx_light_eval e;
- *   if (lx_light_evaluate(&l, p, n, &e)) use(e.illuminance);   // lux
+ *   if (lx_light_evaluate(&l, lx_v3(0, 0, 0), lx_v3(0, 1, 0), &e))
+ *       printf("%g lx\n", e.illuminance.y);               // 800 / 2^2 = 200
  */
 #ifndef LUXEL_LIGHT_H
 #define LUXEL_LIGHT_H

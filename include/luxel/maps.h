@@ -10,11 +10,17 @@
  * THREADING  Pure functions.
  *
  * USAGE
+ *   lx_scene *scene;
+ *   if (lx_scene_load("room.glb", NULL, &scene) != LX_OK) return 1;
+ *   const lx_mesh *mesh = &scene->meshes[0];
  *   lx_vec4 *t = malloc(sizeof *t * mesh->vertex_count);
- *   lx_compute_tangents(mesh, 0, t);
- *   lx_vec3 b = lx_scale(lx_cross(n, lx_v3(t[i].x, t[i].y, t[i].z)), t[i].w);
- *   lx_vec3 n2 = lx_tangent_to_world(m, n, t[i]);   // m from a normal map
+ *   if (t && lx_compute_tangents(mesh, 0, t) == LX_OK) {
+ *       lx_vec3 m = lx_v3(0.6f, 0, 0.8f);   // a normal-map texel, tangent space
+ *       lx_vec3 n = lx_tangent_to_world(m, mesh->normals[0], t[0]);
+ *       printf("perturbed normal (%g, %g, %g)\n", n.x, n.y, n.z);
+ *   }
  *   free(t);
+ *   lx_scene_destroy(scene);
  */
 #ifndef LUXEL_MAPS_H
 #define LUXEL_MAPS_H

@@ -6,10 +6,11 @@
  * THREADING  Pure functions.
  *
  * USAGE
- *   lx_vec3 n = lx_normalize(lx_cross(lx_sub(b, a), lx_sub(c, a)));
+ *   lx_vec3 a = lx_v3(0, 0, 0), b = lx_v3(1, 0, 0), c = lx_v3(0, 0, -1);
+ *   lx_vec3 n = lx_normalize(lx_cross(lx_sub(b, a), lx_sub(c, a)));   // (0, 1, 0)
  *   lx_mat4 m = lx_mat4_translate(lx_v3(0, 2, 0));
  *   lx_vec3 p = lx_mat4_point(&m, a);
- *   float d = lx_length(lx_sub(p, a));   // 2
+ *   printf("normal (%g, %g, %g), moved %g m\n", n.x, n.y, n.z, lx_length(lx_sub(p, a)));
  */
 #ifndef LUXEL_MATH_H
 #define LUXEL_MATH_H

@@ -21,8 +21,10 @@
  *
  * USAGE
  *   lx_scene *scene;
- *   if (lx_scene_load("room.glb", NULL, &scene) != LX_OK) die(lx_last_error());
- *   lx_lights_json_apply(scene, "lights.json");       // optional
+ *   if (lx_scene_load("room.glb", NULL, &scene) != LX_OK) {
+ *       fprintf(stderr, "%s\n", lx_last_error());
+ *       return 1;
+ *   }
  *   printf("%u nodes, %u lights\n", scene->node_count, scene->light_count);
  *   lx_scene_destroy(scene);
  */

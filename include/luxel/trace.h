@@ -13,11 +13,15 @@
  *   and commit must not overlap queries.
  *
  * USAGE
+ *   lx_scene *scene;
  *   lx_tracer *tr;
- *   lx_tracer_create(scene, &tr);
- *   lx_ray r = {.origin = p, .dir = l, .tmin = 0, .tmax = dist};
- *   bool blocked = lx_tracer_occluded(tr, &r);
+ *   if (lx_scene_load("room.glb", NULL, &scene) != LX_OK) return 1;
+ *   if (lx_tracer_create(scene, &tr) != LX_OK) { lx_scene_destroy(scene); return 1; }
+ *   lx_ray r = {.origin = lx_v3(0, 1, 0), .dir = lx_v3(0, -1, 0), .tmin = 0, .tmax = 100};
+ *   lx_hit hit;
+ *   if (lx_tracer_closest(tr, &r, &hit)) printf("floor %g m below\n", hit.t);
  *   lx_tracer_destroy(tr);
+ *   lx_scene_destroy(scene);
  */
 #ifndef LUXEL_TRACE_H
 #define LUXEL_TRACE_H
