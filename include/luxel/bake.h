@@ -18,9 +18,13 @@
  * MEMORY  lx_baker_create copies what it needs from the scene (the scene
  *   may be destroyed afterwards). Info structs are borrowed until
  *   lx_baker_destroy.
- * THREADING  One baker is used from one thread at a time; it runs OpenMP
- *   over texel tiles internally (desc.threads). Results are bit-identical
- *   for any thread count.
+ * THREADING  lx_baker_create, lx_dilate and the *_desc_defaults are
+ *   thread-safe; several bakers may run on different threads at once. One
+ *   baker is used from one thread at a time (every lx_baker_* call on it,
+ *   the read-only ones included, while another may change it); it runs
+ *   OpenMP over texel tiles internally, at most desc.threads threads, and
+ *   its results are bit-identical for any thread count. The progress
+ *   callback is called from one thread at a time, not always the caller's.
  *
  * USAGE
  *   lx_scene *scene;

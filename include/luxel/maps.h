@@ -7,7 +7,8 @@
  *   (up in the image), matching normal maps whose green channel is "up".
  * ERRORS  LX_ERR_INVALID for missing inputs.
  * MEMORY  The caller owns every buffer.
- * THREADING  Pure functions.
+ * THREADING  Every function is thread-safe (pure: it reads its inputs and
+ *   writes only the caller's buffers).
  *
  * USAGE
  *   lx_scene *scene;

@@ -3,7 +3,7 @@
  * CONVENTIONS  Right-handed, +Y up, metres. lx_mat4 is column-major like
  *   glTF: m[col*4 + row]; points transform as M * (x, y, z, 1).
  * ERRORS / MEMORY  None: plain values, header-only inline functions.
- * THREADING  Pure functions.
+ * THREADING  Every function is thread-safe (pure, inline).
  *
  * USAGE
  *   lx_vec3 a = lx_v3(0, 0, 0), b = lx_v3(1, 0, 0), c = lx_v3(0, 0, -1);

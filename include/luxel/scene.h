@@ -16,8 +16,11 @@
  * MEMORY  lx_scene_load / lx_scene_create allocate; lx_scene_destroy frees
  *   the scene and everything it points to. Pointers into a scene are
  *   borrowed until lx_scene_destroy.
- * THREADING  A scene is read-only once loaded; reading it from several
- *   threads is safe.
+ * THREADING  lx_scene_load, lx_gltf_lights_load and lx_triangle_degenerate
+ *   are thread-safe (loads of different files may run at once). A scene is
+ *   read-only once built: reading one from several threads is safe, but the
+ *   functions that change a scene (lx_scene_add_*, lx_scene_adopt_profile,
+ *   lx_lights_json_apply*) must not run while another thread uses it.
  *
  * USAGE
  *   lx_scene *scene;

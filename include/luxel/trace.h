@@ -9,8 +9,10 @@
  *   Embree error, named). Queries cannot fail.
  * MEMORY  The tracer copies the geometry it needs; the scene may be freed
  *   after lx_tracer_create. lx_tracer_destroy releases everything.
- * THREADING  Queries may run on many threads at once. set_node_transform
- *   and commit must not overlap queries.
+ * THREADING  lx_tracer_create* is thread-safe. Queries (lx_tracer_occluded*,
+ *   lx_tracer_closest, lx_tracer_nearest_distance) may run on many threads
+ *   at once on one tracer; lx_tracer_set_node_transform and
+ *   lx_tracer_commit must not overlap queries or each other.
  *
  * USAGE
  *   lx_scene *scene;
