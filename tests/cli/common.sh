@@ -1,18 +1,21 @@
 # Shared pieces of the CLI end-to-end tests (sourced by tests/cli/test_*.sh;
 # not a test itself). Each script is run as
-#     bash test_X.sh LUXEL GEN_SCENES WORKDIR
+#     bash test_X.sh LUXEL GEN_SCENES WORKDIR [CASE]
 # and sources this file with its arguments: LUXEL and GEN become absolute
-# paths, WORK is emptied and recreated, and the check functions below print
-# one line per check. `finish` prints "N passed, M failed" and exits 1 when
-# any check failed.
+# paths, WORK is emptied and recreated, CASE (when given) names the one case
+# to run, and the check functions below print one line per check. `finish`
+# prints "N passed, M failed, K skipped" and exits 1 when any check failed,
+# else 77 (CTest's SKIP_RETURN_CODE) when a case was skipped: a script whose
+# cases may not run on every machine runs one case per CTest test.
 #
 # Only bash and coreutils (printf, head, od, cmp, stat...) plus awk are used:
 # test inputs are written here by code, never downloaded or checked in.
 
-if [ $# -ne 3 ]; then
-    echo "usage: bash $0 LUXEL GEN_SCENES WORKDIR" >&2
+if [ $# -ne 3 ] && [ $# -ne 4 ]; then
+    echo "usage: bash $0 LUXEL GEN_SCENES WORKDIR [CASE]" >&2
     exit 2
 fi
+CASE_NAME=${4:-}
 
 abspath() { # a path made absolute (the file need not exist)
     case $1 in
@@ -43,11 +46,14 @@ cd "$WORK" || exit 2
 
 PASSED=0
 FAILED=0
+SKIPPED=0
 OUT=$WORK/.stdout # stdout, stderr and exit status of the last `run`
 ERR=$WORK/.stderr
 RC=0
 
 pass() { PASSED=$((PASSED + 1)); printf 'ok    %s\n' "$1"; }
+# skip DESCRIPTION: a case this machine cannot run (finish then exits 77).
+skip() { SKIPPED=$((SKIPPED + 1)); printf 'skip  %s\n' "$1"; }
 fail() {
     FAILED=$((FAILED + 1))
     printf 'FAIL  %s\n' "$1"
@@ -221,7 +227,8 @@ EOF
 }
 
 finish() {
-    echo "$PASSED passed, $FAILED failed"
-    [ "$FAILED" -eq 0 ]
-    exit $?
+    echo "$PASSED passed, $FAILED failed, $SKIPPED skipped"
+    [ "$FAILED" -eq 0 ] || exit 1
+    [ "$SKIPPED" -eq 0 ] || exit 77
+    exit 0
 }

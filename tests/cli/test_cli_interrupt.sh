@@ -1,8 +1,11 @@
-# End-to-end tests of interrupting `luxel bake` (DESIGN.md section 4: "an
-# error or Ctrl-C never leaves a partial or corrupt file"): SIGINT while the
-# lightmaps are computed, SIGINT and SIGTERM while the files are written.
-# Each interrupted run must exit non-zero, say so on stderr, and leave the
-# output folder missing (no finished files, no temporary files, no folder).
+# End-to-end tests of interrupting luxel (DESIGN.md section 4: "an error or
+# Ctrl-C never leaves a partial or corrupt file"). Each run is stopped at a
+# known phase by the test hook LUXEL_TEST_PAUSE=PHASE (the CLI says
+# "luxel: test: paused at PHASE" and waits for a signal), so the signal
+# lands mid-run every time. An interrupted run must end by its signal (exit
+# status 128 + N), print one error line saying it was interrupted, and
+# leave the output folder as it was: missing when the run would have made
+# it, with the previous run's files untouched when it was there.
 #
 # usage: bash test_cli_interrupt.sh LUXEL GEN_SCENES WORKDIR
 set -u
@@ -10,82 +13,94 @@ set -u
 
 "$GEN" "$WORK/scenes" >/dev/null || { echo "gen_scenes failed"; exit 1; }
 RETRO=$WORK/scenes/retro.glb
-# 8 lightmaps of 1024^2: a few seconds of baking, then of writing
-BIG=(bake "$RETRO" --resolution 1024 --threads 2)
-ALL_FILES=17 # 8 lightmaps, 8 previews, the manifest
+SKY=$WORK/scenes/sky.pfm
+BAKE=(bake "$RETRO" --resolution 64 --threads 2)
 
-# wait_for CONDITION-COMMAND...: polls every 10 ms for up to 30 s.
-wait_for() {
+# wait_for_pause PID: waits (up to 60 s) until the run says it paused;
+# false when it ended first.
+wait_for_pause() {
     local i
-    for ((i = 0; i < 3000; i++)); do
-        "$@" && return 0
+    for ((i = 0; i < 6000; i++)); do
+        grep -qs '^luxel: test: paused at ' "$ERR" && return 0
+        kill -0 "$1" 2>/dev/null || return 1
         sleep 0.01
     done
     return 1
 }
-# files written so far, staged ones included (the CLI writes into a hidden
-# staging folder inside the output folder and moves them out at the end)
-has_files() { [ -d "$1" ] && [ "$(find "$1" -type f | wc -l)" -ge "$2" ]; }
-alive() { kill -0 "$1" 2>/dev/null; }
 
-# interrupted LABEL OUTDIR: checks after an interrupted run.
-interrupted() {
-    local label=$1 out=$2
-    if [ "$RC" -eq 0 ]; then
-        # the run won the race and finished: then every file must be there
-        if [ "$(ls -A "$out" | wc -l)" -eq "$ALL_FILES" ]; then
-            pass "$label: finished before the signal, with all $ALL_FILES files"
-        else
-            fail "$label: exit 0 but $(ls -A "$out" | wc -l) files, want $ALL_FILES"
-        fi
-        return
+# interrupt LABEL PHASE SIGNAL OUTDIR ARGS...: runs luxel ARGS... -o OUTDIR
+# paused at PHASE, sends SIGNAL, and checks how the run ended.
+interrupt() {
+    local label=$1 phase=$2 sig=$3 out=$4
+    shift 4
+    LUXEL_TEST_PAUSE=$phase "$LUXEL" "$@" -o "$out" >"$OUT" 2>"$ERR" </dev/null &
+    local pid=$!
+    if ! wait_for_pause "$pid"; then
+        wait "$pid"
+        fail "$label: the run never paused at '$phase' (exit $?)"
+        show_stderr
+        return 1
     fi
-    pass "$label: exit status $RC (non-zero)"
-    expect_stderr_has "$label: says it was interrupted" '^luxel: error: .*interrupt'
-    expect_no_output "$label" "$out"
+    kill -"$sig" "$pid"
+    wait "$pid"
+    RC=$?
+    local want=$((128 + $(kill -l "$sig")))
+    if [ "$RC" -eq "$want" ]; then
+        pass "$label: ended by SIG$sig (exit status $want)"
+    else
+        fail "$label: exit status $RC, want $want"
+        show_stderr
+    fi
+    expect_error "$label" "interrupted"
 }
 
-# ---- SIGINT while computing -------------------------------------------------------
+# ---- while computing: nothing was written, so nothing is left --------------------
 
-out=$WORK/out_compute
-"$LUXEL" "${BIG[@]}" -o "$out" >"$OUT" 2>"$ERR" &
-pid=$!
-sleep 0.3
-if [ -e "$out" ]; then
-    echo "skip  SIGINT while computing: the bake reached the writing stage within 0.3 s"
-fi
-kill -INT "$pid"
-wait "$pid"
-RC=$?
-interrupted "SIGINT while computing" "$out"
-check "SIGINT while computing: one error line" test "$(grep -c '^luxel: error:' "$ERR")" -eq 1
+interrupt "SIGINT while building texel maps" "texel maps" INT "$WORK/o1" "${BAKE[@]}"
+expect_no_output "SIGINT while building texel maps" "$WORK/o1"
+check "SIGINT while building texel maps: says nothing was written" \
+    grep -q 'interrupted; nothing written' "$ERR"
 
-# ---- SIGINT / SIGTERM while writing ---------------------------------------------------
+interrupt "SIGTERM while baking" bake TERM "$WORK/o2" "${BAKE[@]}"
+expect_no_output "SIGTERM while baking" "$WORK/o2"
 
-# SIG:N sends SIG once the output folder holds N entries: the folder is
-# created just before the first file, so N = 0 most likely hits the first
-# file half-written and N = 3 leaves finished files to remove.
-for spec in INT:3 TERM:3 INT:0; do
-    sig=${spec%:*} n=${spec#*:}
-    out=$WORK/out_write_$sig$n
-    "$LUXEL" "${BIG[@]}" -o "$out" >"$OUT" 2>"$ERR" &
-    pid=$!
-    if wait_for has_files "$out" "$n"; then
-        kill -"$sig" "$pid" 2>/dev/null
-        wait "$pid"
-        RC=$?
-        interrupted "SIG$sig while writing (after $n files)" "$out"
+interrupt "SIGHUP while evaluating dynamic lights" "dynamic lights" HUP "$WORK/o3" "${BAKE[@]}"
+expect_no_output "SIGHUP while evaluating dynamic lights" "$WORK/o3"
+
+interrupt "ibl: SIGINT while filtering specular" specular INT "$WORK/o4" ibl "$SKY"
+expect_no_output "ibl: SIGINT while filtering specular" "$WORK/o4"
+
+# ---- while writing: staged files are removed, the folders the run made too -------
+
+interrupt "SIGINT while writing" write INT "$WORK/o5" "${BAKE[@]}"
+expect_no_output "SIGINT while writing" "$WORK/o5"
+check "SIGINT while writing: says the outputs were removed" \
+    grep -q 'interrupted; outputs removed' "$ERR"
+
+interrupt "SIGTERM while writing into new nested folders" write TERM "$WORK/n1/n2/out" \
+    "${BAKE[@]}"
+check "SIGTERM while writing into new nested folders: every folder it made is gone" \
+    test ! -e "$WORK/n1"
+
+interrupt "ibl: SIGTERM while writing" write TERM "$WORK/o6" ibl "$SKY" --layout ktx
+expect_no_output "ibl: SIGTERM while writing" "$WORK/o6"
+
+# ---- into a folder that holds an earlier run: it stays exactly as it was ---------
+
+run "$LUXEL" "${BAKE[@]}" -q -o "$WORK/prev"
+expect_rc 0 "a first bake into prev/"
+echo "not luxel's" >"$WORK/prev/notes.txt"
+before=$(cd "$WORK/prev" && ls -A | LC_ALL=C sort | xargs cksum)
+for phase in bake write; do
+    interrupt "SIGINT at '$phase' over an earlier run" "$phase" INT "$WORK/prev" \
+        bake "$RETRO" --resolution 32 --threads 2
+    after=$(cd "$WORK/prev" && ls -A | LC_ALL=C sort | xargs cksum)
+    if [ "$before" = "$after" ]; then
+        pass "SIGINT at '$phase' over an earlier run: every file as it was, nothing added"
     else
-        alive "$pid" && kill -KILL "$pid"
-        wait "$pid"
-        fail "SIG$sig while writing: the bake never started writing"
+        fail "SIGINT at '$phase' over an earlier run: the folder changed" \
+            "before: $(echo $before)" "after:  $(echo $after)"
     fi
 done
-
-# ---- a normal run afterwards is complete ------------------------------------------------
-
-run "$LUXEL" bake "$RETRO" --resolution 64 -q -o "$WORK/out_write_INT3"
-expect_rc 0 "a new bake into the interrupted run's folder"
-check "it writes all $ALL_FILES files" test "$(ls -A "$WORK/out_write_INT3" | wc -l)" -eq "$ALL_FILES"
 
 finish

@@ -85,26 +85,6 @@ expect_rc 1 "bake of 2100 lightmaps failing at the last"
 expect_error "bake of 2100 lightmaps failing at the last" "n2099.exr" "half-float range"
 expect_no_output "bake of 2100 lightmaps failing at the last" "$WORK/many_out"
 
-# an interrupt while writing removes them too: SIGINT once 3 files are
-# staged (8 lightmaps of 1024^2 take a few seconds to write)
-has_files() { [ -d "$1" ] && [ "$(find "$1" -type f | wc -l)" -ge "$2" ]; }
-"$LUXEL" bake "$WORK/scenes/retro.glb" --resolution 1024 --threads 2 \
-    -o "$WORK/int1/int2/out" >"$OUT" 2>"$ERR" &
-pid=$!
-for ((i = 0; i < 3000; i++)); do
-    has_files "$WORK/int1" 3 && break
-    sleep 0.01
-done
-kill -INT "$pid" 2>/dev/null
-wait "$pid"
-RC=$?
-if [ "$RC" -eq 0 ]; then
-    echo "skip  SIGINT while writing into nested folders: the bake finished first"
-else
-    expect_stderr_has "SIGINT while writing into nested folders: says so" '^luxel: error: .*interrupt'
-    check "SIGINT while writing removes every folder it created" test ! -e "$WORK/int1"
-fi
-
 # ---- sky intensity overflow -----------------------------------------------------------
 
 for shadows in "" --sky-shadows; do
