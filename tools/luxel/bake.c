@@ -54,6 +54,7 @@ static const char *bake_usage =
     "  --threads N             worker threads (default: all cores)\n"
     "  --skip-degenerate       skip zero-area triangles with a warning instead of\n"
     "                          failing\n"
+    "  -v, --verbose           the time of each phase, and notes\n"
     "  -q, --quiet             no progress bar or summary\n"
     "  -h, --help              show this help\n";
 
@@ -120,6 +121,7 @@ static int parse_args(int argc, char **argv, bake_args *a)
         {"no-sky-shadows", no_argument, NULL, OPT_NO_SKY_SHADOWS},
         {"sky-samples", required_argument, NULL, OPT_SKY_SAMPLES},
         {"quiet", no_argument, NULL, 'q'},
+        {"verbose", no_argument, NULL, 'v'},
         {"help", no_argument, NULL, 'h'},
         {NULL, 0, NULL, 0}};
     memset(a, 0, sizeof *a);
@@ -134,7 +136,7 @@ static int parse_args(int argc, char **argv, bake_args *a)
     int c;
     long n;
     double f;
-    while ((c = getopt_long(argc, argv, ":o:qh", options, NULL)) != -1) {
+    while ((c = getopt_long(argc, argv, ":o:qvh", options, NULL)) != -1) {
         switch (c) {
         case 'o':
             if (!*optarg)
@@ -240,6 +242,9 @@ static int parse_args(int argc, char **argv, bake_args *a)
             break;
         case 'q':
             a->quiet = true;
+            break;
+        case 'v':
+            cli_set_verbose(true);
             break;
         case 'h': {
             /* the defaults shown are the library's */
@@ -348,13 +353,13 @@ int cmd_bake(int argc, char **argv)
     cli_stage stage = {0};
     lx_cubemap sky_env = {0};
     int status = EXIT_FAILED;
-    double t0 = cli_now();
 
     lx_scene_load_desc ld = {.skip_degenerate = a.desc.skip_degenerate};
     if (lx_scene_load(a.scene, &ld, &scene) != LX_OK) {
         cli_error("%s", lx_last_error());
         goto done;
     }
+    cli_phase("import");
     if (a.lights && lx_lights_json_apply(scene, a.lights) != LX_OK) {
         cli_error("%s", lx_last_error());
         goto done;
@@ -397,6 +402,7 @@ int cmd_bake(int argc, char **argv)
         lx_sky_desc given = {&sky_env, sky.intensity, sky.shadows, sky.samples};
         a.desc.sky = lx_sky_desc_defaults(&given);
     }
+    cli_phase(sky.environment ? "lights and sky" : "lights");
 
     /* the output folder is checked (and made) before the long work */
     if (!cli_stage_begin(&stage, a.output))
@@ -408,6 +414,7 @@ int cmd_bake(int argc, char **argv)
     a.desc.progress_user = &progress;
     lx_status created = lx_baker_create(scene, &a.desc, &baker);
     cli_progress_finish(&progress);
+    cli_phase("texel maps and BVH");
     lx_cubemap_free(&sky_env);
     if (created != LX_OK) {
         if (created == LX_ERR_CANCELLED)
@@ -448,12 +455,15 @@ int cmd_bake(int argc, char **argv)
 
     cli_progress_init(&progress, "bake", a.quiet);
     lx_status st = lx_baker_bake(baker);
+    cli_progress_finish(&progress);
+    cli_phase("bake");
     /* a scene's dynamic lights are part of its look: evaluate them once too */
     if (st == LX_OK) {
         cli_progress_init(&progress, "dynamic lights", a.quiet);
         st = lx_baker_update(baker);
+        cli_progress_finish(&progress);
+        cli_phase("dynamic lights");
     }
-    cli_progress_finish(&progress);
     if (st != LX_OK) {
         if (st == LX_ERR_CANCELLED)
             cli_report_interrupt(false);
@@ -461,7 +471,6 @@ int cmd_bake(int argc, char **argv)
             cli_error("%s", lx_last_error());
         goto done;
     }
-    double t_bake = cli_now() - t0;
 
     for (uint32_t m = 0; m < maps; m++) {
         if (lx_baker_apply_alloc(baker, m, &images[m]) != LX_OK) {
@@ -477,6 +486,7 @@ int cmd_bake(int argc, char **argv)
                scene->light_count ? " where it has texels" : " (it has no lights)");
     double ev = a.has_exposure ? a.exposure_ev100 : metered;
     float exposure = lx_exposure_from_ev100((float)ev) * preview_scale(&a);
+    cli_phase("apply and meter");
     /* seed 001: pre-exposed values are the quantity times 1/(1.2 * 2^EV100) */
     float pre_exposure = lx_exposure_from_ev100((float)ev);
 
@@ -507,6 +517,7 @@ int cmd_bake(int argc, char **argv)
     }
     cJSON *list = cJSON_AddArrayToObject(manifest, "lightmaps");
     bool failed = false;
+    double t_maps = 0.0, t_previews = 0.0;
     for (uint32_t m = 0; m < maps && !failed; m++) {
         const lx_lightmap_info *info = lx_baker_lightmap_info(baker, m);
         char file[300], preview[300];
@@ -517,11 +528,15 @@ int cmd_bake(int argc, char **argv)
                                   .exposure = a.format == LX_IMAGE_PNG ? exposure
                                               : a.pre_expose           ? pre_exposure
                                                                        : 1.0f};
+        double t = cli_now();
         failed = !cli_stage_image(&stage, file, &images[m], &wd);
+        t_maps += cli_now() - t;
         bool want_preview = a.format != LX_IMAGE_PNG;
         if (!failed && want_preview) {
             lx_image_write_desc pd = {.format = LX_IMAGE_PNG, .exposure = exposure};
+            t = cli_now();
             failed = !cli_stage_image(&stage, preview, &images[m], &pd);
+            t_previews += cli_now() - t;
         }
         cJSON_AddItemToArray(list, manifest_entry(scene, info, file, want_preview ? preview : NULL,
                                                   a.desc.quantity));
@@ -538,6 +553,14 @@ int cmd_bake(int argc, char **argv)
         failed = true;
     if (failed)
         goto done;
+    char what[64];
+    snprintf(what, sizeof what, "%u lightmaps (%s)", maps, lx_image_format_extension(a.format));
+    cli_phase_part(what, t_maps);
+    if (a.format != LX_IMAGE_PNG) {
+        snprintf(what, sizeof what, "%u previews (png)", maps);
+        cli_phase_part(what, t_previews);
+    }
+    cli_phase("write and publish");
     if (!a.quiet) {
         uint64_t texels = 0;
         for (uint32_t m = 0; m < maps; m++)
@@ -545,7 +568,7 @@ int cmd_bake(int argc, char **argv)
         fprintf(stderr,
                 "luxel: baked %u lightmaps (%llu texels, %u lights) in %.2f s; preview EV100 "
                 "%.2f%s\n",
-                maps, (unsigned long long)texels, scene->light_count, t_bake, ev,
+                maps, (unsigned long long)texels, scene->light_count, cli_elapsed(), ev,
                 a.has_exposure ? "" : " (auto)");
         printf("%s/manifest.json\n", a.output);
     }

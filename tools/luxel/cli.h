@@ -76,6 +76,18 @@ bool cli_test_fail_rename(void);
 
 /* Monotonic seconds. */
 double cli_now(void);
+/* Seconds since main started. */
+double cli_elapsed(void);
+
+/* --verbose: log lines of level INFO are shown (warnings always are), and
+ * cli_phase prints "luxel: <name>  <seconds> s", the time since the
+ * previous phase ended (or since main started). */
+void cli_set_verbose(bool verbose);
+bool cli_verbose(void);
+void cli_phase(const char *name);
+/* Under --verbose, one part of the phase that is running: "luxel:   <name>
+ * <seconds> s" (the clock is not reset). */
+void cli_phase_part(const char *name, double seconds);
 
 /* strdup and a/b joined, malloc'd; NULL when out of memory. */
 char *cli_strdup(const char *s);

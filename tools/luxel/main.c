@@ -122,6 +122,38 @@ double cli_now(void)
     return (double)ts.tv_sec + (double)ts.tv_nsec * 1e-9;
 }
 
+static double main_start, phase_end;
+static bool verbose;
+
+double cli_elapsed(void)
+{
+    return cli_now() - main_start;
+}
+
+void cli_set_verbose(bool v)
+{
+    verbose = v;
+}
+
+bool cli_verbose(void)
+{
+    return verbose;
+}
+
+void cli_phase(const char *name)
+{
+    double now = cli_now();
+    if (verbose)
+        fprintf(stderr, "luxel: %-24s %8.3f s\n", name, now - phase_end);
+    phase_end = now;
+}
+
+void cli_phase_part(const char *name, double seconds)
+{
+    if (verbose)
+        fprintf(stderr, "luxel:   %-22s %8.3f s\n", name, seconds);
+}
+
 char *cli_strdup(const char *s)
 {
     return strdup(s);
@@ -287,7 +319,7 @@ void cli_progress_finish(cli_progress *p)
 
 static void print_log(void *user, lx_log_level level, const char *message)
 {
-    if (level == LX_LOG_DEBUG)
+    if (level < (verbose ? LX_LOG_INFO : LX_LOG_WARN))
         return;
     fprintf(stderr, "luxel: %s%s\n", level == LX_LOG_WARN ? "warning: " : "", message);
 }
@@ -296,6 +328,7 @@ int main(int argc, char **argv)
 {
     /* before any thread exists, so every thread inherits the mask */
     cli_block_signals();
+    main_start = phase_end = cli_now();
     if (argc < 2) {
         fputs(main_usage, stderr);
         return EXIT_USAGE;
