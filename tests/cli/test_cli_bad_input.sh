@@ -1,5 +1,5 @@
 # End-to-end tests of `luxel bake` / `luxel info` on bad input (DESIGN.md
-# section 4 and the issue's list): missing, unreadable and corrupt files,
+# section 4): missing, unreadable and corrupt files,
 # non-finite coordinates, zero-area triangles in space and in UV, overlapping
 # lightmap UVs, impossible resolutions and memory requests, unknown options
 # and malformed lights JSON. Every failure must exit with the exact status
@@ -381,7 +381,7 @@ bad "missing lights JSON" 1 "no_lights.json" bake "$ROOM" --lights "$IN/no_light
 mkdir "$IN/folder.json"
 bad "a folder as lights JSON" 1 "folder.json" bake "$ROOM" --lights "$IN/folder.json"
 
-# ---- the sky (issue 4) --------------------------------------------------------
+# ---- the sky ------------------------------------------------------------------
 
 bad "--sky: missing environment" 1 "no_sky.hdr" bake "$ROOM" --sky "$IN/no_sky.hdr"
 printf 'PF\n4 2\n-1.0\n' >"$IN/short.pfm"

@@ -329,7 +329,7 @@ run "$LUXEL" bake "$ROOM" --resolution 32 --format pfm -q -o "$WORK/soft2" --thr
     --lights "$WORK/soft.json"
 check "soft bake: the same bytes with 1 thread" cmp -s "$WORK/soft/room.pfm" "$WORK/soft2/room.pfm"
 
-# Sky light (issue 4): gen_scenes' sky through a lights JSON in another
+# Sky light: gen_scenes' sky through a lights JSON in another
 # folder (the path is relative to the JSON), with sky shadows; the manifest
 # records it; 1 and 2 threads give the same bytes; --sky on the command line
 # wins over the file's.
