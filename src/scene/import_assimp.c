@@ -479,7 +479,10 @@ static lx_status check_dropped_faces(const import_ctx *c)
      * fails such files itself): nothing to compare */
     if (n == c->ai->mNumMeshes) {
         const cJSON *meshes = lx_gltf_get(c->gltf, "meshes");
+        size_t first = 0; /* entry of the current mesh's primitive 0 */
         for (size_t k = 0; k < n && st == LX_OK; k++) {
+            if (k > 0 && mesh_of[k] != mesh_of[k - 1])
+                first = k;
             const struct aiMesh *am = c->ai->mMeshes[k];
             if (want[k] == UINT64_MAX || !(am->mPrimitiveTypes & aiPrimitiveType_TRIANGLE) ||
                 (uint64_t)am->mNumFaces >= want[k])
@@ -488,8 +491,9 @@ static lx_status check_dropped_faces(const import_ctx *c)
             lx_gltf_label(who, sizeof who, "mesh", mesh_of[k],
                           cJSON_GetArrayItem(meshes, (int)mesh_of[k]));
             st = lx_fail(LX_ERR_FORMAT,
-                         "%s: %s: %llu of %llu triangles have vertex indices out of range", c->path,
-                         who, (unsigned long long)(want[k] - am->mNumFaces),
+                         "%s: %s: primitive %zu: %llu of %llu triangles have vertex indices out "
+                         "of range",
+                         c->path, who, k - first, (unsigned long long)(want[k] - am->mNumFaces),
                          (unsigned long long)want[k]);
         }
     }

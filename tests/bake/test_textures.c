@@ -80,27 +80,9 @@ static lx_light sun_along(const double dir_in[3], float lux, double dir_out[3])
 static lx_scene *load_quad(const char *dir, const char *name, const lx_test_quad *q,
                            const char *material, const char *texture_uri, const float tangent[16])
 {
-    float pos[12], nrm[12], uv0[8], uv1[8];
-    uint32_t idx[6];
-    lx_test_quad_arrays(q, pos, nrm, uv0, uv1, idx);
-    lx_test_gltf *g = lx_test_gltf_new();
-    if (texture_uri)
-        lx_test_gltf_texture(g, texture_uri);
-    int mat = lx_test_gltf_material(g, material);
-    lx_test_primitive p = {.vertex_count = 4,
-                           .position = pos,
-                           .normal = nrm,
-                           .tangent = tangent,
-                           .uv0 = uv0,
-                           .uv1 = uv1,
-                           .index_count = 6,
-                           .indices = idx,
-                           .material = mat};
-    lx_test_gltf_node(g, "quad", lx_test_gltf_mesh(g, "quad", &p, 1), "");
     char path[1024];
     snprintf(path, sizeof path, "%s/%s.gltf", dir, name);
-    lx_test_gltf_write(g, path);
-    lx_test_gltf_free(g);
+    lx_test_write_quad_gltf(path, q, material, &texture_uri, 1, tangent);
     lx_scene *scene = NULL;
     if (lx_scene_load(path, NULL, &scene) != LX_OK)
         fail_msg("%s: %s", path, lx_last_error());

@@ -2,6 +2,7 @@
  * the glTF 2.0 specification (accessors over bufferViews of one buffer,
  * POSITION with min/max, componentType 5126 float and 5125 uint32). */
 #include "gltf_writer.h"
+#include "texture_oracle.h"
 
 #include <setjmp.h>
 #include <stdarg.h>
@@ -227,4 +228,29 @@ void lx_test_write_png(const char *path, int w, int h, int channels, const uint8
 {
     if (!stbi_write_png(path, w, h, channels, pixels, w * channels))
         fail_msg("cannot write %s", path);
+}
+
+void lx_test_write_quad_gltf(const char *path, const lx_test_quad *q, const char *material,
+                             const char *const *uris, int texture_count, const float *tangent)
+{
+    float pos[12], nrm[12], uv0[8], uv1[8];
+    uint32_t idx[6];
+    lx_test_quad_arrays(q, pos, nrm, uv0, uv1, idx);
+    lx_test_gltf *g = lx_test_gltf_new();
+    for (int i = 0; i < texture_count; i++)
+        lx_test_gltf_texture(g, uris[i]);
+    lx_test_gltf_use_extension(g, "KHR_texture_transform");
+    int mat = lx_test_gltf_material(g, material);
+    lx_test_primitive p = {.vertex_count = 4,
+                           .position = pos,
+                           .normal = nrm,
+                           .tangent = tangent,
+                           .uv0 = uv0,
+                           .uv1 = uv1,
+                           .index_count = 6,
+                           .indices = idx,
+                           .material = mat};
+    lx_test_gltf_node(g, "quad", lx_test_gltf_mesh(g, "quad", &p, 1), "");
+    lx_test_gltf_write(g, path);
+    lx_test_gltf_free(g);
 }

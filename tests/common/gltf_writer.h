@@ -43,6 +43,14 @@ void lx_test_gltf_use_extension(lx_test_gltf *g, const char *name);
 /* Writes the .gltf. */
 void lx_test_gltf_write(const lx_test_gltf *g, const char *path);
 
+struct lx_test_quad;
+/* A .gltf of quad q (texture_oracle.h) as one node "quad" with mesh
+ * "quad": POSITION, NORMAL, TEXCOORD_0 and _1 from q, TANGENT when tangent
+ * (4 floats for each of the 4 corners) is not NULL, one material given as
+ * JSON text using textures 0..texture_count-1 of the images at uris. */
+void lx_test_write_quad_gltf(const char *path, const struct lx_test_quad *q, const char *material,
+                             const char *const *uris, int texture_count, const float *tangent);
+
 /* An 8-bit PNG of w x h pixels with channels (1..4) bytes each, row 0 at
  * the top. */
 void lx_test_write_png(const char *path, int w, int h, int channels, const uint8_t *pixels);
