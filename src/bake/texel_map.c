@@ -345,10 +345,17 @@ static uint32_t collect_slots(const lx_scene *scene, const lx_node *node, slot *
                        scene->path, node->name, m->name);
             continue;
         }
-        if (*uv_set == 0 && warn)
+        if (*uv_set == 0 && warn && !m->uv[1])
             lx_log(LX_LOG_WARN,
                    "%s: node '%s': mesh '%s' has no TEXCOORD_1; its lightmap "
                    "uses TEXCOORD_0",
+                   scene->path, node->name, m->name);
+        else if (*uv_set == 0 && warn)
+            /* a node has one lightmap UV set: one mesh without TEXCOORD_1
+             * sends all of them to TEXCOORD_0 */
+            lx_log(LX_LOG_WARN,
+                   "%s: node '%s': mesh '%s': its TEXCOORD_1 is not used: another mesh of "
+                   "the node has none, so the node's lightmap uses TEXCOORD_0",
                    scene->path, node->name, m->name);
         slots[n++] = (slot){m, node->meshes[k], first, uv};
         first += m->triangle_count;

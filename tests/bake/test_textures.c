@@ -12,7 +12,9 @@
  *   bitangent cross(n, t) * w toward -v, green up);
  * - a mesh without UVs casts shadows: a UV-less triangle over a floor, in
  *   its own node and in the floor's node; every floor texel is dark exactly
- *   when a ray from it toward the light hits the triangle.
+ *   when a ray from it toward the light hits the triangle;
+ * - a node whose meshes do not all have TEXCOORD_1 bakes all of them on
+ *   TEXCOORD_0, with one warning per mesh saying what happens to it.
  *
  * Expected values come from texture_oracle.c (the sRGB formula, bilinear
  * REPEAT filtering and the quads' affine UV maps, in double) and from an
@@ -459,13 +461,71 @@ static void uvless_occluder_same_node(void **state)
     check_uvless_shadow(true);
 }
 
+/* ---- the lightmap UV set of a node -------------------------------------------- */
+
+static int warn_no_uv1, warn_unused_uv1;
+static void count_uv_warnings(void *user, lx_log_level level, const char *msg)
+{
+    (void)user;
+    if (level != LX_LOG_WARN)
+        return;
+    warn_no_uv1 += strstr(msg, "'half' has no TEXCOORD_1; its lightmap uses TEXCOORD_0") != NULL;
+    warn_unused_uv1 += strstr(msg, "'full': its TEXCOORD_1 is not used") != NULL;
+}
+
+/* A node whose meshes do not all have TEXCOORD_1 bakes every mesh on
+ * TEXCOORD_0 (one lightmap UV space per node), warning once per mesh with
+ * what happens to it. Texel counts are closed forms: "full" covers the
+ * left half of TEXCOORD_0 (16 of 32 columns), "half" the right half. */
+static void texcoord0_for_the_whole_node(void **state)
+{
+    (void)state;
+    lx_scene *scene = lx_test_new_scene("uv-sets");
+    lx_material white = {.name = "white", .base_color = {1, 1, 1, 1}};
+    assert_int_equal(lx_scene_add_material(scene, &white, NULL), LX_OK);
+    lx_mesh a = lx_test_plane("full", 1.0f, 0.0f, 0.0f, 0.0f, 1);
+    lx_mesh b = lx_test_plane("half", 1.0f, 0.0f, 2.0f, 0.0f, 1);
+    for (uint32_t v = 0; v < a.vertex_count; v++) {
+        a.uv[0][v].x *= 0.5f;                      /* TEXCOORD_0: the left half */
+        b.uv[0][v].x = 0.5f + 0.5f * b.uv[0][v].x; /* the right half */
+    }
+    free(b.uv[1]);
+    b.uv[1] = NULL;
+    uint32_t mi[2];
+    assert_int_equal(lx_scene_add_mesh(scene, &a, &mi[0]), LX_OK);
+    assert_int_equal(lx_scene_add_mesh(scene, &b, &mi[1]), LX_OK);
+    lx_test_mesh_free(&a);
+    lx_test_mesh_free(&b);
+    lx_mat4 id = lx_mat4_identity();
+    assert_int_equal(lx_scene_add_node(scene, "pair", &id, mi, 2, NULL), LX_OK);
+    lx_bake_desc desc = {.resolution = RES, .threads = 2};
+    lx_baker *baker;
+    warn_no_uv1 = warn_unused_uv1 = 0;
+    lx_set_log_callback(count_uv_warnings, NULL);
+    lx_status st = lx_baker_create(scene, &desc, &baker);
+    lx_set_log_callback(NULL, NULL);
+    assert_int_equal(st, LX_OK);
+    const lx_lightmap_info *info = lx_baker_lightmap_info(baker, 0);
+    assert_int_equal(info->uv_set, 0);
+    assert_int_equal(info->used_texels, RES * RES);
+    assert_int_equal(info->overlap_texels, 0);
+    assert_int_equal(warn_no_uv1, 1);
+    assert_int_equal(warn_unused_uv1, 1);
+    lx_baker_destroy(baker);
+    lx_scene_destroy(scene);
+}
+
 int main(void)
 {
     lx_test_watchdog(300);
     const struct CMUnitTest tests[] = {
-        cmocka_unit_test(checker_radiance),         cmocka_unit_test(normal_map_mirrored),
-        cmocka_unit_test(normal_map_plain),         cmocka_unit_test(normal_map_skewed),
-        cmocka_unit_test(uvless_occluder_own_node), cmocka_unit_test(uvless_occluder_same_node),
+        cmocka_unit_test(checker_radiance),
+        cmocka_unit_test(normal_map_mirrored),
+        cmocka_unit_test(normal_map_plain),
+        cmocka_unit_test(normal_map_skewed),
+        cmocka_unit_test(uvless_occluder_own_node),
+        cmocka_unit_test(uvless_occluder_same_node),
+        cmocka_unit_test(texcoord0_for_the_whole_node),
     };
     return cmocka_run_group_tests(tests, NULL, NULL);
 }
