@@ -263,13 +263,14 @@ void lx_gltf_label(char *buf, size_t size, const char *what, size_t index, const
 
 /* ---- primitives ------------------------------------------------------------ */
 
-/* The count of accessor `ref` (an index into accessors), or false. */
-static bool accessor_count(const cJSON *accessors, const cJSON *ref, uint64_t *count)
+/* The count of accessor `ref` (an index into the n accessors), or false. */
+static bool accessor_count(const cJSON *const *accessors, size_t n, const cJSON *ref,
+                           uint64_t *count)
 {
-    size_t n = cJSON_IsArray(accessors) ? (size_t)cJSON_GetArraySize(accessors) : 0, i;
+    size_t i;
     if (!lx_gltf_index(ref, n, &i))
         return false;
-    const cJSON *c = lx_gltf_get(cJSON_GetArrayItem(accessors, (int)i), "count");
+    const cJSON *c = lx_gltf_get(accessors[i], "count");
     if (!cJSON_IsNumber(c) || !(c->valuedouble >= 0.0) || c->valuedouble != floor(c->valuedouble) ||
         c->valuedouble > 4294967295.0)
         return false;
@@ -284,7 +285,7 @@ lx_status lx_gltf_primitive_triangles(const char *file, const cJSON *root, uint6
     *mesh_of = NULL;
     *count = 0;
     const cJSON *meshes = lx_gltf_get(root, "meshes");
-    const cJSON *accessors = lx_gltf_get(root, "accessors");
+    const cJSON *acc_list = lx_gltf_get(root, "accessors");
     if (!cJSON_IsArray(meshes))
         return LX_OK;
     size_t n = 0;
@@ -294,13 +295,22 @@ lx_status lx_gltf_primitive_triangles(const char *file, const cJSON *root, uint6
     }
     if (n == 0)
         return LX_OK;
+    /* the accessors by index: cJSON's own lookup walks the list */
+    size_t na = 0;
+    for (const cJSON *a = cJSON_IsArray(acc_list) ? acc_list->child : NULL; a; a = a->next)
+        na++;
     uint64_t *tri = malloc(n * sizeof *tri);
     uint32_t *owner = malloc(n * sizeof *owner);
-    if (!tri || !owner) {
+    const cJSON **accessors = malloc((na ? na : 1) * sizeof *accessors);
+    if (!tri || !owner || !accessors) {
         free(tri);
         free(owner);
+        free(accessors);
         return failf(file, LX_ERR_NOMEM, "out of memory for %zu primitives", n);
     }
+    na = 0;
+    for (const cJSON *a = cJSON_IsArray(acc_list) ? acc_list->child : NULL; a; a = a->next)
+        accessors[na++] = a;
     size_t k = 0;
     uint32_t mi = 0;
     for (const cJSON *m = meshes->child; m; m = m->next, mi++) {
@@ -312,11 +322,9 @@ lx_status lx_gltf_primitive_triangles(const char *file, const cJSON *root, uint6
             double md = mode ? (cJSON_IsNumber(mode) ? mode->valuedouble : -1.0) : 4.0;
             uint64_t c;
             const cJSON *indices = lx_gltf_get(p, "indices");
-            bool known =
-                indices ? accessor_count(accessors, indices, &c)
-                        : accessor_count(accessors,
-                                         lx_gltf_get(lx_gltf_get(p, "attributes"), "POSITION"), &c);
-            if (!known)
+            const cJSON *ref =
+                indices ? indices : lx_gltf_get(lx_gltf_get(p, "attributes"), "POSITION");
+            if (!accessor_count(accessors, na, ref, &c))
                 continue;
             if (md == 4.0) /* TRIANGLES: a trailing partial triangle is no triangle */
                 tri[k] = c / 3;
@@ -324,6 +332,7 @@ lx_status lx_gltf_primitive_triangles(const char *file, const cJSON *root, uint6
                 tri[k] = c - 2;
         }
     }
+    free(accessors);
     *triangles = tri;
     *mesh_of = owner;
     *count = n;
