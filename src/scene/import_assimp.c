@@ -549,6 +549,11 @@ lx_status lx_scene_load(const char *path, const lx_scene_load_desc *in, lx_scene
         if (st != LX_OK)
             return st;
     }
+    /* a .gltf that is not JSON would be handed to whichever assimp reader
+     * claims its bytes (its OpenGEX reader overruns a buffer on 20 bytes
+     * of "vertexarray (attrib)") */
+    if (kind == LX_GLTF_NONE && has_extension(path, ".gltf"))
+        return lx_fail(LX_ERR_FORMAT, "%s: not glTF: the file is not JSON text", path);
     cJSON *gltf = NULL;
     if (kind != LX_GLTF_NONE) {
         lx_status st = lx_gltf_json_read(path, &gltf);

@@ -452,6 +452,26 @@ static void dropped_faces_named(void **state)
         fail_msg("message '%s'", msg);
 }
 
+/* A .gltf that is not JSON is refused before assimp looks for a reader
+ * that claims its bytes (found by fuzz_scene: assimp's OpenGEX reader
+ * overruns a heap buffer on these 20 bytes). */
+static void gltf_that_is_not_json(void **state)
+{
+    (void)state;
+    const char *dir = lx_test_dir("test_tt_not_json");
+    char path[1024];
+    snprintf(path, sizeof path, "%s/ogex.gltf", dir);
+    FILE *fp = fopen(path, "wb");
+    assert_non_null(fp);
+    fputs("vertexarray (attrib)", fp);
+    assert_int_equal(fclose(fp), 0);
+    lx_scene *s = NULL;
+    assert_int_equal(lx_scene_load(path, NULL, &s), LX_ERR_FORMAT);
+    assert_null(s);
+    if (!strstr(lx_last_error(), "ogex.gltf: not glTF"))
+        fail_msg("message '%s'", lx_last_error());
+}
+
 int main(void)
 {
     lx_test_watchdog(300);
@@ -462,6 +482,7 @@ int main(void)
         cmocka_unit_test(base_color_transforms),
         cmocka_unit_test(normal_transforms),
         cmocka_unit_test(dropped_faces_named),
+        cmocka_unit_test(gltf_that_is_not_json),
     };
     return cmocka_run_group_tests(tests, NULL, NULL);
 }
