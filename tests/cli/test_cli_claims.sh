@@ -12,7 +12,9 @@
 #   (a scale by a power of two commutes with rounding), x3 three times up
 #   to float rounding, alone and on top of a sun;
 # - an unshadowed --sky const:L on an open floor facing up gives pi * L lux
-#   in every texel (the SH of a constant are exact).
+#   in every texel (the SH of a constant are exact);
+# - a malformed KHR_texture_transform fails with one error line naming the
+#   file, the material and the field, and writes nothing.
 #
 # Expected values are closed forms (pi * L, the UV areas) and the
 # invariants the options state; PFM values are decoded bit-exactly from
@@ -209,5 +211,21 @@ check "--sky const:0.25,0.5,2: pi times each channel" \
     'function abs(x) { return x < 0 ? -x : x }
      { L = c == 0 ? 0.25 : c == 1 ? 0.5 : 2 }
      abs(a - 3.14159265358979 * L) <= 2.5e-6 * 3.14159265358979 * L'
+
+# ---- a malformed KHR_texture_transform ---------------------------------------------
+
+write_uv_quad "$IN/bad_tt.gltf" bad_tt "$FULL" || exit 1
+# the same quad with a material whose normal texture's transform has a
+# three-number offset
+awk '{ sub(/"mode": 4}/, "\"mode\": 4, \"material\": 0}") }
+     /"buffers"/ { print " \"materials\": [{\"name\": \"tiles\", \"normalTexture\": {\"index\": 0,"
+                   print "   \"extensions\": {\"KHR_texture_transform\": {\"offset\": [0, 0, 1]}}}}],"
+                   print " \"textures\": [{\"source\": 0}], \"images\": [{\"uri\": \"n.png\"}]," }
+     { print }' "$IN/bad_tt.gltf" >"$IN/bad_tt2.gltf" && mv "$IN/bad_tt2.gltf" "$IN/bad_tt.gltf"
+run "$LUXEL" bake "$IN/bad_tt.gltf" --resolution 16 -o "$WORK/bad_tt"
+expect_rc 1 "a malformed KHR_texture_transform"
+expect_error "a malformed KHR_texture_transform" "bad_tt.gltf" "material 0 ('tiles')" \
+    "normalTexture: KHR_texture_transform" "offset must be 2 finite numbers"
+expect_no_output "a malformed KHR_texture_transform" "$WORK/bad_tt"
 
 finish
