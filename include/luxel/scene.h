@@ -7,8 +7,10 @@
  *   top-left of the image (glTF); OBJ's bottom-left V is flipped on import.
  *   uv[0] is TEXCOORD_0, uv[1] TEXCOORD_1. Tangents are xyz + w handedness:
  *   bitangent = cross(normal, tangent.xyz) * w (glTF).
- *   Lights are world-space lx_lights with native units (cd, lx); glTF
- *   KHR_lights_punctual fields are read exactly from the file's JSON.
+ *   Lights are world-space lx_lights with native units (cd, lx). What
+ *   assimp drops or changes is read from a glTF file's own JSON:
+ *   KHR_lights_punctual's fields, KHR_texture_transform (lx_uv_transform)
+ *   and its texCoord override.
  * ERRORS  Loaders fail with a message naming the file and the place:
  *   "room.glb: mesh 'floor': vertex 12: position is not finite".
  *   Problems that do not stop a load (a mesh with no UVs...) are reported
@@ -56,16 +58,45 @@ typedef struct lx_mesh {
     uint32_t material;           /* index into scene->materials */
 } lx_mesh;
 
+/* A texture's KHR_texture_transform (Khronos extension spec): the texture
+ * is read at uv' = offset + R(rotation) * (scale * uv), R = [cos -sin;
+ * sin cos] - the extension's matrix translation * rotation * scale, in
+ * glTF's UV space (origin top-left, as every UV in luxel). A zeroed struct
+ * (enabled false) is the identity. */
+typedef struct lx_uv_transform {
+    bool enabled;   /* false: uv' = uv and the fields below are ignored */
+    lx_vec2 offset; /* in UV units */
+    float rotation; /* radians */
+    lx_vec2 scale;
+} lx_uv_transform;
+
+/* uv' for uv under t (computed in double, rounded once). */
+static inline lx_vec2 lx_uv_transform_apply(const lx_uv_transform *t, lx_vec2 uv)
+{
+    if (!t->enabled)
+        return uv;
+    double c = cos((double)t->rotation), s = sin((double)t->rotation);
+    double su = (double)t->scale.x * uv.x, sv = (double)t->scale.y * uv.y;
+    return lx_v2((float)(t->offset.x + c * su - s * sv), (float)(t->offset.y + s * su + c * sv));
+}
+
+/* Textures are sampled bilinearly with wrap-around (glTF's REPEAT) at the
+ * texel's uv[*_uv_set] under *_transform. A normal map's tangent frame
+ * belongs to the mesh's UV set (its tangents, else ones computed from
+ * uv[normal_uv_set] as glTF asks), not to the transform: the transform
+ * only moves where the map is read. */
 typedef struct lx_material {
     char *name;
-    lx_vec4 base_color;      /* linear RGBA factor */
-    lx_image base_color_map; /* linear RGBA (sRGB-decoded), width 0 if none */
-    int base_color_uv_set;
-    char *base_color_map_path; /* where it came from (for messages), or NULL */
-    lx_image normal_map;       /* raw tangent-space normals in [0,1], width 0 if none */
-    float normal_scale;        /* glTF normalTexture.scale, 1 by default */
-    int normal_uv_set;         /* UV set the normal map uses */
-    char *normal_map_path;     /* where it came from (for messages), or NULL */
+    lx_vec4 base_color;                   /* linear RGBA factor */
+    lx_image base_color_map;              /* linear RGBA (sRGB-decoded), width 0 if none */
+    int base_color_uv_set;                /* texCoord (or KHR_texture_transform's override) */
+    char *base_color_map_path;            /* where it came from (for messages), or NULL */
+    lx_uv_transform base_color_transform; /* KHR_texture_transform of the map */
+    lx_image normal_map;                  /* raw tangent-space normals in [0,1], width 0 if none */
+    float normal_scale;                   /* glTF normalTexture.scale, 1 by default */
+    int normal_uv_set;                    /* UV set the normal map uses */
+    char *normal_map_path;                /* where it came from (for messages), or NULL */
+    lx_uv_transform normal_transform;     /* KHR_texture_transform of the map */
 } lx_material;
 
 typedef struct lx_node {

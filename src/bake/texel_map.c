@@ -291,8 +291,11 @@ static void sample_normal_map(const lx_material *mat, const lx_mesh *m, const lx
     const lx_vec2 *uv = m->uv[mat->normal_uv_set];
     float u = uv[i[0]].x * w0 + uv[i[1]].x * w1 + uv[i[2]].x * w2;
     float v = uv[i[0]].y * w0 + uv[i[1]].y * w1 + uv[i[2]].y * w2;
+    /* KHR_texture_transform moves where the map is read; the tangent frame
+     * stays the UV set's own (scene.h) */
+    lx_vec2 at = lx_uv_transform_apply(&mat->normal_transform, lx_v2(u, v));
     float c[4];
-    lx_image_sample_bilinear(&mat->normal_map, u, v, c);
+    lx_image_sample_bilinear(&mat->normal_map, at.x, at.y, c);
     lx_vec3 t = lx_v3(0, 0, 0);
     for (int k = 0; k < 3; k++) {
         float wk = k == 0 ? w0 : (k == 1 ? w1 : w2);
@@ -311,8 +314,9 @@ static lx_vec3 sample_albedo(const lx_material *mat, const lx_mesh *m, const uin
     if (mat->base_color_map.width > 0 && uv) {
         float u = uv[i[0]].x * w0 + uv[i[1]].x * w1 + uv[i[2]].x * w2;
         float v = uv[i[0]].y * w0 + uv[i[1]].y * w1 + uv[i[2]].y * w2;
+        lx_vec2 at = lx_uv_transform_apply(&mat->base_color_transform, lx_v2(u, v));
         float c[4] = {1, 1, 1, 1};
-        lx_image_sample_bilinear(&mat->base_color_map, u, v, c);
+        lx_image_sample_bilinear(&mat->base_color_map, at.x, at.y, c);
         a = lx_mul(a, lx_v3(c[0], c[1], c[2]));
     }
     return a;
@@ -341,10 +345,17 @@ static uint32_t collect_slots(const lx_scene *scene, const lx_node *node, slot *
                        scene->path, node->name, m->name);
             continue;
         }
-        if (*uv_set == 0 && warn)
+        if (*uv_set == 0 && warn && !m->uv[1])
             lx_log(LX_LOG_WARN,
                    "%s: node '%s': mesh '%s' has no TEXCOORD_1; its lightmap "
                    "uses TEXCOORD_0",
+                   scene->path, node->name, m->name);
+        else if (*uv_set == 0 && warn)
+            /* a node has one lightmap UV set: one mesh without TEXCOORD_1
+             * sends all of them to TEXCOORD_0 */
+            lx_log(LX_LOG_WARN,
+                   "%s: node '%s': mesh '%s': its TEXCOORD_1 is not used: another mesh of "
+                   "the node has none, so the node's lightmap uses TEXCOORD_0",
                    scene->path, node->name, m->name);
         slots[n++] = (slot){m, node->meshes[k], first, uv};
         first += m->triangle_count;

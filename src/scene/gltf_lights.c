@@ -1,139 +1,21 @@
 /* glTF 2.0 KHR_lights_punctual (Khronos extension spec): point, spot and
  * directional lights defined in the root "extensions" and placed by the
  * nodes that reference them; a light shines down its node's local -Z.
- * Read from the glTF JSON directly (cJSON) because assimp drops the exact
- * fields; .glb files are located through their 12-byte header and first
- * (JSON) chunk per the glTF 2.0 binary container spec. Node world matrices
+ * Read from the glTF JSON directly (cJSON, through gltf_json.c) because
+ * assimp drops the exact fields. Node world matrices
  * are T * R * S (or "matrix"), parent times child, column-major. */
 #include "luxel/scene.h"
 #include "core/internal.h"
 
+#include "gltf_json.h"
 #include "json_text.h"
 
 #include <cjson/cJSON.h>
-#include <errno.h>
 #include <stdio.h>
 #include <stdlib.h>
 #include <string.h>
 
-/* A .gltf is all JSON but may embed base64 buffers: allow big files. */
-#define LX_GLTF_TEXT_MAX ((size_t)1 << 30)
-#define LX_GLB_MAGIC 0x46546C67u      /* "glTF" little-endian */
-#define LX_GLB_CHUNK_JSON 0x4E4F534Au /* "JSON" */
-#define LX_GLB_HEADER 12u
-#define LX_GLB_CHUNK_HEADER 8u
-
 #define failf(file, st, ...) lx_json_fail(st, file, NULL, __VA_ARGS__)
-
-/* ---- the container ------------------------------------------------------ */
-
-static uint32_t le32(const uint8_t *p)
-{
-    return (uint32_t)p[0] | (uint32_t)p[1] << 8 | (uint32_t)p[2] << 16 | (uint32_t)p[3] << 24;
-}
-
-/* Checks a GLB's header and first chunk header (head holds the first
- * head_len bytes of a file of total bytes) and finds the JSON chunk. */
-static lx_status glb_locate(const char *file, const uint8_t *head, size_t head_len, uint64_t total,
-                            uint64_t *json_offset, uint32_t *json_size)
-{
-    if (total < LX_GLB_HEADER || head_len < LX_GLB_HEADER)
-        return failf(file, LX_ERR_FORMAT, "truncated GLB: %llu bytes, the header needs 12",
-                     (unsigned long long)total);
-    if (le32(head) != LX_GLB_MAGIC)
-        return failf(file, LX_ERR_FORMAT, "not a GLB file (bad magic)");
-    uint32_t version = le32(head + 4), length = le32(head + 8);
-    if (version != 2)
-        return failf(file, LX_ERR_UNSUPPORTED, "GLB version %u (only version 2 is supported)",
-                     version);
-    if (length > total)
-        return failf(file, LX_ERR_FORMAT,
-                     "truncated GLB: the header says %u bytes, the file has %llu", length,
-                     (unsigned long long)total);
-    if (length < LX_GLB_HEADER + LX_GLB_CHUNK_HEADER || head_len < 20)
-        return failf(file, LX_ERR_FORMAT, "truncated GLB: %u bytes leave no room for a chunk",
-                     length);
-    uint32_t chunk_len = le32(head + 12), chunk_type = le32(head + 16);
-    if (chunk_type != LX_GLB_CHUNK_JSON)
-        return failf(file, LX_ERR_FORMAT,
-                     "GLB: the first chunk has type 0x%08X, not JSON (0x4E4F534A)", chunk_type);
-    if (chunk_len > length - LX_GLB_HEADER - LX_GLB_CHUNK_HEADER)
-        return failf(file, LX_ERR_FORMAT,
-                     "truncated GLB: the JSON chunk of %u bytes runs past the end (%u bytes)",
-                     chunk_len, length);
-    *json_offset = LX_GLB_HEADER + LX_GLB_CHUNK_HEADER;
-    *json_size = chunk_len;
-    return LX_OK;
-}
-
-static lx_status parse_json(const char *file, const char *text, size_t size, cJSON **root)
-{
-    *root = NULL;
-    const char *nul = memchr(text, '\0', size);
-    if (nul)
-        return failf(file, LX_ERR_FORMAT,
-                     "neither glTF JSON (NUL byte at offset %zu) nor GLB (no 'glTF' magic)",
-                     (size_t)(nul - text));
-    return lx_json_parse_text(file, text, size, root);
-}
-
-/* ---- typed values --------------------------------------------------------- */
-
-/* Numbers: finite, also as a float. */
-static bool number(const cJSON *item, float *out)
-{
-    if (!cJSON_IsNumber(item) || !isfinite(item->valuedouble) ||
-        !isfinite((float)item->valuedouble))
-        return false;
-    *out = (float)item->valuedouble;
-    return true;
-}
-
-/* An array of exactly n finite numbers. */
-static bool numbers(const cJSON *item, float *out, int n)
-{
-    if (!cJSON_IsArray(item) || cJSON_GetArraySize(item) != n)
-        return false;
-    int i = 0;
-    for (const cJSON *e = item->child; e; e = e->next)
-        if (!number(e, &out[i++]))
-            return false;
-    return true;
-}
-
-/* An integer index in [0, count). */
-static bool index_in(const cJSON *item, size_t count, size_t *out)
-{
-    if (!cJSON_IsNumber(item))
-        return false;
-    double v = item->valuedouble;
-    if (!(v >= 0.0) || v != floor(v) || v >= (double)count)
-        return false;
-    *out = (size_t)v;
-    return true;
-}
-
-static const cJSON *get(const cJSON *obj, const char *key)
-{
-    return cJSON_IsObject(obj) ? cJSON_GetObjectItemCaseSensitive(obj, key) : NULL;
-}
-
-/* The string at key, or NULL when absent or not a string. */
-static const char *get_string(const cJSON *obj, const char *key)
-{
-    const cJSON *s = get(obj, key);
-    return cJSON_IsString(s) && s->valuestring ? s->valuestring : NULL;
-}
-
-/* "node 3 ('Lamp')" for messages. */
-static void label(char *buf, size_t size, const char *what, size_t index, const cJSON *obj)
-{
-    const char *name = get_string(obj, "name");
-    if (name)
-        snprintf(buf, size, "%s %zu ('%.60s')", what, index, name);
-    else
-        snprintf(buf, size, "%s %zu", what, index);
-}
 
 /* ---- light definitions ---------------------------------------------------- */
 
@@ -145,10 +27,10 @@ typedef struct def {
 static lx_status read_def(const char *file, const cJSON *obj, size_t index, def *out)
 {
     char who[128];
-    label(who, sizeof who, "KHR_lights_punctual light", index, obj);
+    lx_gltf_label(who, sizeof who, "KHR_lights_punctual light", index, obj);
     if (!cJSON_IsObject(obj))
         return failf(file, LX_ERR_FORMAT, "%s is not an object", who);
-    const char *type = get_string(obj, "type");
+    const char *type = lx_gltf_get_string(obj, "type");
     if (!type)
         return failf(file, LX_ERR_FORMAT, "%s: missing 'type'", who);
     lx_light_type t;
@@ -164,33 +46,33 @@ static lx_status read_def(const char *file, const cJSON *obj, size_t index, def 
     lx_light l = lx_light_defaults(t);
     const cJSON *it;
     float v[3];
-    if ((it = get(obj, "color"))) {
-        if (!numbers(it, v, 3))
+    if ((it = lx_gltf_get(obj, "color"))) {
+        if (!lx_gltf_numbers(it, v, 3))
             return failf(file, LX_ERR_FORMAT, "%s: color must be 3 finite numbers", who);
         if (v[0] < 0.0f || v[1] < 0.0f || v[2] < 0.0f)
             return failf(file, LX_ERR_INVALID, "%s: color has a negative component", who);
         l.color = lx_v3(v[0], v[1], v[2]);
     }
-    if ((it = get(obj, "intensity"))) {
-        if (!number(it, &l.intensity))
+    if ((it = lx_gltf_get(obj, "intensity"))) {
+        if (!lx_gltf_number(it, &l.intensity))
             return failf(file, LX_ERR_FORMAT, "%s: intensity must be a finite number", who);
         if (l.intensity < 0.0f)
             return failf(file, LX_ERR_INVALID, "%s: intensity %g is negative", who, l.intensity);
     }
-    if ((it = get(obj, "range"))) {
-        if (!number(it, &l.range))
+    if ((it = lx_gltf_get(obj, "range"))) {
+        if (!lx_gltf_number(it, &l.range))
             return failf(file, LX_ERR_FORMAT, "%s: range must be a finite number", who);
         if (!(l.range > 0.0f))
             return failf(file, LX_ERR_INVALID, "%s: range %g must be above 0", who, l.range);
     }
-    if (t == LX_LIGHT_SPOT && (it = get(obj, "spot"))) {
+    if (t == LX_LIGHT_SPOT && (it = lx_gltf_get(obj, "spot"))) {
         if (!cJSON_IsObject(it))
             return failf(file, LX_ERR_FORMAT, "%s: spot must be an object", who);
         const cJSON *a;
-        if ((a = get(it, "innerConeAngle")) && !number(a, &l.inner_angle))
+        if ((a = lx_gltf_get(it, "innerConeAngle")) && !lx_gltf_number(a, &l.inner_angle))
             return failf(file, LX_ERR_FORMAT, "%s: spot.innerConeAngle must be a finite number",
                          who);
-        if ((a = get(it, "outerConeAngle")) && !number(a, &l.outer_angle))
+        if ((a = lx_gltf_get(it, "outerConeAngle")) && !lx_gltf_number(a, &l.outer_angle))
             return failf(file, LX_ERR_FORMAT, "%s: spot.outerConeAngle must be a finite number",
                          who);
     }
@@ -211,7 +93,7 @@ static lx_status read_def(const char *file, const cJSON *obj, size_t index, def 
                          l.inner_angle, l.outer_angle);
     }
     out->light = l;
-    out->name = get_string(obj, "name");
+    out->name = lx_gltf_get_string(obj, "name");
     return LX_OK;
 }
 
@@ -220,17 +102,17 @@ static lx_status read_def(const char *file, const cJSON *obj, size_t index, def 
 static lx_status local_matrix(const char *file, const cJSON *node, const char *who, lx_mat4 *m)
 {
     const cJSON *it;
-    if ((it = get(node, "matrix"))) {
-        if (!numbers(it, m->m, 16))
+    if ((it = lx_gltf_get(node, "matrix"))) {
+        if (!lx_gltf_numbers(it, m->m, 16))
             return failf(file, LX_ERR_FORMAT, "%s: matrix must be 16 finite numbers", who);
         return LX_OK;
     }
     float t[3] = {0, 0, 0}, r[4] = {0, 0, 0, 1}, s[3] = {1, 1, 1};
-    if ((it = get(node, "translation")) && !numbers(it, t, 3))
+    if ((it = lx_gltf_get(node, "translation")) && !lx_gltf_numbers(it, t, 3))
         return failf(file, LX_ERR_FORMAT, "%s: translation must be 3 finite numbers", who);
-    if ((it = get(node, "rotation")) && !numbers(it, r, 4))
+    if ((it = lx_gltf_get(node, "rotation")) && !lx_gltf_numbers(it, r, 4))
         return failf(file, LX_ERR_FORMAT, "%s: rotation must be 4 finite numbers", who);
-    if ((it = get(node, "scale")) && !numbers(it, s, 3))
+    if ((it = lx_gltf_get(node, "scale")) && !lx_gltf_numbers(it, s, 3))
         return failf(file, LX_ERR_FORMAT, "%s: scale must be 3 finite numbers", who);
     /* Exporters write quaternions rounded; renormalize so R stays a rotation. */
     double qn =
@@ -266,7 +148,7 @@ static void graph_free(graph *g)
  * node's world matrix from the roots down, without recursion. */
 static lx_status build_graph(const char *file, const cJSON *root, graph *g)
 {
-    const cJSON *nodes = get(root, "nodes");
+    const cJSON *nodes = lx_gltf_get(root, "nodes");
     if (nodes && !cJSON_IsArray(nodes))
         return failf(file, LX_ERR_FORMAT, "'nodes' must be an array");
     size_t n = 0;
@@ -294,12 +176,12 @@ static lx_status build_graph(const char *file, const cJSON *root, graph *g)
     lx_status st = LX_OK;
     char who[128];
     for (i = 0; i < n && st == LX_OK; i++) {
-        label(who, sizeof who, "node", i, g->nodes[i]);
+        lx_gltf_label(who, sizeof who, "node", i, g->nodes[i]);
         if (!cJSON_IsObject(g->nodes[i])) {
             st = failf(file, LX_ERR_FORMAT, "%s is not an object", who);
             break;
         }
-        const cJSON *children = get(g->nodes[i], "children");
+        const cJSON *children = lx_gltf_get(g->nodes[i], "children");
         if (!children)
             continue;
         if (!cJSON_IsArray(children)) {
@@ -308,7 +190,7 @@ static lx_status build_graph(const char *file, const cJSON *root, graph *g)
         }
         for (const cJSON *c = children->child; c && st == LX_OK; c = c->next) {
             size_t k;
-            if (!index_in(c, n, &k))
+            if (!lx_gltf_index(c, n, &k))
                 st = failf(file, LX_ERR_FORMAT, "%s: child %g is not a node index (%zu nodes)", who,
                            cJSON_IsNumber(c) ? c->valuedouble : -1.0, n);
             else if (k == i)
@@ -329,14 +211,14 @@ static lx_status build_graph(const char *file, const cJSON *root, graph *g)
         size_t k = stack[--top];
         g->order[g->reached++] = k;
         seen[k] = true;
-        label(who, sizeof who, "node", k, g->nodes[k]);
+        lx_gltf_label(who, sizeof who, "node", k, g->nodes[k]);
         lx_mat4 local;
         if ((st = local_matrix(file, g->nodes[k], who, &local)) != LX_OK)
             break;
         g->world[k] = g->parent[k] < 0 ? local : lx_mat4_mul(&g->world[g->parent[k]], &local);
         if (!lx_mat4_finite(&g->world[k]))
             st = failf(file, LX_ERR_FORMAT, "%s: world transform is not finite", who);
-        const cJSON *children = get(g->nodes[k], "children");
+        const cJSON *children = lx_gltf_get(g->nodes[k], "children");
         for (const cJSON *c = children ? children->child : NULL; c; c = c->next)
             stack[top++] = (size_t)c->valuedouble; /* checked above */
     }
@@ -358,11 +240,11 @@ static lx_status build_graph(const char *file, const cJSON *root, graph *g)
  * node when the file has no scenes. */
 static lx_status select_scene(const char *file, const cJSON *root, graph *g)
 {
-    const cJSON *scenes = get(root, "scenes");
+    const cJSON *scenes = lx_gltf_get(root, "scenes");
     if (scenes && !cJSON_IsArray(scenes))
         return failf(file, LX_ERR_FORMAT, "'scenes' must be an array");
     size_t scene_count = (size_t)(scenes ? cJSON_GetArraySize(scenes) : 0);
-    const cJSON *which = get(root, "scene");
+    const cJSON *which = lx_gltf_get(root, "scene");
     if (scene_count == 0) {
         if (which)
             return failf(file, LX_ERR_FORMAT, "'scene' is given but there are no scenes");
@@ -371,12 +253,12 @@ static lx_status select_scene(const char *file, const cJSON *root, graph *g)
         return LX_OK;
     }
     size_t s = 0;
-    if (which && !index_in(which, scene_count, &s))
+    if (which && !lx_gltf_index(which, scene_count, &s))
         return failf(file, LX_ERR_FORMAT, "'scene' is not a scene index (%zu scenes)", scene_count);
     const cJSON *sc = cJSON_GetArrayItem(scenes, (int)s);
     if (!cJSON_IsObject(sc))
         return failf(file, LX_ERR_FORMAT, "scene %zu is not an object", s);
-    const cJSON *roots = get(sc, "nodes");
+    const cJSON *roots = lx_gltf_get(sc, "nodes");
     if (roots && !cJSON_IsArray(roots))
         return failf(file, LX_ERR_FORMAT, "scene %zu: nodes must be an array", s);
     bool *marked = calloc(g->count ? g->count : 1, sizeof *marked);
@@ -384,7 +266,7 @@ static lx_status select_scene(const char *file, const cJSON *root, graph *g)
         return failf(file, LX_ERR_NOMEM, "out of memory for %zu nodes", g->count);
     for (const cJSON *r = roots ? roots->child : NULL; r; r = r->next) {
         size_t k;
-        if (!index_in(r, g->count, &k)) {
+        if (!lx_gltf_index(r, g->count, &k)) {
             free(marked);
             return failf(file, LX_ERR_FORMAT, "scene %zu: node %g is not a node index (%zu nodes)",
                          s, cJSON_IsNumber(r) ? r->valuedouble : -1.0, g->count);
@@ -513,13 +395,13 @@ static lx_status node_light(const char *file, const cJSON *node, const char *who
                             bool *has, size_t *index)
 {
     *has = false;
-    const cJSON *ext = get(get(node, "extensions"), "KHR_lights_punctual");
+    const cJSON *ext = lx_gltf_get(lx_gltf_get(node, "extensions"), "KHR_lights_punctual");
     if (!ext)
         return LX_OK;
-    const cJSON *li = get(ext, "light");
+    const cJSON *li = lx_gltf_get(ext, "light");
     if (!li)
         return failf(file, LX_ERR_FORMAT, "%s: KHR_lights_punctual without 'light'", who);
-    if (!index_in(li, def_count, index))
+    if (!lx_gltf_index(li, def_count, index))
         return failf(file, LX_ERR_FORMAT, "%s: light %g is out of range (%zu lights)", who,
                      cJSON_IsNumber(li) ? li->valuedouble : -1.0, def_count);
     *has = true;
@@ -553,7 +435,7 @@ static lx_status load_lights(lx_scene *scene, const char *file, const cJSON *roo
     for (size_t i = 0; i < g.count && st == LX_OK; i++) {
         bool has;
         size_t li;
-        label(who, sizeof who, "node", i, g.nodes[i]);
+        lx_gltf_label(who, sizeof who, "node", i, g.nodes[i]);
         if (g.included[i] &&
             (st = node_light(file, g.nodes[i], who, def_count, &has, &li)) == LX_OK && has)
             count++;
@@ -569,7 +451,7 @@ static lx_status load_lights(lx_scene *scene, const char *file, const cJSON *roo
     for (size_t i = 0; i < g.count && st == LX_OK && n < count; i++) {
         bool has;
         size_t li;
-        label(who, sizeof who, "node", i, g.nodes[i]);
+        lx_gltf_label(who, sizeof who, "node", i, g.nodes[i]);
         if (!g.included[i] || node_light(file, g.nodes[i], who, def_count, &has, &li) != LX_OK ||
             !has)
             continue;
@@ -580,7 +462,7 @@ static lx_status load_lights(lx_scene *scene, const char *file, const cJSON *roo
         snprintf(fallback, sizeof fallback, "light%zu", li);
         const char *base = defs[li].name;
         if (!base || !base[0])
-            base = get_string(g.nodes[i], "name");
+            base = lx_gltf_get_string(g.nodes[i], "name");
         if (!base || !base[0])
             base = fallback;
         if ((st = unique_name(file, base, &used, &next, l->name)) != LX_OK)
@@ -604,34 +486,27 @@ static lx_status load_lights(lx_scene *scene, const char *file, const cJSON *roo
     return st;
 }
 
-static lx_status load_json(lx_scene *scene, const char *file, const char *text, size_t size)
+lx_status lx_gltf_lights_from_json(lx_scene *scene, const char *file, const cJSON *root)
 {
-    cJSON *root;
-    lx_status st = parse_json(file, text, size, &root);
-    if (st != LX_OK)
-        return st;
+    const cJSON *khr = lx_gltf_get(lx_gltf_get(root, "extensions"), "KHR_lights_punctual");
+    if (!khr)
+        return LX_OK; /* files without the extension have no lights */
+    lx_status st = LX_OK;
     def *defs = NULL;
     size_t def_count = 0;
-    const cJSON *khr = get(get(root, "extensions"), "KHR_lights_punctual");
-    if (!cJSON_IsObject(root)) {
-        st = failf(file, LX_ERR_FORMAT, "the top level of the glTF JSON is not an object");
-    } else if (khr) {
-        /* Files without the extension have no lights: nothing to do. */
-        const cJSON *list = get(khr, "lights");
-        if (!cJSON_IsObject(khr) || (list && !cJSON_IsArray(list)))
-            st = failf(file, LX_ERR_FORMAT, "KHR_lights_punctual: 'lights' must be an array");
-        for (const cJSON *e = list ? list->child : NULL; e; e = e->next)
-            def_count++;
-        if (st == LX_OK && def_count > 0 && !(defs = malloc(def_count * sizeof *defs)))
-            st = failf(file, LX_ERR_NOMEM, "out of memory for %zu lights", def_count);
-        size_t i = 0;
-        for (const cJSON *e = list ? list->child : NULL; e && st == LX_OK; e = e->next, i++)
-            st = read_def(file, e, i, &defs[i]);
-        if (st == LX_OK)
-            st = load_lights(scene, file, root, defs, def_count);
-    }
+    const cJSON *list = lx_gltf_get(khr, "lights");
+    if (!cJSON_IsObject(khr) || (list && !cJSON_IsArray(list)))
+        st = failf(file, LX_ERR_FORMAT, "KHR_lights_punctual: 'lights' must be an array");
+    for (const cJSON *e = list ? list->child : NULL; e; e = e->next)
+        def_count++;
+    if (st == LX_OK && def_count > 0 && !(defs = malloc(def_count * sizeof *defs)))
+        st = failf(file, LX_ERR_NOMEM, "out of memory for %zu lights", def_count);
+    size_t i = 0;
+    for (const cJSON *e = list ? list->child : NULL; e && st == LX_OK; e = e->next, i++)
+        st = read_def(file, e, i, &defs[i]);
+    if (st == LX_OK)
+        st = load_lights(scene, file, root, defs, def_count);
     free(defs);
-    cJSON_Delete(root);
     return st;
 }
 
@@ -643,16 +518,12 @@ lx_status lx_gltf_lights_load_memory(lx_scene *scene, const void *bytes, size_t 
         return failf(file, LX_ERR_INVALID, "no scene to add the lights to");
     if (!bytes && size > 0)
         return failf(file, LX_ERR_INVALID, "no bytes");
-    const uint8_t *b = bytes ? bytes : (const uint8_t *)"";
-    if (size >= 4 && memcmp(b, "glTF", 4) == 0) {
-        uint64_t off;
-        uint32_t len;
-        lx_status st = glb_locate(file, b, size, size, &off, &len);
-        if (st != LX_OK)
-            return st;
-        return load_json(scene, file, (const char *)b + off, len);
-    }
-    return load_json(scene, file, (const char *)b, size);
+    cJSON *root;
+    lx_status st = lx_gltf_json_read_memory(file, bytes, size, &root);
+    if (st == LX_OK)
+        st = lx_gltf_lights_from_json(scene, file, root);
+    cJSON_Delete(root);
+    return st;
 }
 
 lx_status lx_gltf_lights_load(lx_scene *scene, const char *path)
@@ -661,87 +532,10 @@ lx_status lx_gltf_lights_load(lx_scene *scene, const char *path)
         return lx_fail(LX_ERR_INVALID, "glTF lights: no path");
     if (!scene)
         return failf(path, LX_ERR_INVALID, "no scene to add the lights to");
-    FILE *fp = fopen(path, "rb");
-    if (!fp)
-        return failf(path, LX_ERR_IO, "cannot open: %s", strerror(errno));
-    uint8_t head[20];
-    size_t head_len = fread(head, 1, sizeof head, fp);
-    if (head_len < 4 || memcmp(head, "glTF", 4) != 0) {
-        /* A .gltf: all of it is JSON. */
-        fclose(fp);
-        char *text;
-        size_t size;
-        lx_status st = lx_read_file(path, LX_GLTF_TEXT_MAX, &text, &size);
-        if (st != LX_OK)
-            return st;
-        st = load_json(scene, path, text, size);
-        free(text);
-        return st;
-    }
-    /* A .glb: read only the JSON chunk, not the binary buffers. */
-    long total = -1;
-    if (fseek(fp, 0, SEEK_END) == 0)
-        total = ftell(fp);
-    uint64_t off;
-    uint32_t len;
-    lx_status st = total < 0 ? failf(path, LX_ERR_IO, "cannot tell the file's size")
-                             : glb_locate(path, head, head_len, (uint64_t)total, &off, &len);
-    char *json = NULL;
-    if (st == LX_OK && !(json = malloc(len ? len : 1)))
-        st = failf(path, LX_ERR_NOMEM, "cannot allocate %u bytes for the JSON chunk", len);
-    if (st == LX_OK && (fseek(fp, (long)off, SEEK_SET) != 0 || fread(json, 1, len, fp) != len))
-        st = failf(path, LX_ERR_IO, "cannot read the JSON chunk");
-    fclose(fp);
+    cJSON *root;
+    lx_status st = lx_gltf_json_read(path, &root);
     if (st == LX_OK)
-        st = load_json(scene, path, json, len);
-    free(json);
-    return st;
-}
-
-lx_status lx_glb_check_file(const char *path)
-{
-    FILE *fp = fopen(path, "rb");
-    if (!fp)
-        return failf(path, LX_ERR_IO, "cannot open: %s", strerror(errno));
-    uint8_t head[12];
-    size_t got = fread(head, 1, sizeof head, fp);
-    lx_status st = LX_OK;
-    if (fseek(fp, 0, SEEK_END) != 0) {
-        fclose(fp);
-        return failf(path, LX_ERR_IO, "cannot seek");
-    }
-    long total = ftell(fp);
-    if (got < sizeof head || total < (long)sizeof head) {
-        fclose(fp);
-        return failf(path, LX_ERR_FORMAT, "truncated GLB: %ld bytes, the header needs 12",
-                     total < 0 ? 0L : total);
-    }
-    if (le32(head) != LX_GLB_MAGIC)
-        st = failf(path, LX_ERR_FORMAT, "not a GLB file (bad magic)");
-    else if (le32(head + 4) != 2)
-        st = failf(path, LX_ERR_UNSUPPORTED, "GLB version %u (only version 2 is supported)",
-                   le32(head + 4));
-    else if ((uint64_t)le32(head + 8) > (uint64_t)total)
-        st = failf(path, LX_ERR_FORMAT, "truncated GLB: the header says %u bytes, the file has %ld",
-                   le32(head + 8), total);
-    /* walk the chunks: each length must fit in what the header declares */
-    uint64_t length = le32(head + 8), pos = LX_GLB_HEADER;
-    for (int chunk = 0; st == LX_OK && pos < length; chunk++) {
-        uint8_t ch[LX_GLB_CHUNK_HEADER];
-        if (length - pos < LX_GLB_CHUNK_HEADER || fseek(fp, (long)pos, SEEK_SET) != 0 ||
-            fread(ch, 1, sizeof ch, fp) != sizeof ch) {
-            st = failf(path, LX_ERR_FORMAT, "truncated GLB: chunk %d header is cut", chunk);
-            break;
-        }
-        uint64_t len = le32(ch);
-        if (len > length - pos - LX_GLB_CHUNK_HEADER) {
-            st = failf(path, LX_ERR_FORMAT,
-                       "truncated GLB: chunk %d of %llu bytes runs past the end (%llu bytes)",
-                       chunk, (unsigned long long)len, (unsigned long long)length);
-            break;
-        }
-        pos += LX_GLB_CHUNK_HEADER + len;
-    }
-    fclose(fp);
+        st = lx_gltf_lights_from_json(scene, path, root);
+    cJSON_Delete(root);
     return st;
 }

@@ -1,11 +1,14 @@
 /* Scene import through assimp's C API (glTF 2.0, OBJ, FBX, ...): meshes,
  * materials with their normal and base-colour textures, and the node
- * hierarchy flattened into world-space instances. glTF's KHR_lights_punctual
- * lights are read from the file's own JSON (gltf_lights.c) because assimp
- * drops their units and range. */
+ * hierarchy flattened into world-space instances. From a glTF file's own
+ * JSON (gltf_json.c) come what assimp drops or changes: KHR_lights_punctual
+ * lights (gltf_lights.c), KHR_texture_transform and texCoord
+ * (gltf_textures.c), and the triangle count of every primitive, so faces
+ * assimp dropped for out-of-range indices are noticed without its log. */
 #include "luxel/scene.h"
 #include "core/internal.h"
 
+#include "gltf_json.h"
 #include "json_text.h"
 
 #include <assimp/cimport.h>
@@ -32,11 +35,17 @@ typedef struct import_ctx {
     const lx_scene_load_desc *desc;
     uint32_t *mesh_map; /* assimp mesh -> lx mesh index, UINT32_MAX if skipped */
     char *folder;
+    const cJSON *gltf; /* the file's glTF 2.0 JSON, or NULL */
 } import_ctx;
 
-/* assimp reports some repairs only through its log (it drops faces whose
- * indices are out of range); the log is process-wide, so imports are
- * serialized and the log is watched while one runs. */
+/* assimp's C API keeps the last error in one process-wide string, which
+ * every failed import assigns (aiImportFileExWithProperties), so imports
+ * are serialized. Its glTF 1.0 importer reports faces it dropped for
+ * out-of-range indices only through its log, also process-wide: for such
+ * files the log is watched while the import runs. glTF 2.0 files are
+ * checked against their JSON instead (check_dropped_faces) and no other
+ * importer drops faces that way, so no other import attaches a log (which
+ * would also make assimp format every message it logs). */
 static pthread_mutex_t import_lock = PTHREAD_MUTEX_INITIALIZER;
 static bool dropped_faces;
 
@@ -164,9 +173,26 @@ static void load_texture(import_ctx *c, const struct aiString *tex_path, bool ra
 
 static lx_status import_materials(import_ctx *c)
 {
+    /* assimp's glTF 2.0 importer makes material i of glTF material i, and
+     * one default material after them */
+    const cJSON *gltf_materials = lx_gltf_get(c->gltf, "materials");
+    unsigned gltf_count =
+        cJSON_IsArray(gltf_materials) ? (unsigned)cJSON_GetArraySize(gltf_materials) : 0;
+    bool by_json = c->gltf && c->ai->mNumMaterials == gltf_count + 1;
+    if (c->gltf && gltf_count && !by_json)
+        lx_log(LX_LOG_WARN,
+               "%s: assimp made %u materials of the file's %u; texCoord and "
+               "KHR_texture_transform are taken from assimp",
+               c->path, c->ai->mNumMaterials, gltf_count);
     for (unsigned i = 0; i < c->ai->mNumMaterials; i++) {
         const struct aiMaterial *am = c->ai->mMaterials[i];
         lx_material m = {0};
+        lx_gltf_texture_ref ref_base = {0}, ref_normal = {0};
+        if (by_json && i < gltf_count) {
+            lx_status st = lx_gltf_material_textures(c->path, c->gltf, i, &ref_base, &ref_normal);
+            if (st != LX_OK)
+                return st;
+        }
         struct aiString name;
         char name_buf[LX_NAME_MAX];
         if (aiGetMaterialString(am, AI_MATKEY_NAME, &name) == aiReturn_SUCCESS && name.length)
@@ -190,6 +216,10 @@ static lx_status import_materials(import_ctx *c)
         if (aiGetMaterialTexture(am, aiTextureType_NORMALS, 0, &tex, NULL, &uv, NULL, NULL, NULL,
                                  NULL) == aiReturn_SUCCESS) {
             load_texture(c, &tex, true, "normal", name_buf, &m.normal_map, &m.normal_map_path);
+            if (ref_normal.present) {
+                uv = ref_normal.tex_coord;
+                m.normal_transform = ref_normal.transform;
+            }
             /* checked unsigned: a huge texCoord must not wrap to -1 */
             m.normal_uv_set = uv < LX_MAX_UV_SETS ? (int)uv : LX_MAX_UV_SETS;
             /* glTF normalTexture.scale scales the map's x and y */
@@ -206,6 +236,10 @@ static lx_status import_materials(import_ctx *c)
                                  NULL) == aiReturn_SUCCESS) {
             load_texture(c, &tex, false, "base colour", name_buf, &m.base_color_map,
                          &m.base_color_map_path);
+            if (ref_base.present) {
+                uv = ref_base.tex_coord;
+                m.base_color_transform = ref_base.transform;
+            }
             m.base_color_uv_set = uv < LX_MAX_UV_SETS ? (int)uv : LX_MAX_UV_SETS;
         }
         if (m.normal_uv_set >= LX_MAX_UV_SETS || m.base_color_uv_set >= LX_MAX_UV_SETS) {
@@ -216,10 +250,12 @@ static lx_status import_materials(import_ctx *c)
             if (m.normal_uv_set >= LX_MAX_UV_SETS) {
                 lx_image_free(&m.normal_map);
                 m.normal_uv_set = 0;
+                m.normal_transform = (lx_uv_transform){0};
             }
             if (m.base_color_uv_set >= LX_MAX_UV_SETS) {
                 lx_image_free(&m.base_color_map);
                 m.base_color_uv_set = 0;
+                m.base_color_transform = (lx_uv_transform){0};
             }
         }
         if (m.normal_scale == 0.0f)
@@ -426,6 +462,58 @@ static lx_status import_node(import_ctx *c, const struct aiNode *node, const lx_
     return LX_OK;
 }
 
+/* Faces assimp's glTF 2.0 importer dropped: it makes one mesh per
+ * primitive, in file order, and leaves out every triangle with a vertex
+ * index past the primitive's vertices (it says so only in its log). A
+ * triangle primitive that comes out with fewer faces than its accessor's
+ * count defines fails the load. */
+static lx_status check_dropped_faces(const import_ctx *c)
+{
+    uint64_t *want;
+    uint32_t *mesh_of;
+    size_t n;
+    lx_status st = lx_gltf_primitive_triangles(c->path, c->gltf, &want, &mesh_of, &n);
+    if (st != LX_OK)
+        return st;
+    /* a count assimp does not match is a file it read some other way (it
+     * fails such files itself): nothing to compare */
+    if (n == c->ai->mNumMeshes) {
+        const cJSON *meshes = lx_gltf_get(c->gltf, "meshes");
+        size_t first = 0; /* entry of the current mesh's primitive 0 */
+        for (size_t k = 0; k < n && st == LX_OK; k++) {
+            if (k > 0 && mesh_of[k] != mesh_of[k - 1])
+                first = k;
+            const struct aiMesh *am = c->ai->mMeshes[k];
+            if (want[k] == UINT64_MAX || !(am->mPrimitiveTypes & aiPrimitiveType_TRIANGLE) ||
+                (uint64_t)am->mNumFaces >= want[k])
+                continue;
+            char who[128];
+            lx_gltf_label(who, sizeof who, "mesh", mesh_of[k],
+                          cJSON_GetArrayItem(meshes, (int)mesh_of[k]));
+            st = lx_fail(LX_ERR_FORMAT,
+                         "%s: %s: primitive %zu: %llu of %llu triangles have vertex indices out "
+                         "of range",
+                         c->path, who, k - first, (unsigned long long)(want[k] - am->mNumFaces),
+                         (unsigned long long)want[k]);
+        }
+    }
+    free(want);
+    free(mesh_of);
+    return st;
+}
+
+/* True when assimp's glTF 2.0 importer read the file (it names itself in
+ * the scene's metadata), so its meshes and materials follow the JSON's. */
+static bool read_by_gltf2(const struct aiScene *ai)
+{
+    const struct aiMetadata *md = ai->mMetaData;
+    for (unsigned i = 0; md && i < md->mNumProperties; i++)
+        if (strcmp(md->mKeys[i].data, "SourceAsset_Format") == 0 &&
+            md->mValues[i].mType == AI_AISTRING && md->mValues[i].mData)
+            return strncmp(((const struct aiString *)md->mValues[i].mData)->data, "glTF2", 5) == 0;
+    return false;
+}
+
 lx_scene_load_desc lx_scene_load_desc_defaults(const lx_scene_load_desc *desc)
 {
     lx_scene_load_desc d = {0};
@@ -454,50 +542,76 @@ lx_status lx_scene_load(const char *path, const lx_scene_load_desc *in, lx_scene
         if (st != LX_OK)
             return st;
     }
-    if (has_extension(path, ".glb")) {
+    /* glTF by content, not by name: assimp recognises it either way */
+    lx_gltf_kind kind = lx_gltf_sniff(path);
+    if (kind == LX_GLTF_GLB || has_extension(path, ".glb")) {
         lx_status st = lx_glb_check_file(path);
         if (st != LX_OK)
             return st;
     }
+    /* a .gltf that is not JSON would be handed to whichever assimp reader
+     * claims its bytes (its OpenGEX reader overruns a buffer on 20 bytes
+     * of "vertexarray (attrib)") */
+    if (kind == LX_GLTF_NONE && has_extension(path, ".gltf"))
+        return lx_fail(LX_ERR_FORMAT, "%s: not glTF: the file is not JSON text", path);
+    cJSON *gltf = NULL;
+    if (kind != LX_GLTF_NONE) {
+        lx_status st = lx_gltf_json_read(path, &gltf);
+        if (st != LX_OK)
+            return st;
+    }
+    bool gltf2 = gltf && lx_gltf_is_v2(gltf);
+    /* only assimp's glTF 1.0 reader needs its log watched */
+    bool watch_log = gltf && !gltf2;
     struct aiPropertyStore *props = aiCreatePropertyStore();
     /* Smooth normals where a file has none, but keep hard edges hard. */
     aiSetImportPropertyFloat(props, AI_CONFIG_PP_GSN_MAX_SMOOTHING_ANGLE, 60.0f);
     unsigned flags = aiProcess_Triangulate | aiProcess_SortByPType | aiProcess_FlipUVs |
                      aiProcess_GenSmoothNormals | aiProcess_JoinIdenticalVertices |
                      aiProcess_ValidateDataStructure;
-    pthread_mutex_lock(&import_lock);
     struct aiLogStream log = {on_assimp_log, NULL};
+    pthread_mutex_lock(&import_lock);
     dropped_faces = false;
-    aiAttachLogStream(&log);
+    if (watch_log)
+        aiAttachLogStream(&log);
     const struct aiScene *ai = aiImportFileExWithProperties(path, flags, NULL, props);
-    aiDetachLogStream(&log);
+    if (watch_log)
+        aiDetachLogStream(&log);
     bool dropped = dropped_faces;
     char why[512];
     snprintf(why, sizeof why, "%s", ai ? "" : aiGetErrorString());
     pthread_mutex_unlock(&import_lock);
     aiReleasePropertyStore(props);
-    if (!ai)
+    if (!ai) {
+        cJSON_Delete(gltf);
         return lx_fail(LX_ERR_FORMAT, "%s: cannot import: %s", path,
                        why[0] ? why : "unknown format or corrupt file");
+    }
     if (dropped) {
         aiReleaseImport(ai);
+        cJSON_Delete(gltf);
         return lx_fail(LX_ERR_FORMAT, "%s: some faces have indices out of range", path);
     }
     /* assimp flags a scene without meshes incomplete; lights alone are fine */
     if (!ai->mRootNode) {
         aiReleaseImport(ai);
+        cJSON_Delete(gltf);
         return lx_fail(LX_ERR_FORMAT, "%s: cannot import: the file has no scene", path);
     }
-    import_ctx c = {.path = path, .ai = ai, .desc = desc};
+    import_ctx c = {
+        .path = path, .ai = ai, .desc = desc, .gltf = gltf2 && read_by_gltf2(ai) ? gltf : NULL};
     lx_status st = lx_scene_create(path, &c.scene);
     if (st != LX_OK) {
         aiReleaseImport(ai);
+        cJSON_Delete(gltf);
         return st;
     }
     c.folder = lx_path_dirname(path);
     c.mesh_map = malloc(sizeof(uint32_t) * (ai->mNumMeshes ? ai->mNumMeshes : 1));
     if (!c.folder || !c.mesh_map)
         st = lx_fail(LX_ERR_NOMEM, "%s: out of memory", path);
+    if (st == LX_OK && c.gltf)
+        st = check_dropped_faces(&c);
     if (st == LX_OK)
         st = import_materials(&c);
     for (unsigned i = 0; st == LX_OK && i < ai->mNumMeshes; i++)
@@ -507,9 +621,10 @@ lx_status lx_scene_load(const char *path, const lx_scene_load_desc *in, lx_scene
         uint32_t counter = 0;
         st = import_node(&c, ai->mRootNode, &root, 0, &counter);
     }
-    if (st == LX_OK && (has_extension(path, ".gltf") || has_extension(path, ".glb")))
-        st = lx_gltf_lights_load(c.scene, path);
+    if (st == LX_OK && gltf)
+        st = lx_gltf_lights_from_json(c.scene, path, gltf);
     aiReleaseImport(ai);
+    cJSON_Delete(gltf);
     free(c.mesh_map);
     free(c.folder);
     if (st != LX_OK) {

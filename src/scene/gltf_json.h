@@ -1,0 +1,73 @@
+/* Private to src/scene: a glTF file's own JSON, for what assimp drops or
+ * changes (KHR_lights_punctual, KHR_texture_transform, the primitives'
+ * index counts), and typed reads from it. */
+#ifndef LX_GLTF_JSON_H
+#define LX_GLTF_JSON_H
+
+#include "luxel/scene.h"
+
+#include <cjson/cJSON.h>
+#include <stdbool.h>
+#include <stddef.h>
+#include <stdint.h>
+
+/* What the start of a file looks like: a GLB container ("glTF" magic),
+ * JSON text (a '{' after white space and an optional UTF-8 byte-order
+ * mark), or anything else. */
+typedef enum lx_gltf_kind { LX_GLTF_NONE = 0, LX_GLTF_GLB, LX_GLTF_TEXT } lx_gltf_kind;
+lx_gltf_kind lx_gltf_sniff(const char *path);
+
+/* The JSON of a .gltf (the whole file) or .glb (its JSON chunk, located
+ * through the 12-byte header; the binary chunk is not read). *root is
+ * freed by the caller with cJSON_Delete. */
+lx_status lx_gltf_json_read(const char *path, cJSON **root);
+/* Same from bytes in memory; file names them in messages. */
+lx_status lx_gltf_json_read_memory(const char *file, const void *bytes, size_t size, cJSON **root);
+
+/* True when asset.version is "2.x". */
+bool lx_gltf_is_v2(const cJSON *root);
+
+/* ---- typed values -------------------------------------------------------- */
+
+/* obj[key] when obj is an object, else NULL. */
+const cJSON *lx_gltf_get(const cJSON *obj, const char *key);
+/* The string at key, or NULL when absent or not a string. */
+const char *lx_gltf_get_string(const cJSON *obj, const char *key);
+/* A finite number that is also finite as a float. */
+bool lx_gltf_number(const cJSON *item, float *out);
+/* An array of exactly n such numbers. */
+bool lx_gltf_numbers(const cJSON *item, float *out, int n);
+/* An integer index in [0, count). */
+bool lx_gltf_index(const cJSON *item, size_t count, size_t *out);
+/* "node 3 ('Lamp')" for messages. */
+void lx_gltf_label(char *buf, size_t size, const char *what, size_t index, const cJSON *obj);
+
+/* ---- readers -------------------------------------------------------------- */
+
+/* KHR_lights_punctual from a parsed glTF (gltf_lights.c). */
+lx_status lx_gltf_lights_from_json(lx_scene *scene, const char *file, const cJSON *root);
+
+/* What the JSON says about one texture of a material (gltf_textures.c). */
+typedef struct lx_gltf_texture_ref {
+    bool present;              /* the material names this texture */
+    uint32_t tex_coord;        /* texCoord, or KHR_texture_transform's override */
+    lx_uv_transform transform; /* KHR_texture_transform, enabled when given */
+} lx_gltf_texture_ref;
+
+/* The baseColorTexture and normalTexture of glTF material `index` (both
+ * zeroed when the file has no such material). Malformed extension fields
+ * fail naming the file, the material and the field. */
+lx_status lx_gltf_material_textures(const char *file, const cJSON *root, size_t index,
+                                    lx_gltf_texture_ref *base_color, lx_gltf_texture_ref *normal);
+
+/* The triangles each primitive defines, in file order (meshes, then their
+ * primitives: the order assimp's glTF 2.0 importer makes its meshes in):
+ * *count entries, each the triangle count of a TRIANGLES, TRIANGLE_STRIP
+ * or TRIANGLE_FAN primitive or UINT64_MAX when that cannot be told (other
+ * modes, missing or malformed accessors: assimp reports those itself).
+ * mesh_of[k] gets the glTF mesh index of entry k. Both arrays are the
+ * caller's to free; on failure both are NULL. */
+lx_status lx_gltf_primitive_triangles(const char *file, const cJSON *root, uint64_t **triangles,
+                                      uint32_t **mesh_of, size_t *count);
+
+#endif
