@@ -1,5 +1,5 @@
 /* luxel/scene.h - triangle meshes, materials, nodes (instances) and lights:
- * import from glTF 2.0 / OBJ / anything assimp reads, programmatic
+ * import from glTF 2.0 and OBJ files, programmatic
  * construction, and the lights JSON that adds to or overrides a scene.
  *
  * CONVENTIONS  Right-handed, +Y up, metres. Mesh data is in object space;
@@ -142,8 +142,10 @@ typedef struct lx_scene_load_desc {
 /* A copy of desc (or of zeros when NULL) with every default filled in. */
 lx_scene_load_desc lx_scene_load_desc_defaults(const lx_scene_load_desc *desc);
 
-/* Imports a scene file through assimp (glTF 2.0, OBJ, FBX, ...), plus the
- * KHR_lights_punctual lights of glTF files. desc may be NULL. Triangles of
+/* Imports a scene file through assimp: glTF 2.0 (.gltf, .glb) or OBJ
+ * (.obj), plus the KHR_lights_punctual lights of glTF files. Other names
+ * fail with LX_ERR_UNSUPPORTED (assimp's other readers are not safe on
+ * malformed files). desc may be NULL. Triangles of
  * zero area in space, non-finite values and out-of-range indices fail the
  * load with a message naming the mesh (see skip_degenerate). */
 lx_status lx_scene_load(const char *path, const lx_scene_load_desc *desc, lx_scene **out);

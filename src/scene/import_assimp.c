@@ -536,6 +536,14 @@ lx_status lx_scene_load(const char *path, const lx_scene_load_desc *in, lx_scene
     if (!probe)
         return lx_fail(LX_ERR_IO, "%s: cannot open: permission denied or unreadable", path);
     fclose(probe);
+    /* assimp picks a reader by the name and, failing that, by sniffing the
+     * bytes, and some of its readers overrun buffers on malformed input
+     * (OpenGEX on 20 bytes of "vertexarray (attrib)"): it only gets the
+     * formats luxel supports, each checked below before assimp reads it */
+    if (!has_extension(path, ".gltf") && !has_extension(path, ".glb") &&
+        !has_extension(path, ".obj"))
+        return lx_fail(LX_ERR_UNSUPPORTED,
+                       "%s: not a scene luxel reads (it reads .gltf, .glb and .obj files)", path);
 
     if (has_extension(path, ".obj")) {
         lx_status st = check_obj_numbers(path);

@@ -92,6 +92,15 @@ chmod 644 "$IN/locked.glb"
 
 # ---- corrupt and truncated files ------------------------------------------------
 
+# formats luxel does not read are refused by name before assimp sees them
+# (assimp sniffs the bytes, and its OpenGEX reader overruns a buffer on
+# these 20 bytes)
+for name in scene.ogex scene.txt scene.fbx scene; do
+    printf 'vertexarray (attrib)' >"$IN/$name"
+    bad "a '$name' file" 1 "$name|not a scene luxel reads" bake "$IN/$name"
+    bad_info "a '$name' file" "$name" "$IN/$name"
+done
+
 head -c 6000 /dev/urandom >"$IN/noise.glb"
 bad "random bytes named .glb" 1 "noise.glb" bake "$IN/noise.glb"
 bad_info "random bytes" "noise.glb" "$IN/noise.glb"
