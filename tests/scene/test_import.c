@@ -8,7 +8,7 @@
  * empty or truncated files, non-finite positions, zero-area triangles with
  * and without skip_degenerate, out-of-range indices. Every failure must name
  * the file. */
-#define _POSIX_C_SOURCE 200809L
+#define _GNU_SOURCE /* setresuid, setgroups */
 #include <stdarg.h>
 #include <stddef.h>
 #include <setjmp.h>
@@ -19,7 +19,9 @@
 #include <stdio.h>
 #include <stdlib.h>
 #include <string.h>
+#include <grp.h>
 #include <sys/stat.h>
+#include <sys/wait.h>
 #include <unistd.h>
 
 #include "helpers.h"
@@ -629,17 +631,41 @@ static void test_missing_file(void **state)
 static void test_unreadable_file(void **state)
 {
     (void)state;
-    if (geteuid() == 0) {
-        skip(); /* root reads anything: permissions cannot make it fail */
-        return;
-    }
-    const char *dir = lx_test_dir("test_import_unreadable");
+    /* a folder every user can reach: as root the load runs as nobody */
+    char dir[] = "/tmp/lx_test_unreadable_XXXXXX";
+    assert_non_null(mkdtemp(dir));
+    assert_int_equal(chmod(dir, 0755), 0);
     char path[1024];
     path_in(path, sizeof path, dir, "locked.obj");
     write_text(path, "v 0 0 0\nv 1 0 0\nv 0 1 0\nf 1 2 3\n");
     assert_int_equal(chmod(path, 0), 0);
-    load_fails(path, NULL, LX_ERR_IO, NULL, NULL);
+    if (geteuid() != 0) {
+        load_fails(path, NULL, LX_ERR_IO, "cannot open", NULL);
+    } else {
+        /* root reads anything: read it as an unprivileged user, in a child
+         * (it cannot become root again) */
+        pid_t pid = fork();
+        assert_true(pid >= 0);
+        if (pid == 0) {
+            if (setgroups(0, NULL) != 0 || setresgid(65534, 65534, 65534) != 0 ||
+                setresuid(65534, 65534, 65534) != 0)
+                _exit(3);
+            lx_scene *s = NULL;
+            lx_status st = lx_scene_load(path, NULL, &s);
+            bool named =
+                strstr(lx_last_error(), "locked.obj") && strstr(lx_last_error(), "cannot open");
+            _exit(st == LX_ERR_IO && !s && named ? 0 : 1);
+        }
+        int status = 0;
+        assert_int_equal(waitpid(pid, &status, 0), pid);
+        assert_true(WIFEXITED(status));
+        if (WEXITSTATUS(status) == 3)
+            fail_msg("cannot become an unprivileged user to test an unreadable file");
+        assert_int_equal(WEXITSTATUS(status), 0);
+    }
     chmod(path, 0644);
+    unlink(path);
+    rmdir(dir);
 }
 
 static void test_garbage_and_empty(void **state)
