@@ -537,6 +537,62 @@ static void test_rect_scan(void **state)
     assert_true(partial >= 10);
 }
 
+/* A non-square rect light's orientation (light.h: width along
+ * cross(up, direction), height along up's part across direction): corners
+ * built here from that rule against lx_rect_light_corners, and the light's
+ * illuminance through lx_light_evaluate at points along each of its axes
+ * against the quadrature of the rect built here. From 0.6 and 1.2 m along
+ * its width a 1.6 x 0.4 rect gives 1.3 and 1.6 times what it gives from as
+ * far along its height, so swapped axes would fail. */
+static void test_rect_light_orientation(void **state)
+{
+    (void)state;
+    const v3d dirs[2] = {d3(0, -1, 0), unit3(d3(0.3, -1.0, 0.2))};
+    const v3d ups[2] = {d3(0, 0, 1), d3(0.2, 0.1, 1.0)};
+    const double w = 1.6, h = 0.4, lum = 500.0;
+    const v3d c = d3(0.1, 2.0, -0.3);
+    for (int f = 0; f < 2; f++) {
+        lx_light l = lx_light_defaults(LX_LIGHT_RECT);
+        l.position = tof(c);
+        l.direction = tof(dirs[f]);
+        l.up = tof(unit3(ups[f]));
+        l.width = (float)w;
+        l.height = (float)h;
+        l.intensity = (float)lum;
+        assert_int_equal(lx_light_validate(&l), LX_OK);
+        v3d d = of(l.direction), up = of(l.up);
+        v3d ex = unit3(cross3(up, d));                     /* width */
+        v3d ey = unit3(sub3(up, mul3(d, dot3(up, d))));    /* height */
+        assert_true(dot3(cross3(ex, ey), d) > 1.0 - 1e-6); /* ex, ey, d right-handed */
+        lx_vec3 want[4], got[4];
+        const double sx[4] = {-1, 1, 1, -1}, sy[4] = {-1, -1, 1, 1};
+        for (int k = 0; k < 4; k++)
+            want[k] = tof(add3(c, add3(mul3(ex, sx[k] * w / 2), mul3(ey, sy[k] * h / 2))));
+        lx_rect_light_corners(&l, got);
+        for (int k = 0; k < 4; k++) /* floats near 2 m: measured 1.2e-7 */
+            assert_true(lx_length(lx_sub(got[k], want[k])) < 5e-7f);
+        double along[2][2]; /* [axis][distance] */
+        for (int axis = 0; axis < 2; axis++)
+            for (int k = 0; k < 2; k++) {
+                double off = k == 0 ? 0.6 : 1.2;
+                v3d p = add3(add3(c, d), mul3(axis == 0 ? ex : ey, off)); /* 1 m in front */
+                lx_vec3 n = tof(mul3(d, -1.0));
+                lx_light_eval e;
+                assert_true(lx_light_evaluate(&l, tof(p), n, &e));
+                double ref = ref_rect(want, lum, p, of(n), 2 * QUAD_STEPS);
+                char what[64];
+                snprintf(what, sizeof what, "%s %g m along its %s", f ? "tilted" : "level", off,
+                         axis == 0 ? "width" : "height");
+                check_kind(RECT, BY_QUADRATURE, what, e.illuminance.x, ref, RECT_QUAD_TOL,
+                           RECT_QUAD_ABS * lum);
+                along[axis][k] = ref;
+            }
+        /* 1.3 and 1.6 times (level) */
+        assert_true(along[0][0] > 1.2 * along[1][0]);
+        assert_true(along[0][1] > 1.2 * along[1][1]);
+    }
+}
+
 static void test_rect_far_field(void **state)
 {
     (void)state;
@@ -1113,16 +1169,16 @@ static int print_errors(void **state)
 int main(void)
 {
     const struct CMUnitTest tests[] = {
-        cmocka_unit_test(test_sphere_positions),  cmocka_unit_test(test_sphere_scan),
-        cmocka_unit_test(test_sphere_far_field),  cmocka_unit_test(test_disk_positions),
-        cmocka_unit_test(test_disk_scan),         cmocka_unit_test(test_disk_far_field),
-        cmocka_unit_test(test_disk_vs_polygon),   cmocka_unit_test(test_rect_positions),
-        cmocka_unit_test(test_rect_scan),         cmocka_unit_test(test_rect_far_field),
-        cmocka_unit_test(test_concave_polygon),   cmocka_unit_test(test_energy_conservation),
-        cmocka_unit_test(test_power_conversions), cmocka_unit_test(test_power_bad_input),
-        cmocka_unit_test(test_line_positions),    cmocka_unit_test(test_tube_positions),
-        cmocka_unit_test(test_tube_scan),         cmocka_unit_test(test_tube_surface_points),
-        cmocka_unit_test(test_tube_units),
+        cmocka_unit_test(test_sphere_positions),    cmocka_unit_test(test_sphere_scan),
+        cmocka_unit_test(test_sphere_far_field),    cmocka_unit_test(test_disk_positions),
+        cmocka_unit_test(test_disk_scan),           cmocka_unit_test(test_disk_far_field),
+        cmocka_unit_test(test_disk_vs_polygon),     cmocka_unit_test(test_rect_positions),
+        cmocka_unit_test(test_rect_scan),           cmocka_unit_test(test_rect_light_orientation),
+        cmocka_unit_test(test_rect_far_field),      cmocka_unit_test(test_concave_polygon),
+        cmocka_unit_test(test_energy_conservation), cmocka_unit_test(test_power_conversions),
+        cmocka_unit_test(test_power_bad_input),     cmocka_unit_test(test_line_positions),
+        cmocka_unit_test(test_tube_positions),      cmocka_unit_test(test_tube_scan),
+        cmocka_unit_test(test_tube_surface_points), cmocka_unit_test(test_tube_units),
     };
     return cmocka_run_group_tests(tests, NULL, print_errors);
 }
