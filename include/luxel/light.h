@@ -219,6 +219,28 @@ double lx_ies_total_lumens(const lx_ies_profile *profile);
 /* Largest candela value. */
 float lx_ies_peak_candela(const lx_ies_profile *profile);
 
+/* Spread of a plane (IES and CIE definitions): in the plane through the
+ * horizontal angles h and h + 180 (0: the C0-C180 plane, 90: C90-C270), the
+ * full angle in degrees between the two directions either side of the
+ * plane's maximum intensity where the candela first falls below `fraction`
+ * of that maximum: LX_IES_BEAM_FRACTION (50%) gives the beam angle,
+ * LX_IES_FIELD_FRACTION (10%) the field angle. Exact for the profile as
+ * lx_ies_candela interpolates it (within a plane, linear between the
+ * vertical angles; dark past the last one, a step there), not sampled.
+ * Where several directions share the maximum, the walk starts from the one
+ * nearest the nadir. *angle_deg is -1 when the intensity never falls that
+ * far on one side, or the plane is dark. Fails with LX_ERR_INVALID (and
+ * leaves *angle_deg alone) for a NULL pointer, a horizontal angle that is
+ * not finite or a fraction not strictly between 0 and 1. */
+#define LX_IES_BEAM_FRACTION 0.5
+#define LX_IES_FIELD_FRACTION 0.1
+lx_status lx_ies_spread_angle(const lx_ies_profile *profile, float horizontal_deg, double fraction,
+                              double *angle_deg);
+/* The beam (50%) and field (10%) angles of one plane, as
+ * lx_ies_spread_angle gives them. */
+lx_status lx_ies_beam_field(const lx_ies_profile *profile, float horizontal_deg, double *beam_deg,
+                            double *field_deg);
+
 /* Horizontal symmetry of a profile, from its first and last horizontal
  * angles: 0 only; 0-90; 0-180; 90-270; 0 to more than 180 (full, the
  * last plane wrapping to 0/360). */
