@@ -101,7 +101,8 @@ typedef struct lx_light {
     float length;        /* metres: tube, between its cap centres */
     float width, height; /* metres: rect, width along cross(up, direction) */
     lx_vec3 up;          /* rect: fixes its rotation about direction */
-    uint32_t samples;    /* soft shadows: points on the light per texel, 0 = 16 */
+    uint32_t samples;    /* soft shadows: points on the light per texel, 0 = the default
+                            (lx_light_sample_count) */
     /* photometric profile (point and spot): candela toward a direction is
      * the profile's value times profile_scale; its 0 deg vertical angle
      * points along direction, its 0 deg horizontal plane toward up (and
@@ -112,6 +113,13 @@ typedef struct lx_light {
 } lx_light;
 
 #define LX_MAX_LIGHT_SAMPLES 1024u
+/* Soft shadows: points on the light per texel when lx_light.samples is 0. */
+#define LX_DEFAULT_LIGHT_SAMPLES 16u
+
+/* The number of points on the light a soft shadow uses: light->samples, or
+ * LX_DEFAULT_LIGHT_SAMPLES when it is 0. Not clamped: lx_light_validate
+ * rejects samples above LX_MAX_LIGHT_SAMPLES. */
+uint32_t lx_light_sample_count(const lx_light *light);
 
 /* True for the area light types (sphere, disk, rect, tube). */
 bool lx_light_is_area(const lx_light *light);

@@ -50,6 +50,11 @@ lx_light lx_light_defaults(lx_light_type type)
     return l;
 }
 
+uint32_t lx_light_sample_count(const lx_light *light)
+{
+    return light->samples ? light->samples : LX_DEFAULT_LIGHT_SAMPLES;
+}
+
 bool lx_light_is_area(const lx_light *light)
 {
     return light->type == LX_LIGHT_SPHERE || light->type == LX_LIGHT_DISK ||

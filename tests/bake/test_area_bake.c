@@ -173,6 +173,28 @@ static void half_hidden_linear_tube_matches_quadrature(void **state)
     lx_baker_destroy(baker);
 }
 
+/* samples 0 bakes with the light model's default count: the same bytes as
+ * asking for lx_light_sample_count's number, and not those of another */
+static void default_samples_are_the_models(void **state)
+{
+    (void)state;
+    lx_light zero = area_light(LX_LIGHT_DISK, LX_SHADOW_SOFT, 0);
+    lx_image a, b, c;
+    lx_baker *ba = bake(zero, true, 2, &a);
+    lx_baker *bb =
+        bake(area_light(LX_LIGHT_DISK, LX_SHADOW_SOFT, lx_light_sample_count(&zero)), true, 2, &b);
+    lx_baker *bc = bake(area_light(LX_LIGHT_DISK, LX_SHADOW_SOFT, lx_light_sample_count(&zero) + 1),
+                        true, 2, &c);
+    assert_memory_equal(a.data, b.data, sizeof(float) * 64 * 3);
+    assert_memory_not_equal(a.data, c.data, sizeof(float) * 64 * 3);
+    lx_image_free(&a);
+    lx_image_free(&b);
+    lx_image_free(&c);
+    lx_baker_destroy(ba);
+    lx_baker_destroy(bb);
+    lx_baker_destroy(bc);
+}
+
 static void soft_shadows_are_deterministic(void **state)
 {
     (void)state;
@@ -210,6 +232,7 @@ int main(void)
         cmocka_unit_test(half_hidden_rect_matches_quadrature),
         cmocka_unit_test(half_hidden_linear_tube_matches_quadrature),
         cmocka_unit_test(soft_shadows_are_deterministic),
+        cmocka_unit_test(default_samples_are_the_models),
         cmocka_unit_test(soft_shadows_need_an_area_light),
     };
     return cmocka_run_group_tests(tests, NULL, NULL);

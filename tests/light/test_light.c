@@ -61,6 +61,13 @@ static void test_defaults(void **state)
     assert_int_equal(lx_light_validate(&l), LX_OK);
     lx_light d = lx_light_defaults(LX_LIGHT_DIRECTIONAL);
     assert_int_equal(lx_light_validate(&d), LX_OK);
+    /* soft-shadow samples: 0 stands for the default, 16 */
+    lx_light a = lx_light_defaults(LX_LIGHT_RECT);
+    assert_int_equal(a.samples, 0);
+    assert_int_equal(LX_DEFAULT_LIGHT_SAMPLES, 16);
+    assert_int_equal(lx_light_sample_count(&a), 16);
+    a.samples = 5;
+    assert_int_equal(lx_light_sample_count(&a), 5);
 }
 
 static void test_range_window(void **state)
