@@ -7,24 +7,62 @@
  *   lights and lux for directional lights; other units are converted when a
  *   light is made (lx_light_intensity_to_native). Angles in radians, spot
  *   angles measured from the axis. Colour is linear Rec.709 RGB.
- *   Evaluation follows Filament's physically based model (seed 001): inverse
- *   square law with the smooth window (1 - (d/r)^4)^2, the spot's smooth
- *   angular attenuation, N.L. The seed-000 "classic" model is
+ *   Evaluation follows Filament's physically based model (R. Guy and
+ *   M. Agopian, "Physically Based Rendering in Filament"): inverse square
+ *   law with the smooth window (1 - (d/r)^4)^2, the spot's smooth angular
+ *   attenuation, N.L. The "classic" model of the per-texel lighting
+ *   document luxel started from (its DynamicLight kernel) is
  *   ((1 - d/range) * |N.L|)^2 * colour * intensity, in the light's own units
  *   (a classic spot also takes the cone attenuation; a classic directional
  *   light gives (N.L)^2 * colour * intensity). Distances below 1 cm are
  *   taken as 1 cm in the inverse square law (Filament's 1e-4 m^2 floor).
  *   A spot with inner == outer is a hard-edged cone (as Blender exports).
- * ERRORS  Validation functions return LX_ERR_INVALID naming the light.
- * MEMORY  lx_light is plain data.
- * THREADING  Pure functions.
+ * ERRORS  lx_light_validate and the conversions return LX_ERR_INVALID
+ *   naming the light ("light 'lamp': outer_angle 100 deg is above 90 deg");
+ *   the IES reader LX_ERR_IO, LX_ERR_FORMAT, LX_ERR_UNSUPPORTED or
+ *   LX_ERR_NOMEM naming the file and line. The message is lx_last_error().
+ *   Evaluation functions do not fail: they take validated lights and finite
+ *   inputs.
+ * MEMORY  lx_light is plain data. An lx_ies_profile is reference counted:
+ *   lx_ies_load / lx_ies_parse return it with one reference, lx_ies_retain
+ *   adds one, lx_ies_free drops one and frees it with the last. A light
+ *   borrows its profile.
+ * THREADING  Every function is thread-safe: the model keeps no state of its
+ *   own (errors go to the calling thread's lx_last_error). A profile is
+ *   never changed after loading, so any number of threads may read it at
+ *   once; lx_ies_retain and lx_ies_free count atomically.
  *
  * USAGE
- *   lx_light l = lx_light_defaults(LX_LIGHT_POINT);
- *   l.position = lx_v3(0, 2, 0);
- *   l.intensity = 800.0f;                      // candela
- *   lx_light_eval e;
- *   if (lx_light_evaluate(&l, p, n, &e)) use(e.illuminance);   // lux
+ *   lx_light spot = lx_light_defaults(LX_LIGHT_SPOT); // at the origin, down -Y
+ *   spot.position = lx_v3(0.0f, 3.0f, 0.0f);
+ *   if (lx_light_intensity_to_native(&spot, 800.0f, LX_UNIT_LUMEN, LX_SPOT_POWER_PI,
+ *                                    &spot.intensity) != LX_OK ||
+ *       lx_light_validate(&spot) != LX_OK)
+ *       return 1;
+ *   lx_light_eval e; // a floor point 0.5 m off the axis, facing up
+ *   if (lx_light_evaluate(&spot, lx_v3(0.5f, 0.0f, 0.0f), lx_v3(0.0f, 1.0f, 0.0f), &e))
+ *       printf("%.1f lx from %.2f m\n", e.illuminance.y, e.distance);
+ *   lx_ies_profile *lamp;
+ *   if (lx_ies_load("lamp.ies", &lamp) != LX_OK) {
+ *       fprintf(stderr, "%s\n", lx_last_error());
+ *       return 1;
+ *   }
+ *   double beam, field;
+ *   if (lx_ies_beam_field(lamp, 0.0f, &beam, &field) != LX_OK) {
+ *       lx_ies_free(lamp);
+ *       return 1;
+ *   }
+ *   printf("%.0f lm, beam %.1f deg, field %.1f deg\n", lx_ies_total_lumens(lamp), beam, field);
+ *   spot.type = LX_LIGHT_POINT; // the lamp's own candela, borrowed
+ *   spot.profile = lamp;
+ *   spot.profile_scale = 1.0f;
+ *   if (lx_light_evaluate(&spot, lx_v3(0.5f, 0.0f, 0.0f), lx_v3(0.0f, 1.0f, 0.0f), &e))
+ *       printf("%.1f lx\n", e.illuminance.y);
+ *   lx_ies_free(lamp);
+ *   float tube = lx_tube_light_illuminance(lx_v3(0.0f, 2.5f, 0.0f), lx_v3(1.0f, 0.0f, 0.0f), 1.2f,
+ *                                          0.02f, 2e4f, lx_v3(0.0f, 0.0f, 0.0f),
+ *                                          lx_v3(0.0f, 1.0f, 0.0f));
+ *   printf("a 1.2 m tube of 20000 nt, 2.5 m up: %.1f lx\n", tube);
  */
 #ifndef LUXEL_LIGHT_H
 #define LUXEL_LIGHT_H
@@ -53,7 +91,7 @@ typedef enum lx_light_type {
 typedef enum lx_shadow_mode {
     LX_SHADOW_HARD = 0, /* one occlusion ray per texel and light */
     LX_SHADOW_NONE,     /* lit only: nothing blocks the light */
-    LX_SHADOW_BLUR,     /* the seed's dynamic blur from the nearest occluder */
+    LX_SHADOW_BLUR,     /* the per-texel document's blur from the nearest occluder */
     LX_SHADOW_SOFT      /* area lights: rays to `samples` points on the light */
 } lx_shadow_mode;
 
@@ -91,8 +129,8 @@ typedef struct lx_light {
     float outer_angle; /* radians from the axis, 0 < outer <= pi/2 */
     lx_falloff_model model;
     lx_shadow_mode shadow;
-    float blur_power;      /* seed's blur exponent, default 1 */
-    float blur_multiplier; /* seed's blur scale, default 1 */
+    float blur_power;      /* blur shadows: exponent, default 1 */
+    float blur_multiplier; /* blur shadows: scale, default 1 */
     lx_vec3 ambient;       /* lux added everywhere in range, falling off with range */
     bool dynamic;          /* re-evaluated by lx_baker_update instead of baked */
     /* area lights (sphere, disk, rect, tube); direction is the emitting side
@@ -175,7 +213,8 @@ typedef struct lx_light_eval {
  * ambient is filled in either case. */
 bool lx_light_evaluate(const lx_light *light, lx_vec3 p, lx_vec3 n, lx_light_eval *out);
 
-/* The seed's blur shadow factor: clamp((occluder_dist / light_dist)^power *
+/* The blur shadow factor of the per-texel lighting document (its "dynamic
+ * blurred shadows"): clamp((occluder_dist / light_dist)^power *
  * multiplier, 0, 1), where occluder_dist is measured from the texel. */
 float lx_light_blur_visibility(const lx_light *light, float occluder_distance,
                                float light_distance);
@@ -190,7 +229,7 @@ float lx_light_blur_visibility(const lx_light *light, float occluder_distance,
  * LX_ERR_INVALID outside [LX_MIN_TEMPERATURE, LX_MAX_TEMPERATURE]. */
 lx_status lx_temperature_to_xy(float kelvin, float *x, float *y);
 
-/* Linear Rec.709/sRGB colour of a black body at kelvin (seed 001): xy, to
+/* Linear Rec.709/sRGB colour of a black body at kelvin (as Filament does): xy, to
  * XYZ at Y = 1, to linear sRGB with the standard matrix, normalized so the
  * largest channel is 1. Components below 0 (outside the sRGB gamut, below
  * about 1900 K) are set to 0. */

@@ -31,8 +31,9 @@
  *   horizon as the disk is; seen from within the radius of the axis line,
  *   the near ball's cone holds the whole capsule and Snyder's sphere form
  *   is exact.
- * - Luminance from power: Filament's area-light conversions (seed 001;
- *   Frostbite 2014 section 4.7.1), L = P / (pi A) with A the emitting area.
+ * - Luminance from power: Filament's area-light conversions (R. Guy and
+ *   M. Agopian, "Physically Based Rendering in Filament"; Frostbite 2014
+ *   section 4.7.1), L = P / (pi A) with A the emitting area.
  * Everything is computed in double and returned as float. */
 #include "luxel/light.h"
 #include "core/internal.h"

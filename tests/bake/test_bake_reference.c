@@ -1,5 +1,5 @@
 /* The fast path (rasterized texel maps, Embree shadow rays) against the
- * seed's brute force (tests/common/reference.c: every texel searches every
+ * per-texel lighting document's brute force (tests/common/reference.c: every texel searches every
  * triangle; every shadow ray tests every triangle of every node).
  *
  * Texel maps: every texel the reference covers must be covered by the fast
@@ -188,7 +188,7 @@ static void uv_texels(const lx_mesh *m, uint32_t tri, int w, int h, double out[3
 }
 
 /* Barycentrics of world point p on a world triangle (Ericson 3.4, the
- * seed's checkIntersectionInTri); *off = distance from the triangle's plane
+ * document's checkIntersectionInTri); *off = distance from the triangle's plane
  * point with those barycentrics. */
 static void world_bary(const lx_ref_triangle *t, lx_vec3 p, double w[3], double *off)
 {
