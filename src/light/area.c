@@ -22,12 +22,18 @@
  * - Line: the inverse-square, cosine-weighted integral of a Lambertian line
  *   element (intensity I sin(alpha)) along the segment, which has an
  *   elementary antiderivative; the horizon clips the segment at one point.
- *   A tube is that line with 2 r L per metre (the cylinder's projected
- *   width) plus a sphere light at each end weighted by the share of its
- *   disk the cap shows, (1 + cos beta) / 2 (Frostbite 2014 section 4.7.4
- *   also builds tubes from a cylinder and a sphere).
- * - Luminance from power: Filament's area-light conversions (seed 001;
- *   Frostbite 2014 section 4.7.1), L = P / (pi A) with A the emitting area.
+ * - Tube (capsule): the same contour integral along the capsule's
+ *   silhouette seen from the receiver, exact in closed form. The capsule is
+ *   the convex hull of the balls at its ends, so its silhouette is two
+ *   cylinder rulings (straight Lambert edges) and two arcs of the circles
+ *   where the cone from the receiver touches the balls (at a constant
+ *   distance from it, so each arc's integral is elementary), clipped by the
+ *   horizon as the disk is; seen from within the radius of the axis line,
+ *   the near ball's cone holds the whole capsule and Snyder's sphere form
+ *   is exact.
+ * - Luminance from power: Filament's area-light conversions (R. Guy and
+ *   M. Agopian, "Physically Based Rendering in Filament"; Frostbite 2014
+ *   section 4.7.1), L = P / (pi A) with A the emitting area.
  * Everything is computed in double and returned as float. */
 #include "luxel/light.h"
 #include "core/internal.h"
@@ -80,37 +86,43 @@ static dvec3 dnormalize(dvec3 a)
 
 /* ---- sphere --------------------------------------------------------------- */
 
+/* The sphere's illuminance over L (so a projected solid angle) for w the
+ * vector from p to the centre and nn the unit normal. */
+static double sphere_form(dvec3 w, double r, dvec3 nn)
+{
+    double d2 = ddot(w, w), r2 = r * r;
+    if (d2 <= r2)
+        return LX_PI_D;
+    double d = sqrt(d2);
+    double cos_t = ddot(w, nn) / d;
+    cos_t = cos_t < -1.0 ? -1.0 : (cos_t > 1.0 ? 1.0 : cos_t);
+    double sin2a = r2 / d2;
+    if (cos_t * cos_t >= sin2a) {
+        /* wholly above (cos_t > sin a) or wholly below the horizon */
+        return cos_t > 0.0 ? LX_PI_D * sin2a * cos_t : 0.0;
+    }
+    /* Snyder 1996 / Frostbite 2014 listing: x = cot a, y = -x cot t */
+    double sin_t = sqrt(1.0 - cos_t * cos_t);
+    double x = sqrt(d2 - r2) / r;
+    double y = -x * cos_t / sin_t;
+    y = y < -1.0 ? -1.0 : (y > 1.0 ? 1.0 : y);
+    double s = sin_t * sqrt(1.0 - y * y);
+    double e = (cos_t * acos(y) - x * s) * sin2a + atan(s / x);
+    return e > 0.0 ? e : 0.0;
+}
+
 float lx_sphere_light_illuminance(lx_vec3 centre, float radius, float luminance, lx_vec3 p,
                                   lx_vec3 n)
 {
     if (!(radius > 0.0f) || !(luminance > 0.0f))
         return 0.0f;
     dvec3 w = dsub(centre, p);
-    double d2 = ddot(w, w);
-    double r = radius, r2 = r * r;
-    if (d2 <= r2)
+    if (ddot(w, w) <= (double)radius * radius)
         return (float)(LX_PI_D * luminance);
     dvec3 nn = dnormalize(dfrom(n));
     if (ddot(nn, nn) == 0.0)
         return 0.0f;
-    double d = sqrt(d2);
-    double cos_t = ddot(w, nn) / d;
-    cos_t = cos_t < -1.0 ? -1.0 : (cos_t > 1.0 ? 1.0 : cos_t);
-    double sin2a = r2 / d2;
-    double e;
-    if (cos_t * cos_t >= sin2a) {
-        /* wholly above (cos_t > sin a) or wholly below the horizon */
-        e = cos_t > 0.0 ? LX_PI_D * sin2a * cos_t : 0.0;
-    } else {
-        /* Snyder 1996 / Frostbite 2014 listing: x = cot a, y = -x cot t */
-        double sin_t = sqrt(1.0 - cos_t * cos_t);
-        double x = sqrt(d2 - r2) / r;
-        double y = -x * cos_t / sin_t;
-        y = y < -1.0 ? -1.0 : (y > 1.0 ? 1.0 : y);
-        double s = sin_t * sqrt(1.0 - y * y);
-        e = (cos_t * acos(y) - x * s) * sin2a + atan(s / x);
-    }
-    return e > 0.0 ? (float)(luminance * e) : 0.0f;
+    return (float)(luminance * sphere_form(w, radius, nn));
 }
 
 /* ---- polygon -------------------------------------------------------------- */
@@ -335,56 +347,215 @@ float lx_line_light_illuminance(lx_vec3 a, lx_vec3 b, float intensity_per_metre,
     return e > 0.0 ? (float)(intensity_per_metre * e) : 0.0f;
 }
 
+/* The capsule: its silhouette seen from p, clipped by p's horizon, is a
+ * closed contour, and the illuminance is Lambert's contour integral along it
+ * (the disk's Stokes form). A capsule is the convex hull of the two balls at
+ * its ends, so the cone of directions toward it is the convex hull of the
+ * balls' two cones. While p is farther than r from the axis line (h > r),
+ * two planes through p touch the cylinder along its rulings, both balls on
+ * the same side, and the silhouette is
+ *   ruling 1 (end a -> end b), the outer arc of b's tangent circle,
+ *   ruling 2 (b -> a), the outer arc of a's tangent circle,
+ * counter-clockwise seen from p; each ruling is a straight edge (Lambert's
+ * term, exact), each arc an arc of the circle where the cone from p touches
+ * the ball, which is at the same distance from p all along, so its integral
+ * is elementary. While h <= r one ball's cone holds the other's and the
+ * capsule shows as that ball (the sphere's exact form). The horizon cuts the
+ * convex silhouette in at most two points; the part below is dropped and a
+ * chord along the horizon closes the contour, as for the disk. */
+
+/* One piece of the contour. A segment from q0 to q1, or an arc of the
+ * circle centre + rho (cos t e1 + sin t e2), t from t0 to t1, of a ball of
+ * angular radius alpha (sin_a = r / D) seen in direction dir, e1 x e2 = -dir. */
+typedef struct tube_piece {
+    bool arc;
+    dvec3 q0, q1;
+    dvec3 centre, e1, e2, dir;
+    double rho, t0, t1, sin_a, cos_a;
+    double cos_g, sin_g; /* arcs: cos and sin of t1 = -t0 */
+} tube_piece;
+
+/* The arc's point at t, from cos t and sin t. */
+static dvec3 arc_point(const tube_piece *pc, double cos_t, double sin_t)
+{
+    return dmadd(dmadd(pc->centre, pc->e1, pc->rho * cos_t), pc->e2, pc->rho * sin_t);
+}
+
+/* The contour integral (R' x R) . n / |R|^2 over the arc's t in [u0, u1]:
+ * with |R|^2 = D^2 - r^2 constant it is
+ * sin^2 a (dir . n) du + sin a cos a ((e2 . n) dcos - (e1 . n) dsin). */
+static double arc_term(const tube_piece *pc, dvec3 nn, double du, double dsin, double dcos)
+{
+    return pc->sin_a * pc->sin_a * ddot(pc->dir, nn) * du +
+           pc->sin_a * pc->cos_a * (ddot(pc->e2, nn) * dcos - ddot(pc->e1, nn) * dsin);
+}
+
+/* Where the arc is above the horizon: up to two intervals of [t0, t1] in
+ * order; returns how many. Height over D cos a: cos a (dir . n) + sin a
+ * (e1 . n cos t + e2 . n sin t). */
+static int arc_visible(const tube_piece *pc, dvec3 nn, double lo[2], double hi[2])
+{
+    double s1 = ddot(pc->e1, nn), s2 = ddot(pc->e2, nn);
+    double sigma = sqrt(s1 * s1 + s2 * s2);
+    double h0 = pc->cos_a * ddot(pc->dir, nn), amp = pc->sin_a * sigma;
+    if (h0 >= amp) {
+        lo[0] = pc->t0, hi[0] = pc->t1;
+        return 1;
+    }
+    if (h0 <= -amp)
+        return 0;
+    /* visible where cos(t - psi) >= -h0 / amp, |t - psi| <= beta (mod 2 pi) */
+    double psi = atan2(s2, s1), beta = acos(-h0 / amp);
+    double base = psi - beta; /* moved into (t0 - 2 pi, t0] */
+    base -= 2.0 * LX_PI_D * ceil((base - pc->t0) / (2.0 * LX_PI_D));
+    int count = 0;
+    for (int j = 0; j < 2; j++) {
+        double a = base + 2.0 * LX_PI_D * j, b = a + 2.0 * beta;
+        a = a > pc->t0 ? a : pc->t0;
+        b = b < pc->t1 ? b : pc->t1;
+        if (b > a) {
+            lo[count] = a, hi[count] = b;
+            count++;
+        }
+    }
+    return count;
+}
+
+/* A visible part of piece `piece`: its parameter range (t for an arc, 0..1
+ * along a ruling) and whether its ends are the piece's own ends. */
+typedef struct tube_part {
+    int piece;
+    bool whole_start, whole_end;
+    double u0, u1;
+} tube_part;
+
+/* The contour's point at parameter u of piece pc; exact at an arc's ends. */
+static dvec3 part_point(const tube_piece *pc, double u)
+{
+    if (!pc->arc)
+        return dmadd(pc->q0, dmadd(pc->q1, pc->q0, -1.0), u);
+    if (u == pc->t1)
+        return arc_point(pc, pc->cos_g, pc->sin_g);
+    if (u == pc->t0)
+        return arc_point(pc, pc->cos_g, -pc->sin_g);
+    return arc_point(pc, cos(u), sin(u));
+}
+
+static double capsule_form(dvec3 a, dvec3 w, double len, double r, dvec3 nn)
+{
+    /* closest point of the segment a + s w, s in [0, len], to p (the origin) */
+    double aw = ddot(a, w);
+    double s_close = -aw < 0.0 ? 0.0 : (-aw > len ? len : -aw);
+    dvec3 close = dmadd(a, w, s_close);
+    if (ddot(close, close) <= r * r)
+        return LX_PI_D;            /* on or inside the capsule */
+    dvec3 perp = dmadd(a, w, -aw); /* from p to the axis line, perpendicular to it */
+    double h = sqrt(ddot(perp, perp));
+    dvec3 b = dmadd(a, w, len);
+    if (!(h > r) || !(len > 0.0)) {
+        /* one ball's cone holds the whole capsule: the nearer end */
+        return sphere_form(ddot(a, a) <= ddot(b, b) ? a : b, r, nn);
+    }
+    double bw = aw + len;
+    dvec3 u = dscale(perp, 1.0 / h), e = dcross(u, w);
+    double rt = sqrt((h - r) * (h + r)); /* h sqrt(1 - r^2 / h^2) */
+    /* the tangent planes' normals nu = -(r/h) u +- (rt/h) e; the rulings
+     * are at a + r nu .. b + r nu */
+    dvec3 off1 = dmadd(dscale(u, -r * r / h), e, r * rt / h);
+    dvec3 off2 = dmadd(dscale(u, -r * r / h), e, -r * rt / h);
+
+    tube_piece pcs[4];
+    pcs[0] = (tube_piece){.arc = false, .q0 = dmadd(a, off1, 1.0), .q1 = dmadd(b, off1, 1.0)};
+    pcs[2] = (tube_piece){.arc = false, .q0 = dmadd(b, off2, 1.0), .q1 = dmadd(a, off2, 1.0)};
+    for (int k = 0; k < 2; k++) {
+        /* pcs[1]: b's arc, pcs[3]: a's. In the plane of w and u (a mirror
+         * plane of the whole picture) the direction away from the other
+         * ball, perpendicular to dir: e1 = (h w - bw u) / D at b and
+         * (aw u - h w) / D at a; then e2 = -dir x e1 = -e at b, +e at a. */
+        dvec3 c = k == 0 ? b : a;
+        double cw = k == 0 ? bw : aw, sign = k == 0 ? 1.0 : -1.0;
+        double d = sqrt(ddot(c, c));
+        tube_piece *pc = &pcs[k == 0 ? 1 : 3];
+        pc->arc = true;
+        pc->dir = dscale(c, 1.0 / d);
+        pc->sin_a = r / d;
+        pc->cos_a = sqrt((d - r) * (d + r)) / d;
+        pc->centre = dscale(pc->dir, d * pc->cos_a * pc->cos_a);
+        pc->rho = d * pc->sin_a * pc->cos_a;
+        pc->e1 = dscale(dmadd(dscale(w, h), u, -cw), sign / d);
+        pc->e2 = dscale(e, -sign);
+        /* the tangent points sit at +-gamma from e1: (x, y) in (e1, e2) is
+         * (sign r^2 cw / (h d), -+ r rt / h), so gamma = atan2(rt d, sign r cw) */
+        double gx = sign * r * cw, gy = rt * d, gl = sqrt(gx * gx + gy * gy);
+        double gamma = atan2(gy, gx);
+        pc->t0 = -gamma;
+        pc->t1 = gamma;
+        pc->cos_g = gx / gl;
+        pc->sin_g = gy / gl;
+    }
+
+    /* the parts above the horizon, in contour order */
+    tube_part parts[8];
+    int count = 0;
+    double sum = 0.0;
+    for (int i = 0; i < 4; i++) {
+        const tube_piece *pc = &pcs[i];
+        if (pc->arc) {
+            double lo[2], hi[2];
+            int m = arc_visible(pc, nn, lo, hi);
+            for (int j = 0; j < m; j++) {
+                bool ws = lo[j] == pc->t0, we = hi[j] == pc->t1;
+                if (ws && we) /* the whole arc, -gamma .. gamma */
+                    sum += arc_term(pc, nn, hi[j] - lo[j], 2.0 * pc->sin_g, 0.0);
+                else
+                    sum += arc_term(pc, nn, hi[j] - lo[j], sin(hi[j]) - sin(lo[j]),
+                                    cos(hi[j]) - cos(lo[j]));
+                parts[count++] = (tube_part){i, ws, we, lo[j], hi[j]};
+            }
+        } else {
+            double h0 = ddot(pc->q0, nn), h1 = ddot(pc->q1, nn);
+            if (h0 < 0.0 && h1 < 0.0)
+                continue;
+            double u0 = h0 < 0.0 ? h0 / (h0 - h1) : 0.0, u1 = h1 < 0.0 ? h0 / (h0 - h1) : 1.0;
+            sum += lambert_edge(u0 > 0.0 ? part_point(pc, u0) : pc->q0,
+                                u1 < 1.0 ? part_point(pc, u1) : pc->q1, nn);
+            parts[count++] = (tube_part){i, !(h0 < 0.0), !(h1 < 0.0), u0, u1};
+        }
+    }
+    if (count == 0)
+        return 0.0;
+    /* close each gap (a stretch below the horizon) with the horizon's chord */
+    for (int k = 0; k < count; k++) {
+        const tube_part *x = &parts[k], *y = &parts[(k + 1) % count];
+        bool joined = x->whole_end && y->whole_start && y->piece == (x->piece + 1) % 4;
+        if (!joined)
+            sum += lambert_edge(part_point(&pcs[x->piece], x->u1),
+                                part_point(&pcs[y->piece], y->u0), nn);
+    }
+    double form = 0.5 * sum;
+    return form > 0.0 ? form : 0.0;
+}
+
 float lx_tube_light_illuminance(lx_vec3 centre, lx_vec3 axis, float length, float radius,
                                 float luminance, lx_vec3 p, lx_vec3 n)
 {
     if (!(radius > 0.0f) || !(luminance > 0.0f) || !(length >= 0.0f))
         return 0.0f;
-    lx_vec3 w = lx_normalize(axis);
-    lx_vec3 half = lx_scale(w, 0.5f * length);
-    lx_vec3 ends[2] = {lx_sub(centre, half), lx_add(centre, half)};
-    /* Each cap is a hemisphere; seen at beta from its pole it shows
-     * pi r^2 (1 + cos beta) / 2 outside the cylinder's band, so it is a
-     * sphere light at its end weighted by that share: half each across the
-     * axis, all of the near cap end-on (and the power stays exact). */
-    double caps = 0.0, cos_beta[2];
-    for (int i = 0; i < 2; i++) {
-        lx_vec3 to_p = lx_sub(p, ends[i]);
-        float d = lx_length(to_p);
-        cos_beta[i] = d > 0.0f ? (double)((i ? 1.0f : -1.0f) * lx_dot(to_p, w) / d) : 1.0;
-        caps += 0.5 * (1.0 + cos_beta[i]) *
-                (double)lx_sphere_light_illuminance(ends[i], radius, luminance, p, n);
+    dvec3 w = dnormalize(dfrom(axis));
+    dvec3 nn = dnormalize(dfrom(n));
+    if (ddot(w, w) == 0.0) {
+        if (!(length > 0.0f))
+            w = dv(1.0, 0.0, 0.0); /* a sphere has no axis to need */
+        else
+            return 0.0f;
     }
-    if (!(length > 0.0f))
-        return (float)caps;
-    /* The side: a line of 2 r L per metre, seen only from outside its
-     * infinite extension. Seen at alpha from the axis, each end circle
-     * shows as an ellipse that shifts the side's visible band away from the
-     * viewer by r cot(alpha) along the axis: under the near cap at the near
-     * end, past the far cap at the far end. The line is shifted the same
-     * way at each end, which changes nothing far away and removes the side
-     * behind the near cap when seen end-on. */
-    lx_vec3 rel = lx_sub(p, centre);
-    float along = lx_dot(rel, w);
-    float h2 = lx_dot(rel, rel) - along * along;
-    if (!(h2 > radius * radius))
-        return (float)caps;
-    double h = sqrt(h2), shifted[2];
-    for (int i = 0; i < 2; i++) {
-        double t = (i ? 0.5 : -0.5) * length; /* the end along the axis */
-        double cot = (t - along) / h;         /* at that end, signed away from p */
-        shifted[i] = t + radius * cot;
+    dvec3 a = dmadd(dsub(centre, p), w, -0.5 * (double)length); /* end a, from p */
+    if (ddot(nn, nn) == 0.0) {
+        /* only a point on or inside the tube gets light without a normal */
+        double form = capsule_form(a, w, length, radius, dv(0.0, 0.0, 0.0));
+        return form >= LX_PI_D ? (float)(LX_PI_D * luminance) : 0.0f;
     }
-    if (!(shifted[1] > shifted[0]))
-        return (float)caps;
-    /* A receiver whose horizon cuts through the tube sees the side's upper
-     * part; the line, on the axis, gives it only when the axis is above. It
-     * is a grazing sliver: about 1% of what the same point gets facing the
-     * tube (tests/light/test_area.c). */
-    double side = lx_line_light_illuminance(lx_madd(centre, w, (float)shifted[0]),
-                                            lx_madd(centre, w, (float)shifted[1]),
-                                            2.0f * radius * luminance, p, n);
-    return (float)(caps + side);
+    return (float)(luminance * capsule_form(a, w, length, radius, nn));
 }
 
 /* ---- luminance from power --------------------------------------------------- */

@@ -1,6 +1,6 @@
-/* Light colours: colour temperature to linear sRGB as seed 001 describes
- * (Filament): the Planckian locus in CIE 1960 UCS by Krystek's rational
- * approximation (M. Krystek, "An algorithm to calculate correlated colour
+/* Light colours: colour temperature to linear sRGB as Filament does (R. Guy
+ * and M. Agopian, "Physically Based Rendering in Filament"): the Planckian locus in CIE 1960 UCS by
+ * Krystek's rational approximation (M. Krystek, "An algorithm to calculate correlated colour
  * temperature", Color Research & Application 10, 1985), CIE 1960 uv to
  * CIE 1931 xy, to XYZ at Y = 1, to linear sRGB with the IEC 61966-2-1
  * matrix, normalized to a largest channel of 1. */

@@ -2,8 +2,9 @@
  * -2002, "Standard File Format for the Electronic Transfer of Photometric
  * Data"): the reader, bilinear interpolation of the candela table extended
  * by the file's horizontal symmetry, and the luminous flux integrated over
- * the sphere (midpoint rule, dOmega = sin(theta) dtheta dphi), as used by the
- * photometric lights of seed 001 (Filament's "Photometric lights").
+ * the sphere (midpoint rule, dOmega = sin(theta) dtheta dphi), as used by
+ * Filament's photometric lights (R. Guy and M. Agopian, "Physically Based
+ * Rendering in Filament").
  *
  * Layout read here: an optional "IESNA:LM-63-<year>" / "IESNA91" first line
  * (a 1986 file has none), keyword or label lines, "TILT=NONE|INCLUDE|file",
@@ -234,7 +235,7 @@ static lx_status read_header(lx_ies_profile *p, ies_reader *r, const char **tilt
 
 static lx_status read_tilt(ies_reader *r)
 {
-    int geometry, count;
+    int geometry = 0, count = 0; /* set whenever read_int succeeds */
     lx_status st = read_int(r, "lamp-to-luminaire geometry", 1, 3, &geometry);
     if (st == LX_OK)
         st = read_int(r, "number of tilt angles", 1, IES_MAX_ANGLES, &count);
@@ -293,8 +294,8 @@ lx_status ies_classify(lx_ies_profile *p, const char *name, int vline, int hline
 
 static lx_status parse(lx_ies_profile *p, ies_reader *r)
 {
-    const char *tb, *te;
-    int tilt_line;
+    const char *tb = NULL, *te = NULL; /* set whenever read_header succeeds */
+    int tilt_line = 0;
     lx_status st = read_header(p, r, &tb, &te, &tilt_line);
     if (st != LX_OK)
         return st;

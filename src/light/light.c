@@ -1,10 +1,12 @@
-/* Punctual light evaluation: Filament's physically based light model (seed
- * 001, "Physically based punctual lights": inverse square law with the
- * smooth range window (1 - (d/r)^4)^2, the spot's smooth angular
- * attenuation, N.L), the seed-000 "classic" CSLight falloff
- * ((1 - d/range) |N.L|)^2 * colour * intensity of its DynamicLight kernel,
- * the seed's dynamic blur shadow factor and its ambient wish list item
- * (ambient that falls off with the light's reach and adds across lights). */
+/* Punctual light evaluation: Filament's physically based light model
+ * (R. Guy and M. Agopian, "Physically Based Rendering in Filament",
+ * "Physically based punctual lights": inverse square law with the smooth
+ * range window (1 - (d/r)^4)^2, the spot's smooth angular attenuation,
+ * N.L), and from the per-texel lighting document luxel started from: its
+ * "classic" CSLight falloff ((1 - d/range) |N.L|)^2 * colour * intensity of
+ * its DynamicLight kernel, its dynamic blur shadow factor and its ambient
+ * wish list item (ambient that falls off with the light's reach and adds
+ * across lights). */
 #include "luxel/light.h"
 #include "core/internal.h"
 
@@ -48,6 +50,11 @@ lx_light lx_light_defaults(lx_light_type type)
     l.up = lx_v3(0.0f, 0.0f, 1.0f);
     l.samples = 0;
     return l;
+}
+
+uint32_t lx_light_sample_count(const lx_light *light)
+{
+    return light->samples ? light->samples : LX_DEFAULT_LIGHT_SAMPLES;
 }
 
 bool lx_light_is_area(const lx_light *light)
@@ -134,7 +141,7 @@ lx_vec3 lx_area_light_point(const lx_light *light, float u, float v, lx_vec3 *no
 }
 
 /* Candela toward the point (along -to_light) from the light's photometric
- * profile (seed 001's photometric lights): the vertical angle from the
+ * profile (Filament's photometric lights): the vertical angle from the
  * light's direction, the horizontal angle around it from up. */
 static float profile_intensity(const lx_light *light, lx_vec3 to_light)
 {
@@ -406,7 +413,7 @@ bool lx_light_evaluate(const lx_light *light, lx_vec3 p, lx_vec3 n, lx_light_eva
     lx_vec3 to_light = lx_sub(light->position, p);
     float dist_sq = lx_dot(to_light, to_light);
     float dist = sqrtf(dist_sq);
-    /* The seed wants ambient to reach only as far as the light does: the
+    /* The document wants ambient to reach only as far as the light does: the
      * same window as the direct light, so several lights' ambients blend. */
     out->ambient = lx_scale(light->ambient, lx_light_range_window(dist_sq, light->range));
     out->distance = dist;

@@ -1,4 +1,5 @@
-/* Photometric units of Filament's physical light model (seed 001): luminous
+/* Photometric units of Filament's physical light model (R. Guy and
+ * M. Agopian, "Physically Based Rendering in Filament"): luminous
  * power (lm) to intensity (cd) for point lights I = P / 4pi and for spot
  * lights I = P / pi or I = P / (2pi (1 - cos outer)), watts through
  * 683 lm/W, lux for directional lights; exposure from EV100 (1 / (1.2 *
@@ -70,7 +71,8 @@ double lx_area_light_projected_area(const lx_light *light)
 }
 
 /* Area lights carry luminance (nits): power goes through the emitting
- * area (issue 3's formulas, lx_area_light_luminance_from_power), candela
+ * area (Filament's and Frostbite's L = P / (pi A),
+ * lx_area_light_luminance_from_power), candela
  * through the area seen along the axis. */
 static lx_status area_to_native(const lx_light *light, const char *who, float value,
                                 lx_light_unit unit, float *native)

@@ -442,10 +442,11 @@ static char *relative_to_file(const ctx *c, const char *rel)
     return path;
 }
 
-/* "ies" (a path relative to this file), "masked" and "multiplier": seed
- * 001's photometric lights. A masked profile keeps its shape and takes the
- * light's intensity as its average (lumens / 4 pi); an unmasked one keeps
- * its own candela times the multiplier. Runs after the intensity is known. */
+/* "ies" (a path relative to this file), "masked" and "multiplier":
+ * Filament's photometric lights. A masked profile keeps its shape and takes
+ * the light's intensity as its average (lumens / 4 pi); an unmasked one
+ * keeps its own candela times the multiplier (a multiplier on a masked
+ * profile is an error, not ignored). Runs after the intensity is known. */
 static lx_status read_profile(ctx *c, const cJSON *obj, lx_light *l)
 {
     lx_status st;
@@ -493,6 +494,10 @@ static lx_status read_profile(ctx *c, const cJSON *obj, lx_light *l)
             return fail(c, LX_ERR_FORMAT, "masked must be true or false");
         masked = cJSON_IsTrue(masked_item);
     }
+    if (masked && mult_item)
+        return fail(c, LX_ERR_FORMAT,
+                    "'multiplier' scales an unmasked profile; a masked one takes its scale from "
+                    "'intensity'");
     if (masked) {
         double lumens = lx_ies_total_lumens(l->profile);
         if (!(lumens > 0.0))

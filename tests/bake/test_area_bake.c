@@ -1,5 +1,5 @@
 /* Area lights in the baker: soft shadows with nothing in the way equal the
- * unshadowed bake (an invariant of the weighted visible fraction), a rect
+ * unshadowed bake exactly (an invariant of the weighted visible fraction), a rect
  * light half hidden behind an occluder's edge matches an independent
  * quadrature of its visible part (and so does a linear tube's), and soft
  * shadows are the same bytes for any thread count. */
@@ -73,7 +73,9 @@ static void soft_unoccluded_equals_unshadowed(void **state)
         lx_baker *b = bake(none_light, false, 2, &none);
         for (int p = 0; p < 64 * 3; p++) {
             assert_true(none.data[p] > 0.0f);
-            assert_true(fabsf(soft.data[p] - none.data[p]) <= 1e-5f * none.data[p]);
+            /* exactly: the weighted visible share is visible / total with
+             * nothing hidden (measured: no difference at all) */
+            assert_true(soft.data[p] == none.data[p]);
         }
         lx_image_free(&soft);
         lx_image_free(&none);
@@ -118,6 +120,7 @@ static void half_hidden_rect_matches_quadrature(void **state)
             double full = visible_rect_quadrature(s.position, -1.0, 1000.0);
             double got = img.data[3 * (y * 8 + x)];
             assert_true(want > 0.3 * full && want < 0.7 * full); /* about half */
+            /* 1024 jittered samples: measured 5.9e-3 (rms 2.3e-3) */
             assert_true(fabs(got - want) <= 0.02 * full);
             checked++;
         }
@@ -163,10 +166,33 @@ static void half_hidden_linear_tube_matches_quadrature(void **state)
             double full = visible_line_quadrature(s.position, -1.0, 200.0);
             double got = img.data[3 * (y * 8 + x)];
             assert_true(want > 0.3 * full && want < 0.7 * full);
+            /* 1024 jittered samples: measured 5.5e-3 (rms 2.3e-3) */
             assert_true(fabs(got - want) <= 0.02 * full);
         }
     lx_image_free(&img);
     lx_baker_destroy(baker);
+}
+
+/* samples 0 bakes with the light model's default count: the same bytes as
+ * asking for lx_light_sample_count's number, and not those of another */
+static void default_samples_are_the_models(void **state)
+{
+    (void)state;
+    lx_light zero = area_light(LX_LIGHT_DISK, LX_SHADOW_SOFT, 0);
+    lx_image a, b, c;
+    lx_baker *ba = bake(zero, true, 2, &a);
+    lx_baker *bb =
+        bake(area_light(LX_LIGHT_DISK, LX_SHADOW_SOFT, lx_light_sample_count(&zero)), true, 2, &b);
+    lx_baker *bc = bake(area_light(LX_LIGHT_DISK, LX_SHADOW_SOFT, lx_light_sample_count(&zero) + 1),
+                        true, 2, &c);
+    assert_memory_equal(a.data, b.data, sizeof(float) * 64 * 3);
+    assert_memory_not_equal(a.data, c.data, sizeof(float) * 64 * 3);
+    lx_image_free(&a);
+    lx_image_free(&b);
+    lx_image_free(&c);
+    lx_baker_destroy(ba);
+    lx_baker_destroy(bb);
+    lx_baker_destroy(bc);
 }
 
 static void soft_shadows_are_deterministic(void **state)
@@ -206,6 +232,7 @@ int main(void)
         cmocka_unit_test(half_hidden_rect_matches_quadrature),
         cmocka_unit_test(half_hidden_linear_tube_matches_quadrature),
         cmocka_unit_test(soft_shadows_are_deterministic),
+        cmocka_unit_test(default_samples_are_the_models),
         cmocka_unit_test(soft_shadows_need_an_area_light),
     };
     return cmocka_run_group_tests(tests, NULL, NULL);

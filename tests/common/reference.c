@@ -1,10 +1,14 @@
-/* The test oracle: seed 000's brute-force per-texel algorithm (UvToWorld:
- * every texel searches every triangle with barycentrics; DynamicLight:
- * every texel, every light, every triangle shadow test), written from the
- * seed and the public headers only, in double precision. See reference.h. */
+/* The test oracle: the per-texel lighting document's brute-force algorithm
+ * (UvToWorld: every texel searches every triangle with barycentrics;
+ * DynamicLight: every texel, every light, every triangle shadow test) and
+ * the light model (Filament's physically based punctual lights, the
+ * document's classic falloff, its blur shadow), written from their
+ * formulas in double precision: nothing here calls src/light, src/bake or
+ * src/trace. See reference.h. */
 #include "reference.h"
 
 #include <math.h>
+#include <stdio.h>
 #include <stdlib.h>
 #include <string.h>
 
@@ -236,7 +240,7 @@ int lx_ref_uv_set(const lx_mesh *mesh)
 
 bool lx_ref_uv_barycentric(lx_vec2 a, lx_vec2 b, lx_vec2 c, double px, double py, double w[3])
 {
-    /* seed 000's UvToWorld: P - P1 = v (P2 - P1) + w (P3 - P1), Cramer's rule */
+    /* the document's UvToWorld: P - P1 = v (P2 - P1) + w (P3 - P1), Cramer's rule */
     double ax = a.x, ay = a.y, bx = b.x, by = b.y, cx = c.x, cy = c.y;
     double denom = (bx - ax) * (cy - ay) - (cx - ax) * (by - ay);
     if (denom == 0.0)
@@ -307,7 +311,7 @@ void lx_ref_texel_map(const lx_scene *scene, uint32_t node_index, int width, int
                     tx->position = to_vec(pw);
                     tx->normal = to_vec(nw);
                     tx->geometric_normal = to_vec(gw);
-                    break; /* the seed: the first triangle found wins */
+                    break; /* as the document: the first triangle found wins */
                 }
             }
         }
@@ -327,22 +331,159 @@ float lx_ref_bias(const lx_ref_scene *rs, lx_vec3 p)
     return 1e-5f * rs->diagonal + 4e-6f * m;
 }
 
+/* ---- the light model, from its formulas ------------------------------------ */
+
+/* One light at a point, in double: what src/light's lx_light_evaluate
+ * computes, written here from the model's definition (luxel/light.h) and
+ * calling nothing of it. */
+typedef struct ref_light_eval {
+    bool direct;        /* some direct light arrives */
+    double to_light[3]; /* unit, from the point toward the light */
+    double distance;    /* INFINITY for a directional light */
+    double e[3];        /* unshadowed illuminance (physical: lux) */
+    double scale[3];    /* the same without N.L and the range falloff */
+    double ambient[3];
+} ref_light_eval;
+
+/* Filament's smooth distance window (1 - (d^2 / range^2)^2)^2, 1 without a
+ * range. */
+static double ref_window(double d2, double range)
+{
+    if (!(range > 0.0))
+        return 1.0;
+    double f = d2 / ((double)range * range);
+    double s = 1.0 - f * f;
+    return s > 0.0 ? s * s : 0.0;
+}
+
+/* Filament's spot attenuation t^2, t = saturate((cos - cos outer) /
+ * max(cos inner - cos outer, 1e-4)); inner == outer is a hard-edged cone. */
+static double ref_spot(const lx_light *l, double cos_angle)
+{
+    if (l->type != LX_LIGHT_SPOT)
+        return 1.0;
+    double co = cos((double)l->outer_angle), ci = cos((double)l->inner_angle);
+    if (!(l->inner_angle < l->outer_angle))
+        return cos_angle >= co ? 1.0 : 0.0;
+    double t = (cos_angle - co) / fmax(ci - co, 1e-4);
+    t = t < 0.0 ? 0.0 : (t > 1.0 ? 1.0 : t);
+    return t * t;
+}
+
+bool lx_ref_light_supported(const lx_light *l)
+{
+    return (l->type == LX_LIGHT_POINT || l->type == LX_LIGHT_SPOT ||
+            l->type == LX_LIGHT_DIRECTIONAL) &&
+           !l->profile;
+}
+
+static ref_light_eval ref_light(const lx_light *l, lx_vec3 pf, lx_vec3 nf)
+{
+    ref_light_eval r;
+    memset(&r, 0, sizeof r);
+    double p[3], n[3], color[3], amb[3];
+    from_vec(pf, p);
+    from_vec(nf, n);
+    from_vec(l->color, color);
+    from_vec(l->ambient, amb);
+    double intensity = l->intensity, scale = 0.0, unattenuated = 0.0;
+    if (l->type == LX_LIGHT_DIRECTIONAL) {
+        /* lux at normal incidence; classic: (N.L)^2 I (no distance) */
+        r.distance = INFINITY;
+        for (int c = 0; c < 3; c++) {
+            r.to_light[c] = -(double)(&l->direction.x)[c];
+            r.ambient[c] = amb[c];
+        }
+        double ndotl = d_dot(n, r.to_light);
+        if (ndotl > 0.0)
+            scale = l->model == LX_MODEL_CLASSIC ? ndotl * ndotl * intensity : intensity * ndotl;
+        unattenuated = intensity;
+    } else {
+        double pos[3], v[3];
+        from_vec(l->position, pos);
+        d_sub(pos, p, v);
+        double d2 = d_dot(v, v), d = sqrt(d2);
+        double window = ref_window(d2, l->range);
+        for (int c = 0; c < 3; c++)
+            r.ambient[c] = amb[c] * window;
+        r.distance = d;
+        if (d > 0.0) {
+            for (int c = 0; c < 3; c++)
+                r.to_light[c] = v[c] / d;
+            double dir[3];
+            from_vec(l->direction, dir);
+            double ndotl = d_dot(n, r.to_light);
+            double spot = ref_spot(l, -d_dot(dir, r.to_light));
+            if (ndotl > 0.0 && spot > 0.0) {
+                if (l->model == LX_MODEL_CLASSIC) {
+                    /* the per-texel document's ((1 - d / range) |N.L|)^2 I */
+                    if (d < l->range) {
+                        double f = (1.0 - d / l->range) * ndotl;
+                        scale = f * f * intensity * spot;
+                    }
+                    unattenuated = intensity * spot;
+                } else {
+                    /* inverse square with Filament's 1e-4 m^2 floor */
+                    scale = intensity * window * spot * ndotl / fmax(d2, 1e-4);
+                    unattenuated = intensity * spot / fmax(d2, 1e-4);
+                }
+            }
+        }
+    }
+    r.direct = scale > 0.0;
+    for (int c = 0; c < 3; c++) {
+        r.e[c] = scale * color[c];
+        r.scale[c] = r.direct ? unattenuated * color[c] : 0.0;
+    }
+    return r;
+}
+
+/* The document's blur: clamp((occluder / light distance)^power * multiplier,
+ * 0, 1); no measurable light distance is fully shadowed. */
+static double ref_blur(const lx_light *l, double occluder, double light_distance)
+{
+    if (!(light_distance > 0.0) || !(occluder >= 0.0))
+        return 0.0;
+    double v = pow(occluder / light_distance, (double)l->blur_power) * l->blur_multiplier;
+    return v > 0.0 ? (v < 1.0 ? v : 1.0) : 0.0;
+}
+
 lx_vec3 lx_ref_shade(const lx_ref_scene *rs, const lx_light *lights, uint32_t light_count,
                      lx_vec3 ambient, lx_vec3 p, lx_vec3 n, lx_vec3 ng, double edge_eps,
                      bool *ambiguous)
 {
+    return lx_ref_shade_scale(rs, lights, light_count, ambient, p, n, ng, edge_eps, ambiguous,
+                              NULL);
+}
+
+lx_vec3 lx_ref_shade_scale(const lx_ref_scene *rs, const lx_light *lights, uint32_t light_count,
+                           lx_vec3 ambient, lx_vec3 p, lx_vec3 n, lx_vec3 ng, double edge_eps,
+                           bool *ambiguous, lx_vec3 *scale)
+{
     double sum[3] = {ambient.x, ambient.y, ambient.z};
+    double big[3] = {ambient.x, ambient.y, ambient.z};
     bool amb = false;
     for (uint32_t l = 0; l < light_count; l++) {
         const lx_light *light = &lights[l];
-        lx_light_eval e;
-        bool direct = lx_light_evaluate(light, p, n, &e);
-        sum[0] += e.ambient.x, sum[1] += e.ambient.y, sum[2] += e.ambient.z;
-        if (!direct)
+        if (!lx_ref_light_supported(light)) {
+            fprintf(stderr,
+                    "reference: light '%.*s' (type %d%s) is not one the oracle evaluates: "
+                    "point, spot and directional lights without a profile only\n",
+                    (int)sizeof light->name, light->name, (int)light->type,
+                    light->profile ? ", with a profile" : "");
+            abort();
+        }
+        ref_light_eval e = ref_light(light, p, n);
+        for (int c = 0; c < 3; c++) {
+            sum[c] += e.ambient[c];
+            big[c] += e.ambient[c] + e.scale[c];
+        }
+        if (!e.direct)
             continue;
+        lx_vec3 to_light = to_vec(e.to_light);
         double vis = 1.0;
         if (light->shadow != LX_SHADOW_NONE) {
-            double side = ng.x * e.to_light.x + ng.y * e.to_light.y + ng.z * e.to_light.z;
+            double side = ng.x * e.to_light[0] + ng.y * e.to_light[1] + ng.z * e.to_light[2];
             double s = side >= 0 ? 1.0 : -1.0;
             double bias = lx_ref_bias(rs, p);
             lx_vec3 o = lx_v3((float)(p.x + s * bias * ng.x), (float)(p.y + s * bias * ng.y),
@@ -352,22 +493,21 @@ lx_vec3 lx_ref_shade(const lx_ref_scene *rs, const lx_light *lights, uint32_t li
                 tmax = 0;
             bool a = false;
             if (light->shadow == LX_SHADOW_HARD) {
-                vis = lx_ref_occluded(rs, o, e.to_light, 0.0, tmax, edge_eps, &a) ? 0.0 : 1.0;
+                vis = lx_ref_occluded(rs, o, to_light, 0.0, tmax, edge_eps, &a) ? 0.0 : 1.0;
             } else {
-                /* the seed's blur: nearest occluder distance / light distance */
+                /* the blur: nearest occluder distance / light distance */
                 lx_ref_hit h;
-                if (lx_ref_closest(rs, o, e.to_light, 0.0, tmax, edge_eps, &h, &a)) {
-                    float d_light = isfinite(e.distance) ? e.distance : rs->diagonal;
-                    vis = lx_light_blur_visibility(light, (float)h.t, d_light);
-                }
+                if (lx_ref_closest(rs, o, to_light, 0.0, tmax, edge_eps, &h, &a))
+                    vis = ref_blur(light, h.t, isfinite(e.distance) ? e.distance : rs->diagonal);
             }
             amb = amb || a;
         }
-        sum[0] += vis * e.illuminance.x;
-        sum[1] += vis * e.illuminance.y;
-        sum[2] += vis * e.illuminance.z;
+        for (int c = 0; c < 3; c++)
+            sum[c] += vis * e.e[c];
     }
     if (ambiguous)
         *ambiguous = amb;
+    if (scale)
+        *scale = to_vec(big);
     return to_vec(sum);
 }

@@ -1,18 +1,26 @@
-/* The test oracle: seed 000's brute-force per-texel lighting, written
- * independently of src/bake and src/trace so the fast path (rasterized
- * texel maps, Embree) can be checked against it.
+/* The test oracle: the per-texel lighting document's brute-force lighting,
+ * written independently of src/bake, src/trace and src/light so the fast
+ * path (rasterized texel maps, Embree, the light model) can be checked
+ * against it.
  *
  * - Texel map: for every texel, every triangle of the node's meshes is
  *   searched (mesh order, then triangle order) for the first whose UV
  *   triangle contains the texel centre ((x+0.5)/W, (y+0.5)/H) with
  *   barycentrics >= 0; the same barycentrics on the world triangle give the
- *   texel's position and interpolated normal (seed 000's UvToWorld kernel).
+ *   texel's position and interpolated normal (the document's UvToWorld kernel).
  *   Lightmap UVs are TEXCOORD_1 when the mesh has them, else TEXCOORD_0.
  *   Normal maps are not applied (the reference scenes have none).
  * - Rays: Moller-Trumbore in double precision against EVERY triangle of
- *   EVERY node in world space, both faces (seed 000's shadow loop).
- * - Lighting: for every light, lx_light_evaluate (the light model is tested
- *   on its own in tests/light) and, unless the light's shadow mode is NONE,
+ *   EVERY node in world space, both faces (the document's shadow loop).
+ * - Lighting: for every light, the light model evaluated from its formulas
+ *   in double (luxel/light.h: Filament's inverse square law with the
+ *   smooth range window (1 - (d/r)^4)^2 and the 1e-4 m^2 floor, the spot's
+ *   smooth cone t^2 or a hard cone when inner == outer, N.L; the classic
+ *   ((1 - d/range) N.L)^2 I, (N.L)^2 I for a directional light; ambient
+ *   times the range window, everywhere for a directional light; the blur
+ *   shadow clamp((d_occluder / d_light)^power * multiplier, 0, 1), the
+ *   scene's diagonal standing in for a directional light's distance), and,
+ *   unless the light's shadow mode is NONE,
  *   a shadow ray toward the light whose origin is offset along the
  *   geometric normal (on the light's side) by
  *     bias = 1e-5 * scene bounding-box diagonal + 4e-6 * max|p| component,
@@ -91,7 +99,7 @@ typedef struct lx_ref_map {
     lx_ref_texel *texels; /* width * height, row 0 at the top */
 } lx_ref_map;
 
-/* The seed's every-texel-times-every-triangle UV -> world map of node. */
+/* The document's every-texel-times-every-triangle UV -> world map of node. */
 void lx_ref_texel_map(const lx_scene *scene, uint32_t node, int width, int height, lx_ref_map *out);
 void lx_ref_map_free(lx_ref_map *map);
 
@@ -103,14 +111,29 @@ int lx_ref_uv_set(const lx_mesh *mesh);
  * false when the UV triangle is degenerate. */
 bool lx_ref_uv_barycentric(lx_vec2 a, lx_vec2 b, lx_vec2 c, double px, double py, double w[3]);
 
+/* True for the lights the oracle evaluates: point, spot and directional
+ * lights without a photometric profile. */
+bool lx_ref_light_supported(const lx_light *light);
+
 /* Light arriving at a surface point: sum over lights of ambient + shadowed
- * direct light (see the header comment), plus `ambient`. n is the shading
+ * direct light (see the header comment), plus `ambient`. Every light must
+ * be one lx_ref_light_supported accepts (the process aborts naming it
+ * otherwise). n is the shading
  * normal, ng the geometric normal (either sign). *ambiguous (may be NULL)
  * is set when a shadow ray was ambiguous in the sense of lx_ref_occluded
  * with edge_eps. */
 lx_vec3 lx_ref_shade(const lx_ref_scene *rs, const lx_light *lights, uint32_t light_count,
                      lx_vec3 ambient, lx_vec3 p, lx_vec3 n, lx_vec3 ng, double edge_eps,
                      bool *ambiguous);
+
+/* lx_ref_shade, and in *scale (may be NULL) the sum over lights of what
+ * reaches p without N.L and without the distance falloff (physical:
+ * I spot / max(d^2, 1e-4), classic: I spot, directional: I; times colour)
+ * plus the ambients: the size of the terms whose float rounding the baked
+ * value carries, for comparisons at grazing light or a range's edge. */
+lx_vec3 lx_ref_shade_scale(const lx_ref_scene *rs, const lx_light *lights, uint32_t light_count,
+                           lx_vec3 ambient, lx_vec3 p, lx_vec3 n, lx_vec3 ng, double edge_eps,
+                           bool *ambiguous, lx_vec3 *scale);
 
 /* Shadow-ray bias for point p in rs (the rule of src/bake/direct.c). */
 float lx_ref_bias(const lx_ref_scene *rs, lx_vec3 p);

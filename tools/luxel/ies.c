@@ -1,11 +1,11 @@
 /* luxel ies: what an IES LM-63 photometric file holds (header fields, total
- * lumens integrated over the sphere, peak candela, beam angle of the main
- * planes) and, with --plot, the polar candela curve of the C0-C180 and
- * C90-C270 planes. Beam angle: the full angle between the two directions of
- * a plane where the intensity is 50% of that plane's maximum (IES/CIE
- * beam spread). Type A and B files are shown as the library converts them
- * to type C (docs/ies.md): their C0-C180 plane holds the vertical angles,
- * C90-C270 the horizontal ones. */
+ * lumens integrated over the sphere, peak candela, beam and field angles of
+ * the main planes) and, with --plot, the polar candela curve of the C0-C180
+ * and C90-C270 planes. Beam and field angle: the full angle between the two
+ * directions of a plane where the intensity falls to 50% and 10% of that
+ * plane's maximum (IES/CIE; lx_ies_beam_field). Type A and B files are shown
+ * as the library converts them to type C (docs/ies.md): their C0-C180 plane
+ * holds the vertical angles, C90-C270 the horizontal ones. */
 #define _POSIX_C_SOURCE 200809L
 #include "cli.h"
 
@@ -20,8 +20,8 @@ static const char *ies_usage =
     "\n"
     "Prints the header of an IES LM-63 photometric file (1986, 1991, 1995 or\n"
     "2002), its total lumens (integrated over the sphere), peak candela and the\n"
-    "beam angle (full angle at 50% of the maximum) of the C0-C180 and C90-C270\n"
-    "planes.\n"
+    "beam and field angles (full angles at 50% and 10% of the maximum) of the\n"
+    "C0-C180 and C90-C270 planes.\n"
     "\n"
     "options:\n"
     "  --plot OUT.png   draw the polar candela curve of the main planes\n"
@@ -29,46 +29,11 @@ static const char *ies_usage =
     "                   of the peak; vertical angle 0 points down)\n"
     "  -h, --help       show this help\n";
 
-#define BEAM_STEPS 36000 /* 0.01 degree around a plane */
-
 /* Intensity at angle a (degrees, -180..180) in the plane through
  * horizontal angles h_pos (a >= 0) and h_pos + 180 (a < 0). */
 static float plane_cd(const lx_ies_profile *p, float h_pos, double a)
 {
     return a >= 0 ? lx_ies_candela(p, (float)a, h_pos) : lx_ies_candela(p, (float)-a, h_pos + 180);
-}
-
-/* Full angle between the 50% directions either side of the plane's maximum;
- * negative when the intensity never falls to 50% (or the plane is dark). */
-static double beam_angle(const lx_ies_profile *p, float h_pos)
-{
-    const double step = 360.0 / BEAM_STEPS;
-    float *v = malloc(BEAM_STEPS * sizeof *v);
-    if (!v)
-        return -1;
-    int imax = 0;
-    for (int k = 0; k < BEAM_STEPS; k++) {
-        v[k] = plane_cd(p, h_pos, -180.0 + k * step);
-        if (v[k] > v[imax])
-            imax = k;
-    }
-    double half = 0.5 * v[imax], edge[2] = {0, 0};
-    bool found[2] = {false, false};
-    for (int side = 0; side < 2 && v[imax] > 0; side++) {
-        int dir = side ? -1 : 1;
-        for (int n = 1; n < BEAM_STEPS; n++) {
-            int k = ((imax + dir * n) % BEAM_STEPS + BEAM_STEPS) % BEAM_STEPS;
-            int kp = ((imax + dir * (n - 1)) % BEAM_STEPS + BEAM_STEPS) % BEAM_STEPS;
-            if (v[k] < half) {
-                double t = (v[kp] - half) / (double)(v[kp] - v[k]);
-                edge[side] = (n - 1 + t) * step;
-                found[side] = true;
-                break;
-            }
-        }
-    }
-    free(v);
-    return found[0] && found[1] ? edge[0] + edge[1] : -1;
 }
 
 /* ---- the polar plot ------------------------------------------------------ */
@@ -159,12 +124,12 @@ static void print_angles(const char *what, int n, const float *a)
     printf("%s: %d (%g..%g deg)\n", what, n, a[0], a[n - 1]);
 }
 
-static void print_beam(const char *plane, double beam)
+static void print_spread(const char *what, const char *plane, double angle, int percent)
 {
-    if (beam < 0)
-        printf("beam angle %s: none (never falls to 50%%)\n", plane);
+    if (angle < 0)
+        printf("%s angle %s: none (never falls to %d%%)\n", what, plane, percent);
     else
-        printf("beam angle %s: %.1f deg\n", plane, beam);
+        printf("%s angle %s: %.1f deg\n", what, plane, angle);
 }
 
 int cmd_ies(int argc, char **argv)
@@ -237,8 +202,17 @@ int cmd_ies(int argc, char **argv)
            in.photometric_type == 1 ? "" : " (after conversion to type C)");
     printf("total lumens: %.6g lm (integrated)\n", lx_ies_total_lumens(p));
     printf("peak candela: %.6g cd\n", lx_ies_peak_candela(p));
-    print_beam("C0-C180", beam_angle(p, 0.0f));
-    print_beam("C90-C270", beam_angle(p, 90.0f));
+    const char *planes[2] = {"C0-C180", "C90-C270"};
+    for (int k = 0; k < 2; k++) {
+        double beam, field;
+        if (lx_ies_beam_field(p, k ? 90.0f : 0.0f, &beam, &field) != LX_OK) {
+            cli_error("%s", lx_last_error());
+            lx_ies_free(p);
+            return EXIT_FAILED;
+        }
+        print_spread("beam", planes[k], beam, 50);
+        print_spread("field", planes[k], field, 10);
+    }
     int rc = EXIT_OK;
     if (plot_path) {
         /* one file, written under a temporary name and renamed */
