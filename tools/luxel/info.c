@@ -56,7 +56,7 @@ static void print_light(const lx_light *l)
     }
     printf("  shadow %s", lx_shadow_mode_name(l->shadow));
     if (l->shadow == LX_SHADOW_SOFT)
-        printf(" (%u samples)", l->samples ? l->samples : 16u);
+        printf(" (%u samples)", lx_light_sample_count(l));
     printf("%s\n", l->dynamic ? "  dynamic" : "");
 }
 
