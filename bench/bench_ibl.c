@@ -98,7 +98,7 @@ typedef struct sh_job {
 static void run_sh(void *p)
 {
     sh_job *j = p;
-    if (lx_sh_project(j->env, &j->sh) != LX_OK)
+    if (lx_sh_project(j->env, NULL, &j->sh) != LX_OK)
         lx_bench_die("lx_sh_project");
 }
 

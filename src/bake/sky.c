@@ -31,11 +31,6 @@
  * well inside a float. */
 #define LX_SKY_MAX_RADIANCE 1e36
 
-static float luminance(const float *rgb)
-{
-    return 0.2126f * rgb[0] + 0.7152f * rgb[1] + 0.0722f * rgb[2];
-}
-
 /* Splits the lookup into base (kept in b->sky_lookup) and peak
  * (b->sky_peak), and builds the peak's sampling table. */
 static lx_status split_peak(lx_baker *b)
@@ -46,7 +41,7 @@ static lx_status split_peak(lx_baker *b)
     double sum = 0.0;
     for (size_t i = 0; i < texels; i++) {
         int y = (int)(i / (size_t)n % (size_t)n), x = (int)(i % (size_t)n);
-        sum += luminance(base->data + 3 * i) * lx_cube_texel_solid_angle(n, x, y);
+        sum += lx_luminance(base->data + 3 * i) * lx_cube_texel_solid_angle(n, x, y);
     }
     double threshold = LX_SKY_PEAK_RATIO * sum / (4.0 * LX_PI);
     double *cdf = malloc(sizeof(double) * (texels + 1));
@@ -60,7 +55,7 @@ static lx_status split_peak(lx_baker *b)
     for (size_t i = 0; i < texels; i++) {
         int y = (int)(i / (size_t)n % (size_t)n), x = (int)(i % (size_t)n);
         float *t = base->data + 3 * i;
-        float lum = luminance(t);
+        double lum = lx_luminance(t);
         double share = 0.0;
         if (lum > threshold) {
             /* the part above the threshold, in the texel's colour */
@@ -69,7 +64,7 @@ static lx_status split_peak(lx_baker *b)
                 peak[3 * i + k] = t[k] * f;
                 t[k] -= peak[3 * i + k];
             }
-            share = luminance(peak + 3 * i) * lx_cube_texel_solid_angle(n, x, y);
+            share = lx_luminance(peak + 3 * i) * lx_cube_texel_solid_angle(n, x, y);
         }
         cdf[i + 1] = cdf[i] + share;
     }
@@ -113,7 +108,9 @@ lx_status lx_sky_prepare(lx_baker *b, const lx_sky_desc *sky)
         return lx_fail(LX_ERR_INVALID, "sky: samples %u is above %u", sky->samples,
                        LX_MAX_SKY_SAMPLES);
     float scale = sky->intensity > 0.0f ? sky->intensity : 1.0f;
-    lx_status st = lx_sh_project(env, &b->sky_sh);
+    /* the baker's threads bound the sky's filters too */
+    lx_ibl_desc run = {.threads = b->desc.threads};
+    lx_status st = lx_sh_project(env, &run, &b->sky_sh);
     if (st != LX_OK) {
         lx_error_prefix("sky");
         return st;
@@ -152,23 +149,14 @@ lx_status lx_sky_prepare(lx_baker *b, const lx_sky_desc *sky)
                    (double)lowest);
         return LX_OK;
     }
-    /* the lookup for escaping rays: box-filtered, scaled */
-    lx_cubemap level = {0};
-    const lx_cubemap *from = env;
-    while (from->size > LX_SKY_LOOKUP_SIZE) {
-        lx_cubemap half;
-        st = lx_cubemap_downsample(from, &half);
-        lx_cubemap_free(&level);
-        if (st != LX_OK)
-            return st;
-        level = half;
-        from = &level;
-    }
-    if (from == env) {
-        if ((st = lx_cubemap_alloc(&level, env->size)) != LX_OK)
-            return st;
-        memcpy(level.data, env->data, (size_t)env->size * env->size * 18 * sizeof(float));
-    }
+    /* the lookup for escaping rays: box-filtered to the size halving
+     * reaches below LX_SKY_LOOKUP_SIZE (in one pass), scaled */
+    int size = env->size;
+    while (size > LX_SKY_LOOKUP_SIZE)
+        size = size / 2 > 0 ? size / 2 : 1;
+    lx_cubemap level;
+    if ((st = lx_cubemap_downsample(env, size, &run, &level)) != LX_OK)
+        return st;
     size_t n = (size_t)level.size * level.size * 18;
     for (size_t i = 0; i < n; i++)
         level.data[i] *= scale;
@@ -199,12 +187,8 @@ static void texel_of(int n, size_t i, int *face, int *x, int *y)
  * filtered, and the base must match the texels the peak was cut from). */
 static size_t texel_index(int n, lx_vec3 d)
 {
-    int face;
-    float s, t;
-    lx_cube_face_coords(d, &face, &s, &t);
-    int x = (int)(s * (float)n), y = (int)(t * (float)n);
-    x = x < 0 ? 0 : x >= n ? n - 1 : x;
-    y = y < 0 ? 0 : y >= n ? n - 1 : y;
+    int face, x, y;
+    lx_cube_texel_at(d, n, &face, &x, &y);
     return ((size_t)face * (size_t)n + (size_t)y) * (size_t)n + (size_t)x;
 }
 
@@ -305,7 +289,7 @@ static lx_vec3 sky_visible(const lx_baker *b, uint32_t map_index, const lx_light
         if (!(cos_n > 0.0f) || !(lx_dot(d, ng) > 0.0f))
             continue;
         const float *l = b->sky_peak + 3 * i;
-        float chroma = cos_n / luminance(l);
+        float chroma = (float)(cos_n / lx_luminance(l));
         lx_light_eval e = {.to_light = d, .distance = INFINITY};
         rays[m] = lx_shadow_ray(b, p, ng, &e);
         w[m++] = lx_v3(l[0] * chroma, l[1] * chroma, l[2] * chroma);

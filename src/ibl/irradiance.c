@@ -19,6 +19,7 @@
 #include "core/internal.h"
 
 #include <math.h>
+#include <stdio.h>
 #include <stdlib.h>
 #include <string.h>
 
@@ -44,31 +45,6 @@ static lx_vec3 unit_corner(int face, int n, double x, double y)
         lx_ibl_face_vector(face, (float)(2.0 * x / n - 1.0), (float)(2.0 * y / n - 1.0)));
 }
 
-/* ibl.h's face table in double. */
-static void face_vector_d(int face, double sc, double tc, double a[3])
-{
-    switch (face) {
-    case LX_FACE_PX:
-        a[0] = 1, a[1] = -tc, a[2] = -sc;
-        break;
-    case LX_FACE_NX:
-        a[0] = -1, a[1] = -tc, a[2] = sc;
-        break;
-    case LX_FACE_PY:
-        a[0] = sc, a[1] = 1, a[2] = tc;
-        break;
-    case LX_FACE_NY:
-        a[0] = sc, a[1] = -1, a[2] = -tc;
-        break;
-    case LX_FACE_PZ:
-        a[0] = sc, a[1] = -tc, a[2] = 1;
-        break;
-    default:
-        a[0] = -sc, a[1] = -tc, a[2] = -1;
-        break;
-    }
-}
-
 /* Phi of face texel (x, y): Lambert's formula over its four edges. */
 static void irradiance_vector(int face, int n, int x, int y, lx_vec3 centre, double phi[3])
 {
@@ -78,7 +54,7 @@ static void irradiance_vector(int face, int n, int x, int y, lx_vec3 centre, dou
         /* corner directions in double: the edges of small texels are short */
         double sc = 2.0 * (x + cx[k]) / n - 1.0, tc = 2.0 * (y + cy[k]) / n - 1.0;
         double a[3];
-        face_vector_d(face, sc, tc, a);
+        lx_ibl_face_vector_d(face, sc, tc, a);
         double len = sqrt(a[0] * a[0] + a[1] * a[1] + a[2] * a[2]);
         for (int c = 0; c < 3; c++)
             v[k][c] = a[c] / len;
@@ -184,12 +160,26 @@ static void irradiance_at(const lights *l, lx_vec3 nrm, float out[3])
         out[k] = (float)e[k];
 }
 
-lx_ibl_desc lx_ibl_desc_defaults(const lx_ibl_desc *desc)
+typedef struct irr_job {
+    const lights *l;
+    lx_cubemap *out;
+    int tiles_side;
+} irr_job;
+
+static bool irr_tile(void *ctx, int tile)
 {
-    lx_ibl_desc d = {0};
-    if (desc)
-        d = *desc;
-    return d;
+    const irr_job *j = ctx;
+    int size = j->out->size, ts = j->tiles_side;
+    int face = tile / (ts * ts), rest = tile % (ts * ts);
+    int x0 = (rest % ts) * LX_IBL_TILE, y0 = (rest / ts) * LX_IBL_TILE;
+    int x1 = x0 + LX_IBL_TILE < size ? x0 + LX_IBL_TILE : size;
+    int y1 = y0 + LX_IBL_TILE < size ? y0 + LX_IBL_TILE : size;
+    for (int y = y0; y < y1; y++)
+        for (int x = x0; x < x1; x++) {
+            lx_vec3 nrm = lx_cube_direction(face, (x + 0.5f) / size, (y + 0.5f) / size);
+            irradiance_at(j->l, nrm, lx_cubemap_texel(j->out, face, x, y));
+        }
+    return true;
 }
 
 lx_status lx_irradiance_brute(const lx_cubemap *src, int size, int source_size,
@@ -212,20 +202,27 @@ lx_status lx_irradiance_brute(const lx_cubemap *src, int size, int source_size,
         return st;
     if ((st = lx_ibl_check_cubemap(src, "irradiance: source cube map", true)) != LX_OK)
         return st;
-    int threads = lx_thread_count(desc.threads);
+    lx_ibl_run run = lx_ibl_run_make(desc.threads, desc.progress, desc.progress_user);
 
-    /* the source, halved until it fits source_size */
-    lx_cubemap small = *src, tmp;
+    /* the source, halved until it fits source_size, in one pass; then the
+     * lights (10 floats a texel, 4 per sub-texel) and the output */
+    int n = lx_ibl_halved_size(src->size, source_size);
+    int k = n >= 128 ? 1 : 128 / n;
+    k = k > 32 ? 32 : k;
+    uint64_t need = (n < src->size ? lx_ibl_cube_bytes(n) : 0) +
+                    (uint64_t)6 * n * n * (40 + 16 * (uint64_t)k * k) +
+                    8ull * (uint64_t)(n * k + 1) * (n * k + 1) / 4 + lx_ibl_cube_bytes(size);
+    char what[160];
+    snprintf(what, sizeof what, "irradiance of a %d x %d cube map from a %d x %d source", size,
+             size, n, n);
+    if ((st = lx_check_memory(need, what)) != LX_OK)
+        return st;
+    lx_cubemap small = *src;
     bool owned = false;
-    while (small.size > source_size) {
-        if ((st = lx_ibl_downsample(&small, &tmp, threads)) != LX_OK) {
-            if (owned)
-                lx_cubemap_free(&small);
+    if (n < src->size) {
+        lx_ibl_run part = lx_ibl_run_part(&run, 0.0, 0.1);
+        if ((st = lx_ibl_downsample(src, n, &part, &small)) != LX_OK)
             return st;
-        }
-        if (owned)
-            lx_cubemap_free(&small);
-        small = tmp;
         owned = true;
     }
     lights l;
@@ -238,31 +235,12 @@ lx_status lx_irradiance_brute(const lx_cubemap *src, int size, int source_size,
         lights_free(&l);
         return st;
     }
-
     int tiles_side = (size + LX_IBL_TILE - 1) / LX_IBL_TILE;
-    int tiles = 6 * tiles_side * tiles_side;
-    lx_ibl_progress prog;
-    lx_ibl_progress_init(&prog, desc.progress, desc.progress_user, (double)6 * size * size, 0.0f,
-                         1.0f);
-#pragma omp parallel for schedule(dynamic, 1) num_threads(threads)
-    for (int tile = 0; tile < tiles; tile++) {
-        if (prog.cancelled)
-            continue;
-        int face = tile / (tiles_side * tiles_side), rest = tile % (tiles_side * tiles_side);
-        int x0 = (rest % tiles_side) * LX_IBL_TILE, y0 = (rest / tiles_side) * LX_IBL_TILE;
-        int x1 = x0 + LX_IBL_TILE < size ? x0 + LX_IBL_TILE : size;
-        int y1 = y0 + LX_IBL_TILE < size ? y0 + LX_IBL_TILE : size;
-        for (int y = y0; y < y1; y++)
-            for (int x = x0; x < x1; x++) {
-                lx_vec3 nrm = lx_cube_direction(face, (x + 0.5f) / size, (y + 0.5f) / size);
-                irradiance_at(&l, nrm, lx_cubemap_texel(out, face, x, y));
-            }
-        lx_ibl_progress_add(&prog, (double)(x1 - x0) * (y1 - y0));
-    }
+    irr_job job = {&l, out, tiles_side};
+    lx_ibl_run part = lx_ibl_run_part(&run, owned ? 0.1 : 0.0, 1.0);
+    st = lx_ibl_for(&part, 6 * tiles_side * tiles_side, NULL, irr_tile, &job, "irradiance");
     lights_free(&l);
-    if (!lx_ibl_progress_end(&prog)) {
+    if (st != LX_OK)
         lx_cubemap_free(out);
-        return lx_fail(LX_ERR_CANCELLED, "irradiance cancelled");
-    }
-    return LX_OK;
+    return st;
 }

@@ -57,7 +57,7 @@ struct lx_ggx_plan {
     ggx_sample *s;
 };
 
-lx_status lx_ggx_plan_build(const lx_ibl_chain *chain, float roughness, int samples,
+lx_status lx_ggx_plan_build(const int *chain_sizes, int chain_count, float roughness, int samples,
                             lx_ggx_plan **out)
 {
     *out = NULL;
@@ -70,9 +70,9 @@ lx_status lx_ggx_plan_build(const lx_ibl_chain *chain, float roughness, int samp
     }
     p->s = s;
     double a = (double)roughness * roughness, a2 = a * a;
-    int size0 = chain->level[0].size;
+    int size0 = chain_sizes[0];
     double omega_p = 4.0 * 3.14159265358979323846 / (6.0 * size0 * size0);
-    int top = chain->count - 1;
+    int top = chain_count - 1;
     for (int i = 0; i < samples; i++) {
         float u, v;
         lx_ibl_hammersley((uint32_t)i, (uint32_t)samples, &u, &v);
@@ -169,9 +169,8 @@ void lx_ggx_tile(const lx_ggx_plan *p, const lx_ibl_padded *pads, lx_cubemap *ou
 /* Far field: a node of texels at least this many times its radius away is
  * one light. */
 #define GGX_FAR 4.0
-/* Nodes and lights a convolution tests in the time of one importance
- * sample (measured 7-10 on bench_ibl's levels: ~3.5 ns against ~25 ns). */
-#define GGX_CONV_PER_SAMPLE 7.0
+/* Lights a convolution sums in the time of one importance sample. */
+#define GGX_CONV_PER_SAMPLE 15.0
 
 /* The lobe D(h) (n.l) / D(n) at angle theta between n = r and l. */
 static double ggx_falloff(double a2, double theta)
@@ -204,17 +203,18 @@ lx_lobe lx_ggx_lobe(float roughness)
     return l;
 }
 
-lx_status lx_ggx_level_build(const lx_ibl_chain *chain, float roughness, int samples, int out_size,
-                             lx_conv_plan **conv, lx_ggx_plan **is, double *cost)
+lx_status lx_ggx_level_plan(const int *chain_sizes, int chain_count, float roughness, int samples,
+                            int out_size, lx_conv_plan **conv, lx_ggx_plan **is, double *cost)
 {
     *conv = NULL, *is = NULL;
     lx_lobe lobe = lx_ggx_lobe(roughness);
-    lx_status st = lx_conv_plan_build(chain, &lobe, out_size, GGX_CONV_PER_SAMPLE * samples, conv);
+    lx_status st = lx_conv_plan_create(chain_sizes, chain_count, &lobe, out_size,
+                                       GGX_CONV_PER_SAMPLE * samples, conv);
     if (st != LX_OK || *conv) {
         *cost = *conv ? lx_conv_plan_cost(*conv) / GGX_CONV_PER_SAMPLE : 0.0;
         return st;
     }
-    st = lx_ggx_plan_build(chain, roughness, samples, is);
+    st = lx_ggx_plan_build(chain_sizes, chain_count, roughness, samples, is);
     *cost = st == LX_OK ? lx_ggx_plan_cost(*is) : 0.0;
     return st;
 }

@@ -61,7 +61,7 @@ static void matches_uniform_quadrature(void **state)
     (void)state;
     const int size = 8;
     lx_image lut;
-    assert_int_equal(lx_dfg_lut(size, 4096, &lut), LX_OK);
+    assert_int_equal(lx_dfg_lut(size, 4096, NULL, &lut), LX_OK);
     assert_int_equal(lut.width, size);
     assert_int_equal(lut.height, size);
     assert_int_equal(lut.channels, 2);
@@ -85,7 +85,7 @@ static void smooth_limit_and_energy(void **state)
     (void)state;
     const int size = 64;
     lx_image lut;
-    assert_int_equal(lx_dfg_lut(size, 512, &lut), LX_OK);
+    assert_int_equal(lx_dfg_lut(size, 512, NULL, &lut), LX_OK);
     /* row 0: roughness 1/128, alpha 6e-5: a mirror */
     for (int x = 8; x < size; x += 8) {
         double nov = (x + 0.5) / size, f = pow(1.0 - nov, 5.0);
@@ -102,7 +102,7 @@ static void smooth_limit_and_energy(void **state)
      * weights G (V.H) / ((N.H)(N.V)) vary most: 2048 samples keep it under
      * 1e-3 there) */
     const int n = 32;
-    assert_int_equal(lx_dfg_lut(n, 2048, &lut), LX_OK);
+    assert_int_equal(lx_dfg_lut(n, 2048, NULL, &lut), LX_OK);
     for (int i = 0; i < n * n; i++) {
         float a = lut.data[2 * i], b = lut.data[2 * i + 1];
         assert_true(a >= 0.0f && b >= 0.0f);
@@ -127,16 +127,16 @@ static void defaults_and_bad_input(void **state)
 {
     (void)state;
     lx_image lut;
-    assert_int_equal(lx_dfg_lut(0, 16, &lut), LX_OK);
+    assert_int_equal(lx_dfg_lut(0, 16, NULL, &lut), LX_OK);
     assert_int_equal(lut.width, 128);
     lx_image_free(&lut);
-    assert_int_equal(lx_dfg_lut(-1, 0, &lut), LX_ERR_INVALID);
+    assert_int_equal(lx_dfg_lut(-1, 0, NULL, &lut), LX_ERR_INVALID);
     assert_non_null(strstr(lx_last_error(), "size -1"));
     assert_null(lut.data);
-    assert_int_equal(lx_dfg_lut(5000, 0, &lut), LX_ERR_INVALID);
-    assert_int_equal(lx_dfg_lut(16, -4, &lut), LX_ERR_INVALID);
+    assert_int_equal(lx_dfg_lut(5000, 0, NULL, &lut), LX_ERR_INVALID);
+    assert_int_equal(lx_dfg_lut(16, -4, NULL, &lut), LX_ERR_INVALID);
     assert_non_null(strstr(lx_last_error(), "-4 samples"));
-    assert_int_equal(lx_dfg_lut(16, 0, NULL), LX_ERR_INVALID);
+    assert_int_equal(lx_dfg_lut(16, 0, NULL, NULL), LX_ERR_INVALID);
 }
 
 int main(void)

@@ -123,7 +123,7 @@ static void downsample_keeps_flux(void **state)
     for (size_t i = 0; i < (size_t)6 * 16 * 16 * 3; i++)
         env.data[i] = (float)((i * 2654435761u) % 1000) / 100.0f;
     lx_cubemap half;
-    assert_int_equal(lx_cubemap_downsample(&env, &half), LX_OK);
+    assert_int_equal(lx_cubemap_downsample(&env, 0, NULL, &half), LX_OK);
     assert_int_equal(half.size, 8);
     double flux[2] = {0, 0};
     const lx_cubemap *maps[2] = {&env, &half};
@@ -140,7 +140,7 @@ static void downsample_keeps_flux(void **state)
 
     /* odd sizes keep a constant constant */
     lx_cubemap odd = constant_env(5, 2.0f, 2.0f, 2.0f);
-    assert_int_equal(lx_cubemap_downsample(&odd, &half), LX_OK);
+    assert_int_equal(lx_cubemap_downsample(&odd, 0, NULL, &half), LX_OK);
     assert_int_equal(half.size, 2);
     for (int i = 0; i < 6 * 2 * 2 * 3; i++)
         assert_float_equal(half.data[i], 2.0f, 1e-6f);
@@ -228,7 +228,7 @@ static void bad_input(void **state)
     assert_int_equal(lx_irradiance_brute(&env, 8, 0, NULL, &out), LX_ERR_INVALID);
     assert_non_null(strstr(lx_last_error(), "1 of 288 values are NaN or infinite"));
     assert_null(out.data);
-    assert_int_equal(lx_cubemap_downsample(&env, &out), LX_ERR_INVALID);
+    assert_int_equal(lx_cubemap_downsample(&env, 0, NULL, &out), LX_ERR_INVALID);
     assert_null(out.data);
     lx_cubemap_free(&env);
 }

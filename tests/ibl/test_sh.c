@@ -52,7 +52,7 @@ static void constant_environment_gives_pi_l(void **state)
     (void)state;
     lx_cubemap env = lx_test_make_env(16, env_constant);
     lx_sh9 sh;
-    assert_int_equal(lx_sh_project(&env, &sh), LX_OK);
+    assert_int_equal(lx_sh_project(&env, NULL, &sh), LX_OK);
     const double L[3] = {0.5, 1.0, 2.0};
     for (int i = 0; i < 200; i++) {
         float e[3];
@@ -61,7 +61,7 @@ static void constant_environment_gives_pi_l(void **state)
             assert_true(fabs(e[c] / (PI_D * L[c]) - 1.0) < 1e-4);
     }
     lx_cubemap irr;
-    assert_int_equal(lx_sh_irradiance_cube(&sh, 8, &irr), LX_OK);
+    assert_int_equal(lx_sh_irradiance_cube(&sh, 8, NULL, &irr), LX_OK);
     assert_int_equal(irr.size, 8);
     for (size_t i = 0; i < 6 * 8 * 8 * 3; i++)
         assert_true(fabs(irr.data[i] / (PI_D * L[i % 3]) - 1.0) < 1e-4);
@@ -90,7 +90,7 @@ static void polynomial_environment_coefficients(void **state)
 
     lx_cubemap env = lx_test_make_env(64, env_poly);
     lx_sh9 sh;
-    assert_int_equal(lx_sh_project(&env, &sh), LX_OK);
+    assert_int_equal(lx_sh_project(&env, NULL, &sh), LX_OK);
     for (int k = 0; k < 9; k++)
         for (int c = 0; c < 3; c++) {
             double err = fabs(sh.c[k][c] - want[k][c]);
@@ -109,7 +109,7 @@ static void band_limited_irradiance_closed_form(void **state)
     (void)state;
     lx_cubemap env = lx_test_make_env(64, env_poly);
     lx_sh9 sh;
-    assert_int_equal(lx_sh_project(&env, &sh), LX_OK);
+    assert_int_equal(lx_sh_project(&env, NULL, &sh), LX_OK);
     for (int i = 0; i < 300; i++) {
         lx_vec3 n = spiral(i, 300);
         double want[3] = {PI_D + 2.0 * PI_D / 3.0 * n.y,
@@ -174,7 +174,7 @@ static void reconstruction_matches_brute_force(void **state)
     (void)state;
     lx_cubemap env = lx_test_make_env(32, env_smooth), brute;
     lx_sh9 sh;
-    assert_int_equal(lx_sh_project(&env, &sh), LX_OK);
+    assert_int_equal(lx_sh_project(&env, NULL, &sh), LX_OK);
     assert_int_equal(lx_irradiance_brute(&env, 8, 32, NULL, &brute), LX_OK);
     double sum = 0.0, worst = 0.0;
     int count = 0;
@@ -231,7 +231,7 @@ static void ringing_is_kept_and_reported(void **state)
         t[0] = t[1] = t[2] = 1e4f;
     }
     lx_sh9 sh;
-    assert_int_equal(lx_sh_project(&env, &sh), LX_OK);
+    assert_int_equal(lx_sh_project(&env, NULL, &sh), LX_OK);
     for (int i = 0; i < 100; i++) {
         lx_vec3 nrm = spiral(i, 100);
         double want = 0.0;
@@ -253,7 +253,7 @@ static void ringing_is_kept_and_reported(void **state)
     g_log[0] = '\0';
     lx_set_log_callback(keep_log, NULL);
     lx_cubemap irr;
-    assert_int_equal(lx_sh_irradiance_cube(&sh, 8, &irr), LX_OK);
+    assert_int_equal(lx_sh_irradiance_cube(&sh, 8, NULL, &irr), LX_OK);
     lx_set_log_callback(NULL, NULL);
     assert_non_null(strstr(g_log, "negative"));
     float lowest = 0.0f;
@@ -270,25 +270,25 @@ static void bad_input(void **state)
     lx_cubemap env;
     assert_int_equal(lx_cubemap_alloc(&env, 4), LX_OK);
     lx_sh9 sh;
-    assert_int_equal(lx_sh_project(&env, NULL), LX_ERR_INVALID);
-    assert_int_equal(lx_sh_project(NULL, &sh), LX_ERR_INVALID);
+    assert_int_equal(lx_sh_project(&env, NULL, NULL), LX_ERR_INVALID);
+    assert_int_equal(lx_sh_project(NULL, NULL, &sh), LX_ERR_INVALID);
     lx_cubemap_texel(&env, 2, 1, 1)[1] = NAN;
     lx_cubemap_texel(&env, 4, 0, 3)[0] = INFINITY;
-    assert_int_equal(lx_sh_project(&env, &sh), LX_ERR_INVALID);
+    assert_int_equal(lx_sh_project(&env, NULL, &sh), LX_ERR_INVALID);
     assert_non_null(strstr(lx_last_error(), "2 of 288 values are NaN or infinite"));
     for (int k = 0; k < 9; k++)
         assert_true(sh.c[k][0] == 0.0f);
     lx_cubemap bad = {0, NULL};
-    assert_int_equal(lx_sh_project(&bad, &sh), LX_ERR_INVALID);
+    assert_int_equal(lx_sh_project(&bad, NULL, &sh), LX_ERR_INVALID);
     assert_non_null(strstr(lx_last_error(), "face size 0"));
 
     memset(&sh, 0, sizeof sh);
     lx_cubemap out;
-    assert_int_equal(lx_sh_irradiance_cube(&sh, 0, &out), LX_ERR_INVALID);
+    assert_int_equal(lx_sh_irradiance_cube(&sh, 0, NULL, &out), LX_ERR_INVALID);
     assert_non_null(strstr(lx_last_error(), "face size 0"));
     assert_null(out.data);
     sh.c[3][2] = NAN;
-    assert_int_equal(lx_sh_irradiance_cube(&sh, 4, &out), LX_ERR_INVALID);
+    assert_int_equal(lx_sh_irradiance_cube(&sh, 4, NULL, &out), LX_ERR_INVALID);
     assert_non_null(strstr(lx_last_error(), "coefficient 3 channel 2"));
     assert_null(out.data);
     lx_cubemap_free(&env);
