@@ -29,14 +29,45 @@
 /* The Hammersley points as Heitz's disk points: (r cos phi, r sin phi,
  * sqrt(1 - t1^2)) per sample. */
 typedef struct dfg_job {
-    int size, samples;
-    const double *t1, *t2, *root;
+    int size, samples, padded;
+    const float *t1, *t2, *root;
     float *out;
 } dfg_job;
 
-static double lambda_ggx(double cos2, double a2)
+/* Four samples at a time (lx_v4f, in float): each lane sums 16 samples,
+ * then the lanes go into double, in a fixed order. */
+#define CHUNK 64
+typedef lx_v4f v4f;
+
+/* The view's constants: V = (vx, 0, vz), its stretched direction
+ * (hx, 0, hz) (alpha = 1: T1 = +y, T2 = (-hz, 0, hx)), Heitz's s, and
+ * 1 + Lambda(v) and 1/2 + Lambda(v). */
+typedef struct dfg_view {
+    float a, a2, vx, vz, hx, hz, s, g1, g0;
+} dfg_view;
+
+/* The weights of samples i..i+3: (1 - Fc) and Fc times G2 / G1(V), the
+ * estimator's f cos / pdf, added to sa, sb. G2 / G1 = (1 + Lv) / (1 + Lv +
+ * Ll) with Ll = (sqrt(lz^2 + a2 (1 - lz^2)) / lz - 1) / 2, written times
+ * lz+ = max(lz, 0): below the horizon (lz <= 0, which V.H <= 0 implies)
+ * the weight is 0 with no test, so the lanes vectorise (|lz| < N.V < 1
+ * keeps 1 - lz^2 > 0 and the denominator positive). */
+static inline void dfg_quad(const dfg_job *j, int i, const dfg_view *v, v4f *sa, v4f *sb)
 {
-    return 0.5 * (sqrt(1.0 + a2 * (1.0 - cos2) / cos2) - 1.0);
+    v4f t1 = lx_v4_load(j->t1 + i);
+    v4f t2 = (1.0f - v->s) * lx_v4_load(j->root + i) + v->s * lx_v4_load(j->t2 + i);
+    v4f nz = lx_v4_sqrt(lx_v4_pos(1.0f - t1 * t1 - t2 * t2));
+    /* the normal in the stretched configuration, back to alpha */
+    v4f mx = v->a * (nz * v->hx - t2 * v->hz), my = v->a * t1;
+    v4f mz = lx_v4_pos(t2 * v->hx + nz * v->hz);
+    v4f inv = 1.0f / lx_v4_sqrt(mx * mx + my * my + mz * mz);
+    v4f vh = (v->vx * mx + v->vz * mz) * inv;
+    v4f lz = 2.0f * vh * mz * inv - v->vz, lp = lx_v4_pos(lz);
+    v4f root = lx_v4_sqrt(lp * lp + v->a2 * (1.0f - lz * lz));
+    v4f w = v->g1 * lp / (v->g0 * lp + 0.5f * root);
+    v4f f1 = 1.0f - vh, f2 = f1 * f1, fc = f2 * f2 * f1;
+    *sa += (1.0f - fc) * w;
+    *sb += fc * w;
 }
 
 static bool dfg_row(void *ctx, int y)
@@ -46,33 +77,31 @@ static bool dfg_row(void *ctx, int y)
     double r = (y + 0.5) / size, a = r * r, a2 = a * a;
     for (int x = 0; x < size; x++) {
         double nov = (x + 0.5) / size;
-        /* V in the x-z plane, N = +z; the view stretched into the
-         * hemisphere configuration (alpha = 1) */
         double vx = sqrt(1.0 - nov * nov), vz = nov;
         double hl = sqrt(a2 * vx * vx + vz * vz);
-        double hx = a * vx / hl, hz = vz / hl; /* T1 = +y, T2 = (-hz, 0, hx) */
-        double s = 0.5 * (1.0 + hz);
-        double lv = lambda_ggx(vz * vz, a2);
-        double sa = 0.0, sb = 0.0;
-        for (int i = 0; i < samples; i++) {
-            double t1 = j->t1[i];
-            double t2 = (1.0 - s) * j->root[i] + s * j->t2[i];
-            double nz = sqrt(fmax(0.0, 1.0 - t1 * t1 - t2 * t2));
-            /* the normal in the stretched configuration, back to alpha */
-            double mx = a * (nz * hx - t2 * hz), my = a * t1, mz = fmax(0.0, t2 * hx + nz * hz);
-            double ml = sqrt(mx * mx + my * my + mz * mz);
-            double vh = (vx * mx + vz * mz) / ml;
-            double lz = 2.0 * vh * mz / ml - vz; /* (L = 2 (V.H) H - V).z */
-            if (!(lz > 0.0) || !(vh > 0.0))
-                continue;
-            double w = (1.0 + lv) / (1.0 + lv + lambda_ggx(lz * lz, a2)); /* G2 / G1(V) */
-            double f1 = 1.0 - vh, f2 = f1 * f1, fc = f2 * f2 * f1;
-            sa += (1.0 - fc) * w;
-            sb += fc * w;
+        double hx = a * vx / hl, hz = vz / hl;
+        double lv = 0.5 * (sqrt(1.0 + a2 * (1.0 - vz * vz) / (vz * vz)) - 1.0);
+        dfg_view v = {(float)a,
+                      (float)a2,
+                      (float)vx,
+                      (float)vz,
+                      (float)hx,
+                      (float)hz,
+                      (float)(0.5 * (1.0 + hz)),
+                      (float)(1.0 + lv),
+                      (float)(0.5 + lv)};
+        double A = 0.0, B = 0.0;
+        for (int c = 0; c < j->padded; c += CHUNK) {
+            int end = c + CHUNK < j->padded ? c + CHUNK : j->padded;
+            v4f sa = {0, 0, 0, 0}, sb = {0, 0, 0, 0};
+            for (int i = c; i < end; i += 4)
+                dfg_quad(j, i, &v, &sa, &sb);
+            A += ((double)sa[0] + sa[1]) + ((double)sa[2] + sa[3]);
+            B += ((double)sb[0] + sb[1]) + ((double)sb[2] + sb[3]);
         }
         float *o = j->out + 2 * ((size_t)y * size + x);
-        o[0] = (float)(sa / samples);
-        o[1] = (float)(sb / samples);
+        o[0] = (float)(A / samples);
+        o[1] = (float)(B / samples);
     }
     return true;
 }
@@ -95,19 +124,27 @@ lx_status lx_dfg_lut(int size, int samples, const lx_ibl_desc *in, lx_image *out
         return st;
     if ((st = lx_image_alloc(out, size, size, 2)) != LX_OK)
         return st;
-    double *pts = malloc(sizeof(double) * 3 * (size_t)samples);
+    /* padded with points of no weight: t1 = 0 and t2 = root = 1 give
+     * V.H = 0, a mirror on the horizon */
+    int padded = (samples + 3) / 4 * 4;
+    float *pts = malloc(sizeof(float) * 3 * (size_t)padded);
     if (!pts) {
         lx_image_free(out);
         return lx_fail(LX_ERR_NOMEM, "DFG table: out of memory");
     }
-    dfg_job job = {size, samples, pts, pts + samples, pts + 2 * (size_t)samples, out->data};
-    for (int i = 0; i < samples; i++) {
-        float u, v;
-        lx_ibl_hammersley((uint32_t)i, (uint32_t)samples, &u, &v);
-        double r = sqrt((double)u), phi = 2.0 * 3.14159265358979323846 * v;
-        pts[i] = r * cos(phi);
-        pts[samples + i] = r * sin(phi);
-        pts[2 * (size_t)samples + i] = sqrt(fmax(0.0, 1.0 - pts[i] * pts[i]));
+    dfg_job job = {size, samples, padded, pts, pts + padded, pts + 2 * (size_t)padded, out->data};
+    for (int i = 0; i < padded; i++) {
+        double t1 = 0.0, t2 = 1.0, root = 1.0;
+        if (i < samples) {
+            float u, v;
+            lx_ibl_hammersley((uint32_t)i, (uint32_t)samples, &u, &v);
+            double r = sqrt((double)u), phi = 2.0 * 3.14159265358979323846 * v;
+            t1 = r * cos(phi), t2 = r * sin(phi);
+            double q = 1.0 - t1 * t1;
+            root = sqrt(q > 0.0 ? q : 0.0);
+        }
+        pts[i] = (float)t1, pts[padded + i] = (float)t2;
+        pts[2 * (size_t)padded + i] = (float)root;
     }
     lx_ibl_run run = lx_ibl_run_make(desc.threads, desc.progress, desc.progress_user);
     st = lx_ibl_for(&run, size, NULL, dfg_row, &job, "DFG table");

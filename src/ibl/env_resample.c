@@ -34,15 +34,18 @@ static int grid_for(double ratio)
     return n < 2.0 ? 2 : n > MAX_GRID ? MAX_GRID : (int)n;
 }
 
-/* atan2(y, x) in [-pi, pi]: the octant reduced to z = min / max in [0, 1]
- * and atan(z) = z p(z^2), p of degree 7 interpolating atan(sqrt(w)) /
- * sqrt(w) at the Chebyshev nodes of [0, 1] (largest error 1.4e-7). */
-static inline float fast_atan2(float y, float x)
+/* atan2(y, x) in [-pi, pi] of four lanes: the octant reduced to
+ * z = min / max in [0, 1] and atan(z) = z p(z^2), p of degree 7
+ * interpolating atan(sqrt(w)) / sqrt(w) at the Chebyshev nodes of [0, 1]
+ * (largest error 1.4e-7). */
+static inline lx_v4f v4_atan2(lx_v4f y, lx_v4f x)
 {
-    float ax = fabsf(x), ay = fabsf(y);
-    float mx = ax > ay ? ax : ay, mn = ax > ay ? ay : ax;
-    float z = mx > 0.0f ? mn / mx : 0.0f, w = z * z;
-    float p = -4.559791986e-03f;
+    lx_v4f ax = lx_v4_abs(x), ay = lx_v4_abs(y);
+    lx_v4i steep = ay > ax;
+    lx_v4f mx = lx_v4_select(steep, ay, ax), mn = lx_v4_select(steep, ax, ay);
+    lx_v4f one = {1.0f, 1.0f, 1.0f, 1.0f};
+    lx_v4f z = mn / lx_v4_select(mx == 0.0f, one, mx), w = z * z; /* 0 / 1 at the origin */
+    lx_v4f p = -4.559791986e-03f * one;
     p = p * w + 2.378051860e-02f;
     p = p * w - 5.882975314e-02f;
     p = p * w + 9.868865458e-02f;
@@ -50,12 +53,10 @@ static inline float fast_atan2(float y, float x)
     p = p * w + 1.996696183e-01f;
     p = p * w - 3.333181266e-01f;
     p = p * w + 9.999998820e-01f;
-    float a = p * z;
-    if (ay > ax)
-        a = 0.5f * PI_F - a;
-    if (x < 0.0f)
-        a = PI_F - a;
-    return y < 0.0f ? -a : a;
+    lx_v4f a = p * z;
+    a = lx_v4_select(steep, 0.5f * PI_F - a, a);
+    a = lx_v4_select(x < 0.0f, PI_F - a, a);
+    return lx_v4_select(y < 0.0f, -a, a);
 }
 
 /* An image's pixel as RGB: grey images give grey, alpha is ignored. */
@@ -69,20 +70,41 @@ static inline void pixel_rgb(const lx_image *img, int x, int y, float out[3])
     }
 }
 
-/* Bilinear sample of an equirect: u wraps around, v stops at the poles. */
-static inline void equirect_sample(const lx_image *img, float u, float v, float out[3])
+/* The bilinear taps of an equirect at four (u, v) in [0, 1) x [0, 1]:
+ * columns x0, x1 (u wraps around), rows y0, y1 (v stops at the poles) and
+ * the weights toward x1 and y1. */
+static inline void v4_taps(const lx_image *img, lx_v4f u, lx_v4f v, int *x0, int *x1, int *y0,
+                           int *y1, float *wx, float *wy)
 {
     int w = img->width, h = img->height;
-    float fx = u * (float)w - 0.5f, fy = v * (float)h - 0.5f;
-    float x0f = floorf(fx), y0f = floorf(fy);
-    float wx = fx - x0f, wy = fy - y0f;
-    int x0 = (int)x0f % w;
-    if (x0 < 0)
-        x0 += w;
-    int x1 = x0 + 1 == w ? 0 : x0 + 1;
-    int y0 = (int)y0f, y1 = y0 + 1;
-    y0 = y0 < 0 ? 0 : y0 >= h ? h - 1 : y0;
-    y1 = y1 < 0 ? 0 : y1 >= h ? h - 1 : y1;
+    lx_v4f fx = u * (float)w - 0.5f, fy = v * (float)h - 0.5f;
+    /* floor: truncated, less one where that rounded up (negative) */
+    lx_v4f tx = __builtin_convertvector(__builtin_convertvector(fx, lx_v4i), lx_v4f);
+    lx_v4f ty = __builtin_convertvector(__builtin_convertvector(fy, lx_v4i), lx_v4f);
+    lx_v4f one = {1.0f, 1.0f, 1.0f, 1.0f}, zero = {0, 0, 0, 0};
+    tx -= lx_v4_select(tx > fx, one, zero);
+    ty -= lx_v4_select(ty > fy, one, zero);
+    lx_v4f ax = fx - tx, ay = fy - ty;
+    lx_v4i ix = __builtin_convertvector(tx, lx_v4i), iy = __builtin_convertvector(ty, lx_v4i);
+    /* fx in [-0.5, w - 0.5): ix in [-1, w - 1] */
+    ix += (ix < 0) & w;
+    ix -= (ix >= w) & w;
+    lx_v4i jx = ix + 1;
+    jx &= ~(jx == w);
+    lx_v4i jy = iy + 1;
+    iy &= ~(iy < 0);
+    jy &= ~(jy < 0);
+    iy -= (iy >= h) & (iy - (h - 1));
+    jy -= (jy >= h) & (jy - (h - 1));
+    memcpy(x0, &ix, sizeof ix), memcpy(x1, &jx, sizeof jx);
+    memcpy(y0, &iy, sizeof iy), memcpy(y1, &jy, sizeof jy);
+    memcpy(wx, &ax, sizeof ax), memcpy(wy, &ay, sizeof ay);
+}
+
+/* The bilinear read at those taps. */
+static inline void equirect_read(const lx_image *img, int x0, int x1, int y0, int y1, float wx,
+                                 float wy, float out[3])
+{
     float a[3], b[3], c[3], d[3];
     pixel_rgb(img, x0, y0, a);
     pixel_rgb(img, x1, y0, b);
@@ -95,14 +117,14 @@ static inline void equirect_sample(const lx_image *img, float u, float v, float 
     }
 }
 
-/* The equirect coordinates of direction v (any length but zero): the
- * inverse of lx_equirect_direction. */
-static inline void equirect_uv(lx_vec3 v, float *u, float *t)
+/* The equirect coordinates (u, t) of four directions (any length but
+ * zero): the inverse of lx_equirect_direction. */
+static inline void v4_equirect_uv(lx_v4f x, lx_v4f y, lx_v4f z, lx_v4f *u, lx_v4f *t)
 {
-    float r = sqrtf(v.x * v.x + v.z * v.z);
-    float uu = fast_atan2(v.x, -v.z) * (0.5f / PI_F) + 0.5f;
-    *u = uu >= 1.0f ? uu - 1.0f : uu;
-    *t = fast_atan2(r, v.y) * (1.0f / PI_F);
+    lx_v4f r = lx_v4_sqrt(x * x + z * z);
+    lx_v4f uu = v4_atan2(x, -z) * (0.5f / PI_F) + 0.5f;
+    *u = lx_v4_select(uu >= 1.0f, uu - 1.0f, uu);
+    *t = v4_atan2(r, y) * (1.0f / PI_F);
 }
 
 /* ---- to a cube map ---------------------------------------------------------- */
@@ -120,7 +142,9 @@ static bool grid_row(void *ctx, int row)
 {
     const grid_job *j = ctx;
     int size = j->out->size, face = row / size, y = row % size;
-    int n = grid_for(j->ratio);
+    const float(*axes)[3] = lx_ibl_face_axes[face];
+    int n = grid_for(j->ratio), offs_n = 0;
+    float offs[MAX_GRID];
     for (int x = 0; x < size; x++) {
         if (j->eq) {
             lx_vec3 c = lx_cube_direction(face, ((float)x + 0.5f) / (float)size,
@@ -128,20 +152,47 @@ static bool grid_row(void *ctx, int row)
             double sin_theta = sqrt(fmax(0.0, 1.0 - (double)c.y * c.y));
             n = grid_for(j->ratio / fmax(sin_theta, 1.0 / MAX_GRID));
         }
+        /* the centres of the n sub-cells of a texel */
+        if (n != offs_n) {
+            for (int i = 0; i < n; i++)
+                offs[i] = ((float)i + 0.5f) / (float)n;
+            offs_n = n;
+        }
         double sum[3] = {0, 0, 0};
         for (int jj = 0; jj < n; jj++) {
-            float t = ((float)y + ((float)jj + 0.5f) / (float)n) / (float)size;
-            for (int i = 0; i < n; i++) {
-                float s = ((float)x + ((float)i + 0.5f) / (float)n) / (float)size;
-                lx_vec3 v = lx_ibl_face_vector(face, 2.0f * s - 1.0f, 2.0f * t - 1.0f);
-                float rgb[3];
-                if (j->eq) {
-                    float u, w;
-                    equirect_uv(v, &u, &w);
-                    equirect_sample(j->eq, u, w, rgb);
-                } else {
-                    lx_ibl_sample(j->cube, v, rgb);
+            float tc = 2.0f * (((float)y + offs[jj]) / (float)size) - 1.0f;
+            /* the face vector major + sc right + tc down, tc fixed */
+            float bx = axes[0][0] + tc * axes[2][0], by = axes[0][1] + tc * axes[2][1];
+            float bz = axes[0][2] + tc * axes[2][2];
+            float sc[MAX_GRID + 3];
+            for (int i = 0; i < n; i++)
+                sc[i] = 2.0f * (((float)x + offs[i]) / (float)size) - 1.0f;
+            if (!j->eq) {
+                for (int i = 0; i < n; i++) {
+                    float rgb[3];
+                    lx_ibl_sample(j->cube,
+                                  lx_v3(bx + sc[i] * axes[1][0], by + sc[i] * axes[1][1],
+                                        bz + sc[i] * axes[1][2]),
+                                  rgb);
+                    sum[0] += rgb[0], sum[1] += rgb[1], sum[2] += rgb[2];
                 }
+                continue;
+            }
+            /* the equirect coordinates and bilinear taps four at a time,
+             * then the reads */
+            int x0[MAX_GRID + 3], x1[MAX_GRID + 3], y0[MAX_GRID + 3], y1[MAX_GRID + 3];
+            float wx[MAX_GRID + 3], wy[MAX_GRID + 3];
+            for (int i = n; i < n + 3; i++)
+                sc[i] = 0.0f;
+            for (int i = 0; i < n; i += 4) {
+                lx_v4f c = lx_v4_load(sc + i), u, w;
+                v4_equirect_uv(bx + c * axes[1][0], by + c * axes[1][1], bz + c * axes[1][2], &u,
+                               &w);
+                v4_taps(j->eq, u, w, x0 + i, x1 + i, y0 + i, y1 + i, wx + i, wy + i);
+            }
+            for (int i = 0; i < n; i++) {
+                float rgb[3];
+                equirect_read(j->eq, x0[i], x1[i], y0[i], y1[i], wx[i], wy[i], rgb);
                 sum[0] += rgb[0], sum[1] += rgb[1], sum[2] += rgb[2];
             }
         }

@@ -13,6 +13,10 @@
 
 #include <math.h>
 #include <stdint.h>
+#include <string.h>
+#if defined(__SSE__)
+#include <xmmintrin.h>
+#endif
 
 /* Face tiles: the unit of parallel work (and of progress) of the filters. */
 #define LX_IBL_TILE 16
@@ -70,6 +74,50 @@ static inline void lx_ibl_face_st(lx_vec3 d, int *face, float *s, float *t)
  * extrapolated direction (*f, *tx, *ty; the texel itself when it is on
  * the face). The tap lx_cubemap_sample takes across an edge. */
 void lx_ibl_texel_across(int size, int face, int x, int y, int *f, int *tx, int *ty);
+
+/* ---- four lanes at a time -------------------------------------------------- */
+
+/* Four floats in one vector (GCC's vector extensions, which clang shares),
+ * for the hot loops the compiler cannot vectorise alone: square roots
+ * (they may set errno) and selects (comparisons may trap). v4_sqrt is
+ * SSE's exact square root where there is SSE, the scalar one elsewhere:
+ * the same values either way. */
+typedef float lx_v4f __attribute__((vector_size(16)));
+typedef int32_t lx_v4i __attribute__((vector_size(16)));
+
+static inline lx_v4f lx_v4_sqrt(lx_v4f x)
+{
+#if defined(__SSE__)
+    return (lx_v4f)_mm_sqrt_ps((__m128)x);
+#else
+    return (lx_v4f){sqrtf(x[0]), sqrtf(x[1]), sqrtf(x[2]), sqrtf(x[3])};
+#endif
+}
+
+/* mask ? a : b per lane, mask all ones or all zeros (a comparison). */
+static inline lx_v4f lx_v4_select(lx_v4i mask, lx_v4f a, lx_v4f b)
+{
+    return (lx_v4f)(((lx_v4i)a & mask) | ((lx_v4i)b & ~mask));
+}
+
+/* |x| and max(x, 0), exactly: bits of the sign cleared, lanes with it set
+ * zeroed. */
+static inline lx_v4f lx_v4_abs(lx_v4f x)
+{
+    return (lx_v4f)((lx_v4i)x & 0x7fffffff);
+}
+
+static inline lx_v4f lx_v4_pos(lx_v4f x)
+{
+    return (lx_v4f)((lx_v4i)x & ~((lx_v4i)x < 0));
+}
+
+static inline lx_v4f lx_v4_load(const float *p)
+{
+    lx_v4f v;
+    memcpy(&v, p, sizeof v);
+    return v;
+}
 
 /* ---- solid angles -------------------------------------------------------- */
 

@@ -25,6 +25,7 @@
 
 typedef struct lights {
     int count, sub;           /* texels, sub-texels per texel (k * k) */
+    int padded;               /* count to a multiple of 4, lights of nothing after it */
     float *cx, *cy, *cz;      /* centre direction */
     float *px, *py, *pz;      /* irradiance vector Phi */
     float *horizon;           /* sin of the texel's angular radius */
@@ -81,10 +82,11 @@ static lx_status lights_build(const lx_cubemap *s, lights *l)
     int n = s->size;
     int k = n >= 128 ? 1 : 128 / n;
     k = k > 32 ? 32 : k;
-    size_t count = (size_t)6 * n * n, sub = (size_t)k * k;
+    size_t count = (size_t)6 * n * n, sub = (size_t)k * k, padded = (count + 3) / 4 * 4;
     l->count = (int)count;
+    l->padded = (int)padded;
     l->sub = (int)sub;
-    l->cx = malloc(sizeof(float) * count * 10);
+    l->cx = calloc(padded * 10, sizeof(float));
     l->sx = malloc(sizeof(float) * count * sub * 4);
     double *omega = lx_ibl_solid_angles(n * k);
     if (!l->cx || !l->sx || !omega) {
@@ -92,10 +94,10 @@ static lx_status lights_build(const lx_cubemap *s, lights *l)
         lights_free(l);
         return lx_fail(LX_ERR_NOMEM, "out of memory for %zu source texels", count);
     }
-    l->cy = l->cx + count, l->cz = l->cy + count;
-    l->px = l->cz + count, l->py = l->px + count, l->pz = l->py + count;
-    l->horizon = l->pz + count;
-    l->r = l->horizon + count, l->g = l->r + count, l->b = l->g + count;
+    l->cy = l->cx + padded, l->cz = l->cy + padded;
+    l->px = l->cz + padded, l->py = l->px + padded, l->pz = l->py + padded;
+    l->horizon = l->pz + padded;
+    l->r = l->horizon + padded, l->g = l->r + padded, l->b = l->g + padded;
     l->sy = l->sx + count * sub, l->sz = l->sy + count * sub, l->sw = l->sz + count * sub;
     for (int face = 0; face < 6; face++)
         for (int y = 0; y < n; y++)
@@ -131,26 +133,46 @@ static lx_status lights_build(const lx_cubemap *s, lights *l)
     return LX_OK;
 }
 
-static void irradiance_at(const lights *l, lx_vec3 nrm, float out[3])
+/* The irradiance at unit normal nrm: the texels wholly above its horizon
+ * four at a time (lx_v4f lanes summed in float over 64 texels, then in
+ * double), and those the horizon cuts (cut: room for every texel's index)
+ * one by one, from their sub-texels. */
+static void irradiance_at(const lights *l, lx_vec3 nrm, int *cut, float out[3])
 {
     double e[3] = {0, 0, 0};
-    for (int t = 0; t < l->count; t++) {
-        float c = nrm.x * l->cx[t] + nrm.y * l->cy[t] + nrm.z * l->cz[t];
-        float h = l->horizon[t];
-        if (c <= -h)
-            continue;
-        double w;
-        if (c >= h) {
-            w = (double)(nrm.x * l->px[t] + nrm.y * l->py[t] + nrm.z * l->pz[t]);
-        } else {
-            w = 0.0;
-            size_t u0 = (size_t)t * l->sub;
-            for (int s = 0; s < l->sub; s++) {
-                size_t u = u0 + s;
-                float cs = nrm.x * l->sx[u] + nrm.y * l->sy[u] + nrm.z * l->sz[u];
-                if (cs > 0.0f)
-                    w += (double)(cs * l->sw[u]);
-            }
+    int ncut = 0;
+    for (int t0 = 0; t0 < l->padded; t0 += 64) {
+        int t1 = t0 + 64 < l->padded ? t0 + 64 : l->padded;
+        lx_v4f sum[3] = {{0, 0, 0, 0}, {0, 0, 0, 0}, {0, 0, 0, 0}};
+        for (int t = t0; t < t1; t += 4) {
+            lx_v4f c = nrm.x * lx_v4_load(l->cx + t) + nrm.y * lx_v4_load(l->cy + t) +
+                       nrm.z * lx_v4_load(l->cz + t);
+            lx_v4f h = lx_v4_load(l->horizon + t);
+            lx_v4i whole = c >= h, part = (c > -h) & ~whole;
+            lx_v4f w = nrm.x * lx_v4_load(l->px + t) + nrm.y * lx_v4_load(l->py + t) +
+                       nrm.z * lx_v4_load(l->pz + t);
+            lx_v4f zero = {0, 0, 0, 0};
+            w = lx_v4_select(whole, w, zero);
+            sum[0] += w * lx_v4_load(l->r + t);
+            sum[1] += w * lx_v4_load(l->g + t);
+            sum[2] += w * lx_v4_load(l->b + t);
+            if (part[0] | part[1] | part[2] | part[3])
+                for (int k = 0; k < 4; k++)
+                    if (part[k])
+                        cut[ncut++] = t + k;
+        }
+        for (int k = 0; k < 3; k++)
+            e[k] += ((double)sum[k][0] + sum[k][1]) + ((double)sum[k][2] + sum[k][3]);
+    }
+    for (int i = 0; i < ncut; i++) {
+        int t = cut[i];
+        double w = 0.0;
+        size_t u0 = (size_t)t * l->sub;
+        for (int s = 0; s < l->sub; s++) {
+            size_t u = u0 + s;
+            float cs = nrm.x * l->sx[u] + nrm.y * l->sy[u] + nrm.z * l->sz[u];
+            if (cs > 0.0f)
+                w += (double)(cs * l->sw[u]);
         }
         e[0] += w * l->r[t];
         e[1] += w * l->g[t];
@@ -169,6 +191,9 @@ typedef struct irr_job {
 static bool irr_tile(void *ctx, int tile)
 {
     const irr_job *j = ctx;
+    int *cut = malloc(sizeof(int) * (size_t)j->l->padded);
+    if (!cut)
+        return false;
     int size = j->out->size, ts = j->tiles_side;
     int face = tile / (ts * ts), rest = tile % (ts * ts);
     int x0 = (rest % ts) * LX_IBL_TILE, y0 = (rest / ts) * LX_IBL_TILE;
@@ -177,8 +202,9 @@ static bool irr_tile(void *ctx, int tile)
     for (int y = y0; y < y1; y++)
         for (int x = x0; x < x1; x++) {
             lx_vec3 nrm = lx_cube_direction(face, (x + 0.5f) / size, (y + 0.5f) / size);
-            irradiance_at(j->l, nrm, lx_cubemap_texel(j->out, face, x, y));
+            irradiance_at(j->l, nrm, cut, lx_cubemap_texel(j->out, face, x, y));
         }
+    free(cut);
     return true;
 }
 

@@ -53,7 +53,7 @@
 #define CONV_TOP 4        /* the top tier has at most this many nodes along a face */
 #define CONV_MAX_TIERS 16 /* 4 x 2^15 > LX_MAX_CUBE_SIZE */
 #define CONV_GROUP 4      /* output texels share a walk in groups of 4x4 */
-#define CONV_LANES 8      /* a texel's sums run in 8 lanes... */
+#define CONV_LANES 8      /* a texel's sums run in 4 lanes... */
 #define CONV_CHUNK 64     /* ...in float over 64 lights, then in double */
 #define PI_D 3.14159265358979323846
 
@@ -361,20 +361,24 @@ static void sum_ggx(const conv_list *l, float a, lx_vec3 r, double out[4])
     double tot[4] = {0, 0, 0, 0};
     for (size_t k0 = 0; k0 < l->count; k0 += CONV_CHUNK) {
         size_t k1 = k0 + CONV_CHUNK < l->count ? k0 + CONV_CHUNK : l->count;
-        float s[4][CONV_LANES] = {{0}};
+        /* two sets of four lanes: r, g, b and the weight */
+        lx_v4f s[2][4] = {{{0}}};
         for (size_t k = k0; k < k1; k += CONV_LANES)
-            for (int j = 0; j < CONV_LANES; j++) {
-                float d = r.x * l->x[k + j] + r.y * l->y[k + j] + r.z * l->z[k + j];
-                float q = 0.5f * (1.0f - d) + 0.5f * (1.0f + d) * a; /* >= a > 0 */
-                float w = 0.5f * (d + fabsf(d)) / (q * q) * l->om[k + j];
-                s[0][j] += w * l->r[k + j];
-                s[1][j] += w * l->g[k + j];
-                s[2][j] += w * l->b[k + j];
-                s[3][j] += w;
+            for (int h = 0; h < 2; h++) {
+                size_t i = k + 4 * (size_t)h;
+                lx_v4f d = r.x * lx_v4_load(l->x + i) + r.y * lx_v4_load(l->y + i) +
+                           r.z * lx_v4_load(l->z + i);
+                lx_v4f q = 0.5f * (1.0f - d) + 0.5f * (1.0f + d) * a; /* >= a > 0 */
+                lx_v4f w = 0.5f * (d + lx_v4_abs(d)) / (q * q) * lx_v4_load(l->om + i);
+                s[h][0] += w * lx_v4_load(l->r + i);
+                s[h][1] += w * lx_v4_load(l->g + i);
+                s[h][2] += w * lx_v4_load(l->b + i);
+                s[h][3] += w;
             }
         for (int c = 0; c < 4; c++)
-            for (int j = 0; j < CONV_LANES; j++)
-                tot[c] += (double)s[c][j];
+            for (int h = 0; h < 2; h++)
+                for (int j = 0; j < 4; j++)
+                    tot[c] += (double)s[h][c][j];
     }
     for (int c = 0; c < 4; c++)
         out[c] = tot[c];

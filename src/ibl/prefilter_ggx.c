@@ -168,7 +168,7 @@ void lx_ggx_tile(const lx_ggx_plan *p, const lx_ibl_padded *pads, lx_cubemap *ou
 #define GGX_TEXELS 3.0
 /* Far field: a node of texels at least this many times its radius away is
  * one light. */
-#define GGX_FAR 4.0
+#define GGX_FAR 3.0
 /* Lights a convolution sums in the time of one importance sample. */
 #define GGX_CONV_PER_SAMPLE 15.0
 
