@@ -348,7 +348,18 @@ lx_status lx_conv_plan_create(const int *chain_sizes, int chain_count, const lx_
                               int out_size, double max_cost, lx_conv_plan **out);
 double lx_conv_plan_cost(const lx_conv_plan *p);
 uint64_t lx_conv_plan_bytes(const lx_conv_plan *p);
-lx_status lx_conv_plan_fill(lx_conv_plan *p, const lx_ibl_chain *chain);
+/* The chain level the plan reads. */
+int lx_conv_plan_level(const lx_conv_plan *p);
+/* The flux vectors of chain level `level` > 0: per texel, the sum of
+ * luminance x solid angle x direction over the level 0 texels under it
+ * (the direction of its light is their centroid); summed from the flux
+ * vectors `finer` of a finer level when not NULL and the sizes nest.
+ * *out is malloc'd, 3 doubles per texel, face-major. */
+lx_status lx_conv_flux(const lx_ibl_chain *chain, int level, const double *finer, int finer_level,
+                       const lx_ibl_run *run, double **out);
+/* Makes the lights from the chain and, when the plan's level is above 0,
+ * that level's flux vectors. */
+lx_status lx_conv_plan_fill(lx_conv_plan *p, const lx_ibl_chain *chain, const double *flux);
 bool lx_conv_tile(const lx_conv_plan *p, lx_cubemap *out, int face, int x0, int y0, int x1, int y1);
 void lx_conv_plan_free(lx_conv_plan *p);
 

@@ -217,12 +217,14 @@ typedef struct job {
     const lx_cubemap *mirror;
     bool mirror_exact;
     int conv_levels[LX_MAX_CUBE_MIPS];
+    double *flux[LX_MAX_CUBE_MIPS + 1]; /* per chain level the convolutions read */
 } job;
 
 static bool fill_item(void *ctx, int i)
 {
     job *j = ctx;
-    return lx_conv_plan_fill(j->p->conv[j->conv_levels[i]], j->chain) == LX_OK;
+    lx_conv_plan *c = j->p->conv[j->conv_levels[i]];
+    return lx_conv_plan_fill(c, j->chain, j->flux[lx_conv_plan_level(c)]) == LX_OK;
 }
 
 static bool pad_item(void *ctx, int i)
@@ -284,13 +286,29 @@ lx_status lx_prefilter(const lx_cubemap *src, const lx_prefilter_desc *in,
         plan_free(&p);
         return st;
     }
-    /* the convolutions' lights and the padded chain, level by level */
+    /* the flux vectors of the chain levels the convolutions read, each
+     * from the next finer one where the sizes nest; then the lights and
+     * the padded chain, level by level */
     int nconv = 0;
+    bool used[LX_MAX_CUBE_MIPS + 1] = {false};
     for (int l = 0; l < mips; l++)
-        if (p.conv[l])
+        if (p.conv[l]) {
             j.conv_levels[nconv++] = l;
-    part = lx_ibl_run_part(&run, 0.04, 0.08);
-    st = lx_ibl_for(&part, nconv, NULL, fill_item, &j, "prefilter");
+            used[lx_conv_plan_level(p.conv[l])] = true;
+        }
+    int nused = 0, done = 0;
+    for (int i = 1; i < chain.count; i++)
+        nused += used[i];
+    for (int i = 1, finer = 0; i < chain.count && st == LX_OK; i++)
+        if (used[i]) {
+            part =
+                lx_ibl_run_part(&run, 0.04 + 0.02 * done / nused, 0.04 + 0.02 * (done + 1) / nused);
+            st = lx_conv_flux(&chain, i, finer ? j.flux[finer] : NULL, finer, &part, &j.flux[i]);
+            finer = i, done++;
+        }
+    part = lx_ibl_run_part(&run, 0.06, 0.08);
+    if (st == LX_OK)
+        st = lx_ibl_for(&part, nconv, NULL, fill_item, &j, "prefilter");
     part = lx_ibl_run_part(&run, 0.08, 0.1);
     if (st == LX_OK && p.sampled)
         st = lx_ibl_for(&part, chain.count, NULL, pad_item, &j, "prefilter");
@@ -328,6 +346,8 @@ lx_status lx_prefilter(const lx_cubemap *src, const lx_prefilter_desc *in,
     }
     free(tiles);
     free(cost);
+    for (int i = 0; i <= LX_MAX_CUBE_MIPS; i++)
+        free(j.flux[i]);
     plan_free(&p);
     for (int i = 0; i < chain.count; i++)
         lx_ibl_padded_free(&pads[i]);

@@ -484,44 +484,92 @@ uint64_t lx_conv_plan_bytes(const lx_conv_plan *p)
            8ull * (uint64_t)(p->n + 1) * (uint64_t)(p->n + 1) + tree_bytes(p->n) / 4;
 }
 
-/* For each texel of the mip `coarse` of `src`: the sum of luminance x
- * solid angle x direction over the source texels under it (its flux
- * vector; the centroid is its direction). malloc'd, NULL when out of
- * memory. */
-static double *flux_vectors(const lx_cubemap *src, const lx_cubemap *coarse)
+int lx_conv_plan_level(const lx_conv_plan *p)
 {
-    int n0 = src->size, n = coarse->size;
-    double *sum = calloc((size_t)6 * n * n * 3, sizeof(double));
-    double *omega = lx_ibl_solid_angles(n0);
-    if (!sum || !omega) {
-        free(sum);
-        free(omega);
-        return NULL;
-    }
-    for (int face = 0; face < 6; face++)
-        for (int y = 0; y < n0; y++)
-            for (int x = 0; x < n0; x++) {
-                const float *c = lx_cubemap_texel(src, face, x, y);
-                double lum = lx_luminance(c);
-                if (!(lum > 0.0))
-                    continue;
-                double w = lum * lx_ibl_omega(omega, n0, x, y);
-                lx_vec3 d = lx_cube_direction(face, (x + 0.5f) / n0, (y + 0.5f) / n0);
-                int X = (int)((long)x * n / n0), Y = (int)((long)y * n / n0);
-                double *q = sum + 3 * (((size_t)face * n + Y) * n + X);
-                q[0] += w * d.x, q[1] += w * d.y, q[2] += w * d.z;
-            }
-    free(omega);
-    return sum;
+    return p->level;
 }
 
-lx_status lx_conv_plan_fill(lx_conv_plan *p, const lx_ibl_chain *chain)
+/* The flux vectors of one row of a coarse level, gathered from level 0
+ * (luminance x solid angle x direction of each source texel under a
+ * coarse texel) or, when the sizes nest, from a finer level's. */
+typedef struct flux_job {
+    const lx_cubemap *src; /* level 0 */
+    const double *omega;   /* its solid angles */
+    const double *finer;   /* or a finer level's flux vectors, */
+    int finer_size;        /* of this face size */
+    int size;
+    double *out;
+} flux_job;
+
+static bool flux_row(void *ctx, int row)
+{
+    const flux_job *j = ctx;
+    int n = j->size, face = row / n, Y = row % n;
+    double *q = j->out + 3 * ((size_t)row * n);
+    memset(q, 0, sizeof(double) * 3 * (size_t)n);
+    if (j->finer) {
+        int k = j->finer_size / n;
+        for (int y = Y * k; y < (Y + 1) * k; y++)
+            for (int x = 0; x < j->finer_size; x++) {
+                const double *f =
+                    j->finer + 3 * (((size_t)face * j->finer_size + y) * j->finer_size + x);
+                double *o = q + 3 * (size_t)(x / k);
+                o[0] += f[0], o[1] += f[1], o[2] += f[2];
+            }
+        return true;
+    }
+    /* source texel x lies under coarse texel floor(x n / n0) */
+    int n0 = j->src->size;
+    int y0 = (int)(((long)Y * n0 + n - 1) / n), y1 = (int)(((long)(Y + 1) * n0 + n - 1) / n);
+    for (int y = y0; y < y1; y++)
+        for (int x = 0; x < n0; x++) {
+            const float *c = lx_cubemap_texel(j->src, face, x, y);
+            double lum = lx_luminance(c);
+            if (!(lum > 0.0))
+                continue;
+            double w = lum * lx_ibl_omega(j->omega, n0, x, y);
+            lx_vec3 d = lx_cube_direction(face, (x + 0.5f) / n0, (y + 0.5f) / n0);
+            double *o = q + 3 * (size_t)((long)x * n / n0);
+            o[0] += w * d.x, o[1] += w * d.y, o[2] += w * d.z;
+        }
+    return true;
+}
+
+lx_status lx_conv_flux(const lx_ibl_chain *chain, int level, const double *finer, int finer_level,
+                       const lx_ibl_run *run, double **out)
+{
+    int n = chain->level[level].size, n0 = chain->level[0].size;
+    flux_job j = {.src = &chain->level[0], .size = n};
+    if (finer && chain->level[finer_level].size % n == 0 &&
+        n0 % chain->level[finer_level].size == 0) {
+        j.finer = finer;
+        j.finer_size = chain->level[finer_level].size;
+    }
+    *out = NULL;
+    j.out = malloc(sizeof(double) * 18 * (size_t)n * n);
+    double *omega = j.finer ? NULL : lx_ibl_solid_angles(n0);
+    if (!j.out || (!j.finer && !omega)) {
+        free(j.out);
+        free(omega);
+        return lx_fail(LX_ERR_NOMEM, "out of memory for the flux of a %d x %d mip", n, n);
+    }
+    j.omega = omega;
+    lx_status st = lx_ibl_for(run, 6 * n, NULL, flux_row, &j, "prefilter");
+    free(omega);
+    if (st != LX_OK) {
+        free(j.out);
+        return st;
+    }
+    *out = j.out;
+    return LX_OK;
+}
+
+lx_status lx_conv_plan_fill(lx_conv_plan *p, const lx_ibl_chain *chain, const double *flux)
 {
     const lx_cubemap *s = p->src = &chain->level[p->level];
     int n = s->size;
     size_t lights = p->lights;
     double *omega = lx_ibl_solid_angles(n);
-    double *flux = p->level > 0 ? flux_vectors(&chain->level[0], s) : NULL;
     /* per node of the tier being built: flux vector, solid angle, solid
      * angle x value */
     double *acc = malloc(sizeof(double) * 7 * (size_t)p->tier[1].count);
@@ -529,9 +577,8 @@ lx_status lx_conv_plan_fill(lx_conv_plan *p, const lx_ibl_chain *chain)
         p->ly = p->lx + lights, p->lz = p->ly + lights, p->lom = p->lz + lights;
         p->lr = p->lom + lights, p->lg = p->lr + lights, p->lb = p->lg + lights;
     }
-    if (!omega || (!flux && p->level > 0) || !acc || !p->lx) {
+    if (!omega || !acc || !p->lx) {
         free(omega);
-        free(flux);
         free(acc);
         return lx_fail(LX_ERR_NOMEM, "out of memory for a convolution of a %d x %d source", n, n);
     }
@@ -564,7 +611,6 @@ lx_status lx_conv_plan_fill(lx_conv_plan *p, const lx_ibl_chain *chain)
                 p->lr[k] = c[0], p->lg[k] = c[1], p->lb[k] = c[2];
             }
     }
-    free(flux);
     free(omega);
     /* the nodes, tier by tier from the bottom: tier 1 from its lights, each
      * tier above from its children. A node's sums overwrite the slot of
