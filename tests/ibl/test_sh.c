@@ -4,8 +4,10 @@
  * 4 pi / 5, of x^2 y^2 4 pi / 15), the irradiance of a constant
  * environment (pi L) and of band-limited ones from the Funk-Hecke factors
  * of the clamped cosine (A0 = pi, A1 = 2 pi / 3, A2 = pi / 4), the basis'
- * orthonormality, the reconstruction against the brute-force irradiance of
- * a smooth environment, and bad input. */
+ * orthonormality, the reconstruction against the irradiance of a smooth
+ * environment integrated here (mean and worst error), the same results
+ * for any thread count, progress, cancellation, and bad input. Every
+ * check compares each value, so each bound is a worst case. */
 #include <stdarg.h>
 #include <stddef.h>
 #include <setjmp.h>
@@ -169,32 +171,117 @@ static void env_smooth(double x, double y, double z, float out[3])
     out[2] = (float)(2.0 + 0.9 * y + 1.0 * lobe);
 }
 
-static void reconstruction_matches_brute_force(void **state)
+/* The irradiance of env_smooth at unit n, integrated here on the function
+ * itself: a 96 x 96 midpoint rule per face, cube_reference's directions
+ * and solid angles (it differs from 192 x 192 by at most 2.5e-5). */
+static void smooth_irradiance(const double n[3], double out[3])
+{
+    const int m = 96;
+    double sum[3] = {0, 0, 0};
+    for (int f = 0; f < 6; f++)
+        for (int y = 0; y < m; y++)
+            for (int x = 0; x < m; x++) {
+                double d[3];
+                lx_test_texel_dir(f, m, x, y, d);
+                double c = n[0] * d[0] + n[1] * d[1] + n[2] * d[2];
+                if (c <= 0.0)
+                    continue;
+                double a = 2.0 * (x + 0.5) / m - 1.0, b = 2.0 * (y + 0.5) / m - 1.0;
+                double w = c * (2.0 / m) * (2.0 / m) / pow(1.0 + a * a + b * b, 1.5);
+                float l[3];
+                env_smooth(d[0], d[1], d[2], l);
+                for (int k = 0; k < 3; k++)
+                    sum[k] += w * l[k];
+            }
+    for (int k = 0; k < 3; k++)
+        out[k] = sum[k];
+}
+
+/* Order-2 SH of a smooth sky against its true irradiance: what is left is
+ * the truncation of the clamped cosine beyond band 2 (Ramamoorthi and
+ * Hanrahan bound it near 3% of the mean for any environment). Measured over
+ * 150 normals and 3 channels: mean 0.23%, worst 2.3% (on the dark side,
+ * where the irradiance is smallest); bounds 0.5% and 5%. */
+static void reconstruction_matches_true_irradiance(void **state)
 {
     (void)state;
-    lx_cubemap env = lx_test_make_env(32, env_smooth), brute;
+    lx_cubemap env = lx_test_make_env(32, env_smooth);
     lx_sh9 sh;
     assert_int_equal(lx_sh_project(&env, NULL, &sh), LX_OK);
-    assert_int_equal(lx_irradiance_brute(&env, 8, 32, NULL, &brute), LX_OK);
     double sum = 0.0, worst = 0.0;
     int count = 0;
-    for (int f = 0; f < 6; f++)
-        for (int y = 0; y < 8; y++)
-            for (int x = 0; x < 8; x++) {
-                lx_vec3 n = lx_cube_direction(f, (x + 0.5f) / 8, (y + 0.5f) / 8);
-                float e[3];
-                lx_sh_irradiance(&sh, n, e);
-                const float *b = lx_cubemap_texel(&brute, f, x, y);
-                for (int c = 0; c < 3; c++) {
-                    double rel = fabs(e[c] - b[c]) / b[c];
-                    sum += rel;
-                    worst = rel > worst ? rel : worst;
-                    count++;
-                }
-            }
-    printf("SH vs brute force: mean %.3f%%, worst %.3f%%\n", 100.0 * sum / count, 100.0 * worst);
-    assert_true(sum / count < 0.01);
-    lx_cubemap_free(&brute);
+    for (int i = 0; i < 150; i++) {
+        lx_vec3 n = spiral(i, 150);
+        double nd[3] = {n.x, n.y, n.z}, want[3];
+        smooth_irradiance(nd, want);
+        float e[3];
+        lx_sh_irradiance(&sh, n, e);
+        for (int c = 0; c < 3; c++) {
+            double rel = fabs(e[c] - want[c]) / want[c];
+            sum += rel;
+            worst = rel > worst ? rel : worst;
+            count++;
+        }
+    }
+    printf("SH vs the true irradiance: mean %.3f%%, worst %.3f%%\n", 100.0 * sum / count,
+           100.0 * worst);
+    assert_true(sum / count < 0.005);
+    assert_true(worst < 0.05);
+    lx_cubemap_free(&env);
+}
+
+typedef struct progress_log {
+    int calls, stop_after;
+    float last;
+    bool monotone;
+} progress_log;
+
+static bool on_progress(void *user, float f)
+{
+    progress_log *p = user;
+    p->monotone = p->monotone && f >= p->last;
+    p->last = f;
+    return ++p->calls < p->stop_after;
+}
+
+/* The same coefficients and cube for 1, 2 and 3 threads; progress up to
+ * 1; a cancelled projection leaves zeros, a cancelled cube nothing. */
+static void threads_progress_cancel(void **state)
+{
+    (void)state;
+    lx_cubemap env = lx_test_make_env(40, env_smooth), irr[3];
+    lx_sh9 sh[3];
+    for (int t = 0; t < 3; t++) {
+        lx_ibl_desc d = {.threads = t + 1};
+        assert_int_equal(lx_sh_project(&env, &d, &sh[t]), LX_OK);
+        assert_int_equal(lx_sh_irradiance_cube(&sh[0], 12, &d, &irr[t]), LX_OK);
+    }
+    for (int t = 1; t < 3; t++) {
+        assert_memory_equal(&sh[0], &sh[t], sizeof sh[0]);
+        assert_memory_equal(irr[0].data, irr[t].data, sizeof(float) * 6 * 12 * 12 * 3);
+    }
+    for (int t = 0; t < 3; t++)
+        lx_cubemap_free(&irr[t]);
+
+    progress_log p = {.stop_after = 1 << 30, .monotone = true};
+    lx_ibl_desc d = {.threads = 2, .progress = on_progress, .progress_user = &p};
+    assert_int_equal(lx_sh_project(&env, &d, &sh[1]), LX_OK);
+    assert_true(p.calls >= 2 && p.monotone);
+    assert_float_equal(p.last, 1.0f, 0.0f);
+    p = (progress_log){.stop_after = 1 << 30, .monotone = true};
+    assert_int_equal(lx_sh_irradiance_cube(&sh[0], 12, &d, &irr[0]), LX_OK);
+    assert_true(p.calls >= 2 && p.monotone);
+    assert_float_equal(p.last, 1.0f, 0.0f);
+    lx_cubemap_free(&irr[0]);
+
+    p = (progress_log){.stop_after = 2, .monotone = true};
+    assert_int_equal(lx_sh_project(&env, &d, &sh[1]), LX_ERR_CANCELLED);
+    assert_non_null(strstr(lx_last_error(), "SH projection cancelled"));
+    for (int k = 0; k < 9; k++)
+        assert_true(sh[1].c[k][0] == 0.0f && sh[1].c[k][1] == 0.0f && sh[1].c[k][2] == 0.0f);
+    p = (progress_log){.stop_after = 2, .monotone = true};
+    assert_int_equal(lx_sh_irradiance_cube(&sh[0], 12, &d, &irr[0]), LX_ERR_CANCELLED);
+    assert_null(irr[0].data);
     lx_cubemap_free(&env);
 }
 
@@ -291,6 +378,15 @@ static void bad_input(void **state)
     assert_int_equal(lx_sh_irradiance_cube(&sh, 4, NULL, &out), LX_ERR_INVALID);
     assert_non_null(strstr(lx_last_error(), "coefficient 3 channel 2"));
     assert_null(out.data);
+    memset(&sh, 0, sizeof sh);
+    lx_ibl_desc d = {.threads = -3};
+    assert_int_equal(lx_sh_irradiance_cube(&sh, 4, &d, &out), LX_ERR_INVALID);
+    assert_non_null(strstr(lx_last_error(), "thread count -3"));
+    assert_null(out.data);
+    lx_cubemap_texel(&env, 2, 1, 1)[1] = 0.0f;
+    lx_cubemap_texel(&env, 4, 0, 3)[0] = 0.0f;
+    assert_int_equal(lx_sh_project(&env, &d, &sh), LX_ERR_INVALID);
+    assert_non_null(strstr(lx_last_error(), "thread count -3"));
     lx_cubemap_free(&env);
 }
 
@@ -302,7 +398,8 @@ int main(void)
         cmocka_unit_test(polynomial_environment_coefficients),
         cmocka_unit_test(band_limited_irradiance_closed_form),
         cmocka_unit_test(basis_is_orthonormal),
-        cmocka_unit_test(reconstruction_matches_brute_force),
+        cmocka_unit_test(reconstruction_matches_true_irradiance),
+        cmocka_unit_test(threads_progress_cancel),
         cmocka_unit_test(ringing_is_kept_and_reported),
         cmocka_unit_test(bad_input),
     };
