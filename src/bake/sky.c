@@ -4,8 +4,9 @@
  * that escape the scene bringing the environment they see.
  *
  * With rays the environment is box-filtered to at most LX_SKY_LOOKUP_SIZE
- * texels a side and split in two, L = base + peak, where peak is what
- * exceeds LX_SKY_PEAK_RATIO times the mean luminance (a sun, a window):
+ * texels a side and split in two, L = base + peak, where peak is the
+ * texels brighter than LX_SKY_PEAK_RATIO times the mean luminance (a sun,
+ * a window), taken whole, and base the rest:
  * - base by stratified cosine-weighted rays over the texel's hemisphere
  *   (Malley's method: points uniform on the unit disk lifted onto the
  *   hemisphere), E = pi / N sum base(w);
@@ -13,8 +14,13 @@
  *   proportional to its peak luminance times solid angle (the seed's "every
  *   texel a directional light", sampled by importance), jittered within the
  *   texel: E = P / M sum cos(w) over the rays that escape, P the peak's
- *   total. A sun then casts clean shadows with a few dozen rays, where
- *   cosine rays alone would almost never find it. */
+ *   total, within the texel at Halton points (bases 2, 3) shifted per
+ *   lightmap texel. A sun then casts clean shadows with a few dozen rays,
+ *   where cosine rays alone would almost never find it. Taking the bright
+ *   texels whole leaves the cosine rays none of the sun to find by chance:
+ *   keeping the part below the threshold in the base (the mean itself
+ *   raised by the sun) made a sun texel's base 1% of its light, found by
+ *   one cosine ray in 200, and 1% noise in the test's sun-lit texels. */
 #include "bake_internal.h"
 #include "core/internal.h"
 
@@ -58,13 +64,12 @@ static lx_status split_peak(lx_baker *b)
         double lum = lx_luminance(t);
         double share = 0.0;
         if (lum > threshold) {
-            /* the part above the threshold, in the texel's colour */
-            float f = (float)(1.0 - threshold / lum);
+            /* the whole texel */
             for (int k = 0; k < 3; k++) {
-                peak[3 * i + k] = t[k] * f;
-                t[k] -= peak[3 * i + k];
+                peak[3 * i + k] = t[k];
+                t[k] = 0.0f;
             }
-            share = lx_luminance(peak + 3 * i) * lx_cube_texel_solid_angle(n, x, y);
+            share = lum * lx_cube_texel_solid_angle(n, x, y);
         }
         cdf[i + 1] = cdf[i] + share;
     }
@@ -207,6 +212,23 @@ static size_t pick_texel(const double *cdf, size_t count, double u)
     return lo;
 }
 
+/* The radical inverse of k in a base: its digits mirrored about the point. */
+static float radical_inverse(uint32_t k, uint32_t base)
+{
+    double inv = 1.0 / base, f = inv, r = 0.0;
+    for (; k; k /= base, f *= inv)
+        r += (double)(k % base) * f;
+    return (float)r;
+}
+
+/* v + offset, wrapped into [0, 1) (a Cranley-Patterson rotation). */
+static float shifted(float v, float offset)
+{
+    float r = v + offset;
+    r = r >= 1.0f ? r - 1.0f : r;
+    return r < 1.0f ? r : 0.99999994f;
+}
+
 /* Casts m rays (directions in rays[], weights per channel in w[]) and adds
  * the weights of those that escape to sum. */
 static void cast(const lx_baker *b, lx_ray *rays, const lx_vec3 *w, uint32_t m, double sum[3])
@@ -275,6 +297,8 @@ static lx_vec3 sky_visible(const lx_baker *b, uint32_t map_index, const lx_light
     size_t texels = (size_t)6 * n * n;
     uint32_t peaks = (want + 1) / 2;
     double total = b->sky_peak_cdf[texels];
+    float ox = lx_random(map_index, pixel, 0, key + 3),
+          oy = lx_random(map_index, pixel, 0, key + 4);
     sum[0] = sum[1] = sum[2] = 0.0;
     m = 0;
     for (uint32_t k = 0; k < peaks; k++) {
@@ -282,8 +306,11 @@ static lx_vec3 sky_visible(const lx_baker *b, uint32_t map_index, const lx_light
         size_t i = pick_texel(b->sky_peak_cdf, texels, u);
         int face, x, y;
         texel_of(n, i, &face, &x, &y);
-        float s = ((float)x + lx_random(map_index, pixel, k, key + 3)) / (float)n;
-        float tt = ((float)y + lx_random(map_index, pixel, k, key + 4)) / (float)n;
+        /* within the texel: the Halton point k (bases 2 and 3: any run of
+         * consecutive k, all a texel gets, is spread evenly over it),
+         * shifted by the texel's own random offset */
+        float s = ((float)x + shifted(radical_inverse(k, 2), ox)) / (float)n;
+        float tt = ((float)y + shifted(radical_inverse(k, 3), oy)) / (float)n;
         lx_vec3 d = lx_cube_direction(face, s, tt);
         float cos_n = lx_dot(d, nrm);
         if (!(cos_n > 0.0f) || !(lx_dot(d, ng) > 0.0f))

@@ -73,3 +73,12 @@ lx_cubemap lx_test_make_env(int size, lx_test_env_fn fn)
             }
     return c;
 }
+
+lx_cubemap lx_test_constant_env(int size, float value)
+{
+    lx_cubemap c;
+    assert_int_equal(lx_cubemap_alloc(&c, size), LX_OK);
+    for (size_t i = 0; i < (size_t)6 * size * size * 3; i++)
+        c.data[i] = value;
+    return c;
+}

@@ -31,4 +31,7 @@ typedef void (*lx_test_env_fn)(double x, double y, double z, float out[3]);
  * the test when it cannot be allocated. Free with lx_cubemap_free. */
 lx_cubemap lx_test_make_env(int size, lx_test_env_fn fn);
 
+/* A cube map holding value in every channel of every texel. */
+lx_cubemap lx_test_constant_env(int size, float value);
+
 #endif

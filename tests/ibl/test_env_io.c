@@ -861,7 +861,8 @@ static void test_bad_shapes(void **state)
     assert_int_equal(lx_cubemap_from_cross(&img, NULL, &c), LX_ERR_INVALID);
     assert_error_mentions("12x6");
     assert_int_equal(lx_cubemap_from_equirect(&img, 0, NULL, &c), LX_ERR_INVALID);
-    assert_int_equal(lx_cubemap_from_equirect(&img, LX_MAX_CUBE_SIZE + 1, NULL, &c), LX_ERR_INVALID);
+    assert_int_equal(lx_cubemap_from_equirect(&img, LX_MAX_CUBE_SIZE + 1, NULL, &c),
+                     LX_ERR_INVALID);
     lx_image_free(&img);
     assert_int_equal(lx_env_constant(lx_v3(1, 1, 1), 3, &c), LX_OK);
     assert_int_equal(lx_cubemap_to_equirect(&c, 7, NULL, &img), LX_ERR_INVALID);
