@@ -116,8 +116,12 @@ lx_status lx_ibl_for(const lx_ibl_run *run, int count, const double *cost, lx_ib
             total += cost ? cost[i] : 1.0;
     }
     total = total > 0.0 ? total : 1.0;
-    double done = 0.0;
+    double done = 0.0, reported = 0.0;
     volatile int stop = 0, nomem = 0;
+    /* whichever thread finishes an item reports, unless another one is
+     * reporting: one at a time, never a smaller fraction than before */
+    omp_lock_t lock;
+    omp_init_lock(&lock);
 #pragma omp parallel for schedule(dynamic, 1) num_threads(run->threads > 0 ? run->threads : 1)
     for (int i = 0; i < count; i++) {
         if (stop)
@@ -132,12 +136,15 @@ lx_status lx_ibl_for(const lx_ibl_run *run, int count, const double *cost, lx_ib
         double now;
 #pragma omp atomic capture
         now = done += cost ? cost[i] : 1.0;
-        if (omp_get_thread_num() == 0 && !stop) {
-            double f = now / total;
-            if (!run->progress(run->user, run->base + run->span * (float)(f < 1.0 ? f : 1.0)))
-                stop = 1;
-        }
+        if (!omp_test_lock(&lock))
+            continue;
+        reported = now > reported ? now : reported;
+        double f = reported / total;
+        if (!stop && !run->progress(run->user, run->base + run->span * (float)(f < 1.0 ? f : 1.0)))
+            stop = 1;
+        omp_unset_lock(&lock);
     }
+    omp_destroy_lock(&lock);
     if (nomem)
         return lx_fail(LX_ERR_NOMEM, "%s: out of memory", what);
     if (!stop && run->progress && !run->progress(run->user, run->base + run->span))

@@ -188,9 +188,10 @@ typedef bool (*lx_ibl_item_fn)(void *ctx, int item);
 
 /* Runs fn(ctx, i) for every i in [0, count) on at most run->threads
  * threads (OpenMP, dynamic schedule): each item must write only outputs of
- * its own, so results do not depend on the thread count. Only thread 0
- * calls the progress callback, after each item it finishes (so one thread
- * at a time), with the work done so far (cost[i] per item, or 1 each when
+ * its own, so results do not depend on the thread count. After each item
+ * the thread that finished it calls the progress callback, unless another
+ * thread is in it (so one thread at a time, never a smaller fraction than
+ * the last), with the work done so far (cost[i] per item, or 1 each when
  * cost is NULL). Once the callback returns false or an item fails, the
  * items not started are skipped. Returns LX_OK, LX_ERR_CANCELLED ("<what>
  * cancelled") or LX_ERR_NOMEM ("<what>: out of memory"); on LX_OK the

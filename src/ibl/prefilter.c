@@ -114,19 +114,22 @@ static lx_status make_plan(int n, const lx_prefilter_desc *d, plan *p)
     uint64_t source = lx_ibl_cube_bytes(n), chain = lx_ibl_chain_bytes(n, 1), levels = 0;
     for (int l = 0; l < d->mips; l++)
         levels += lx_ibl_cube_bytes(level_size(d, l));
-    char what[400];
-    int what_len = snprintf(what, sizeof what,
-                            "prefilter: a %d x %d source into %d levels of %d x %d and down", n, n,
-                            d->mips, d->size, d->size);
-    (void)what_len;
+    char what[400], a[32], b[32], c[32], e[32], f[32];
+    lx_format_bytes(source, a, sizeof a);
+    lx_format_bytes(chain, b, sizeof b);
+    lx_format_bytes(levels, f, sizeof f);
+    snprintf(what, sizeof what,
+             "prefilter: a %d x %d source (%s) with its mips (%s) into %d levels of %d x %d and "
+             "down (%s)",
+             n, n, a, b, d->mips, d->size, d->size, f);
     /* the source, its chain and the levels, before anything is made */
     lx_status st = lx_check_memory(source + chain + levels, what);
     for (int l = 0; l < d->mips && st == LX_OK; l++) {
         int size = level_size(d, l);
         p->cost[l] = 1.0;
         if (d->filter == LX_SPECULAR_PHONG) {
-            float e = d->phong_exponents ? d->phong_exponents[l] : lx_phong_level_exponent(l);
-            lx_lobe lobe = lx_phong_lobe(e);
+            float n_l = d->phong_exponents ? d->phong_exponents[l] : lx_phong_level_exponent(l);
+            lx_lobe lobe = lx_phong_lobe(n_l);
             st = lx_conv_plan_create(p->sizes, p->chain_count, &lobe, size, HUGE_VAL, &p->conv[l]);
             if (st == LX_OK)
                 p->cost[l] = lx_conv_plan_cost(p->conv[l]);
@@ -146,12 +149,8 @@ static lx_status make_plan(int n, const lx_prefilter_desc *d, plan *p)
     for (int l = 0; l < d->mips; l++)
         if (p->conv[l])
             lights += lx_conv_plan_bytes(p->conv[l]);
-    char a[32], b[32], c[32], e[32], f[32];
-    lx_format_bytes(source, a, sizeof a);
-    lx_format_bytes(chain, b, sizeof b);
     lx_format_bytes(pads, c, sizeof c);
     lx_format_bytes(lights, e, sizeof e);
-    lx_format_bytes(levels, f, sizeof f);
     snprintf(what, sizeof what,
              "prefilter: a %d x %d source (%s) with its mips (%s), padded copies (%s) and "
              "convolution work (%s) into %d levels of %d x %d and down (%s)",
