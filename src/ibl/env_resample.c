@@ -28,8 +28,14 @@
 #define MAX_GRID 32
 #define PI_F 3.14159265358979323846f
 
+/* Samples per side of a target texel covering `ratio` source texels per
+ * side: more than ratio, so the grid is finer than the source; one where
+ * the texel is at most half a source texel (an upsampling), as the
+ * bilinear source is then nearly flat over it. */
 static int grid_for(double ratio)
 {
+    if (ratio <= 0.5)
+        return 1;
     double n = ceil(ratio) + 1.0;
     return n < 2.0 ? 2 : n > MAX_GRID ? MAX_GRID : (int)n;
 }

@@ -82,3 +82,17 @@ lx_cubemap lx_test_constant_env(int size, float value)
         c.data[i] = value;
     return c;
 }
+
+lx_test_progress lx_test_progress_make(int stop_after)
+{
+    lx_test_progress p = {0, stop_after > 0 ? stop_after : 1 << 30, 0.0f, true};
+    return p;
+}
+
+bool lx_test_progress_fn(void *user, float fraction)
+{
+    lx_test_progress *p = user;
+    p->monotone = p->monotone && fraction >= p->last;
+    p->last = fraction;
+    return ++p->calls < p->stop_after;
+}

@@ -18,6 +18,7 @@
 #include <stdio.h>
 #include <string.h>
 
+#include "cube_reference.h"
 #include "helpers.h"
 #include "luxel/ibl.h"
 
@@ -153,20 +154,6 @@ static void smooth_limit_and_energy(void **state)
     lx_image_free(&lut);
 }
 
-typedef struct progress_log {
-    int calls, stop_after;
-    float last;
-    bool monotone;
-} progress_log;
-
-static bool on_progress(void *user, float f)
-{
-    progress_log *p = user;
-    p->monotone = p->monotone && f >= p->last;
-    p->last = f;
-    return ++p->calls < p->stop_after;
-}
-
 /* The same bytes for 1, 2 and 3 threads; progress up to 1; cancelling
  * leaves no table. */
 static void threads_progress_cancel(void **state)
@@ -181,13 +168,13 @@ static void threads_progress_cancel(void **state)
     assert_memory_equal(lut[0].data, lut[2].data, sizeof(float) * 24 * 24 * 2);
     for (int t = 0; t < 3; t++)
         lx_image_free(&lut[t]);
-    progress_log p = {.stop_after = 1 << 30, .monotone = true};
-    lx_ibl_desc d = {.threads = 2, .progress = on_progress, .progress_user = &p};
+    lx_test_progress p = lx_test_progress_make(0);
+    lx_ibl_desc d = {.threads = 2, .progress = lx_test_progress_fn, .progress_user = &p};
     assert_int_equal(lx_dfg_lut(32, 64, &d, &lut[0]), LX_OK);
     assert_true(p.calls >= 2 && p.monotone);
     assert_float_equal(p.last, 1.0f, 0.0f);
     lx_image_free(&lut[0]);
-    p = (progress_log){.stop_after = 2, .monotone = true};
+    p = lx_test_progress_make(2);
     assert_int_equal(lx_dfg_lut(32, 64, &d, &lut[0]), LX_ERR_CANCELLED);
     assert_non_null(strstr(lx_last_error(), "DFG table cancelled"));
     assert_null(lut[0].data);

@@ -202,20 +202,6 @@ static void ktx_holds_the_levels(void **state)
 
 /* ---- failures leave nothing ------------------------------------------------ */
 
-typedef struct progress_log {
-    int calls, stop_after;
-    float last;
-    bool monotone;
-} progress_log;
-
-static bool on_progress(void *user, float f)
-{
-    progress_log *p = user;
-    p->monotone = p->monotone && f >= p->last;
-    p->last = f;
-    return ++p->calls < p->stop_after;
-}
-
 static void failures_leave_nothing(void **state)
 {
     (void)state;
@@ -242,12 +228,13 @@ static void failures_leave_nothing(void **state)
     assert_int_equal(lx_test_count_files(dir), 0);
 
     /* progress cancels after the second file */
-    progress_log p = {.stop_after = 2, .monotone = true};
-    d = (lx_env_write_desc){.format = LX_IMAGE_PFM, .progress = on_progress, .progress_user = &p};
+    lx_test_progress p = lx_test_progress_make(2);
+    d = (lx_env_write_desc){
+        .format = LX_IMAGE_PFM, .progress = lx_test_progress_fn, .progress_user = &p};
     assert_int_equal(lx_env_write(dir, "cancel", levels, 3, &d), LX_ERR_CANCELLED);
     assert_int_equal(lx_test_count_files(dir), 0);
     /* and runs to 1 when let be */
-    p = (progress_log){.stop_after = 1 << 30, .monotone = true};
+    p = lx_test_progress_make(0);
     assert_int_equal(lx_env_write(dir, "all", levels, 3, &d), LX_OK);
     assert_true(p.monotone && p.calls >= 3);
     assert_float_equal(p.last, 1.0f, 1e-6f);
@@ -345,13 +332,13 @@ static void check_run(const char *what, convert_fn fn, const void *in, bytes_fn 
             fail_msg("%s: %d threads give other bytes than 1", what, t);
         release(out1);
     }
-    progress_log p = {.stop_after = 1 << 30, .monotone = true};
-    d = (lx_ibl_desc){.threads = 2, .progress = on_progress, .progress_user = &p};
+    lx_test_progress p = lx_test_progress_make(0);
+    d = (lx_ibl_desc){.threads = 2, .progress = lx_test_progress_fn, .progress_user = &p};
     assert_int_equal(fn(in, &d, out1), LX_OK);
     if (!(p.calls >= 2 && p.monotone && p.last == 1.0f))
         fail_msg("%s: %d progress calls, last %g, monotone %d", what, p.calls, p.last, p.monotone);
     release(out1);
-    p = (progress_log){.stop_after = 2, .monotone = true};
+    p = lx_test_progress_make(2);
     assert_int_equal(fn(in, &d, out1), LX_ERR_CANCELLED);
     assert_error_mentions("cancelled");
     assert_int_equal(bytes(out1, &b), 0);

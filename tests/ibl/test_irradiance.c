@@ -174,33 +174,18 @@ static void same_bytes_for_any_thread_count(void **state)
     lx_cubemap_free(&env);
 }
 
-typedef struct progress_log {
-    int calls, stop_after;
-    float last;
-    bool monotone;
-} progress_log;
-
-static bool on_progress(void *user, float f)
-{
-    progress_log *p = user;
-    if (f < p->last)
-        p->monotone = false;
-    p->last = f;
-    return ++p->calls < p->stop_after;
-}
-
 static void progress_and_cancel(void **state)
 {
     (void)state;
     lx_cubemap env = pattern_env(8), out;
-    progress_log p = {.stop_after = 1 << 30, .monotone = true};
-    lx_ibl_desc d = {.threads = 2, .progress = on_progress, .progress_user = &p};
+    lx_test_progress p = lx_test_progress_make(0);
+    lx_ibl_desc d = {.threads = 2, .progress = lx_test_progress_fn, .progress_user = &p};
     assert_int_equal(lx_irradiance_brute(&env, 40, 8, &d, &out), LX_OK);
     assert_true(p.calls >= 2 && p.monotone);
     assert_float_equal(p.last, 1.0f, 0.0f);
     lx_cubemap_free(&out);
 
-    p = (progress_log){.stop_after = 1, .monotone = true};
+    p = lx_test_progress_make(1);
     assert_int_equal(lx_irradiance_brute(&env, 40, 8, &d, &out), LX_ERR_CANCELLED);
     assert_null(out.data);
     assert_int_equal(out.size, 0);

@@ -230,20 +230,6 @@ static void reconstruction_matches_true_irradiance(void **state)
     lx_cubemap_free(&env);
 }
 
-typedef struct progress_log {
-    int calls, stop_after;
-    float last;
-    bool monotone;
-} progress_log;
-
-static bool on_progress(void *user, float f)
-{
-    progress_log *p = user;
-    p->monotone = p->monotone && f >= p->last;
-    p->last = f;
-    return ++p->calls < p->stop_after;
-}
-
 /* The same coefficients and cube for 1, 2 and 3 threads; progress up to
  * 1; a cancelled projection leaves zeros, a cancelled cube nothing. */
 static void threads_progress_cancel(void **state)
@@ -263,23 +249,23 @@ static void threads_progress_cancel(void **state)
     for (int t = 0; t < 3; t++)
         lx_cubemap_free(&irr[t]);
 
-    progress_log p = {.stop_after = 1 << 30, .monotone = true};
-    lx_ibl_desc d = {.threads = 2, .progress = on_progress, .progress_user = &p};
+    lx_test_progress p = lx_test_progress_make(0);
+    lx_ibl_desc d = {.threads = 2, .progress = lx_test_progress_fn, .progress_user = &p};
     assert_int_equal(lx_sh_project(&env, &d, &sh[1]), LX_OK);
     assert_true(p.calls >= 2 && p.monotone);
     assert_float_equal(p.last, 1.0f, 0.0f);
-    p = (progress_log){.stop_after = 1 << 30, .monotone = true};
+    p = lx_test_progress_make(0);
     assert_int_equal(lx_sh_irradiance_cube(&sh[0], 12, &d, &irr[0]), LX_OK);
     assert_true(p.calls >= 2 && p.monotone);
     assert_float_equal(p.last, 1.0f, 0.0f);
     lx_cubemap_free(&irr[0]);
 
-    p = (progress_log){.stop_after = 2, .monotone = true};
+    p = lx_test_progress_make(2);
     assert_int_equal(lx_sh_project(&env, &d, &sh[1]), LX_ERR_CANCELLED);
     assert_non_null(strstr(lx_last_error(), "SH projection cancelled"));
     for (int k = 0; k < 9; k++)
         assert_true(sh[1].c[k][0] == 0.0f && sh[1].c[k][1] == 0.0f && sh[1].c[k][2] == 0.0f);
-    p = (progress_log){.stop_after = 2, .monotone = true};
+    p = lx_test_progress_make(2);
     assert_int_equal(lx_sh_irradiance_cube(&sh[0], 12, &d, &irr[0]), LX_ERR_CANCELLED);
     assert_null(irr[0].data);
     lx_cubemap_free(&env);
