@@ -63,7 +63,7 @@
  *       st = lx_env_write(".", "specular", spec, levels, &wd);
  *   printf("irradiance facing up: %g lux (%s)\n",
  *          lx_cubemap_texel(&irr, LX_FACE_PY, 16, 16)[1], lx_status_name(st));
- *   for (int i = 0; st == LX_OK && i < levels; i++)
+ *   for (int i = 0; i < LX_MAX_CUBE_MIPS; i++) // zeroed if it failed
  *       lx_cubemap_free(&spec[i]);
  *   lx_cubemap_free(&irr);
  *   lx_cubemap_free(&env);

@@ -401,8 +401,8 @@ static bool cross_row(void *ctx, int row)
 
 lx_status lx_ibl_cube_from_cross(const lx_image *cross, const lx_ibl_run *run, lx_cubemap *out)
 {
-    int size;
-    bool vertical;
+    int size = 0;
+    bool vertical = false;
     lx_ibl_cross_shape(cross->width, cross->height, &size, &vertical);
     lx_status st = lx_cubemap_alloc(out, size);
     if (st != LX_OK)

@@ -109,7 +109,7 @@ lx_status lx_env_write_check(int size, int count, const lx_env_write_desc *desc)
     if (size < 1 || size > LX_MAX_CUBE_SIZE)
         return lx_fail(LX_ERR_INVALID, "environment: face size %d is outside 1..%d", size,
                        LX_MAX_CUBE_SIZE);
-    int sizes[LX_MAX_CUBE_MIPS];
+    int sizes[LX_MAX_CUBE_MIPS] = {0};
     for (int l = 0; l < count; l++)
         sizes[l] = size >> l > 0 ? size >> l : 1;
     return check_memory("environment", sizes, count, &d);
@@ -176,7 +176,7 @@ lx_status lx_env_write(const char *folder, const char *stem, const lx_cubemap *l
         return st;
     if (!levels)
         return lx_fail(LX_ERR_INVALID, "%s: no levels (NULL)", stem);
-    int sizes[LX_MAX_CUBE_MIPS];
+    int sizes[LX_MAX_CUBE_MIPS] = {0};
     for (int l = 0; l < count; l++) {
         char what[240];
         snprintf(what, sizeof what, "%s: level %d", stem, l);

@@ -166,8 +166,8 @@ lx_status lx_sh_project(const lx_cubemap *c, const lx_ibl_desc *in, lx_sh9 *out)
     /* world monomial sums, then the coefficients */
     double sum[9][3] = {{0}};
     for (int face = 0; face < 6; face++) {
-        int pm[3];
-        double sg[3];
+        int pm[3] = {0, 0, 0};
+        double sg[3] = {0, 0, 0};
         face_perm_sign(face, pm, sg);
         for (int ch = 0; ch < 3; ch++) {
             double w1 = local[face][M1][ch];
