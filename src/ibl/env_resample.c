@@ -153,10 +153,13 @@ static bool grid_row(void *ctx, int row)
     float offs[MAX_GRID];
     for (int x = 0; x < size; x++) {
         if (j->eq) {
-            lx_vec3 c = lx_cube_direction(face, ((float)x + 0.5f) / (float)size,
-                                          ((float)y + 0.5f) / (float)size);
-            double sin_theta = sqrt(fmax(0.0, 1.0 - (double)c.y * c.y));
-            n = grid_for(j->ratio / fmax(sin_theta, 1.0 / MAX_GRID));
+            /* sin(theta) of the texel centre: its distance from the y axis
+             * over its length */
+            lx_vec3 c = lx_ibl_face_vector(face, 2.0f * ((float)x + 0.5f) / (float)size - 1.0f,
+                                           2.0f * ((float)y + 0.5f) / (float)size - 1.0f);
+            double r2 = (double)c.x * c.x + (double)c.z * c.z;
+            double sin_theta = sqrt(r2 / (r2 + (double)c.y * c.y));
+            n = grid_for(j->ratio / (sin_theta > 1.0 / MAX_GRID ? sin_theta : 1.0 / MAX_GRID));
         }
         /* the centres of the n sub-cells of a texel */
         if (n != offs_n) {
