@@ -244,11 +244,20 @@ static bool image_ok(const lx_image *img)
            img->channels <= 4;
 }
 
+/* The run of a public conversion's desc (NULL: all cores, no progress),
+ * its thread count checked. */
+static lx_status start(const lx_ibl_desc *in, lx_ibl_run *run)
+{
+    lx_ibl_desc d = lx_ibl_desc_defaults(in);
+    *run = lx_ibl_run_make(d.threads, d.progress, d.progress_user);
+    return lx_ibl_check_threads(d.threads);
+}
+
 lx_status lx_cubemap_from_equirect(const lx_image *eq, int size, const lx_ibl_desc *in,
                                    lx_cubemap *out)
 {
     memset(out, 0, sizeof *out);
-    lx_ibl_desc d = lx_ibl_desc_defaults(in);
+    lx_ibl_run run;
     if (!image_ok(eq))
         return lx_fail(LX_ERR_INVALID, "lx_cubemap_from_equirect: invalid image");
     if (eq->width != 2 * eq->height)
@@ -256,14 +265,13 @@ lx_status lx_cubemap_from_equirect(const lx_image *eq, int size, const lx_ibl_de
                        "equirect is %dx%d; an equirect must be exactly twice as wide as it is "
                        "tall",
                        eq->width, eq->height);
-    lx_status st = lx_ibl_check_threads(d.threads);
+    lx_status st = start(in, &run);
     if (st != LX_OK)
         return st;
     char name[96];
     snprintf(name, sizeof name, "%d x %d faces from a %d x %d equirect", size, size, eq->width,
              eq->height);
     lx_ibl_warn_upsampling(name, size, eq->width / 4.0);
-    lx_ibl_run run = lx_ibl_run_make(d.threads, d.progress, d.progress_user);
     return lx_ibl_cube_from_equirect(eq, size, &run, out);
 }
 
@@ -336,13 +344,13 @@ lx_status lx_cubemap_to_equirect(const lx_cubemap *c, int width, const lx_ibl_de
                                  lx_image *out)
 {
     memset(out, 0, sizeof *out);
-    lx_ibl_desc d = lx_ibl_desc_defaults(in);
+    lx_ibl_run run;
     if (!c || !c->data || c->size < 1)
         return lx_fail(LX_ERR_INVALID, "lx_cubemap_to_equirect: invalid cube map");
     if (width < 2 || width % 2 != 0 || width > MAX_EQUIRECT_WIDTH)
         return lx_fail(LX_ERR_INVALID, "equirect width %d must be even and in 2..%d", width,
                        MAX_EQUIRECT_WIDTH);
-    lx_status st = lx_ibl_check_threads(d.threads);
+    lx_status st = start(in, &run);
     if (st != LX_OK)
         return st;
     char name[96];
@@ -350,7 +358,6 @@ lx_status lx_cubemap_to_equirect(const lx_cubemap *c, int width, const lx_ibl_de
              c->size);
     if (width > 16.0 * c->size)
         lx_log(LX_LOG_WARN, "%s upsamples them %.0fx", name, width / (4.0 * c->size));
-    lx_ibl_run run = lx_ibl_run_make(d.threads, d.progress, d.progress_user);
     return lx_ibl_cube_to_equirect(c, width, &run, out);
 }
 
@@ -420,7 +427,7 @@ lx_status lx_ibl_cube_from_cross(const lx_image *cross, const lx_ibl_run *run, l
 lx_status lx_cubemap_from_cross(const lx_image *cross, const lx_ibl_desc *in, lx_cubemap *out)
 {
     memset(out, 0, sizeof *out);
-    lx_ibl_desc d = lx_ibl_desc_defaults(in);
+    lx_ibl_run run;
     if (!image_ok(cross))
         return lx_fail(LX_ERR_INVALID, "lx_cubemap_from_cross: invalid image");
     int size;
@@ -430,10 +437,9 @@ lx_status lx_cubemap_from_cross(const lx_image *cross, const lx_ibl_desc *in, lx
                        "cross is %dx%d; a cross must be 4:3 (horizontal) or 3:4 (vertical) "
                        "with square faces",
                        cross->width, cross->height);
-    lx_status st = lx_ibl_check_threads(d.threads);
+    lx_status st = start(in, &run);
     if (st != LX_OK)
         return st;
-    lx_ibl_run run = lx_ibl_run_make(d.threads, d.progress, d.progress_user);
     return lx_ibl_cube_from_cross(cross, &run, out);
 }
 
@@ -455,12 +461,11 @@ lx_status lx_cubemap_to_cross(const lx_cubemap *c, bool vertical, const lx_ibl_d
                               lx_image *out)
 {
     memset(out, 0, sizeof *out);
-    lx_ibl_desc d = lx_ibl_desc_defaults(in);
+    lx_ibl_run run;
     if (!c || !c->data || c->size < 1 || c->size > LX_MAX_CUBE_SIZE)
         return lx_fail(LX_ERR_INVALID, "lx_cubemap_to_cross: invalid cube map");
-    lx_status st = lx_ibl_check_threads(d.threads);
+    lx_status st = start(in, &run);
     if (st != LX_OK)
         return st;
-    lx_ibl_run run = lx_ibl_run_make(d.threads, d.progress, d.progress_user);
     return lx_ibl_cube_to_cross(c, vertical, &run, out);
 }
