@@ -285,6 +285,38 @@ static void bad_input(void **state)
     d = (lx_env_write_desc){.format = LX_IMAGE_PFM};
     expect_write_error(path_in(dir, "missing"), "x", levels, 1, &d, LX_ERR_IO, "missing/x_px.pfm");
     assert_int_equal(lx_test_count_files(dir), 0);
+
+    /* the loads and conversions refuse a negative thread count, leaving
+     * their outputs empty */
+    lx_ibl_desc bad = {.threads = -2};
+    lx_image img, eq;
+    lx_cubemap c = {.size = 99};
+    assert_int_equal(lx_image_alloc(&eq, 16, 8, 3), LX_OK);
+    assert_int_equal(lx_cubemap_from_equirect(&eq, 4, &bad, &c), LX_ERR_INVALID);
+    assert_error_mentions("thread count -2");
+    assert_null(c.data);
+    img.data = (float *)&img;
+    assert_int_equal(lx_cubemap_to_equirect(&levels[0], 16, &bad, &img), LX_ERR_INVALID);
+    assert_error_mentions("thread count -2");
+    assert_null(img.data);
+    img.data = (float *)&img;
+    assert_int_equal(lx_cubemap_to_cross(&levels[0], false, &bad, &img), LX_ERR_INVALID);
+    assert_null(img.data);
+    lx_image cross;
+    assert_int_equal(lx_image_alloc(&cross, 16, 12, 3), LX_OK);
+    assert_int_equal(lx_cubemap_from_cross(&cross, &bad, &c), LX_ERR_INVALID);
+    assert_error_mentions("thread count -2");
+    assert_null(c.data);
+    lx_env_load_desc ld = {.threads = -2};
+    assert_int_equal(lx_env_from_image(&eq, "sky.hdr", &ld, &c), LX_ERR_INVALID);
+    assert_error_mentions("sky.hdr: thread count -2");
+    assert_null(c.data);
+    assert_int_equal(lx_env_load(path_in(dir, "none.hdr"), &ld, &c), LX_ERR_INVALID);
+    assert_error_mentions("none.hdr: thread count -2");
+    assert_null(c.data);
+    lx_image_free(&cross);
+    lx_image_free(&eq);
+    assert_int_equal(lx_test_count_files(dir), 0);
     free_chain(levels, 2);
 }
 
