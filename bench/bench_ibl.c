@@ -19,8 +19,15 @@
  *     above, and the 9x9 texels around the sun's), on all threads. The
  *     Phong chain is timed the same way against a brute-force Phong
  *     level.
+ *  4. The whole `luxel ibl sky.pfm --layout ktx` process on gen_scenes'
+ *     1024x512 HDR sky (256^2 faces, 9 GGX levels, brute irradiance, SH,
+ *     the 128^2 DFG table; target < 0.7 s wall on 2 cores), against the
+ *     same library calls made in this process (load, SH, irradiance,
+ *     prefilter, seam fix, DFG table, the KTX and EXR files): the ratio is
+ *     what the process adds (start-up, staging, publishing). With
+ *     --threads 1 its CPU use must be ~100%.
  *
- * Usage: bench_ibl [--reps N] [--threads N]
+ * Usage: bench_ibl [--reps N] [--threads N] [--only-cli] (--only-cli: section 4 alone)
  * The last line is a one-line summary.
  */
 #define _POSIX_C_SOURCE 200809L
@@ -30,10 +37,15 @@
 
 #include "luxel/ibl.h"
 
+#include <limits.h>
 #include <math.h>
 #include <stdio.h>
 #include <stdlib.h>
 #include <string.h>
+#include <sys/resource.h>
+#include <sys/stat.h>
+#include <sys/wait.h>
+#include <unistd.h>
 
 static int g_threads, g_reps = 3;
 
@@ -98,7 +110,7 @@ typedef struct sh_job {
 static void run_sh(void *p)
 {
     sh_job *j = p;
-    if (lx_sh_project(j->env, &j->sh) != LX_OK)
+    if (lx_sh_project(j->env, NULL, &j->sh) != LX_OK)
         lx_bench_die("lx_sh_project");
 }
 
@@ -407,15 +419,178 @@ static double ggx_levels_vs_brute(const lx_cubemap *env, const double *omega, co
     return worst_mean;
 }
 
+/* ---- [4] the whole luxel ibl run ------------------------------------------ */
+
+/* bin/<name> beside this program (make bench runs it from build/bin). */
+static char *sibling(const char *name)
+{
+    char self[PATH_MAX];
+    ssize_t n = readlink("/proc/self/exe", self, sizeof self - 1);
+    if (n <= 0)
+        return NULL;
+    self[n] = '\0';
+    char *slash = strrchr(self, '/');
+    if (!slash)
+        return NULL;
+    *slash = '\0';
+    size_t len = strlen(self) + strlen(name) + 2;
+    char *path = malloc(len);
+    if (path)
+        snprintf(path, len, "%s/%s", self, name);
+    if (path && access(path, X_OK) != 0) {
+        free(path);
+        return NULL;
+    }
+    return path;
+}
+
+/* Runs argv to its end: wall seconds, and the child's CPU seconds in *cpu;
+ * negative when it fails. */
+static double run_process(char *const argv[], double *cpu)
+{
+    double t0 = lx_bench_now();
+    pid_t pid = fork();
+    if (pid < 0)
+        return -1.0;
+    if (pid == 0) {
+        execv(argv[0], argv);
+        _exit(127);
+    }
+    int status;
+    struct rusage before, after;
+    getrusage(RUSAGE_CHILDREN, &before);
+    if (waitpid(pid, &status, 0) != pid || !WIFEXITED(status) || WEXITSTATUS(status) != 0)
+        return -1.0;
+    double wall = lx_bench_now() - t0;
+    getrusage(RUSAGE_CHILDREN, &after);
+    *cpu = (double)(after.ru_utime.tv_sec - before.ru_utime.tv_sec) +
+           1e-6 * (double)(after.ru_utime.tv_usec - before.ru_utime.tv_usec) +
+           (double)(after.ru_stime.tv_sec - before.ru_stime.tv_sec) +
+           1e-6 * (double)(after.ru_stime.tv_usec - before.ru_stime.tv_usec);
+    return wall;
+}
+
+/* The library calls of `luxel ibl ENV --layout ktx` in this process. */
+typedef struct cli_job {
+    const char *sky, *out;
+} cli_job;
+
+static void run_library(void *p)
+{
+    const cli_job *j = p;
+    lx_cubemap env, irr, spec[LX_MAX_CUBE_MIPS];
+    lx_sh9 sh;
+    int count;
+    lx_image lut;
+    lx_env_load_desc ld = {.threads = g_threads};
+    lx_ibl_desc d = {.threads = g_threads};
+    lx_prefilter_desc pd = {.threads = g_threads};
+    if (lx_env_load(j->sky, &ld, &env) != LX_OK || lx_sh_project(&env, &d, &sh) != LX_OK ||
+        lx_irradiance_brute(&env, 32, 0, &d, &irr) != LX_OK ||
+        lx_prefilter(&env, &pd, spec, &count) != LX_OK || lx_dfg_lut(128, 0, &d, &lut) != LX_OK)
+        lx_bench_die("the library's ibl calls");
+    lx_cubemap_fix_seams(&irr);
+    for (int i = 0; i < count; i++)
+        lx_cubemap_fix_seams(&spec[i]);
+    lx_image rgb;
+    if (lx_image_alloc(&rgb, lut.width, lut.height, 3) != LX_OK)
+        lx_bench_die("lx_image_alloc");
+    for (int i = 0; i < lut.width * lut.height; i++)
+        rgb.data[3 * i] = lut.data[2 * i], rgb.data[3 * i + 1] = lut.data[2 * i + 1];
+    lx_env_write_desc wd = {.layout = LX_ENV_KTX, .threads = g_threads};
+    lx_image_write_desc id = {.format = LX_IMAGE_EXR, .threads = g_threads};
+    char *lut_path = lx_path_join(j->out, "dfg_lut.exr");
+    if (!lut_path || lx_env_write(j->out, "irradiance", &irr, 1, &wd) != LX_OK ||
+        lx_env_write(j->out, "specular", spec, count, &wd) != LX_OK ||
+        lx_image_write(lut_path, &rgb, &id) != LX_OK)
+        lx_bench_die("writing the ibl files");
+    free(lut_path);
+    lx_image_free(&rgb);
+    lx_image_free(&lut);
+    for (int i = 0; i < count; i++)
+        lx_cubemap_free(&spec[i]);
+    lx_cubemap_free(&irr);
+    lx_cubemap_free(&env);
+}
+
+/* Section [4]; returns the CLI's best wall time (0 when it cannot run). */
+static double bench_cli(double *cpu_share_one, double *ratio)
+{
+    printf("\n[4] THE WHOLE `luxel ibl sky.pfm --layout ktx` RUN  gen_scenes' 1024x512 sky, 256^2 "
+           "faces, 9 GGX levels, irradiance, SH, DFG table; baseline: the same library calls in "
+           "this process\n");
+    char *luxel = sibling("luxel"), *gen = sibling("gen_scenes");
+    char dir[] = "/tmp/bench_ibl.XXXXXX";
+    if (!luxel || !gen || !mkdtemp(dir)) {
+        printf("  skipped: luxel and gen_scenes must be beside bench_ibl (build/bin)\n");
+        free(luxel);
+        free(gen);
+        return 0.0;
+    }
+    char scenes[64], sky[96], out[64], lib_out[64], threads_arg[16];
+    snprintf(scenes, sizeof scenes, "%s/scenes", dir);
+    snprintf(sky, sizeof sky, "%s/sky.pfm", scenes);
+    snprintf(out, sizeof out, "%s/out", dir);
+    snprintf(lib_out, sizeof lib_out, "%s/lib", dir);
+    snprintf(threads_arg, sizeof threads_arg, "%d", g_threads);
+    double cpu = 0.0;
+    char *gen_argv[] = {gen, scenes, NULL};
+    if (run_process(gen_argv, &cpu) < 0.0 || mkdir(lib_out, 0777) != 0)
+        lx_bench_die("gen_scenes");
+    char *argv_n[] = {luxel,       "ibl",       sky,  "--layout", "ktx", "-q",
+                      "--threads", threads_arg, "-o", out,        NULL};
+    char *argv_1[] = {luxel,       "ibl", sky,  "--layout", "ktx", "-q",
+                      "--threads", "1",   "-o", out,        NULL};
+    double best = INFINITY, best_cpu = 0.0, best1 = INFINITY, best1_cpu = 0.0;
+    int runs = 5 * g_reps;
+    for (int i = 0; i < runs; i++) {
+        double t = run_process(argv_n, &cpu);
+        if (t < 0.0)
+            lx_bench_die("luxel ibl");
+        if (t < best)
+            best = t, best_cpu = cpu;
+        t = run_process(argv_1, &cpu);
+        if (t < 0.0)
+            lx_bench_die("luxel ibl --threads 1");
+        if (t < best1)
+            best1 = t, best1_cpu = cpu;
+    }
+    cli_job job = {sky, lib_out};
+    int lib_runs;
+    double t_lib = best_of(run_library, &job, runs, 0.0, &lib_runs);
+    printf("  %-44s %10s %10s %10s\n", "figure (best of runs)", "wall", "CPU", "ratio");
+    printf("  %-44s %8.3f s %8.0f %% %9.2fx  (%d runs)\n", "luxel ibl, all threads", best,
+           100.0 * best_cpu / best, best / t_lib, runs);
+    printf("  %-44s %8.3f s %8.0f %% %9.2fx  (%d runs)\n", "luxel ibl --threads 1", best1,
+           100.0 * best1_cpu / best1, best1 / t_lib, runs);
+    printf("  %-44s %8.3f s %10s %9.2fx  (%d runs)\n", "baseline: the library calls, all threads",
+           t_lib, "", 1.0, lib_runs);
+    printf("  => %.3f s wall (target < 0.7 s: %s), %.2fx the library calls alone; --threads 1 "
+           "uses %.0f%% CPU\n",
+           best, best < 0.7 ? "MET" : "NOT MET", best / t_lib, 100.0 * best1_cpu / best1);
+    *cpu_share_one = best1_cpu / best1;
+    *ratio = best / t_lib;
+    char rm[160];
+    snprintf(rm, sizeof rm, "rm -rf '%s'", dir);
+    if (system(rm) != 0)
+        fprintf(stderr, "bench_ibl: could not remove %s\n", dir);
+    free(luxel);
+    free(gen);
+    return best;
+}
+
 int main(int argc, char **argv)
 {
+    bool only_cli = false;
     for (int i = 1; i < argc; i++) {
         if (!strcmp(argv[i], "--reps") && i + 1 < argc)
             g_reps = atoi(argv[++i]);
         else if (!strcmp(argv[i], "--threads") && i + 1 < argc)
             g_threads = atoi(argv[++i]);
+        else if (!strcmp(argv[i], "--only-cli"))
+            only_cli = true;
         else {
-            fprintf(stderr, "usage: %s [--reps N] [--threads N]\n", argv[0]);
+            fprintf(stderr, "usage: %s [--reps N] [--threads N] [--only-cli]\n", argv[0]);
             return 2;
         }
     }
@@ -425,6 +600,14 @@ int main(int argc, char **argv)
     lx_bench_header("bench_ibl", g_threads);
     double t_start = lx_bench_now();
     char a[32], b[32], load[32];
+    if (only_cli) {
+        double cpu_one, ratio, t = bench_cli(&cpu_one, &ratio);
+        printf("bench_ibl: luxel ibl of a 1024x512 sky %.3f s (target < 0.7 s: %s, %.2fx its "
+               "library calls, %.0f%% CPU with --threads 1); %d threads, load %s\n",
+               t, t > 0.0 && t < 0.7 ? "MET" : "NOT MET", ratio, 100.0 * cpu_one, g_threads,
+               lx_bench_load(load, sizeof load));
+        return 0;
+    }
 
     /* [1] */
     lx_cubemap env512 = make_env(512);
@@ -523,14 +706,20 @@ int main(int argc, char **argv)
     free(brute);
     lx_cubemap_free(&env256);
 
+    /* [4] */
+    double cpu_one = 0.0, cli_ratio = 0.0;
+    double t_cli = bench_cli(&cpu_one, &cli_ratio);
+
     printf("\ntotal bench time %.1f s\n", lx_bench_now() - t_start);
     printf(
         "bench_ibl: SH 6x512^2 %.2f ms (target < 20 ms: %s, %.2fx a plain sum); brute "
         "irradiance 6x32^2 %.1f ms (%.0fx the seed's loop); GGX chain 6x256^2 %.3f s (target "
         "< 1 s: %s, %.2fx one brute 8x8 level, levels' mean error <= %.2f%%); Phong chain %.3f s; "
-        "%d threads, load %s\n",
+        "luxel ibl of a 1024x512 sky %.3f s (target < 0.7 s: %s, %.2fx its library calls, "
+        "%.0f%% CPU with --threads 1); %d threads, load %s\n",
         1e3 * t_sh, t_sh < 0.020 ? "MET" : "NOT MET", t_sh / t_sum, 1e3 * t_irr, irr_speedup,
         t_pre[0], t_pre[0] < 1.0 ? "MET" : "NOT MET", t_pre[0] / t_brute[0], 100.0 * ggx_mean,
-        t_pre[1], g_threads, lx_bench_load(load, sizeof load));
+        t_pre[1], t_cli, t_cli > 0.0 && t_cli < 0.7 ? "MET" : "NOT MET", cli_ratio, 100.0 * cpu_one,
+        g_threads, lx_bench_load(load, sizeof load));
     return 0;
 }

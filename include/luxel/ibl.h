@@ -2,7 +2,7 @@
  * irradiance (brute force and order-2 spherical harmonics), prefiltered
  * specular environments (GGX with a mip chain, Phong lobes), the split-sum
  * DFG lookup table, seam handling, and the layouts engines read (faces,
- * cross, equirect, KTX 1.1).
+ * cross, equirect, KTX 1.1) in and out.
  *
  * CONVENTIONS  +Y up, right-handed (glTF). Environment values are radiance
  *   in nits; irradiance outputs are in lux. An equirect pixel centre (u, v)
@@ -18,21 +18,57 @@
  *   them with pictures.
  * ERRORS  Every function that can fail returns lx_status and sets a message
  *   naming the file and the problem (non-2:1 equirect, unequal faces, NaN
- *   or negative texels with their count...).
+ *   or negative texels with their count...). On failure or cancellation
+ *   outputs are zeroed and no file is left behind.
  * MEMORY  lx_cubemap_alloc and every function filling an lx_cubemap or
- *   lx_image allocate; lx_cubemap_free / lx_image_free release.
- * THREADING  Filters run OpenMP over face tiles (desc.threads; the calls
- *   without a desc use all cores); results are bit-identical for any thread
- *   count: every texel is computed alone, sums run in a fixed order, and
- *   GGX samples come from one fixed Hammersley set.
+ *   lx_image allocate; lx_cubemap_free / lx_image_free release. Each call
+ *   that allocates a lot (loading, resampling, lx_prefilter, lx_env_write)
+ *   first adds up its whole peak - its input, every buffer it will hold at
+ *   once, its outputs - and fails with LX_ERR_NOMEM naming the GiB when
+ *   that is more than the machine has, before allocating any of it.
+ *   lx_prefilter_check and lx_env_write_check run the same test on sizes
+ *   alone, to check a whole run before its environment is made. Making
+ *   faces more than 4x finer than a source's own detail (an upsampled
+ *   environment, specular level 0, an equirect) logs an LX_LOG_WARN naming
+ *   the memory it takes.
+ * THREADING  Every long call takes threads, a progress callback and its
+ *   user pointer: lx_ibl_desc (threads 0 = all cores), or the call's own
+ *   desc with the same three fields (lx_env_load_desc, lx_env_write_desc,
+ *   lx_prefilter_desc). OpenMP runs at most that many threads; the
+ *   callback is called from one thread at a time, a few times a second,
+ *   and returning false cancels (LX_ERR_CANCELLED, outputs zeroed, no
+ *   file written). Results are bit-identical for any thread count: every
+ *   texel is computed alone, sums run in a fixed order, GGX samples come
+ *   from one fixed Hammersley set. All functions are thread-safe on
+ *   distinct outputs: they keep no state between calls and only read their
+ *   inputs (lx_cubemap_fix_seams writes the cube map it is given, so one
+ *   call per cube map at a time); lx_set_log_callback's callback hears the
+ *   warnings from any thread.
  *
  * USAGE
- *   lx_cubemap env, irr;
- *   if (lx_env_load("sky.hdr", NULL, &env) != LX_OK) return 1;
+ *   lx_cubemap env, irr, spec[LX_MAX_CUBE_MIPS];
  *   lx_sh9 sh;
- *   if (lx_sh_project(&env, &sh) == LX_OK && lx_sh_irradiance_cube(&sh, 32, &irr) == LX_OK)
- *       lx_cubemap_free(&irr);
+ *   int levels;
+ *   if (lx_env_load("sky.hdr", NULL, &env) != LX_OK)
+ *       return 1;
+ *   if (lx_sh_project(&env, NULL, &sh) != LX_OK ||
+ *       lx_sh_irradiance_cube(&sh, 32, NULL, &irr) != LX_OK) {
+ *       lx_cubemap_free(&env);
+ *       return 1;
+ *   }
+ *   lx_prefilter_desc pd = {.filter = LX_SPECULAR_GGX, .size = 64};
+ *   lx_status st = lx_prefilter(&env, &pd, spec, &levels);
+ *   lx_env_write_desc wd = {.layout = LX_ENV_KTX};
+ *   if (st == LX_OK)
+ *       st = lx_env_write(".", "specular", spec, levels, &wd);
+ *   printf("irradiance facing up: %g lux (%s)\n",
+ *          lx_cubemap_texel(&irr, LX_FACE_PY, 16, 16)[1], lx_status_name(st));
+ *   for (int i = 0; i < LX_MAX_CUBE_MIPS; i++) // zeroed if it failed
+ *       lx_cubemap_free(&spec[i]);
+ *   lx_cubemap_free(&irr);
  *   lx_cubemap_free(&env);
+ *   if (st != LX_OK)
+ *       return 1;
  */
 #ifndef LUXEL_IBL_H
 #define LUXEL_IBL_H
@@ -66,6 +102,10 @@ lx_vec3 lx_cube_direction(int face, float s, float t);
 /* The face a direction (not necessarily unit, not zero) leaves the cube
  * through and its face coordinates (s, t) in [0,1]^2. Ties go to X, then Y. */
 void lx_cube_face_coords(lx_vec3 dir, int *face, float *s, float *t);
+/* The texel (*face, *x, *y) of a size x size face map that a direction (not
+ * zero) falls in: the face lx_cube_face_coords picks, x = floor(s size)
+ * kept inside the face. */
+void lx_cube_texel_at(lx_vec3 dir, int size, int *face, int *x, int *y);
 /* The exact solid angle (steradians) of texel (x, y) on a face of size
  * texels per side; the 6*size^2 texels sum to 4 pi. */
 double lx_cube_texel_solid_angle(int size, int x, int y);
@@ -77,6 +117,19 @@ void lx_equirect_coords(lx_vec3 dir, float *u, float *v);
 /* Levels of a full mip chain from a face of size texels down to 1x1 (each
  * level half the one before, rounded down): 1 + floor(log2(size)). */
 int lx_cube_mip_count(int size);
+
+/* ---- threads and progress --------------------------------------------- */
+
+/* What every long call without options of its own takes. desc may be NULL
+ * (all cores, no progress). */
+typedef struct lx_ibl_desc {
+    int threads;             /* at most this many threads, 0 = all cores */
+    lx_progress_fn progress; /* may be NULL; returning false cancels */
+    void *progress_user;
+} lx_ibl_desc;
+
+/* A copy of desc (or of zeros when NULL) with every default filled in. */
+lx_ibl_desc lx_ibl_desc_defaults(const lx_ibl_desc *desc);
 
 /* ---- cube maps ------------------------------------------------------- */
 
@@ -105,39 +158,51 @@ lx_image lx_cubemap_face_image(const lx_cubemap *c, int face);
  * face are taken from the neighbouring face, so filtering has no seams. */
 void lx_cubemap_sample(const lx_cubemap *c, lx_vec3 dir, float out[3]);
 
-/* Half-size cube map (size / 2, at least 1): each texel the solid-angle
- * weighted mean of the 2x2 texels it covers (an odd size: of the 2.x
- * texels it covers, each weighted by its covered fraction too). Rejects
- * NaN or infinite texels. dst is allocated; free it with lx_cubemap_free.
- * Uses all cores. */
-lx_status lx_cubemap_downsample(const lx_cubemap *src, lx_cubemap *dst);
+/* A smaller cube map of size texels a side (1..src->size; 0 = half, at
+ * least 1): each texel the solid-angle weighted mean of the source texels
+ * it covers, those it covers in part weighted by the covered fraction of
+ * their side too; halving repeatedly gives the same when the sizes divide.
+ * Rejects NaN or infinite texels. dst is allocated; free it with
+ * lx_cubemap_free. desc may be NULL. */
+lx_status lx_cubemap_downsample(const lx_cubemap *src, int size, const lx_ibl_desc *desc,
+                                lx_cubemap *dst);
 
 /* The seed's seam fix: texels that lie along a cube edge are replaced by
- * the mean of themselves and their neighbour across the edge, corner
- * texels by the mean of the three that meet there, so both sides agree. */
+ * the mean of themselves and their neighbour across the edge (the texel
+ * lx_cubemap_sample takes there), corner texels by the mean of the three
+ * that meet there, so both sides agree. Touches 12 size texels: no desc. */
 void lx_cubemap_fix_seams(lx_cubemap *c);
 
 /* ---- environments in and out ---------------------------------------- */
 
 typedef enum lx_env_layout {
-    LX_ENV_AUTO = 0, /* from the shape: 2:1 equirect, 4:3 or 3:4 cross,
-                        a name ending in _px.<ext> for six faces */
+    LX_ENV_AUTO = 0, /* in: from the shape (2:1 equirect, 4:3 or 3:4 cross, a
+                        name ending in _px.<ext> for six faces); out: FACES */
     LX_ENV_EQUIRECT,
-    LX_ENV_CROSS, /* horizontal (4:3) or vertical (3:4) */
-    LX_ENV_FACES, /* path names the +X face: <name>_px.<ext> */
-    LX_ENV_KTX    /* output only: one KTX 1.1 file */
+    LX_ENV_CROSS,         /* in: horizontal (4:3) or vertical (3:4); out: horizontal */
+    LX_ENV_FACES,         /* in: path names the +X face <name>_px.<ext>; out: six files */
+    LX_ENV_KTX,           /* out only: one KTX 1.1 file, the levels as its mips */
+    LX_ENV_CROSS_VERTICAL /* in: as CROSS; out: a vertical cross */
 } lx_env_layout;
 
 typedef struct lx_env_load_desc {
     lx_env_layout layout;
-    float intensity; /* multiplier on every texel, 0 = 1 */
-    int size;        /* cube face size; 0 = from the input (equirect: width/4) */
+    float intensity;         /* multiplier on every texel, 0 = 1 */
+    int size;                /* cube face size; 0 = from the input (equirect: width/4) */
+    int threads;             /* resampling threads, 0 = all cores */
+    lx_progress_fn progress; /* may be NULL; returning false cancels */
+    void *progress_user;
 } lx_env_load_desc;
 
+/* A copy of desc (or of zeros when NULL) with every default filled in. */
+lx_env_load_desc lx_env_load_desc_defaults(const lx_env_load_desc *desc);
+
 /* Loads an environment (any format lx_image_load reads; 8-bit files are
- * sRGB decoded) into a cube map. Rejects a non-2:1 equirect, a cross of the
- * wrong proportions, faces of unequal sizes, and NaN, infinite or negative
- * texels (the message gives their count). desc may be NULL. */
+ * sRGB decoded) into a cube map at desc->size (resampled by a box filter:
+ * each texel the mean of a grid of bilinear samples over it). Rejects a
+ * non-2:1 equirect, a cross of the wrong proportions, faces of unequal
+ * sizes, and NaN, infinite or negative texels (the message gives their
+ * count). desc may be NULL. */
 lx_status lx_env_load(const char *path, const lx_env_load_desc *desc, lx_cubemap *out);
 
 /* The same for an image already in memory (1 to 4 channels; grey is
@@ -151,38 +216,71 @@ lx_status lx_env_constant(lx_vec3 radiance, int size, lx_cubemap *out);
 
 /* Layout conversions. From an equirect, each cube texel is the mean of a
  * stratified set of equirect bilinear samples over the texel; to an
- * equirect, each pixel is the mean of lx_cubemap_sample over the pixel. */
-lx_status lx_cubemap_from_equirect(const lx_image *equirect, int size, lx_cubemap *out);
-lx_status lx_cubemap_to_equirect(const lx_cubemap *c, int width, lx_image *out);
-lx_status lx_cubemap_from_cross(const lx_image *cross, lx_cubemap *out);
-lx_status lx_cubemap_to_cross(const lx_cubemap *c, bool vertical, lx_image *out);
+ * equirect, each pixel is the mean of lx_cubemap_sample over the pixel.
+ * desc may be NULL. */
+lx_status lx_cubemap_from_equirect(const lx_image *equirect, int size, const lx_ibl_desc *desc,
+                                   lx_cubemap *out);
+lx_status lx_cubemap_to_equirect(const lx_cubemap *c, int width, const lx_ibl_desc *desc,
+                                 lx_image *out);
+lx_status lx_cubemap_from_cross(const lx_image *cross, const lx_ibl_desc *desc, lx_cubemap *out);
+lx_status lx_cubemap_to_cross(const lx_cubemap *c, bool vertical, const lx_ibl_desc *desc,
+                              lx_image *out);
+
+/* Called by lx_env_write before it creates each file, with the file's
+ * name (no folder); returning false stops the write (LX_ERR_CANCELLED). */
+typedef bool (*lx_env_file_fn)(void *user, const char *name);
+
+typedef struct lx_env_write_desc {
+    lx_env_layout layout;    /* AUTO = FACES; FACES, CROSS, CROSS_VERTICAL, EQUIRECT, KTX */
+    lx_image_format format;  /* of the images (not KTX); AUTO = EXR */
+    bool half;               /* 16-bit floats: EXR half, KTX RGBA16F (else RGBA32F) */
+    bool mip_names;          /* name levels <stem>_m<L> even when there is one */
+    int threads;             /* conversion and encoding threads, 0 = all cores */
+    lx_progress_fn progress; /* may be NULL; returning false cancels */
+    void *progress_user;
+    lx_env_file_fn on_file; /* may be NULL: hears each file's name first */
+    void *on_file_user;
+} lx_env_write_desc;
+
+/* A copy of desc (or of zeros when NULL) with every default filled in. */
+lx_env_write_desc lx_env_write_desc_defaults(const lx_env_write_desc *desc);
+
+/* Writes levels[0..count) (a cube map and its mips) into folder, named from
+ * stem: KTX one file <stem>.ktx (the levels must halve down from level 0,
+ * RGBA16F or RGBA32F, A = 1); the image layouts one or six files per level
+ * named <stem>[_m<L>][_<face>].<ext> - _m<L> when count > 1 or
+ * desc->mip_names, _px ... _nz for FACES, an equirect 4N x 2N. Each file is
+ * written atomically (a temporary name renamed when complete); on failure
+ * or cancellation the files this call wrote are removed again (one it
+ * replaced stays replaced: write into a fresh folder for all or nothing).
+ * Rejects NaN or infinite values, and values beyond 65504 in half floats,
+ * naming the file and texel. desc may be NULL. */
+lx_status lx_env_write(const char *folder, const char *stem, const lx_cubemap *levels, int count,
+                       const lx_env_write_desc *desc);
+
+/* Checks, without a cube map, what lx_env_write of count levels from a
+ * face size `size` down would be refused: the desc, and its peak memory
+ * (the levels and the image each is written from). */
+lx_status lx_env_write_check(int size, int count, const lx_env_write_desc *desc);
 
 /* Writes levels[0..count) (a cube map and its mips, each half the size of
- * the one before) as one KTX 1.1 file, RGBA16F when half else RGBA32F,
- * atomically. */
+ * the one before) as one KTX 1.1 file at path, RGBA16F when half else
+ * RGBA32F, atomically (lx_env_write with LX_ENV_KTX, at a path of the
+ * caller's choosing). */
 lx_status lx_ktx_write_cubemap(const char *path, const lx_cubemap *levels, int count, bool half);
 
 /* ---- diffuse irradiance --------------------------------------------- */
-
-typedef struct lx_ibl_desc {
-    int threads;             /* 0 = all cores */
-    lx_progress_fn progress; /* may be NULL; returning false cancels */
-    void *progress_user;
-} lx_ibl_desc;
-
-/* A copy of desc (or of zeros when NULL) with every default filled in. */
-lx_ibl_desc lx_ibl_desc_defaults(const lx_ibl_desc *desc);
 
 /* The seed's brute force: every source texel a directional light of
  * radiance * exact solid angle, weighted by the cosine. The cosine is
  * integrated exactly over each texel (its irradiance vector, Lambert's
  * formula); a texel the horizon cuts is split into sub-texels, so a
  * constant environment L gives pi L to ~2e-5. The source is first
- * downsampled (lx_cubemap_downsample) until its face size is at most
- * source_size (0 = 32). out gets a cube map of size texels per side
- * (0 = 32), irradiance in lux. Cost: 6 size^2 x 6 source^2 texel pairs.
- * Rejects NaN or infinite texels. desc may be NULL. On failure or
- * cancellation out is left zeroed. */
+ * downsampled (lx_cubemap_downsample, in one pass) to its size halved
+ * until it is at most source_size (0 = 32). out gets a cube map of size
+ * texels per side (0 = 32), irradiance in lux. Cost: 6 size^2 x 6
+ * source^2 texel pairs. Rejects NaN or infinite texels. desc may be NULL.
+ * On failure or cancellation out is left zeroed. */
 lx_status lx_irradiance_brute(const lx_cubemap *src, int size, int source_size,
                               const lx_ibl_desc *desc, lx_cubemap *out);
 
@@ -201,9 +299,10 @@ typedef struct lx_sh9 {
  * orthonormal frame). */
 void lx_sh9_basis(lx_vec3 d, float y[9]);
 /* Projects a cube map (radiance, nits) with exact texel solid angles, sums
- * in double; uses all cores, the same result for any number. Fails with
- * LX_ERR_INVALID when the cube map holds NaN or infinite texels. */
-lx_status lx_sh_project(const lx_cubemap *c, lx_sh9 *out);
+ * in double, the same result for any thread count. Fails with
+ * LX_ERR_INVALID when the cube map holds NaN or infinite texels. desc may
+ * be NULL. */
+lx_status lx_sh_project(const lx_cubemap *c, const lx_ibl_desc *desc, lx_sh9 *out);
 /* Irradiance (lux) at unit normal n: the paper's equation 13. NOT clamped:
  * the order-2 truncation rings, and an environment dominated by a small,
  * strong light comes out slightly negative about 120 degrees away from it
@@ -214,8 +313,10 @@ void lx_sh_irradiance(const lx_sh9 *sh, lx_vec3 n, float out[3]);
 extern const float lx_sh_irradiance_constants[5];
 /* lx_sh_irradiance at every texel centre of a size^2 cube map (allocated;
  * free with lx_cubemap_free). Not clamped either: negative texels are
- * kept, and a warning counting them goes to the log callback. */
-lx_status lx_sh_irradiance_cube(const lx_sh9 *sh, int size, lx_cubemap *out);
+ * kept, and a warning counting them goes to the log callback. desc may be
+ * NULL. */
+lx_status lx_sh_irradiance_cube(const lx_sh9 *sh, int size, const lx_ibl_desc *desc,
+                                lx_cubemap *out);
 
 /* ---- specular -------------------------------------------------------- */
 
@@ -270,19 +371,28 @@ float lx_phong_level_exponent(int level);
  * covers), leaving out texels where the lobe is below 1e-4 of its peak.
  * Both read across face edges, so the levels have no seams. Threads,
  * progress and cancellation from desc (may be NULL); the result is the
- * same for any thread count. Rejects NaN or infinite source texels. */
+ * same for any thread count. Rejects NaN or infinite source texels, and
+ * (LX_ERR_NOMEM, before allocating) a run whose source, mips, padded
+ * copies, convolution lights and levels together exceed the machine's
+ * memory. A level 0 more than 4x the source's size logs a warning. */
 lx_status lx_prefilter(const lx_cubemap *src, const lx_prefilter_desc *desc,
                        lx_cubemap levels[LX_MAX_CUBE_MIPS], int *count);
+
+/* What lx_prefilter of a source of face size source_size with desc would
+ * refuse, checked on the sizes alone (nothing large is allocated): the
+ * desc and the peak memory, with lx_prefilter's messages. */
+lx_status lx_prefilter_check(int source_size, const lx_prefilter_desc *desc);
 
 /* The split-sum DFG table for GGX (Karis 2013): texel (x, y), row 0 at the
  * top, holds N.V = (x + 0.5) / size and perceptual roughness
  * (y + 0.5) / size (alpha = roughness^2); channel 0 is the scale A and
  * channel 1 the bias B on F0 (specular = F0 * A + B). G is Smith's
- * height-correlated masking-shadowing (Heitz 2014). samples Hammersley
- * importance samples per texel. size 0 = 128 (1..4096), samples 0 = 1024
+ * height-correlated masking-shadowing (Heitz 2014); the integrals are
+ * estimated from samples Hammersley-placed visible normals (Heitz 2018),
+ * the same for every texel. size 0 = 128 (1..4096), samples 0 = 1024
  * (1..2^20). out is allocated (size*size*2 floats); free with
- * lx_image_free. Uses all cores; the same result for any number. */
-lx_status lx_dfg_lut(int size, int samples, lx_image *out);
+ * lx_image_free. desc may be NULL. */
+lx_status lx_dfg_lut(int size, int samples, const lx_ibl_desc *desc, lx_image *out);
 
 #ifdef __cplusplus
 }

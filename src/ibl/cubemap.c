@@ -7,6 +7,7 @@
 #include "core/internal.h"
 
 #include <math.h>
+#include <stdio.h>
 #include <stdlib.h>
 #include <string.h>
 
@@ -16,24 +17,15 @@ const char *lx_cube_face_name(int face)
     return face >= 0 && face < 6 ? names[face] : "?";
 }
 
-/* Direction (not normalised) through face coordinates sc, tc in [-1, 1]. */
-lx_vec3 lx_ibl_face_vector(int face, float sc, float tc)
-{
-    switch (face) {
-    case LX_FACE_PX:
-        return lx_v3(1.0f, -tc, -sc);
-    case LX_FACE_NX:
-        return lx_v3(-1.0f, -tc, sc);
-    case LX_FACE_PY:
-        return lx_v3(sc, 1.0f, tc);
-    case LX_FACE_NY:
-        return lx_v3(sc, -1.0f, -tc);
-    case LX_FACE_PZ:
-        return lx_v3(sc, -tc, 1.0f);
-    default:
-        return lx_v3(-sc, -tc, -1.0f);
-    }
-}
+/* major axis, right (sc), down (tc): ibl.h's table */
+const float lx_ibl_face_axes[6][3][3] = {
+    {{1, 0, 0}, {0, 0, -1}, {0, -1, 0}},  /* +X (1, -tc, -sc) */
+    {{-1, 0, 0}, {0, 0, 1}, {0, -1, 0}},  /* -X (-1, -tc, sc) */
+    {{0, 1, 0}, {1, 0, 0}, {0, 0, 1}},    /* +Y (sc, 1, tc) */
+    {{0, -1, 0}, {1, 0, 0}, {0, 0, -1}},  /* -Y (sc, -1, -tc) */
+    {{0, 0, 1}, {1, 0, 0}, {0, -1, 0}},   /* +Z (sc, -tc, 1) */
+    {{0, 0, -1}, {-1, 0, 0}, {0, -1, 0}}, /* -Z (-sc, -tc, -1) */
+};
 
 lx_vec3 lx_cube_direction(int face, float s, float t)
 {
@@ -45,19 +37,13 @@ void lx_cube_face_coords(lx_vec3 d, int *face, float *s, float *t)
     lx_ibl_face_st(d, face, s, t);
 }
 
-/* Solid angle of the face rectangle [0, a] x [0, b] (face at distance 1). */
-static double corner_solid_angle(double a, double b)
-{
-    return atan2(a * b, sqrt(a * a + b * b + 1.0));
-}
-
 double lx_cube_texel_solid_angle(int size, int x, int y)
 {
     double inv = 2.0 / size;
     double x0 = x * inv - 1.0, x1 = (x + 1) * inv - 1.0;
     double y0 = y * inv - 1.0, y1 = (y + 1) * inv - 1.0;
-    return corner_solid_angle(x0, y0) - corner_solid_angle(x0, y1) - corner_solid_angle(x1, y0) +
-           corner_solid_angle(x1, y1);
+    return lx_ibl_corner(x0, y0) - lx_ibl_corner(x0, y1) - lx_ibl_corner(x1, y0) +
+           lx_ibl_corner(x1, y1);
 }
 
 lx_vec3 lx_equirect_direction(float u, float v)
@@ -93,7 +79,9 @@ lx_status lx_cubemap_alloc(lx_cubemap *c, int size)
     if (size < 1 || size > LX_MAX_CUBE_SIZE)
         return lx_fail(LX_ERR_INVALID, "cube map size %d is outside 1..%d", size, LX_MAX_CUBE_SIZE);
     uint64_t count = 6ull * (uint64_t)size * (uint64_t)size * 3ull;
-    lx_status st = lx_check_memory(count * sizeof(float), "cube map");
+    char what[64];
+    snprintf(what, sizeof what, "a %d x %d cube map", size, size);
+    lx_status st = lx_check_memory(count * sizeof(float), what);
     if (st != LX_OK)
         return st;
     c->data = calloc((size_t)count, sizeof(float));
@@ -118,22 +106,32 @@ lx_image lx_cubemap_face_image(const lx_cubemap *c, int face)
     return img;
 }
 
-/* Texel (x, y) of a face where x or y may be one step off the face: the
- * texel whose centre is nearest the extrapolated direction. */
-static const float *texel_across(const lx_cubemap *c, int face, int x, int y)
+void lx_cube_texel_at(lx_vec3 dir, int size, int *face, int *x, int *y)
 {
-    int n = c->size;
-    if (x >= 0 && x < n && y >= 0 && y < n)
-        return lx_cubemap_texel(c, face, x, y);
+    float s, t;
+    lx_ibl_face_st(dir, face, &s, &t);
+    int n = size, tx = (int)(s * (float)n), ty = (int)(t * (float)n);
+    *x = tx < 0 ? 0 : tx >= n ? n - 1 : tx;
+    *y = ty < 0 ? 0 : ty >= n ? n - 1 : ty;
+}
+
+void lx_ibl_texel_across(int size, int face, int x, int y, int *f, int *tx, int *ty)
+{
+    int n = size;
+    if (x >= 0 && x < n && y >= 0 && y < n) {
+        *f = face, *tx = x, *ty = y;
+        return;
+    }
     float sc = 2.0f * ((float)x + 0.5f) / (float)n - 1.0f;
     float tc = 2.0f * ((float)y + 0.5f) / (float)n - 1.0f;
-    int f;
-    float s, t;
-    lx_cube_face_coords(lx_ibl_face_vector(face, sc, tc), &f, &s, &t);
-    int nx = (int)(s * (float)n), ny = (int)(t * (float)n);
-    nx = nx < 0 ? 0 : nx >= n ? n - 1 : nx;
-    ny = ny < 0 ? 0 : ny >= n ? n - 1 : ny;
-    return lx_cubemap_texel(c, f, nx, ny);
+    lx_cube_texel_at(lx_ibl_face_vector(face, sc, tc), n, f, tx, ty);
+}
+
+static const float *texel_across(const lx_cubemap *c, int face, int x, int y)
+{
+    int f, tx, ty;
+    lx_ibl_texel_across(c->size, face, x, y, &f, &tx, &ty);
+    return lx_cubemap_texel(c, f, tx, ty);
 }
 
 void lx_cubemap_sample(const lx_cubemap *c, lx_vec3 dir, float out[3])

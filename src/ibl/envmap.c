@@ -1,266 +1,20 @@
-/* Environments in and out of cube maps: loading (layout detection from the
- * name and the shape, validation of sizes and values), constant
- * environments, and the equirect and cross layouts.
- *
- * Resampling is the plain box filter over the target texel or pixel: its
- * mean is estimated from an n x n grid of bilinear samples at the centres
- * of equal sub-cells of the texel in face (or equirect) coordinates, n
- * chosen so the grid is finer than the source's texels. The cross layouts
- * are the common ones of cube map tools (AMD CubeMapGen, cmft): faces in
- * the OpenGL orientation, +Z in the middle, and in the vertical cross -Z
- * below -Y turned by 180 degrees, so neighbouring faces meet edge to edge. */
-#include "luxel/ibl.h"
+/* Environments into cube maps: loading (layout detection from the name
+ * and the shape, validation of sizes and values, the memory a load needs
+ * checked before it is taken), the asked face size (env_resample.c) and
+ * intensity, and constant environments. */
+#include "ibl_internal.h"
 #include "core/internal.h"
 
 #include <math.h>
+#include <stdarg.h>
 #include <stdio.h>
 #include <stdlib.h>
 #include <string.h>
-
-/* Largest equirect width lx_cubemap_to_equirect makes (a 4 x 16384 face). */
-#define MAX_EQUIRECT_WIDTH (4 * LX_MAX_CUBE_SIZE)
-/* Most samples per side of a texel or pixel. */
-#define MAX_GRID 32
-
-static int grid_for(double ratio)
-{
-    double n = ceil(ratio) + 1.0;
-    return n < 2.0 ? 2 : n > MAX_GRID ? MAX_GRID : (int)n;
-}
-
-/* RGB of pixel (x, y): grey images give grey, alpha is ignored. */
-static void pixel_rgb(const lx_image *img, int x, int y, float out[3])
-{
-    const float *p = img->data + ((size_t)y * (size_t)img->width + (size_t)x) * img->channels;
-    if (img->channels >= 3) {
-        out[0] = p[0];
-        out[1] = p[1];
-        out[2] = p[2];
-    } else {
-        out[0] = out[1] = out[2] = p[0];
-    }
-}
-
-static float *pixel_at(const lx_image *img, int x, int y)
-{
-    return img->data + ((size_t)y * (size_t)img->width + (size_t)x) * img->channels;
-}
-
-/* Bilinear sample of an equirect: u wraps around, v stops at the poles. */
-static void equirect_sample(const lx_image *img, float u, float v, float out[3])
-{
-    int w = img->width, h = img->height;
-    float fx = u * (float)w - 0.5f, fy = v * (float)h - 0.5f;
-    float x0f = floorf(fx), y0f = floorf(fy);
-    float wx = fx - x0f, wy = fy - y0f;
-    int x0 = (int)x0f % w;
-    if (x0 < 0)
-        x0 += w;
-    int x1 = x0 + 1 == w ? 0 : x0 + 1;
-    int y0 = (int)y0f, y1 = y0 + 1;
-    y0 = y0 < 0 ? 0 : y0 >= h ? h - 1 : y0;
-    y1 = y1 < 0 ? 0 : y1 >= h ? h - 1 : y1;
-    float a[3], b[3], c[3], d[3];
-    pixel_rgb(img, x0, y0, a);
-    pixel_rgb(img, x1, y0, b);
-    pixel_rgb(img, x0, y1, c);
-    pixel_rgb(img, x1, y1, d);
-    for (int k = 0; k < 3; k++) {
-        float top = a[k] + (b[k] - a[k]) * wx;
-        float bottom = c[k] + (d[k] - c[k]) * wx;
-        out[k] = top + (bottom - top) * wy;
-    }
-}
 
 static bool image_ok(const lx_image *img)
 {
     return img && img->data && img->width > 0 && img->height > 0 && img->channels >= 1 &&
            img->channels <= 4;
-}
-
-/* Fills a cube map of size texels a side, each texel the mean of an n x n
- * grid of lookup(source, direction) over the texel, n from the ratio of the
- * source's resolution to the cube's (grid_for). */
-typedef void (*direction_lookup)(const void *source, lx_vec3 dir, float rgb[3]);
-
-static lx_status cube_by_grid(int size, double ratio, bool equirect_source, direction_lookup lookup,
-                              const void *source, lx_cubemap *out)
-{
-    lx_status st = lx_cubemap_alloc(out, size);
-    if (st != LX_OK)
-        return st;
-    int rows = 6 * size;
-#pragma omp parallel for schedule(dynamic)
-    for (int row = 0; row < rows; row++) {
-        int face = row / size, y = row % size;
-        for (int x = 0; x < size; x++) {
-            /* An equirect's columns crowd together toward the poles, 1 /
-             * sin(theta) more of them across a texel: the grid grows with
-             * them so a small sun there is not missed between samples. */
-            int n = grid_for(ratio);
-            if (equirect_source) {
-                lx_vec3 c = lx_cube_direction(face, ((float)x + 0.5f) / (float)size,
-                                              ((float)y + 0.5f) / (float)size);
-                double sin_theta = sqrt(fmax(0.0, 1.0 - (double)c.y * c.y));
-                n = grid_for(ratio / fmax(sin_theta, 1.0 / MAX_GRID));
-            }
-            double sum[3] = {0, 0, 0};
-            for (int j = 0; j < n; j++)
-                for (int i = 0; i < n; i++) {
-                    float s = ((float)x + ((float)i + 0.5f) / (float)n) / (float)size;
-                    float t = ((float)y + ((float)j + 0.5f) / (float)n) / (float)size;
-                    float rgb[3];
-                    lookup(source, lx_cube_direction(face, s, t), rgb);
-                    for (int k = 0; k < 3; k++)
-                        sum[k] += rgb[k];
-                }
-            float *texel = lx_cubemap_texel(out, face, x, y);
-            for (int k = 0; k < 3; k++)
-                texel[k] = (float)(sum[k] / (double)(n * n));
-        }
-    }
-    return LX_OK;
-}
-
-static void equirect_lookup(const void *source, lx_vec3 dir, float rgb[3])
-{
-    float u, v;
-    lx_equirect_coords(dir, &u, &v);
-    equirect_sample(source, u, v, rgb);
-}
-
-static void cube_lookup(const void *source, lx_vec3 dir, float rgb[3])
-{
-    lx_cubemap_sample(source, dir, rgb);
-}
-
-/* ---- equirect ------------------------------------------------------------ */
-
-lx_status lx_cubemap_from_equirect(const lx_image *eq, int size, lx_cubemap *out)
-{
-    memset(out, 0, sizeof *out);
-    if (!image_ok(eq))
-        return lx_fail(LX_ERR_INVALID, "lx_cubemap_from_equirect: invalid image");
-    if (eq->width != 2 * eq->height)
-        return lx_fail(LX_ERR_INVALID,
-                       "equirect is %dx%d; an equirect must be exactly twice as wide as it is "
-                       "tall",
-                       eq->width, eq->height);
-    return cube_by_grid(size, (double)eq->width / (4.0 * size), true, equirect_lookup, eq, out);
-}
-
-lx_status lx_cubemap_to_equirect(const lx_cubemap *c, int width, lx_image *out)
-{
-    memset(out, 0, sizeof *out);
-    if (!c || !c->data || c->size < 1)
-        return lx_fail(LX_ERR_INVALID, "lx_cubemap_to_equirect: invalid cube map");
-    if (width < 2 || width % 2 != 0 || width > MAX_EQUIRECT_WIDTH)
-        return lx_fail(LX_ERR_INVALID, "equirect width %d must be even and in 2..%d", width,
-                       MAX_EQUIRECT_WIDTH);
-    int height = width / 2;
-    lx_status st = lx_image_alloc(out, width, height, 3);
-    if (st != LX_OK)
-        return st;
-    int n = grid_for(4.0 * c->size / (double)width);
-#pragma omp parallel for schedule(dynamic)
-    for (int y = 0; y < height; y++) {
-        for (int x = 0; x < width; x++) {
-            double sum[3] = {0, 0, 0};
-            for (int j = 0; j < n; j++)
-                for (int i = 0; i < n; i++) {
-                    float u = ((float)x + ((float)i + 0.5f) / (float)n) / (float)width;
-                    float v = ((float)y + ((float)j + 0.5f) / (float)n) / (float)height;
-                    float rgb[3];
-                    lx_cubemap_sample(c, lx_equirect_direction(u, v), rgb);
-                    for (int k = 0; k < 3; k++)
-                        sum[k] += rgb[k];
-                }
-            float *p = pixel_at(out, x, y);
-            for (int k = 0; k < 3; k++)
-                p[k] = (float)(sum[k] / (double)(n * n));
-        }
-    }
-    return LX_OK;
-}
-
-/* ---- cross --------------------------------------------------------------- */
-
-/* Where each face sits in a cross, in face-size units (column, row). */
-static const int cross_h[6][2] = {{2, 1}, {0, 1}, {1, 0}, {1, 2}, {1, 1}, {3, 1}};
-static const int cross_v[6][2] = {{2, 1}, {0, 1}, {1, 0}, {1, 2}, {1, 1}, {1, 3}};
-
-/* The cross pixel that holds face texel (x, y). */
-static void cross_pixel(bool vertical, int size, int face, int x, int y, int *px, int *py)
-{
-    const int *cell = vertical ? cross_v[face] : cross_h[face];
-    if (vertical && face == LX_FACE_NZ) {
-        /* turned by 180 degrees so its top edge meets -Y's bottom edge */
-        x = size - 1 - x;
-        y = size - 1 - y;
-    }
-    *px = cell[0] * size + x;
-    *py = cell[1] * size + y;
-}
-
-/* The face size of a cross and whether it is vertical; false if the image
- * has neither 4:3 nor 3:4 proportions with whole faces. */
-static bool cross_shape(int w, int h, int *size, bool *vertical)
-{
-    if (w % 4 == 0 && h == w / 4 * 3) {
-        *size = w / 4;
-        *vertical = false;
-        return true;
-    }
-    if (w % 3 == 0 && h == w / 3 * 4) {
-        *size = w / 3;
-        *vertical = true;
-        return true;
-    }
-    return false;
-}
-
-lx_status lx_cubemap_from_cross(const lx_image *cross, lx_cubemap *out)
-{
-    memset(out, 0, sizeof *out);
-    if (!image_ok(cross))
-        return lx_fail(LX_ERR_INVALID, "lx_cubemap_from_cross: invalid image");
-    int size;
-    bool vertical;
-    if (!cross_shape(cross->width, cross->height, &size, &vertical))
-        return lx_fail(LX_ERR_INVALID,
-                       "cross is %dx%d; a cross must be 4:3 (horizontal) or 3:4 (vertical) "
-                       "with square faces",
-                       cross->width, cross->height);
-    lx_status st = lx_cubemap_alloc(out, size);
-    if (st != LX_OK)
-        return st;
-    for (int f = 0; f < 6; f++)
-        for (int y = 0; y < size; y++)
-            for (int x = 0; x < size; x++) {
-                int px, py;
-                cross_pixel(vertical, size, f, x, y, &px, &py);
-                pixel_rgb(cross, px, py, lx_cubemap_texel(out, f, x, y));
-            }
-    return LX_OK;
-}
-
-lx_status lx_cubemap_to_cross(const lx_cubemap *c, bool vertical, lx_image *out)
-{
-    memset(out, 0, sizeof *out);
-    if (!c || !c->data || c->size < 1 || c->size > LX_MAX_CUBE_SIZE)
-        return lx_fail(LX_ERR_INVALID, "lx_cubemap_to_cross: invalid cube map");
-    int size = c->size;
-    lx_status st = lx_image_alloc(out, (vertical ? 3 : 4) * size, (vertical ? 4 : 3) * size, 3);
-    if (st != LX_OK)
-        return st;
-    for (int f = 0; f < 6; f++)
-        for (int y = 0; y < size; y++)
-            for (int x = 0; x < size; x++) {
-                int px, py;
-                cross_pixel(vertical, size, f, x, y, &px, &py);
-                memcpy(pixel_at(out, px, py), lx_cubemap_texel(c, f, x, y), 3 * sizeof(float));
-            }
-    return LX_OK;
 }
 
 /* ---- validation ---------------------------------------------------------- */
@@ -350,6 +104,20 @@ static lx_status load_rgb(const char *path, lx_image *img)
     return lx_image_load(path, &ld, img);
 }
 
+/* Fails with LX_ERR_NOMEM when bytes are more than the machine has; the
+ * message starts with the printf-formatted description of what needs
+ * them. */
+static lx_status check_bytes(uint64_t bytes, const char *fmt, ...) LX_PRINTF(2, 3);
+static lx_status check_bytes(uint64_t bytes, const char *fmt, ...)
+{
+    char what[640];
+    va_list ap;
+    va_start(ap, fmt);
+    vsnprintf(what, sizeof what, fmt, ap);
+    va_end(ap);
+    return lx_check_memory(bytes, what);
+}
+
 static lx_status load_faces(const char *path, lx_cubemap *out)
 {
     long at = px_suffix(path);
@@ -384,8 +152,10 @@ static lx_status load_faces(const char *path, lx_cubemap *out)
         }
         if (st == LX_OK && f == 0) {
             size = img.width;
-            st = lx_cubemap_alloc(out, size);
-            if (st != LX_OK)
+            /* the cube map besides the face being read */
+            st = check_bytes(lx_ibl_cube_bytes(size) + 12ull * size * size, "%s: six %d x %d faces",
+                             path, size, size);
+            if (st == LX_OK && (st = lx_cubemap_alloc(out, size)) != LX_OK)
                 lx_error_prefix(path);
         }
         if (st == LX_OK)
@@ -399,21 +169,18 @@ static lx_status load_faces(const char *path, lx_cubemap *out)
     return st;
 }
 
-/* A cube map of another size: each texel the box-filtered mean of c. */
-static lx_status resample_cube(const lx_cubemap *c, int size, lx_cubemap *out)
-{
-    return cube_by_grid(size, (double)c->size / (double)size, false, cube_lookup, c, out);
-}
-
-/* An equirect or a cross image (layout AUTO, EQUIRECT or CROSS) as a cube
- * map; name is for messages. */
+/* An equirect or a cross image (layout AUTO, EQUIRECT or a cross) as a
+ * cube map of face size `size` (0 = the image's own); name is for
+ * messages. An equirect goes straight to that size, a cross is copied
+ * (and resampled by finish). */
 static lx_status image_layout(const lx_image *img, const char *path, lx_env_layout layout, int size,
-                              lx_cubemap *out)
+                              const lx_ibl_run *run, lx_cubemap *out)
 {
     lx_status st = LX_OK;
     int cross_size;
     bool vertical;
-    bool is_cross = cross_shape(img->width, img->height, &cross_size, &vertical);
+    bool is_cross = lx_ibl_cross_shape(img->width, img->height, &cross_size, &vertical);
+    uint64_t image_bytes = 4ull * img->width * img->height * img->channels;
     if (layout == LX_ENV_AUTO) {
         if (img->width == 2 * img->height)
             layout = LX_ENV_EQUIRECT;
@@ -446,7 +213,16 @@ static lx_status image_layout(const lx_image *img, const char *path, lx_env_layo
                          path, img->width, img->height, size, size, LX_MAX_CUBE_SIZE);
             goto done;
         }
-        st = lx_cubemap_from_equirect(img, size, out);
+        st = check_bytes(image_bytes + lx_ibl_cube_bytes(size),
+                         "%s: a %d x %d equirect resampled to %d x %d faces", path, img->width,
+                         img->height, size, size);
+        if (st != LX_OK)
+            goto done;
+        char name[512];
+        snprintf(name, sizeof name, "%s: %d x %d faces from a %d x %d equirect", path, size, size,
+                 img->width, img->height);
+        lx_ibl_warn_upsampling(name, size, img->width / 4.0);
+        st = lx_ibl_cube_from_equirect(img, size, run, out);
     } else {
         if (!is_cross) {
             st = lx_fail(LX_ERR_FORMAT,
@@ -460,7 +236,13 @@ static lx_status image_layout(const lx_image *img, const char *path, lx_env_layo
                          LX_MAX_CUBE_SIZE);
             goto done;
         }
-        st = lx_cubemap_from_cross(img, out);
+        st = check_bytes(image_bytes + lx_ibl_cube_bytes(cross_size),
+                         "%s: a %d x %d cross of %d x %d faces", path, img->width, img->height,
+                         cross_size, cross_size);
+        if (st != LX_OK)
+            goto done;
+        lx_ibl_run part = lx_ibl_run_part(run, 0.0, 0.1);
+        st = lx_ibl_cube_from_cross(img, &part, out);
         if (st == LX_OK)
             st = check_cube_values(out, path);
     }
@@ -472,13 +254,21 @@ done:
     return st;
 }
 
-/* Checks desc (NULL: defaults) into *d and the intensity multiplier. */
-static lx_status check_desc(const char *name, const lx_env_load_desc *desc, lx_env_load_desc *d,
-                            float *intensity)
+lx_env_load_desc lx_env_load_desc_defaults(const lx_env_load_desc *desc)
 {
-    *d = desc ? *desc : (lx_env_load_desc){0};
-    *intensity = d->intensity == 0.0f ? 1.0f : d->intensity;
-    if (!isfinite(*intensity) || *intensity < 0.0f)
+    lx_env_load_desc d = {0};
+    if (desc)
+        d = *desc;
+    if (d.intensity == 0.0f)
+        d.intensity = 1.0f;
+    return d;
+}
+
+/* Checks desc (NULL: defaults) into *d. */
+static lx_status check_desc(const char *name, const lx_env_load_desc *desc, lx_env_load_desc *d)
+{
+    *d = lx_env_load_desc_defaults(desc);
+    if (!isfinite(d->intensity) || d->intensity < 0.0f)
         return lx_fail(LX_ERR_INVALID, "%s: intensity %g must be a finite number > 0", name,
                        (double)d->intensity);
     if (d->size < 0 || d->size > LX_MAX_CUBE_SIZE)
@@ -487,26 +277,45 @@ static lx_status check_desc(const char *name, const lx_env_load_desc *desc, lx_e
     if (d->layout == LX_ENV_KTX)
         return lx_fail(LX_ERR_UNSUPPORTED, "%s: KTX is an output layout; luxel does not read it",
                        name);
-    if (d->layout < LX_ENV_AUTO || d->layout > LX_ENV_KTX)
+    if (d->layout < LX_ENV_AUTO || d->layout > LX_ENV_CROSS_VERTICAL)
         return lx_fail(LX_ERR_INVALID, "%s: unknown layout %d", name, (int)d->layout);
-    return LX_OK;
+    lx_status st = lx_ibl_check_threads(d->threads);
+    if (st != LX_OK)
+        lx_error_prefix(name);
+    /* the cube map asked for, before any file is read */
+    if (st == LX_OK && d->size)
+        st = check_bytes(lx_ibl_cube_bytes(d->size), "%s: a %d x %d environment", name, d->size,
+                         d->size);
+    return st;
 }
 
 /* The asked size and intensity applied to a loaded cube map. */
-static lx_status finish(const char *name, const lx_env_load_desc *d, float intensity,
+static lx_status finish(const char *name, const lx_env_load_desc *d, const lx_ibl_run *run,
                         lx_cubemap *out)
 {
     lx_status st;
     if (d->size != 0 && d->size != out->size) {
+        st = check_bytes(lx_ibl_cube_bytes(out->size) + lx_ibl_cube_bytes(d->size),
+                         "%s: %d x %d faces resampled to %d x %d", name, out->size, out->size,
+                         d->size, d->size);
+        char what[512];
+        snprintf(what, sizeof what, "%s: %d x %d faces from %d x %d ones", name, d->size, d->size,
+                 out->size, out->size);
+        if (st == LX_OK)
+            lx_ibl_warn_upsampling(what, d->size, out->size);
         lx_cubemap resized;
-        st = resample_cube(out, d->size, &resized);
+        lx_ibl_run part = lx_ibl_run_part(run, 0.1, 1.0);
+        if (st == LX_OK)
+            st = lx_ibl_cube_resample(out, d->size, &part, &resized);
         lx_cubemap_free(out);
         if (st != LX_OK) {
-            lx_error_prefix(name);
+            if (strncmp(lx_last_error(), name, strlen(name)) != 0)
+                lx_error_prefix(name);
             return st;
         }
         *out = resized;
     }
+    float intensity = d->intensity;
     if (intensity != 1.0f) {
         size_t n = 6 * (size_t)out->size * (size_t)out->size * 3, overflow = 0;
         for (size_t i = 0; i < n; i++) {
@@ -519,6 +328,10 @@ static lx_status finish(const char *name, const lx_env_load_desc *d, float inten
                            name, (double)intensity, overflow);
         }
     }
+    if (run->progress && !run->progress(run->user, 1.0f)) {
+        lx_cubemap_free(out);
+        return lx_fail(LX_ERR_CANCELLED, "%s: loading cancelled", name);
+    }
     return LX_OK;
 }
 
@@ -529,20 +342,21 @@ lx_status lx_env_load(const char *path, const lx_env_load_desc *desc, lx_cubemap
     if (!path || !out)
         return lx_fail(LX_ERR_INVALID, "lx_env_load: path and out must not be NULL");
     lx_env_load_desc d;
-    float intensity;
-    lx_status st = check_desc(path, desc, &d, &intensity);
+    lx_status st = check_desc(path, desc, &d);
     if (st != LX_OK)
         return st;
+    lx_ibl_run run = lx_ibl_run_make(d.threads, d.progress, d.progress_user);
+    lx_ibl_run first = lx_ibl_run_part(&run, 0.0, 0.999);
     if (d.layout == LX_ENV_FACES || (d.layout == LX_ENV_AUTO && px_suffix(path) >= 0)) {
         st = load_faces(path, out);
     } else {
         lx_image img;
         if ((st = load_rgb(path, &img)) != LX_OK)
             return st;
-        st = image_layout(&img, path, d.layout, d.size, out);
+        st = image_layout(&img, path, d.layout, d.size, &first, out);
         lx_image_free(&img);
     }
-    return st == LX_OK ? finish(path, &d, intensity, out) : st;
+    return st == LX_OK ? finish(path, &d, &first, out) : st;
 }
 
 lx_status lx_env_from_image(const lx_image *img, const char *name, const lx_env_load_desc *desc,
@@ -554,14 +368,15 @@ lx_status lx_env_from_image(const lx_image *img, const char *name, const lx_env_
     if (!out || !image_ok(img))
         return lx_fail(LX_ERR_INVALID, "%s: no image, or an image without pixels", name);
     lx_env_load_desc d;
-    float intensity;
-    lx_status st = check_desc(name, desc, &d, &intensity);
+    lx_status st = check_desc(name, desc, &d);
     if (st != LX_OK)
         return st;
     if (d.layout == LX_ENV_FACES)
         return lx_fail(LX_ERR_INVALID, "%s: six faces come from files (lx_env_load)", name);
-    st = image_layout(img, name, d.layout, d.size, out);
-    return st == LX_OK ? finish(name, &d, intensity, out) : st;
+    lx_ibl_run run = lx_ibl_run_make(d.threads, d.progress, d.progress_user);
+    lx_ibl_run first = lx_ibl_run_part(&run, 0.0, 0.999);
+    st = image_layout(img, name, d.layout, d.size, &first, out);
+    return st == LX_OK ? finish(name, &d, &first, out) : st;
 }
 
 lx_status lx_env_constant(lx_vec3 radiance, int size, lx_cubemap *out)

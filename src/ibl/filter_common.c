@@ -1,12 +1,14 @@
 /* Shared machinery of the IBL filters: exact texel solid-angle tables (the
  * solid angle of a face rectangle seen from the cube centre, as in
- * cubemap.c), argument checks, progress and cancellation of the tiled
- * OpenMP loops, and a bilinear sampler with a fast path inside a face. */
+ * cubemap.c), argument checks, the parallel loop with progress and
+ * cancellation, and the bilinear samplers (a fast path inside a face, and
+ * padded copies whose border holds the texels across each edge). */
 #include "ibl_internal.h"
 #include "core/internal.h"
 
 #include <math.h>
 #include <omp.h>
+#include <stdio.h>
 #include <stdlib.h>
 #include <string.h>
 
@@ -14,7 +16,8 @@ double *lx_ibl_solid_angles(int n)
 {
     int h = (n + 1) / 2;
     double *q = malloc(sizeof(double) * (size_t)h * (size_t)h);
-    /* F on two neighbouring grid lines: grid point i is at (2i - n) / n */
+    /* the corner function on two neighbouring grid lines: grid point i is
+     * at (2i - n) / n */
     double *lo = malloc(sizeof(double) * (size_t)(h + 1));
     double *hi = malloc(sizeof(double) * (size_t)(h + 1));
     if (!q || !lo || !hi) {
@@ -26,10 +29,8 @@ double *lx_ibl_solid_angles(int n)
     }
     for (int j = 0; j <= h; j++) {
         double b = (double)(2 * j - n) / (double)n;
-        for (int i = 0; i <= h; i++) {
-            double a = (double)(2 * i - n) / (double)n;
-            hi[i] = atan2(a * b, sqrt(a * a + b * b + 1.0));
-        }
+        for (int i = 0; i <= h; i++)
+            hi[i] = lx_ibl_corner((double)(2 * i - n) / (double)n, b);
         if (j > 0)
             for (int i = 0; i < h; i++)
                 q[(size_t)(j - 1) * h + i] = lo[i] - lo[i + 1] - hi[i] + hi[i + 1];
@@ -70,93 +71,96 @@ lx_status lx_ibl_check_threads(int threads)
     return LX_OK;
 }
 
-void lx_ibl_progress_init(lx_ibl_progress *p, lx_progress_fn fn, void *user, double total,
-                          float base, float span)
+void lx_ibl_warn_upsampling(const char *name, int size, double source_size)
 {
-    p->fn = fn;
-    p->user = user;
-    p->total = total > 0.0 ? total : 1.0;
-    p->done = 0.0;
-    p->base = base;
-    p->span = span;
-    p->cancelled = 0;
-}
-
-void lx_ibl_progress_add(lx_ibl_progress *p, double work)
-{
-    if (!p->fn)
+    if (!((double)size > 4.0 * source_size))
         return;
-    double done;
-#pragma omp atomic capture
-    done = p->done += work;
-    if (omp_get_thread_num() != 0 || p->cancelled)
-        return;
-    double f = done / p->total;
-    if (f > 1.0)
-        f = 1.0;
-    if (!p->fn(p->user, p->base + p->span * (float)f))
-        p->cancelled = 1;
+    char bytes[32];
+    lx_format_bytes(lx_ibl_cube_bytes(size), bytes, sizeof bytes);
+    lx_log(LX_LOG_WARN,
+           "%s upsample it %.0fx: the %s cube map holds no more detail than %.0f x %.0f faces "
+           "would",
+           name, (double)size / source_size, bytes, source_size, source_size);
 }
 
-bool lx_ibl_progress_end(lx_ibl_progress *p)
+/* ---- the parallel loop ------------------------------------------------------ */
+
+lx_ibl_desc lx_ibl_desc_defaults(const lx_ibl_desc *desc)
 {
-    if (p->cancelled)
-        return false;
-    if (p->fn && !p->fn(p->user, p->base + p->span))
-        p->cancelled = 1;
-    return !p->cancelled;
+    lx_ibl_desc d = {0};
+    if (desc)
+        d = *desc;
+    return d;
 }
 
-lx_status lx_ibl_chain_build(const lx_cubemap *src, int min_size, int threads, lx_ibl_chain *out)
+lx_ibl_run lx_ibl_run_make(int threads, lx_progress_fn progress, void *user)
 {
-    memset(out, 0, sizeof *out);
-    out->level[0] = *src;
-    out->count = 1;
-    if (min_size < 1)
-        min_size = 1;
-    while (out->level[out->count - 1].size / 2 >= min_size && out->count <= LX_MAX_CUBE_MIPS) {
-        lx_status st =
-            lx_ibl_downsample(&out->level[out->count - 1], &out->level[out->count], threads);
-        if (st != LX_OK) {
-            lx_ibl_chain_free(out);
-            return st;
-        }
-        out->count++;
+    lx_ibl_run r = {lx_thread_count(threads), progress, user, 0.0f, 1.0f};
+    return r;
+}
+
+lx_ibl_run lx_ibl_run_part(const lx_ibl_run *run, double from, double to)
+{
+    lx_ibl_run r = *run;
+    r.base = run->base + (float)(from * run->span);
+    r.span = (float)((to - from) * run->span);
+    return r;
+}
+
+lx_status lx_ibl_for(const lx_ibl_run *run, int count, const double *cost, lx_ibl_item_fn fn,
+                     void *ctx, const char *what)
+{
+    double total = 0.0;
+    if (run->progress) {
+        for (int i = 0; i < count; i++)
+            total += cost ? cost[i] : 1.0;
     }
+    total = total > 0.0 ? total : 1.0;
+    double done = 0.0, reported = 0.0;
+    volatile int stop = 0, nomem = 0;
+    /* whichever thread finishes an item reports, unless another one is
+     * reporting: one at a time, never a smaller fraction than before */
+    omp_lock_t lock;
+    omp_init_lock(&lock);
+#pragma omp parallel for schedule(dynamic, 1) num_threads(run->threads > 0 ? run->threads : 1)
+    for (int i = 0; i < count; i++) {
+        if (stop)
+            continue;
+        if (!fn(ctx, i)) {
+            nomem = 1;
+            stop = 1;
+            continue;
+        }
+        if (!run->progress)
+            continue;
+        double now;
+#pragma omp atomic capture
+        now = done += cost ? cost[i] : 1.0;
+        if (!omp_test_lock(&lock))
+            continue;
+        reported = now > reported ? now : reported;
+        double f = reported / total;
+        if (!stop && !run->progress(run->user, run->base + run->span * (float)(f < 1.0 ? f : 1.0)))
+            stop = 1;
+        omp_unset_lock(&lock);
+    }
+    omp_destroy_lock(&lock);
+    if (nomem)
+        return lx_fail(LX_ERR_NOMEM, "%s: out of memory", what);
+    if (!stop && run->progress && !run->progress(run->user, run->base + run->span))
+        stop = 1;
+    if (stop)
+        return lx_fail(LX_ERR_CANCELLED, "%s cancelled", what);
     return LX_OK;
 }
 
-void lx_ibl_chain_free(lx_ibl_chain *chain)
-{
-    for (int i = 1; i < chain->count; i++)
-        lx_cubemap_free(&chain->level[i]);
-    memset(chain, 0, sizeof *chain);
-}
+/* ---- sampling ------------------------------------------------------------------ */
 
 void lx_ibl_sample(const lx_cubemap *c, lx_vec3 d, float out[3])
 {
-    /* lx_cube_face_coords, inlined */
-    float ax = fabsf(d.x), ay = fabsf(d.y), az = fabsf(d.z);
-    float sc, tc, ma;
     int face;
-    if (ax >= ay && ax >= az) {
-        ma = ax;
-        face = d.x >= 0.0f ? LX_FACE_PX : LX_FACE_NX;
-        sc = d.x >= 0.0f ? -d.z : d.z;
-        tc = -d.y;
-    } else if (ay >= az) {
-        ma = ay;
-        face = d.y >= 0.0f ? LX_FACE_PY : LX_FACE_NY;
-        sc = d.x;
-        tc = d.y >= 0.0f ? d.z : -d.z;
-    } else {
-        ma = az;
-        face = d.z >= 0.0f ? LX_FACE_PZ : LX_FACE_NZ;
-        sc = d.z >= 0.0f ? d.x : -d.x;
-        tc = -d.y;
-    }
-    float s = lx_saturate(0.5f * (sc / ma + 1.0f));
-    float t = lx_saturate(0.5f * (tc / ma + 1.0f));
+    float s, t;
+    lx_ibl_face_st(d, &face, &s, &t);
     int n = c->size;
     float fx = s * (float)n - 0.5f, fy = t * (float)n - 0.5f;
     float x0f = floorf(fx), y0f = floorf(fy);
@@ -185,22 +189,9 @@ lx_status lx_ibl_pad(const lx_cubemap *c, lx_ibl_padded *out)
     for (int face = 0; face < 6; face++)
         for (int y = -1; y <= n; y++)
             for (int x = -1; x <= n; x++) {
-                const float *src;
-                if (x >= 0 && x < n && y >= 0 && y < n) {
-                    src = lx_cubemap_texel(c, face, x, y);
-                } else {
-                    /* the texel whose centre is nearest the extrapolated
-                     * direction, as lx_cubemap_sample takes it */
-                    float sc = 2.0f * ((float)x + 0.5f) / (float)n - 1.0f;
-                    float tc = 2.0f * ((float)y + 0.5f) / (float)n - 1.0f;
-                    int f;
-                    float s, t;
-                    lx_cube_face_coords(lx_ibl_face_vector(face, sc, tc), &f, &s, &t);
-                    int nx = (int)(s * (float)n), ny = (int)(t * (float)n);
-                    nx = nx < 0 ? 0 : nx >= n ? n - 1 : nx;
-                    ny = ny < 0 ? 0 : ny >= n ? n - 1 : ny;
-                    src = lx_cubemap_texel(c, f, nx, ny);
-                }
+                int f, tx, ty;
+                lx_ibl_texel_across(n, face, x, y, &f, &tx, &ty);
+                const float *src = lx_cubemap_texel(c, f, tx, ty);
                 float *dst =
                     out->data + (((size_t)face * w + (size_t)(y + 1)) * w + (size_t)(x + 1)) * 3;
                 dst[0] = src[0], dst[1] = src[1], dst[2] = src[2];

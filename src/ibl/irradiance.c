@@ -19,11 +19,13 @@
 #include "core/internal.h"
 
 #include <math.h>
+#include <stdio.h>
 #include <stdlib.h>
 #include <string.h>
 
 typedef struct lights {
     int count, sub;           /* texels, sub-texels per texel (k * k) */
+    int padded;               /* count to a multiple of 4, lights of nothing after it */
     float *cx, *cy, *cz;      /* centre direction */
     float *px, *py, *pz;      /* irradiance vector Phi */
     float *horizon;           /* sin of the texel's angular radius */
@@ -44,31 +46,6 @@ static lx_vec3 unit_corner(int face, int n, double x, double y)
         lx_ibl_face_vector(face, (float)(2.0 * x / n - 1.0), (float)(2.0 * y / n - 1.0)));
 }
 
-/* ibl.h's face table in double. */
-static void face_vector_d(int face, double sc, double tc, double a[3])
-{
-    switch (face) {
-    case LX_FACE_PX:
-        a[0] = 1, a[1] = -tc, a[2] = -sc;
-        break;
-    case LX_FACE_NX:
-        a[0] = -1, a[1] = -tc, a[2] = sc;
-        break;
-    case LX_FACE_PY:
-        a[0] = sc, a[1] = 1, a[2] = tc;
-        break;
-    case LX_FACE_NY:
-        a[0] = sc, a[1] = -1, a[2] = -tc;
-        break;
-    case LX_FACE_PZ:
-        a[0] = sc, a[1] = -tc, a[2] = 1;
-        break;
-    default:
-        a[0] = -sc, a[1] = -tc, a[2] = -1;
-        break;
-    }
-}
-
 /* Phi of face texel (x, y): Lambert's formula over its four edges. */
 static void irradiance_vector(int face, int n, int x, int y, lx_vec3 centre, double phi[3])
 {
@@ -78,7 +55,7 @@ static void irradiance_vector(int face, int n, int x, int y, lx_vec3 centre, dou
         /* corner directions in double: the edges of small texels are short */
         double sc = 2.0 * (x + cx[k]) / n - 1.0, tc = 2.0 * (y + cy[k]) / n - 1.0;
         double a[3];
-        face_vector_d(face, sc, tc, a);
+        lx_ibl_face_vector_d(face, sc, tc, a);
         double len = sqrt(a[0] * a[0] + a[1] * a[1] + a[2] * a[2]);
         for (int c = 0; c < 3; c++)
             v[k][c] = a[c] / len;
@@ -105,10 +82,11 @@ static lx_status lights_build(const lx_cubemap *s, lights *l)
     int n = s->size;
     int k = n >= 128 ? 1 : 128 / n;
     k = k > 32 ? 32 : k;
-    size_t count = (size_t)6 * n * n, sub = (size_t)k * k;
+    size_t count = (size_t)6 * n * n, sub = (size_t)k * k, padded = (count + 3) / 4 * 4;
     l->count = (int)count;
+    l->padded = (int)padded;
     l->sub = (int)sub;
-    l->cx = malloc(sizeof(float) * count * 10);
+    l->cx = calloc(padded * 10, sizeof(float));
     l->sx = malloc(sizeof(float) * count * sub * 4);
     double *omega = lx_ibl_solid_angles(n * k);
     if (!l->cx || !l->sx || !omega) {
@@ -116,10 +94,10 @@ static lx_status lights_build(const lx_cubemap *s, lights *l)
         lights_free(l);
         return lx_fail(LX_ERR_NOMEM, "out of memory for %zu source texels", count);
     }
-    l->cy = l->cx + count, l->cz = l->cy + count;
-    l->px = l->cz + count, l->py = l->px + count, l->pz = l->py + count;
-    l->horizon = l->pz + count;
-    l->r = l->horizon + count, l->g = l->r + count, l->b = l->g + count;
+    l->cy = l->cx + padded, l->cz = l->cy + padded;
+    l->px = l->cz + padded, l->py = l->px + padded, l->pz = l->py + padded;
+    l->horizon = l->pz + padded;
+    l->r = l->horizon + padded, l->g = l->r + padded, l->b = l->g + padded;
     l->sy = l->sx + count * sub, l->sz = l->sy + count * sub, l->sw = l->sz + count * sub;
     for (int face = 0; face < 6; face++)
         for (int y = 0; y < n; y++)
@@ -155,26 +133,58 @@ static lx_status lights_build(const lx_cubemap *s, lights *l)
     return LX_OK;
 }
 
-static void irradiance_at(const lights *l, lx_vec3 nrm, float out[3])
+/* The irradiance at unit normal nrm: the texels wholly above its horizon
+ * four at a time (lx_v4f lanes summed in float over 64 texels, then in
+ * double), and those the horizon cuts (cut: room for every texel's index)
+ * one by one, from their sub-texels. */
+static void irradiance_at(const lights *l, lx_vec3 nrm, int *cut, float out[3])
 {
     double e[3] = {0, 0, 0};
-    for (int t = 0; t < l->count; t++) {
-        float c = nrm.x * l->cx[t] + nrm.y * l->cy[t] + nrm.z * l->cz[t];
-        float h = l->horizon[t];
-        if (c <= -h)
-            continue;
-        double w;
-        if (c >= h) {
-            w = (double)(nrm.x * l->px[t] + nrm.y * l->py[t] + nrm.z * l->pz[t]);
-        } else {
-            w = 0.0;
-            size_t u0 = (size_t)t * l->sub;
-            for (int s = 0; s < l->sub; s++) {
+    int ncut = 0;
+    for (int t0 = 0; t0 < l->padded; t0 += 64) {
+        int t1 = t0 + 64 < l->padded ? t0 + 64 : l->padded;
+        lx_v4f sum[3] = {{0, 0, 0, 0}, {0, 0, 0, 0}, {0, 0, 0, 0}};
+        for (int t = t0; t < t1; t += 4) {
+            lx_v4f c = nrm.x * lx_v4_load(l->cx + t) + nrm.y * lx_v4_load(l->cy + t) +
+                       nrm.z * lx_v4_load(l->cz + t);
+            lx_v4f h = lx_v4_load(l->horizon + t);
+            lx_v4i whole = c >= h, part = (c > -h) & ~whole;
+            lx_v4f w = nrm.x * lx_v4_load(l->px + t) + nrm.y * lx_v4_load(l->py + t) +
+                       nrm.z * lx_v4_load(l->pz + t);
+            lx_v4f zero = {0, 0, 0, 0};
+            w = lx_v4_select(whole, w, zero);
+            sum[0] += w * lx_v4_load(l->r + t);
+            sum[1] += w * lx_v4_load(l->g + t);
+            sum[2] += w * lx_v4_load(l->b + t);
+            if (part[0] | part[1] | part[2] | part[3])
+                for (int k = 0; k < 4; k++)
+                    if (part[k])
+                        cut[ncut++] = t + k;
+        }
+        for (int k = 0; k < 3; k++)
+            e[k] += ((double)sum[k][0] + sum[k][1]) + ((double)sum[k][2] + sum[k][3]);
+    }
+    for (int i = 0; i < ncut; i++) {
+        int t = cut[i];
+        double w = 0.0;
+        size_t u0 = (size_t)t * l->sub;
+        int s = 0;
+        if (l->sub % 4 == 0) {
+            /* the sub-texels four at a time, max(cos, 0) x solid angle */
+            lx_v4f sum = {0, 0, 0, 0};
+            for (; s < l->sub; s += 4) {
                 size_t u = u0 + s;
-                float cs = nrm.x * l->sx[u] + nrm.y * l->sy[u] + nrm.z * l->sz[u];
-                if (cs > 0.0f)
-                    w += (double)(cs * l->sw[u]);
+                lx_v4f cs = nrm.x * lx_v4_load(l->sx + u) + nrm.y * lx_v4_load(l->sy + u) +
+                            nrm.z * lx_v4_load(l->sz + u);
+                sum += lx_v4_pos(cs) * lx_v4_load(l->sw + u);
             }
+            w = ((double)sum[0] + sum[1]) + ((double)sum[2] + sum[3]);
+        }
+        for (; s < l->sub; s++) {
+            size_t u = u0 + s;
+            float cs = nrm.x * l->sx[u] + nrm.y * l->sy[u] + nrm.z * l->sz[u];
+            if (cs > 0.0f)
+                w += (double)(cs * l->sw[u]);
         }
         e[0] += w * l->r[t];
         e[1] += w * l->g[t];
@@ -184,12 +194,30 @@ static void irradiance_at(const lights *l, lx_vec3 nrm, float out[3])
         out[k] = (float)e[k];
 }
 
-lx_ibl_desc lx_ibl_desc_defaults(const lx_ibl_desc *desc)
+typedef struct irr_job {
+    const lights *l;
+    lx_cubemap *out;
+    int tiles_side;
+} irr_job;
+
+static bool irr_tile(void *ctx, int tile)
 {
-    lx_ibl_desc d = {0};
-    if (desc)
-        d = *desc;
-    return d;
+    const irr_job *j = ctx;
+    int *cut = malloc(sizeof(int) * (size_t)j->l->padded);
+    if (!cut)
+        return false;
+    int size = j->out->size, ts = j->tiles_side;
+    int face = tile / (ts * ts), rest = tile % (ts * ts);
+    int x0 = (rest % ts) * LX_IBL_TILE, y0 = (rest / ts) * LX_IBL_TILE;
+    int x1 = x0 + LX_IBL_TILE < size ? x0 + LX_IBL_TILE : size;
+    int y1 = y0 + LX_IBL_TILE < size ? y0 + LX_IBL_TILE : size;
+    for (int y = y0; y < y1; y++)
+        for (int x = x0; x < x1; x++) {
+            lx_vec3 nrm = lx_cube_direction(face, (x + 0.5f) / size, (y + 0.5f) / size);
+            irradiance_at(j->l, nrm, cut, lx_cubemap_texel(j->out, face, x, y));
+        }
+    free(cut);
+    return true;
 }
 
 lx_status lx_irradiance_brute(const lx_cubemap *src, int size, int source_size,
@@ -212,20 +240,27 @@ lx_status lx_irradiance_brute(const lx_cubemap *src, int size, int source_size,
         return st;
     if ((st = lx_ibl_check_cubemap(src, "irradiance: source cube map", true)) != LX_OK)
         return st;
-    int threads = lx_thread_count(desc.threads);
+    lx_ibl_run run = lx_ibl_run_make(desc.threads, desc.progress, desc.progress_user);
 
-    /* the source, halved until it fits source_size */
-    lx_cubemap small = *src, tmp;
+    /* the source, halved until it fits source_size, in one pass; then the
+     * lights (10 floats a texel, 4 per sub-texel) and the output */
+    int n = lx_ibl_halved_size(src->size, source_size);
+    int k = n >= 128 ? 1 : 128 / n;
+    k = k > 32 ? 32 : k;
+    uint64_t need = (n < src->size ? lx_ibl_cube_bytes(n) : 0) +
+                    (uint64_t)6 * n * n * (40 + 16 * (uint64_t)k * k) +
+                    8ull * (uint64_t)(n * k + 1) * (n * k + 1) / 4 + lx_ibl_cube_bytes(size);
+    char what[160];
+    snprintf(what, sizeof what, "irradiance of a %d x %d cube map from a %d x %d source", size,
+             size, n, n);
+    if ((st = lx_check_memory(need, what)) != LX_OK)
+        return st;
+    lx_cubemap small = *src;
     bool owned = false;
-    while (small.size > source_size) {
-        if ((st = lx_ibl_downsample(&small, &tmp, threads)) != LX_OK) {
-            if (owned)
-                lx_cubemap_free(&small);
+    if (n < src->size) {
+        lx_ibl_run part = lx_ibl_run_part(&run, 0.0, 0.1);
+        if ((st = lx_ibl_downsample(src, n, &part, &small)) != LX_OK)
             return st;
-        }
-        if (owned)
-            lx_cubemap_free(&small);
-        small = tmp;
         owned = true;
     }
     lights l;
@@ -238,31 +273,12 @@ lx_status lx_irradiance_brute(const lx_cubemap *src, int size, int source_size,
         lights_free(&l);
         return st;
     }
-
     int tiles_side = (size + LX_IBL_TILE - 1) / LX_IBL_TILE;
-    int tiles = 6 * tiles_side * tiles_side;
-    lx_ibl_progress prog;
-    lx_ibl_progress_init(&prog, desc.progress, desc.progress_user, (double)6 * size * size, 0.0f,
-                         1.0f);
-#pragma omp parallel for schedule(dynamic, 1) num_threads(threads)
-    for (int tile = 0; tile < tiles; tile++) {
-        if (prog.cancelled)
-            continue;
-        int face = tile / (tiles_side * tiles_side), rest = tile % (tiles_side * tiles_side);
-        int x0 = (rest % tiles_side) * LX_IBL_TILE, y0 = (rest / tiles_side) * LX_IBL_TILE;
-        int x1 = x0 + LX_IBL_TILE < size ? x0 + LX_IBL_TILE : size;
-        int y1 = y0 + LX_IBL_TILE < size ? y0 + LX_IBL_TILE : size;
-        for (int y = y0; y < y1; y++)
-            for (int x = x0; x < x1; x++) {
-                lx_vec3 nrm = lx_cube_direction(face, (x + 0.5f) / size, (y + 0.5f) / size);
-                irradiance_at(&l, nrm, lx_cubemap_texel(out, face, x, y));
-            }
-        lx_ibl_progress_add(&prog, (double)(x1 - x0) * (y1 - y0));
-    }
+    irr_job job = {&l, out, tiles_side};
+    lx_ibl_run part = lx_ibl_run_part(&run, owned ? 0.1 : 0.0, 1.0);
+    st = lx_ibl_for(&part, 6 * tiles_side * tiles_side, NULL, irr_tile, &job, "irradiance");
     lights_free(&l);
-    if (!lx_ibl_progress_end(&prog)) {
+    if (st != LX_OK)
         lx_cubemap_free(out);
-        return lx_fail(LX_ERR_CANCELLED, "irradiance cancelled");
-    }
-    return LX_OK;
+    return st;
 }

@@ -11,8 +11,7 @@
  * Half floats round to nearest, ties to even (IEEE 754-2008 binary16),
  * subnormals included; values above the largest half (65504) are rejected
  * rather than clamped. */
-#include "luxel/ibl.h"
-
+#include "ibl_internal.h"
 #include "core/internal.h"
 
 #include <errno.h>
@@ -82,6 +81,13 @@ static lx_status check_levels(const char *path, const lx_cubemap *levels, int co
 
 lx_status lx_ktx_write_cubemap(const char *path, const lx_cubemap *levels, int count, bool half)
 {
+    lx_ibl_run run = lx_ibl_run_make(1, NULL, NULL);
+    return lx_ibl_ktx_write(path, levels, count, half, &run);
+}
+
+lx_status lx_ibl_ktx_write(const char *path, const lx_cubemap *levels, int count, bool half,
+                           const lx_ibl_run *run)
+{
     if (!path)
         return lx_fail(LX_ERR_INVALID, "lx_ktx_write_cubemap: path is NULL");
     lx_status st = check_levels(path, levels, count, half);
@@ -136,15 +142,20 @@ lx_status lx_ktx_write_cubemap(const char *path, const lx_cubemap *levels, int c
     memcpy(kv + 4, kv_key, sizeof kv_key);
     memcpy(kv + 4 + sizeof kv_key, kv_value, strlen(kv_value) + 1);
     ok = ok && fwrite(kv, 1, kv_total, fp) == kv_total;
-    for (int l = 0; l < count && ok; l++) {
+    /* progress by faces written, each weighed by its texels */
+    double total = 0.0, done = 0.0;
+    for (int l = 0; l < count; l++)
+        total += 6.0 * levels[l].size * levels[l].size;
+    bool cancelled = false;
+    for (int l = 0; l < count && ok && !cancelled; l++) {
         const lx_cubemap *c = &levels[l];
         size_t face_bytes = (size_t)c->size * (size_t)c->size * texel_bytes;
         unsigned char size_field[4];
         put_u32(size_field, (uint32_t)face_bytes);
         ok = fwrite(size_field, 1, 4, fp) == 4;
         /* face_bytes is a multiple of 8: no cube or mip padding is needed */
-        for (int face = 0; face < 6 && ok; face++)
-            for (int y = 0; y < c->size && ok; y++) {
+        for (int face = 0; face < 6 && ok && !cancelled; face++)
+            for (int y = 0; y < c->size && ok && !cancelled; y++) {
                 const float *src = lx_cubemap_texel(c, face, 0, y);
                 unsigned char *p = row;
                 for (int x = 0; x < c->size; x++) {
@@ -164,9 +175,19 @@ lx_status lx_ktx_write_cubemap(const char *path, const lx_cubemap *levels, int c
                 }
                 size_t n = (size_t)(p - row);
                 ok = fwrite(row, 1, n, fp) == n;
+                done += c->size;
+                /* a few times a second: every 2^20 texels and at each level's end */
+                if (run->progress && ok &&
+                    ((y + 1) % (1 + (1 << 20) / c->size) == 0 || (face == 5 && y == c->size - 1)))
+                    cancelled =
+                        !run->progress(run->user, run->base + run->span * (float)(done / total));
             }
     }
     free(row);
+    if (cancelled) {
+        lx_out_abort(&f);
+        return lx_fail(LX_ERR_CANCELLED, "%s: writing cancelled", path);
+    }
     if (!ok) {
         int err = errno;
         lx_out_abort(&f);

@@ -10,6 +10,7 @@
 #include "core/internal.h"
 
 #include <math.h>
+#include <stdio.h>
 #include <stdlib.h>
 #include <string.h>
 
@@ -42,15 +43,17 @@ lx_prefilter_desc lx_prefilter_desc_defaults(const lx_prefilter_desc *desc)
     return d;
 }
 
-static lx_status validate(const lx_cubemap *src, lx_prefilter_desc *d)
+/* Checks desc against a source of face size source_size and fills size
+ * and mips. */
+static lx_status validate(int source_size, lx_prefilter_desc *d)
 {
-    lx_status st = lx_ibl_check_cubemap(src, "prefilter: source cube map", true);
-    if (st != LX_OK)
-        return st;
+    if (source_size < 1 || source_size > LX_MAX_CUBE_SIZE)
+        return lx_fail(LX_ERR_INVALID, "prefilter: source face size %d is outside 1..%d",
+                       source_size, LX_MAX_CUBE_SIZE);
     if (d->filter != LX_SPECULAR_GGX && d->filter != LX_SPECULAR_PHONG)
         return lx_fail(LX_ERR_INVALID, "prefilter: unknown filter %d", (int)d->filter);
     if (d->size == 0)
-        d->size = src->size < 256 ? src->size : 256;
+        d->size = source_size < 256 ? source_size : 256;
     if (d->size < 1 || d->size > LX_MAX_CUBE_SIZE)
         return lx_fail(LX_ERR_INVALID, "prefilter: face size %d is outside 1..%d", d->size,
                        LX_MAX_CUBE_SIZE);
@@ -73,6 +76,101 @@ static lx_status validate(const lx_cubemap *src, lx_prefilter_desc *d)
                                (double)e, i);
         }
     return lx_ibl_check_threads(d->threads);
+}
+
+static int level_size(const lx_prefilter_desc *d, int l)
+{
+    return d->size >> l > 0 ? d->size >> l : 1;
+}
+
+/* What one call computes: the source's chain sizes and each level's plan
+ * (made from the sizes alone, before any texel is read). */
+typedef struct plan {
+    int sizes[LX_MAX_CUBE_MIPS + 1], chain_count;
+    lx_ggx_plan *ggx[LX_MAX_CUBE_MIPS];
+    lx_conv_plan *conv[LX_MAX_CUBE_MIPS];
+    double cost[LX_MAX_CUBE_MIPS];
+    bool sampled; /* some level samples the padded chain */
+} plan;
+
+static void plan_free(plan *p)
+{
+    for (int l = 0; l < LX_MAX_CUBE_MIPS; l++) {
+        lx_ggx_plan_free(p->ggx[l]);
+        lx_conv_plan_free(p->conv[l]);
+        p->ggx[l] = NULL;
+        p->conv[l] = NULL;
+    }
+}
+
+/* The plans of every level of d for a source of face size n, and a check
+ * that the call's whole peak fits in memory: the source, its mip chain,
+ * padded copies of the chain (when a level samples it), the convolutions'
+ * lights and the levels. */
+static lx_status make_plan(int n, const lx_prefilter_desc *d, plan *p)
+{
+    memset(p, 0, sizeof *p);
+    p->chain_count = lx_ibl_chain_sizes(n, 1, p->sizes);
+    uint64_t source = lx_ibl_cube_bytes(n), chain = lx_ibl_chain_bytes(n, 1), levels = 0;
+    for (int l = 0; l < d->mips; l++)
+        levels += lx_ibl_cube_bytes(level_size(d, l));
+    char what[400], a[32], b[32], c[32], e[32], f[32];
+    lx_format_bytes(source, a, sizeof a);
+    lx_format_bytes(chain, b, sizeof b);
+    lx_format_bytes(levels, f, sizeof f);
+    snprintf(what, sizeof what,
+             "prefilter: a %d x %d source (%s) with its mips (%s) into %d levels of %d x %d and "
+             "down (%s)",
+             n, n, a, b, d->mips, d->size, d->size, f);
+    /* the source, its chain and the levels, before anything is made */
+    lx_status st = lx_check_memory(source + chain + levels, what);
+    for (int l = 0; l < d->mips && st == LX_OK; l++) {
+        int size = level_size(d, l);
+        p->cost[l] = 1.0;
+        if (d->filter == LX_SPECULAR_PHONG) {
+            float n_l = d->phong_exponents ? d->phong_exponents[l] : lx_phong_level_exponent(l);
+            lx_lobe lobe = lx_phong_lobe(n_l);
+            st = lx_conv_plan_create(p->sizes, p->chain_count, &lobe, size, HUGE_VAL, &p->conv[l]);
+            if (st == LX_OK)
+                p->cost[l] = lx_conv_plan_cost(p->conv[l]);
+        } else if (l > 0) {
+            st = lx_ggx_level_plan(p->sizes, p->chain_count, lx_ggx_level_roughness(l, d->mips),
+                                   d->samples, size, &p->conv[l], &p->ggx[l], &p->cost[l]);
+            p->sampled = p->sampled || p->ggx[l];
+        }
+    }
+    if (st != LX_OK) {
+        plan_free(p);
+        return st;
+    }
+    uint64_t pads = 0, lights = 0;
+    for (int i = 0; p->sampled && i < p->chain_count; i++)
+        pads += lx_ibl_padded_bytes(p->sizes[i]);
+    for (int l = 0; l < d->mips; l++)
+        if (p->conv[l])
+            lights += lx_conv_plan_bytes(p->conv[l]);
+    lx_format_bytes(pads, c, sizeof c);
+    lx_format_bytes(lights, e, sizeof e);
+    snprintf(what, sizeof what,
+             "prefilter: a %d x %d source (%s) with its mips (%s), padded copies (%s) and "
+             "convolution work (%s) into %d levels of %d x %d and down (%s)",
+             n, n, a, b, c, e, d->mips, d->size, d->size, f);
+    st = lx_check_memory(source + chain + pads + lights + levels, what);
+    if (st != LX_OK)
+        plan_free(p);
+    return st;
+}
+
+lx_status lx_prefilter_check(int source_size, const lx_prefilter_desc *desc)
+{
+    lx_prefilter_desc d = lx_prefilter_desc_defaults(desc);
+    lx_status st = validate(source_size, &d);
+    if (st != LX_OK)
+        return st;
+    plan p;
+    st = make_plan(source_size, &d, &p);
+    plan_free(&p);
+    return st;
 }
 
 /* Level 0 of GGX (roughness 0): the source at the level's size, from the
@@ -108,6 +206,46 @@ typedef struct tile {
     int level, face, x0, y0, x1, y1;
 } tile;
 
+/* The state the parallel steps share. */
+typedef struct job {
+    plan *p;
+    lx_ibl_chain *chain;
+    lx_ibl_padded *pads;
+    lx_cubemap *levels;
+    const tile *tiles;
+    const lx_cubemap *mirror;
+    bool mirror_exact;
+    int conv_levels[LX_MAX_CUBE_MIPS];
+    double *flux[LX_MAX_CUBE_MIPS + 1]; /* per chain level the convolutions read */
+} job;
+
+static bool fill_item(void *ctx, int i)
+{
+    job *j = ctx;
+    lx_conv_plan *c = j->p->conv[j->conv_levels[i]];
+    return lx_conv_plan_fill(c, j->chain, j->flux[lx_conv_plan_level(c)]) == LX_OK;
+}
+
+static bool pad_item(void *ctx, int i)
+{
+    job *j = ctx;
+    return lx_ibl_pad(&j->chain->level[i], &j->pads[i]) == LX_OK;
+}
+
+static bool tile_item(void *ctx, int i)
+{
+    const job *j = ctx;
+    const tile *t = &j->tiles[i];
+    lx_cubemap *out = &j->levels[t->level];
+    if (j->p->conv[t->level])
+        return lx_conv_tile(j->p->conv[t->level], out, t->face, t->x0, t->y0, t->x1, t->y1);
+    if (j->p->ggx[t->level])
+        lx_ggx_tile(j->p->ggx[t->level], j->pads, out, t->face, t->x0, t->y0, t->x1, t->y1);
+    else
+        mirror_tile(j->mirror, j->mirror_exact, out, t->face, t->x0, t->y0, t->x1, t->y1);
+    return true;
+}
+
 static void free_levels(lx_cubemap *levels, int count)
 {
     for (int i = 0; i < count; i++)
@@ -122,100 +260,94 @@ lx_status lx_prefilter(const lx_cubemap *src, const lx_prefilter_desc *in,
     *count = 0;
     memset(levels, 0, sizeof(lx_cubemap) * LX_MAX_CUBE_MIPS);
     lx_prefilter_desc d = lx_prefilter_desc_defaults(in);
-    lx_status st = validate(src, &d);
+    lx_status st = lx_ibl_check_cubemap(src, "prefilter: source cube map", true);
+    if (st == LX_OK)
+        st = validate(src->size, &d);
     if (st != LX_OK)
         return st;
-    int threads = lx_thread_count(d.threads);
+    char name[96];
+    snprintf(name, sizeof name, "prefilter: %d x %d specular faces from a %d x %d source", d.size,
+             d.size, src->size, src->size);
+    lx_ibl_warn_upsampling(name, d.size, src->size);
+    plan p;
+    if ((st = make_plan(src->size, &d, &p)) != LX_OK)
+        return st;
     int mips = d.mips;
+    lx_ibl_run run = lx_ibl_run_make(d.threads, d.progress, d.progress_user);
 
     lx_ibl_chain chain;
-    if ((st = lx_ibl_chain_build(src, 1, threads, &chain)) != LX_OK)
-        return st;
     lx_ibl_padded pads[LX_MAX_CUBE_MIPS + 1] = {{0}};
-    lx_ggx_plan *ggx[LX_MAX_CUBE_MIPS] = {0};
-    lx_conv_plan *conv[LX_MAX_CUBE_MIPS] = {0};
-    bool sampled = false;
-    const lx_cubemap *mirror = NULL;
-    bool mirror_exact = false;
-    double cost[LX_MAX_CUBE_MIPS];
     tile *tiles = NULL;
+    job j = {.p = &p, .chain = &chain, .pads = pads, .levels = levels};
+    lx_ibl_run part = lx_ibl_run_part(&run, 0.0, 0.04);
+    st = lx_ibl_chain_build(src, 1, &part, &chain);
+    if (st != LX_OK) {
+        plan_free(&p);
+        return st;
+    }
+    /* the flux vectors of the chain levels the convolutions read, each
+     * from the next finer one where the sizes nest; then the lights and
+     * the padded chain, level by level */
+    int nconv = 0;
+    bool used[LX_MAX_CUBE_MIPS + 1] = {false};
+    for (int l = 0; l < mips; l++)
+        if (p.conv[l]) {
+            j.conv_levels[nconv++] = l;
+            used[lx_conv_plan_level(p.conv[l])] = true;
+        }
+    int nused = 0, done = 0;
+    for (int i = 1; i < chain.count; i++)
+        nused += used[i];
+    for (int i = 1, finer = 0; i < chain.count && st == LX_OK; i++)
+        if (used[i]) {
+            part =
+                lx_ibl_run_part(&run, 0.04 + 0.02 * done / nused, 0.04 + 0.02 * (done + 1) / nused);
+            st = lx_conv_flux(&chain, i, finer ? j.flux[finer] : NULL, finer, &part, &j.flux[i]);
+            finer = i, done++;
+        }
+    part = lx_ibl_run_part(&run, 0.06, 0.08);
+    if (st == LX_OK)
+        st = lx_ibl_for(&part, nconv, NULL, fill_item, &j, "prefilter");
+    part = lx_ibl_run_part(&run, 0.08, 0.1);
+    if (st == LX_OK && p.sampled)
+        st = lx_ibl_for(&part, chain.count, NULL, pad_item, &j, "prefilter");
     int ntiles = 0;
     for (int l = 0; l < mips && st == LX_OK; l++) {
-        int size = d.size >> l > 0 ? d.size >> l : 1;
+        int size = level_size(&d, l), side = (size + LX_IBL_TILE - 1) / LX_IBL_TILE;
         st = lx_cubemap_alloc(&levels[l], size);
-        if (st != LX_OK)
-            break;
-        cost[l] = 1.0;
-        if (d.filter == LX_SPECULAR_PHONG) {
-            float e = d.phong_exponents ? d.phong_exponents[l] : lx_phong_level_exponent(l);
-            lx_lobe lobe = lx_phong_lobe(e);
-            st = lx_conv_plan_build(&chain, &lobe, size, HUGE_VAL, &conv[l]);
-            if (st == LX_OK)
-                cost[l] = lx_conv_plan_cost(conv[l]);
-        } else if (l == 0) {
-            mirror = mirror_source(&chain, size, &mirror_exact);
-        } else {
-            st = lx_ggx_level_build(&chain, lx_ggx_level_roughness(l, mips), d.samples, size,
-                                    &conv[l], &ggx[l], &cost[l]);
-            sampled = sampled || ggx[l];
-        }
-        int side = (size + LX_IBL_TILE - 1) / LX_IBL_TILE;
         ntiles += 6 * side * side;
     }
-    /* importance samples read the chain's levels through a border */
-    for (int i = 0; sampled && i < chain.count && st == LX_OK; i++)
-        st = lx_ibl_pad(&chain.level[i], &pads[i]);
-    if (st == LX_OK && !(tiles = malloc(sizeof(tile) * (size_t)ntiles)))
-        st = lx_fail(LX_ERR_NOMEM, "out of memory");
-    double total = 0.0;
+    if (st == LX_OK)
+        j.mirror = mirror_source(&chain, levels[0].size, &j.mirror_exact);
+    double *cost = NULL;
+    if (st == LX_OK && (!(tiles = malloc(sizeof(tile) * (size_t)ntiles)) ||
+                        !(cost = malloc(sizeof(double) * (size_t)ntiles))))
+        st = lx_fail(LX_ERR_NOMEM, "prefilter: out of memory");
     if (st == LX_OK) {
+        /* every tile of every level in one loop, each weighed by its cost */
         int k = 0;
         for (int l = 0; l < mips; l++) {
             int size = levels[l].size, side = (size + LX_IBL_TILE - 1) / LX_IBL_TILE;
             for (int face = 0; face < 6; face++)
                 for (int ty = 0; ty < side; ty++)
-                    for (int tx = 0; tx < side; tx++) {
-                        tile *t = &tiles[k++];
+                    for (int tx = 0; tx < side; tx++, k++) {
+                        tile *t = &tiles[k];
                         t->level = l, t->face = face;
                         t->x0 = tx * LX_IBL_TILE, t->y0 = ty * LX_IBL_TILE;
                         t->x1 = t->x0 + LX_IBL_TILE < size ? t->x0 + LX_IBL_TILE : size;
                         t->y1 = t->y0 + LX_IBL_TILE < size ? t->y0 + LX_IBL_TILE : size;
+                        cost[k] = p.cost[l] * (t->x1 - t->x0) * (t->y1 - t->y0);
                     }
-            total += cost[l] * 6.0 * size * size;
         }
+        j.tiles = tiles;
+        part = lx_ibl_run_part(&run, 0.1, 1.0);
+        st = lx_ibl_for(&part, ntiles, cost, tile_item, &j, "prefilter");
     }
-
-    if (st == LX_OK) {
-        lx_ibl_progress prog;
-        lx_ibl_progress_init(&prog, d.progress, d.progress_user, total, 0.0f, 1.0f);
-        volatile int nomem = 0;
-#pragma omp parallel for schedule(dynamic, 1) num_threads(threads)
-        for (int i = 0; i < ntiles; i++) {
-            if (prog.cancelled || nomem)
-                continue;
-            const tile *t = &tiles[i];
-            lx_cubemap *out = &levels[t->level];
-            if (conv[t->level]) {
-                if (!lx_conv_tile(conv[t->level], out, t->face, t->x0, t->y0, t->x1, t->y1))
-                    nomem = 1;
-            } else if (!ggx[t->level]) {
-                mirror_tile(mirror, mirror_exact, out, t->face, t->x0, t->y0, t->x1, t->y1);
-            } else {
-                lx_ggx_tile(ggx[t->level], pads, out, t->face, t->x0, t->y0, t->x1, t->y1);
-            }
-            lx_ibl_progress_add(&prog, cost[t->level] * (t->x1 - t->x0) * (t->y1 - t->y0));
-        }
-        if (nomem)
-            st = lx_fail(LX_ERR_NOMEM, "prefilter: out of memory");
-        else if (!lx_ibl_progress_end(&prog))
-            st = lx_fail(LX_ERR_CANCELLED, "prefilter cancelled");
-    }
-
     free(tiles);
-    for (int l = 0; l < mips; l++) {
-        lx_ggx_plan_free(ggx[l]);
-        lx_conv_plan_free(conv[l]);
-    }
+    free(cost);
+    for (int i = 0; i <= LX_MAX_CUBE_MIPS; i++)
+        free(j.flux[i]);
+    plan_free(&p);
     for (int i = 0; i < chain.count; i++)
         lx_ibl_padded_free(&pads[i]);
     lx_ibl_chain_free(&chain);

@@ -6,20 +6,21 @@
  * normalised by its own sum, computed one of two ways:
  *  - directly (prefilter_conv.c with lx_ggx_lobe): on the source mip whose
  *    texels are at most 1/3 of the lobe's half-width at half maximum, each
- *    texel a light at its flux centroid, nodes of texels at least 4 of
- *    their radii away taken as one light (GGX's tail falls as the inverse
- *    fourth power of the angle, so a sun lights the whole hemisphere
- *    through it), nothing past where D falls below 1e-8 of its peak. On
- *    bench_ibl's sky with a 2e4-nit sun every level of a 256^2 source is
- *    within 0.05-0.21% of the brute-force convolution on average (0.8% at
- *    worst), where importance sampling with 256 samples was 2-9% off
- *    (30-85% at worst, the sun seen through the samples' pattern), and it
- *    takes less time;
+ *    texel a light at its flux centroid, nodes of texels at least 3 of
+ *    their radii away (from every texel of a group of 4x4) taken as one
+ *    light (GGX's tail falls as the inverse fourth power of the angle, so
+ *    a sun lights the whole hemisphere through it), nothing past where D
+ *    falls below 1e-8 of its peak. On bench_ibl's sky with a 2e4-nit sun
+ *    every level of a 256^2 source is within 0.04-0.21% of the
+ *    brute-force convolution on average (0.8% at worst), where importance
+ *    sampling with 256 samples was 2-9% off (30-85% at worst, the sun seen
+ *    through the samples' pattern), and it takes less time;
  *  - by importance sampling, where the direct convolution would cost more
- *    than desc.samples samples per texel (one sample takes as long as ~7
- *    nodes and lights; the convolution's count is measured on its tree
- *    before its lights are made; with 256 samples that is level 1 of
- *    chains of 512^2 and more, whose tree has one more tier):
+ *    than desc.samples samples per texel (one sample takes as long as ~24
+ *    lights of a group's list; the convolution's count is measured on its
+ *    tree before its lights are made; with 256 samples no level of a
+ *    chain up to 2048^2 is sampled, whose sharpest levels sum ~2000
+ *    lights a texel):
  *    desc.samples Hammersley directions of the GGX distribution, with
  *    filtered importance sampling from M. Colbert and J. Krivanek,
  *    "GPU-Based Importance Sampling", GPU Gems 3 ch. 20: each sample reads
@@ -57,7 +58,7 @@ struct lx_ggx_plan {
     ggx_sample *s;
 };
 
-lx_status lx_ggx_plan_build(const lx_ibl_chain *chain, float roughness, int samples,
+lx_status lx_ggx_plan_build(const int *chain_sizes, int chain_count, float roughness, int samples,
                             lx_ggx_plan **out)
 {
     *out = NULL;
@@ -70,9 +71,9 @@ lx_status lx_ggx_plan_build(const lx_ibl_chain *chain, float roughness, int samp
     }
     p->s = s;
     double a = (double)roughness * roughness, a2 = a * a;
-    int size0 = chain->level[0].size;
+    int size0 = chain_sizes[0];
     double omega_p = 4.0 * 3.14159265358979323846 / (6.0 * size0 * size0);
-    int top = chain->count - 1;
+    int top = chain_count - 1;
     for (int i = 0; i < samples; i++) {
         float u, v;
         lx_ibl_hammersley((uint32_t)i, (uint32_t)samples, &u, &v);
@@ -168,10 +169,11 @@ void lx_ggx_tile(const lx_ggx_plan *p, const lx_ibl_padded *pads, lx_cubemap *ou
 #define GGX_TEXELS 3.0
 /* Far field: a node of texels at least this many times its radius away is
  * one light. */
-#define GGX_FAR 4.0
-/* Nodes and lights a convolution tests in the time of one importance
- * sample (measured 7-10 on bench_ibl's levels: ~3.5 ns against ~25 ns). */
-#define GGX_CONV_PER_SAMPLE 7.0
+#define GGX_FAR 3.0
+/* Lights a convolution sums in the time of one importance sample
+ * (measured 23-26 on levels 1-4 of a 256^2 chain: ~1.1 ns a light, list
+ * building included, against ~26 ns a sample). */
+#define GGX_CONV_PER_SAMPLE 24.0
 
 /* The lobe D(h) (n.l) / D(n) at angle theta between n = r and l. */
 static double ggx_falloff(double a2, double theta)
@@ -204,17 +206,18 @@ lx_lobe lx_ggx_lobe(float roughness)
     return l;
 }
 
-lx_status lx_ggx_level_build(const lx_ibl_chain *chain, float roughness, int samples, int out_size,
-                             lx_conv_plan **conv, lx_ggx_plan **is, double *cost)
+lx_status lx_ggx_level_plan(const int *chain_sizes, int chain_count, float roughness, int samples,
+                            int out_size, lx_conv_plan **conv, lx_ggx_plan **is, double *cost)
 {
     *conv = NULL, *is = NULL;
     lx_lobe lobe = lx_ggx_lobe(roughness);
-    lx_status st = lx_conv_plan_build(chain, &lobe, out_size, GGX_CONV_PER_SAMPLE * samples, conv);
+    lx_status st = lx_conv_plan_create(chain_sizes, chain_count, &lobe, out_size,
+                                       GGX_CONV_PER_SAMPLE * samples, conv);
     if (st != LX_OK || *conv) {
         *cost = *conv ? lx_conv_plan_cost(*conv) / GGX_CONV_PER_SAMPLE : 0.0;
         return st;
     }
-    st = lx_ggx_plan_build(chain, roughness, samples, is);
+    st = lx_ggx_plan_build(chain_sizes, chain_count, roughness, samples, is);
     *cost = st == LX_OK ? lx_ggx_plan_cost(*is) : 0.0;
     return st;
 }

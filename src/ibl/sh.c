@@ -28,12 +28,18 @@ void lx_sh9_basis(lx_vec3 d, float y[9])
 }
 
 /* How each face's direction (x, y, z) is made of its local coordinates
- * (a, b, c) = (1, sc, tc) / sqrt(1 + sc^2 + tc^2) (ibl.h's face table):
- * world axis i = sign[i] * local[perm[i]]. */
-static const int face_perm[6][3] = {{0, 2, 1}, {0, 2, 1}, {1, 0, 2},
-                                    {1, 0, 2}, {1, 2, 0}, {1, 2, 0}};
-static const double face_sign[6][3] = {{1, -1, -1}, {-1, -1, 1}, {1, 1, 1},
-                                       {1, -1, -1}, {1, -1, 1},  {-1, -1, -1}};
+ * (a, b, c) = (1, sc, tc) / sqrt(1 + sc^2 + tc^2): world axis i =
+ * sign * local[perm], read off the face table (lx_ibl_face_axes: exactly
+ * one of the major, right and down axes has a component along i). */
+static void face_perm_sign(int face, int perm[3], double sign[3])
+{
+    for (int i = 0; i < 3; i++)
+        for (int k = 0; k < 3; k++)
+            if (lx_ibl_face_axes[face][k][i] != 0.0f) {
+                perm[i] = k;
+                sign[i] = lx_ibl_face_axes[face][k][i];
+            }
+}
 
 /* Local monomials: 1, a, b, c, aa, bb, cc, ab, ac, bc. */
 enum { M1, MA, MB, MC, MAA, MBB, MCC, MAB, MAC, MBC, MONOMIALS };
@@ -100,56 +106,69 @@ static void project_row(const lx_cubemap *c, const double *omega, int y, double 
     }
 }
 
-lx_status lx_sh_project(const lx_cubemap *c, lx_sh9 *out)
+typedef struct project_job {
+    const lx_cubemap *c;
+    const double *omega;
+    double *partial; /* per row: [6][MONOMIALS][3] */
+} project_job;
+
+#define ROW_SUMS ((size_t)6 * MONOMIALS * 3)
+
+static bool project_item(void *ctx, int y)
+{
+    const project_job *j = ctx;
+    double *scratch = malloc(sizeof(double) * 9 * (size_t)j->c->size);
+    if (!scratch)
+        return false;
+    project_row(j->c, j->omega, y, scratch, scratch + 6 * (size_t)j->c->size,
+                (double(*)[MONOMIALS][3])(j->partial + ROW_SUMS * (size_t)y));
+    free(scratch);
+    return true;
+}
+
+lx_status lx_sh_project(const lx_cubemap *c, const lx_ibl_desc *in, lx_sh9 *out)
 {
     if (!out)
         return lx_fail(LX_ERR_INVALID, "SH projection: no output (NULL)");
     memset(out, 0, sizeof *out);
+    lx_ibl_desc desc = lx_ibl_desc_defaults(in);
     /* no separate scan for NaN: a bad texel makes the sums non-finite */
     lx_status st = lx_ibl_check_cubemap(c, "SH projection: cube map", false);
+    if (st == LX_OK)
+        st = lx_ibl_check_threads(desc.threads);
     if (st != LX_OK)
         return st;
     int n = c->size;
-    size_t row_sums = (size_t)6 * MONOMIALS * 3;
     double *omega = lx_ibl_solid_angles(n);
-    double *partial = malloc(sizeof(double) * row_sums * (size_t)n);
+    double *partial = malloc(sizeof(double) * ROW_SUMS * (size_t)n);
     if (!omega || !partial) {
         free(omega);
         free(partial);
         return lx_fail(LX_ERR_NOMEM, "out of memory projecting a %d x %d cube map", n, n);
     }
-    volatile int nomem = 0;
     /* one partial sum per row index, added up in row order afterwards:
      * the same result for any number of threads */
-#pragma omp parallel num_threads(lx_thread_count(0))
-    {
-        double *scratch = malloc(sizeof(double) * 9 * (size_t)n);
-        if (!scratch)
-            nomem = 1;
-#pragma omp for schedule(static)
-        for (int y = 0; y < n; y++)
-            if (scratch)
-                project_row(c, omega, y, scratch, scratch + 6 * (size_t)n,
-                            (double(*)[MONOMIALS][3])(partial + row_sums * (size_t)y));
-        free(scratch);
-    }
-    if (nomem) {
+    project_job job = {c, omega, partial};
+    lx_ibl_run run = lx_ibl_run_make(desc.threads, desc.progress, desc.progress_user);
+    st = lx_ibl_for(&run, n, NULL, project_item, &job, "SH projection");
+    if (st != LX_OK) {
         free(partial);
         free(omega);
-        return lx_fail(LX_ERR_NOMEM, "out of memory projecting a %d x %d cube map", n, n);
+        return st;
     }
     double local[6][MONOMIALS][3] = {{{0}}};
     for (int y = 0; y < n; y++)
-        for (size_t k = 0; k < row_sums; k++)
-            (&local[0][0][0])[k] += partial[row_sums * (size_t)y + k];
+        for (size_t k = 0; k < ROW_SUMS; k++)
+            (&local[0][0][0])[k] += partial[ROW_SUMS * (size_t)y + k];
     free(partial);
     free(omega);
 
     /* world monomial sums, then the coefficients */
     double sum[9][3] = {{0}};
     for (int face = 0; face < 6; face++) {
-        const int *pm = face_perm[face];
-        const double *sg = face_sign[face];
+        int pm[3] = {0, 0, 0};
+        double sg[3] = {0, 0, 0};
+        face_perm_sign(face, pm, sg);
         for (int ch = 0; ch < 3; ch++) {
             double w1 = local[face][M1][ch];
             double w[3], ww[3][3];
@@ -212,12 +231,42 @@ void lx_sh_irradiance(const lx_sh9 *sh, lx_vec3 n, float out[3])
     }
 }
 
-lx_status lx_sh_irradiance_cube(const lx_sh9 *sh, int size, lx_cubemap *out)
+typedef struct cube_job {
+    const lx_sh9 *sh;
+    lx_cubemap *out;
+    long *negative; /* per row */
+    float *lowest;  /* per row */
+} cube_job;
+
+static bool cube_row(void *ctx, int r)
+{
+    const cube_job *j = ctx;
+    int size = j->out->size, face = r / size, y = r % size;
+    long negative = 0;
+    float lowest = 0.0f;
+    for (int x = 0; x < size; x++) {
+        lx_vec3 d = lx_cube_direction(face, (x + 0.5f) / size, (y + 0.5f) / size);
+        float *o = lx_cubemap_texel(j->out, face, x, y);
+        lx_sh_irradiance(j->sh, d, o);
+        for (int k = 0; k < 3; k++) {
+            negative += o[k] < 0.0f;
+            lowest = o[k] < lowest ? o[k] : lowest;
+        }
+    }
+    j->negative[r] = negative;
+    j->lowest[r] = lowest;
+    return true;
+}
+
+lx_status lx_sh_irradiance_cube(const lx_sh9 *sh, int size, const lx_ibl_desc *in, lx_cubemap *out)
 {
     if (!out)
         return lx_fail(LX_ERR_INVALID, "SH irradiance: no output cube map (NULL)");
     memset(out, 0, sizeof *out);
+    lx_ibl_desc desc = lx_ibl_desc_defaults(in);
     lx_status st = check_sh(sh);
+    if (st == LX_OK)
+        st = lx_ibl_check_threads(desc.threads);
     if (st != LX_OK)
         return st;
     if (size < 1 || size > LX_MAX_CUBE_SIZE)
@@ -226,21 +275,24 @@ lx_status lx_sh_irradiance_cube(const lx_sh9 *sh, int size, lx_cubemap *out)
     if ((st = lx_cubemap_alloc(out, size)) != LX_OK)
         return st;
     int rows = 6 * size;
+    cube_job job = {sh, out, malloc(sizeof(long) * (size_t)rows),
+                    malloc(sizeof(float) * (size_t)rows)};
+    if (!job.negative || !job.lowest)
+        st = lx_fail(LX_ERR_NOMEM, "SH irradiance: out of memory");
+    lx_ibl_run run = lx_ibl_run_make(desc.threads, desc.progress, desc.progress_user);
+    if (st == LX_OK)
+        st = lx_ibl_for(&run, rows, NULL, cube_row, &job, "SH irradiance");
     long negative = 0;
     float lowest = 0.0f;
-#pragma omp parallel for schedule(static) num_threads(lx_thread_count(0))                          \
-    reduction(+ : negative) reduction(min : lowest)
-    for (int r = 0; r < rows; r++) {
-        int face = r / size, y = r % size;
-        for (int x = 0; x < size; x++) {
-            lx_vec3 d = lx_cube_direction(face, (x + 0.5f) / size, (y + 0.5f) / size);
-            float *o = lx_cubemap_texel(out, face, x, y);
-            lx_sh_irradiance(sh, d, o);
-            for (int k = 0; k < 3; k++) {
-                negative += o[k] < 0.0f;
-                lowest = o[k] < lowest ? o[k] : lowest;
-            }
-        }
+    for (int r = 0; st == LX_OK && r < rows; r++) {
+        negative += job.negative[r];
+        lowest = job.lowest[r] < lowest ? job.lowest[r] : lowest;
+    }
+    free(job.negative);
+    free(job.lowest);
+    if (st != LX_OK) {
+        lx_cubemap_free(out);
+        return st;
     }
     if (negative)
         lx_log(LX_LOG_WARN,

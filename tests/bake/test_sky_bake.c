@@ -18,6 +18,7 @@
 #include "helpers.h"
 
 #include <math.h>
+#include <stdio.h>
 #include <stdlib.h>
 #include <string.h>
 
@@ -70,6 +71,10 @@ static lx_baker *bake_sky(const lx_cubemap *env, bool shadows, uint32_t samples,
 
 static void check_all(const lx_image *img, double want, double rel_tol, const char *what)
 {
+    double worst = 0.0;
+    for (int i = 0; i < img->width * img->height * 3; i++)
+        worst = fmax(worst, fabs(img->data[i] - want) / want);
+    printf("%s: worst relative error %.3g%%\n", what, 100.0 * worst);
     for (int i = 0; i < img->width * img->height * 3; i++)
         if (!(fabs(img->data[i] - want) <= rel_tol * want))
             fail_msg("%s: texel value %d is %.7g, want %.7g (tolerance %g)", what, i / 3,
@@ -83,7 +88,8 @@ static void constant_sky_is_pi_l(void **state)
     for (int shadows = 0; shadows <= 1; shadows++) {
         lx_image img;
         lx_baker *b = bake_sky(&env, shadows, 16, false, NULL, 0, 2, &img);
-        check_all(&img, 2.0 * PI_D, 1e-4, shadows ? "open floor, sky shadows" : "open floor");
+        /* measured: 8.6e-7 (SH) and 2.8e-8 (rays), float rounding */
+        check_all(&img, 2.0 * PI_D, 5e-6, shadows ? "open floor, sky shadows" : "open floor");
         lx_image_free(&img);
         lx_baker_destroy(b);
     }
@@ -98,16 +104,18 @@ static void linear_sky_matches_cosine_integrals(void **state)
     const double up = PI_D + 2.0 * PI_D / 3.0, down = PI_D - 2.0 * PI_D / 3.0;
     lx_image img;
     lx_baker *b = bake_sky(&env, false, 0, false, NULL, 0, 2, &img);
-    check_all(&img, up, 2e-3, "unshadowed, facing up");
+    /* measured: 1.4e-6 and 1.9e-6 (L is of band 1: the SH are exact); with
+     * rays 7.8e-4 (1024 strata, the cube's texel-centre values) */
+    check_all(&img, up, 1e-5, "unshadowed, facing up");
     lx_image_free(&img);
     lx_baker_destroy(b);
     b = bake_sky(&env, false, 0, true, NULL, 0, 2, &img);
-    check_all(&img, down, 5e-3, "unshadowed, facing down");
+    check_all(&img, down, 1e-5, "unshadowed, facing down");
     lx_image_free(&img);
     lx_baker_destroy(b);
     /* rays: stratified over 1024 strata, the box-filtered lookup */
     b = bake_sky(&env, true, 1024, false, NULL, 0, 2, &img);
-    check_all(&img, up, 5e-3, "sky shadows, facing up");
+    check_all(&img, up, 3e-3, "sky shadows, facing up");
     lx_image_free(&img);
     lx_baker_destroy(b);
     lx_cubemap_free(&env);
@@ -122,10 +130,13 @@ static void roof_takes_its_form_factor(void **state)
     lx_image img;
     lx_baker *b = bake_sky(&env, true, 1024, false, &roof, 1, 2, &img);
     lx_test_mesh_free(&roof);
-    /* the roof as a rect light of luminance 2 seen from below: pi L F */
+    /* the roof as a rect light of luminance 2 seen from below: pi L F.
+     * Measured: within 0.63% of 2 pi (the cosine rays' noise along the
+     * roof's edges); bound 2%. */
     lx_vec3 corners[4] = {lx_v3(-0.5f, 0.5f, -0.5f), lx_v3(0.5f, 0.5f, -0.5f),
                           lx_v3(0.5f, 0.5f, 0.5f), lx_v3(-0.5f, 0.5f, 0.5f)};
     int checked = 0;
+    double worst = 0.0;
     for (int y = 0; y < 8; y++)
         for (int x = 0; x < 8; x++) {
             lx_texel_sample s;
@@ -134,11 +145,13 @@ static void roof_takes_its_form_factor(void **state)
             double want = 2.0 * PI_D - blocked;
             double got = img.data[3 * (y * 8 + x)];
             assert_true(blocked > 0.2 * 2.0 * PI_D); /* the roof matters */
-            if (!(fabs(got - want) <= 0.01 * 2.0 * PI_D))
+            worst = fmax(worst, fabs(got - want) / (2.0 * PI_D));
+            if (!(fabs(got - want) <= 0.02 * 2.0 * PI_D))
                 fail_msg("texel (%d, %d): %.5g, want %.5g", x, y, got, want);
             checked++;
         }
     assert_int_equal(checked, 64);
+    printf("roof: worst error %.3g%% of pi L\n", 100.0 * worst);
     lx_image_free(&img);
     lx_baker_destroy(b);
     lx_cubemap_free(&env);
@@ -161,25 +174,32 @@ static lx_cubemap sun_env(int *sun_x, int *sun_y)
     return env;
 }
 
+/* Measured: the open floor within 0.13% of the closed form (the texel
+ * taken whole by the peak rays, 128 of them at Halton points within it;
+ * the closed form puts its light at the centre, 0.12% of the worst), bound
+ * 0.5%; under the roof, with 1024 rays, within 0.58% of pi 100 (the noise
+ * of the cosine rays along the roof's edges; 1.9% with 256), bound 2%. */
 static void sun_texel_lights_like_a_directional_light(void **state)
 {
     (void)state;
     int sx, sy;
     lx_cubemap env = sun_env(&sx, &sy);
-    lx_vec3 d = lx_cube_direction(LX_FACE_PY, (sx + 0.5f) / 16, (sy + 0.5f) / 16);
-    double omega = lx_cube_texel_solid_angle(16, sx, sy);
-    double want = PI_D * 100.0 + 1e7 * omega * d.y;
+    double d[3];
+    lx_test_texel_dir(LX_FACE_PY, 16, sx, sy, d);
+    double omega = lx_test_texel_omega(16, sx, sy, 64);
+    double want = PI_D * 100.0 + 1e7 * omega * d[1];
     lx_image img;
     lx_baker *b = bake_sky(&env, true, 256, false, NULL, 0, 2, &img);
-    check_all(&img, want, 0.015, "open floor under a sun texel");
+    check_all(&img, want, 0.005, "open floor under a sun texel");
     lx_image_free(&img);
     lx_baker_destroy(b);
 
     lx_mesh roof = lx_test_plane("roof", 4.0f, 0.5f, 0.0f, 0.0f, 1);
-    b = bake_sky(&env, true, 256, false, &roof, 1, 2, &img);
+    b = bake_sky(&env, true, 1024, false, &roof, 1, 2, &img);
     lx_test_mesh_free(&roof);
     lx_vec3 corners[4] = {lx_v3(-2.0f, 0.5f, -2.0f), lx_v3(2.0f, 0.5f, -2.0f),
                           lx_v3(2.0f, 0.5f, 2.0f), lx_v3(-2.0f, 0.5f, 2.0f)};
+    double worst = 0.0;
     for (int y = 0; y < 8; y++)
         for (int x = 0; x < 8; x++) {
             lx_texel_sample ts;
@@ -187,9 +207,11 @@ static void sun_texel_lights_like_a_directional_light(void **state)
             double shaded =
                 PI_D * 100.0 - lx_rect_light_illuminance(corners, 100.0f, ts.position, ts.normal);
             double got = img.data[3 * (y * 8 + x)];
+            worst = fmax(worst, fabs(got - shaded) / (PI_D * 100.0));
             if (!(fabs(got - shaded) <= 0.02 * PI_D * 100.0))
                 fail_msg("texel (%d, %d) under the roof: %.5g, want %.5g", x, y, got, shaded);
         }
+    printf("under the roof: worst error %.3g%% of pi 100\n", 100.0 * worst);
     lx_image_free(&img);
     lx_baker_destroy(b);
     lx_cubemap_free(&env);

@@ -13,22 +13,15 @@
 
 #include <cmocka.h>
 
+#include "cube_reference.h"
 #include "helpers.h"
 
 #include <math.h>
+#include <stdio.h>
 #include <stdlib.h>
 #include <string.h>
 
 #define PI_D 3.14159265358979323846
-
-static lx_cubemap grey_env(int size, float value)
-{
-    lx_cubemap env;
-    assert_int_equal(lx_cubemap_alloc(&env, size), LX_OK);
-    for (size_t i = 0; i < (size_t)6 * size * size * 3; i++)
-        env.data[i] = value;
-    return env;
-}
 
 static lx_scene *floor_scene(void)
 {
@@ -77,7 +70,7 @@ static void overflowing_intensity_is_an_error(void **state)
 {
     (void)state;
     /* 1e30 nits x 1e30: every SH coefficient and lookup texel overflows */
-    lx_cubemap env = grey_env(4, 1e30f);
+    lx_cubemap env = lx_test_constant_env(4, 1e30f);
     expect_rejected(&env, 1e30f, false, "overflow");
     expect_rejected(&env, 1e30f, true, "overflow");
     lx_cubemap_free(&env);
@@ -86,7 +79,7 @@ static void overflowing_intensity_is_an_error(void **state)
 static void negative_texel_is_an_error(void **state)
 {
     (void)state;
-    lx_cubemap env = grey_env(4, 1.0f);
+    lx_cubemap env = lx_test_constant_env(4, 1.0f);
     /* one texel far below zero: the mean luminance (and with it the peak
      * threshold) goes negative */
     float *t = lx_cubemap_texel(&env, LX_FACE_NY, 1, 2);
@@ -100,7 +93,7 @@ static void negative_texel_is_an_error(void **state)
 static void bright_sky_still_bakes_pi_l(void **state)
 {
     (void)state;
-    lx_cubemap env = grey_env(4, 1e30f);
+    lx_cubemap env = lx_test_constant_env(4, 1e30f);
     for (int shadows = 0; shadows <= 1; shadows++) {
         lx_scene *scene = floor_scene();
         lx_bake_desc desc = {.resolution = 8, .padding = LX_PADDING_NONE, .threads = 2};
@@ -113,8 +106,12 @@ static void bright_sky_still_bakes_pi_l(void **state)
         assert_int_equal(lx_baker_bake(b), LX_OK);
         lx_image img;
         assert_int_equal(lx_baker_apply_alloc(b, lx_test_map_of(b, 0), &img), LX_OK);
+        double worst = 0.0;
         for (int i = 0; i < 8 * 8 * 3; i++)
-            lx_test_assert_rel(img.data[i], PI_D * 1e30, 1e-3);
+            worst = fmax(worst, fabs(img.data[i] / (PI_D * 1e30) - 1.0));
+        printf("1e30 nits, shadows %d: worst relative error %.2g\n", shadows, worst);
+        /* measured: 8.5e-7 (SH) and 8.3e-8 (rays), float rounding */
+        assert_true(worst < 5e-6);
         lx_image_free(&img);
         lx_baker_destroy(b);
     }

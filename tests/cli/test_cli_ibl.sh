@@ -200,6 +200,143 @@ check "ktx --half: 4 levels down to 1x1" test "$(u32 "$K" 56)" = 4
 KV=$(u32 "$K" 60)
 check "ktx --half: 1.0 is 0x3c00" test "$(od -An -tx1 -j $((64 + KV + 4)) -N 8 "$K" | tr -d ' \n')" = "003c003c003c003c"
 
+# ---- the seam fix and --no-seam-fix --------------------------------------------------------
+
+# texel FILE N X Y: the three floats of texel (x, y), row 0 at the top, of an
+# N x N PFM (whose rows are stored bottom first)
+texel() { tail -c $(($2 * $2 * 12)) "$1" | od -An -tf4 -v -w12 | sed -n "$((($2 - 1 - $4) * $2 + $3 + 1))p"; }
+first() { echo "$1" | awk '{ print $1 }'; }
+
+# A horizontal cross of 4 x 4 faces, each face its own value (as above):
+# file rows bottom first, -Y's four rows, the middle four, +Y's four.
+row4() { printf '%s ' $(repeat 4 "$1") $(repeat 4 "$2") $(repeat 4 "$3") $(repeat 4 "$4"); }
+pfm "$IN/cross4.pfm" 16 12 $(for i in 1 2 3 4; do row4 0 0.125 0 0; done) \
+    $(for i in 1 2 3 4; do row4 0.25 0.75 0.5 0.875; done) $(for i in 1 2 3 4; do row4 0 2 0 0; done)
+# specular level 0 is the environment itself: without the fix every +X texel
+# keeps +X's 0.5 (the filter's value), though +Z across the edge is 0.75
+run "$LUXEL" ibl "$IN/cross4.pfm" --specular ggx --mips 1 --irradiance --no-seam-fix --format pfm -q -o "$WORK/nofix"
+expect_rc 0 "--no-seam-fix"
+check "--no-seam-fix: +X keeps its value at every texel" all_near 0.5 0 < <(pfm_values "$WORK/nofix/specular_m0_px.pfm" $((4 * 4 * 12)))
+check "--no-seam-fix: +Z across the edge is 0.75" test "$(first "$(texel "$WORK/nofix/specular_m0_pz.pfm" 4 3 1)")" = 0.75
+run "$LUXEL" ibl "$IN/cross4.pfm" --specular ggx --mips 1 --irradiance --format pfm -q -o "$WORK/fix"
+expect_rc 0 "the seam fix (default)"
+check "seam fix: +X's edge texel by +Z is (0.5 + 0.75) / 2" test "$(first "$(texel "$WORK/fix/specular_m0_px.pfm" 4 0 1)")" = 0.625
+check "seam fix: +X's edge texel by +Y is (0.5 + 2) / 2" test "$(first "$(texel "$WORK/fix/specular_m0_px.pfm" 4 1 0)")" = 1.25
+check "seam fix: +X's inner texel keeps 0.5" test "$(first "$(texel "$WORK/fix/specular_m0_px.pfm" 4 1 1)")" = 0.5
+# irradiance: the unfixed edge texels differ across the edge, the fixed
+# ones are their mean, the inner texels are the same either way
+a=$(first "$(texel "$WORK/nofix/irradiance_px.pfm" 4 0 2)")
+b=$(first "$(texel "$WORK/nofix/irradiance_pz.pfm" 4 3 2)")
+m=$(first "$(texel "$WORK/fix/irradiance_px.pfm" 4 0 2)")
+check "--no-seam-fix: irradiance differs across the +X/+Z edge ($a, $b)" awk -v a="$a" -v b="$b" 'BEGIN { exit !(a != b) }'
+check "seam fix: the edge texel is the mean of the unfixed pair ($m)" awk -v a="$a" -v b="$b" -v m="$m" 'BEGIN { d = m - (a + b) / 2; exit !(d < 1e-6 * m && -d < 1e-6 * m) }'
+check "the inner irradiance texels do not change" test "$(texel "$WORK/fix/irradiance_px.pfm" 4 1 2)" = "$(texel "$WORK/nofix/irradiance_px.pfm" 4 1 2)"
+
+# ---- --lut alone: the DFG table against a quadrature -----------------------------------------
+
+run "$LUXEL" ibl const:1 --lut --format pfm -q -o "$WORK/lut"
+expect_rc 0 "--lut alone"
+expect_files "--lut alone writes only the DFG table" "$WORK/lut" dfg_lut.pfm
+check "--lut: 128 x 128" grep -q '^128 128$' "$WORK/lut/dfg_lut.pfm"
+# A and B of the split-sum integral at N.V = nv, roughness r: the midpoint
+# rule over (cos theta_l, phi_l in [0, pi]) of D G2 (1 - Fc or Fc) / (4 N.V),
+# uniform in solid angle (GGX D, Smith's height-correlated G2, Schlick's Fc)
+dfg_reference() {
+    awk -v nv="$1" -v r="$2" -v nu=128 -v np=256 '
+        function lam(c, a2) { return (sqrt(1 + a2 * (1 - c * c) / (c * c)) - 1) / 2 }
+        BEGIN {
+            pi = atan2(0, -1); a2 = r ^ 4; vx = sqrt(1 - nv * nv); vz = nv; lv = lam(nv, a2)
+            for (i = 0; i < nu; i++) {
+                cl = (i + 0.5) / nu; sl = sqrt(1 - cl * cl); g = 1 / (1 + lv + lam(cl, a2))
+                for (j = 0; j < np; j++) {
+                    phi = pi * (j + 0.5) / np; lx = sl * cos(phi); ly = sl * sin(phi)
+                    hx = vx + lx; hz = vz + cl; hl = sqrt(hx * hx + ly * ly + hz * hz)
+                    nh = hz / hl; vh = (vx * hx + vz * hz) / hl; q = nh * nh * (a2 - 1) + 1
+                    f = a2 / (pi * q * q) * g / (4 * nv); fc = (1 - vh) ^ 5
+                    sa += (1 - fc) * f; sb += fc * f
+                }
+            }
+            dw = 2 * pi / (nu * np); printf "%.8f %.8f\n", sa * dw, sb * dw
+        }'
+}
+# texels (x, y): N.V = (x + 0.5) / 128, roughness (y + 0.5) / 128; the
+# table is within 1e-4 of A and 0.2% of B there (the rule's own error
+# 3e-5): bounds 5e-4 on A and 1% of B
+for xy in "40 80" "100 120" "20 64" "64 100"; do
+    set -- $xy
+    nv=$(awk -v x="$1" 'BEGIN { print (x + 0.5) / 128 }')
+    r=$(awk -v y="$2" 'BEGIN { print (y + 0.5) / 128 }')
+    got=$(echo $(texel "$WORK/lut/dfg_lut.pfm" 128 "$1" "$2"))
+    want=$(dfg_reference "$nv" "$r")
+    check "--lut: texel ($1, $2) = ($got) against ($want)" awk -v g="$got" -v w="$want" 'BEGIN {
+        split(g, a, " "); split(w, b, " "); da = a[1] - b[1]; db = a[2] - b[2]
+        exit !(da < 5e-4 && -da < 5e-4 && db < 0.01 * b[2] && -db < 0.01 * b[2] && a[3] == 0) }'
+done
+
+# ---- --specular phong --phong-exponents: each level's lobe --------------------------------
+
+# A cross of 8 x 8 faces, black but for one texel of +Z, (5, 3), of 1 nit:
+# each level's texel r is then Omega_b w(r.l_b) / sum_t Omega_t w(r.l_t)
+# with w = max(0, r.l)^n for its exponent n, lights below 1e-4 of the peak
+# left out; computed here over every source texel (the face table, texel
+# centres, exact texel solid angles). At exponents 16 and 4 the lobes are
+# wider than a texel, so both levels read the source itself.
+pfm "$IN/onelight.pfm" 32 24 $(repeat 397 0) 1 $(repeat 370 0)
+run "$LUXEL" ibl "$IN/onelight.pfm" --specular phong --phong-exponents 16,4 --no-seam-fix --format pfm -q -o "$WORK/phong"
+expect_rc 0 "--specular phong --phong-exponents 16,4"
+want=()
+for f in $FACES; do want+=("specular_m0_$f.pfm" "specular_m1_$f.pfm"); done
+expect_files "--phong-exponents 16,4: two levels" "$WORK/phong" "${want[@]}"
+# phong_level N M FACE: the level of exponent N and face size M, texel values
+# in PFM order (bottom row first)
+phong_level() {
+    awk -v n="$1" -v m="$2" -v face="$3" -v N=8 -v bf=4 -v bx=5 -v by=3 '
+        function dir(f, sc, tc, d,   l) {
+            if (f == 0) { d[1] = 1; d[2] = -tc; d[3] = -sc }
+            else if (f == 1) { d[1] = -1; d[2] = -tc; d[3] = sc }
+            else if (f == 2) { d[1] = sc; d[2] = 1; d[3] = tc }
+            else if (f == 3) { d[1] = sc; d[2] = -1; d[3] = -tc }
+            else if (f == 4) { d[1] = sc; d[2] = -tc; d[3] = 1 }
+            else { d[1] = -sc; d[2] = -tc; d[3] = -1 }
+            l = sqrt(d[1] * d[1] + d[2] * d[2] + d[3] * d[3]); d[1] /= l; d[2] /= l; d[3] /= l
+        }
+        function corner(a, b) { return atan2(a * b, sqrt(a * a + b * b + 1)) }
+        BEGIN {
+            cut = exp(log(1e-4) / n); k = 0
+            for (f = 0; f < 6; f++) for (y = 0; y < N; y++) for (x = 0; x < N; x++) {
+                dir(f, 2 * (x + 0.5) / N - 1, 2 * (y + 0.5) / N - 1, d)
+                lx[k] = d[1]; ly[k] = d[2]; lz[k] = d[3]
+                x0 = 2 * x / N - 1; x1 = 2 * (x + 1) / N - 1; y0 = 2 * y / N - 1; y1 = 2 * (y + 1) / N - 1
+                om[k] = corner(x0, y0) - corner(x0, y1) - corner(x1, y0) + corner(x1, y1)
+                if (f == bf && x == bx && y == by) b = k
+                k++
+            }
+            for (y = m - 1; y >= 0; y--) for (x = 0; x < m; x++) {
+                dir(face, 2 * (x + 0.5) / m - 1, 2 * (y + 0.5) / m - 1, r)
+                den = 0; num = 0
+                for (t = 0; t < k; t++) {
+                    c = r[1] * lx[t] + r[2] * ly[t] + r[3] * lz[t]
+                    if (c < cut) continue
+                    w = om[t] * c ^ n; den += w; if (t == b) num = w
+                }
+                printf "%.9g\n", num / den
+            }
+        }'
+}
+phong_ok() { # phong_ok FILE N M FACE
+    paste <(pfm_values "$1" $(($3 * $3 * 12)) | awk 'NR % 3 == 1') <(phong_level "$2" "$3" "$4") |
+        awk '{ d = $1 - $2; if (d < 0) d = -d; if (d > 1e-4 * $2 + 1e-7) bad++; if ($2 > peak) peak = $2 }
+             END { exit !(bad == 0 && NR > 0) }'
+}
+for f in $FACES; do
+    i=$(echo "$FACES" | tr ' ' '\n' | grep -n "^$f$" | cut -d: -f1)
+    check "--phong-exponents: level 0 face $f is the lobe of exponent 16" phong_ok "$WORK/phong/specular_m0_$f.pfm" 16 8 $((i - 1))
+    check "--phong-exponents: level 1 face $f is the lobe of exponent 4" phong_ok "$WORK/phong/specular_m1_$f.pfm" 4 4 $((i - 1))
+done
+# and the check tells lobes apart: level 0 is not the default's (2048)
+not_phong_ok() { ! phong_ok "$@"; }
+check "--phong-exponents: level 0 of +Z is not the default lobe of 2048" not_phong_ok "$WORK/phong/specular_m0_pz.pfm" 2048 8 4
+
 # ---- determinism ------------------------------------------------------------------------
 
 run "$LUXEL" ibl "$IN/cross.pfm" --size 8 --samples 32 --format pfm --threads 1 -q -o "$WORK/t1"
@@ -253,6 +390,10 @@ bad "--intensity negative" 2 "--intensity|-1" const:1 --intensity -1
 bad "--intensity nan" 2 "--intensity|nan" const:1 --intensity nan
 bad "--samples 0" 2 "--samples" const:1 --specular ggx --samples 0
 bad "--threads 0" 2 "--threads" const:1 --threads 0
+bad "--specular-size 0" 2 "--specular-size|'0'" const:1 --specular ggx --specular-size 0
+bad "--specular-size too large" 2 "--specular-size|99999" const:1 --specular ggx --specular-size 99999
+bad "--specular-size not a number" 2 "--specular-size|abc" const:1 --specular ggx --specular-size abc
+bad "--specular-size without --specular" 2 "--specular-size|add --specular" const:1 --sh --specular-size 64
 bad "malformed const:" 2 "const:1,x" const:1,x
 bad "negative const:" 2 "const:-1,1,1" const:-1,1,1
 bad "unknown option" 2 "--frobnicate" const:1 --frobnicate
@@ -278,8 +419,6 @@ run "$LUXEL" ibl const:1 --size 4 --sh -o "$WORK/afile"
 expect_rc 1 "-o names a file"
 expect_error "-o names a file" "afile"
 
-# ---- interrupts: nothing left behind ------------------------------------------------------
-
 wait_for() { # polls every 10 ms for up to 30 s
     local i
     for ((i = 0; i < 3000; i++)); do
@@ -288,6 +427,94 @@ wait_for() { # polls every 10 ms for up to 30 s
     done
     return 1
 }
+# wait_for_pause PHASE: until the run says it paused there (or ends)
+wait_for_pause() {
+    local i
+    for ((i = 0; i < 3000; i++)); do
+        grep -q "^luxel: test: paused at $1" "$ERR" && return 0
+        kill -0 "$pid" 2>/dev/null || return 1
+        sleep 0.01
+    done
+    return 1
+}
+
+# ---- memory: a run that cannot fit fails before it starts ---------------------------
+
+# 15 Phong lobes of exponent 1e6 each take the whole 16384^2 environment
+# as their lights: far more memory than any machine has. The library
+# refuses it on the sizes alone, so the run fails at once, naming the GiB,
+# before the 18 GiB environment is made.
+E15=1e6$(for i in $(seq 14); do printf ',1e6'; done)
+bad "a run that needs more memory than the machine" 1 "const:1|prefilter: a 16384 x 16384 source (18.0 GiB)|GiB of memory, the machine has" \
+    const:1 --size 16384 --specular phong --phong-exponents "$E15" --specular-size 16384
+
+# ---- upsampling: a warning at once, naming the memory ----------------------------------
+
+# a 16 x 8 equirect holds 4 x 4 faces of detail: 64 x 64 faces upsample it
+# 16x; the warning comes before the resampling starts (it is on stderr when
+# the run reaches its first progress report)
+pfm "$IN/small_eq.pfm" 16 8 $(repeat 128 0.5)
+out=$WORK/out_upsample
+LUXEL_TEST_PAUSE=environment "$LUXEL" ibl "$IN/small_eq.pfm" --size 64 --irradiance=sh -o "$out" >"$OUT" 2>"$ERR" &
+pid=$!
+if wait_for_pause environment; then
+    expect_stderr_has "upsampling: warned before the work" "^luxel: warning: .*small_eq.pfm: 64 x 64 faces from a 16 x 8 equirect upsample it 16x: the .*MiB cube map"
+    kill -INT "$pid"
+fi
+wait "$pid"
+RC=$?
+check "upsampling: interrupted at the pause" test "$RC" -ne 0
+expect_no_output "upsampling, interrupted" "$out"
+run "$LUXEL" ibl const:1 --size 16 --specular ggx --specular-size 128 --samples 16 -q -o "$WORK/up_spec"
+expect_rc 0 "--specular-size 8x the environment"
+expect_stderr_has "--specular-size 8x: a warning" "^luxel: warning: prefilter: 128 x 128 specular faces from a 16 x 16 source upsample it 8x"
+
+# ---- every phase: threads bounded, progress reported, an interrupt obeyed -----------------
+
+# A 64 x 32 equirect, all of it filtered: LUXEL_TEST_PAUSE stops the run at
+# the first progress report of each phase, and a SIGINT there must end it
+# with nothing written. At the last phase ("write", after the first file
+# is staged) every phase has run: with --threads 1 the process must never
+# have started a second thread (OpenMP keeps the threads it starts).
+pfm "$IN/eq64.pfm" 64 32 $(repeat 2048 0.5)
+for phase in environment sh irradiance specular dfg write; do
+    out=$WORK/out_phase_$phase
+    LUXEL_TEST_PAUSE=$phase "$LUXEL" ibl "$IN/eq64.pfm" --threads 1 -o "$out" >"$OUT" 2>"$ERR" &
+    pid=$!
+    if wait_for_pause "$phase"; then
+        pass "phase $phase: reports progress"
+        threads=$(awk '/^Threads:/ { print $2 }' "/proc/$pid/status" 2>/dev/null)
+        [ "$phase" = write ] && check "--threads 1: one thread through every phase (now $threads)" test "$threads" = 1
+        kill -INT "$pid"
+    else
+        fail "phase $phase: never reported progress"
+        kill -KILL "$pid" 2>/dev/null
+    fi
+    wait "$pid"
+    RC=$?
+    check "phase $phase: interrupted (status $RC)" test "$RC" -ne 0
+    expect_stderr_has "phase $phase: says it was interrupted" '^luxel: error: .*interrupt'
+    expect_no_output "phase $phase, interrupted" "$out"
+done
+if [ "$(nproc)" -ge 2 ]; then
+    out=$WORK/out_threads2
+    LUXEL_TEST_PAUSE=write "$LUXEL" ibl "$IN/eq64.pfm" --threads 2 -o "$out" >"$OUT" 2>"$ERR" &
+    pid=$!
+    if wait_for_pause write; then
+        threads=$(awk '/^Threads:/ { print $2 }' "/proc/$pid/status" 2>/dev/null)
+        check "--threads 2: two threads (now $threads)" test "$threads" = 2
+        kill -INT "$pid"
+    else
+        fail "--threads 2: never reached the write phase"
+        kill -KILL "$pid" 2>/dev/null
+    fi
+    wait "$pid"
+else
+    echo "skip  --threads 2: one CPU"
+fi
+
+# ---- interrupts: nothing left behind ------------------------------------------------------
+
 has_files() { [ -d "$1" ] && [ "$(find "$1" -type f | wc -l)" -ge "$2" ]; }
 # interrupted LABEL OUTDIR ALL: after a signal, a non-zero exit, a message
 # and an empty folder - or, if the run won the race, all ALL files.

@@ -73,3 +73,26 @@ lx_cubemap lx_test_make_env(int size, lx_test_env_fn fn)
             }
     return c;
 }
+
+lx_cubemap lx_test_constant_env(int size, float value)
+{
+    lx_cubemap c;
+    assert_int_equal(lx_cubemap_alloc(&c, size), LX_OK);
+    for (size_t i = 0; i < (size_t)6 * size * size * 3; i++)
+        c.data[i] = value;
+    return c;
+}
+
+lx_test_progress lx_test_progress_make(int stop_after)
+{
+    lx_test_progress p = {0, stop_after > 0 ? stop_after : 1 << 30, 0.0f, true};
+    return p;
+}
+
+bool lx_test_progress_fn(void *user, float fraction)
+{
+    lx_test_progress *p = user;
+    p->monotone = p->monotone && fraction >= p->last;
+    p->last = fraction;
+    return ++p->calls < p->stop_after;
+}

@@ -31,4 +31,21 @@ typedef void (*lx_test_env_fn)(double x, double y, double z, float out[3]);
  * the test when it cannot be allocated. Free with lx_cubemap_free. */
 lx_cubemap lx_test_make_env(int size, lx_test_env_fn fn);
 
+/* A progress callback's record for the IBL tests: how many calls, the
+ * last fraction, whether the fractions never fell; the callback returns
+ * false (cancel) at call number stop_after. */
+typedef struct lx_test_progress {
+    int calls, stop_after;
+    float last;
+    bool monotone;
+} lx_test_progress;
+
+/* A record that never cancels, or that cancels at call stop_after. */
+lx_test_progress lx_test_progress_make(int stop_after);
+/* An lx_progress_fn; user is an lx_test_progress. */
+bool lx_test_progress_fn(void *user, float fraction);
+
+/* A cube map holding value in every channel of every texel. */
+lx_cubemap lx_test_constant_env(int size, float value);
+
 #endif

@@ -146,7 +146,7 @@ static void test_cross_round_trip_exact(void **state)
         assert_int_equal(lx_cubemap_alloc(&c, 7), LX_OK);
         fill_random(&c, 21 + vertical);
         lx_image cross;
-        assert_int_equal(lx_cubemap_to_cross(&c, vertical, &cross), LX_OK);
+        assert_int_equal(lx_cubemap_to_cross(&c, vertical, NULL, &cross), LX_OK);
         assert_int_equal(cross.width, vertical ? 21 : 28);
         assert_int_equal(cross.height, vertical ? 28 : 21);
         /* cells that hold no face are black */
@@ -155,7 +155,7 @@ static void test_cross_round_trip_exact(void **state)
                 if (cell_face(vertical, x / 7, y / 7) < 0)
                     for (int k = 0; k < 3; k++)
                         assert_true(cross.data[((size_t)y * cross.width + x) * 3 + k] == 0.0f);
-        assert_int_equal(lx_cubemap_from_cross(&cross, &back), LX_OK);
+        assert_int_equal(lx_cubemap_from_cross(&cross, NULL, &back), LX_OK);
         assert_cubes_equal(&c, &back);
         lx_cubemap_free(&back);
 
@@ -200,7 +200,7 @@ static void test_cross_layout_continuous(void **state)
             }
     for (int vertical = 0; vertical < 2; vertical++) {
         lx_image img;
-        assert_int_equal(lx_cubemap_to_cross(&c, vertical, &img), LX_OK);
+        assert_int_equal(lx_cubemap_to_cross(&c, vertical, NULL, &img), LX_OK);
         int pairs = 0, boundary_pairs = 0;
         for (int y = 0; y < img.height; y++)
             for (int x = 0; x < img.width; x++)
@@ -320,7 +320,7 @@ static void test_equirect_round_trip(void **state)
     lx_image eq, back;
     make_smooth_equirect(&eq, w);
     lx_cubemap c;
-    assert_int_equal(lx_cubemap_from_equirect(&eq, size, &c), LX_OK);
+    assert_int_equal(lx_cubemap_from_equirect(&eq, size, NULL, &c), LX_OK);
     /* every cube texel against the formula at its centre */
     double worst = 0.0;
     for (int f = 0; f < 6; f++)
@@ -337,7 +337,7 @@ static void test_equirect_round_trip(void **state)
     print_message("equirect -> cube: largest relative error %.3g%%\n", 100 * worst);
     assert_true(worst < 0.01);
     /* and back to the equirect */
-    assert_int_equal(lx_cubemap_to_equirect(&c, w, &back), LX_OK);
+    assert_int_equal(lx_cubemap_to_equirect(&c, w, NULL, &back), LX_OK);
     assert_int_equal(back.width, w);
     assert_int_equal(back.height, w / 2);
     worst = 0.0;
@@ -376,11 +376,11 @@ static void test_constant_environment(void **state)
         assert_true(c.data[3 * i + 2] == 2.0f);
     }
     lx_image eq;
-    assert_int_equal(lx_cubemap_to_equirect(&c, 30, &eq), LX_OK);
+    assert_int_equal(lx_cubemap_to_equirect(&c, 30, NULL, &eq), LX_OK);
     for (size_t i = 0; i < 30 * 15; i++)
         assert_true(fabsf(eq.data[3 * i] - 1.0f) < 1e-6f &&
                     fabsf(eq.data[3 * i + 2] - 2.0f) < 1e-6f);
-    assert_int_equal(lx_cubemap_from_equirect(&eq, 5, &r), LX_OK);
+    assert_int_equal(lx_cubemap_from_equirect(&eq, 5, NULL, &r), LX_OK);
     for (size_t i = 0; i < 6 * 25; i++)
         assert_true(fabsf(r.data[3 * i + 1] - 0.5f) < 1e-6f);
     lx_cubemap_free(&r);
@@ -388,7 +388,7 @@ static void test_constant_environment(void **state)
     /* a cross loaded at another size */
     const char *dir = lx_test_dir("ibl_env_io/constant");
     lx_image cross;
-    assert_int_equal(lx_cubemap_to_cross(&c, false, &cross), LX_OK);
+    assert_int_equal(lx_cubemap_to_cross(&c, false, NULL, &cross), LX_OK);
     write_image_pfm(path_in(dir, "c.pfm"), &cross);
     lx_env_load_desc d = {.size = 4};
     assert_int_equal(lx_env_load(path_in(dir, "c.pfm"), &d, &r), LX_OK);
@@ -853,19 +853,20 @@ static void test_bad_shapes(void **state)
     /* the library calls themselves */
     lx_image img;
     assert_int_equal(lx_image_alloc(&img, 12, 9, 3), LX_OK);
-    assert_int_equal(lx_cubemap_from_equirect(&img, 4, &c), LX_ERR_INVALID);
+    assert_int_equal(lx_cubemap_from_equirect(&img, 4, NULL, &c), LX_ERR_INVALID);
     assert_error_mentions("12x9");
     assert_null(c.data);
     lx_image_free(&img);
     assert_int_equal(lx_image_alloc(&img, 12, 6, 3), LX_OK);
-    assert_int_equal(lx_cubemap_from_cross(&img, &c), LX_ERR_INVALID);
+    assert_int_equal(lx_cubemap_from_cross(&img, NULL, &c), LX_ERR_INVALID);
     assert_error_mentions("12x6");
-    assert_int_equal(lx_cubemap_from_equirect(&img, 0, &c), LX_ERR_INVALID);
-    assert_int_equal(lx_cubemap_from_equirect(&img, LX_MAX_CUBE_SIZE + 1, &c), LX_ERR_INVALID);
+    assert_int_equal(lx_cubemap_from_equirect(&img, 0, NULL, &c), LX_ERR_INVALID);
+    assert_int_equal(lx_cubemap_from_equirect(&img, LX_MAX_CUBE_SIZE + 1, NULL, &c),
+                     LX_ERR_INVALID);
     lx_image_free(&img);
     assert_int_equal(lx_env_constant(lx_v3(1, 1, 1), 3, &c), LX_OK);
-    assert_int_equal(lx_cubemap_to_equirect(&c, 7, &img), LX_ERR_INVALID);
-    assert_int_equal(lx_cubemap_to_equirect(&c, 0, &img), LX_ERR_INVALID);
+    assert_int_equal(lx_cubemap_to_equirect(&c, 7, NULL, &img), LX_ERR_INVALID);
+    assert_int_equal(lx_cubemap_to_equirect(&c, 0, NULL, &img), LX_ERR_INVALID);
     assert_null(img.data);
     lx_cubemap_free(&c);
     assert_int_equal(lx_env_constant(lx_v3(1, -1, 1), 3, &c), LX_ERR_INVALID);

@@ -123,7 +123,7 @@ static void downsample_keeps_flux(void **state)
     for (size_t i = 0; i < (size_t)6 * 16 * 16 * 3; i++)
         env.data[i] = (float)((i * 2654435761u) % 1000) / 100.0f;
     lx_cubemap half;
-    assert_int_equal(lx_cubemap_downsample(&env, &half), LX_OK);
+    assert_int_equal(lx_cubemap_downsample(&env, 0, NULL, &half), LX_OK);
     assert_int_equal(half.size, 8);
     double flux[2] = {0, 0};
     const lx_cubemap *maps[2] = {&env, &half};
@@ -140,7 +140,7 @@ static void downsample_keeps_flux(void **state)
 
     /* odd sizes keep a constant constant */
     lx_cubemap odd = constant_env(5, 2.0f, 2.0f, 2.0f);
-    assert_int_equal(lx_cubemap_downsample(&odd, &half), LX_OK);
+    assert_int_equal(lx_cubemap_downsample(&odd, 0, NULL, &half), LX_OK);
     assert_int_equal(half.size, 2);
     for (int i = 0; i < 6 * 2 * 2 * 3; i++)
         assert_float_equal(half.data[i], 2.0f, 1e-6f);
@@ -174,33 +174,18 @@ static void same_bytes_for_any_thread_count(void **state)
     lx_cubemap_free(&env);
 }
 
-typedef struct progress_log {
-    int calls, stop_after;
-    float last;
-    bool monotone;
-} progress_log;
-
-static bool on_progress(void *user, float f)
-{
-    progress_log *p = user;
-    if (f < p->last)
-        p->monotone = false;
-    p->last = f;
-    return ++p->calls < p->stop_after;
-}
-
 static void progress_and_cancel(void **state)
 {
     (void)state;
     lx_cubemap env = pattern_env(8), out;
-    progress_log p = {.stop_after = 1 << 30, .monotone = true};
-    lx_ibl_desc d = {.threads = 2, .progress = on_progress, .progress_user = &p};
+    lx_test_progress p = lx_test_progress_make(0);
+    lx_ibl_desc d = {.threads = 2, .progress = lx_test_progress_fn, .progress_user = &p};
     assert_int_equal(lx_irradiance_brute(&env, 40, 8, &d, &out), LX_OK);
     assert_true(p.calls >= 2 && p.monotone);
     assert_float_equal(p.last, 1.0f, 0.0f);
     lx_cubemap_free(&out);
 
-    p = (progress_log){.stop_after = 1, .monotone = true};
+    p = lx_test_progress_make(1);
     assert_int_equal(lx_irradiance_brute(&env, 40, 8, &d, &out), LX_ERR_CANCELLED);
     assert_null(out.data);
     assert_int_equal(out.size, 0);
@@ -228,7 +213,7 @@ static void bad_input(void **state)
     assert_int_equal(lx_irradiance_brute(&env, 8, 0, NULL, &out), LX_ERR_INVALID);
     assert_non_null(strstr(lx_last_error(), "1 of 288 values are NaN or infinite"));
     assert_null(out.data);
-    assert_int_equal(lx_cubemap_downsample(&env, &out), LX_ERR_INVALID);
+    assert_int_equal(lx_cubemap_downsample(&env, 0, NULL, &out), LX_ERR_INVALID);
     assert_null(out.data);
     lx_cubemap_free(&env);
 }

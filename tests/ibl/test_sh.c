@@ -4,8 +4,10 @@
  * 4 pi / 5, of x^2 y^2 4 pi / 15), the irradiance of a constant
  * environment (pi L) and of band-limited ones from the Funk-Hecke factors
  * of the clamped cosine (A0 = pi, A1 = 2 pi / 3, A2 = pi / 4), the basis'
- * orthonormality, the reconstruction against the brute-force irradiance of
- * a smooth environment, and bad input. */
+ * orthonormality, the reconstruction against the irradiance of a smooth
+ * environment integrated here (mean and worst error), the same results
+ * for any thread count, progress, cancellation, and bad input. Every
+ * check compares each value, so each bound is a worst case. */
 #include <stdarg.h>
 #include <stddef.h>
 #include <setjmp.h>
@@ -52,7 +54,7 @@ static void constant_environment_gives_pi_l(void **state)
     (void)state;
     lx_cubemap env = lx_test_make_env(16, env_constant);
     lx_sh9 sh;
-    assert_int_equal(lx_sh_project(&env, &sh), LX_OK);
+    assert_int_equal(lx_sh_project(&env, NULL, &sh), LX_OK);
     const double L[3] = {0.5, 1.0, 2.0};
     for (int i = 0; i < 200; i++) {
         float e[3];
@@ -61,7 +63,7 @@ static void constant_environment_gives_pi_l(void **state)
             assert_true(fabs(e[c] / (PI_D * L[c]) - 1.0) < 1e-4);
     }
     lx_cubemap irr;
-    assert_int_equal(lx_sh_irradiance_cube(&sh, 8, &irr), LX_OK);
+    assert_int_equal(lx_sh_irradiance_cube(&sh, 8, NULL, &irr), LX_OK);
     assert_int_equal(irr.size, 8);
     for (size_t i = 0; i < 6 * 8 * 8 * 3; i++)
         assert_true(fabs(irr.data[i] / (PI_D * L[i % 3]) - 1.0) < 1e-4);
@@ -90,7 +92,7 @@ static void polynomial_environment_coefficients(void **state)
 
     lx_cubemap env = lx_test_make_env(64, env_poly);
     lx_sh9 sh;
-    assert_int_equal(lx_sh_project(&env, &sh), LX_OK);
+    assert_int_equal(lx_sh_project(&env, NULL, &sh), LX_OK);
     for (int k = 0; k < 9; k++)
         for (int c = 0; c < 3; c++) {
             double err = fabs(sh.c[k][c] - want[k][c]);
@@ -109,7 +111,7 @@ static void band_limited_irradiance_closed_form(void **state)
     (void)state;
     lx_cubemap env = lx_test_make_env(64, env_poly);
     lx_sh9 sh;
-    assert_int_equal(lx_sh_project(&env, &sh), LX_OK);
+    assert_int_equal(lx_sh_project(&env, NULL, &sh), LX_OK);
     for (int i = 0; i < 300; i++) {
         lx_vec3 n = spiral(i, 300);
         double want[3] = {PI_D + 2.0 * PI_D / 3.0 * n.y,
@@ -169,32 +171,103 @@ static void env_smooth(double x, double y, double z, float out[3])
     out[2] = (float)(2.0 + 0.9 * y + 1.0 * lobe);
 }
 
-static void reconstruction_matches_brute_force(void **state)
+/* The irradiance of env_smooth at unit n, integrated here on the function
+ * itself: a 96 x 96 midpoint rule per face, cube_reference's directions
+ * and solid angles (it differs from 192 x 192 by at most 2.5e-5). */
+static void smooth_irradiance(const double n[3], double out[3])
+{
+    const int m = 96;
+    double sum[3] = {0, 0, 0};
+    for (int f = 0; f < 6; f++)
+        for (int y = 0; y < m; y++)
+            for (int x = 0; x < m; x++) {
+                double d[3];
+                lx_test_texel_dir(f, m, x, y, d);
+                double c = n[0] * d[0] + n[1] * d[1] + n[2] * d[2];
+                if (c <= 0.0)
+                    continue;
+                double a = 2.0 * (x + 0.5) / m - 1.0, b = 2.0 * (y + 0.5) / m - 1.0;
+                double w = c * (2.0 / m) * (2.0 / m) / pow(1.0 + a * a + b * b, 1.5);
+                float l[3];
+                env_smooth(d[0], d[1], d[2], l);
+                for (int k = 0; k < 3; k++)
+                    sum[k] += w * l[k];
+            }
+    for (int k = 0; k < 3; k++)
+        out[k] = sum[k];
+}
+
+/* Order-2 SH of a smooth sky against its true irradiance: what is left is
+ * the truncation of the clamped cosine beyond band 2 (Ramamoorthi and
+ * Hanrahan bound it near 3% of the mean for any environment). Measured over
+ * 150 normals and 3 channels: mean 0.23%, worst 2.3% (on the dark side,
+ * where the irradiance is smallest); bounds 0.5% and 5%. */
+static void reconstruction_matches_true_irradiance(void **state)
 {
     (void)state;
-    lx_cubemap env = lx_test_make_env(32, env_smooth), brute;
+    lx_cubemap env = lx_test_make_env(32, env_smooth);
     lx_sh9 sh;
-    assert_int_equal(lx_sh_project(&env, &sh), LX_OK);
-    assert_int_equal(lx_irradiance_brute(&env, 8, 32, NULL, &brute), LX_OK);
+    assert_int_equal(lx_sh_project(&env, NULL, &sh), LX_OK);
     double sum = 0.0, worst = 0.0;
     int count = 0;
-    for (int f = 0; f < 6; f++)
-        for (int y = 0; y < 8; y++)
-            for (int x = 0; x < 8; x++) {
-                lx_vec3 n = lx_cube_direction(f, (x + 0.5f) / 8, (y + 0.5f) / 8);
-                float e[3];
-                lx_sh_irradiance(&sh, n, e);
-                const float *b = lx_cubemap_texel(&brute, f, x, y);
-                for (int c = 0; c < 3; c++) {
-                    double rel = fabs(e[c] - b[c]) / b[c];
-                    sum += rel;
-                    worst = rel > worst ? rel : worst;
-                    count++;
-                }
-            }
-    printf("SH vs brute force: mean %.3f%%, worst %.3f%%\n", 100.0 * sum / count, 100.0 * worst);
-    assert_true(sum / count < 0.01);
-    lx_cubemap_free(&brute);
+    for (int i = 0; i < 150; i++) {
+        lx_vec3 n = spiral(i, 150);
+        double nd[3] = {n.x, n.y, n.z}, want[3];
+        smooth_irradiance(nd, want);
+        float e[3];
+        lx_sh_irradiance(&sh, n, e);
+        for (int c = 0; c < 3; c++) {
+            double rel = fabs(e[c] - want[c]) / want[c];
+            sum += rel;
+            worst = rel > worst ? rel : worst;
+            count++;
+        }
+    }
+    printf("SH vs the true irradiance: mean %.3f%%, worst %.3f%%\n", 100.0 * sum / count,
+           100.0 * worst);
+    assert_true(sum / count < 0.005);
+    assert_true(worst < 0.05);
+    lx_cubemap_free(&env);
+}
+
+/* The same coefficients and cube for 1, 2 and 3 threads; progress up to
+ * 1; a cancelled projection leaves zeros, a cancelled cube nothing. */
+static void threads_progress_cancel(void **state)
+{
+    (void)state;
+    lx_cubemap env = lx_test_make_env(40, env_smooth), irr[3];
+    lx_sh9 sh[3];
+    for (int t = 0; t < 3; t++) {
+        lx_ibl_desc d = {.threads = t + 1};
+        assert_int_equal(lx_sh_project(&env, &d, &sh[t]), LX_OK);
+        assert_int_equal(lx_sh_irradiance_cube(&sh[0], 12, &d, &irr[t]), LX_OK);
+    }
+    for (int t = 1; t < 3; t++) {
+        assert_memory_equal(&sh[0], &sh[t], sizeof sh[0]);
+        assert_memory_equal(irr[0].data, irr[t].data, sizeof(float) * 6 * 12 * 12 * 3);
+    }
+    for (int t = 0; t < 3; t++)
+        lx_cubemap_free(&irr[t]);
+
+    lx_test_progress p = lx_test_progress_make(0);
+    lx_ibl_desc d = {.threads = 2, .progress = lx_test_progress_fn, .progress_user = &p};
+    assert_int_equal(lx_sh_project(&env, &d, &sh[1]), LX_OK);
+    assert_true(p.calls >= 2 && p.monotone);
+    assert_float_equal(p.last, 1.0f, 0.0f);
+    p = lx_test_progress_make(0);
+    assert_int_equal(lx_sh_irradiance_cube(&sh[0], 12, &d, &irr[0]), LX_OK);
+    assert_true(p.calls >= 2 && p.monotone);
+    assert_float_equal(p.last, 1.0f, 0.0f);
+    lx_cubemap_free(&irr[0]);
+
+    p = lx_test_progress_make(2);
+    assert_int_equal(lx_sh_project(&env, &d, &sh[1]), LX_ERR_CANCELLED);
+    assert_non_null(strstr(lx_last_error(), "SH projection cancelled"));
+    for (int k = 0; k < 9; k++)
+        assert_true(sh[1].c[k][0] == 0.0f && sh[1].c[k][1] == 0.0f && sh[1].c[k][2] == 0.0f);
+    p = lx_test_progress_make(2);
+    assert_int_equal(lx_sh_irradiance_cube(&sh[0], 12, &d, &irr[0]), LX_ERR_CANCELLED);
+    assert_null(irr[0].data);
     lx_cubemap_free(&env);
 }
 
@@ -231,7 +304,7 @@ static void ringing_is_kept_and_reported(void **state)
         t[0] = t[1] = t[2] = 1e4f;
     }
     lx_sh9 sh;
-    assert_int_equal(lx_sh_project(&env, &sh), LX_OK);
+    assert_int_equal(lx_sh_project(&env, NULL, &sh), LX_OK);
     for (int i = 0; i < 100; i++) {
         lx_vec3 nrm = spiral(i, 100);
         double want = 0.0;
@@ -253,7 +326,7 @@ static void ringing_is_kept_and_reported(void **state)
     g_log[0] = '\0';
     lx_set_log_callback(keep_log, NULL);
     lx_cubemap irr;
-    assert_int_equal(lx_sh_irradiance_cube(&sh, 8, &irr), LX_OK);
+    assert_int_equal(lx_sh_irradiance_cube(&sh, 8, NULL, &irr), LX_OK);
     lx_set_log_callback(NULL, NULL);
     assert_non_null(strstr(g_log, "negative"));
     float lowest = 0.0f;
@@ -270,27 +343,36 @@ static void bad_input(void **state)
     lx_cubemap env;
     assert_int_equal(lx_cubemap_alloc(&env, 4), LX_OK);
     lx_sh9 sh;
-    assert_int_equal(lx_sh_project(&env, NULL), LX_ERR_INVALID);
-    assert_int_equal(lx_sh_project(NULL, &sh), LX_ERR_INVALID);
+    assert_int_equal(lx_sh_project(&env, NULL, NULL), LX_ERR_INVALID);
+    assert_int_equal(lx_sh_project(NULL, NULL, &sh), LX_ERR_INVALID);
     lx_cubemap_texel(&env, 2, 1, 1)[1] = NAN;
     lx_cubemap_texel(&env, 4, 0, 3)[0] = INFINITY;
-    assert_int_equal(lx_sh_project(&env, &sh), LX_ERR_INVALID);
+    assert_int_equal(lx_sh_project(&env, NULL, &sh), LX_ERR_INVALID);
     assert_non_null(strstr(lx_last_error(), "2 of 288 values are NaN or infinite"));
     for (int k = 0; k < 9; k++)
         assert_true(sh.c[k][0] == 0.0f);
     lx_cubemap bad = {0, NULL};
-    assert_int_equal(lx_sh_project(&bad, &sh), LX_ERR_INVALID);
+    assert_int_equal(lx_sh_project(&bad, NULL, &sh), LX_ERR_INVALID);
     assert_non_null(strstr(lx_last_error(), "face size 0"));
 
     memset(&sh, 0, sizeof sh);
     lx_cubemap out;
-    assert_int_equal(lx_sh_irradiance_cube(&sh, 0, &out), LX_ERR_INVALID);
+    assert_int_equal(lx_sh_irradiance_cube(&sh, 0, NULL, &out), LX_ERR_INVALID);
     assert_non_null(strstr(lx_last_error(), "face size 0"));
     assert_null(out.data);
     sh.c[3][2] = NAN;
-    assert_int_equal(lx_sh_irradiance_cube(&sh, 4, &out), LX_ERR_INVALID);
+    assert_int_equal(lx_sh_irradiance_cube(&sh, 4, NULL, &out), LX_ERR_INVALID);
     assert_non_null(strstr(lx_last_error(), "coefficient 3 channel 2"));
     assert_null(out.data);
+    memset(&sh, 0, sizeof sh);
+    lx_ibl_desc d = {.threads = -3};
+    assert_int_equal(lx_sh_irradiance_cube(&sh, 4, &d, &out), LX_ERR_INVALID);
+    assert_non_null(strstr(lx_last_error(), "thread count -3"));
+    assert_null(out.data);
+    lx_cubemap_texel(&env, 2, 1, 1)[1] = 0.0f;
+    lx_cubemap_texel(&env, 4, 0, 3)[0] = 0.0f;
+    assert_int_equal(lx_sh_project(&env, &d, &sh), LX_ERR_INVALID);
+    assert_non_null(strstr(lx_last_error(), "thread count -3"));
     lx_cubemap_free(&env);
 }
 
@@ -302,7 +384,8 @@ int main(void)
         cmocka_unit_test(polynomial_environment_coefficients),
         cmocka_unit_test(band_limited_irradiance_closed_form),
         cmocka_unit_test(basis_is_orthonormal),
-        cmocka_unit_test(reconstruction_matches_brute_force),
+        cmocka_unit_test(reconstruction_matches_true_irradiance),
+        cmocka_unit_test(threads_progress_cancel),
         cmocka_unit_test(ringing_is_kept_and_reported),
         cmocka_unit_test(bad_input),
     };

@@ -35,6 +35,13 @@ bool cli_parse_rgb(const char *s, lx_vec3 *out);
  * is zeroed on failure. */
 int cli_load_environment(const char *command, const char *env, float intensity, int size,
                          lx_cubemap *out);
+/* The same with the library's threads bounded (0 = all cores) and a
+ * progress bar labelled "environment" (none when quiet). */
+int cli_load_environment_run(const char *command, const char *env, float intensity, int size,
+                             int threads, bool quiet, lx_cubemap *out);
+/* The face size cli_load_environment gives ENV at `size` when it is known
+ * before loading (size itself, or a constant's default), else 0. */
+int cli_environment_size(const char *env, int size);
 
 /* Progress bar on stderr: drawn only when stderr is a terminal, not quiet,
  * and the work has run for more than a second. Returns false once the run

@@ -28,8 +28,8 @@ static bool parse_constant(const char *env, lx_vec3 *rgb, bool *bad)
     return false;
 }
 
-int cli_load_environment(const char *command, const char *env, float intensity, int size,
-                         lx_cubemap *out)
+int cli_load_environment_run(const char *command, const char *env, float intensity, int size,
+                             int threads, bool quiet, lx_cubemap *out)
 {
     memset(out, 0, sizeof *out);
     lx_vec3 constant;
@@ -51,10 +51,37 @@ int cli_load_environment(const char *command, const char *env, float intensity, 
                                "a constant environment is const:R,G,B or const:L with finite "
                                "values >= 0, not '%s'",
                                env);
-    lx_env_load_desc ld = {.intensity = intensity, .size = size};
-    if (lx_env_load(env, &ld, out) != LX_OK) {
+    cli_progress progress;
+    cli_progress_init(&progress, "environment", quiet);
+    lx_env_load_desc ld = {.intensity = intensity,
+                           .size = size,
+                           .threads = threads,
+                           .progress = cli_progress_update,
+                           .progress_user = &progress};
+    lx_status st = lx_env_load(env, &ld, out);
+    cli_progress_finish(&progress);
+    if (st == LX_ERR_CANCELLED) {
+        cli_report_interrupt(false);
+        return EXIT_FAILED;
+    }
+    if (st != LX_OK) {
         cli_error("%s", lx_last_error());
         return EXIT_FAILED;
     }
     return EXIT_OK;
+}
+
+int cli_load_environment(const char *command, const char *env, float intensity, int size,
+                         lx_cubemap *out)
+{
+    return cli_load_environment_run(command, env, intensity, size, 0, true, out);
+}
+
+int cli_environment_size(const char *env, int size)
+{
+    if (size)
+        return size;
+    lx_vec3 constant;
+    bool bad;
+    return parse_constant(env, &constant, &bad) ? CONSTANT_SIZE : 0;
 }

@@ -15,7 +15,6 @@
 #include <stdio.h>
 #include <stdlib.h>
 #include <string.h>
-#include <unistd.h>
 
 static const char *ibl_usage =
     "usage: luxel ibl ENV [options]\n"
@@ -73,6 +72,7 @@ enum {
     OPT_LUT,
     OPT_ENVIRONMENT,
     OPT_SIZE,
+    OPT_SPECULAR_SIZE,
     OPT_LAYOUT,
     OPT_FORMAT,
     OPT_HALF,
@@ -80,8 +80,6 @@ enum {
     OPT_INTENSITY,
     OPT_THREADS
 };
-
-typedef enum { LAYOUT_FACES, LAYOUT_CROSS, LAYOUT_VCROSS, LAYOUT_EQUIRECT, LAYOUT_KTX } layout;
 
 #define LUT_SIZE 128
 #define IRRADIANCE_SIZE 32
@@ -98,7 +96,8 @@ typedef struct ibl_args {
     int phong_count;
     int samples;
     int size;
-    layout layout;
+    int specular_size;
+    lx_env_layout layout;
     lx_image_format format;
     bool half;
     bool seam_fix;
@@ -130,28 +129,31 @@ static bool parse_exponents(const char *s, ibl_args *a)
 
 static int parse_args(int argc, char **argv, ibl_args *a)
 {
-    static const struct option options[] = {{"output", required_argument, NULL, 'o'},
-                                            {"irradiance", optional_argument, NULL, OPT_IRRADIANCE},
-                                            {"sh", no_argument, NULL, OPT_SH},
-                                            {"specular", required_argument, NULL, OPT_SPECULAR},
-                                            {"mips", required_argument, NULL, OPT_MIPS},
-                                            {"phong-exponents", required_argument, NULL, OPT_PHONG},
-                                            {"samples", required_argument, NULL, OPT_SAMPLES},
-                                            {"lut", no_argument, NULL, OPT_LUT},
-                                            {"environment", no_argument, NULL, OPT_ENVIRONMENT},
-                                            {"size", required_argument, NULL, OPT_SIZE},
-                                            {"layout", required_argument, NULL, OPT_LAYOUT},
-                                            {"format", required_argument, NULL, OPT_FORMAT},
-                                            {"half", no_argument, NULL, OPT_HALF},
-                                            {"no-seam-fix", no_argument, NULL, OPT_NO_SEAM_FIX},
-                                            {"intensity", required_argument, NULL, OPT_INTENSITY},
-                                            {"threads", required_argument, NULL, OPT_THREADS},
-                                            {"quiet", no_argument, NULL, 'q'},
-                                            {"help", no_argument, NULL, 'h'},
-                                            {NULL, 0, NULL, 0}};
+    static const struct option options[] = {
+        {"output", required_argument, NULL, 'o'},
+        {"irradiance", optional_argument, NULL, OPT_IRRADIANCE},
+        {"sh", no_argument, NULL, OPT_SH},
+        {"specular", required_argument, NULL, OPT_SPECULAR},
+        {"mips", required_argument, NULL, OPT_MIPS},
+        {"phong-exponents", required_argument, NULL, OPT_PHONG},
+        {"samples", required_argument, NULL, OPT_SAMPLES},
+        {"lut", no_argument, NULL, OPT_LUT},
+        {"environment", no_argument, NULL, OPT_ENVIRONMENT},
+        {"size", required_argument, NULL, OPT_SIZE},
+        {"specular-size", required_argument, NULL, OPT_SPECULAR_SIZE},
+        {"layout", required_argument, NULL, OPT_LAYOUT},
+        {"format", required_argument, NULL, OPT_FORMAT},
+        {"half", no_argument, NULL, OPT_HALF},
+        {"no-seam-fix", no_argument, NULL, OPT_NO_SEAM_FIX},
+        {"intensity", required_argument, NULL, OPT_INTENSITY},
+        {"threads", required_argument, NULL, OPT_THREADS},
+        {"quiet", no_argument, NULL, 'q'},
+        {"help", no_argument, NULL, 'h'},
+        {NULL, 0, NULL, 0}};
     memset(a, 0, sizeof *a);
     a->output = "ibl";
     a->format = LX_IMAGE_EXR;
+    a->layout = LX_ENV_FACES;
     a->seam_fix = true;
     a->intensity = 1.0f;
     opterr = 0;
@@ -219,17 +221,24 @@ static int parse_args(int argc, char **argv, ibl_args *a)
                                        LX_MAX_CUBE_SIZE, optarg);
             a->size = (int)n;
             break;
+        case OPT_SPECULAR_SIZE:
+            if (!cli_parse_int(optarg, 1, LX_MAX_CUBE_SIZE, &n))
+                return cli_usage_error("ibl",
+                                       "--specular-size must be an integer in 1..%d, not '%s'",
+                                       LX_MAX_CUBE_SIZE, optarg);
+            a->specular_size = (int)n;
+            break;
         case OPT_LAYOUT:
             if (strcmp(optarg, "faces") == 0)
-                a->layout = LAYOUT_FACES;
+                a->layout = LX_ENV_FACES;
             else if (strcmp(optarg, "cross") == 0)
-                a->layout = LAYOUT_CROSS;
+                a->layout = LX_ENV_CROSS;
             else if (strcmp(optarg, "vcross") == 0)
-                a->layout = LAYOUT_VCROSS;
+                a->layout = LX_ENV_CROSS_VERTICAL;
             else if (strcmp(optarg, "equirect") == 0)
-                a->layout = LAYOUT_EQUIRECT;
+                a->layout = LX_ENV_EQUIRECT;
             else if (strcmp(optarg, "ktx") == 0)
-                a->layout = LAYOUT_KTX;
+                a->layout = LX_ENV_KTX;
             else
                 return cli_usage_error(
                     "ibl", "--layout must be faces, cross, vcross, equirect or ktx, not '%s'",
@@ -278,9 +287,9 @@ static int parse_args(int argc, char **argv, ibl_args *a)
     a->env = argv[optind];
     if (!a->irradiance && !a->sh && !a->specular && !a->lut && !a->environment)
         a->irradiance = a->sh = a->specular = a->lut = true;
-    if (!a->specular && (a->mips || a->phong_count))
-        return cli_usage_error("ibl", "--mips and --phong-exponents apply to the specular "
-                                      "chain: add --specular");
+    if (!a->specular && (a->mips || a->phong_count || a->specular_size))
+        return cli_usage_error("ibl", "--mips, --phong-exponents and --specular-size apply to "
+                                      "the specular chain: add --specular");
     if (!a->specular && !a->lut && a->samples)
         return cli_usage_error("ibl", "--samples applies to --specular and --lut");
     if (a->phong_count && a->filter != LX_SPECULAR_PHONG)
@@ -289,7 +298,7 @@ static int parse_args(int argc, char **argv, ibl_args *a)
         return cli_usage_error("ibl", "--mips %d but %d Phong exponents", a->mips, a->phong_count);
     if (a->phong_count)
         a->mips = a->phong_count;
-    if (a->half && a->format != LX_IMAGE_EXR && a->layout != LAYOUT_KTX)
+    if (a->half && a->format != LX_IMAGE_EXR && a->layout != LX_ENV_KTX)
         return cli_usage_error("ibl", "--half applies to --format exr and --layout ktx only");
     return 0;
 }
@@ -301,6 +310,7 @@ typedef struct writer {
     const ibl_args *a;
     char **written; /* names, for the list on stdout */
     int written_count;
+    bool reported; /* a callback printed why it stopped the library */
 } writer;
 
 static bool note(writer *w, const char *name)
@@ -320,60 +330,53 @@ static bool note(writer *w, const char *name)
     return true;
 }
 
-static bool put_image(writer *w, const char *name, const lx_image *img)
+/* lx_env_write's on_file: each file is staged (tracked, so a failed or
+ * interrupted run removes it) before the library creates it. */
+static bool stage_file(void *user, const char *name)
 {
-    lx_image_write_desc wd = {.format = w->a->format, .half = w->a->half};
-    return cli_stage_image(&w->stage, name, img, &wd) && note(w, name);
+    writer *w = user;
+    char *path = cli_stage_path(&w->stage, name);
+    bool ok = path && note(w, name);
+    free(path);
+    w->reported = w->reported || !ok;
+    return ok;
 }
 
-/* One cube map (and its mips) in the chosen layout: STEM.ktx, or per level
- * STEM[_mL]_<face>.EXT (faces) / STEM[_mL].EXT (cross, equirect). */
-static bool put_cube(writer *w, const char *stem, const lx_cubemap *levels, int count,
-                     bool level_names)
+/* The write desc of the run's layout and format. */
+static lx_env_write_desc write_desc(const ibl_args *a, bool mip_names)
 {
-    const ibl_args *a = w->a;
-    const char *ext = lx_image_format_extension(a->format);
-    char name[256];
-    if (a->layout == LAYOUT_KTX) {
-        snprintf(name, sizeof name, "%s.ktx", stem);
-        char *path = cli_stage_path(&w->stage, name);
-        if (!path)
-            return false;
-        lx_status s = lx_ktx_write_cubemap(path, levels, count, a->half);
-        free(path);
-        return cli_stage_finish(&w->stage, name, s) && note(w, name);
+    lx_env_write_desc d = {.layout = a->layout,
+                           .format = a->format,
+                           .half = a->half,
+                           .mip_names = mip_names,
+                           .threads = a->threads};
+    return d;
+}
+
+/* One cube map (and its mips) in the run's layout, into the staging
+ * folder: STEM.ktx, or per level STEM[_mL]_<face>.EXT (faces) /
+ * STEM[_mL].EXT (cross, equirect). */
+static bool put_cube(writer *w, const char *stem, const lx_cubemap *levels, int count,
+                     bool mip_names)
+{
+    cli_progress progress;
+    cli_progress_init(&progress, "write", w->a->quiet);
+    lx_env_write_desc d = write_desc(w->a, mip_names);
+    d.progress = cli_progress_update;
+    d.progress_user = &progress;
+    d.on_file = stage_file;
+    d.on_file_user = w;
+    lx_status s = lx_env_write(w->stage.dir, stem, levels, count, &d);
+    cli_progress_finish(&progress);
+    if (s == LX_OK)
+        return true;
+    if (w->reported)
+        return false;
+    if (s == LX_ERR_CANCELLED) {
+        cli_report_interrupt(true);
+        return false;
     }
-    for (int l = 0; l < count; l++) {
-        char base[200];
-        if (level_names)
-            snprintf(base, sizeof base, "%s_m%d", stem, l);
-        else
-            snprintf(base, sizeof base, "%s", stem);
-        const lx_cubemap *c = &levels[l];
-        if (a->layout == LAYOUT_FACES) {
-            for (int f = 0; f < 6; f++) {
-                snprintf(name, sizeof name, "%s_%s.%s", base, lx_cube_face_name(f), ext);
-                lx_image face = lx_cubemap_face_image(c, f);
-                if (!put_image(w, name, &face))
-                    return false;
-            }
-            continue;
-        }
-        lx_image img;
-        lx_status s = a->layout == LAYOUT_EQUIRECT
-                          ? lx_cubemap_to_equirect(c, 4 * c->size, &img)
-                          : lx_cubemap_to_cross(c, a->layout == LAYOUT_VCROSS, &img);
-        if (s != LX_OK) {
-            cli_error("%s: %s", stem, lx_last_error());
-            return false;
-        }
-        snprintf(name, sizeof name, "%s.%s", base, ext);
-        bool ok = put_image(w, name, &img);
-        lx_image_free(&img);
-        if (!ok)
-            return false;
-    }
-    return true;
+    return cli_stage_finish(&w->stage, stem, s);
 }
 
 /* A JSON number with the fewest digits that read back as the same float. */
@@ -415,47 +418,53 @@ static char *sh_json(const lx_sh9 *sh)
 
 /* ---- the command ----------------------------------------------------------- */
 
-/* Bytes the run holds at its peak with an environment of env_size and a
- * specular chain of spec_size (a bound: a 2048^2 environment filtered at
- * that size peaks at 0.8x it): the environment E = 72 size^2, and the
- * largest of what each step adds while it runs - irradiance its first
- * half-size copy (E / 4); the specular chain the source's mips (E / 3),
- * their padded copies (4 E / 3) and the convolutions' lights (E) besides
- * its levels (4/3 of 72 spec^2); writing a cross or an equirect one image
- * of 4/3 of the largest cube besides the levels. */
-static double peak_bytes(const ibl_args *a, int env_size, int spec_size)
+/* The face size of specular level 0 for an environment of env_size. */
+static int specular_size(const ibl_args *a, int env_size)
 {
-    double e = 72.0 * env_size * env_size;
-    double levels = a->specular ? 96.0 * spec_size * spec_size : 0.0;
-    double work = 0.0;
-    if (a->irradiance && !a->irradiance_sh)
-        work = 0.25 * e;
-    double chain = e / 3.0 + 4.0 * e / 3.0 + e;
-    if (a->specular && work < chain + levels)
-        work = chain + levels;
-    if (a->layout == LAYOUT_CROSS || a->layout == LAYOUT_VCROSS || a->layout == LAYOUT_EQUIRECT) {
-        int largest = a->environment ? env_size : a->specular ? spec_size : IRRADIANCE_SIZE;
-        double image = levels + 96.0 * largest * largest;
-        work = image > work ? image : work;
-    }
-    return e + work;
+    if (a->specular_size)
+        return a->specular_size;
+    return env_size < 256 ? env_size : 256;
 }
 
-/* All of the run at once must fit in memory, not each allocation alone:
- * false with the error printed when it does not. */
-static bool fits(const ibl_args *a, int env_size)
+static int irradiance_size(int env_size)
 {
-    int spec_size = a->size ? a->size : (env_size < 256 ? env_size : 256);
-    double need = peak_bytes(a, env_size, spec_size);
-    long pages = sysconf(_SC_PHYS_PAGES), page_size = sysconf(_SC_PAGESIZE);
-    double have = pages > 0 && page_size > 0 ? (double)pages * (double)page_size : 0.0;
-    if (have == 0.0 || need <= have)
-        return true;
-    const double gib = 1024.0 * 1024.0 * 1024.0;
-    cli_error("%s: filtering a %d x %d environment needs %.1f GiB of memory, the machine has "
-              "%.1f GiB",
-              a->env, env_size, env_size, need / gib, have / gib);
-    return false;
+    return env_size < IRRADIANCE_SIZE ? env_size : IRRADIANCE_SIZE;
+}
+
+static lx_prefilter_desc prefilter_desc(const ibl_args *a, int env_size)
+{
+    lx_prefilter_desc d = {.filter = a->filter,
+                           .size = specular_size(a, env_size),
+                           .mips = a->mips,
+                           .samples = a->samples,
+                           .phong_exponents = a->phong_count ? a->phong : NULL,
+                           .threads = a->threads};
+    return d;
+}
+
+/* Whether the library would take every step of the run for an environment
+ * of env_size, asked before the long work (and, when the size is known
+ * from the options, before the environment is made): the specular chain's
+ * and each output's memory. Prints the error. */
+static bool run_fits(const ibl_args *a, int env_size)
+{
+    lx_status st = LX_OK;
+    if (a->specular) {
+        lx_prefilter_desc d = prefilter_desc(a, env_size);
+        st = lx_prefilter_check(env_size, &d);
+        if (st == LX_OK && a->layout != LX_ENV_KTX) {
+            lx_env_write_desc w = write_desc(a, true);
+            int size = specular_size(a, env_size);
+            st = lx_env_write_check(size, a->mips ? a->mips : lx_cube_mip_count(size), &w);
+        }
+    }
+    if (st == LX_OK && a->environment) {
+        lx_env_write_desc w = write_desc(a, false);
+        st = lx_env_write_check(env_size, 1, &w);
+    }
+    if (st != LX_OK)
+        cli_error("%s: %s", a->env, lx_last_error());
+    return st == LX_OK;
 }
 
 static bool cancelled_or_failed(lx_status s, const char *what)
@@ -488,45 +497,51 @@ int cmd_ibl(int argc, char **argv)
     w.a = &a;
     double t0 = cli_now();
 
-    /* the environment; with --size its size is known before it is made */
-    if (a.size && !fits(&a, a.size))
+    /* a run that cannot fit fails before its environment is made, when
+     * the options tell its size */
+    int known = cli_environment_size(a.env, a.size);
+    if (a.specular && a.mips && known && a.mips > lx_cube_mip_count(specular_size(&a, known))) {
+        status = cli_usage_error("ibl", "--mips %d: a specular cube of size %d has only %d levels",
+                                 a.mips, specular_size(&a, known),
+                                 lx_cube_mip_count(specular_size(&a, known)));
+        goto done;
+    }
+    if (known && !run_fits(&a, known))
         goto done;
     /* the output folder is checked (and made) before the long work */
     if (!cli_stage_begin(&w.stage, a.output))
         goto done;
-    int loaded = cli_load_environment("ibl", a.env, a.intensity, a.size, &env);
+    int loaded =
+        cli_load_environment_run("ibl", a.env, a.intensity, a.size, a.threads, a.quiet, &env);
     if (loaded != EXIT_OK) {
         status = loaded;
         goto done;
     }
-
-    /* the specular chain's size and levels */
-    int spec_size = a.size ? a.size : (env.size < 256 ? env.size : 256);
+    int spec_size = specular_size(&a, env.size);
     if (a.specular && a.mips > lx_cube_mip_count(spec_size)) {
         status = cli_usage_error("ibl", "--mips %d: a specular cube of size %d has only %d levels",
                                  a.mips, spec_size, lx_cube_mip_count(spec_size));
         goto done;
     }
-    if (!fits(&a, env.size))
+    if (!known && !run_fits(&a, env.size))
         goto done;
 
     cli_progress progress;
+    lx_ibl_desc run = {
+        .threads = a.threads, .progress = cli_progress_update, .progress_user = &progress};
     if (a.irradiance || a.sh) {
-        if (cancelled_or_failed(lx_sh_project(&env, &sh), a.env))
+        cli_progress_init(&progress, "sh", a.quiet);
+        lx_status s = lx_sh_project(&env, &run, &sh);
+        cli_progress_finish(&progress);
+        if (cancelled_or_failed(s, a.env))
             goto done;
     }
     if (a.irradiance) {
-        int irr_size = env.size < IRRADIANCE_SIZE ? env.size : IRRADIANCE_SIZE;
-        lx_status s;
-        if (a.irradiance_sh) {
-            s = lx_sh_irradiance_cube(&sh, irr_size, &irr);
-        } else {
-            cli_progress_init(&progress, "irradiance", a.quiet);
-            lx_ibl_desc d = {
-                .threads = a.threads, .progress = cli_progress_update, .progress_user = &progress};
-            s = lx_irradiance_brute(&env, irr_size, 0, &d, &irr);
-            cli_progress_finish(&progress);
-        }
+        cli_progress_init(&progress, "irradiance", a.quiet);
+        lx_status s = a.irradiance_sh
+                          ? lx_sh_irradiance_cube(&sh, irradiance_size(env.size), &run, &irr)
+                          : lx_irradiance_brute(&env, irradiance_size(env.size), 0, &run, &irr);
+        cli_progress_finish(&progress);
         if (cancelled_or_failed(s, a.env))
             goto done;
         if (a.seam_fix)
@@ -534,14 +549,9 @@ int cmd_ibl(int argc, char **argv)
     }
     if (a.specular) {
         cli_progress_init(&progress, "specular", a.quiet);
-        lx_prefilter_desc d = {.filter = a.filter,
-                               .size = spec_size,
-                               .mips = a.mips,
-                               .samples = a.samples,
-                               .phong_exponents = a.phong_count ? a.phong : NULL,
-                               .threads = a.threads,
-                               .progress = cli_progress_update,
-                               .progress_user = &progress};
+        lx_prefilter_desc d = prefilter_desc(&a, env.size);
+        d.progress = cli_progress_update;
+        d.progress_user = &progress;
         lx_status s = lx_prefilter(&env, &d, spec, &spec_count);
         cli_progress_finish(&progress);
         if (cancelled_or_failed(s, a.env))
@@ -551,7 +561,10 @@ int cmd_ibl(int argc, char **argv)
                 lx_cubemap_fix_seams(&spec[l]);
     }
     if (a.lut) {
-        if (cancelled_or_failed(lx_dfg_lut(LUT_SIZE, a.samples, &lut), "DFG table"))
+        cli_progress_init(&progress, "dfg", a.quiet);
+        lx_status s = lx_dfg_lut(LUT_SIZE, a.samples, &run, &lut);
+        cli_progress_finish(&progress);
+        if (cancelled_or_failed(s, "DFG table"))
             goto done;
         /* RG in an RGB image (B = 0): every format here stores RGB */
         if (lx_image_alloc(&lut_rgb, lut.width, lut.height, 3) != LX_OK) {
@@ -585,7 +598,8 @@ int cmd_ibl(int argc, char **argv)
     if (ok && a.lut) {
         char name[32];
         snprintf(name, sizeof name, "dfg_lut.%s", lx_image_format_extension(a.format));
-        lx_image_write_desc wd = {.format = a.format, .half = a.half && a.format == LX_IMAGE_EXR};
+        lx_image_write_desc wd = {
+            .format = a.format, .half = a.half && a.format == LX_IMAGE_EXR, .threads = a.threads};
         ok = cli_stage_image(&w.stage, name, &lut_rgb, &wd) && note(&w, name);
     }
     if (ok && a.environment)
