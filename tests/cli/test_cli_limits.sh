@@ -1,4 +1,4 @@
-# cases: bake_nodes bake_retro bake_density
+# cases: bake_nodes bake_retro bake_density ibl_run
 # End-to-end tests of requests too large for the machine's memory (DESIGN.md
 # section 4: "a 100000^2 lightmap fails up front with a message that says
 # how much was asked"). Whether a case can run depends on the machine: one
@@ -69,6 +69,21 @@ bake_density)
     # small: the sum must be checked up front, not discovered by running out
     oom_case "--texel-density 1e6 --max-resolution 2048 on 1024 nodes" 1024 2048 \
         bake "$IN/many.obj" --texel-density 1000000 --max-resolution 2048 -q
+    ;;
+ibl_run)
+    # a 16384^2 constant environment is 18 GiB; its specular chain at that
+    # size holds it, its mips (6 GiB) and 24 GiB of levels at once, each of
+    # which alone would fit: an error up front naming the size and the
+    # memory, before the environment is made (on a machine with less than
+    # 48 GiB, where the run cannot fit)
+    if [ "$MEM_BYTES" -ge $((48 * 1024 * 1024 * 1024)) ]; then
+        skip "ibl --size 16384 --specular-size 16384: this machine has $MEM_BYTES bytes, the run may fit"
+    else
+        run "$LUXEL" ibl const:1 --size 16384 --specular ggx --specular-size 16384 -q -o "$WORK/huge"
+        expect_rc 1 "ibl --size 16384 --specular-size 16384"
+        expect_error "ibl --size 16384 --specular-size 16384" "16384 x 16384" "GiB of memory"
+        expect_no_output "ibl --size 16384 --specular-size 16384" "$WORK/huge"
+    fi
     ;;
 *)
     fail "unknown case '$CASE_NAME'"

@@ -96,21 +96,7 @@ for shadows in "" --sky-shadows; do
     expect_no_output "$label" "$WORK/bright"
 done
 
-# ---- ibl: the whole run must fit in memory, not each allocation alone ----------------
-
-# a 16384^2 constant environment is 18 GiB; its specular chain at that size
-# holds it, its mips (6 GiB) and 24 GiB of levels at once, each of which
-# alone would fit: an error up front naming the size and the memory, before
-# the environment is made (on a machine with less than 48 GiB, where the
-# run cannot fit)
-mem_kb=$(awk '/^MemTotal:/ { print $2 }' /proc/meminfo 2>/dev/null)
-if [ -n "$mem_kb" ] && [ "$mem_kb" -lt $((48 * 1024 * 1024)) ]; then
-    run "$LUXEL" ibl const:1 --size 16384 --specular ggx --specular-size 16384 -q -o "$WORK/huge"
-    expect_rc 1 "ibl --size 16384 --specular-size 16384"
-    expect_error "ibl --size 16384 --specular-size 16384" "16384 x 16384" "GiB of memory"
-    expect_no_output "ibl --size 16384 --specular-size 16384" "$WORK/huge"
-else
-    echo "skip  ibl --size 16384: this machine may have the memory for it"
-fi
+# The whole ibl run must fit in memory, not each allocation alone:
+# tests/cli/test_cli_limits.sh (case ibl_run).
 
 finish

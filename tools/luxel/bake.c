@@ -393,8 +393,8 @@ int cmd_bake(int argc, char **argv)
         if (a.sky_samples)
             sky.samples = (uint32_t)a.sky_samples;
         /* the SH need no more than 256 texels a side, sky shadows 64 */
-        int loaded =
-            cli_load_environment("bake", sky.environment, 1.0f, LX_SKY_LOAD_SIZE, &sky_env);
+        int loaded = cli_load_environment_run("bake", sky.environment, 1.0f, LX_SKY_LOAD_SIZE,
+                                              a.desc.threads, a.quiet, &sky_env);
         if (loaded != EXIT_OK) {
             status = loaded;
             goto done;
@@ -413,8 +413,7 @@ int cmd_bake(int argc, char **argv)
     a.desc.progress = cli_progress_update;
     a.desc.progress_user = &progress;
     lx_status created = lx_baker_create(scene, &a.desc, &baker);
-    cli_progress_finish(&progress);
-    cli_phase("texel maps and BVH");
+    cli_progress_finish(&progress); /* the texel maps and the BVH */
     lx_cubemap_free(&sky_env);
     if (created != LX_OK) {
         if (created == LX_ERR_CANCELLED)
@@ -456,13 +455,11 @@ int cmd_bake(int argc, char **argv)
     cli_progress_init(&progress, "bake", a.quiet);
     lx_status st = lx_baker_bake(baker);
     cli_progress_finish(&progress);
-    cli_phase("bake");
     /* a scene's dynamic lights are part of its look: evaluate them once too */
     if (st == LX_OK) {
         cli_progress_init(&progress, "dynamic lights", a.quiet);
         st = lx_baker_update(baker);
         cli_progress_finish(&progress);
-        cli_phase("dynamic lights");
     }
     if (st != LX_OK) {
         if (st == LX_ERR_CANCELLED)

@@ -48,6 +48,7 @@ int cli_environment_size(const char *env, int size);
  * is interrupted, which cancels the library call it reports for. */
 typedef struct cli_progress {
     const char *label; /* also the phase name of LUXEL_TEST_PAUSE */
+    const char *phase; /* what --verbose calls the phase; NULL = the label */
     bool enabled;
     bool drawn;
     double start;
@@ -55,6 +56,7 @@ typedef struct cli_progress {
 } cli_progress;
 void cli_progress_init(cli_progress *p, const char *label, bool quiet);
 bool cli_progress_update(void *user, float fraction);
+/* Clears the bar and ends the phase named by the label (cli_phase). */
 void cli_progress_finish(cli_progress *p);
 
 /* ---- interrupts (main.c) -------------------------------------------------

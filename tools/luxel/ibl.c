@@ -59,6 +59,7 @@ static const char *ibl_usage =
     "                           averaged across faces (the seed's seam fix)\n"
     "  --intensity X            multiply the environment by X (default 1)\n"
     "  --threads N              worker threads (default: all cores)\n"
+    "  -v, --verbose            the time of each phase, and notes\n"
     "  -q, --quiet              no progress bar, no list of files\n"
     "  -h, --help               show this help\n";
 
@@ -148,6 +149,7 @@ static int parse_args(int argc, char **argv, ibl_args *a)
         {"intensity", required_argument, NULL, OPT_INTENSITY},
         {"threads", required_argument, NULL, OPT_THREADS},
         {"quiet", no_argument, NULL, 'q'},
+        {"verbose", no_argument, NULL, 'v'},
         {"help", no_argument, NULL, 'h'},
         {NULL, 0, NULL, 0}};
     memset(a, 0, sizeof *a);
@@ -161,7 +163,7 @@ static int parse_args(int argc, char **argv, ibl_args *a)
     int c;
     long n;
     double f;
-    while ((c = getopt_long(argc, argv, ":o:qh", options, NULL)) != -1) {
+    while ((c = getopt_long(argc, argv, ":o:qvh", options, NULL)) != -1) {
         switch (c) {
         case 'o':
             if (!*optarg)
@@ -270,6 +272,9 @@ static int parse_args(int argc, char **argv, ibl_args *a)
         case 'q':
             a->quiet = true;
             break;
+        case 'v':
+            cli_set_verbose(true);
+            break;
         case 'h':
             fputs(ibl_usage, stdout);
             return -1;
@@ -367,6 +372,9 @@ static bool put_cube(writer *w, const char *stem, const lx_cubemap *levels, int 
     d.on_file = stage_file;
     d.on_file_user = w;
     lx_status s = lx_env_write(w->stage.dir, stem, levels, count, &d);
+    char phase[64];
+    snprintf(phase, sizeof phase, "write %s", stem);
+    progress.phase = phase;
     cli_progress_finish(&progress);
     if (s == LX_OK)
         return true;
@@ -495,7 +503,6 @@ int cmd_ibl(int argc, char **argv)
     writer w;
     memset(&w, 0, sizeof w);
     w.a = &a;
-    double t0 = cli_now();
 
     /* a run that cannot fit fails before its environment is made, when
      * the options tell its size */
@@ -576,7 +583,6 @@ int cmd_ibl(int argc, char **argv)
             lut_rgb.data[3 * i + 1] = lut.data[i * lut.channels + 1];
         }
     }
-    double t_compute = cli_now() - t0;
     if (cli_interrupted()) {
         cli_report_interrupt(false);
         goto done;
@@ -608,9 +614,10 @@ int cmd_ibl(int argc, char **argv)
         ok = cli_stage_publish(&w.stage);
     if (!ok)
         goto done;
+    cli_phase("write and publish");
     if (!a.quiet) {
         fprintf(stderr, "luxel: %d file%s from a %d x %d environment in %.2f s\n", w.written_count,
-                w.written_count == 1 ? "" : "s", env.size, env.size, t_compute);
+                w.written_count == 1 ? "" : "s", env.size, env.size, cli_elapsed());
         for (int i = 0; i < w.written_count; i++)
             printf("%s/%s\n", a.output, w.written[i]);
     }

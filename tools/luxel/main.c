@@ -275,6 +275,7 @@ bool cli_test_fail_rename(void)
 void cli_progress_init(cli_progress *p, const char *label, bool quiet)
 {
     p->label = label;
+    p->phase = NULL;
     p->enabled = !quiet && isatty(2);
     p->drawn = false;
     p->start = cli_now();
@@ -313,6 +314,7 @@ void cli_progress_finish(cli_progress *p)
     if (p->drawn)
         fprintf(stderr, "\r%*s\r", 70, "");
     p->drawn = false;
+    cli_phase(p->phase ? p->phase : p->label);
 }
 
 /* ---- logging and dispatch ----------------------------------------------- */
