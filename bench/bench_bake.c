@@ -39,10 +39,13 @@
 #include <stdio.h>
 #include <stdlib.h>
 #include <string.h>
+#include <fcntl.h>
+#include <sys/wait.h>
+#include <unistd.h>
 
 #define TILE LX_BENCH_TILE
 
-static int g_threads, g_reps = 3, g_res = 1024;
+static int g_threads, g_reps = 3, g_res = 1024, g_cli_res = 1024;
 static bool g_skip_raw;
 
 /* ---- raw throughput: the lx_tracer modes, then Embree on a flat BVH ------ */
@@ -369,6 +372,393 @@ static bake_result bench_full_bake(void)
     return res;
 }
 
+/* Every ray once through Embree's packet calls rtcOccluded4/8/16 (width
+ * w), the rays of one tile toward one light in packets of w with a valid
+ * mask on the last; same tiles, schedule and threads as flat_run. */
+#define PACKET_RUN(W)                                                                              \
+    static double packet_run##W(RTCScene flat, const lx_bench_rays *rs, int threads,               \
+                                uint8_t *occluded)                                                 \
+    {                                                                                              \
+        const int L = rs->lights;                                                                  \
+        double t0 = lx_bench_now();                                                                \
+        _Pragma("omp parallel for schedule(dynamic, 4) num_threads(threads)") for (int tile = 0;   \
+                                                                                   tile <          \
+                                                                                   rs->tiles;      \
+                                                                                   tile++)         \
+        {                                                                                          \
+            struct RTCIntersectContext ctx;                                                        \
+            rtcInitIntersectContext(&ctx);                                                         \
+            ctx.flags = RTC_INTERSECT_CONTEXT_FLAG_COHERENT;                                       \
+            struct RTCRay##W pk;                                                                   \
+            int valid[W];                                                                          \
+            for (int l = 0; l < L; l++) {                                                          \
+                uint32_t s = rs->batch[(size_t)tile * L + l];                                      \
+                uint32_t e = rs->batch[(size_t)tile * L + l + 1];                                  \
+                for (uint32_t b = s; b < e; b += W) {                                              \
+                    for (int j = 0; j < W; j++) {                                                  \
+                        const lx_ray *r = &rs->rays[b + j < e ? b + j : s];                        \
+                        valid[j] = b + j < e ? -1 : 0;                                             \
+                        pk.org_x[j] = r->origin.x, pk.org_y[j] = r->origin.y;                      \
+                        pk.org_z[j] = r->origin.z, pk.tnear[j] = r->tmin;                          \
+                        pk.dir_x[j] = r->dir.x, pk.dir_y[j] = r->dir.y, pk.dir_z[j] = r->dir.z;    \
+                        pk.time[j] = 0.0f, pk.tfar[j] = r->tmax, pk.mask[j] = 0xFFFFFFFFu;         \
+                        pk.id[j] = 0, pk.flags[j] = 0;                                             \
+                    }                                                                              \
+                    rtcOccluded##W(valid, flat, &ctx, &pk);                                        \
+                    for (int j = 0; j < W && b + j < e; j++)                                       \
+                        occluded[b + j] = pk.tfar[j] < 0.0f;                                       \
+                }                                                                                  \
+            }                                                                                      \
+        }                                                                                          \
+        return lx_bench_now() - t0;                                                                \
+    }
+PACKET_RUN(4)
+PACKET_RUN(8)
+PACKET_RUN(16)
+
+/* rtcOccluded16 on 4x4 blocks of full 8x8 tiles (the others as rows) */
+static double packet_run16q(RTCScene flat, const lx_bench_rays *rs, int threads, uint8_t *occluded)
+{
+    const int L = rs->lights;
+    double t0 = lx_bench_now();
+#pragma omp parallel for schedule(dynamic, 4) num_threads(threads)
+    for (int tile = 0; tile < rs->tiles; tile++) {
+        struct RTCIntersectContext ctx;
+        rtcInitIntersectContext(&ctx);
+        ctx.flags = RTC_INTERSECT_CONTEXT_FLAG_COHERENT;
+        struct RTCRay16 pk;
+        int valid[16];
+        for (int l = 0; l < L; l++) {
+            uint32_t s = rs->batch[(size_t)tile * L + l];
+            uint32_t e = rs->batch[(size_t)tile * L + l + 1];
+            bool full = e - s == 64;
+            for (uint32_t b = 0; b < e - s; b += 16) {
+                uint32_t idx[16];
+                for (int j = 0; j < 16; j++) {
+                    uint32_t q = b / 16;
+                    idx[j] = full ? ((q / 2) * 4 + j / 4) * 8 + (q % 2) * 4 + j % 4 : b + j;
+                    valid[j] = idx[j] < e - s ? -1 : 0;
+                    const lx_ray *r = &rs->rays[s + (idx[j] < e - s ? idx[j] : 0)];
+                    pk.org_x[j] = r->origin.x, pk.org_y[j] = r->origin.y;
+                    pk.org_z[j] = r->origin.z, pk.tnear[j] = r->tmin;
+                    pk.dir_x[j] = r->dir.x, pk.dir_y[j] = r->dir.y, pk.dir_z[j] = r->dir.z;
+                    pk.time[j] = 0.0f, pk.tfar[j] = r->tmax, pk.mask[j] = 0xFFFFFFFFu;
+                    pk.id[j] = 0, pk.flags[j] = 0;
+                }
+                rtcOccluded16(valid, flat, &ctx, &pk);
+                for (int j = 0; j < 16; j++)
+                    if (valid[j])
+                        occluded[s + idx[j]] = pk.tfar[j] < 0.0f;
+            }
+        }
+    }
+    return lx_bench_now() - t0;
+}
+
+/* ---- [3] the whole luxel bake process ------------------------------------ */
+
+/* The luxel CLI next to this program (both are in build/bin). */
+static void luxel_path(char *out, size_t size)
+{
+    char self[4096];
+    ssize_t n = readlink("/proc/self/exe", self, sizeof self - 1);
+    if (n <= 0)
+        lx_bench_die("readlink /proc/self/exe");
+    self[n] = '\0';
+    char *slash = strrchr(self, '/');
+    if (slash)
+        *slash = '\0';
+    snprintf(out, size, "%s/luxel", self);
+}
+
+/* Runs argv as a child process; returns its wall time in seconds, ending
+ * the bench if it fails. */
+static double run_child(char *const argv[], const char *log)
+{
+    fflush(stdout);
+    double t0 = lx_bench_now();
+    pid_t pid = fork();
+    if (pid < 0)
+        lx_bench_die("fork");
+    if (pid == 0) {
+        /* the CLI's warnings (the occluders have no UVs) go to a file */
+        int fd = open(log, O_WRONLY | O_CREAT | O_TRUNC, 0644);
+        if (fd >= 0) {
+            dup2(fd, 2);
+            close(fd);
+        }
+        execv(argv[0], argv);
+        _exit(127);
+    }
+    int status;
+    if (waitpid(pid, &status, 0) != pid || !WIFEXITED(status) || WEXITSTATUS(status) != 0) {
+        fprintf(stderr, "bench_bake: %s %s failed (status %d); its messages are in %s\n", argv[0],
+                argv[1], status, log);
+        exit(1);
+    }
+    return lx_bench_now() - t0;
+}
+
+typedef struct cli_phases {
+    double import, texel_maps, bvh, bake, dynamic, apply, exr, png;
+} cli_phases;
+
+static void phases_min(cli_phases *best, const cli_phases *p)
+{
+    best->import = fmin(best->import, p->import);
+    best->texel_maps = fmin(best->texel_maps, p->texel_maps);
+    best->bvh = fmin(best->bvh, p->bvh);
+    best->bake = fmin(best->bake, p->bake);
+    best->dynamic = fmin(best->dynamic, p->dynamic);
+    best->apply = fmin(best->apply, p->apply);
+    best->exr = fmin(best->exr, p->exr);
+    best->png = fmin(best->png, p->png);
+}
+
+/* What `luxel bake` does, phase by phase, in this process (the library
+ * calls bake.c makes, with its settings). Returns the baker and scene
+ * (the caller destroys them) and the lightmap in *img. */
+static void cli_phases_run(const char *glb, const char *json, const char *dir, int res,
+                           cli_phases *ph, lx_scene **scene_out, lx_baker **baker_out,
+                           lx_image *img)
+{
+    double t0 = lx_bench_now();
+    lx_scene *scene;
+    if (lx_scene_load(glb, NULL, &scene) != LX_OK || lx_lights_json_apply(scene, json) != LX_OK)
+        lx_bench_die("load");
+    double t1 = lx_bench_now();
+    lx_bake_desc desc = lx_bake_desc_defaults(NULL);
+    desc.resolution = res;
+    desc.threads = g_threads;
+    desc.padding = LX_PADDING_RECOMMENDED;
+    lx_baker *b;
+    if (lx_baker_create(scene, &desc, &b) != LX_OK)
+        lx_bench_die("lx_baker_create");
+    double t2 = lx_bench_now();
+    /* lx_baker_create builds the texel maps, then the BVH: the BVH's share
+     * is the same build timed on its own */
+    lx_tracer *tr;
+    if (lx_tracer_create_threads(scene, g_threads, &tr) != LX_OK)
+        lx_bench_die("lx_tracer_create_threads");
+    double t3 = lx_bench_now();
+    lx_tracer_destroy(tr);
+    double t4 = lx_bench_now();
+    if (lx_baker_bake(b) != LX_OK)
+        lx_bench_die("lx_baker_bake");
+    double t5 = lx_bench_now();
+    if (lx_baker_update(b) != LX_OK)
+        lx_bench_die("lx_baker_update");
+    double t6 = lx_bench_now();
+    if (lx_baker_apply_alloc(b, 0, img) != LX_OK)
+        lx_bench_die("lx_baker_apply_alloc");
+    float ev;
+    bool lit;
+    lx_baker_meter_ev100(b, &ev, &lit);
+    double t7 = lx_bench_now();
+    char path[1100];
+    snprintf(path, sizeof path, "%s/phase.exr", dir);
+    lx_image_write_desc wd = {.format = LX_IMAGE_EXR, .threads = g_threads};
+    if (lx_image_write(path, img, &wd) != LX_OK)
+        lx_bench_die("lx_image_write exr");
+    double t8 = lx_bench_now();
+    snprintf(path, sizeof path, "%s/phase.png", dir);
+    lx_image_write_desc pd = {.format = LX_IMAGE_PNG,
+                              .exposure = lx_exposure_from_ev100(ev) / LX_PI,
+                              .threads = g_threads};
+    if (lx_image_write(path, img, &pd) != LX_OK)
+        lx_bench_die("lx_image_write png");
+    double t9 = lx_bench_now();
+    *ph = (cli_phases){.import = t1 - t0,
+                       .texel_maps = (t2 - t1) - (t3 - t2),
+                       .bvh = t3 - t2,
+                       .bake = t5 - t4,
+                       .dynamic = t6 - t5,
+                       .apply = t7 - t6,
+                       .exr = t8 - t7,
+                       .png = t9 - t8};
+    *scene_out = scene;
+    *baker_out = b;
+}
+
+typedef struct cli_result {
+    bool ran, raw;
+    int res;
+    double wall, samples_s, flat1_rays_s, ratio;
+} cli_result;
+
+enum { RAW_CLI_MODES = 6 };
+static const char *cli_raw_names[RAW_CLI_MODES] = {
+    "Embree flat BVH, rtcOccluded1",  "Embree flat BVH, rtcOccluded1M coh.",
+    "Embree flat BVH, rtcOccluded4",  "Embree flat BVH, rtcOccluded8",
+    "Embree flat BVH, rtcOccluded16", "Embree flat BVH, rtcOccluded16 4x4"};
+
+static double cli_raw_run(int m, RTCScene flat, const lx_bench_rays *rs, uint8_t *occ)
+{
+    switch (m) {
+    case 0:
+        return flat_run(false, flat, rs, g_threads, occ);
+    case 1:
+        return flat_run(true, flat, rs, g_threads, occ);
+    case 2:
+        return packet_run4(flat, rs, g_threads, occ);
+    case 3:
+        return packet_run8(flat, rs, g_threads, occ);
+    case 4:
+        return packet_run16(flat, rs, g_threads, occ);
+    default:
+        return packet_run16q(flat, rs, g_threads, occ);
+    }
+}
+
+static cli_result bench_cli(void)
+{
+    cli_result res = {.ran = true, .raw = !g_skip_raw, .res = g_cli_res};
+    lx_test_scene_info si_;
+    lx_scene *gen = lx_test_spheres_scene("bench-cli", 40.0f, 32, 21, 16, 8, false, &si_);
+    enum { GRID = 4, LIGHTS = GRID * GRID };
+    lx_light lights[LIGHTS];
+    lx_test_grid_lights(GRID, 40.0f, 8.0f, lights);
+    char tag[64], dir[1024], glb[1100], json[1100], out[1100], exr[1200], luxel[4200], errlog[1100];
+    snprintf(tag, sizeof tag, "bench-cli-%ld", (long)getpid());
+    snprintf(dir, sizeof dir, "%s", lx_test_dir(tag));
+    snprintf(glb, sizeof glb, "%s/scene.glb", dir);
+    snprintf(json, sizeof json, "%s/lights.json", dir);
+    snprintf(out, sizeof out, "%s/out", dir);
+    snprintf(errlog, sizeof errlog, "%s/luxel-stderr.txt", dir);
+    lx_test_write_glb(gen, glb);
+    lx_test_write_lights_json(lights, LIGHTS, json);
+    lx_scene_destroy(gen);
+    luxel_path(luxel, sizeof luxel);
+    printf("\n[3] WHOLE luxel bake PROCESS  %u triangles (ground %u + %u spheres), %dx%d "
+           "lightmap, %d point lights without range (every texel sees every light), hard "
+           "shadows, %d threads\n",
+           si_.triangles, si_.ground_triangles, si_.spheres, g_cli_res, g_cli_res, LIGHTS,
+           g_threads);
+    printf("  the CLI, timed as a child process from fork to exit: %s bake scene.glb --lights "
+           "lights.json -o out --resolution %d --threads %d -q  (writes an EXR, a PNG preview "
+           "and the manifest)\n",
+           luxel, g_cli_res, g_threads);
+
+    char res_s[16], thr_s[16];
+    snprintf(res_s, sizeof res_s, "%d", g_cli_res);
+    snprintf(thr_s, sizeof thr_s, "%d", g_threads);
+    char *argv[] = {luxel,          "bake", glb,         "--lights", json, "-o", out,
+                    "--resolution", res_s,  "--threads", thr_s,      "-q", NULL};
+
+    cli_phases best = {INFINITY, INFINITY, INFINITY, INFINITY,
+                       INFINITY, INFINITY, INFINITY, INFINITY};
+    double best_wall = INFINITY, best_raw[RAW_CLI_MODES];
+    for (int m = 0; m < RAW_CLI_MODES; m++)
+        best_raw[m] = INFINITY;
+    lx_scene *scene = NULL;
+    lx_baker *b = NULL;
+    lx_image img = {0};
+    lx_bench_rays rs = {0};
+    RTCDevice dev = NULL;
+    RTCScene flat = NULL;
+    uint8_t *occ[RAW_CLI_MODES] = {0};
+    /* interleaved repetitions: machine noise hits the process and the raw
+     * figures alike */
+    for (int rep = 0; rep < g_reps; rep++) {
+        best_wall = fmin(best_wall, run_child(argv, errlog));
+        cli_phases ph;
+        if (b) {
+            lx_baker_destroy(b);
+            lx_scene_destroy(scene);
+            lx_image_free(&img);
+        }
+        cli_phases_run(glb, json, dir, g_cli_res, &ph, &scene, &b, &img);
+        phases_min(&best, &ph);
+        if (g_skip_raw)
+            continue;
+        if (rep == 0) {
+            lx_bench_rays_build(b, scene, &rs);
+            dev = rtcNewDevice(NULL);
+            flat = flat_scene(dev, scene);
+            for (int m = 0; m < RAW_CLI_MODES; m++)
+                if (!(occ[m] = malloc(rs.count + 1)))
+                    lx_bench_die("malloc");
+        }
+        for (int m = 0; m < RAW_CLI_MODES; m++)
+            best_raw[m] = fmin(best_raw[m], cli_raw_run(m, flat, &rs, occ[m]));
+    }
+    const lx_lightmap_info *info = lx_baker_lightmap_info(b, 0);
+    uint64_t samples = (uint64_t)info->used_texels * scene->light_count;
+
+    /* the CLI's lightmap is this process's, bit for bit */
+    snprintf(exr, sizeof exr, "%s/%s.exr", out, info->name);
+    lx_image got;
+    if (lx_image_load(exr, NULL, &got) != LX_OK)
+        lx_bench_die("lx_image_load");
+    size_t n = (size_t)img.width * img.height * 3, differ = 0;
+    for (size_t i = 0; i < n; i++)
+        differ += got.width != img.width || memcmp(&got.data[i], &img.data[i], 4) != 0;
+    lx_image_free(&got);
+
+    res.wall = best_wall;
+    res.samples_s = (double)samples / best_wall;
+    double sum = best.import + best.texel_maps + best.bvh + best.bake + best.dynamic + best.apply +
+                 best.exr + best.png;
+    printf("  used texels %u; texel-light samples %llu; check: the CLI's EXR %s this "
+           "process's lightmap (%zu differing values)\n",
+           info->used_texels, (unsigned long long)samples, differ ? "DIFFERS FROM" : "equals",
+           differ);
+    if (!g_skip_raw) {
+        uint64_t blocked = 0;
+        for (uint64_t j = 0; j < rs.count; j++)
+            blocked += occ[0][j];
+        printf("  %.1f%% of the %llu rays blocked\n", 100.0 * (double)blocked / (double)rs.count,
+               (unsigned long long)rs.count);
+    }
+    printf("\n  %-40s %7s  %6s   (best of %d, interleaved)\n", "phase, in this process", "time",
+           "share", g_reps);
+    const char *names[8] = {"import (assimp + lights JSON)",
+                            "texel maps",
+                            "BVH (Embree)",
+                            "bake (static lights)",
+                            "dynamic lights",
+                            "apply + exposure meter",
+                            "EXR encode + write",
+                            "PNG encode + write"};
+    const double *vals = &best.import;
+    for (int k = 0; k < 8; k++)
+        printf("  %-40s %7.3f s %5.1f%%\n", names[k], vals[k], 100.0 * vals[k] / best_wall);
+    printf("  %-40s %7.3f s %5.1f%%\n", "sum of the phases", sum, 100.0 * sum / best_wall);
+    printf("  %-40s %7.3f s  (process start and exit, staging, manifest)\n", "rest of the process",
+           best_wall - sum);
+    char a[32], c[32];
+    printf("  %-40s %7.3f s  %ssamples/s\n", "WHOLE luxel bake process", best_wall,
+           lx_bench_si(res.samples_s, a));
+    if (!g_skip_raw) {
+        double best1 = best_raw[0];
+        res.flat1_rays_s = (double)rs.count / best1;
+        res.ratio = res.samples_s / res.flat1_rays_s;
+        printf("\n  %-40s %7s  %14s %s\n", "raw Embree, the same rays", "time", "per second",
+               "process / this");
+        for (int m = 0; m < RAW_CLI_MODES; m++) {
+            uint64_t dis = 0;
+            for (uint64_t j = 0; j < rs.count; j++)
+                dis += occ[m][j] != occ[0][j];
+            double rays_s = (double)rs.count / best_raw[m];
+            printf("  %-40s %7.3f s %12srays/s %6.2fx%s\n", cli_raw_names[m], best_raw[m],
+                   lx_bench_si(rays_s, c), res.samples_s / rays_s,
+                   dis ? "  (occlusion differs!)" : "");
+        }
+        printf("\n  => whole process at %.2fx raw single-ray Embree rtcOccluded1 "
+               "(target >= 1.50x: %s; aim 2x)\n",
+               res.ratio, res.ratio >= 1.5 ? "MET" : "NOT MET");
+        for (int m = 0; m < RAW_CLI_MODES; m++)
+            free(occ[m]);
+        rtcReleaseScene(flat);
+        rtcReleaseDevice(dev);
+        lx_bench_rays_free(&rs);
+    }
+    lx_image_free(&img);
+    lx_baker_destroy(b);
+    lx_scene_destroy(scene);
+    return res;
+}
+
 /* ---- [2] the brute-force reference ---------------------------------------- */
 
 /* tests/common/reference.h on every texel of node 0's lightmap: the
@@ -509,15 +899,18 @@ int main(int argc, char **argv)
             g_reps = atoi(argv[++i]);
         else if (!strcmp(argv[i], "--threads") && i + 1 < argc)
             g_threads = atoi(argv[++i]);
+        else if (!strcmp(argv[i], "--cli-res") && i + 1 < argc)
+            g_cli_res = atoi(argv[++i]);
         else if (!strcmp(argv[i], "--only") && i + 1 < argc &&
-                 (!strcmp(argv[i + 1], "bake") || !strcmp(argv[i + 1], "brute")))
+                 (!strcmp(argv[i + 1], "bake") || !strcmp(argv[i + 1], "brute") ||
+                  !strcmp(argv[i + 1], "cli")))
             only = argv[++i];
         else if (!strcmp(argv[i], "--skip-raw"))
             g_skip_raw = true;
         else {
             fprintf(stderr,
-                    "usage: %s [--res N] [--reps N] [--threads N] [--only bake|brute] "
-                    "[--skip-raw]\n",
+                    "usage: %s [--res N] [--cli-res N] [--reps N] [--threads N] "
+                    "[--only bake|brute|cli] [--skip-raw]\n",
                     argv[0]);
             return 2;
         }
@@ -533,6 +926,9 @@ int main(int argc, char **argv)
         bake = bench_full_bake();
     if (!only || !strcmp(only, "brute"))
         brute = bench_brute_force();
+    cli_result cli = {0};
+    if (!only || !strcmp(only, "cli"))
+        cli = bench_cli();
 
     char a[32], load[32];
     printf("\ntotal bench time %.1f s\n", lx_bench_now() - t0);
@@ -547,6 +943,14 @@ int main(int argc, char **argv)
     if (brute.ran)
         printf(" %.0fx faster than the brute-force reference (%u of %u texels differ);",
                brute.speedup, brute.bad, brute.used);
+    if (cli.ran && cli.raw)
+        printf(" whole luxel bake %dx%d x16 lights %ssamples/s in %.2f s = %.2fx raw "
+               "rtcOccluded1 %srays/s (target >= 1.50x: %s);",
+               cli.res, cli.res, lx_bench_si(cli.samples_s, a), cli.wall, cli.ratio,
+               lx_bench_si(cli.flat1_rays_s, load), cli.ratio >= 1.5 ? "MET" : "NOT MET");
+    else if (cli.ran)
+        printf(" whole luxel bake %dx%d x16 lights %ssamples/s in %.2f s;", cli.res, cli.res,
+               lx_bench_si(cli.samples_s, a), cli.wall);
     printf(" %d threads, load %s\n", g_threads, lx_bench_load(load, sizeof load));
     return 0;
 }

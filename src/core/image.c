@@ -403,10 +403,10 @@ lx_status lx_image_write(const char *path, const lx_image *img, const lx_image_w
         s = lx_img_write_pfm(f.fp, path, img, exposure);
         break;
     case LX_IMAGE_EXR:
-        s = lx_img_write_exr(f.fp, path, img, exposure, d.half);
+        s = lx_img_write_exr(f.fp, path, img, exposure, d.half, d.threads);
         break;
     default:
-        s = lx_img_write_stb(f.fp, path, img, format, exposure);
+        s = lx_img_write_stb(f.fp, path, img, format, exposure, d.threads);
         break;
     }
     if (s != LX_OK) {

@@ -5,6 +5,7 @@
 #include "core/internal.h"
 #include "helpers.h"
 
+#include <cjson/cJSON.h>
 #include <embree3/rtcore.h>
 #include <math.h>
 #include <stdio.h>
@@ -167,6 +168,218 @@ lx_scene *lx_test_spheres_scene(const char *name, float size, int ground_n, int 
             lx_bench_die("lx_scene_add_light");
     }
     return scene;
+}
+
+void lx_test_grid_lights(int n, float size, float height, lx_light *out)
+{
+    static const lx_vec3 colors[4] = {{1, 0.9f, 0.8f}, {0.8f, 0.9f, 1}, {1, 1, 1}, {1, 0.8f, 0.6f}};
+    lx_test_rand_seed(777u);
+    for (int j = 0; j < n; j++)
+        for (int i = 0; i < n; i++) {
+            int k = j * n + i;
+            lx_light l = lx_light_defaults(LX_LIGHT_POINT);
+            snprintf(l.name, sizeof l.name, "grid%d", k);
+            float cell = size / (float)n;
+            float x = -size / 2 + cell * ((float)i + 0.25f + 0.5f * lx_test_rand());
+            float z = -size / 2 + cell * ((float)j + 0.25f + 0.5f * lx_test_rand());
+            float y = height * (0.9f + 0.2f * lx_test_rand());
+            l.position = lx_v3(x, y, z);
+            l.color = colors[k & 3];
+            l.intensity = 40.0f * y * y; /* ~40 lux straight below */
+            l.shadow = LX_SHADOW_HARD;
+            out[k] = l;
+        }
+}
+
+/* ---- glTF writing ---------------------------------------------------------- */
+
+typedef struct glb_bin {
+    unsigned char *data;
+    size_t len, cap;
+} glb_bin;
+
+static size_t bin_append(glb_bin *b, const void *src, size_t n)
+{
+    while (b->len % 4)
+        b->len++; /* every view starts 4-aligned (zeros: the buffer is calloc'd) */
+    size_t need = b->len + n;
+    if (need > b->cap) {
+        size_t cap = b->cap ? b->cap : 1 << 20;
+        while (cap < need + 4)
+            cap *= 2;
+        unsigned char *d = realloc(b->data, cap);
+        if (!d)
+            lx_bench_die("realloc");
+        memset(d + b->cap, 0, cap - b->cap);
+        b->data = d;
+        b->cap = cap;
+    }
+    size_t at = b->len;
+    memcpy(b->data + at, src, n);
+    b->len = need;
+    return at;
+}
+
+/* One bufferView and accessor over n bytes of src; returns the accessor. */
+static int glb_accessor(cJSON *views, cJSON *accessors, glb_bin *b, const void *src, size_t bytes,
+                        uint32_t count, int component, const char *type, int target)
+{
+    size_t at = bin_append(b, src, bytes);
+    cJSON *v = cJSON_CreateObject();
+    cJSON_AddNumberToObject(v, "buffer", 0);
+    cJSON_AddNumberToObject(v, "byteOffset", (double)at);
+    cJSON_AddNumberToObject(v, "byteLength", (double)bytes);
+    cJSON_AddNumberToObject(v, "target", target);
+    cJSON_AddItemToArray(views, v);
+    cJSON *a = cJSON_CreateObject();
+    cJSON_AddNumberToObject(a, "bufferView", cJSON_GetArraySize(views) - 1);
+    cJSON_AddNumberToObject(a, "componentType", component);
+    cJSON_AddNumberToObject(a, "count", count);
+    cJSON_AddStringToObject(a, "type", type);
+    cJSON_AddItemToArray(accessors, a);
+    return cJSON_GetArraySize(accessors) - 1;
+}
+
+static void put_le32(unsigned char *p, uint32_t v)
+{
+    p[0] = (unsigned char)v, p[1] = (unsigned char)(v >> 8), p[2] = (unsigned char)(v >> 16),
+    p[3] = (unsigned char)(v >> 24);
+}
+
+void lx_test_write_glb(const lx_scene *scene, const char *path)
+{
+    enum { FLOAT = 5126, UINT = 5125, ARRAY = 34962, ELEMENTS = 34963 };
+    cJSON *root = cJSON_CreateObject();
+    cJSON *asset = cJSON_AddObjectToObject(root, "asset");
+    cJSON_AddStringToObject(asset, "version", "2.0");
+    cJSON_AddStringToObject(asset, "generator", "luxel tests/common/scenes.c");
+    cJSON_AddNumberToObject(root, "scene", 0);
+    cJSON *scenes = cJSON_AddArrayToObject(root, "scenes");
+    cJSON *sc = cJSON_CreateObject();
+    cJSON *roots = cJSON_AddArrayToObject(sc, "nodes");
+    cJSON_AddItemToArray(scenes, sc);
+    cJSON *nodes = cJSON_AddArrayToObject(root, "nodes");
+    cJSON *meshes = cJSON_AddArrayToObject(root, "meshes");
+    cJSON *accessors = cJSON_AddArrayToObject(root, "accessors");
+    cJSON *views = cJSON_AddArrayToObject(root, "bufferViews");
+    glb_bin bin = {0};
+    for (uint32_t n = 0; n < scene->node_count; n++) {
+        const lx_node *node = &scene->nodes[n];
+        cJSON *mesh = cJSON_CreateObject();
+        cJSON_AddStringToObject(mesh, "name", node->name);
+        cJSON *prims = cJSON_AddArrayToObject(mesh, "primitives");
+        for (uint32_t k = 0; k < node->mesh_count; k++) {
+            const lx_mesh *m = &scene->meshes[node->meshes[k]];
+            cJSON *prim = cJSON_CreateObject();
+            cJSON *attr = cJSON_AddObjectToObject(prim, "attributes");
+            int pos = glb_accessor(views, accessors, &bin, m->positions,
+                                   sizeof(lx_vec3) * m->vertex_count, m->vertex_count, FLOAT,
+                                   "VEC3", ARRAY);
+            lx_vec3 lo = m->positions[0], hi = lo; /* POSITION needs its bounds */
+            for (uint32_t v = 1; v < m->vertex_count; v++) {
+                lo = lx_v3(fminf(lo.x, m->positions[v].x), fminf(lo.y, m->positions[v].y),
+                           fminf(lo.z, m->positions[v].z));
+                hi = lx_v3(fmaxf(hi.x, m->positions[v].x), fmaxf(hi.y, m->positions[v].y),
+                           fmaxf(hi.z, m->positions[v].z));
+            }
+            cJSON *acc = cJSON_GetArrayItem(accessors, pos);
+            cJSON_AddItemToObject(acc, "min",
+                                  cJSON_CreateFloatArray((float[]){lo.x, lo.y, lo.z}, 3));
+            cJSON_AddItemToObject(acc, "max",
+                                  cJSON_CreateFloatArray((float[]){hi.x, hi.y, hi.z}, 3));
+            cJSON_AddNumberToObject(attr, "POSITION", pos);
+            if (m->normals)
+                cJSON_AddNumberToObject(attr, "NORMAL",
+                                        glb_accessor(views, accessors, &bin, m->normals,
+                                                     sizeof(lx_vec3) * m->vertex_count,
+                                                     m->vertex_count, FLOAT, "VEC3", ARRAY));
+            for (int u = 0; u < LX_MAX_UV_SETS; u++)
+                if (m->uv[u])
+                    cJSON_AddNumberToObject(attr, u ? "TEXCOORD_1" : "TEXCOORD_0",
+                                            glb_accessor(views, accessors, &bin, m->uv[u],
+                                                         sizeof(lx_vec2) * m->vertex_count,
+                                                         m->vertex_count, FLOAT, "VEC2", ARRAY));
+            cJSON_AddNumberToObject(prim, "indices",
+                                    glb_accessor(views, accessors, &bin, m->indices,
+                                                 sizeof(uint32_t) * 3 * m->triangle_count,
+                                                 3 * m->triangle_count, UINT, "SCALAR", ELEMENTS));
+            cJSON_AddItemToArray(prims, prim);
+        }
+        cJSON_AddItemToArray(meshes, mesh);
+        cJSON *nd = cJSON_CreateObject();
+        cJSON_AddStringToObject(nd, "name", node->name);
+        cJSON_AddNumberToObject(nd, "mesh", n);
+        cJSON_AddItemToArray(nodes, nd);
+        cJSON_AddItemToArray(roots, cJSON_CreateNumber(n));
+    }
+    while (bin.len % 4)
+        bin.len++;
+    cJSON *buffers = cJSON_AddArrayToObject(root, "buffers");
+    cJSON *buf = cJSON_CreateObject();
+    cJSON_AddNumberToObject(buf, "byteLength", (double)bin.len);
+    cJSON_AddItemToArray(buffers, buf);
+    char *json = cJSON_PrintUnformatted(root);
+    cJSON_Delete(root);
+    if (!json)
+        lx_bench_die("cJSON_PrintUnformatted");
+    size_t jlen = strlen(json), jpad = (jlen + 3) & ~(size_t)3;
+    unsigned char head[20];
+    memcpy(head, "glTF", 4);
+    put_le32(head + 4, 2);
+    put_le32(head + 8, (uint32_t)(12 + 8 + jpad + 8 + bin.len));
+    put_le32(head + 12, (uint32_t)jpad);
+    memcpy(head + 16, "JSON", 4);
+    unsigned char bin_head[8];
+    put_le32(bin_head, (uint32_t)bin.len);
+    memcpy(bin_head + 4, "BIN\0", 4);
+    FILE *f = fopen(path, "wb");
+    bool ok = f && fwrite(head, 1, 20, f) == 20 && fwrite(json, 1, jlen, f) == jlen &&
+              fwrite("   ", 1, jpad - jlen, f) == jpad - jlen && fwrite(bin_head, 1, 8, f) == 8 &&
+              fwrite(bin.data, 1, bin.len, f) == bin.len;
+    ok = f && fclose(f) == 0 && ok;
+    free(json);
+    free(bin.data);
+    if (!ok) {
+        fprintf(stderr, "%s: cannot write %s\n", program, path);
+        exit(1);
+    }
+}
+
+void lx_test_write_lights_json(const lx_light *lights, uint32_t count, const char *path)
+{
+    cJSON *root = cJSON_CreateObject();
+    cJSON *list = cJSON_AddArrayToObject(root, "lights");
+    for (uint32_t i = 0; i < count; i++) {
+        const lx_light *l = &lights[i];
+        cJSON *o = cJSON_CreateObject();
+        cJSON_AddStringToObject(o, "name", l->name);
+        cJSON_AddStringToObject(o, "type", "point");
+        cJSON_AddItemToObject(
+            o, "position",
+            cJSON_CreateFloatArray((float[]){l->position.x, l->position.y, l->position.z}, 3));
+        cJSON_AddItemToObject(
+            o, "color", cJSON_CreateFloatArray((float[]){l->color.x, l->color.y, l->color.z}, 3));
+        cJSON_AddNumberToObject(o, "intensity", l->intensity);
+        cJSON_AddStringToObject(o, "unit", "cd");
+        if (l->range > 0.0f)
+            cJSON_AddNumberToObject(o, "range", l->range);
+        cJSON_AddStringToObject(o, "shadow",
+                                l->shadow == LX_SHADOW_NONE   ? "none"
+                                : l->shadow == LX_SHADOW_BLUR ? "blur"
+                                                              : "hard");
+        cJSON_AddBoolToObject(o, "dynamic", l->dynamic);
+        cJSON_AddItemToArray(list, o);
+    }
+    char *text = cJSON_Print(root);
+    cJSON_Delete(root);
+    FILE *f = text ? fopen(path, "w") : NULL;
+    bool ok = f && fputs(text, f) >= 0;
+    ok = f && fclose(f) == 0 && ok;
+    free(text);
+    if (!ok) {
+        fprintf(stderr, "%s: cannot write %s\n", program, path);
+        exit(1);
+    }
 }
 
 /* ---- the bake's shadow rays ---------------------------------------------- */

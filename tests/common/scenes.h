@@ -47,6 +47,22 @@ typedef struct lx_test_scene_info {
 lx_scene *lx_test_spheres_scene(const char *name, float size, int ground_n, int grid, int slices,
                                 int stacks, bool dynamic, lx_test_scene_info *info);
 
+/* n x n point lights (hard shadows, no range: every texel facing up sees
+ * every one) on a jittered grid `height` above a ground of side size, each
+ * giving ~40 lux straight below it. out holds n * n lights. */
+void lx_test_grid_lights(int n, float size, float height, lx_light *out);
+
+/* Writes scene's nodes and meshes (positions, normals, TEXCOORD_0/1 when
+ * present, 32-bit indices, identity transforms) as a binary glTF 2.0 file;
+ * lights are left out (give them in a lights JSON). Ends the process on
+ * failure. */
+void lx_test_write_glb(const lx_scene *scene, const char *path);
+
+/* Writes point lights as a lights JSON (docs/lights-json.md): name,
+ * position, colour, intensity in cd, shadow mode; floats printed so they
+ * read back exactly. Ends the process on failure. */
+void lx_test_write_lights_json(const lx_light *lights, uint32_t count, const char *path);
+
 /* ---- the bake's shadow rays ---------------------------------------------- */
 
 /* Rays grouped [tile][light][ray] exactly as the bake batches them. */
