@@ -8,6 +8,7 @@
 #include "core/internal.h"
 
 #include <embree3/rtcore.h>
+#include <stddef.h>
 #include <stdio.h>
 #include <stdlib.h>
 #include <string.h>
@@ -255,6 +256,41 @@ void lx_tracer_occluded_batch(const lx_tracer *tr, const lx_ray *rays, uint32_t 
         for (uint32_t i = 0; i < n; i++)
             occluded[base + i] = buf[i].tfar < 0.0f;
     }
+}
+
+/* lx_ray_packet is Embree's RTCRay16, field for field, so a packet goes to
+ * rtcOccluded16 as it is. */
+_Static_assert(sizeof(lx_ray_packet) == sizeof(struct RTCRay16), "packet layout");
+_Static_assert(offsetof(lx_ray_packet, tmin) == offsetof(struct RTCRay16, tnear), "tnear");
+_Static_assert(offsetof(lx_ray_packet, dir_x) == offsetof(struct RTCRay16, dir_x), "dir_x");
+_Static_assert(offsetof(lx_ray_packet, internal_time) == offsetof(struct RTCRay16, time), "time");
+_Static_assert(offsetof(lx_ray_packet, tmax) == offsetof(struct RTCRay16, tfar), "tfar");
+_Static_assert(offsetof(lx_ray_packet, internal) == offsetof(struct RTCRay16, mask), "mask");
+_Static_assert(offsetof(struct RTCRay16, id) == offsetof(struct RTCRay16, mask) + 64, "id");
+_Static_assert(offsetof(struct RTCRay16, flags) == offsetof(struct RTCRay16, mask) + 128, "flags");
+
+uint32_t lx_tracer_occluded_packet(const lx_tracer *tr, lx_ray_packet *packet, uint32_t active)
+{
+    active &= (1u << LX_RAY_PACKET) - 1u;
+    if (!active)
+        return 0;
+    /* written through the packet's own type, read back after the call */
+    _Alignas(64) int valid[LX_RAY_PACKET]; /* Embree loads it as one vector */
+    for (int i = 0; i < LX_RAY_PACKET; i++) {
+        valid[i] = (active >> i) & 1u ? -1 : 0;
+        packet->internal_time[i] = 0.0f;
+        packet->internal[0][i] = 0xFFFFFFFFu; /* mask */
+        packet->internal[1][i] = 0;           /* id */
+        packet->internal[2][i] = 0;           /* flags */
+    }
+    struct RTCIntersectContext ctx;
+    rtcInitIntersectContext(&ctx);
+    ctx.flags = RTC_INTERSECT_CONTEXT_FLAG_COHERENT;
+    rtcOccluded16(valid, tr->scene, &ctx, (struct RTCRay16 *)(void *)packet);
+    uint32_t blocked = 0;
+    for (int i = 0; i < LX_RAY_PACKET; i++)
+        blocked |= (uint32_t)(packet->tmax[i] < 0.0f) << i;
+    return blocked & active;
 }
 
 bool lx_tracer_closest(const lx_tracer *tr, const lx_ray *ray, lx_hit *hit)
