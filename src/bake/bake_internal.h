@@ -31,7 +31,8 @@ typedef struct lx_lightmap {
     lx_vec3 *world_geometric_normal;
     uint8_t *mask;   /* width * height */
     float *baked;    /* width * height * 3 */
-    float *realtime; /* width * height * 3 */
+    float *realtime; /* width * height * 3; NULL (reads as zero) until the
+                        first update with dynamic lights */
 } lx_lightmap;
 
 struct lx_baker {

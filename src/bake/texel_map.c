@@ -444,12 +444,12 @@ lx_status lx_texel_map_build(const lx_scene *scene, uint32_t node_index, const l
     map->tile_start = malloc(sizeof(uint32_t) * (map->tile_count + 1));
     map->mask = calloc(pixels, 1);
     map->baked = calloc(pixels * 3, sizeof(float));
-    map->realtime = calloc(pixels * 3, sizeof(float));
+    /* map->realtime: made by the first update with dynamic lights (baker.c) */
     map->world_position = malloc(sizeof(lx_vec3) * (used ? used : 1));
     map->world_normal = malloc(sizeof(lx_vec3) * (used ? used : 1));
     map->world_geometric_normal = malloc(sizeof(lx_vec3) * (used ? used : 1));
-    if (!map->texels || !map->tile_start || !map->mask || !map->baked || !map->realtime ||
-        !map->world_position || !map->world_normal || !map->world_geometric_normal) {
+    if (!map->texels || !map->tile_start || !map->mask || !map->baked || !map->world_position ||
+        !map->world_normal || !map->world_geometric_normal) {
         st = lx_fail(LX_ERR_NOMEM, "%s: out of memory", what);
         goto done;
     }

