@@ -515,69 +515,106 @@ static void phases_min(cli_phases *best, const cli_phases *p)
     best->png = fmin(best->png, p->png);
 }
 
-/* What `luxel bake` does, phase by phase, in this process (the library
- * calls bake.c makes, with its settings). Returns the baker and scene
- * (the caller destroys them) and the lightmap in *img. */
-static void cli_phases_run(const char *glb, const char *json, const char *dir, int res,
-                           cli_phases *ph, lx_scene **scene_out, lx_baker **baker_out,
-                           lx_image *img)
+/* lx_baker_create reports progress after each node's texel map, then
+ * builds the BVH: the last report's time splits the two. */
+static bool note_progress(void *user, float done)
 {
+    (void)done;
+    *(double *)user = lx_bench_now();
+    return true;
+}
+
+/* What `luxel bake` does, phase by phase (the library calls bake.c makes,
+ * with its settings), in a fresh process like the CLI's: the bench runs
+ * itself with --phases-child and reads the times from a pipe. Fills ph. */
+static void phases_child_main(int argc, char **argv)
+{
+    if (argc != 7)
+        exit(2);
+    const char *glb = argv[2], *json = argv[3], *dir = argv[4];
+    int res = atoi(argv[5]);
+    g_threads = atoi(argv[6]);
     double t0 = lx_bench_now();
     lx_scene *scene;
     if (lx_scene_load(glb, NULL, &scene) != LX_OK || lx_lights_json_apply(scene, json) != LX_OK)
         lx_bench_die("load");
-    double t1 = lx_bench_now();
+    double t1 = lx_bench_now(), t_maps = t1;
     lx_bake_desc desc = lx_bake_desc_defaults(NULL);
     desc.resolution = res;
     desc.threads = g_threads;
     desc.padding = LX_PADDING_RECOMMENDED;
+    desc.progress = note_progress;
+    desc.progress_user = &t_maps;
     lx_baker *b;
     if (lx_baker_create(scene, &desc, &b) != LX_OK)
         lx_bench_die("lx_baker_create");
-    double t2 = lx_bench_now();
-    /* lx_baker_create builds the texel maps, then the BVH: the BVH's share
-     * is the same build timed on its own */
-    lx_tracer *tr;
-    if (lx_tracer_create_threads(scene, g_threads, &tr) != LX_OK)
-        lx_bench_die("lx_tracer_create_threads");
-    double t3 = lx_bench_now();
-    lx_tracer_destroy(tr);
-    double t4 = lx_bench_now();
+    double t2 = lx_bench_now(), maps_end = t_maps; /* the bake reports progress too */
     if (lx_baker_bake(b) != LX_OK)
         lx_bench_die("lx_baker_bake");
-    double t5 = lx_bench_now();
+    double t3 = lx_bench_now();
     if (lx_baker_update(b) != LX_OK)
         lx_bench_die("lx_baker_update");
-    double t6 = lx_bench_now();
-    if (lx_baker_apply_alloc(b, 0, img) != LX_OK)
+    double t4 = lx_bench_now();
+    lx_image img;
+    if (lx_baker_apply_alloc(b, 0, &img) != LX_OK)
         lx_bench_die("lx_baker_apply_alloc");
     float ev;
     bool lit;
     lx_baker_meter_ev100(b, &ev, &lit);
-    double t7 = lx_bench_now();
+    double t5 = lx_bench_now();
     char path[1100];
     snprintf(path, sizeof path, "%s/phase.exr", dir);
     lx_image_write_desc wd = {.format = LX_IMAGE_EXR, .threads = g_threads};
-    if (lx_image_write(path, img, &wd) != LX_OK)
+    if (lx_image_write(path, &img, &wd) != LX_OK)
         lx_bench_die("lx_image_write exr");
-    double t8 = lx_bench_now();
+    double t6 = lx_bench_now();
     snprintf(path, sizeof path, "%s/phase.png", dir);
     lx_image_write_desc pd = {.format = LX_IMAGE_PNG,
                               .exposure = lx_exposure_from_ev100(ev) / LX_PI,
                               .threads = g_threads};
-    if (lx_image_write(path, img, &pd) != LX_OK)
+    if (lx_image_write(path, &img, &pd) != LX_OK)
         lx_bench_die("lx_image_write png");
-    double t9 = lx_bench_now();
-    *ph = (cli_phases){.import = t1 - t0,
-                       .texel_maps = (t2 - t1) - (t3 - t2),
-                       .bvh = t3 - t2,
-                       .bake = t5 - t4,
-                       .dynamic = t6 - t5,
-                       .apply = t7 - t6,
-                       .exr = t8 - t7,
-                       .png = t9 - t8};
-    *scene_out = scene;
-    *baker_out = b;
+    double t7 = lx_bench_now();
+    printf("%.9f %.9f %.9f %.9f %.9f %.9f %.9f %.9f\n", t1 - t0, maps_end - t1, t2 - maps_end,
+           t3 - t2, t4 - t3, t5 - t4, t6 - t5, t7 - t6);
+    fflush(stdout);
+    _exit(0); /* like the CLI, but the freeing is not a phase */
+}
+
+static void cli_phases_run(const char *self, const char *glb, const char *json, const char *dir,
+                           int res, cli_phases *ph)
+{
+    int fd[2];
+    if (pipe(fd) != 0)
+        lx_bench_die("pipe");
+    char res_s[16], thr_s[16];
+    snprintf(res_s, sizeof res_s, "%d", res);
+    snprintf(thr_s, sizeof thr_s, "%d", g_threads);
+    fflush(stdout);
+    pid_t pid = fork();
+    if (pid < 0)
+        lx_bench_die("fork");
+    if (pid == 0) {
+        dup2(fd[1], 1);
+        close(fd[0]);
+        close(fd[1]);
+        execl(self, self, "--phases-child", glb, json, dir, res_s, thr_s, (char *)NULL);
+        _exit(127);
+    }
+    close(fd[1]);
+    FILE *in = fdopen(fd[0], "r");
+    double *v = &ph->import;
+    int got = 0;
+    for (int k = 0; k < 8 && in; k++)
+        got += fscanf(in, "%lf", &v[k]) == 1;
+    if (in)
+        fclose(in);
+    int status;
+    if (waitpid(pid, &status, 0) != pid || !WIFEXITED(status) || WEXITSTATUS(status) != 0 ||
+        got != 8) {
+        fprintf(stderr, "bench_bake: the phase-timing child failed (status %d)\n", status);
+        exit(1);
+    }
 }
 
 typedef struct cli_result {
@@ -650,9 +687,24 @@ static cli_result bench_cli(void)
     double best_wall = INFINITY, best_raw[RAW_CLI_MODES];
     for (int m = 0; m < RAW_CLI_MODES; m++)
         best_raw[m] = INFINITY;
-    lx_scene *scene = NULL;
-    lx_baker *b = NULL;
-    lx_image img = {0};
+    char self[4096];
+    ssize_t len = readlink("/proc/self/exe", self, sizeof self - 1);
+    if (len <= 0)
+        lx_bench_die("readlink /proc/self/exe");
+    self[len] = '\0';
+    /* this process's own bake of the scene: the rays, and the check */
+    lx_scene *scene;
+    if (lx_scene_load(glb, NULL, &scene) != LX_OK || lx_lights_json_apply(scene, json) != LX_OK)
+        lx_bench_die("load");
+    lx_bake_desc desc = lx_bake_desc_defaults(NULL);
+    desc.resolution = g_cli_res;
+    desc.threads = g_threads;
+    desc.padding = LX_PADDING_RECOMMENDED;
+    lx_baker *b;
+    lx_image img;
+    if (lx_baker_create(scene, &desc, &b) != LX_OK || lx_baker_bake(b) != LX_OK ||
+        lx_baker_update(b) != LX_OK || lx_baker_apply_alloc(b, 0, &img) != LX_OK)
+        lx_bench_die("bake");
     lx_bench_rays rs = {0};
     RTCDevice dev = NULL;
     RTCScene flat = NULL;
@@ -662,12 +714,7 @@ static cli_result bench_cli(void)
     for (int rep = 0; rep < g_reps; rep++) {
         best_wall = fmin(best_wall, run_child(argv, errlog));
         cli_phases ph;
-        if (b) {
-            lx_baker_destroy(b);
-            lx_scene_destroy(scene);
-            lx_image_free(&img);
-        }
-        cli_phases_run(glb, json, dir, g_cli_res, &ph, &scene, &b, &img);
+        cli_phases_run(self, glb, json, dir, g_cli_res, &ph);
         phases_min(&best, &ph);
         if (g_skip_raw)
             continue;
@@ -710,8 +757,8 @@ static cli_result bench_cli(void)
         printf("  %.1f%% of the %llu rays blocked\n", 100.0 * (double)blocked / (double)rs.count,
                (unsigned long long)rs.count);
     }
-    printf("\n  %-40s %7s  %6s   (best of %d, interleaved)\n", "phase, in this process", "time",
-           "share", g_reps);
+    printf("\n  %-40s %7s  %6s   (best of %d, interleaved)\n",
+           "phase (the CLI's calls, fresh process)", "time", "share", g_reps);
     const char *names[8] = {"import (assimp + lights JSON)",
                             "texel maps",
                             "BVH (Embree)",
@@ -891,6 +938,8 @@ static brute_result bench_brute_force(void)
 
 int main(int argc, char **argv)
 {
+    if (argc > 1 && !strcmp(argv[1], "--phases-child"))
+        phases_child_main(argc, argv);
     const char *only = NULL;
     for (int i = 1; i < argc; i++) {
         if (!strcmp(argv[i], "--res") && i + 1 < argc)

@@ -210,7 +210,12 @@ lx_status lx_baker_set_node_transform(lx_baker *b, uint32_t node, const lx_mat4 
 {
     if (node >= b->node_count)
         return lx_fail(LX_ERR_INVALID, "node %u out of range (count %u)", node, b->node_count);
-    lx_status st = lx_tracer_set_node_transform(b->tracer, node, world);
+    /* the object space a move needs, before anything changes */
+    lx_status st = LX_OK;
+    if (b->node_map[node] != UINT32_MAX &&
+        (st = lx_texel_map_keep_object_space(&b->maps[b->node_map[node]])) != LX_OK)
+        return st;
+    st = lx_tracer_set_node_transform(b->tracer, node, world);
     if (st != LX_OK)
         return st;
     b->node_world[node] = *world;

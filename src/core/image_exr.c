@@ -320,22 +320,27 @@ lx_status lx_img_load_exr(const unsigned char *data, size_t size, const char *na
 
 typedef struct exr_out {
     FILE *fp;
+    uint64_t pos; /* where the stream is */
     bool failed;
 } exr_out;
 
 /* OpenEXRCore writes with pwrite semantics: it comes back to fill in the
- * chunk offset table at the end. */
+ * chunk offset table at the end. Writes in sequence skip the seek, which
+ * would flush the stream on every chunk. */
 static int64_t file_write(exr_const_context_t ctxt, void *user, const void *buffer, uint64_t sz,
                           uint64_t offset, exr_stream_error_func_ptr_t error_cb)
 {
     (void)ctxt;
     (void)error_cb;
     exr_out *o = user;
-    if (offset > (uint64_t)INT64_MAX || fseeko(o->fp, (off_t)offset, SEEK_SET) != 0 ||
+    if (offset > (uint64_t)INT64_MAX ||
+        (offset != o->pos && fseeko(o->fp, (off_t)offset, SEEK_SET) != 0) ||
         fwrite(buffer, 1, (size_t)sz, o->fp) != sz) {
         o->failed = true;
+        o->pos = UINT64_MAX;
         return -1;
     }
+    o->pos = offset + sz;
     return (int64_t)sz;
 }
 
@@ -519,7 +524,7 @@ lx_status lx_img_write_exr(FILE *fp, const char *path, const lx_image *img, floa
     exr_job job = {.img = img, .exposure = exposure, .half = half, .failed_chunk = INT32_MAX};
     job.count = exr_channel_layout(img->channels, job.names, job.index);
 
-    exr_out o = {fp, false};
+    exr_out o = {fp, (uint64_t)ftello(fp), false};
     exr_context_initializer_t init = EXR_DEFAULT_CONTEXT_INITIALIZER;
     init.error_handler_fn = exr_on_error;
     init.user_data = &o;

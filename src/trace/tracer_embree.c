@@ -8,6 +8,9 @@
 #include "core/internal.h"
 
 #include <embree3/rtcore.h>
+#if defined(__SSE2__)
+#include <emmintrin.h>
+#endif
 #include <stddef.h>
 #include <stdio.h>
 #include <stdlib.h>
@@ -274,22 +277,36 @@ uint32_t lx_tracer_occluded_packet(const lx_tracer *tr, lx_ray_packet *packet, u
     active &= (1u << LX_RAY_PACKET) - 1u;
     if (!active)
         return 0;
+    /* the lanes' valid words, four at a time from the mask's nibbles */
+    static const int32_t nibble[16][4] = {
+        {0, 0, 0, 0},   {-1, 0, 0, 0},   {0, -1, 0, 0},   {-1, -1, 0, 0},
+        {0, 0, -1, 0},  {-1, 0, -1, 0},  {0, -1, -1, 0},  {-1, -1, -1, 0},
+        {0, 0, 0, -1},  {-1, 0, 0, -1},  {0, -1, 0, -1},  {-1, -1, 0, -1},
+        {0, 0, -1, -1}, {-1, 0, -1, -1}, {0, -1, -1, -1}, {-1, -1, -1, -1}};
+    _Alignas(64) int32_t valid[LX_RAY_PACKET]; /* Embree loads it as one vector */
+    for (int i = 0; i < LX_RAY_PACKET; i += 4)
+        memcpy(valid + i, nibble[(active >> i) & 15u], sizeof nibble[0]);
     /* written through the packet's own type, read back after the call */
-    _Alignas(64) int valid[LX_RAY_PACKET]; /* Embree loads it as one vector */
-    for (int i = 0; i < LX_RAY_PACKET; i++) {
-        valid[i] = (active >> i) & 1u ? -1 : 0;
-        packet->internal_time[i] = 0.0f;
-        packet->internal[0][i] = 0xFFFFFFFFu; /* mask */
-        packet->internal[1][i] = 0;           /* id */
-        packet->internal[2][i] = 0;           /* flags */
-    }
+    memset(packet->internal_time, 0, sizeof packet->internal_time);
+    memset(packet->internal[0], 0xFF, sizeof packet->internal[0]); /* mask: every geometry */
+    memset(packet->internal[1], 0, sizeof packet->internal[1]);    /* id */
+    memset(packet->internal[2], 0, sizeof packet->internal[2]);    /* flags */
     struct RTCIntersectContext ctx;
     rtcInitIntersectContext(&ctx);
     ctx.flags = RTC_INTERSECT_CONTEXT_FLAG_COHERENT;
-    rtcOccluded16(valid, tr->scene, &ctx, (struct RTCRay16 *)(void *)packet);
+    rtcOccluded16((const int *)valid, tr->scene, &ctx, (struct RTCRay16 *)(void *)packet);
     uint32_t blocked = 0;
+#if defined(__SSE2__)
+    /* whole-vector loads of what Embree just stored as vectors: scalar
+     * loads of its lanes would stall on store forwarding */
+    for (int i = 0; i < LX_RAY_PACKET; i += 4) {
+        __m128 t = _mm_load_ps(packet->tmax + i);
+        blocked |= (uint32_t)_mm_movemask_ps(_mm_cmplt_ps(t, _mm_setzero_ps())) << i;
+    }
+#else
     for (int i = 0; i < LX_RAY_PACKET; i++)
         blocked |= (uint32_t)(packet->tmax[i] < 0.0f) << i;
+#endif
     return blocked & active;
 }
 
