@@ -516,11 +516,13 @@ int cmd_bake(int argc, char **argv)
                                   .half = a.half,
                                   .exposure = a.format == LX_IMAGE_PNG ? exposure
                                               : a.pre_expose           ? pre_exposure
-                                                                       : 1.0f};
+                                                                       : 1.0f,
+                                  .threads = a.desc.threads};
         failed = !cli_stage_image(&stage, file, &images[m], &wd);
         bool want_preview = a.format != LX_IMAGE_PNG;
         if (!failed && want_preview) {
-            lx_image_write_desc pd = {.format = LX_IMAGE_PNG, .exposure = exposure};
+            lx_image_write_desc pd = {
+                .format = LX_IMAGE_PNG, .exposure = exposure, .threads = a.desc.threads};
             failed = !cli_stage_image(&stage, preview, &images[m], &pd);
         }
         cJSON_AddItemToArray(list, manifest_entry(scene, info, file, want_preview ? preview : NULL,
