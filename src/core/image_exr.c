@@ -1,8 +1,11 @@
 /* OpenEXR reading and writing through OpenEXR 3's C API, OpenEXRCore (see
  * openexr.com, "Reading and Writing Image Files with the C-language API").
  * Reads part 0 of scanline or tiled files (level 0), channels R, G, B, A or
- * Y, A; writes one scanline part with ZIP compression. Half floats are
- * converted with round-to-nearest-even (IEEE 754-2008 binary16). */
+ * Y, A; writes one scanline part: 32-bit floats uncompressed, half floats
+ * with ZIP, its chunks encoded on several threads (one encode pipeline per
+ * thread, as OpenEXRCore's pipelines are meant to be used) and written in
+ * order. Half floats are converted with round-to-nearest-even (IEEE
+ * 754-2008 binary16). */
 #define _POSIX_C_SOURCE 200809L
 #include "image_internal.h"
 
@@ -508,11 +511,11 @@ static void encode_chunks(exr_job *job, int chunk_count, int threads)
 
 /* The compression luxel writes. 32-bit floats: none. The low mantissa
  * bytes of a lightmap are noise that no lossless method packs: ZIP saves 7%
- * on bench_bake's lightmap at any zlib level and costs 15-20 times the
- * time of writing the bytes as they are (PIZ: 17%, at 20 times). Half
+ * on bench_bake's lightmap at any zlib level and costs 10-20 times the
+ * time of writing the bytes as they are (PIZ saves 17%, at 12 times). Half
  * floats: ZIP (zlib deflate of 16-scanline chunks after EXR's byte-split
- * predictor), level 1: 44% of the raw size, within 15% of level 6's size
- * at a third of its time. */
+ * predictor), level 1: 44% of the raw size, 14% above level 6's size at a
+ * third of its time. */
 #define LX_EXR_ZIP_LEVEL 1
 
 lx_status lx_img_write_exr(FILE *fp, const char *path, const lx_image *img, float exposure,

@@ -1,6 +1,7 @@
 /* PNG/JPEG/TGA/Radiance HDR through stb_image and stb_image_write (the
- * implementations are compiled into Debian's libstb). 8-bit and 16-bit data
- * use the sRGB transfer function of IEC 61966-2-1:1999; alpha stays linear. */
+ * implementations are compiled into Debian's libstb; the PNG writer's is
+ * image_png.c's, with zlib as its deflate). 8-bit and 16-bit data use the
+ * sRGB transfer function of IEC 61966-2-1:1999; alpha stays linear. */
 #include "image_internal.h"
 
 #include <zlib.h>
@@ -425,13 +426,16 @@ static void write_to_file(void *context, void *data, int size)
  * value of the sRGB midpoint between codes k - 1 and k), so v's code is
  * the count of thresholds <= v. Each threshold is kept as the smallest
  * float at or above its double value (a float compares with it exactly as
- * with the double), and a table over the float's top 16 bits (sign,
- * exponent and 7 mantissa bits) gives the count at the bottom of v's
- * bucket, one or two steps short of the answer. */
+ * with the double), and a table over the float's top 19 bits (sign,
+ * exponent and 10 mantissa bits: buckets 0.1% wide, narrower than the gap
+ * between any two thresholds) gives the count at the bottom of v's
+ * bucket, at most one step short of the answer. */
+#define SRGB8_SHIFT 13
+#define SRGB8_FIRST (0x39000000u >> SRGB8_SHIFT) /* below threshold[0] */
+#define SRGB8_LAST (0x3f800000u >> SRGB8_SHIFT)  /* 1.0f */
 typedef struct srgb8_encoder {
-    float threshold[255];
-    uint32_t first_bucket; /* bucket of threshold[0]: below it, code 0 */
-    uint8_t start[0x3f81 - 0x3800];
+    float threshold[256]; /* [255]: above every float, a sentinel */
+    uint8_t start[SRGB8_LAST - SRGB8_FIRST + 1];
 } srgb8_encoder;
 
 static void srgb8_init(srgb8_encoder *enc)
@@ -444,17 +448,15 @@ static void srgb8_init(srgb8_encoder *enc)
             f = nextafterf(f, INFINITY);
         enc->threshold[k - 1] = f;
     }
-    uint32_t bits;
-    memcpy(&bits, &enc->threshold[0], sizeof bits);
-    enc->first_bucket = bits >> 16; /* 0x391d..., above 0x3800 */
+    enc->threshold[255] = INFINITY;
     int k = 0;
-    for (uint32_t b = enc->first_bucket; b <= 0x3f80; b++) {
-        uint32_t lo = b << 16;
+    for (uint32_t b = SRGB8_FIRST; b <= SRGB8_LAST; b++) {
+        uint32_t lo = b << SRGB8_SHIFT;
         float v;
         memcpy(&v, &lo, sizeof v);
         while (k < 255 && v >= enc->threshold[k])
             k++;
-        enc->start[b - 0x3800] = (uint8_t)k;
+        enc->start[b - SRGB8_FIRST] = (uint8_t)k;
     }
 }
 
@@ -466,8 +468,9 @@ static unsigned char encode_srgb8(const srgb8_encoder *enc, float v)
         return 255;
     uint32_t bits;
     memcpy(&bits, &v, sizeof bits);
-    int k = enc->start[(bits >> 16) - 0x3800];
-    while (k < 255 && v >= enc->threshold[k])
+    int k = enc->start[(bits >> SRGB8_SHIFT) - SRGB8_FIRST];
+    k += v >= enc->threshold[k];   /* one threshold at most in a bucket */
+    while (v >= enc->threshold[k]) /* (never taken; kept exact regardless) */
         k++;
     return (unsigned char)k;
 }
