@@ -20,12 +20,32 @@
  *     lx_baker_bake: the speed-up, and their agreement (texels within 1%,
  *     near-tie texels the oracle flags left out).
  *
+ *  3. The whole `luxel bake` process on the hard case: the same ~100k
+ *     triangles written as a .glb (tests/common/scenes.h), 16 point lights
+ *     without range in a --lights JSON (every texel sees every light: 16.8M
+ *     shadow rays at 1024x1024), the real CLI run as a child process and
+ *     timed from fork to exit (import to every file written). Its
+ *     texel-light samples per second against raw single-ray Embree
+ *     (rtcOccluded1 on a flat BVH built here, same tiles, schedule and
+ *     threads) on the same rays, traced right after each CLI run (target
+ *     >= 1.5x; best against best, and the median of the pairs), plus the
+ *     other ways to cast them (rtcOccluded1M, 4-, 8- and 16-wide packets).
+ *     Phases (import, texel maps, BVH, bake, dynamic lights, apply, each
+ *     file's encoding) come from the CLI's library calls in a fresh process
+ *     (this program re-run with --phases-child), each the best of the
+ *     repetitions. The writers against the ones luxel had (OpenEXRCore's ZIP
+ *     at its default level on one thread; stb_image_write's own deflate),
+ *     and the EXR + PNG time as a share of the bake (target <= 25%). Check:
+ *     the CLI's EXR equals this process's lightmap bit for bit.
+ *
  * The real-time update rate is bench_realtime's.
  *
- * Usage: bench_bake [--res N] [--reps N] [--threads N] [--only bake|brute]
- *                   [--skip-raw]
- * --res sets the full bake's resolution; --skip-raw times the bake alone.
- * The last line is a one-line summary.
+ * Usage: bench_bake [--res N] [--cli-res N] [--reps N] [--threads N]
+ *                   [--only bake|brute|cli] [--skip-raw]
+ * --res sets [1]'s resolution, --cli-res [3]'s (4096 shows the phases of a
+ * large lightmap; with --skip-raw, which leaves out the raw figures and
+ * their 48 bytes of stored ray per sample). [3] repeats 5 times unless
+ * --reps is given. The last line is a one-line summary.
  */
 #define _POSIX_C_SOURCE 200809L
 #define _DEFAULT_SOURCE /* sync() */
