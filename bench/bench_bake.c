@@ -53,18 +53,14 @@
 #include "core/internal.h"
 #include "reference.h"
 #include "scenes.h"
+#include "bench_cli.h"
 
-#include <OpenEXR/openexr.h>
 #include <embree3/rtcore.h>
-#include <stb/stb_image_write.h>
-#include <sys/stat.h>
 #include <math.h>
 #include <omp.h>
 #include <stdio.h>
 #include <stdlib.h>
 #include <string.h>
-#include <fcntl.h>
-#include <sys/wait.h>
 #include <unistd.h>
 
 #define TILE LX_BENCH_TILE
@@ -90,51 +86,6 @@ static const char *raw_names[RAW_MODES] = {
     "Embree flat BVH, rtcOccluded1M coh.",
 };
 
-static void to_rtc(const lx_ray *r, struct RTCRay *o)
-{
-    o->org_x = r->origin.x, o->org_y = r->origin.y, o->org_z = r->origin.z;
-    o->dir_x = r->dir.x, o->dir_y = r->dir.y, o->dir_z = r->dir.z;
-    o->tnear = r->tmin, o->tfar = r->tmax, o->time = 0.0f;
-    o->mask = 0xFFFFFFFFu, o->id = 0, o->flags = 0;
-}
-
-/* Every ray once straight through Embree (rtcOccluded1 or coherent
- * rtcOccluded1M), same tiles and schedule; returns seconds. */
-static double flat_run(bool stream, RTCScene flat, const lx_bench_rays *rs, int threads,
-                       uint8_t *occluded)
-{
-    const int L = rs->lights;
-    double t0 = lx_bench_now();
-#pragma omp parallel for schedule(dynamic, 4) num_threads(threads)
-    for (int tile = 0; tile < rs->tiles; tile++) {
-        struct RTCIntersectContext ctx;
-        rtcInitIntersectContext(&ctx);
-        if (stream)
-            ctx.flags = RTC_INTERSECT_CONTEXT_FLAG_COHERENT;
-        struct RTCRay buf[TILE * TILE];
-        for (int l = 0; l < L; l++) {
-            uint32_t s = rs->batch[(size_t)tile * L + l], e = rs->batch[(size_t)tile * L + l + 1];
-            uint32_t n = e - s;
-            const lx_ray *r = rs->rays + s;
-            uint8_t *o = occluded + s;
-            if (!stream) {
-                for (uint32_t j = 0; j < n; j++) {
-                    to_rtc(&r[j], &buf[0]);
-                    rtcOccluded1(flat, &ctx, &buf[0]);
-                    o[j] = buf[0].tfar < 0.0f;
-                }
-            } else if (n) {
-                for (uint32_t j = 0; j < n; j++)
-                    to_rtc(&r[j], &buf[j]);
-                rtcOccluded1M(flat, &ctx, buf, n, sizeof(struct RTCRay));
-                for (uint32_t j = 0; j < n; j++)
-                    o[j] = buf[j].tfar < 0.0f;
-            }
-        }
-    }
-    return lx_bench_now() - t0;
-}
-
 static double raw_run(raw_mode mode, const lx_tracer *tr, RTCScene flat, const lx_bench_rays *rs,
                       uint8_t *occluded)
 {
@@ -146,49 +97,10 @@ static double raw_run(raw_mode mode, const lx_tracer *tr, RTCScene flat, const l
     case RAW_BATCH_INCOH:
         return lx_bench_trace(tr, rs, LX_BENCH_BATCH_INCOHERENT, g_threads, occluded);
     case RAW_FLAT_1:
-        return flat_run(false, flat, rs, g_threads, occluded);
+        return lx_bench_flat_trace(LX_FLAT_1, flat, rs, g_threads, occluded);
     default:
-        return flat_run(true, flat, rs, g_threads, occluded);
+        return lx_bench_flat_trace(LX_FLAT_1M, flat, rs, g_threads, occluded);
     }
-}
-
-/* One Embree scene holding every triangle in world space (what a user of
- * raw Embree would build for a static bake), same flags as the tracer. */
-static RTCScene flat_scene(RTCDevice dev, const lx_scene *scene)
-{
-    RTCScene s = rtcNewScene(dev);
-    rtcSetSceneFlags(s, RTC_SCENE_FLAG_ROBUST);
-    rtcSetSceneBuildQuality(s, RTC_BUILD_QUALITY_HIGH);
-    uint32_t nv = 0, nt = 0;
-    for (uint32_t n = 0; n < scene->node_count; n++)
-        for (uint32_t k = 0; k < scene->nodes[n].mesh_count; k++) {
-            const lx_mesh *m = &scene->meshes[scene->nodes[n].meshes[k]];
-            nv += m->vertex_count;
-            nt += m->triangle_count;
-        }
-    RTCGeometry g = rtcNewGeometry(dev, RTC_GEOMETRY_TYPE_TRIANGLE);
-    float *v = rtcSetNewGeometryBuffer(g, RTC_BUFFER_TYPE_VERTEX, 0, RTC_FORMAT_FLOAT3,
-                                       3 * sizeof(float), nv);
-    unsigned *ix = rtcSetNewGeometryBuffer(g, RTC_BUFFER_TYPE_INDEX, 0, RTC_FORMAT_UINT3,
-                                           3 * sizeof(unsigned), nt);
-    uint32_t vb = 0, tb = 0;
-    for (uint32_t n = 0; n < scene->node_count; n++)
-        for (uint32_t k = 0; k < scene->nodes[n].mesh_count; k++) {
-            const lx_mesh *m = &scene->meshes[scene->nodes[n].meshes[k]];
-            for (uint32_t i = 0; i < m->vertex_count; i++) {
-                lx_vec3 p = lx_mat4_point(&scene->nodes[n].world, m->positions[i]);
-                v[3 * (vb + i)] = p.x, v[3 * (vb + i) + 1] = p.y, v[3 * (vb + i) + 2] = p.z;
-            }
-            for (uint32_t i = 0; i < 3 * m->triangle_count; i++)
-                ix[3 * tb + i] = vb + m->indices[i];
-            vb += m->vertex_count;
-            tb += m->triangle_count;
-        }
-    rtcCommitGeometry(g);
-    rtcAttachGeometry(s, g);
-    rtcReleaseGeometry(g);
-    rtcCommitScene(s);
-    return s;
 }
 
 /* The bake's per-sample work without the rays: lx_light_evaluate and the
@@ -311,7 +223,7 @@ static bake_result bench_full_bake(void)
         t_tracer = lx_bench_now() - t0;
         dev = rtcNewDevice(NULL);
         t0 = lx_bench_now();
-        flat = flat_scene(dev, scene);
+        flat = lx_bench_flat_scene(dev, scene);
         t_flat = lx_bench_now() - t0;
         for (int m = 0; m < RAW_MODES; m++)
             if (!(occ[m] = malloc(rs.count + 1)))
@@ -397,250 +309,7 @@ static bake_result bench_full_bake(void)
     return res;
 }
 
-/* Every ray once through Embree's packet calls rtcOccluded4/8/16 (width
- * w), the rays of one tile toward one light in packets of w with a valid
- * mask on the last; same tiles, schedule and threads as flat_run. */
-#define PACKET_RUN(W)                                                                              \
-    static double packet_run##W(RTCScene flat, const lx_bench_rays *rs, int threads,               \
-                                uint8_t *occluded)                                                 \
-    {                                                                                              \
-        const int L = rs->lights;                                                                  \
-        double t0 = lx_bench_now();                                                                \
-        _Pragma("omp parallel for schedule(dynamic, 4) num_threads(threads)") for (int tile = 0;   \
-                                                                                   tile <          \
-                                                                                   rs->tiles;      \
-                                                                                   tile++)         \
-        {                                                                                          \
-            struct RTCIntersectContext ctx;                                                        \
-            rtcInitIntersectContext(&ctx);                                                         \
-            ctx.flags = RTC_INTERSECT_CONTEXT_FLAG_COHERENT;                                       \
-            struct RTCRay##W pk;                                                                   \
-            int valid[W];                                                                          \
-            for (int l = 0; l < L; l++) {                                                          \
-                uint32_t s = rs->batch[(size_t)tile * L + l];                                      \
-                uint32_t e = rs->batch[(size_t)tile * L + l + 1];                                  \
-                for (uint32_t b = s; b < e; b += W) {                                              \
-                    for (int j = 0; j < W; j++) {                                                  \
-                        const lx_ray *r = &rs->rays[b + j < e ? b + j : s];                        \
-                        valid[j] = b + j < e ? -1 : 0;                                             \
-                        pk.org_x[j] = r->origin.x, pk.org_y[j] = r->origin.y;                      \
-                        pk.org_z[j] = r->origin.z, pk.tnear[j] = r->tmin;                          \
-                        pk.dir_x[j] = r->dir.x, pk.dir_y[j] = r->dir.y, pk.dir_z[j] = r->dir.z;    \
-                        pk.time[j] = 0.0f, pk.tfar[j] = r->tmax, pk.mask[j] = 0xFFFFFFFFu;         \
-                        pk.id[j] = 0, pk.flags[j] = 0;                                             \
-                    }                                                                              \
-                    rtcOccluded##W(valid, flat, &ctx, &pk);                                        \
-                    for (int j = 0; j < W && b + j < e; j++)                                       \
-                        occluded[b + j] = pk.tfar[j] < 0.0f;                                       \
-                }                                                                                  \
-            }                                                                                      \
-        }                                                                                          \
-        return lx_bench_now() - t0;                                                                \
-    }
-PACKET_RUN(4)
-PACKET_RUN(8)
-PACKET_RUN(16)
-
-/* rtcOccluded16 on 4x4 blocks of full 8x8 tiles (the others as rows) */
-static double packet_run16q(RTCScene flat, const lx_bench_rays *rs, int threads, uint8_t *occluded)
-{
-    const int L = rs->lights;
-    double t0 = lx_bench_now();
-#pragma omp parallel for schedule(dynamic, 4) num_threads(threads)
-    for (int tile = 0; tile < rs->tiles; tile++) {
-        struct RTCIntersectContext ctx;
-        rtcInitIntersectContext(&ctx);
-        ctx.flags = RTC_INTERSECT_CONTEXT_FLAG_COHERENT;
-        struct RTCRay16 pk;
-        int valid[16];
-        for (int l = 0; l < L; l++) {
-            uint32_t s = rs->batch[(size_t)tile * L + l];
-            uint32_t e = rs->batch[(size_t)tile * L + l + 1];
-            bool full = e - s == 64;
-            for (uint32_t b = 0; b < e - s; b += 16) {
-                uint32_t idx[16];
-                for (int j = 0; j < 16; j++) {
-                    uint32_t q = b / 16;
-                    idx[j] = full ? ((q / 2) * 4 + j / 4) * 8 + (q % 2) * 4 + j % 4 : b + j;
-                    valid[j] = idx[j] < e - s ? -1 : 0;
-                    const lx_ray *r = &rs->rays[s + (idx[j] < e - s ? idx[j] : 0)];
-                    pk.org_x[j] = r->origin.x, pk.org_y[j] = r->origin.y;
-                    pk.org_z[j] = r->origin.z, pk.tnear[j] = r->tmin;
-                    pk.dir_x[j] = r->dir.x, pk.dir_y[j] = r->dir.y, pk.dir_z[j] = r->dir.z;
-                    pk.time[j] = 0.0f, pk.tfar[j] = r->tmax, pk.mask[j] = 0xFFFFFFFFu;
-                    pk.id[j] = 0, pk.flags[j] = 0;
-                }
-                rtcOccluded16(valid, flat, &ctx, &pk);
-                for (int j = 0; j < 16; j++)
-                    if (valid[j])
-                        occluded[s + idx[j]] = pk.tfar[j] < 0.0f;
-            }
-        }
-    }
-    return lx_bench_now() - t0;
-}
-
 /* ---- [3] the whole luxel bake process ------------------------------------ */
-
-/* The luxel CLI next to this program (both are in build/bin). */
-static void luxel_path(char *out, size_t size)
-{
-    char self[4096];
-    ssize_t n = readlink("/proc/self/exe", self, sizeof self - 1);
-    if (n <= 0)
-        lx_bench_die("readlink /proc/self/exe");
-    self[n] = '\0';
-    char *slash = strrchr(self, '/');
-    if (slash)
-        *slash = '\0';
-    snprintf(out, size, "%s/luxel", self);
-}
-
-/* Runs argv as a child process; returns its wall time in seconds, ending
- * the bench if it fails. */
-static double run_child(char *const argv[], const char *log)
-{
-    fflush(stdout);
-    double t0 = lx_bench_now();
-    pid_t pid = fork();
-    if (pid < 0)
-        lx_bench_die("fork");
-    if (pid == 0) {
-        /* the CLI's warnings (the occluders have no UVs) go to a file */
-        int fd = open(log, O_WRONLY | O_CREAT | O_TRUNC, 0644);
-        if (fd >= 0) {
-            dup2(fd, 2);
-            close(fd);
-        }
-        execv(argv[0], argv);
-        _exit(127);
-    }
-    int status;
-    if (waitpid(pid, &status, 0) != pid || !WIFEXITED(status) || WEXITSTATUS(status) != 0) {
-        fprintf(stderr, "bench_bake: %s %s failed (status %d); its messages are in %s\n", argv[0],
-                argv[1], status, log);
-        exit(1);
-    }
-    return lx_bench_now() - t0;
-}
-
-typedef struct cli_phases {
-    double import, texel_maps, bvh, bake, dynamic, apply, exr, png;
-} cli_phases;
-
-static void phases_min(cli_phases *best, const cli_phases *p)
-{
-    best->import = fmin(best->import, p->import);
-    best->texel_maps = fmin(best->texel_maps, p->texel_maps);
-    best->bvh = fmin(best->bvh, p->bvh);
-    best->bake = fmin(best->bake, p->bake);
-    best->dynamic = fmin(best->dynamic, p->dynamic);
-    best->apply = fmin(best->apply, p->apply);
-    best->exr = fmin(best->exr, p->exr);
-    best->png = fmin(best->png, p->png);
-}
-
-/* lx_baker_create reports progress after each node's texel map, then
- * builds the BVH: the last report's time splits the two. */
-static bool note_progress(void *user, float done)
-{
-    (void)done;
-    *(double *)user = lx_bench_now();
-    return true;
-}
-
-/* What `luxel bake` does, phase by phase (the library calls bake.c makes,
- * with its settings), in a fresh process like the CLI's: the bench runs
- * itself with --phases-child and reads the times from a pipe. Fills ph. */
-static void phases_child_main(int argc, char **argv)
-{
-    if (argc != 7)
-        exit(2);
-    const char *glb = argv[2], *json = argv[3], *dir = argv[4];
-    int res = atoi(argv[5]);
-    g_threads = atoi(argv[6]);
-    double t0 = lx_bench_now();
-    lx_scene *scene;
-    if (lx_scene_load(glb, NULL, &scene) != LX_OK || lx_lights_json_apply(scene, json) != LX_OK)
-        lx_bench_die("load");
-    double t1 = lx_bench_now(), t_maps = t1;
-    lx_bake_desc desc = lx_bake_desc_defaults(NULL);
-    desc.resolution = res;
-    desc.threads = g_threads;
-    desc.padding = LX_PADDING_RECOMMENDED;
-    desc.progress = note_progress;
-    desc.progress_user = &t_maps;
-    lx_baker *b;
-    if (lx_baker_create(scene, &desc, &b) != LX_OK)
-        lx_bench_die("lx_baker_create");
-    double t2 = lx_bench_now(), maps_end = t_maps; /* the bake reports progress too */
-    if (lx_baker_bake(b) != LX_OK)
-        lx_bench_die("lx_baker_bake");
-    double t3 = lx_bench_now();
-    if (lx_baker_update(b) != LX_OK)
-        lx_bench_die("lx_baker_update");
-    double t4 = lx_bench_now();
-    lx_image img;
-    if (lx_baker_apply_alloc(b, 0, &img) != LX_OK)
-        lx_bench_die("lx_baker_apply_alloc");
-    float ev;
-    bool lit;
-    lx_baker_meter_ev100(b, &ev, &lit);
-    double t5 = lx_bench_now();
-    char path[1100];
-    snprintf(path, sizeof path, "%s/phase.exr", dir);
-    lx_image_write_desc wd = {.format = LX_IMAGE_EXR, .threads = g_threads};
-    if (lx_image_write(path, &img, &wd) != LX_OK)
-        lx_bench_die("lx_image_write exr");
-    double t6 = lx_bench_now();
-    snprintf(path, sizeof path, "%s/phase.png", dir);
-    lx_image_write_desc pd = {.format = LX_IMAGE_PNG,
-                              .exposure = lx_exposure_from_ev100(ev) / LX_PI,
-                              .threads = g_threads};
-    if (lx_image_write(path, &img, &pd) != LX_OK)
-        lx_bench_die("lx_image_write png");
-    double t7 = lx_bench_now();
-    printf("%.9f %.9f %.9f %.9f %.9f %.9f %.9f %.9f\n", t1 - t0, maps_end - t1, t2 - maps_end,
-           t3 - t2, t4 - t3, t5 - t4, t6 - t5, t7 - t6);
-    fflush(stdout);
-    _exit(0); /* like the CLI, but the freeing is not a phase */
-}
-
-static void cli_phases_run(const char *self, const char *glb, const char *json, const char *dir,
-                           int res, cli_phases *ph)
-{
-    int fd[2];
-    if (pipe(fd) != 0)
-        lx_bench_die("pipe");
-    char res_s[16], thr_s[16];
-    snprintf(res_s, sizeof res_s, "%d", res);
-    snprintf(thr_s, sizeof thr_s, "%d", g_threads);
-    fflush(stdout);
-    pid_t pid = fork();
-    if (pid < 0)
-        lx_bench_die("fork");
-    if (pid == 0) {
-        dup2(fd[1], 1);
-        close(fd[0]);
-        close(fd[1]);
-        execl(self, self, "--phases-child", glb, json, dir, res_s, thr_s, (char *)NULL);
-        _exit(127);
-    }
-    close(fd[1]);
-    FILE *in = fdopen(fd[0], "r");
-    double *v = &ph->import;
-    int got = 0;
-    for (int k = 0; k < 8 && in; k++)
-        got += fscanf(in, "%lf", &v[k]) == 1;
-    if (in)
-        fclose(in);
-    int status;
-    if (waitpid(pid, &status, 0) != pid || !WIFEXITED(status) || WEXITSTATUS(status) != 0 ||
-        got != 8) {
-        fprintf(stderr, "bench_bake: the phase-timing child failed (status %d)\n", status);
-        exit(1);
-    }
-}
 
 typedef struct cli_result {
     bool ran, raw;
@@ -648,141 +317,9 @@ typedef struct cli_result {
     double wall, samples_s, flat1_rays_s, ratio, median_ratio, writes_share;
 } cli_result;
 
-/* ---- the writers against the ones luxel had: OpenEXRCore's ZIP at its
- * default level on one thread, stb_image_write's own PNG deflate ---------- */
-
-typedef struct file_sink {
-    FILE *fp;
-    uint64_t pos;
-} file_sink;
-
-static int64_t sink_write(exr_const_context_t ctxt, void *user, const void *buffer, uint64_t sz,
-                          uint64_t offset, exr_stream_error_func_ptr_t error_cb)
-{
-    (void)ctxt;
-    (void)error_cb;
-    file_sink *o = user;
-    if (fseeko(o->fp, (off_t)offset, SEEK_SET) != 0 || fwrite(buffer, 1, sz, o->fp) != sz)
-        return -1;
-    return (int64_t)sz;
-}
-
-static void close_synced(FILE *fp)
-{
-    if (fflush(fp) != 0 || fsync(fileno(fp)) != 0 || fclose(fp) != 0)
-        lx_bench_die("closing a baseline file");
-}
-
-/* A float RGB EXR as luxel wrote it before: ZIP (zlib's default level),
- * chunks encoded and written one after another on one thread. */
-static double old_exr(const lx_image *img, const char *path)
-{
-    double t0 = lx_bench_now();
-    size_t plane = (size_t)img->width * img->height;
-    float *planes = malloc(plane * 3 * sizeof(float));
-    if (!planes)
-        lx_bench_die("malloc");
-    for (int k = 0; k < 3; k++) /* B, G, R: file order */
-        for (size_t i = 0; i < plane; i++)
-            planes[(size_t)k * plane + i] = img->data[3 * i + (2 - k)];
-    file_sink o = {fopen(path, "wb"), 0};
-    if (!o.fp)
-        lx_bench_die(path);
-    exr_context_initializer_t init = EXR_DEFAULT_CONTEXT_INITIALIZER;
-    init.user_data = &o;
-    init.write_fn = sink_write;
-    exr_context_t ctx;
-    int part;
-    static const char *names[3] = {"B", "G", "R"};
-    bool ok = exr_start_write(&ctx, path, EXR_WRITE_FILE_DIRECTLY, &init) == EXR_ERR_SUCCESS &&
-              exr_add_part(ctx, NULL, EXR_STORAGE_SCANLINE, &part) == EXR_ERR_SUCCESS &&
-              exr_initialize_required_attr_simple(ctx, part, img->width, img->height,
-                                                  EXR_COMPRESSION_ZIP) == EXR_ERR_SUCCESS;
-    for (int k = 0; k < 3 && ok; k++)
-        ok = exr_add_channel(ctx, part, names[k], EXR_PIXEL_FLOAT, EXR_PERCEPTUALLY_LOGARITHMIC, 1,
-                             1) == EXR_ERR_SUCCESS;
-    ok = ok && exr_write_header(ctx) == EXR_ERR_SUCCESS;
-    int32_t lines = 16;
-    ok = ok && exr_get_scanlines_per_chunk(ctx, part, &lines) == EXR_ERR_SUCCESS;
-    exr_encode_pipeline_t enc = EXR_ENCODE_PIPELINE_INITIALIZER;
-    for (int y = 0; y < img->height && ok; y += lines) {
-        exr_chunk_info_t ci;
-        ok = exr_write_scanline_chunk_info(ctx, part, y, &ci) == EXR_ERR_SUCCESS &&
-             (y ? exr_encoding_update(ctx, part, &ci, &enc)
-                : exr_encoding_initialize(ctx, part, &ci, &enc)) == EXR_ERR_SUCCESS;
-        for (int c = 0; c < enc.channel_count && ok; c++) {
-            exr_coding_channel_info_t *ch = &enc.channels[c];
-            int k = ch->channel_name[0] == 'B' ? 0 : ch->channel_name[0] == 'G' ? 1 : 2;
-            ch->user_data_type = EXR_PIXEL_FLOAT;
-            ch->user_bytes_per_element = 4;
-            ch->user_pixel_stride = 4;
-            ch->user_line_stride = img->width * 4;
-            ch->encode_from_ptr =
-                (const uint8_t *)(planes + (size_t)k * plane + (size_t)y * img->width);
-        }
-        if (ok && y == 0)
-            ok = exr_encoding_choose_default_routines(ctx, part, &enc) == EXR_ERR_SUCCESS;
-        ok = ok && exr_encoding_run(ctx, part, &enc) == EXR_ERR_SUCCESS;
-    }
-    exr_encoding_destroy(ctx, &enc);
-    ok = exr_finish(&ctx) == EXR_ERR_SUCCESS && ok;
-    free(planes);
-    if (!ok)
-        lx_bench_die("the baseline EXR writer");
-    close_synced(o.fp);
-    return lx_bench_now() - t0;
-}
-
-static void stb_sink(void *context, void *data, int size)
-{
-    fwrite(data, 1, (size_t)size, (FILE *)context);
-}
-
-/* A preview PNG as luxel wrote it before: sRGB codes by binary search over
- * the code thresholds, stb_image_write's PNG with its own deflate (level 8,
- * each row's filter picked from all five). */
-static double old_png(const lx_image *img, float exposure, const char *path)
-{
-    double t0 = lx_bench_now();
-    double th[255];
-    for (int k = 1; k <= 255; k++) {
-        double c = ((double)k - 0.5) / 255.0;
-        th[k - 1] = c <= 0.04045 ? c / 12.92 : pow((c + 0.055) / 1.055, 2.4);
-    }
-    size_t n = (size_t)img->width * img->height * 3;
-    unsigned char *bytes = malloc(n);
-    if (!bytes)
-        lx_bench_die("malloc");
-    for (size_t i = 0; i < n; i++) {
-        double v = (double)(img->data[i] * exposure);
-        int lo = 0, hi = 255;
-        while (lo < hi) {
-            int mid = (lo + hi + 1) / 2;
-            if (v >= th[mid - 1])
-                lo = mid;
-            else
-                hi = mid - 1;
-        }
-        bytes[i] = (unsigned char)lo;
-    }
-    FILE *fp = fopen(path, "wb");
-    if (!fp ||
-        !stbi_write_png_to_func(stb_sink, fp, img->width, img->height, 3, bytes, img->width * 3))
-        lx_bench_die("the baseline PNG writer");
-    close_synced(fp);
-    free(bytes);
-    return lx_bench_now() - t0;
-}
-
-static long file_size(const char *path)
-{
-    struct stat st;
-    return stat(path, &st) == 0 ? (long)st.st_size : -1;
-}
-
 /* luxel's writers and the old ones on the same lightmap, best of reps;
- * prints the figures and returns the time of luxel's EXR + PNG. */
-static double bench_writers(const lx_image *img, float exposure, const char *dir)
+ * prints the figures. */
+static void bench_writers(const lx_image *img, float exposure, const char *dir)
 {
     char p[6][1100];
     const char *names[6] = {"luxel.exr", "luxel-half.exr", "luxel.png",
@@ -811,9 +348,9 @@ static double bench_writers(const lx_image *img, float exposure, const char *dir
             lx_bench_die("lx_image_write");
         best[2] = fmin(best[2], lx_bench_now() - t0);
         sync();
-        best[3] = fmin(best[3], old_exr(img, p[3]));
+        best[3] = fmin(best[3], lx_bench_old_exr(img, p[3]));
         sync();
-        best[4] = fmin(best[4], old_png(img, exposure, p[4]));
+        best[4] = fmin(best[4], lx_bench_old_png(img, exposure, p[4]));
         sync();
         t0 = lx_bench_now();
         pd.threads = 1;
@@ -832,37 +369,12 @@ static double bench_writers(const lx_image *img, float exposure, const char *dir
     const int order[6] = {3, 0, 1, 4, 2, 5};
     for (int i = 0; i < 6; i++) {
         int k = order[i];
-        printf("  %-44s %7.3f s %12ld", what[k], best[k], file_size(p[k]));
+        printf("  %-44s %7.3f s %12ld", what[k], best[k], lx_bench_file_size(p[k]));
         if (k == 0 || k == 1)
             printf("  %5.1fx faster", best[3] / best[k]);
         if (k == 2 || k == 5)
             printf("  %5.1fx faster", best[4] / best[k]);
         printf("\n");
-    }
-    return best[0] + best[2];
-}
-
-enum { RAW_CLI_MODES = 6 };
-static const char *cli_raw_names[RAW_CLI_MODES] = {
-    "Embree flat BVH, rtcOccluded1",  "Embree flat BVH, rtcOccluded1M coh.",
-    "Embree flat BVH, rtcOccluded4",  "Embree flat BVH, rtcOccluded8",
-    "Embree flat BVH, rtcOccluded16", "Embree flat BVH, rtcOccluded16 4x4"};
-
-static double cli_raw_run(int m, RTCScene flat, const lx_bench_rays *rs, uint8_t *occ)
-{
-    switch (m) {
-    case 0:
-        return flat_run(false, flat, rs, g_threads, occ);
-    case 1:
-        return flat_run(true, flat, rs, g_threads, occ);
-    case 2:
-        return packet_run4(flat, rs, g_threads, occ);
-    case 3:
-        return packet_run8(flat, rs, g_threads, occ);
-    case 4:
-        return packet_run16(flat, rs, g_threads, occ);
-    default:
-        return packet_run16q(flat, rs, g_threads, occ);
     }
 }
 
@@ -884,7 +396,7 @@ static cli_result bench_cli(void)
     lx_test_write_glb(gen, glb);
     lx_test_write_lights_json(lights, LIGHTS, json);
     lx_scene_destroy(gen);
-    luxel_path(luxel, sizeof luxel);
+    lx_bench_sibling("luxel", luxel, sizeof luxel);
     printf("\n[3] WHOLE luxel bake PROCESS  %u triangles (ground %u + %u spheres), %dx%d "
            "lightmap, %d point lights without range (every texel sees every light), hard "
            "shadows, %d threads\n",
@@ -901,16 +413,11 @@ static cli_result bench_cli(void)
     char *argv[] = {luxel,          "bake", glb,         "--lights", json, "-o", out,
                     "--resolution", res_s,  "--threads", thr_s,      "-q", NULL};
 
-    cli_phases best = {INFINITY, INFINITY, INFINITY, INFINITY,
-                       INFINITY, INFINITY, INFINITY, INFINITY};
-    double best_wall = INFINITY, best_raw[RAW_CLI_MODES];
-    for (int m = 0; m < RAW_CLI_MODES; m++)
+    lx_bench_phases best = {INFINITY, INFINITY, INFINITY, INFINITY,
+                            INFINITY, INFINITY, INFINITY, INFINITY};
+    double best_wall = INFINITY, best_raw[LX_FLAT_MODES];
+    for (int m = 0; m < LX_FLAT_MODES; m++)
         best_raw[m] = INFINITY;
-    char self[4096];
-    ssize_t len = readlink("/proc/self/exe", self, sizeof self - 1);
-    if (len <= 0)
-        lx_bench_die("readlink /proc/self/exe");
-    self[len] = '\0';
     /* this process's own bake of the scene: the rays, and the check */
     lx_scene *scene;
     if (lx_scene_load(glb, NULL, &scene) != LX_OK || lx_lights_json_apply(scene, json) != LX_OK)
@@ -927,12 +434,12 @@ static cli_result bench_cli(void)
     lx_bench_rays rs = {0};
     RTCDevice dev = NULL;
     RTCScene flat = NULL;
-    uint8_t *occ[RAW_CLI_MODES] = {0};
+    uint8_t *occ[LX_FLAT_MODES] = {0};
     if (!g_skip_raw) {
         lx_bench_rays_build(b, scene, &rs);
         dev = rtcNewDevice(NULL);
-        flat = flat_scene(dev, scene);
-        for (int m = 0; m < RAW_CLI_MODES; m++)
+        flat = lx_bench_flat_scene(dev, scene);
+        for (int m = 0; m < LX_FLAT_MODES; m++)
             if (!(occ[m] = malloc(rs.count + 1)))
                 lx_bench_die("malloc");
     }
@@ -943,18 +450,18 @@ static cli_result bench_cli(void)
     int nratios = 0;
     for (int rep = 0; rep < reps; rep++) {
         sync(); /* the last run's write-back is not this one's */
-        double wall = run_child(argv, errlog);
+        double wall = lx_bench_run_child(argv, errlog);
         best_wall = fmin(best_wall, wall);
-        for (int m = 0; m < RAW_CLI_MODES && !g_skip_raw; m++) {
-            double t = cli_raw_run(m, flat, &rs, occ[m]);
+        for (int m = 0; m < LX_FLAT_MODES && !g_skip_raw; m++) {
+            double t = lx_bench_flat_trace((lx_bench_flat_mode)m, flat, &rs, g_threads, occ[m]);
             best_raw[m] = fmin(best_raw[m], t);
             if (m == 0 && nratios < 64)
                 ratios[nratios++] = t / wall; /* samples = rays: throughputs' ratio */
         }
         sync();
-        cli_phases ph;
-        cli_phases_run(self, glb, json, dir, g_cli_res, &ph);
-        phases_min(&best, &ph);
+        lx_bench_phases ph;
+        lx_bench_phases_run(glb, json, dir, g_cli_res, g_threads, &ph);
+        lx_bench_phases_min(&best, &ph);
     }
     for (int i = 1; i < nratios; i++) /* insertion sort for the median */
         for (int j = i; j > 0 && ratios[j] < ratios[j - 1]; j--) {
@@ -992,17 +499,10 @@ static cli_result bench_cli(void)
     }
     printf("\n  %-40s %7s  %6s   (best of %d, interleaved)\n",
            "phase (the CLI's calls, fresh process)", "time", "share", reps);
-    const char *names[8] = {"import (assimp + lights JSON)",
-                            "texel maps",
-                            "BVH (Embree)",
-                            "bake (static lights)",
-                            "dynamic lights",
-                            "apply + exposure meter",
-                            "EXR encode + write",
-                            "PNG encode + write"};
     const double *vals = &best.import;
-    for (int k = 0; k < 8; k++)
-        printf("  %-40s %7.3f s %5.1f%%\n", names[k], vals[k], 100.0 * vals[k] / best_wall);
+    for (int k = 0; k < LX_BENCH_PHASES; k++)
+        printf("  %-40s %7.3f s %5.1f%%\n", lx_bench_phase_names[k], vals[k],
+               100.0 * vals[k] / best_wall);
     printf("  %-40s %7.3f s %5.1f%%\n", "sum of the phases", sum, 100.0 * sum / best_wall);
     printf("  %-40s %7.3f s  (process start and exit, staging, manifest, freeing;\n"
            "  %-40s            each figure is its own best, so this takes the noise)\n",
@@ -1013,9 +513,11 @@ static cli_result bench_cli(void)
     float ev;
     bool lit;
     lx_baker_meter_ev100(b, &ev, &lit);
-    double writes = bench_writers(&img, lx_exposure_from_ev100(ev) / LX_PI, dir);
-    res.writes_share = writes / best.bake;
-    printf("  => the EXR and the PNG take %.0f%% of the bake's time (target <= 25%%: %s)\n",
+    bench_writers(&img, lx_exposure_from_ev100(ev) / LX_PI, dir);
+    /* the share from the phases: written as the CLI writes, fresh process */
+    res.writes_share = (best.exr + best.png) / best.bake;
+    printf("  => the EXR and the PNG take %.0f%% of the bake's time in the phases above (target "
+           "<= 25%%: %s)\n",
            100.0 * res.writes_share, res.writes_share <= 0.25 ? "MET" : "NOT MET");
     if (!g_skip_raw) {
         double best1 = best_raw[0];
@@ -1023,12 +525,12 @@ static cli_result bench_cli(void)
         res.ratio = res.samples_s / res.flat1_rays_s;
         printf("\n  %-40s %7s  %14s %s\n", "raw Embree, the same rays", "time", "per second",
                "process / this");
-        for (int m = 0; m < RAW_CLI_MODES; m++) {
+        for (int m = 0; m < LX_FLAT_MODES; m++) {
             uint64_t dis = 0;
             for (uint64_t j = 0; j < rs.count; j++)
                 dis += occ[m][j] != occ[0][j];
             double rays_s = (double)rs.count / best_raw[m];
-            printf("  %-40s %7.3f s %12srays/s %6.2fx%s\n", cli_raw_names[m], best_raw[m],
+            printf("  %-40s %7.3f s %12srays/s %6.2fx%s\n", lx_bench_flat_names[m], best_raw[m],
                    lx_bench_si(rays_s, c), res.samples_s / rays_s,
                    dis ? "  (occlusion differs!)" : "");
         }
@@ -1036,7 +538,7 @@ static cli_result bench_cli(void)
                "best (target >= 1.50x: %s; aim 2x); the median of the %d side-by-side pairs: "
                "%.2fx\n",
                res.ratio, res.ratio >= 1.5 ? "MET" : "NOT MET", nratios, res.median_ratio);
-        for (int m = 0; m < RAW_CLI_MODES; m++)
+        for (int m = 0; m < LX_FLAT_MODES; m++)
             free(occ[m]);
         rtcReleaseScene(flat);
         rtcReleaseDevice(dev);
@@ -1180,8 +682,7 @@ static brute_result bench_brute_force(void)
 
 int main(int argc, char **argv)
 {
-    if (argc > 1 && !strcmp(argv[1], "--phases-child"))
-        phases_child_main(argc, argv);
+    lx_bench_phases_child(argc, argv); /* returns unless this is the phase-timing child */
     const char *only = NULL;
     for (int i = 1; i < argc; i++) {
         if (!strcmp(argv[i], "--res") && i + 1 < argc)

@@ -495,6 +495,199 @@ double lx_bench_trace(const lx_tracer *tr, const lx_bench_rays *rs, lx_bench_tra
     return lx_bench_now() - t0;
 }
 
+/* ---- raw Embree on a flat BVH --------------------------------------------- */
+
+/* One Embree scene holding every triangle in world space (what a user of
+ * raw Embree would build for a static bake), same flags as the tracer. */
+RTCScene lx_bench_flat_scene(RTCDevice dev, const lx_scene *scene)
+{
+    RTCScene s = rtcNewScene(dev);
+    rtcSetSceneFlags(s, RTC_SCENE_FLAG_ROBUST);
+    rtcSetSceneBuildQuality(s, RTC_BUILD_QUALITY_HIGH);
+    uint32_t nv = 0, nt = 0;
+    for (uint32_t n = 0; n < scene->node_count; n++)
+        for (uint32_t k = 0; k < scene->nodes[n].mesh_count; k++) {
+            const lx_mesh *m = &scene->meshes[scene->nodes[n].meshes[k]];
+            nv += m->vertex_count;
+            nt += m->triangle_count;
+        }
+    RTCGeometry g = rtcNewGeometry(dev, RTC_GEOMETRY_TYPE_TRIANGLE);
+    float *v = rtcSetNewGeometryBuffer(g, RTC_BUFFER_TYPE_VERTEX, 0, RTC_FORMAT_FLOAT3,
+                                       3 * sizeof(float), nv);
+    unsigned *ix = rtcSetNewGeometryBuffer(g, RTC_BUFFER_TYPE_INDEX, 0, RTC_FORMAT_UINT3,
+                                           3 * sizeof(unsigned), nt);
+    uint32_t vb = 0, tb = 0;
+    for (uint32_t n = 0; n < scene->node_count; n++)
+        for (uint32_t k = 0; k < scene->nodes[n].mesh_count; k++) {
+            const lx_mesh *m = &scene->meshes[scene->nodes[n].meshes[k]];
+            for (uint32_t i = 0; i < m->vertex_count; i++) {
+                lx_vec3 p = lx_mat4_point(&scene->nodes[n].world, m->positions[i]);
+                v[3 * (vb + i)] = p.x, v[3 * (vb + i) + 1] = p.y, v[3 * (vb + i) + 2] = p.z;
+            }
+            for (uint32_t i = 0; i < 3 * m->triangle_count; i++)
+                ix[3 * tb + i] = vb + m->indices[i];
+            vb += m->vertex_count;
+            tb += m->triangle_count;
+        }
+    rtcCommitGeometry(g);
+    rtcAttachGeometry(s, g);
+    rtcReleaseGeometry(g);
+    rtcCommitScene(s);
+    return s;
+}
+
+static void to_rtc(const lx_ray *r, struct RTCRay *o)
+{
+    o->org_x = r->origin.x, o->org_y = r->origin.y, o->org_z = r->origin.z;
+    o->dir_x = r->dir.x, o->dir_y = r->dir.y, o->dir_z = r->dir.z;
+    o->tnear = r->tmin, o->tfar = r->tmax, o->time = 0.0f;
+    o->mask = 0xFFFFFFFFu, o->id = 0, o->flags = 0;
+}
+
+/* Every ray once straight through Embree (rtcOccluded1 or coherent
+ * rtcOccluded1M), same tiles and schedule; returns seconds. */
+static double flat_run(bool stream, RTCScene flat, const lx_bench_rays *rs, int threads,
+                       uint8_t *occluded)
+{
+    const int L = rs->lights;
+    double t0 = lx_bench_now();
+#pragma omp parallel for schedule(dynamic, 4) num_threads(threads)
+    for (int tile = 0; tile < rs->tiles; tile++) {
+        struct RTCIntersectContext ctx;
+        rtcInitIntersectContext(&ctx);
+        if (stream)
+            ctx.flags = RTC_INTERSECT_CONTEXT_FLAG_COHERENT;
+        struct RTCRay buf[LX_BENCH_TILE * LX_BENCH_TILE];
+        for (int l = 0; l < L; l++) {
+            uint32_t s = rs->batch[(size_t)tile * L + l], e = rs->batch[(size_t)tile * L + l + 1];
+            uint32_t n = e - s;
+            const lx_ray *r = rs->rays + s;
+            uint8_t *o = occluded + s;
+            if (!stream) {
+                for (uint32_t j = 0; j < n; j++) {
+                    to_rtc(&r[j], &buf[0]);
+                    rtcOccluded1(flat, &ctx, &buf[0]);
+                    o[j] = buf[0].tfar < 0.0f;
+                }
+            } else if (n) {
+                for (uint32_t j = 0; j < n; j++)
+                    to_rtc(&r[j], &buf[j]);
+                rtcOccluded1M(flat, &ctx, buf, n, sizeof(struct RTCRay));
+                for (uint32_t j = 0; j < n; j++)
+                    o[j] = buf[j].tfar < 0.0f;
+            }
+        }
+    }
+    return lx_bench_now() - t0;
+}
+
+/* Every ray once through Embree's packet calls rtcOccluded4/8/16 (width
+ * w), the rays of one tile toward one light in packets of w with a valid
+ * mask on the last; same tiles, schedule and threads as flat_run. */
+#define PACKET_RUN(W)                                                                              \
+    static double packet_run##W(RTCScene flat, const lx_bench_rays *rs, int threads,               \
+                                uint8_t *occluded)                                                 \
+    {                                                                                              \
+        const int L = rs->lights;                                                                  \
+        double t0 = lx_bench_now();                                                                \
+        _Pragma("omp parallel for schedule(dynamic, 4) num_threads(threads)") for (int tile = 0;   \
+                                                                                   tile <          \
+                                                                                   rs->tiles;      \
+                                                                                   tile++)         \
+        {                                                                                          \
+            struct RTCIntersectContext ctx;                                                        \
+            rtcInitIntersectContext(&ctx);                                                         \
+            ctx.flags = RTC_INTERSECT_CONTEXT_FLAG_COHERENT;                                       \
+            struct RTCRay##W pk;                                                                   \
+            int valid[W];                                                                          \
+            for (int l = 0; l < L; l++) {                                                          \
+                uint32_t s = rs->batch[(size_t)tile * L + l];                                      \
+                uint32_t e = rs->batch[(size_t)tile * L + l + 1];                                  \
+                for (uint32_t b = s; b < e; b += W) {                                              \
+                    for (int j = 0; j < W; j++) {                                                  \
+                        const lx_ray *r = &rs->rays[b + j < e ? b + j : s];                        \
+                        valid[j] = b + j < e ? -1 : 0;                                             \
+                        pk.org_x[j] = r->origin.x, pk.org_y[j] = r->origin.y;                      \
+                        pk.org_z[j] = r->origin.z, pk.tnear[j] = r->tmin;                          \
+                        pk.dir_x[j] = r->dir.x, pk.dir_y[j] = r->dir.y, pk.dir_z[j] = r->dir.z;    \
+                        pk.time[j] = 0.0f, pk.tfar[j] = r->tmax, pk.mask[j] = 0xFFFFFFFFu;         \
+                        pk.id[j] = 0, pk.flags[j] = 0;                                             \
+                    }                                                                              \
+                    rtcOccluded##W(valid, flat, &ctx, &pk);                                        \
+                    for (int j = 0; j < W && b + j < e; j++)                                       \
+                        occluded[b + j] = pk.tfar[j] < 0.0f;                                       \
+                }                                                                                  \
+            }                                                                                      \
+        }                                                                                          \
+        return lx_bench_now() - t0;                                                                \
+    }
+PACKET_RUN(4)
+PACKET_RUN(8)
+PACKET_RUN(16)
+
+/* rtcOccluded16 on 4x4 blocks of full 8x8 tiles (the others as rows) */
+static double packet_run16q(RTCScene flat, const lx_bench_rays *rs, int threads, uint8_t *occluded)
+{
+    const int L = rs->lights;
+    double t0 = lx_bench_now();
+#pragma omp parallel for schedule(dynamic, 4) num_threads(threads)
+    for (int tile = 0; tile < rs->tiles; tile++) {
+        struct RTCIntersectContext ctx;
+        rtcInitIntersectContext(&ctx);
+        ctx.flags = RTC_INTERSECT_CONTEXT_FLAG_COHERENT;
+        struct RTCRay16 pk;
+        int valid[16];
+        for (int l = 0; l < L; l++) {
+            uint32_t s = rs->batch[(size_t)tile * L + l];
+            uint32_t e = rs->batch[(size_t)tile * L + l + 1];
+            bool full = e - s == 64;
+            for (uint32_t b = 0; b < e - s; b += 16) {
+                uint32_t idx[16];
+                for (int j = 0; j < 16; j++) {
+                    uint32_t q = b / 16;
+                    idx[j] = full ? ((q / 2) * 4 + j / 4) * 8 + (q % 2) * 4 + j % 4 : b + j;
+                    valid[j] = idx[j] < e - s ? -1 : 0;
+                    const lx_ray *r = &rs->rays[s + (idx[j] < e - s ? idx[j] : 0)];
+                    pk.org_x[j] = r->origin.x, pk.org_y[j] = r->origin.y;
+                    pk.org_z[j] = r->origin.z, pk.tnear[j] = r->tmin;
+                    pk.dir_x[j] = r->dir.x, pk.dir_y[j] = r->dir.y, pk.dir_z[j] = r->dir.z;
+                    pk.time[j] = 0.0f, pk.tfar[j] = r->tmax, pk.mask[j] = 0xFFFFFFFFu;
+                    pk.id[j] = 0, pk.flags[j] = 0;
+                }
+                rtcOccluded16(valid, flat, &ctx, &pk);
+                for (int j = 0; j < 16; j++)
+                    if (valid[j])
+                        occluded[s + idx[j]] = pk.tfar[j] < 0.0f;
+            }
+        }
+    }
+    return lx_bench_now() - t0;
+}
+
+double lx_bench_flat_trace(lx_bench_flat_mode mode, RTCScene flat, const lx_bench_rays *rs,
+                           int threads, uint8_t *occluded)
+{
+    switch (mode) {
+    case LX_FLAT_1:
+        return flat_run(false, flat, rs, threads, occluded);
+    case LX_FLAT_1M:
+        return flat_run(true, flat, rs, threads, occluded);
+    case LX_FLAT_PACKET4:
+        return packet_run4(flat, rs, threads, occluded);
+    case LX_FLAT_PACKET8:
+        return packet_run8(flat, rs, threads, occluded);
+    case LX_FLAT_PACKET16:
+        return packet_run16(flat, rs, threads, occluded);
+    default:
+        return packet_run16q(flat, rs, threads, occluded);
+    }
+}
+
+const char *const lx_bench_flat_names[LX_FLAT_MODES] = {
+    "Embree flat BVH, rtcOccluded1",  "Embree flat BVH, rtcOccluded1M coh.",
+    "Embree flat BVH, rtcOccluded4",  "Embree flat BVH, rtcOccluded8",
+    "Embree flat BVH, rtcOccluded16", "Embree flat BVH, rtcOccluded16 4x4"};
+
 /* ---- report -------------------------------------------------------------- */
 
 static void cpu_model(char *out, size_t size)
