@@ -10,12 +10,12 @@
 #define LX_TILE 8
 
 /* One covered texel. Its position and normals are in the lightmap's
- * world_* arrays (and object_* for a node that can move). */
+ * world_* arrays (and object_* for a node that can move), its base colour
+ * in albedo. */
 typedef struct lx_texel {
     uint32_t pixel;    /* y * width + x */
     uint32_t mesh;     /* scene mesh index */
     uint32_t triangle; /* in that mesh */
-    lx_vec3 albedo;    /* base colour (factor x texture) */
 } lx_texel;
 
 typedef struct lx_lightmap {
@@ -33,6 +33,8 @@ typedef struct lx_lightmap {
     lx_vec3 *object_position;
     lx_vec3 *object_normal;
     lx_vec3 *object_geometric_normal;
+    lx_vec3 *albedo; /* per texel base colour (factor x texture); NULL unless
+                        the bake is of radiance, the one use of it */
     uint8_t *mask;   /* width * height */
     float *baked;    /* width * height * 3 */
     float *realtime; /* width * height * 3; NULL (reads as zero) until the
@@ -65,8 +67,8 @@ struct lx_baker {
 
 /* Bytes a lightmap needs per texel at most: raster scratch, mask, baked and
  * real-time RGB, and a texel record with its world- and object-space
- * copies. */
-#define LX_BYTES_PER_TEXEL (4 * 4 + 2 + 2 * 12 + sizeof(lx_texel) + 2 * 3 * 12)
+ * copies and its albedo. */
+#define LX_BYTES_PER_TEXEL (4 * 4 + 2 + 2 * 12 + sizeof(lx_texel) + 2 * 3 * 12 + 12)
 
 /* The size of node's lightmap under desc (texel_map.c); 0 x 0 when the node
  * has no UVs. */

@@ -320,7 +320,7 @@ lx_status lx_baker_apply(const lx_baker *b, uint32_t map_index, lx_image *out)
                                   map->baked[3 * p + 1] + (rt ? rt[3 * p + 1] : 0.0f),
                                   map->baked[3 * p + 2] + (rt ? rt[3 * p + 2] : 0.0f));
                 if (b->desc.quantity == LX_QUANTITY_RADIANCE)
-                    e = lx_scale(lx_mul(e, t->albedo), 1.0f / LX_PI);
+                    e = lx_scale(lx_mul(e, map->albedo[i]), 1.0f / LX_PI);
                 out->data[3 * p] = e.x;
                 out->data[3 * p + 1] = e.y;
                 out->data[3 * p + 2] = e.z;
@@ -389,9 +389,9 @@ void lx_baker_meter_ev100(const lx_baker *b, float *ev100, bool *lit)
                           map->baked[p + 1] + (rt ? rt[p + 1] : 0.0f),
                           map->baked[p + 2] + (rt ? rt[p + 2] : 0.0f)};
             if (b->desc.quantity == LX_QUANTITY_RADIANCE) {
-                e[0] *= t->albedo.x;
-                e[1] *= t->albedo.y;
-                e[2] *= t->albedo.z;
+                e[0] *= map->albedo[i].x;
+                e[1] *= map->albedo[i].y;
+                e[2] *= map->albedo[i].z;
             }
             sum += lx_luminance(e) * scale;
             n++;

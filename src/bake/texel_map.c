@@ -469,8 +469,11 @@ lx_status lx_texel_map_build(const lx_scene *scene, uint32_t node_index, const l
     map->world_position = malloc(sizeof(lx_vec3) * (used ? used : 1));
     map->world_normal = malloc(sizeof(lx_vec3) * (used ? used : 1));
     map->world_geometric_normal = malloc(sizeof(lx_vec3) * (used ? used : 1));
+    if (desc->quantity == LX_QUANTITY_RADIANCE)
+        map->albedo = malloc(sizeof(lx_vec3) * (used ? used : 1));
     if (!map->texels || !map->tile_start || !map->mask || !map->world_position ||
-        !map->world_normal || !map->world_geometric_normal) {
+        !map->world_normal || !map->world_geometric_normal ||
+        (desc->quantity == LX_QUANTITY_RADIANCE && !map->albedo)) {
         st = lx_fail(LX_ERR_NOMEM, "%s: out of memory", what);
         goto done;
     }
@@ -545,7 +548,8 @@ lx_status lx_texel_map_build(const lx_scene *scene, uint32_t node_index, const l
                     const lx_material *mat = &scene->materials[m->material];
                     if (tangents[s])
                         sample_normal_map(mat, m, tangents[s], i, w0, w1, w2, &nrm);
-                    tx_->albedo = sample_albedo(mat, m, i, w0, w1, w2);
+                    if (map->albedo)
+                        map->albedo[n] = sample_albedo(mat, m, i, w0, w1, w2);
                     place_texel(map, n++, &node->world, &nm, position, nrm, geometric);
                     map->mask[p] = 1;
                 }
@@ -635,6 +639,7 @@ void lx_texel_map_free(lx_lightmap *map)
     free(map->object_position);
     free(map->object_normal);
     free(map->object_geometric_normal);
+    free(map->albedo);
     free(map->mask);
     free(map->baked);
     free(map->realtime);
