@@ -39,6 +39,9 @@ check-asan: deps
 
 bench: all
 	$(BUILD)/bin/bench_bake
+	@# the phases of a 4096x4096 bake of the same scene (no raw figures:
+	@# they would store 268M rays)
+	$(BUILD)/bin/bench_bake --only cli --cli-res 4096 --skip-raw --reps 1
 	$(BUILD)/bin/bench_realtime
 	$(BUILD)/bin/bench_ibl
 

@@ -11,17 +11,32 @@
  *   after lx_tracer_create. lx_tracer_destroy releases everything.
  * THREADING  lx_tracer_create* is thread-safe. Queries (lx_tracer_occluded*,
  *   lx_tracer_closest, lx_tracer_nearest_distance) may run on many threads
- *   at once on one tracer; lx_tracer_set_node_transform and
- *   lx_tracer_commit must not overlap queries or each other.
+ *   at once on one tracer, each thread with its own lx_ray_packet;
+ *   lx_tracer_set_node_transform and lx_tracer_commit must not overlap
+ *   queries or each other.
  *
  * USAGE
  *   lx_scene *scene;
+ *   if (lx_scene_load("room.glb", NULL, &scene) != LX_OK)
+ *       return 1;
  *   lx_tracer *tr;
- *   if (lx_scene_load("room.glb", NULL, &scene) != LX_OK) return 1;
- *   if (lx_tracer_create(scene, &tr) != LX_OK) { lx_scene_destroy(scene); return 1; }
- *   lx_ray r = {.origin = lx_v3(0, 1, 0), .dir = lx_v3(0, -1, 0), .tmin = 0, .tmax = 100};
- *   lx_hit hit;
- *   if (lx_tracer_closest(tr, &r, &hit)) printf("floor %g m below\n", hit.t);
+ *   if (lx_tracer_create(scene, &tr) != LX_OK) {
+ *       lx_scene_destroy(scene);
+ *       return 1;
+ *   }
+ *   lx_ray r = {.origin = {0, 1, 0}, .dir = {0, -1, 0}, .tmin = 0, .tmax = 10};
+ *   bool blocked = lx_tracer_occluded(tr, &r); // the room's floor is below
+ *   lx_ray_packet pk;                          // 16 coherent rays at once
+ *   for (int i = 0; i < LX_RAY_PACKET; i++) {
+ *       pk.origin_x[i] = -0.75f + 0.1f * (float)i, pk.origin_y[i] = 1, pk.origin_z[i] = 0;
+ *       pk.dir_x[i] = 0, pk.dir_y[i] = -1, pk.dir_z[i] = 0;
+ *       pk.tmin[i] = 0, pk.tmax[i] = 10;
+ *   }
+ *   uint32_t hit = lx_tracer_occluded_packet(tr, &pk, 0xFFFFu);
+ *   int n = 0;
+ *   for (int i = 0; i < LX_RAY_PACKET; i++)
+ *       n += (hit >> i) & 1u;
+ *   printf("down: %s; packet: %d of 16 blocked\n", blocked ? "blocked" : "free", n);
  *   lx_tracer_destroy(tr);
  *   lx_scene_destroy(scene);
  */
@@ -74,6 +89,42 @@ bool lx_tracer_occluded(const lx_tracer *tracer, const lx_ray *ray);
  * 1 when ray i is blocked. */
 void lx_tracer_occluded_batch(const lx_tracer *tracer, const lx_ray *rays, uint32_t count,
                               bool coherent, uint8_t *occluded);
+
+/* Rays in one lx_tracer_occluded_packet call. */
+#define LX_RAY_PACKET 16
+
+#if defined(__cplusplus)
+#define LX_ALIGN64 alignas(64)
+#else
+#define LX_ALIGN64 _Alignas(64)
+#endif
+
+/* LX_RAY_PACKET rays as structure of arrays (lane i of each field is ray
+ * i), laid out as the tracer hands them to Embree, without a copy. Fill
+ * origin, dir, tmin and tmax of the lanes you use; the rest is the
+ * tracer's. 64-byte aligned: declare it, or allocate it with
+ * aligned_alloc(64, ...). */
+typedef struct lx_ray_packet {
+    LX_ALIGN64 float origin_x[LX_RAY_PACKET];
+    float origin_y[LX_RAY_PACKET];
+    float origin_z[LX_RAY_PACKET];
+    float tmin[LX_RAY_PACKET];
+    float dir_x[LX_RAY_PACKET];
+    float dir_y[LX_RAY_PACKET];
+    float dir_z[LX_RAY_PACKET];
+    float internal_time[LX_RAY_PACKET];  /* set by the tracer */
+    float tmax[LX_RAY_PACKET];           /* a blocked lane's comes back negative */
+    uint32_t internal[3][LX_RAY_PACKET]; /* set by the tracer */
+} lx_ray_packet;
+
+/* Occlusion of the lanes of packet whose bit is set in `active` (bit i =
+ * lane i), traced together as one SIMD packet (Embree's rtcOccluded16; on
+ * CPUs without 16-wide vectors Embree splits it). Returns the bits of the
+ * active lanes that are blocked. Fastest for coherent rays: neighbouring
+ * texels toward one light, where it traces 1.5-2.5x the rays per second of
+ * lx_tracer_occluded_batch (bench_bake). The same ray gives the same answer
+ * in any lane and any packet. */
+uint32_t lx_tracer_occluded_packet(const lx_tracer *tracer, lx_ray_packet *packet, uint32_t active);
 
 /* Nearest hit within [tmin, tmax]; false when none. */
 bool lx_tracer_closest(const lx_tracer *tracer, const lx_ray *ray, lx_hit *hit);

@@ -9,15 +9,13 @@
  * also the unit of parallel work, so results do not depend on threads. */
 #define LX_TILE 8
 
-/* One covered texel, in object space (what survives a node moving). */
+/* One covered texel. Its position and normals are in the lightmap's
+ * world_* arrays (and object_* for a node that can move), its base colour
+ * in albedo. */
 typedef struct lx_texel {
     uint32_t pixel;    /* y * width + x */
     uint32_t mesh;     /* scene mesh index */
     uint32_t triangle; /* in that mesh */
-    lx_vec3 position;  /* object space */
-    lx_vec3 normal;    /* object space shading normal, normal map applied */
-    lx_vec3 geometric_normal;
-    lx_vec3 albedo; /* base colour (factor x texture) */
 } lx_texel;
 
 typedef struct lx_lightmap {
@@ -27,11 +25,20 @@ typedef struct lx_lightmap {
     uint32_t *tile_start; /* tile_count + 1 offsets into texels */
     uint32_t tile_count;
     lx_vec3 *world_position; /* per texel, for the node's current transform */
-    lx_vec3 *world_normal;
+    lx_vec3 *world_normal;   /* shading normal, normal map applied */
     lx_vec3 *world_geometric_normal;
+    /* the same in object space, what survives the node moving; NULL while
+     * the node sits at the identity it was built at (the world arrays are
+     * then object space: a static bake keeps one copy) */
+    lx_vec3 *object_position;
+    lx_vec3 *object_normal;
+    lx_vec3 *object_geometric_normal;
+    lx_vec3 *albedo; /* per texel base colour (factor x texture); NULL unless
+                        the bake is of radiance, the one use of it */
     uint8_t *mask;   /* width * height */
     float *baked;    /* width * height * 3 */
-    float *realtime; /* width * height * 3 */
+    float *realtime; /* width * height * 3; NULL (reads as zero) until the
+                        first update with dynamic lights */
 } lx_lightmap;
 
 struct lx_baker {
@@ -59,8 +66,9 @@ struct lx_baker {
 };
 
 /* Bytes a lightmap needs per texel at most: raster scratch, mask, baked and
- * real-time RGB, and a texel record with its world-space copies. */
-#define LX_BYTES_PER_TEXEL (4 * 4 + 2 + 2 * 12 + sizeof(lx_texel) + 3 * 12)
+ * real-time RGB, and a texel record with its world- and object-space
+ * copies and its albedo. */
+#define LX_BYTES_PER_TEXEL (4 * 4 + 2 + 2 * 12 + sizeof(lx_texel) + 2 * 3 * 12 + 12)
 
 /* The size of node's lightmap under desc (texel_map.c); 0 x 0 when the node
  * has no UVs. */
@@ -73,7 +81,11 @@ void lx_texel_map_size(const lx_scene *scene, uint32_t node, const lx_bake_desc 
 lx_status lx_texel_map_build(const lx_scene *scene, uint32_t node, const lx_bake_desc *desc,
                              lx_lightmap *map);
 void lx_texel_map_free(lx_lightmap *map);
-/* Recomputes world positions and normals from a node transform. */
+/* Makes the object-space copies a move needs (a map built at the
+ * identity has none); LX_ERR_NOMEM when they do not fit. */
+lx_status lx_texel_map_keep_object_space(lx_lightmap *map);
+/* Recomputes world positions and normals from a node transform; the map
+ * has its object-space copies (lx_texel_map_keep_object_space). */
 void lx_texel_map_transform(lx_lightmap *map, const lx_mat4 *world);
 
 /* Adds the given lights (indices into baker->lights) into target

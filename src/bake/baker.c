@@ -210,7 +210,12 @@ lx_status lx_baker_set_node_transform(lx_baker *b, uint32_t node, const lx_mat4 
 {
     if (node >= b->node_count)
         return lx_fail(LX_ERR_INVALID, "node %u out of range (count %u)", node, b->node_count);
-    lx_status st = lx_tracer_set_node_transform(b->tracer, node, world);
+    /* the object space a move needs, before anything changes */
+    lx_status st = LX_OK;
+    if (b->node_map[node] != UINT32_MAX &&
+        (st = lx_texel_map_keep_object_space(&b->maps[b->node_map[node]])) != LX_OK)
+        return st;
+    st = lx_tracer_set_node_transform(b->tracer, node, world);
     if (st != LX_OK)
         return st;
     b->node_world[node] = *world;
@@ -235,7 +240,9 @@ static void clear_buffers(lx_baker *b, bool realtime)
     for (uint32_t m = 0; m < b->map_count; m++) {
         lx_lightmap *map = &b->maps[m];
         size_t n = (size_t)map->info.width * map->info.height * 3;
-        memset(realtime ? map->realtime : map->baked, 0, n * sizeof(float));
+        float *buf = realtime ? map->realtime : map->baked;
+        if (buf)
+            memset(buf, 0, n * sizeof(float));
     }
 }
 
@@ -259,7 +266,26 @@ lx_status lx_baker_update(lx_baker *b)
     if (!idx)
         return lx_fail(LX_ERR_NOMEM, "out of memory");
     uint32_t n = select_lights(b, true, idx);
-    lx_status st = lx_bake_lights(b, idx, n, lx_v3(0, 0, 0), true, 0.0f, 1.0f);
+    lx_status st = LX_OK;
+    /* The real-time buffers are made on the first update that has dynamic
+     * lights: a static bake never touches their memory (12 bytes a texel,
+     * and fresh pages cost as much as the work on them). Until then they
+     * read as zero. */
+    if (n == 0) {
+        clear_buffers(b, true); /* no dynamic light: zero where they exist */
+        if (b->desc.progress && !b->desc.progress(b->desc.progress_user, 1.0f))
+            st = lx_fail(LX_ERR_CANCELLED, "bake cancelled");
+    } else {
+        for (uint32_t m = 0; m < b->map_count && st == LX_OK; m++) {
+            lx_lightmap *map = &b->maps[m];
+            size_t count = (size_t)map->info.width * map->info.height * 3;
+            if (!map->realtime && !(map->realtime = calloc(count, sizeof(float))))
+                st = lx_fail(LX_ERR_NOMEM, "lightmap '%s': out of memory for the real-time buffer",
+                             map->name);
+        }
+        if (st == LX_OK)
+            st = lx_bake_lights(b, idx, n, lx_v3(0, 0, 0), true, 0.0f, 1.0f);
+    }
     if (idx != idx_buf)
         free(idx);
     return st;
@@ -276,18 +302,29 @@ lx_status lx_baker_apply(const lx_baker *b, uint32_t map_index, lx_image *out)
         return lx_fail(LX_ERR_INVALID, "lightmap '%s': output must be a %dx%d RGB image", map->name,
                        w, h);
     size_t pixels = (size_t)w * h;
-    memset(out->data, 0, pixels * 3 * sizeof(float));
-    for (uint32_t i = 0; i < map->info.used_texels; i++) {
-        const lx_texel *t = &map->texels[i];
-        size_t p = t->pixel;
-        lx_vec3 e = lx_v3(map->baked[3 * p] + map->realtime[3 * p],
-                          map->baked[3 * p + 1] + map->realtime[3 * p + 1],
-                          map->baked[3 * p + 2] + map->realtime[3 * p + 2]);
-        if (b->desc.quantity == LX_QUANTITY_RADIANCE)
-            e = lx_scale(lx_mul(e, t->albedo), 1.0f / LX_PI);
-        out->data[3 * p] = e.x;
-        out->data[3 * p + 1] = e.y;
-        out->data[3 * p + 2] = e.z;
+    const float *rt = map->realtime; /* NULL: no dynamic light yet, zero */
+    int threads = lx_thread_count(b->desc.threads);
+    /* rows, then tiles, in parallel: each pixel is written by one
+     * iteration */
+#pragma omp parallel num_threads(threads)
+    {
+#pragma omp for schedule(static)
+        for (int y = 0; y < h; y++)
+            memset(out->data + (size_t)y * w * 3, 0, (size_t)w * 3 * sizeof(float));
+#pragma omp for schedule(static)
+        for (int tile = 0; tile < (int)map->tile_count; tile++)
+            for (uint32_t i = map->tile_start[tile]; i < map->tile_start[tile + 1]; i++) {
+                const lx_texel *t = &map->texels[i];
+                size_t p = t->pixel;
+                lx_vec3 e = lx_v3(map->baked[3 * p] + (rt ? rt[3 * p] : 0.0f),
+                                  map->baked[3 * p + 1] + (rt ? rt[3 * p + 1] : 0.0f),
+                                  map->baked[3 * p + 2] + (rt ? rt[3 * p + 2] : 0.0f));
+                if (b->desc.quantity == LX_QUANTITY_RADIANCE)
+                    e = lx_scale(lx_mul(e, map->albedo[i]), 1.0f / LX_PI);
+                out->data[3 * p] = e.x;
+                out->data[3 * p + 1] = e.y;
+                out->data[3 * p + 2] = e.z;
+            }
     }
     if (b->desc.padding > 0) {
         uint8_t *mask = malloc(pixels);
@@ -347,13 +384,14 @@ void lx_baker_meter_ev100(const lx_baker *b, float *ev100, bool *lit)
         for (uint32_t i = 0; i < map->info.used_texels; i++) {
             const lx_texel *t = &map->texels[i];
             size_t p = (size_t)t->pixel * 3;
-            float e[3] = {map->baked[p] + map->realtime[p],
-                          map->baked[p + 1] + map->realtime[p + 1],
-                          map->baked[p + 2] + map->realtime[p + 2]};
+            const float *rt = map->realtime; /* NULL reads as zero */
+            float e[3] = {map->baked[p] + (rt ? rt[p] : 0.0f),
+                          map->baked[p + 1] + (rt ? rt[p + 1] : 0.0f),
+                          map->baked[p + 2] + (rt ? rt[p + 2] : 0.0f)};
             if (b->desc.quantity == LX_QUANTITY_RADIANCE) {
-                e[0] *= t->albedo.x;
-                e[1] *= t->albedo.y;
-                e[2] *= t->albedo.z;
+                e[0] *= map->albedo[i].x;
+                e[1] *= map->albedo[i].y;
+                e[2] *= map->albedo[i].z;
             }
             sum += lx_luminance(e) * scale;
             n++;

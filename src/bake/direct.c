@@ -135,6 +135,299 @@ static void light_tile(const lx_baker *b, uint32_t map_index, const lx_lightmap 
             accum[pending[j].texel] = lx_add(accum[pending[j].texel], pending[j].illuminance);
 }
 
+/* ---- the lean loop: punctual lights with hard or no shadows ---------------
+ * Point, spot and directional lights without a photometric profile, the
+ * bulk of a bake, skip lx_light_evaluate's general path: what does not
+ * change per texel is worked out once per light, a tile's texels are
+ * shaded 16 at a time in structure-of-arrays form (vectorized), and their
+ * shadow rays go to the tracer as one coherent packet. Every operation is
+ * lx_light_evaluate's and lx_shadow_ray's, in their order, so the results
+ * are the same bits. */
+
+typedef struct fast_light {
+    bool directional, classic, spot, spot_hard, shadowed;
+    float px, py, pz; /* position; directional: the unit vector to the light */
+    float ax, ay, az; /* spot axis (the light's direction) */
+    float intensity, range, range_sq;
+    float cos_outer, spot_scale, spot_offset;
+    float cr, cg, cb; /* colour */
+    float mr, mg, mb; /* ambient */
+} fast_light;
+
+/* false when the light needs the general path. */
+static bool fast_light_init(const lx_light *l, fast_light *f)
+{
+    memset(f, 0, sizeof *f);
+    if (l->profile || (l->shadow != LX_SHADOW_HARD && l->shadow != LX_SHADOW_NONE))
+        return false;
+    if (l->type != LX_LIGHT_POINT && l->type != LX_LIGHT_SPOT && l->type != LX_LIGHT_DIRECTIONAL)
+        return false;
+    f->directional = l->type == LX_LIGHT_DIRECTIONAL;
+    f->classic = l->model == LX_MODEL_CLASSIC;
+    f->shadowed = l->shadow == LX_SHADOW_HARD;
+    if (f->directional) {
+        lx_vec3 t = lx_neg(l->direction);
+        f->px = t.x, f->py = t.y, f->pz = t.z;
+    } else {
+        f->px = l->position.x, f->py = l->position.y, f->pz = l->position.z;
+    }
+    f->ax = l->direction.x, f->ay = l->direction.y, f->az = l->direction.z;
+    f->intensity = l->intensity;
+    f->range = l->range;
+    f->range_sq = l->range * l->range;
+    if (l->type == LX_LIGHT_SPOT) {
+        /* lx_light_spot_attenuation's constants */
+        f->spot = true;
+        f->cos_outer = cosf(l->outer_angle);
+        float cos_inner = cosf(l->inner_angle);
+        f->spot_hard = !(l->inner_angle < l->outer_angle);
+        float delta = cos_inner - f->cos_outer;
+        f->spot_scale = 1.0f / (delta > 1e-4f ? delta : 1e-4f);
+        f->spot_offset = -f->cos_outer * f->spot_scale;
+    }
+    f->cr = l->color.x, f->cg = l->color.y, f->cb = l->color.z;
+    f->mr = l->ambient.x, f->mg = l->ambient.y, f->mb = l->ambient.z;
+    return true;
+}
+
+enum { TILE_TEXELS = LX_TILE * LX_TILE };
+
+/* A tile's texels in structure-of-arrays form, one lane per place in the
+ * 8x8 tile, ordered by 4x4 block: a packet of 16 rays starts from a square
+ * of texels, not two rows (10% more rays per second on bench_bake's
+ * scene). Places without a texel (chart borders) are lanes that repeat
+ * another lane's data and are never traced or stored. */
+typedef struct tile_soa {
+    int32_t texel[TILE_TEXELS];                  /* index from the tile's first texel, -1: none */
+    uint32_t lanes[TILE_TEXELS / LX_RAY_PACKET]; /* per packet: lanes with a texel */
+    float px[TILE_TEXELS], py[TILE_TEXELS], pz[TILE_TEXELS];
+    float nx[TILE_TEXELS], ny[TILE_TEXELS], nz[TILE_TEXELS];
+    float gx[TILE_TEXELS], gy[TILE_TEXELS], gz[TILE_TEXELS];
+    float bias[TILE_TEXELS]; /* lx_shadow_ray's origin offset */
+    float acc[3][TILE_TEXELS];
+} tile_soa;
+
+static void lane_set(tile_soa *t, int k, lx_vec3 p, lx_vec3 n, lx_vec3 g, float bias)
+{
+    t->px[k] = p.x, t->py[k] = p.y, t->pz[k] = p.z;
+    t->nx[k] = n.x, t->ny[k] = n.y, t->nz[k] = n.z;
+    t->gx[k] = g.x, t->gy[k] = g.y, t->gz[k] = g.z;
+    t->bias[k] = bias;
+}
+
+static void tile_load(const lx_baker *b, const lx_lightmap *map, uint32_t first, uint32_t count,
+                      tile_soa *t)
+{
+    uint32_t width = (uint32_t)map->info.width;
+    for (int q = 0; q < TILE_TEXELS / LX_RAY_PACKET; q++)
+        t->lanes[q] = 0;
+    for (int k = 0; k < TILE_TEXELS; k++)
+        t->texel[k] = -1;
+    for (uint32_t j = 0; j < count; j++) {
+        uint32_t i = first + j, pixel = map->texels[i].pixel;
+        uint32_t x = pixel % width % LX_TILE, y = pixel / width % LX_TILE;
+        int block = (int)(y / 4 * 2 + x / 4), lane = (int)(y % 4 * 4 + x % 4);
+        int k = block * LX_RAY_PACKET + lane;
+        lx_vec3 p = map->world_position[i];
+        lane_set(t, k, p, map->world_normal[i], map->world_geometric_normal[i],
+                 b->bias + 4e-6f * lx_max_abs_component(p));
+        t->texel[k] = (int32_t)j;
+        t->lanes[block] |= 1u << lane;
+    }
+    /* empty places copy a texel so every lane computes on real numbers */
+    int any = 0;
+    while (t->texel[any] < 0)
+        any++;
+    for (int k = 0; k < TILE_TEXELS; k++)
+        if (t->texel[k] < 0)
+            lane_set(t, k, lx_v3(t->px[any], t->py[any], t->pz[any]),
+                     lx_v3(t->nx[any], t->ny[any], t->nz[any]),
+                     lx_v3(t->gx[any], t->gy[any], t->gz[any]), t->bias[any]);
+}
+
+/* 16 lanes as one value (GCC/Clang vector extensions: the compiler splits
+ * them into the target's SIMD registers). Selects are bitwise, so no lane
+ * computes anything a scalar evaluation would not. */
+#if defined(__GNUC__)
+/* the helpers below are static inline: no ABI is crossed */
+#pragma GCC diagnostic ignored "-Wpsabi"
+#endif
+typedef float v16f __attribute__((vector_size(64)));
+typedef int32_t v16i __attribute__((vector_size(64)));
+
+static inline __attribute__((always_inline)) v16f vload(const float *p)
+{
+    v16f v;
+    memcpy(&v, p, sizeof v);
+    return v;
+}
+
+static inline __attribute__((always_inline)) void vstore(float *p, v16f v)
+{
+    memcpy(p, &v, sizeof v);
+}
+
+static inline __attribute__((always_inline)) v16f vsplat(float x)
+{
+    return (v16f){0} + x;
+}
+
+/* m ? a : b, lane by lane (m is 0 or -1) */
+static inline __attribute__((always_inline)) v16f vsel(v16i m, v16f a, v16f b)
+{
+    return (v16f)(((v16i)a & m) | ((v16i)b & ~m));
+}
+
+/* The lanes [base, base + 16) of a tile for one fast light: ambient into
+ * t->acc, the unshadowed illuminance into e, lit (lane mask) where it
+ * lights, and the shadow rays into pk: lx_light_evaluate and
+ * lx_shadow_ray, operation for operation. directional, classic and spot
+ * are constants in each caller, so each kind of light gets its own code. */
+static inline __attribute__((always_inline)) void
+shade_lanes(const fast_light *f, tile_soa *t, uint32_t base, lx_ray_packet *pk, float e[3][16],
+            int32_t lit[16], bool directional, bool classic, bool spot)
+{
+    v16f px = vload(t->px + base), py = vload(t->py + base), pz = vload(t->pz + base);
+    v16f one = vsplat(1.0f), zero = vsplat(0.0f);
+    v16f tx, ty, tz, dist = vsplat(INFINITY), window = one, d2 = one;
+    v16i ok;
+    if (directional) {
+        tx = vsplat(f->px), ty = vsplat(f->py), tz = vsplat(f->pz);
+    } else {
+        tx = f->px - px, ty = f->py - py, tz = f->pz - pz;
+        d2 = tx * tx + ty * ty + tz * tz;
+        float d2s[16], ds[16];
+        vstore(d2s, d2);
+        for (int j = 0; j < 16; j++)
+            ds[j] = sqrtf(d2s[j]);
+        dist = vload(ds);
+        /* lx_light_range_window */
+        if (f->range > 0.0f) {
+            v16f factor = d2 / f->range_sq;
+            v16f smooth = 1.0f - factor * factor;
+            window = vsel(smooth > 0.0f, smooth * smooth, zero);
+        }
+    }
+    vstore(t->acc[0] + base, vload(t->acc[0] + base) + f->mr * window);
+    vstore(t->acc[1] + base, vload(t->acc[1] + base) + f->mg * window);
+    vstore(t->acc[2] + base, vload(t->acc[2] + base) + f->mb * window);
+    v16f lx = tx, ly = ty, lz = tz;
+    if (!directional) {
+        v16f inv = 1.0f / dist;
+        lx = tx * inv, ly = ty * inv, lz = tz * inv;
+    }
+    v16f ndotl = vload(t->nx + base) * lx + vload(t->ny + base) * ly + vload(t->nz + base) * lz;
+    ok = ndotl > 0.0f;
+    if (!directional)
+        ok &= dist > 0.0f;
+    v16f att = one;
+    if (spot) {
+        v16f c = -(f->ax * lx + f->ay * ly + f->az * lz);
+        if (f->spot_hard) {
+            att = vsel(c >= f->cos_outer, one, zero);
+        } else {
+            v16f u = c * f->spot_scale + f->spot_offset;
+            u = vsel(u < 0.0f, zero, vsel(u > 1.0f, one, u));
+            att = u * u;
+        }
+        ok &= att > 0.0f;
+    }
+    v16f en;
+    if (directional && classic) {
+        en = ndotl * ndotl * f->intensity;
+    } else if (directional) {
+        en = f->intensity * ndotl;
+    } else if (classic) {
+        ok &= dist < f->range;
+        v16f v = (1.0f - dist / f->range) * ndotl;
+        en = v * v * f->intensity * att;
+    } else {
+        v16f dc = vsel(d2 > 1e-4f, d2, vsplat(1e-4f)); /* LX_MIN_DISTANCE_SQ */
+        en = f->intensity * window * att * ndotl / dc;
+    }
+    ok &= en > 0.0f;
+    vstore(e[0], f->cr * en);
+    vstore(e[1], f->cg * en);
+    vstore(e[2], f->cb * en);
+    memcpy(lit, &ok, sizeof ok);
+    /* lx_shadow_ray: off the surface on the light's side */
+    v16f gx = vload(t->gx + base), gy = vload(t->gy + base), gz = vload(t->gz + base);
+    v16f bias = vload(t->bias + base);
+    v16i front = gx * lx + gy * ly + gz * lz >= 0.0f;
+    v16f ox = gx * bias, oy = gy * bias, oz = gz * bias;
+    vstore(pk->origin_x, vsel(front, px + ox, px - ox));
+    vstore(pk->origin_y, vsel(front, py + oy, py - oy));
+    vstore(pk->origin_z, vsel(front, pz + oz, pz - oz));
+    vstore(pk->dir_x, lx);
+    vstore(pk->dir_y, ly);
+    vstore(pk->dir_z, lz);
+    vstore(pk->tmin, zero);
+    v16f tmax = directional ? dist : dist - 2.0f * bias;
+    vstore(pk->tmax, vsel(tmax < 0.0f, zero, tmax));
+}
+
+/* One fast light on a tile: lx_light_evaluate, lx_shadow_ray and
+ * light_tile's sums, 16 lanes at a time. Built for AVX-512, AVX2 and the
+ * baseline, chosen at load time: without FMA contraction (-ffp-contract=off)
+ * the wider units compute the same bits. */
+#if defined(__GNUC__) && defined(__x86_64__) && !defined(__clang__)
+__attribute__((target_clones("avx512f", "avx2", "default")))
+#endif
+static void
+fast_light_tile(const lx_baker *b, const fast_light *f, tile_soa *t)
+{
+    lx_ray_packet pk;
+    float e[3][LX_RAY_PACKET];
+    int32_t lit[LX_RAY_PACKET];
+    for (uint32_t base = 0; base < TILE_TEXELS; base += LX_RAY_PACKET) {
+        uint32_t lanes = t->lanes[base / LX_RAY_PACKET];
+        if (!lanes)
+            continue;
+        if (f->directional)
+            shade_lanes(f, t, base, &pk, e, lit, true, f->classic, false);
+        else if (f->classic)
+            shade_lanes(f, t, base, &pk, e, lit, false, true, f->spot);
+        else if (f->spot)
+            shade_lanes(f, t, base, &pk, e, lit, false, false, true);
+        else
+            shade_lanes(f, t, base, &pk, e, lit, false, false, false);
+        uint32_t active = 0;
+        for (uint32_t j = 0; j < LX_RAY_PACKET; j++)
+            active |= (uint32_t)(lit[j] != 0) << j;
+        active &= lanes;
+        if (!active)
+            continue;
+        uint32_t blocked = f->shadowed ? lx_tracer_occluded_packet(b->tracer, &pk, active) : 0;
+        uint32_t add = active & ~blocked;
+        int32_t on[LX_RAY_PACKET];
+        for (int j = 0; j < LX_RAY_PACKET; j++)
+            on[j] = (add >> j) & 1u ? -1 : 0;
+        v16i m;
+        memcpy(&m, on, sizeof m);
+        for (int c = 0; c < 3; c++) {
+            v16f a = vload(t->acc[c] + base);
+            vstore(t->acc[c] + base, vsel(m, a + vload(e[c]), a));
+        }
+    }
+}
+
+/* The sums between the lanes and texel order (the general path's). */
+static void acc_to_vec3(const tile_soa *t, lx_vec3 *accum)
+{
+    for (int k = 0; k < TILE_TEXELS; k++)
+        if (t->texel[k] >= 0)
+            accum[t->texel[k]] = lx_v3(t->acc[0][k], t->acc[1][k], t->acc[2][k]);
+}
+
+static void vec3_to_acc(const lx_vec3 *accum, tile_soa *t)
+{
+    for (int k = 0; k < TILE_TEXELS; k++)
+        if (t->texel[k] >= 0) {
+            lx_vec3 a = accum[t->texel[k]];
+            t->acc[0][k] = a.x, t->acc[1][k] = a.y, t->acc[2][k] = a.z;
+        }
+}
+
 lx_status lx_bake_lights(lx_baker *b, const uint32_t *lights, uint32_t light_count, lx_vec3 ambient,
                          bool to_realtime, float progress_base, float progress_span)
 {
@@ -156,6 +449,16 @@ lx_status lx_bake_lights(lx_baker *b, const uint32_t *lights, uint32_t light_cou
         /* progress counts texels, plus one per tile so empty tiles count */
         total_work += b->maps[m].info.used_texels + b->maps[m].tile_count;
     }
+    fast_light *fast = malloc(sizeof(fast_light) * (light_count + 1));
+    bool *is_fast = malloc(sizeof(bool) * (light_count + 1));
+    if (!fast || !is_fast) {
+        free(fast);
+        free(is_fast);
+        free(map_first_tile);
+        return lx_fail(LX_ERR_NOMEM, "out of memory");
+    }
+    for (uint32_t l = 0; l < light_count; l++)
+        is_fast[l] = fast_light_init(&b->lights[lights[l]], &fast[l]);
     int tiles = (int)map_first_tile[b->map_count];
     int threads = lx_thread_count(b->desc.threads);
     bool report = b->desc.progress != NULL;
@@ -175,19 +478,33 @@ lx_status lx_bake_lights(lx_baker *b, const uint32_t *lights, uint32_t light_cou
         uint32_t first = map->tile_start[tile];
         uint32_t count = map->tile_start[tile + 1] - first;
         if (count) {
-            lx_vec3 accum[LX_TILE * LX_TILE];
-            for (uint32_t k = 0; k < count; k++)
-                accum[k] = ambient;
-            for (uint32_t l = 0; l < light_count; l++)
+            tile_soa t;
+            lx_vec3 accum[TILE_TEXELS];
+            tile_load(b, map, first, count, &t);
+            for (uint32_t k = 0; k < TILE_TEXELS; k++)
+                t.acc[0][k] = ambient.x, t.acc[1][k] = ambient.y, t.acc[2][k] = ambient.z;
+            for (uint32_t l = 0; l < light_count; l++) {
+                if (is_fast[l]) {
+                    fast_light_tile(b, &fast[l], &t);
+                    continue;
+                }
+                acc_to_vec3(&t, accum);
                 light_tile(b, m, map, first, count, lights[l], accum);
-            if (!to_realtime && b->has_sky)
+                vec3_to_acc(accum, &t);
+            }
+            if (!to_realtime && b->has_sky) {
+                acc_to_vec3(&t, accum);
                 lx_sky_tile(b, m, map, first, count, accum);
+                vec3_to_acc(accum, &t);
+            }
             /* every texel belongs to one tile: plain stores, no clearing */
-            for (uint32_t k = 0; k < count; k++) {
-                float *px = target + (size_t)map->texels[first + k].pixel * 3;
-                px[0] = accum[k].x;
-                px[1] = accum[k].y;
-                px[2] = accum[k].z;
+            for (int k = 0; k < TILE_TEXELS; k++) {
+                if (t.texel[k] < 0)
+                    continue;
+                float *px = target + (size_t)map->texels[first + (uint32_t)t.texel[k]].pixel * 3;
+                px[0] = t.acc[0][k];
+                px[1] = t.acc[1][k];
+                px[2] = t.acc[2][k];
             }
         }
         if (report) {
@@ -203,6 +520,8 @@ lx_status lx_bake_lights(lx_baker *b, const uint32_t *lights, uint32_t light_cou
         }
     }
     free(map_first_tile);
+    free(fast);
+    free(is_fast);
     if (cancelled)
         return lx_fail(LX_ERR_CANCELLED, "bake cancelled");
     if (report && !b->desc.progress(b->desc.progress_user, progress_base + progress_span))

@@ -322,6 +322,22 @@ static lx_vec3 sample_albedo(const lx_material *mat, const lx_mesh *m, const uin
     return a;
 }
 
+/* Texel n's world-space position and normals under world (nm: its normal
+ * matrix), as lx_texel_map_transform computes them, and its object space
+ * when the map keeps it. */
+static void place_texel(lx_lightmap *map, uint32_t n, const lx_mat4 *world, const lx_mat4 *nm,
+                        lx_vec3 position, lx_vec3 normal, lx_vec3 geometric)
+{
+    map->world_position[n] = lx_mat4_point(world, position);
+    map->world_normal[n] = lx_normalize(lx_mat4_vector(nm, normal));
+    map->world_geometric_normal[n] = lx_normalize(lx_mat4_vector(nm, geometric));
+    if (map->object_position) {
+        map->object_position[n] = position;
+        map->object_normal[n] = normal;
+        map->object_geometric_normal[n] = geometric;
+    }
+}
+
 /* Choose the node's lightmap UV set and its meshes with UVs. */
 static uint32_t collect_slots(const lx_scene *scene, const lx_node *node, slot *slots, int *uv_set,
                               bool warn)
@@ -399,17 +415,23 @@ lx_status lx_texel_map_build(const lx_scene *scene, uint32_t node_index, const l
     }
 
     raster_ctx r = {.width = w, .height = h};
-    r.owner = malloc(sizeof(uint32_t) * pixels);
-    r.b1 = malloc(sizeof(float) * pixels);
-    r.b2 = malloc(sizeof(float) * pixels);
-    r.distance = malloc(sizeof(float) * pixels);
-    r.strict = calloc(pixels, 1);
+    /* The raster's buffers in one block (17 bytes a pixel) that becomes
+     * the baked buffer (12) once the texels are gathered: fresh memory
+     * costs a page fault per page, often more than the work done on it. */
+    unsigned char *block = malloc(17 * (size_t)pixels);
+    r.owner = (uint32_t *)block;
+    r.b1 = (float *)(block + 4 * (size_t)pixels);
+    r.b2 = (float *)(block + 8 * (size_t)pixels);
+    r.distance = (float *)(block + 12 * (size_t)pixels);
+    r.strict = block + 16 * (size_t)pixels;
+    if (block)
+        memset(r.strict, 0, pixels);
     uint32_t total_triangles = 0;
     for (uint32_t s = 0; s < slot_count; s++)
         total_triangles += slots[s].mesh->triangle_count;
     uint8_t *skip = malloc(total_triangles ? total_triangles : 1);
     r.slot_overlap = calloc(slot_count, sizeof(uint32_t));
-    if (!r.owner || !r.b1 || !r.b2 || !r.distance || !r.strict || !skip || !r.slot_overlap) {
+    if (!block || !skip || !r.slot_overlap) {
         st = lx_fail(LX_ERR_NOMEM, "%s: out of memory", what);
         goto done;
     }
@@ -454,13 +476,15 @@ lx_status lx_texel_map_build(const lx_scene *scene, uint32_t node_index, const l
     map->texels = malloc(sizeof(lx_texel) * (used ? used : 1));
     map->tile_start = malloc(sizeof(uint32_t) * (map->tile_count + 1));
     map->mask = calloc(pixels, 1);
-    map->baked = calloc(pixels * 3, sizeof(float));
-    map->realtime = calloc(pixels * 3, sizeof(float));
+    /* map->realtime: made by the first update with dynamic lights (baker.c) */
     map->world_position = malloc(sizeof(lx_vec3) * (used ? used : 1));
     map->world_normal = malloc(sizeof(lx_vec3) * (used ? used : 1));
     map->world_geometric_normal = malloc(sizeof(lx_vec3) * (used ? used : 1));
-    if (!map->texels || !map->tile_start || !map->mask || !map->baked || !map->realtime ||
-        !map->world_position || !map->world_normal || !map->world_geometric_normal) {
+    if (desc->quantity == LX_QUANTITY_RADIANCE)
+        map->albedo = malloc(sizeof(lx_vec3) * (used ? used : 1));
+    if (!map->texels || !map->tile_start || !map->mask || !map->world_position ||
+        !map->world_normal || !map->world_geometric_normal ||
+        (desc->quantity == LX_QUANTITY_RADIANCE && !map->albedo)) {
         st = lx_fail(LX_ERR_NOMEM, "%s: out of memory", what);
         goto done;
     }
@@ -487,6 +511,22 @@ lx_status lx_texel_map_build(const lx_scene *scene, uint32_t node_index, const l
         st = tangents[s] ? lx_compute_tangents(m, mat->normal_uv_set, tangents[s])
                          : lx_fail(LX_ERR_NOMEM, "%s: out of memory", what);
     }
+    /* world space as lx_texel_map_transform computes it; object space kept
+     * only for a node away from the identity (the world arrays are object
+     * space otherwise, up to the rounding of a renormalization) */
+    lx_mat4 nm, id = lx_mat4_identity();
+    if (!lx_mat4_normal_matrix(&node->world, &nm))
+        nm = node->world;
+    bool identity = true;
+    for (int k = 0; k < 16; k++)
+        identity &= node->world.m[k] == id.m[k];
+    if (!identity && st == LX_OK) {
+        map->object_position = malloc(sizeof(lx_vec3) * (used ? used : 1));
+        map->object_normal = malloc(sizeof(lx_vec3) * (used ? used : 1));
+        map->object_geometric_normal = malloc(sizeof(lx_vec3) * (used ? used : 1));
+        if (!map->object_position || !map->object_normal || !map->object_geometric_normal)
+            st = lx_fail(LX_ERR_NOMEM, "%s: out of memory", what);
+    }
     uint32_t n = 0;
     for (int ty = 0; ty < tiles_y && st == LX_OK; ty++)
         for (int tx = 0; tx < tiles_x; tx++) {
@@ -503,24 +543,25 @@ lx_status lx_texel_map_build(const lx_scene *scene, uint32_t node_index, const l
                     uint32_t t = r.owner[p] - slots[s].first_triangle;
                     const uint32_t *i = &m->indices[3 * t];
                     float w1 = r.b1[p], w2 = r.b2[p], w0 = 1.0f - w1 - w2;
-                    lx_texel *tx_ = &map->texels[n++];
+                    lx_texel *tx_ = &map->texels[n];
                     tx_->pixel = (uint32_t)p;
                     tx_->mesh = slots[s].mesh_index;
                     tx_->triangle = t;
                     lx_vec3 pa = m->positions[i[0]], pb = m->positions[i[1]],
                             pc = m->positions[i[2]];
-                    tx_->position =
+                    lx_vec3 position =
                         lx_add(lx_add(lx_scale(pa, w0), lx_scale(pb, w1)), lx_scale(pc, w2));
-                    tx_->geometric_normal = lx_normalize(lx_cross(lx_sub(pb, pa), lx_sub(pc, pa)));
+                    lx_vec3 geometric = lx_normalize(lx_cross(lx_sub(pb, pa), lx_sub(pc, pa)));
                     lx_vec3 nrm = lx_add(
                         lx_add(lx_scale(m->normals[i[0]], w0), lx_scale(m->normals[i[1]], w1)),
                         lx_scale(m->normals[i[2]], w2));
-                    nrm = lx_length(nrm) > 1e-12f ? lx_normalize(nrm) : tx_->geometric_normal;
+                    nrm = lx_length(nrm) > 1e-12f ? lx_normalize(nrm) : geometric;
                     const lx_material *mat = &scene->materials[m->material];
                     if (tangents[s])
                         sample_normal_map(mat, m, tangents[s], i, w0, w1, w2, &nrm);
-                    tx_->normal = nrm;
-                    tx_->albedo = sample_albedo(mat, m, i, w0, w1, w2);
+                    if (map->albedo)
+                        map->albedo[n] = sample_albedo(mat, m, i, w0, w1, w2);
+                    place_texel(map, n++, &node->world, &nm, position, nrm, geometric);
                     map->mask[p] = 1;
                 }
         }
@@ -531,14 +572,14 @@ lx_status lx_texel_map_build(const lx_scene *scene, uint32_t node_index, const l
             free(tangents[s]);
     free(tangents);
     free(own_tangents);
-    if (st == LX_OK)
-        lx_texel_map_transform(map, &node->world);
+    if (st == LX_OK) {
+        /* the raster is done with: its block is the (zeroed) baked buffer */
+        map->baked = (float *)block;
+        memset(map->baked, 0, sizeof(float) * 3 * (size_t)pixels);
+        block = NULL;
+    }
 done:
-    free(r.owner);
-    free(r.b1);
-    free(r.b2);
-    free(r.distance);
-    free(r.strict);
+    free(block);
     free(r.slot_overlap);
     free(skip);
     free(slots);
@@ -562,16 +603,39 @@ void lx_texel_map_size(const lx_scene *scene, uint32_t node_index, const lx_bake
     free(slots);
 }
 
+lx_status lx_texel_map_keep_object_space(lx_lightmap *map)
+{
+    if (map->object_position)
+        return LX_OK;
+    size_t bytes = sizeof(lx_vec3) * (map->info.used_texels ? map->info.used_texels : 1);
+    lx_vec3 *p = malloc(bytes), *n = malloc(bytes), *g = malloc(bytes);
+    if (!p || !n || !g) {
+        free(p);
+        free(n);
+        free(g);
+        return lx_fail(LX_ERR_NOMEM, "lightmap '%s': out of memory for its object space",
+                       map->name);
+    }
+    /* built at the identity: the world arrays are the object space */
+    memcpy(p, map->world_position, bytes);
+    memcpy(n, map->world_normal, bytes);
+    memcpy(g, map->world_geometric_normal, bytes);
+    map->object_position = p;
+    map->object_normal = n;
+    map->object_geometric_normal = g;
+    return LX_OK;
+}
+
 void lx_texel_map_transform(lx_lightmap *map, const lx_mat4 *world)
 {
     lx_mat4 nm;
     if (!lx_mat4_normal_matrix(world, &nm))
         nm = *world;
     for (uint32_t i = 0; i < map->info.used_texels; i++) {
-        const lx_texel *t = &map->texels[i];
-        map->world_position[i] = lx_mat4_point(world, t->position);
-        map->world_normal[i] = lx_normalize(lx_mat4_vector(&nm, t->normal));
-        map->world_geometric_normal[i] = lx_normalize(lx_mat4_vector(&nm, t->geometric_normal));
+        map->world_position[i] = lx_mat4_point(world, map->object_position[i]);
+        map->world_normal[i] = lx_normalize(lx_mat4_vector(&nm, map->object_normal[i]));
+        map->world_geometric_normal[i] =
+            lx_normalize(lx_mat4_vector(&nm, map->object_geometric_normal[i]));
     }
 }
 
@@ -583,6 +647,10 @@ void lx_texel_map_free(lx_lightmap *map)
     free(map->world_position);
     free(map->world_normal);
     free(map->world_geometric_normal);
+    free(map->object_position);
+    free(map->object_normal);
+    free(map->object_geometric_normal);
+    free(map->albedo);
     free(map->mask);
     free(map->baked);
     free(map->realtime);

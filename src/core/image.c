@@ -321,30 +321,53 @@ lx_status lx_image_load(const char *path, const lx_image_load_desc *desc, lx_ima
 
 /* ---- writing ------------------------------------------------------------- */
 
-/* Every value must survive the trip into the file: finite, finite after
- * exposure, and inside the format's range (half floats, RGBE). Runs before
- * the output is opened so a bad image leaves nothing behind. */
-static lx_status check_writable(const char *path, const lx_image *img, lx_image_format format,
-                                float exposure, bool half)
+/* What is wrong with value v of channel c on its way into the file, or
+ * NULL: finite, finite after exposure, and inside the format's range (half
+ * floats, RGBE). */
+static inline const char *value_problem(float v, int c, int channels, lx_image_format format,
+                                        float exposure, bool half)
 {
-    size_t n = (size_t)img->width * (size_t)img->height * (size_t)img->channels;
+    /* exposure scales light, never alpha */
+    bool alpha = (channels == 2 || channels == 4) && c == channels - 1;
+    float e = alpha ? v : v * exposure;
+    if (!isfinite(v))
+        return isnan(v) ? "is NaN" : "is infinite";
+    if (!isfinite(e))
+        return "overflows when multiplied by the exposure";
+    if (format == LX_IMAGE_EXR && half && fabsf(e) > LX_HALF_MAX)
+        return "exceeds the half-float range (65504); write a 32-bit float EXR instead";
+    if (format == LX_IMAGE_HDR && e >= LX_RGBE_LIMIT)
+        return "exceeds the Radiance HDR range (2^127)";
+    return NULL;
+}
+
+/* Every value must survive the trip into the file. Runs before the output
+ * is opened so a bad image leaves nothing behind: rows are checked on
+ * `threads` threads, and only when one fails does a serial scan find the
+ * first bad value to name. */
+static lx_status check_writable(const char *path, const lx_image *img, lx_image_format format,
+                                float exposure, bool half, int threads)
+{
+    int nc = img->channels;
+    size_t row = (size_t)img->width * (size_t)nc;
+    int bad = 0;
+#pragma omp parallel for schedule(static) reduction(| : bad) num_threads(lx_thread_count(threads))
+    for (int y = 0; y < img->height; y++) {
+        const float *v = img->data + (size_t)y * row;
+        for (size_t i = 0; i < row; i++)
+            bad |= value_problem(v[i], (int)(i % (size_t)nc), nc, format, exposure, half) != NULL;
+    }
+    if (!bad)
+        return LX_OK;
+    size_t n = row * (size_t)img->height;
     for (size_t i = 0; i < n; i++) {
-        float v = img->data[i];
-        /* exposure scales light, never alpha */
-        int c = (int)(i % (size_t)img->channels);
-        bool alpha = (img->channels == 2 || img->channels == 4) && c == img->channels - 1;
-        float e = alpha ? v : v * exposure;
-        const char *problem = NULL;
-        if (!isfinite(v))
-            problem = isnan(v) ? "is NaN" : "is infinite";
-        else if (!isfinite(e))
-            problem = "overflows when multiplied by the exposure";
-        else if (format == LX_IMAGE_EXR && half && fabsf(e) > LX_HALF_MAX)
-            problem = "exceeds the half-float range (65504); write a 32-bit float EXR instead";
-        else if (format == LX_IMAGE_HDR && e >= LX_RGBE_LIMIT)
-            problem = "exceeds the Radiance HDR range (2^127)";
+        int c = (int)(i % (size_t)nc);
+        const char *problem = value_problem(img->data[i], c, nc, format, exposure, half);
         if (problem) {
-            size_t px = i / (size_t)img->channels;
+            float v = img->data[i];
+            bool alpha = (nc == 2 || nc == 4) && c == nc - 1;
+            float e = alpha ? v : v * exposure;
+            size_t px = i / (size_t)nc;
             char value[48] = "";
             if (isfinite(v))
                 snprintf(value, sizeof value, ": value %g", (double)e);
@@ -390,7 +413,7 @@ lx_status lx_image_write(const char *path, const lx_image *img, const lx_image_w
     if (!isfinite(exposure) || exposure < 0.0f)
         return lx_fail(LX_ERR_INVALID, "%s: exposure %g must be a finite value >= 0", path,
                        (double)d.exposure);
-    lx_status s = check_writable(path, img, format, exposure, d.half);
+    lx_status s = check_writable(path, img, format, exposure, d.half, d.threads);
     if (s != LX_OK)
         return s;
 
@@ -403,10 +426,10 @@ lx_status lx_image_write(const char *path, const lx_image *img, const lx_image_w
         s = lx_img_write_pfm(f.fp, path, img, exposure);
         break;
     case LX_IMAGE_EXR:
-        s = lx_img_write_exr(f.fp, path, img, exposure, d.half);
+        s = lx_img_write_exr(f.fp, path, img, exposure, d.half, d.threads);
         break;
     default:
-        s = lx_img_write_stb(f.fp, path, img, format, exposure);
+        s = lx_img_write_stb(f.fp, path, img, format, exposure, d.threads);
         break;
     }
     if (s != LX_OK) {

@@ -26,13 +26,21 @@ LX_IMG_HIDDEN lx_status lx_img_load_exr(const unsigned char *data, size_t size, 
 
 /* Writers to an open temporary file. The caller has checked img (1..4
  * channels, finite values, exposed values in the format's range) and
- * commits or aborts the file. exposure is the multiplier (never 0). */
+ * commits or aborts the file. exposure is the multiplier (never 0);
+ * threads bounds the encoding threads (0 = all cores). */
 LX_IMG_HIDDEN lx_status lx_img_write_stb(FILE *fp, const char *path, const lx_image *img,
-                                         lx_image_format format, float exposure);
+                                         lx_image_format format, float exposure, int threads);
 LX_IMG_HIDDEN lx_status lx_img_write_pfm(FILE *fp, const char *path, const lx_image *img,
                                          float exposure);
 LX_IMG_HIDDEN lx_status lx_img_write_exr(FILE *fp, const char *path, const lx_image *img,
-                                         float exposure, bool half);
+                                         float exposure, bool half, int threads);
+
+/* A PNG file of 8-bit pixels (channels 1..4, rows top to bottom) in memory
+ * from malloc, *out_len bytes; NULL when out of memory. Deflates on up to
+ * `threads` threads (0 = all cores); the bytes do not depend on it
+ * (image_png.c). */
+LX_IMG_HIDDEN unsigned char *lx_img_png_encode(const unsigned char *pixels, int width, int height,
+                                               int channels, int threads, int *out_len);
 
 /* The bound below which stb's RGBE encoder keeps its exponent byte in
  * range (2^127). */

@@ -1,6 +1,7 @@
 /* PNG/JPEG/TGA/Radiance HDR through stb_image and stb_image_write (the
- * implementations are compiled into Debian's libstb). 8-bit and 16-bit data
- * use the sRGB transfer function of IEC 61966-2-1:1999; alpha stays linear. */
+ * implementations are compiled into Debian's libstb; the PNG writer's is
+ * image_png.c's, with zlib as its deflate). 8-bit and 16-bit data use the
+ * sRGB transfer function of IEC 61966-2-1:1999; alpha stays linear. */
 #include "image_internal.h"
 
 #include <zlib.h>
@@ -420,28 +421,58 @@ static void write_to_file(void *context, void *data, int size)
     fwrite(data, 1, (size_t)size, (FILE *)context);
 }
 
-/* thresholds[k - 1] is the linear value from which code k is the nearest
- * 8-bit sRGB code, so encoding is an exact search instead of a pow per
- * value. */
-static void srgb_thresholds(double thresholds[255])
+/* 8-bit sRGB encoding by an exact search instead of a pow per value:
+ * code k is the nearest to linear v from threshold[k - 1] on (the linear
+ * value of the sRGB midpoint between codes k - 1 and k), so v's code is
+ * the count of thresholds <= v. Each threshold is kept as the smallest
+ * float at or above its double value (a float compares with it exactly as
+ * with the double), and a table over the float's top 19 bits (sign,
+ * exponent and 10 mantissa bits: buckets 0.1% wide, narrower than the gap
+ * between any two thresholds) gives the count at the bottom of v's
+ * bucket, at most one step short of the answer. */
+#define SRGB8_SHIFT 13
+#define SRGB8_FIRST (0x39000000u >> SRGB8_SHIFT) /* below threshold[0] */
+#define SRGB8_LAST (0x3f800000u >> SRGB8_SHIFT)  /* 1.0f */
+typedef struct srgb8_encoder {
+    float threshold[256]; /* [255]: above every float, a sentinel */
+    uint8_t start[SRGB8_LAST - SRGB8_FIRST + 1];
+} srgb8_encoder;
+
+static void srgb8_init(srgb8_encoder *enc)
 {
     for (int k = 1; k <= 255; k++) {
         double c = ((double)k - 0.5) / 255.0;
-        thresholds[k - 1] = c <= 0.04045 ? c / 12.92 : pow((c + 0.055) / 1.055, 2.4);
+        double t = c <= 0.04045 ? c / 12.92 : pow((c + 0.055) / 1.055, 2.4);
+        float f = (float)t;
+        if ((double)f < t)
+            f = nextafterf(f, INFINITY);
+        enc->threshold[k - 1] = f;
+    }
+    enc->threshold[255] = INFINITY;
+    int k = 0;
+    for (uint32_t b = SRGB8_FIRST; b <= SRGB8_LAST; b++) {
+        uint32_t lo = b << SRGB8_SHIFT;
+        float v;
+        memcpy(&v, &lo, sizeof v);
+        while (k < 255 && v >= enc->threshold[k])
+            k++;
+        enc->start[b - SRGB8_FIRST] = (uint8_t)k;
     }
 }
 
-static unsigned char encode_srgb8(const double thresholds[255], float v)
+static unsigned char encode_srgb8(const srgb8_encoder *enc, float v)
 {
-    int lo = 0, hi = 255; /* answer in [lo, hi]: count of thresholds <= v */
-    while (lo < hi) {
-        int mid = (lo + hi + 1) / 2;
-        if ((double)v >= thresholds[mid - 1])
-            lo = mid;
-        else
-            hi = mid - 1;
-    }
-    return (unsigned char)lo;
+    if (!(v >= enc->threshold[0]))
+        return 0; /* NaN, negative, or below code 1 */
+    if (v >= 1.0f)
+        return 255;
+    uint32_t bits;
+    memcpy(&bits, &v, sizeof bits);
+    int k = enc->start[(bits >> SRGB8_SHIFT) - SRGB8_FIRST];
+    k += v >= enc->threshold[k];   /* one threshold at most in a bucket */
+    while (v >= enc->threshold[k]) /* (never taken; kept exact regardless) */
+        k++;
+    return (unsigned char)k;
 }
 
 static unsigned char encode_unorm8(float v)
@@ -451,7 +482,7 @@ static unsigned char encode_unorm8(float v)
 }
 
 static lx_status write_8bit(FILE *fp, const char *path, const lx_image *img, lx_image_format format,
-                            float exposure)
+                            float exposure, int threads)
 {
     int c = img->channels;
     /* stb_image_write sizes its buffers with int arithmetic */
@@ -462,24 +493,39 @@ static lx_status write_8bit(FILE *fp, const char *path, const lx_image *img, lx_
     unsigned char *bytes = malloc(n);
     if (!bytes)
         return lx_fail(LX_ERR_NOMEM, "%s: cannot allocate %zu bytes", path, n);
-    double thresholds[255];
-    srgb_thresholds(thresholds);
-    for (size_t i = 0; i < n; i++) {
-        float v = img->data[i];
-        bytes[i] = is_alpha((int)(i % (size_t)c), c) ? encode_unorm8(v)
-                                                     : encode_srgb8(thresholds, v * exposure);
+    srgb8_encoder enc;
+    srgb8_init(&enc);
+    int colour = c == 2 || c == 4 ? c - 1 : c; /* channels before alpha */
+    /* rows in parallel: each value's code depends on that value alone */
+#pragma omp parallel for schedule(static) num_threads(lx_thread_count(threads))
+    for (int y = 0; y < img->height; y++) {
+        size_t first = (size_t)y * (size_t)img->width;
+        for (size_t p = first; p < first + (size_t)img->width; p++) {
+            const float *v = img->data + p * (size_t)c;
+            unsigned char *b = bytes + p * (size_t)c;
+            for (int k = 0; k < colour; k++)
+                b[k] = encode_srgb8(&enc, v[k] * exposure);
+            if (colour < c)
+                b[colour] = encode_unorm8(v[colour]);
+        }
+    }
+    if (format == LX_IMAGE_PNG) {
+        int len = 0;
+        unsigned char *png = lx_img_png_encode(bytes, img->width, img->height, c, threads, &len);
+        free(bytes);
+        if (!png)
+            return lx_fail(LX_ERR_NOMEM, "%s: out of memory encoding png", path);
+        fwrite(png, 1, (size_t)len, fp);
+        free(png);
+        return LX_OK;
     }
     int ok;
     switch (format) {
     case LX_IMAGE_JPG:
         ok = stbi_write_jpg_to_func(write_to_file, fp, img->width, img->height, c, bytes, 95);
         break;
-    case LX_IMAGE_TGA:
-        ok = stbi_write_tga_to_func(write_to_file, fp, img->width, img->height, c, bytes);
-        break;
     default:
-        ok = stbi_write_png_to_func(write_to_file, fp, img->width, img->height, c, bytes,
-                                    img->width * c);
+        ok = stbi_write_tga_to_func(write_to_file, fp, img->width, img->height, c, bytes);
         break;
     }
     free(bytes);
@@ -520,9 +566,9 @@ static lx_status write_hdr(FILE *fp, const char *path, const lx_image *img, floa
 }
 
 lx_status lx_img_write_stb(FILE *fp, const char *path, const lx_image *img, lx_image_format format,
-                           float exposure)
+                           float exposure, int threads)
 {
     if (format == LX_IMAGE_HDR)
         return write_hdr(fp, path, img, exposure);
-    return write_8bit(fp, path, img, format, exposure);
+    return write_8bit(fp, path, img, format, exposure, threads);
 }

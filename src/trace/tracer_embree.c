@@ -8,6 +8,10 @@
 #include "core/internal.h"
 
 #include <embree3/rtcore.h>
+#if defined(__SSE2__)
+#include <emmintrin.h>
+#endif
+#include <stddef.h>
 #include <stdio.h>
 #include <stdlib.h>
 #include <string.h>
@@ -255,6 +259,55 @@ void lx_tracer_occluded_batch(const lx_tracer *tr, const lx_ray *rays, uint32_t 
         for (uint32_t i = 0; i < n; i++)
             occluded[base + i] = buf[i].tfar < 0.0f;
     }
+}
+
+/* lx_ray_packet is Embree's RTCRay16, field for field, so a packet goes to
+ * rtcOccluded16 as it is. */
+_Static_assert(sizeof(lx_ray_packet) == sizeof(struct RTCRay16), "packet layout");
+_Static_assert(offsetof(lx_ray_packet, tmin) == offsetof(struct RTCRay16, tnear), "tnear");
+_Static_assert(offsetof(lx_ray_packet, dir_x) == offsetof(struct RTCRay16, dir_x), "dir_x");
+_Static_assert(offsetof(lx_ray_packet, internal_time) == offsetof(struct RTCRay16, time), "time");
+_Static_assert(offsetof(lx_ray_packet, tmax) == offsetof(struct RTCRay16, tfar), "tfar");
+_Static_assert(offsetof(lx_ray_packet, internal) == offsetof(struct RTCRay16, mask), "mask");
+_Static_assert(offsetof(struct RTCRay16, id) == offsetof(struct RTCRay16, mask) + 64, "id");
+_Static_assert(offsetof(struct RTCRay16, flags) == offsetof(struct RTCRay16, mask) + 128, "flags");
+
+uint32_t lx_tracer_occluded_packet(const lx_tracer *tr, lx_ray_packet *packet, uint32_t active)
+{
+    active &= (1u << LX_RAY_PACKET) - 1u;
+    if (!active)
+        return 0;
+    /* the lanes' valid words, four at a time from the mask's nibbles */
+    static const int32_t nibble[16][4] = {
+        {0, 0, 0, 0},   {-1, 0, 0, 0},   {0, -1, 0, 0},   {-1, -1, 0, 0},
+        {0, 0, -1, 0},  {-1, 0, -1, 0},  {0, -1, -1, 0},  {-1, -1, -1, 0},
+        {0, 0, 0, -1},  {-1, 0, 0, -1},  {0, -1, 0, -1},  {-1, -1, 0, -1},
+        {0, 0, -1, -1}, {-1, 0, -1, -1}, {0, -1, -1, -1}, {-1, -1, -1, -1}};
+    _Alignas(64) int32_t valid[LX_RAY_PACKET]; /* Embree loads it as one vector */
+    for (int i = 0; i < LX_RAY_PACKET; i += 4)
+        memcpy(valid + i, nibble[(active >> i) & 15u], sizeof nibble[0]);
+    /* written through the packet's own type, read back after the call */
+    memset(packet->internal_time, 0, sizeof packet->internal_time);
+    memset(packet->internal[0], 0xFF, sizeof packet->internal[0]); /* mask: every geometry */
+    memset(packet->internal[1], 0, sizeof packet->internal[1]);    /* id */
+    memset(packet->internal[2], 0, sizeof packet->internal[2]);    /* flags */
+    struct RTCIntersectContext ctx;
+    rtcInitIntersectContext(&ctx);
+    ctx.flags = RTC_INTERSECT_CONTEXT_FLAG_COHERENT;
+    rtcOccluded16((const int *)valid, tr->scene, &ctx, (struct RTCRay16 *)(void *)packet);
+    uint32_t blocked = 0;
+#if defined(__SSE2__)
+    /* whole-vector loads of what Embree just stored as vectors: scalar
+     * loads of its lanes would stall on store forwarding */
+    for (int i = 0; i < LX_RAY_PACKET; i += 4) {
+        __m128 t = _mm_load_ps(packet->tmax + i);
+        blocked |= (uint32_t)_mm_movemask_ps(_mm_cmplt_ps(t, _mm_setzero_ps())) << i;
+    }
+#else
+    for (int i = 0; i < LX_RAY_PACKET; i++)
+        blocked |= (uint32_t)(packet->tmax[i] < 0.0f) << i;
+#endif
+    return blocked & active;
 }
 
 bool lx_tracer_closest(const lx_tracer *tr, const lx_ray *ray, lx_hit *hit)

@@ -5,6 +5,7 @@
 #include "core/internal.h"
 #include "helpers.h"
 
+#include <cjson/cJSON.h>
 #include <embree3/rtcore.h>
 #include <math.h>
 #include <stdio.h>
@@ -169,6 +170,218 @@ lx_scene *lx_test_spheres_scene(const char *name, float size, int ground_n, int 
     return scene;
 }
 
+void lx_test_grid_lights(int n, float size, float height, lx_light *out)
+{
+    static const lx_vec3 colors[4] = {{1, 0.9f, 0.8f}, {0.8f, 0.9f, 1}, {1, 1, 1}, {1, 0.8f, 0.6f}};
+    lx_test_rand_seed(777u);
+    for (int j = 0; j < n; j++)
+        for (int i = 0; i < n; i++) {
+            int k = j * n + i;
+            lx_light l = lx_light_defaults(LX_LIGHT_POINT);
+            snprintf(l.name, sizeof l.name, "grid%d", k);
+            float cell = size / (float)n;
+            float x = -size / 2 + cell * ((float)i + 0.25f + 0.5f * lx_test_rand());
+            float z = -size / 2 + cell * ((float)j + 0.25f + 0.5f * lx_test_rand());
+            float y = height * (0.9f + 0.2f * lx_test_rand());
+            l.position = lx_v3(x, y, z);
+            l.color = colors[k & 3];
+            l.intensity = 40.0f * y * y; /* ~40 lux straight below */
+            l.shadow = LX_SHADOW_HARD;
+            out[k] = l;
+        }
+}
+
+/* ---- glTF writing ---------------------------------------------------------- */
+
+typedef struct glb_bin {
+    unsigned char *data;
+    size_t len, cap;
+} glb_bin;
+
+static size_t bin_append(glb_bin *b, const void *src, size_t n)
+{
+    while (b->len % 4)
+        b->len++; /* every view starts 4-aligned (zeros: the buffer is calloc'd) */
+    size_t need = b->len + n;
+    if (need > b->cap) {
+        size_t cap = b->cap ? b->cap : 1 << 20;
+        while (cap < need + 4)
+            cap *= 2;
+        unsigned char *d = realloc(b->data, cap);
+        if (!d)
+            lx_bench_die("realloc");
+        memset(d + b->cap, 0, cap - b->cap);
+        b->data = d;
+        b->cap = cap;
+    }
+    size_t at = b->len;
+    memcpy(b->data + at, src, n);
+    b->len = need;
+    return at;
+}
+
+/* One bufferView and accessor over n bytes of src; returns the accessor. */
+static int glb_accessor(cJSON *views, cJSON *accessors, glb_bin *b, const void *src, size_t bytes,
+                        uint32_t count, int component, const char *type, int target)
+{
+    size_t at = bin_append(b, src, bytes);
+    cJSON *v = cJSON_CreateObject();
+    cJSON_AddNumberToObject(v, "buffer", 0);
+    cJSON_AddNumberToObject(v, "byteOffset", (double)at);
+    cJSON_AddNumberToObject(v, "byteLength", (double)bytes);
+    cJSON_AddNumberToObject(v, "target", target);
+    cJSON_AddItemToArray(views, v);
+    cJSON *a = cJSON_CreateObject();
+    cJSON_AddNumberToObject(a, "bufferView", cJSON_GetArraySize(views) - 1);
+    cJSON_AddNumberToObject(a, "componentType", component);
+    cJSON_AddNumberToObject(a, "count", count);
+    cJSON_AddStringToObject(a, "type", type);
+    cJSON_AddItemToArray(accessors, a);
+    return cJSON_GetArraySize(accessors) - 1;
+}
+
+static void put_le32(unsigned char *p, uint32_t v)
+{
+    p[0] = (unsigned char)v, p[1] = (unsigned char)(v >> 8), p[2] = (unsigned char)(v >> 16),
+    p[3] = (unsigned char)(v >> 24);
+}
+
+void lx_test_write_glb(const lx_scene *scene, const char *path)
+{
+    enum { FLOAT = 5126, UINT = 5125, ARRAY = 34962, ELEMENTS = 34963 };
+    cJSON *root = cJSON_CreateObject();
+    cJSON *asset = cJSON_AddObjectToObject(root, "asset");
+    cJSON_AddStringToObject(asset, "version", "2.0");
+    cJSON_AddStringToObject(asset, "generator", "luxel tests/common/scenes.c");
+    cJSON_AddNumberToObject(root, "scene", 0);
+    cJSON *scenes = cJSON_AddArrayToObject(root, "scenes");
+    cJSON *sc = cJSON_CreateObject();
+    cJSON *roots = cJSON_AddArrayToObject(sc, "nodes");
+    cJSON_AddItemToArray(scenes, sc);
+    cJSON *nodes = cJSON_AddArrayToObject(root, "nodes");
+    cJSON *meshes = cJSON_AddArrayToObject(root, "meshes");
+    cJSON *accessors = cJSON_AddArrayToObject(root, "accessors");
+    cJSON *views = cJSON_AddArrayToObject(root, "bufferViews");
+    glb_bin bin = {0};
+    for (uint32_t n = 0; n < scene->node_count; n++) {
+        const lx_node *node = &scene->nodes[n];
+        cJSON *mesh = cJSON_CreateObject();
+        cJSON_AddStringToObject(mesh, "name", node->name);
+        cJSON *prims = cJSON_AddArrayToObject(mesh, "primitives");
+        for (uint32_t k = 0; k < node->mesh_count; k++) {
+            const lx_mesh *m = &scene->meshes[node->meshes[k]];
+            cJSON *prim = cJSON_CreateObject();
+            cJSON *attr = cJSON_AddObjectToObject(prim, "attributes");
+            int pos = glb_accessor(views, accessors, &bin, m->positions,
+                                   sizeof(lx_vec3) * m->vertex_count, m->vertex_count, FLOAT,
+                                   "VEC3", ARRAY);
+            lx_vec3 lo = m->positions[0], hi = lo; /* POSITION needs its bounds */
+            for (uint32_t v = 1; v < m->vertex_count; v++) {
+                lo = lx_v3(fminf(lo.x, m->positions[v].x), fminf(lo.y, m->positions[v].y),
+                           fminf(lo.z, m->positions[v].z));
+                hi = lx_v3(fmaxf(hi.x, m->positions[v].x), fmaxf(hi.y, m->positions[v].y),
+                           fmaxf(hi.z, m->positions[v].z));
+            }
+            cJSON *acc = cJSON_GetArrayItem(accessors, pos);
+            cJSON_AddItemToObject(acc, "min",
+                                  cJSON_CreateFloatArray((float[]){lo.x, lo.y, lo.z}, 3));
+            cJSON_AddItemToObject(acc, "max",
+                                  cJSON_CreateFloatArray((float[]){hi.x, hi.y, hi.z}, 3));
+            cJSON_AddNumberToObject(attr, "POSITION", pos);
+            if (m->normals)
+                cJSON_AddNumberToObject(attr, "NORMAL",
+                                        glb_accessor(views, accessors, &bin, m->normals,
+                                                     sizeof(lx_vec3) * m->vertex_count,
+                                                     m->vertex_count, FLOAT, "VEC3", ARRAY));
+            for (int u = 0; u < LX_MAX_UV_SETS; u++)
+                if (m->uv[u])
+                    cJSON_AddNumberToObject(attr, u ? "TEXCOORD_1" : "TEXCOORD_0",
+                                            glb_accessor(views, accessors, &bin, m->uv[u],
+                                                         sizeof(lx_vec2) * m->vertex_count,
+                                                         m->vertex_count, FLOAT, "VEC2", ARRAY));
+            cJSON_AddNumberToObject(prim, "indices",
+                                    glb_accessor(views, accessors, &bin, m->indices,
+                                                 sizeof(uint32_t) * 3 * m->triangle_count,
+                                                 3 * m->triangle_count, UINT, "SCALAR", ELEMENTS));
+            cJSON_AddItemToArray(prims, prim);
+        }
+        cJSON_AddItemToArray(meshes, mesh);
+        cJSON *nd = cJSON_CreateObject();
+        cJSON_AddStringToObject(nd, "name", node->name);
+        cJSON_AddNumberToObject(nd, "mesh", n);
+        cJSON_AddItemToArray(nodes, nd);
+        cJSON_AddItemToArray(roots, cJSON_CreateNumber(n));
+    }
+    while (bin.len % 4)
+        bin.len++;
+    cJSON *buffers = cJSON_AddArrayToObject(root, "buffers");
+    cJSON *buf = cJSON_CreateObject();
+    cJSON_AddNumberToObject(buf, "byteLength", (double)bin.len);
+    cJSON_AddItemToArray(buffers, buf);
+    char *json = cJSON_PrintUnformatted(root);
+    cJSON_Delete(root);
+    if (!json)
+        lx_bench_die("cJSON_PrintUnformatted");
+    size_t jlen = strlen(json), jpad = (jlen + 3) & ~(size_t)3;
+    unsigned char head[20];
+    memcpy(head, "glTF", 4);
+    put_le32(head + 4, 2);
+    put_le32(head + 8, (uint32_t)(12 + 8 + jpad + 8 + bin.len));
+    put_le32(head + 12, (uint32_t)jpad);
+    memcpy(head + 16, "JSON", 4);
+    unsigned char bin_head[8];
+    put_le32(bin_head, (uint32_t)bin.len);
+    memcpy(bin_head + 4, "BIN\0", 4);
+    FILE *f = fopen(path, "wb");
+    bool ok = f && fwrite(head, 1, 20, f) == 20 && fwrite(json, 1, jlen, f) == jlen &&
+              fwrite("   ", 1, jpad - jlen, f) == jpad - jlen && fwrite(bin_head, 1, 8, f) == 8 &&
+              fwrite(bin.data, 1, bin.len, f) == bin.len;
+    ok = f && fclose(f) == 0 && ok;
+    free(json);
+    free(bin.data);
+    if (!ok) {
+        fprintf(stderr, "%s: cannot write %s\n", program, path);
+        exit(1);
+    }
+}
+
+void lx_test_write_lights_json(const lx_light *lights, uint32_t count, const char *path)
+{
+    cJSON *root = cJSON_CreateObject();
+    cJSON *list = cJSON_AddArrayToObject(root, "lights");
+    for (uint32_t i = 0; i < count; i++) {
+        const lx_light *l = &lights[i];
+        cJSON *o = cJSON_CreateObject();
+        cJSON_AddStringToObject(o, "name", l->name);
+        cJSON_AddStringToObject(o, "type", "point");
+        cJSON_AddItemToObject(
+            o, "position",
+            cJSON_CreateFloatArray((float[]){l->position.x, l->position.y, l->position.z}, 3));
+        cJSON_AddItemToObject(
+            o, "color", cJSON_CreateFloatArray((float[]){l->color.x, l->color.y, l->color.z}, 3));
+        cJSON_AddNumberToObject(o, "intensity", l->intensity);
+        cJSON_AddStringToObject(o, "unit", "cd");
+        if (l->range > 0.0f)
+            cJSON_AddNumberToObject(o, "range", l->range);
+        cJSON_AddStringToObject(o, "shadow",
+                                l->shadow == LX_SHADOW_NONE   ? "none"
+                                : l->shadow == LX_SHADOW_BLUR ? "blur"
+                                                              : "hard");
+        cJSON_AddBoolToObject(o, "dynamic", l->dynamic);
+        cJSON_AddItemToArray(list, o);
+    }
+    char *text = cJSON_Print(root);
+    cJSON_Delete(root);
+    FILE *f = text ? fopen(path, "w") : NULL;
+    bool ok = f && fputs(text, f) >= 0;
+    ok = f && fclose(f) == 0 && ok;
+    free(text);
+    if (!ok) {
+        fprintf(stderr, "%s: cannot write %s\n", program, path);
+        exit(1);
+    }
+}
+
 /* ---- the bake's shadow rays ---------------------------------------------- */
 
 lx_ray lx_bench_shadow_ray(float base_bias, lx_vec3 p, lx_vec3 ng, const lx_light_eval *e)
@@ -281,6 +494,199 @@ double lx_bench_trace(const lx_tracer *tr, const lx_bench_rays *rs, lx_bench_tra
         }
     return lx_bench_now() - t0;
 }
+
+/* ---- raw Embree on a flat BVH --------------------------------------------- */
+
+/* One Embree scene holding every triangle in world space (what a user of
+ * raw Embree would build for a static bake), same flags as the tracer. */
+RTCScene lx_bench_flat_scene(RTCDevice dev, const lx_scene *scene)
+{
+    RTCScene s = rtcNewScene(dev);
+    rtcSetSceneFlags(s, RTC_SCENE_FLAG_ROBUST);
+    rtcSetSceneBuildQuality(s, RTC_BUILD_QUALITY_HIGH);
+    uint32_t nv = 0, nt = 0;
+    for (uint32_t n = 0; n < scene->node_count; n++)
+        for (uint32_t k = 0; k < scene->nodes[n].mesh_count; k++) {
+            const lx_mesh *m = &scene->meshes[scene->nodes[n].meshes[k]];
+            nv += m->vertex_count;
+            nt += m->triangle_count;
+        }
+    RTCGeometry g = rtcNewGeometry(dev, RTC_GEOMETRY_TYPE_TRIANGLE);
+    float *v = rtcSetNewGeometryBuffer(g, RTC_BUFFER_TYPE_VERTEX, 0, RTC_FORMAT_FLOAT3,
+                                       3 * sizeof(float), nv);
+    unsigned *ix = rtcSetNewGeometryBuffer(g, RTC_BUFFER_TYPE_INDEX, 0, RTC_FORMAT_UINT3,
+                                           3 * sizeof(unsigned), nt);
+    uint32_t vb = 0, tb = 0;
+    for (uint32_t n = 0; n < scene->node_count; n++)
+        for (uint32_t k = 0; k < scene->nodes[n].mesh_count; k++) {
+            const lx_mesh *m = &scene->meshes[scene->nodes[n].meshes[k]];
+            for (uint32_t i = 0; i < m->vertex_count; i++) {
+                lx_vec3 p = lx_mat4_point(&scene->nodes[n].world, m->positions[i]);
+                v[3 * (vb + i)] = p.x, v[3 * (vb + i) + 1] = p.y, v[3 * (vb + i) + 2] = p.z;
+            }
+            for (uint32_t i = 0; i < 3 * m->triangle_count; i++)
+                ix[3 * tb + i] = vb + m->indices[i];
+            vb += m->vertex_count;
+            tb += m->triangle_count;
+        }
+    rtcCommitGeometry(g);
+    rtcAttachGeometry(s, g);
+    rtcReleaseGeometry(g);
+    rtcCommitScene(s);
+    return s;
+}
+
+static void to_rtc(const lx_ray *r, struct RTCRay *o)
+{
+    o->org_x = r->origin.x, o->org_y = r->origin.y, o->org_z = r->origin.z;
+    o->dir_x = r->dir.x, o->dir_y = r->dir.y, o->dir_z = r->dir.z;
+    o->tnear = r->tmin, o->tfar = r->tmax, o->time = 0.0f;
+    o->mask = 0xFFFFFFFFu, o->id = 0, o->flags = 0;
+}
+
+/* Every ray once straight through Embree (rtcOccluded1 or coherent
+ * rtcOccluded1M), same tiles and schedule; returns seconds. */
+static double flat_run(bool stream, RTCScene flat, const lx_bench_rays *rs, int threads,
+                       uint8_t *occluded)
+{
+    const int L = rs->lights;
+    double t0 = lx_bench_now();
+#pragma omp parallel for schedule(dynamic, 4) num_threads(threads)
+    for (int tile = 0; tile < rs->tiles; tile++) {
+        struct RTCIntersectContext ctx;
+        rtcInitIntersectContext(&ctx);
+        if (stream)
+            ctx.flags = RTC_INTERSECT_CONTEXT_FLAG_COHERENT;
+        struct RTCRay buf[LX_BENCH_TILE * LX_BENCH_TILE];
+        for (int l = 0; l < L; l++) {
+            uint32_t s = rs->batch[(size_t)tile * L + l], e = rs->batch[(size_t)tile * L + l + 1];
+            uint32_t n = e - s;
+            const lx_ray *r = rs->rays + s;
+            uint8_t *o = occluded + s;
+            if (!stream) {
+                for (uint32_t j = 0; j < n; j++) {
+                    to_rtc(&r[j], &buf[0]);
+                    rtcOccluded1(flat, &ctx, &buf[0]);
+                    o[j] = buf[0].tfar < 0.0f;
+                }
+            } else if (n) {
+                for (uint32_t j = 0; j < n; j++)
+                    to_rtc(&r[j], &buf[j]);
+                rtcOccluded1M(flat, &ctx, buf, n, sizeof(struct RTCRay));
+                for (uint32_t j = 0; j < n; j++)
+                    o[j] = buf[j].tfar < 0.0f;
+            }
+        }
+    }
+    return lx_bench_now() - t0;
+}
+
+/* Every ray once through Embree's packet calls rtcOccluded4/8/16 (width
+ * w), the rays of one tile toward one light in packets of w with a valid
+ * mask on the last; same tiles, schedule and threads as flat_run. */
+#define PACKET_RUN(W)                                                                              \
+    static double packet_run##W(RTCScene flat, const lx_bench_rays *rs, int threads,               \
+                                uint8_t *occluded)                                                 \
+    {                                                                                              \
+        const int L = rs->lights;                                                                  \
+        double t0 = lx_bench_now();                                                                \
+        _Pragma("omp parallel for schedule(dynamic, 4) num_threads(threads)") for (int tile = 0;   \
+                                                                                   tile <          \
+                                                                                   rs->tiles;      \
+                                                                                   tile++)         \
+        {                                                                                          \
+            struct RTCIntersectContext ctx;                                                        \
+            rtcInitIntersectContext(&ctx);                                                         \
+            ctx.flags = RTC_INTERSECT_CONTEXT_FLAG_COHERENT;                                       \
+            struct RTCRay##W pk;                                                                   \
+            int valid[W];                                                                          \
+            for (int l = 0; l < L; l++) {                                                          \
+                uint32_t s = rs->batch[(size_t)tile * L + l];                                      \
+                uint32_t e = rs->batch[(size_t)tile * L + l + 1];                                  \
+                for (uint32_t b = s; b < e; b += W) {                                              \
+                    for (int j = 0; j < W; j++) {                                                  \
+                        const lx_ray *r = &rs->rays[b + j < e ? b + j : s];                        \
+                        valid[j] = b + j < e ? -1 : 0;                                             \
+                        pk.org_x[j] = r->origin.x, pk.org_y[j] = r->origin.y;                      \
+                        pk.org_z[j] = r->origin.z, pk.tnear[j] = r->tmin;                          \
+                        pk.dir_x[j] = r->dir.x, pk.dir_y[j] = r->dir.y, pk.dir_z[j] = r->dir.z;    \
+                        pk.time[j] = 0.0f, pk.tfar[j] = r->tmax, pk.mask[j] = 0xFFFFFFFFu;         \
+                        pk.id[j] = 0, pk.flags[j] = 0;                                             \
+                    }                                                                              \
+                    rtcOccluded##W(valid, flat, &ctx, &pk);                                        \
+                    for (int j = 0; j < W && b + j < e; j++)                                       \
+                        occluded[b + j] = pk.tfar[j] < 0.0f;                                       \
+                }                                                                                  \
+            }                                                                                      \
+        }                                                                                          \
+        return lx_bench_now() - t0;                                                                \
+    }
+PACKET_RUN(4)
+PACKET_RUN(8)
+PACKET_RUN(16)
+
+/* rtcOccluded16 on 4x4 blocks of full 8x8 tiles (the others as rows) */
+static double packet_run16q(RTCScene flat, const lx_bench_rays *rs, int threads, uint8_t *occluded)
+{
+    const int L = rs->lights;
+    double t0 = lx_bench_now();
+#pragma omp parallel for schedule(dynamic, 4) num_threads(threads)
+    for (int tile = 0; tile < rs->tiles; tile++) {
+        struct RTCIntersectContext ctx;
+        rtcInitIntersectContext(&ctx);
+        ctx.flags = RTC_INTERSECT_CONTEXT_FLAG_COHERENT;
+        struct RTCRay16 pk;
+        int valid[16];
+        for (int l = 0; l < L; l++) {
+            uint32_t s = rs->batch[(size_t)tile * L + l];
+            uint32_t e = rs->batch[(size_t)tile * L + l + 1];
+            bool full = e - s == 64;
+            for (uint32_t b = 0; b < e - s; b += 16) {
+                uint32_t idx[16];
+                for (int j = 0; j < 16; j++) {
+                    uint32_t q = b / 16;
+                    idx[j] = full ? ((q / 2) * 4 + j / 4) * 8 + (q % 2) * 4 + j % 4 : b + j;
+                    valid[j] = idx[j] < e - s ? -1 : 0;
+                    const lx_ray *r = &rs->rays[s + (idx[j] < e - s ? idx[j] : 0)];
+                    pk.org_x[j] = r->origin.x, pk.org_y[j] = r->origin.y;
+                    pk.org_z[j] = r->origin.z, pk.tnear[j] = r->tmin;
+                    pk.dir_x[j] = r->dir.x, pk.dir_y[j] = r->dir.y, pk.dir_z[j] = r->dir.z;
+                    pk.time[j] = 0.0f, pk.tfar[j] = r->tmax, pk.mask[j] = 0xFFFFFFFFu;
+                    pk.id[j] = 0, pk.flags[j] = 0;
+                }
+                rtcOccluded16(valid, flat, &ctx, &pk);
+                for (int j = 0; j < 16; j++)
+                    if (valid[j])
+                        occluded[s + idx[j]] = pk.tfar[j] < 0.0f;
+            }
+        }
+    }
+    return lx_bench_now() - t0;
+}
+
+double lx_bench_flat_trace(lx_bench_flat_mode mode, RTCScene flat, const lx_bench_rays *rs,
+                           int threads, uint8_t *occluded)
+{
+    switch (mode) {
+    case LX_FLAT_1:
+        return flat_run(false, flat, rs, threads, occluded);
+    case LX_FLAT_1M:
+        return flat_run(true, flat, rs, threads, occluded);
+    case LX_FLAT_PACKET4:
+        return packet_run4(flat, rs, threads, occluded);
+    case LX_FLAT_PACKET8:
+        return packet_run8(flat, rs, threads, occluded);
+    case LX_FLAT_PACKET16:
+        return packet_run16(flat, rs, threads, occluded);
+    default:
+        return packet_run16q(flat, rs, threads, occluded);
+    }
+}
+
+const char *const lx_bench_flat_names[LX_FLAT_MODES] = {
+    "Embree flat BVH, rtcOccluded1",  "Embree flat BVH, rtcOccluded1M coh.",
+    "Embree flat BVH, rtcOccluded4",  "Embree flat BVH, rtcOccluded8",
+    "Embree flat BVH, rtcOccluded16", "Embree flat BVH, rtcOccluded16 4x4"};
 
 /* ---- report -------------------------------------------------------------- */
 

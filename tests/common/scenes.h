@@ -10,6 +10,10 @@
  *   src/bake/direct.c's origin/tmax rule) and grouped in the bake's 8x8
  *   tiles, light by light, so raw tracer throughput can be measured on
  *   exactly the same work; lx_bench_trace runs them through an lx_tracer.
+ * - lx_bench_flat_*: the same rays straight through Embree on one flat BVH
+ *   (rtcOccluded1, rtcOccluded1M, 4-, 8- and 16-wide packets).
+ * - lx_test_write_glb / lx_test_write_lights_json: a scene as a .glb and
+ *   its lights as a lights JSON, for running the CLI on it.
  * - the machine report: CPU model, load average, clock, SI-prefixed rates.
  *
  * Errors end the process with a message (these are benchmark tools). */
@@ -17,6 +21,8 @@
 #define LX_TEST_SCENES_H
 
 #include "luxel/luxel.h"
+
+#include <embree3/rtcore.h>
 
 #define LX_BENCH_TILE 8   /* LX_TILE in src/bake/bake_internal.h */
 #define LX_BENCH_LIGHTS 4 /* lights in every lx_test_spheres_scene */
@@ -46,6 +52,22 @@ typedef struct lx_test_scene_info {
  * size above it (dynamic or not). */
 lx_scene *lx_test_spheres_scene(const char *name, float size, int ground_n, int grid, int slices,
                                 int stacks, bool dynamic, lx_test_scene_info *info);
+
+/* n x n point lights (hard shadows, no range: every texel facing up sees
+ * every one) on a jittered grid `height` above a ground of side size, each
+ * giving ~40 lux straight below it. out holds n * n lights. */
+void lx_test_grid_lights(int n, float size, float height, lx_light *out);
+
+/* Writes scene's nodes and meshes (positions, normals, TEXCOORD_0/1 when
+ * present, 32-bit indices, identity transforms) as a binary glTF 2.0 file;
+ * lights are left out (give them in a lights JSON). Ends the process on
+ * failure. */
+void lx_test_write_glb(const lx_scene *scene, const char *path);
+
+/* Writes point lights as a lights JSON (docs/lights-json.md): name,
+ * position, colour, intensity in cd, shadow mode; floats printed so they
+ * read back exactly. Ends the process on failure. */
+void lx_test_write_lights_json(const lx_light *lights, uint32_t count, const char *path);
 
 /* ---- the bake's shadow rays ---------------------------------------------- */
 
@@ -81,6 +103,29 @@ typedef enum lx_bench_trace_mode {
  * occluded[ray] and returns the seconds taken. */
 double lx_bench_trace(const lx_tracer *tracer, const lx_bench_rays *rs, lx_bench_trace_mode mode,
                       int threads, uint8_t *occluded);
+
+/* ---- raw Embree on a flat BVH (what a user of raw Embree would build) ---- */
+
+/* One Embree scene holding every triangle in world space, the tracer's
+ * flags (robust, high build quality). */
+RTCScene lx_bench_flat_scene(RTCDevice dev, const lx_scene *scene);
+
+typedef enum lx_bench_flat_mode {
+    LX_FLAT_1,       /* rtcOccluded1, one ray per call */
+    LX_FLAT_1M,      /* rtcOccluded1M, coherent, a tile's rays toward a light */
+    LX_FLAT_PACKET4, /* rtcOccluded4/8/16 on those rays in order, valid masks */
+    LX_FLAT_PACKET8,
+    LX_FLAT_PACKET16,
+    LX_FLAT_PACKET16_BLOCKS, /* rtcOccluded16 on 4x4 blocks of full tiles */
+    LX_FLAT_MODES
+} lx_bench_flat_mode;
+
+extern const char *const lx_bench_flat_names[LX_FLAT_MODES];
+
+/* Traces every ray once over the bake's tiles and OpenMP schedule on
+ * `threads`; fills occluded[ray] and returns the seconds taken. */
+double lx_bench_flat_trace(lx_bench_flat_mode mode, RTCScene flat, const lx_bench_rays *rs,
+                           int threads, uint8_t *occluded);
 
 /* ---- report -------------------------------------------------------------- */
 

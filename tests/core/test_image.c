@@ -10,6 +10,7 @@
 #include "luxel/core.h"
 #include "core/internal.h"
 
+#include <OpenEXR/openexr.h>
 #include <dirent.h>
 #include <math.h>
 #include <stdio.h>
@@ -324,7 +325,8 @@ static void test_exr_float_round_trip(void **state)
     (void)state;
     const char *dir = test_dir("exr_float");
     for (int c = 1; c <= 4; c++) {
-        /* 37 rows: ZIP chunks hold 16, so the last chunk is partial */
+        /* 37 rows: an odd count for any chunking (float files are uncompressed,
+         * one scanline a chunk; half files ZIP, 16) */
         lx_image img = make(53, 37, c);
         fill(&img, -5.0f, 50000.0f, (uint32_t)c);
         memcpy(img.data, (const float[]){1e-42f, 3.0e38f}, 2 * sizeof(float)); /* tiny, huge */
@@ -549,6 +551,228 @@ static void test_png_built(void **state)
     n += put_chunk(png + n, "IDAT", (const unsigned char[]){0x78, 1, 0x03, 0x3e, 0, 0, 0, 0, 0}, 9);
     n += put_chunk(png + n, "IEND", "", 0);
     load_fails(png, n, "dist.png", LX_ERR_FORMAT, "dist.png: corrupt PNG: the compressed image");
+}
+
+/* ---- the writers' threads -------------------------------------------------- */
+
+static bool same_file(const char *a, const char *b)
+{
+    size_t na, nb;
+    unsigned char *da = read_all(a, &na), *db = read_all(b, &nb);
+    bool same = na == nb && memcmp(da, db, na) == 0;
+    free(da);
+    free(db);
+    return same;
+}
+
+/* A file read straight through OpenEXRCore (not luxel's reader): its
+ * compression, channels and pixels, every channel decoded to float planes,
+ * in file (alphabetical) order. */
+static float *exr_core_read(const char *path, int *w, int *h, int *channels,
+                            exr_compression_t *compression)
+{
+    exr_context_t ctx;
+    exr_context_initializer_t init = EXR_DEFAULT_CONTEXT_INITIALIZER;
+    assert_int_equal(exr_start_read(&ctx, path, &init), EXR_ERR_SUCCESS);
+    exr_attr_box2i_t dw;
+    const exr_attr_chlist_t *list;
+    int32_t lines;
+    assert_int_equal(exr_get_data_window(ctx, 0, &dw), EXR_ERR_SUCCESS);
+    assert_int_equal(exr_get_channels(ctx, 0, &list), EXR_ERR_SUCCESS);
+    assert_int_equal(exr_get_compression(ctx, 0, compression), EXR_ERR_SUCCESS);
+    assert_int_equal(exr_get_scanlines_per_chunk(ctx, 0, &lines), EXR_ERR_SUCCESS);
+    *w = dw.max.x - dw.min.x + 1, *h = dw.max.y - dw.min.y + 1, *channels = list->num_channels;
+    size_t plane = (size_t)*w * (size_t)*h;
+    float *planes = calloc(plane * (size_t)*channels, sizeof(float));
+    assert_non_null(planes);
+    exr_decode_pipeline_t dec = EXR_DECODE_PIPELINE_INITIALIZER;
+    for (int y = 0; y < *h; y += lines) {
+        exr_chunk_info_t ci;
+        assert_int_equal(exr_read_scanline_chunk_info(ctx, 0, dw.min.y + y, &ci), EXR_ERR_SUCCESS);
+        assert_int_equal(y == 0 ? exr_decoding_initialize(ctx, 0, &ci, &dec)
+                                : exr_decoding_update(ctx, 0, &ci, &dec),
+                         EXR_ERR_SUCCESS);
+        for (int c = 0; c < dec.channel_count; c++) {
+            exr_coding_channel_info_t *ch = &dec.channels[c];
+            ch->user_data_type = EXR_PIXEL_FLOAT;
+            ch->user_bytes_per_element = 4;
+            ch->user_pixel_stride = 4;
+            ch->user_line_stride = *w * 4;
+            ch->decode_to_ptr = (uint8_t *)(planes + (size_t)c * plane + (size_t)y * *w);
+        }
+        if (y == 0)
+            assert_int_equal(exr_decoding_choose_default_routines(ctx, 0, &dec), EXR_ERR_SUCCESS);
+        assert_int_equal(exr_decoding_run(ctx, 0, &dec), EXR_ERR_SUCCESS);
+    }
+    exr_decoding_destroy(ctx, &dec);
+    exr_finish(&ctx);
+    return planes;
+}
+
+/* EXR files are the same bytes on 1, 2, 3 and all threads; 32-bit floats
+ * are stored uncompressed and come back exactly, halves go through ZIP
+ * (16-scanline chunks, the last partial) and come back rounded to the
+ * nearest half, through luxel's reader and through OpenEXRCore directly. */
+static void test_exr_threads(void **state)
+{
+    (void)state;
+    const char *dir = test_dir("exr_threads");
+    for (int half = 0; half < 2; half++)
+        for (int c = 1; c <= 4; c++) {
+            lx_image img = make(301, 77, c);
+            fill(&img, -3.0f, 3000.0f, (uint32_t)(10 * half + c));
+            const int threads[] = {1, 2, 3, 0};
+            char name[4][64];
+            for (int t = 0; t < 4; t++) {
+                snprintf(name[t], sizeof name[t], "%d_%d_%d.exr", half, c, threads[t]);
+                lx_image_write_desc wd = {.half = half, .threads = threads[t]};
+                assert_int_equal(lx_image_write(path_in(dir, name[t]), &img, &wd), LX_OK);
+            }
+            for (int t = 1; t < 4; t++)
+                if (!same_file(path_in(dir, name[0]), path_in(dir, name[t])))
+                    fail_msg("%s and %s differ", name[0], name[t]);
+            lx_image ours = load_ok(path_in(dir, name[0]), NULL);
+            int w, h, nc;
+            exr_compression_t comp;
+            float *core = exr_core_read(path_in(dir, name[0]), &w, &h, &nc, &comp);
+            assert_true(w == 301 && h == 77 && nc == c && ours.channels == c);
+            assert_int_equal(comp, half ? EXR_COMPRESSION_ZIP : EXR_COMPRESSION_NONE);
+            /* file order is alphabetical: A, B, G, R or A, Y */
+            static const int rgba_plane[4][4] = {
+                {0}, {1, 0}, {2, 1, 0}, {3, 2, 1, 0}}; /* luxel channel -> plane */
+            for (size_t i = 0; i < (size_t)w * h; i++)
+                for (int k = 0; k < c; k++) {
+                    float v = img.data[i * c + k], a = ours.data[i * c + k];
+                    float b = core[(size_t)rgba_plane[c - 1][k] * w * h + i];
+                    /* binary16: 11 significant bits, subnormals below 2^-14 */
+                    double tol = !half                     ? 0.0
+                                 : fabs(v) >= 6.1035156e-5 ? fabs(v) * 0x1p-11
+                                                           : 0x1p-25;
+                    if (a != b || fabs((double)a - v) > tol)
+                        fail_msg("%s pixel %zu channel %d: wrote %.9g, luxel read %.9g, "
+                                 "OpenEXRCore read %.9g",
+                                 name[0], i, k, v, a, b);
+                }
+            free(core);
+            lx_image_free(&ours);
+            lx_image_free(&img);
+        }
+}
+
+/* The nearest code to 255 x srgb(v), or -1 when v lies within 1e-9 of a
+ * midpoint between two codes (where float rounding may go either way). */
+static int ref_srgb8_clear(double v)
+{
+    if (v <= 0.0)
+        return 0;
+    if (v >= 1.0)
+        return 255;
+    double x = 255.0 * ref_linear_to_srgb(v);
+    double frac = x - floor(x);
+    if (fabs(frac - 0.5) < 1e-9)
+        return -1;
+    return (int)floor(x + 0.5);
+}
+
+/* PNG files large enough for many deflate strips are the same bytes on 1,
+ * 2, 3 and all threads, and stb decodes each to exactly the 8-bit codes
+ * the IEC 61966-2-1 formula gives (ties left out), alpha unexposed. */
+static void test_png_threads(void **state)
+{
+    (void)state;
+    const char *dir = test_dir("png_threads");
+    const int sizes[2][3] = {{700, 400, 3}, {333, 517, 4}}; /* 820 KiB and 672 KiB */
+    for (int s = 0; s < 2; s++) {
+        int w = sizes[s][0], h = sizes[s][1], c = sizes[s][2];
+        lx_image img = make(w, h, c);
+        /* smooth gradients (what previews are) with noise on top */
+        for (int y = 0; y < h; y++)
+            for (int x = 0; x < w; x++)
+                for (int k = 0; k < c; k++)
+                    img.data[((size_t)y * w + x) * c + k] =
+                        0.4f * (float)(x + k * 37) / (float)w + 0.3f * (float)y / (float)h +
+                        0.05f * lx_random(7, (uint32_t)(y * w + x), (uint32_t)k, 0);
+        const float exposure = 1.3f;
+        const int threads[] = {1, 2, 3, 0};
+        char name[4][64];
+        for (int t = 0; t < 4; t++) {
+            snprintf(name[t], sizeof name[t], "%d_%d.png", s, threads[t]);
+            lx_image_write_desc wd = {.exposure = exposure, .threads = threads[t]};
+            assert_int_equal(lx_image_write(path_in(dir, name[t]), &img, &wd), LX_OK);
+        }
+        for (int t = 1; t < 4; t++)
+            if (!same_file(path_in(dir, name[0]), path_in(dir, name[t])))
+                fail_msg("%s and %s differ", name[0], name[t]);
+        lx_image_load_desc rd = {.raw_8bit = true};
+        lx_image raw = load_ok(path_in(dir, name[0]), &rd);
+        assert_true(raw.width == w && raw.height == h && raw.channels == c);
+        size_t checked = 0;
+        for (size_t i = 0; i < (size_t)w * h * c; i++) {
+            bool alpha = c == 4 && i % 4 == 3;
+            double v = img.data[i];
+            /* alpha: linear 8-bit, ties (within float rounding) left out */
+            double a = 255.0 * fmin(fmax(v, 0.0), 1.0);
+            int want = alpha ? (fabs(a - floor(a) - 0.5) < 1e-4 ? -1 : (int)floor(a + 0.5))
+                             : ref_srgb8_clear((double)(float)(img.data[i] * exposure));
+            if (want < 0)
+                continue;
+            if (code8(raw.data[i]) != want)
+                fail_msg("%s value %zu (%.9g): code %d, want %d", name[0], i, v, code8(raw.data[i]),
+                         want);
+            checked++;
+        }
+        assert_true(checked > (size_t)w * h * c * 99 / 100);
+        lx_image_free(&raw);
+        lx_image_free(&img);
+    }
+}
+
+/* Every 256th float from 0 to 1 (about 4 million values) encodes to the
+ * nearest sRGB code, as the formula in double says (ties left out). */
+static void test_srgb8_encoder_exhaustive(void **state)
+{
+    (void)state;
+    const char *dir = test_dir("srgb8");
+    const uint32_t top = 0x3f800000u, step = 256;
+    const int w = 4096, h = (int)((top / step + 1 + w - 1) / w);
+    lx_image img = make(w, h, 1);
+    size_t n = 0;
+    for (uint32_t bits = 0; bits <= top; bits += step) {
+        memcpy(&img.data[n++], &bits, sizeof bits);
+    }
+    while (n < (size_t)w * h)
+        img.data[n++] = 1.0f;
+    assert_int_equal(lx_image_write(path_in(dir, "all.png"), &img, NULL), LX_OK);
+    lx_image_load_desc rd = {.raw_8bit = true};
+    lx_image raw = load_ok(path_in(dir, "all.png"), &rd);
+    for (size_t i = 0; i < n; i++) {
+        int want = ref_srgb8_clear(img.data[i]);
+        if (want >= 0 && code8(raw.data[i]) != want)
+            fail_msg("%.9g (bits %08x): code %d, want %d", img.data[i], (unsigned)(i * step),
+                     code8(raw.data[i]), want);
+    }
+    lx_image_free(&raw);
+    lx_image_free(&img);
+}
+
+/* With bad values in several rows (checked on several threads), the first
+ * in memory order is the one named. */
+static void test_write_names_first_bad_value(void **state)
+{
+    (void)state;
+    const char *dir = test_dir("first_bad");
+    lx_image img = make(64, 200, 3);
+    fill(&img, 0.0f, 1.0f, 3);
+    img.data[(150 * 64 + 3) * 3 + 1] = NAN;
+    img.data[(40 * 64 + 60) * 3 + 2] = INFINITY;
+    img.data[(40 * 64 + 61) * 3 + 0] = NAN;
+    for (int threads = 1; threads <= 3; threads++) {
+        lx_image_write_desc wd = {.threads = threads};
+        assert_int_equal(lx_image_write(path_in(dir, "b.exr"), &img, &wd), LX_ERR_INVALID);
+        assert_error_mentions("pixel (60, 40) channel 2");
+    }
+    assert_int_equal(count_files(dir, false), 0);
+    lx_image_free(&img);
 }
 
 static void test_8bit_formats_round_trip(void **state)
@@ -796,6 +1020,10 @@ int main(void)
         cmocka_unit_test(test_hdr_round_trip),
         cmocka_unit_test(test_png_code_values),
         cmocka_unit_test(test_png_built),
+        cmocka_unit_test(test_exr_threads),
+        cmocka_unit_test(test_png_threads),
+        cmocka_unit_test(test_srgb8_encoder_exhaustive),
+        cmocka_unit_test(test_write_names_first_bad_value),
         cmocka_unit_test(test_8bit_formats_round_trip),
         cmocka_unit_test(test_8bit_and_hdr_bad),
         cmocka_unit_test(test_channel_conversion),

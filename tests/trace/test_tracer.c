@@ -2,7 +2,7 @@
  * tests/common/reference.c over every triangle of every node in world space:
  * random rays over several meshes placed by rotated, scaled, mirrored and
  * shared-mesh nodes; closest hit (node, mesh, triangle, t, u, v), occlusion,
- * nearest distance and batched occlusion agree, except for rays passing
+ * nearest distance, batched and packet occlusion agree, except for rays passing
  * within 1e-4 (barycentric) of an edge or hitting at the very end of their
  * range, which are skipped. Moving a node and committing moves its hits. */
 #include <stdarg.h>
@@ -229,6 +229,70 @@ static void compare_batch(const lx_tracer *tr, const ray_case *rc, bool coherent
                      rc[i].hit);
 }
 
+/* Puts ray r in lane j of packet pk. */
+static void packet_set(lx_ray_packet *pk, int j, const lx_ray *r)
+{
+    pk->origin_x[j] = r->origin.x, pk->origin_y[j] = r->origin.y, pk->origin_z[j] = r->origin.z;
+    pk->dir_x[j] = r->dir.x, pk->dir_y[j] = r->dir.y, pk->dir_z[j] = r->dir.z;
+    pk->tmin[j] = r->tmin, pk->tmax[j] = r->tmax;
+}
+
+/* lx_tracer_occluded_packet over every ray, in three passes that put each
+ * ray in a different lane beside different rays, with random lanes left
+ * out: an active lane answers as the brute-force reference (ambiguous rays
+ * skipped) and, every ray included, the same in every pass and as
+ * lx_tracer_occluded; an inactive lane answers 0 and keeps its tmax. */
+static void compare_packets(const lx_tracer *tr, const ray_case *rc)
+{
+    static int answer[RAYS];
+    for (int i = 0; i < RAYS; i++)
+        answer[i] = -1;
+    rng_state = 777;
+    for (int pass = 0; pass < 3; pass++) {
+        int stride = pass == 0 ? 1 : pass == 1 ? 7 : 13; /* coprime with RAYS */
+        for (int base = 0; base < RAYS; base += LX_RAY_PACKET) {
+            lx_ray_packet pk;
+            int which[LX_RAY_PACKET];
+            uint32_t active = 0;
+            for (int j = 0; j < LX_RAY_PACKET; j++) {
+                which[j] = ((base + j) * stride + pass) % RAYS;
+                packet_set(&pk, j, &rc[which[j]].ray);
+                /* pass 0 traces every ray; later passes leave out a third */
+                bool on = base + j < RAYS && (pass == 0 || rnd() < 0.67);
+                active |= (uint32_t)on << j;
+            }
+            float tmax_before[LX_RAY_PACKET];
+            memcpy(tmax_before, pk.tmax, sizeof tmax_before);
+            dirty_stack();
+            uint32_t blocked = lx_tracer_occluded_packet(tr, &pk, active);
+            assert_int_equal(blocked & ~active, 0);
+            for (int j = 0; j < LX_RAY_PACKET; j++) {
+                const ray_case *c = &rc[which[j]];
+                if (!((active >> j) & 1u)) {
+                    assert_true(pk.tmax[j] == tmax_before[j] || isnan(tmax_before[j]));
+                    continue;
+                }
+                int got = (int)((blocked >> j) & 1u);
+                if (!c->ambiguous && got != c->hit)
+                    fail_msg("packet pass %d lane %d ray %d: occluded %d, reference %d", pass, j,
+                             which[j], got, c->hit);
+                if (answer[which[j]] >= 0 && answer[which[j]] != got)
+                    fail_msg("ray %d: lane %d of pass %d answers %d, an earlier lane %d", which[j],
+                             j, pass, got, answer[which[j]]);
+                answer[which[j]] = got;
+            }
+        }
+    }
+    for (int i = 0; i < RAYS; i++)
+        if (answer[i] != (int)lx_tracer_occluded(tr, &rc[i].ray))
+            fail_msg("ray %d: packet answers %d, lx_tracer_occluded %d", i, answer[i], !answer[i]);
+    /* nothing active: nothing traced, nothing blocked */
+    lx_ray_packet pk;
+    for (int j = 0; j < LX_RAY_PACKET; j++)
+        packet_set(&pk, j, &rc[j].ray);
+    assert_int_equal(lx_tracer_occluded_packet(tr, &pk, 0), 0);
+}
+
 /* ---- tests ------------------------------------------------------------------------- */
 
 static void test_random_rays(void **state)
@@ -348,6 +412,7 @@ static void test_coherent_batch(void **state)
     compare_batch(tr, rc, false, true);
     compare_batch(tr, rc, true, false);
     compare_batch(tr, rc, true, true);
+    compare_packets(tr, rc);
     lx_ref_scene_free(&rs);
     lx_tracer_destroy(tr);
     lx_scene_destroy(s);
@@ -390,6 +455,13 @@ static void test_coherent_batch(void **state)
         lx_tracer_occluded_batch(tr, rays, 1 + (uint32_t)tile % 64, true, occ);
         for (int k = 0; k <= tile % 64; k++)
             assert_int_equal(occ[k], 0);
+        /* the same tile as four packets of 4x4 texels */
+        for (int q = 0; q < 4; q++) {
+            lx_ray_packet pk;
+            for (int j = 0; j < LX_RAY_PACKET; j++)
+                packet_set(&pk, j, &rays[(q / 2 * 4 + j / 4) * 8 + q % 2 * 4 + j % 4]);
+            assert_int_equal(lx_tracer_occluded_packet(tr, &pk, 0xFFFFu), 0);
+        }
     }
     lx_tracer_destroy(tr);
     lx_scene_destroy(s);

@@ -524,13 +524,15 @@ int cmd_bake(int argc, char **argv)
                                   .half = a.half,
                                   .exposure = a.format == LX_IMAGE_PNG ? exposure
                                               : a.pre_expose           ? pre_exposure
-                                                                       : 1.0f};
+                                                                       : 1.0f,
+                                  .threads = a.desc.threads};
         double t = cli_now();
         failed = !cli_stage_image(&stage, file, &images[m], &wd);
         t_maps += cli_now() - t;
         bool want_preview = a.format != LX_IMAGE_PNG;
         if (!failed && want_preview) {
-            lx_image_write_desc pd = {.format = LX_IMAGE_PNG, .exposure = exposure};
+            lx_image_write_desc pd = {
+                .format = LX_IMAGE_PNG, .exposure = exposure, .threads = a.desc.threads};
             t = cli_now();
             failed = !cli_stage_image(&stage, preview, &images[m], &pd);
             t_previews += cli_now() - t;
