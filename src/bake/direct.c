@@ -43,7 +43,7 @@ lx_ray lx_shadow_ray(const lx_baker *b, lx_vec3 p, lx_vec3 ng, const lx_light_ev
 static float soft_visibility(const lx_baker *b, uint32_t map_index, const lx_lightmap *map,
                              uint32_t texel, uint32_t light_index, const lx_light *light)
 {
-    uint32_t want = light->samples ? light->samples : 16u;
+    uint32_t want = lx_light_sample_count(light);
     uint32_t sx = (uint32_t)sqrtf((float)want);
     sx = sx ? sx : 1u;
     uint32_t sy = (want + sx - 1) / sx;
