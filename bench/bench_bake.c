@@ -218,7 +218,7 @@ static bake_result bench_full_bake(void)
     uint8_t *occ[RAW_MODES] = {0};
     if (!g_skip_raw) {
         t0 = lx_bench_now();
-        if (lx_tracer_create(scene, &tr) != LX_OK)
+        if (lx_tracer_create(scene, NULL, &tr) != LX_OK)
             lx_bench_die("lx_tracer_create");
         t_tracer = lx_bench_now() - t0;
         dev = rtcNewDevice(NULL);

@@ -114,7 +114,7 @@ int main(int argc, char **argv)
     if (!g_skip_raw) {
         lx_bench_rays_build(b, scene, &rs);
         lx_tracer *tr;
-        if (lx_tracer_create(scene, &tr) != LX_OK)
+        if (lx_tracer_create(scene, NULL, &tr) != LX_OK)
             lx_bench_die("lx_tracer_create");
         uint8_t *occ = malloc(rs.count + 1);
         if (!occ)

@@ -118,8 +118,9 @@ typedef struct lx_lightmap_info {
 
 /* Builds the texel maps of every node with UVs and the ray structures.
  * Lights are copied from scene->lights, ambient from scene->ambient.
- * desc->progress, when set, hears the fraction of maps built and may stop
- * the build (LX_ERR_CANCELLED, *out stays NULL). */
+ * desc->progress, when set, hears the texel maps (the first 90%) and the
+ * BVH build (the rest) and may stop either (LX_ERR_CANCELLED, *out stays
+ * NULL). */
 lx_status lx_baker_create(const lx_scene *scene, const lx_bake_desc *desc, lx_baker **out);
 void lx_baker_destroy(lx_baker *baker);
 

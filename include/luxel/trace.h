@@ -9,7 +9,7 @@
  *   Embree error, named). Queries cannot fail.
  * MEMORY  The tracer copies the geometry it needs; the scene may be freed
  *   after lx_tracer_create. lx_tracer_destroy releases everything.
- * THREADING  lx_tracer_create* is thread-safe. Queries (lx_tracer_occluded*,
+ * THREADING  lx_tracer_create is thread-safe. Queries (lx_tracer_occluded*,
  *   lx_tracer_closest, lx_tracer_nearest_distance) may run on many threads
  *   at once on one tracer, each thread with its own lx_ray_packet;
  *   lx_tracer_set_node_transform and lx_tracer_commit must not overlap
@@ -20,7 +20,7 @@
  *   if (lx_scene_load("room.glb", NULL, &scene) != LX_OK)
  *       return 1;
  *   lx_tracer *tr;
- *   if (lx_tracer_create(scene, &tr) != LX_OK) {
+ *   if (lx_tracer_create(scene, NULL, &tr) != LX_OK) {
  *       lx_scene_destroy(scene);
  *       return 1;
  *   }
@@ -68,11 +68,19 @@ typedef struct lx_hit {
     float u, v;        /* barycentrics of vertices 1 and 2 */
 } lx_hit;
 
-/* Builds the ray structures for every node of scene. */
-lx_status lx_tracer_create(const lx_scene *scene, lx_tracer **out);
-/* The same with Embree's own build threads held to `threads` (0 = all
- * cores), for callers that bound their thread count. */
-lx_status lx_tracer_create_threads(const lx_scene *scene, int threads, lx_tracer **out);
+typedef struct lx_tracer_desc {
+    int threads;             /* Embree's BVH-build threads, 0 = all cores */
+    lx_progress_fn progress; /* hears the BVH build (fraction built); may be NULL;
+                                returning false cancels it (LX_ERR_CANCELLED) */
+    void *progress_user;
+} lx_tracer_desc;
+
+/* A copy of desc (or of zeros when NULL) with every default filled in. */
+lx_tracer_desc lx_tracer_desc_defaults(const lx_tracer_desc *desc);
+
+/* Builds the ray structures for every node of scene. desc may be NULL. On
+ * failure or cancellation *out stays NULL. */
+lx_status lx_tracer_create(const lx_scene *scene, const lx_tracer_desc *desc, lx_tracer **out);
 void lx_tracer_destroy(lx_tracer *tracer);
 
 /* Moves a node; takes effect at the next lx_tracer_commit. */

@@ -54,6 +54,15 @@ static lx_status validate_desc(const lx_bake_desc *d)
     return LX_OK;
 }
 
+/* lx_baker_create's progress: the texel maps, then the BVH build. */
+#define TEXEL_MAPS_SHARE 0.9f
+
+static bool bvh_progress(void *user, float fraction)
+{
+    const lx_bake_desc *d = user;
+    return d->progress(d->progress_user, TEXEL_MAPS_SHARE + (1.0f - TEXEL_MAPS_SHARE) * fraction);
+}
+
 lx_status lx_baker_create(const lx_scene *scene, const lx_bake_desc *in, lx_baker **out)
 {
     *out = NULL;
@@ -136,13 +145,16 @@ lx_status lx_baker_create(const lx_scene *scene, const lx_bake_desc *in, lx_bake
         }
         b->node_map[n] = b->map_count++;
         /* building large texel maps takes long enough to report and stop */
-        if (desc.progress &&
-            !desc.progress(desc.progress_user, (float)(n + 1) / (float)scene->node_count)) {
+        if (desc.progress && !desc.progress(desc.progress_user, TEXEL_MAPS_SHARE * (float)(n + 1) /
+                                                                    (float)scene->node_count)) {
             lx_baker_destroy(b);
             return lx_fail(LX_ERR_CANCELLED, "bake cancelled");
         }
     }
-    st = lx_tracer_create_threads(scene, desc.threads, &b->tracer);
+    lx_tracer_desc td = {.threads = desc.threads,
+                         .progress = desc.progress ? bvh_progress : NULL,
+                         .progress_user = &desc};
+    st = lx_tracer_create(scene, &td, &b->tracer);
     if (st != LX_OK) {
         lx_baker_destroy(b);
         return st;

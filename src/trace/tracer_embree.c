@@ -8,6 +8,8 @@
 #include "core/internal.h"
 
 #include <embree3/rtcore.h>
+#include <pthread.h>
+#include <stdatomic.h>
 #if defined(__SSE2__)
 #include <emmintrin.h>
 #endif
@@ -82,15 +84,46 @@ static RTCGeometry new_geometry(RTCDevice dev, const lx_mesh *m, const lx_mat4 *
     return geom;
 }
 
-lx_status lx_tracer_create(const lx_scene *scene, lx_tracer **out)
+lx_tracer_desc lx_tracer_desc_defaults(const lx_tracer_desc *desc)
 {
-    return lx_tracer_create_threads(scene, 0, out);
+    lx_tracer_desc d = {0};
+    if (desc)
+        d = *desc;
+    return d; /* every field's zero is its default */
 }
 
-lx_status lx_tracer_create_threads(const lx_scene *scene, int threads, lx_tracer **out)
+/* Embree's build progress, which its build threads may report at once,
+ * turned into lx_progress_fn's contract: one call at a time (a thread that
+ * finds another reporting goes on), never backwards. */
+typedef struct build_progress {
+    lx_progress_fn fn;
+    void *user;
+    pthread_mutex_t lock;
+    double reported;
+    _Atomic bool cancelled;
+} build_progress;
+
+static bool on_build_progress(void *ptr, double n)
+{
+    build_progress *p = ptr;
+    if (atomic_load(&p->cancelled))
+        return false;
+    if (pthread_mutex_trylock(&p->lock) == 0) {
+        if (n > p->reported)
+            p->reported = n;
+        if (!p->fn(p->user, (float)p->reported))
+            atomic_store(&p->cancelled, true);
+        pthread_mutex_unlock(&p->lock);
+    }
+    return !atomic_load(&p->cancelled);
+}
+
+lx_status lx_tracer_create(const lx_scene *scene, const lx_tracer_desc *in, lx_tracer **out)
 {
     *out = NULL;
     embree_error[0] = '\0';
+    lx_tracer_desc desc = lx_tracer_desc_defaults(in);
+    int threads = desc.threads;
     if (threads < 0)
         return lx_fail(LX_ERR_INVALID, "tracer: thread count %d is negative", threads);
     lx_tracer *tr = calloc(1, sizeof *tr);
@@ -162,8 +195,18 @@ lx_status lx_tracer_create_threads(const lx_scene *scene, int threads, lx_tracer
         }
     }
     tr->node_first_geometry[scene->node_count] = g;
+    build_progress monitor = {.fn = desc.progress, .user = desc.progress_user};
+    pthread_mutex_init(&monitor.lock, NULL);
+    if (desc.progress)
+        rtcSetSceneProgressMonitorFunction(tr->scene, on_build_progress, &monitor);
     rtcCommitScene(tr->scene);
+    /* later commits (moved nodes) report to nobody: the monitor is gone */
+    rtcSetSceneProgressMonitorFunction(tr->scene, NULL, NULL);
+    pthread_mutex_destroy(&monitor.lock);
     lx_status st = embree_status(scene->path);
+    if (atomic_load(&monitor.cancelled))
+        st =
+            lx_fail(LX_ERR_CANCELLED, "%s: building the ray structures was cancelled", scene->path);
     if (st != LX_OK) {
         lx_tracer_destroy(tr);
         return st;

@@ -154,7 +154,7 @@ static void test_lean_loop_is_the_light_model(void **state)
     (void)state;
     lx_scene *s = fast_scene();
     lx_tracer *tr;
-    assert_int_equal(lx_tracer_create(s, &tr), LX_OK);
+    assert_int_equal(lx_tracer_create(s, NULL, &tr), LX_OK);
     lx_vec3 lo, hi;
     assert_true(lx_scene_bounds(s, &lo, &hi));
     float diagonal = lx_length(lx_sub(hi, lo)), base = 1e-5f * diagonal;

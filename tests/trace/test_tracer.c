@@ -19,6 +19,9 @@
 #include "helpers.h"
 #include "core/internal.h"
 #include "reference.h"
+#include "scenes.h"
+
+#include <stdatomic.h>
 
 #define RAYS 1000
 #define EDGE_EPS 1e-4
@@ -300,7 +303,7 @@ static void test_random_rays(void **state)
     (void)state;
     lx_scene *s = make_scene();
     lx_tracer *tr;
-    assert_int_equal(lx_tracer_create(s, &tr), LX_OK);
+    assert_int_equal(lx_tracer_create(s, NULL, &tr), LX_OK);
     lx_ref_scene rs;
     lx_ref_scene_build(s, &rs);
     static ray_case rc[RAYS];
@@ -344,7 +347,7 @@ static void test_move_node_and_commit(void **state)
     (void)state;
     lx_scene *s = make_scene();
     lx_tracer *tr;
-    assert_int_equal(lx_tracer_create(s, &tr), LX_OK);
+    assert_int_equal(lx_tracer_create(s, NULL, &tr), LX_OK);
 
     /* a ray straight down onto the identity box's top (node 0, top at 1.3) */
     lx_ray down = {lx_v3(-1.1f, 4.0f, 0.35f), 0.0f, lx_v3(0, -1, 0), INFINITY};
@@ -403,7 +406,7 @@ static void test_coherent_batch(void **state)
     (void)state;
     lx_scene *s = make_scene();
     lx_tracer *tr;
-    assert_int_equal(lx_tracer_create(s, &tr), LX_OK);
+    assert_int_equal(lx_tracer_create(s, NULL, &tr), LX_OK);
     lx_ref_scene rs;
     lx_ref_scene_build(s, &rs);
     static ray_case rc[RAYS];
@@ -423,7 +426,7 @@ static void test_coherent_batch(void **state)
     lx_mesh plane = lx_test_plane("ground", 4.0f, 0.0f, 0.0f, 0.0f, 1);
     lx_test_add(s, &plane);
     lx_test_mesh_free(&plane);
-    assert_int_equal(lx_tracer_create(s, &tr), LX_OK);
+    assert_int_equal(lx_tracer_create(s, NULL, &tr), LX_OK);
     /* two rays of such a tile, exactly */
     lx_ray two[2] = {{{0x1.cp-3f, 0x1.04dbcep-14f, -0x1.68p+0f},
                       0.0f,
@@ -467,9 +470,61 @@ static void test_coherent_batch(void **state)
     lx_scene_destroy(s);
 }
 
+/* The BVH build reports progress through lx_tracer_desc: from one thread
+ * at a time (Embree's build threads may report at once), in [0, 1], never
+ * backwards; returning false cancels the build with nothing made. */
+typedef struct build_log {
+    int calls;
+    float last;
+    bool backwards, out_of_range;
+    _Atomic int inside, overlaps;
+    int cancel_at; /* stop at this call, 0 = never */
+} build_log;
+
+static bool on_build(void *user, float fraction)
+{
+    build_log *log = user;
+    if (atomic_fetch_add(&log->inside, 1) != 0)
+        atomic_fetch_add(&log->overlaps, 1);
+    log->calls++;
+    log->backwards = log->backwards || fraction < log->last;
+    log->out_of_range = log->out_of_range || !(fraction >= 0.0f && fraction <= 1.0f);
+    log->last = fraction;
+    bool go_on = log->cancel_at == 0 || log->calls < log->cancel_at;
+    atomic_fetch_sub(&log->inside, 1);
+    return go_on;
+}
+
+static void test_build_progress_and_cancel(void **state)
+{
+    (void)state;
+    lx_test_scene_info info;
+    /* about 100k triangles: a build Embree reports on */
+    lx_scene *scene = lx_test_spheres_scene("progress", 40.0f, 32, 21, 16, 8, false, &info);
+    build_log log = {0};
+    lx_tracer_desc d = {.threads = 2, .progress = on_build, .progress_user = &log};
+    lx_tracer *tr = NULL;
+    assert_int_equal(lx_tracer_create(scene, &d, &tr), LX_OK);
+    assert_non_null(tr);
+    assert_true(log.calls > 0);
+    assert_false(log.backwards);
+    assert_false(log.out_of_range);
+    assert_int_equal(atomic_load(&log.overlaps), 0);
+    lx_tracer_destroy(tr);
+
+    build_log stop = {.cancel_at = 1};
+    d.progress_user = &stop;
+    tr = (lx_tracer *)&stop; /* must be reset */
+    assert_int_equal(lx_tracer_create(scene, &d, &tr), LX_ERR_CANCELLED);
+    assert_null(tr);
+    assert_non_null(strstr(lx_last_error(), "cancelled"));
+    lx_scene_destroy(scene);
+}
+
 int main(void)
 {
     const struct CMUnitTest tests[] = {
+        cmocka_unit_test(test_build_progress_and_cancel),
         cmocka_unit_test(test_random_rays), cmocka_unit_test(test_move_node_and_commit),
         cmocka_unit_test(test_coherent_batch), /* last: a hang ends the program */
     };
