@@ -15,6 +15,7 @@
 
 typedef struct raster_ctx {
     int width, height;
+    int row0, row1;  /* the band of rows this rasterization writes, [row0, row1) */
     uint32_t *owner; /* per pixel: node-local triangle id, UINT32_MAX = none */
     float *b1, *b2;  /* barycentrics of vertices 1 and 2 */
     float *distance; /* 0 for centre coverage, else texel-space distance */
@@ -127,8 +128,8 @@ static void uv_to_texel(const raster_ctx *r, lx_vec2 uv, double out[2])
     out[1] = (double)uv.y * r->height;
 }
 
-/* The texel rectangle a triangle may touch, grown by pad; false when it
- * lies wholly outside the lightmap. Clamped in double before converting, so
+/* The texel rectangle a triangle may touch, grown by pad, within the
+ * rows of the band; false when it lies wholly outside them. Clamped in double before converting, so
  * UVs far outside [0,1] neither overflow an int nor cost a long loop. */
 static bool bbox(const double *v[3], int pad, const raster_ctx *r, int *x0, int *y0, int *x1,
                  int *y1)
@@ -137,13 +138,13 @@ static bool bbox(const double *v[3], int pad, const raster_ctx *r, int *x0, int 
     double maxx = fmax(v[0][0], fmax(v[1][0], v[2][0])) + pad;
     double miny = fmin(v[0][1], fmin(v[1][1], v[2][1])) - pad;
     double maxy = fmax(v[0][1], fmax(v[1][1], v[2][1])) + pad;
-    double w = r->width, h = r->height;
-    if (!(maxx >= 0.0 && minx < w && maxy >= 0.0 && miny < h))
+    double w = r->width, lo = r->row0, hi = r->row1;
+    if (!(maxx >= 0.0 && minx < w && maxy >= lo && miny < hi))
         return false;
     *x0 = (int)fmax(floor(minx), 0.0);
-    *y0 = (int)fmax(floor(miny), 0.0);
+    *y0 = (int)fmax(floor(miny), lo);
     *x1 = (int)fmin(floor(maxx), w - 1.0);
-    *y1 = (int)fmin(floor(maxy), h - 1.0);
+    *y1 = (int)fmin(floor(maxy), hi - 1.0);
     return true;
 }
 
@@ -208,6 +209,113 @@ static void raster_borders(raster_ctx *r, const double *v[3], uint32_t id)
             r->b2[p] = (float)w[2];
             r->distance[p] = d;
         }
+}
+
+/* Rows per band: the unit of parallel rasterization. */
+#define RASTER_BAND 32
+
+/* Both passes over every triangle, in parallel over bands of rows: each
+ * band runs pass 1 then pass 2 over the triangles that reach it, in mesh
+ * and triangle order, so every texel sees the same triangles in the same
+ * order as one serial sweep would and the result is the same for any
+ * thread count. Triangles are listed per band first (a counting sort in
+ * triangle order), so a band skips the ones that miss it. */
+static lx_status raster_bands(raster_ctx *r, const slot *slots, uint32_t slot_count,
+                              const uint8_t *skip, uint32_t total_triangles, int threads,
+                              const char *what)
+{
+    int bands = (r->height + RASTER_BAND - 1) / RASTER_BAND;
+    uint32_t *band_start = calloc((size_t)bands + 1, sizeof(uint32_t));
+    uint32_t *band_fill = calloc((size_t)bands, sizeof(uint32_t));
+    uint32_t *counts = calloc((size_t)bands * (slot_count + 1), sizeof(uint32_t));
+    uint32_t *tri_slot = malloc(sizeof(uint32_t) * (total_triangles ? total_triangles : 1));
+    int *tri_rows = malloc(2 * sizeof(int) * (total_triangles ? total_triangles : 1));
+    lx_status st = LX_OK;
+    if (!band_start || !band_fill || !counts || !tri_slot || !tri_rows) {
+        st = lx_fail(LX_ERR_NOMEM, "%s: out of memory", what);
+        goto done;
+    }
+    /* the bands each triangle's rows reach (its border pass grows it by 1) */
+    uint64_t entries = 0;
+    for (uint32_t s = 0; s < slot_count; s++) {
+        const lx_mesh *m = slots[s].mesh;
+        for (uint32_t t = 0; t < m->triangle_count; t++) {
+            uint32_t id = slots[s].first_triangle + t;
+            tri_slot[id] = s;
+            tri_rows[2 * id] = 1; /* empty: row0 > row1 */
+            tri_rows[2 * id + 1] = 0;
+            if (skip[id])
+                continue;
+            const uint32_t *i = &m->indices[3 * t];
+            double a[2], b[2], c[2];
+            uv_to_texel(r, slots[s].uv[i[0]], a);
+            uv_to_texel(r, slots[s].uv[i[1]], b);
+            uv_to_texel(r, slots[s].uv[i[2]], c);
+            const double *v[3] = {a, b, c};
+            int x0, y0, x1, y1;
+            if (!bbox(v, 1, r, &x0, &y0, &x1, &y1))
+                continue;
+            tri_rows[2 * id] = y0 / RASTER_BAND;
+            tri_rows[2 * id + 1] = y1 / RASTER_BAND;
+            for (int k = y0 / RASTER_BAND; k <= y1 / RASTER_BAND; k++)
+                band_start[k + 1]++;
+            entries += (uint64_t)(y1 / RASTER_BAND - y0 / RASTER_BAND + 1);
+        }
+    }
+    if (entries > UINT32_MAX) {
+        st = lx_fail(LX_ERR_NOMEM, "%s: too many triangle rows to rasterize", what);
+        goto done;
+    }
+    for (int k = 0; k < bands; k++)
+        band_start[k + 1] += band_start[k];
+    uint32_t *list = malloc(sizeof(uint32_t) * (entries ? entries : 1));
+    if (!list) {
+        st = lx_fail(LX_ERR_NOMEM, "%s: out of memory", what);
+        goto done;
+    }
+    for (uint32_t id = 0; id < total_triangles; id++)
+        for (int k = tri_rows[2 * id]; k <= tri_rows[2 * id + 1]; k++)
+            list[band_start[k] + band_fill[k]++] = id;
+
+#pragma omp parallel for schedule(dynamic, 1) num_threads(lx_thread_count(threads))
+    for (int k = 0; k < bands; k++) {
+        raster_ctx br = *r;
+        br.row0 = k * RASTER_BAND;
+        br.row1 = br.row0 + RASTER_BAND < r->height ? br.row0 + RASTER_BAND : r->height;
+        br.overlap = 0;
+        br.slot_overlap = counts + (size_t)k * (slot_count + 1);
+        for (int pass = 0; pass < 2; pass++)
+            for (uint32_t e = band_start[k]; e < band_start[k + 1]; e++) {
+                uint32_t id = list[e], s = tri_slot[id];
+                const lx_mesh *m = slots[s].mesh;
+                const uint32_t *i = &m->indices[3 * (id - slots[s].first_triangle)];
+                double a[2], b[2], c[2];
+                uv_to_texel(&br, slots[s].uv[i[0]], a);
+                uv_to_texel(&br, slots[s].uv[i[1]], b);
+                uv_to_texel(&br, slots[s].uv[i[2]], c);
+                const double *v[3] = {a, b, c};
+                if (pass == 0)
+                    raster_centres(&br, v, id, s);
+                else
+                    raster_borders(&br, v, id);
+            }
+        br.slot_overlap[slot_count] = br.overlap;
+    }
+    free(list);
+    /* overlap counts summed in band order */
+    for (int k = 0; k < bands; k++) {
+        const uint32_t *c = counts + (size_t)k * (slot_count + 1);
+        for (uint32_t s = 0; s < slot_count; s++)
+            r->slot_overlap[s] += c[s];
+        r->overlap += c[slot_count];
+    }
+done:
+    free(band_start);
+    free(band_fill);
+    free(counts);
+    free(tri_slot);
+    free(tri_rows);
+    return st;
 }
 
 /* Lightmap size for texel density: R^2 * uv_area = T^2 * world_area. */
@@ -414,7 +522,7 @@ lx_status lx_texel_map_build(const lx_scene *scene, uint32_t node_index, const l
         return st;
     }
 
-    raster_ctx r = {.width = w, .height = h};
+    raster_ctx r = {.width = w, .height = h, .row0 = 0, .row1 = h};
     /* The raster's buffers in one block (17 bytes a pixel) that becomes
      * the baked buffer (12) once the texels are gathered: fresh memory
      * costs a page fault per page, often more than the work done on it. */
@@ -442,24 +550,9 @@ lx_status lx_texel_map_build(const lx_scene *scene, uint32_t node_index, const l
     if (st != LX_OK)
         goto done;
 
-    for (int pass = 0; pass < 2; pass++)
-        for (uint32_t s = 0; s < slot_count; s++) {
-            const lx_mesh *m = slots[s].mesh;
-            for (uint32_t t = 0; t < m->triangle_count; t++) {
-                if (skip[slots[s].first_triangle + t])
-                    continue;
-                const uint32_t *i = &m->indices[3 * t];
-                double a[2], b[2], c[2];
-                uv_to_texel(&r, slots[s].uv[i[0]], a);
-                uv_to_texel(&r, slots[s].uv[i[1]], b);
-                uv_to_texel(&r, slots[s].uv[i[2]], c);
-                const double *v[3] = {a, b, c};
-                if (pass == 0)
-                    raster_centres(&r, v, slots[s].first_triangle + t, s);
-                else
-                    raster_borders(&r, v, slots[s].first_triangle + t);
-            }
-        }
+    st = raster_bands(&r, slots, slot_count, skip, total_triangles, desc->threads, what);
+    if (st != LX_OK)
+        goto done;
     map->info.overlap_texels = r.overlap;
     for (uint32_t s = 0; s < slot_count; s++)
         if (r.slot_overlap[s])
@@ -469,7 +562,9 @@ lx_status lx_texel_map_build(const lx_scene *scene, uint32_t node_index, const l
 
     /* gather covered texels tile by tile */
     uint32_t used = 0;
-    for (uint64_t p = 0; p < pixels; p++)
+    int64_t pixel_count = (int64_t)pixels;
+#pragma omp parallel for schedule(static) reduction(+ : used) num_threads(lx_thread_count(desc->threads))
+    for (int64_t p = 0; p < pixel_count; p++)
         used += r.owner[p] != UINT32_MAX;
     int tiles_x = (w + LX_TILE - 1) / LX_TILE, tiles_y = (h + LX_TILE - 1) / LX_TILE;
     map->tile_count = (uint32_t)tiles_x * (uint32_t)tiles_y;
@@ -527,45 +622,63 @@ lx_status lx_texel_map_build(const lx_scene *scene, uint32_t node_index, const l
         if (!map->object_position || !map->object_normal || !map->object_geometric_normal)
             st = lx_fail(LX_ERR_NOMEM, "%s: out of memory", what);
     }
-    uint32_t n = 0;
-    for (int ty = 0; ty < tiles_y && st == LX_OK; ty++)
-        for (int tx = 0; tx < tiles_x; tx++) {
-            map->tile_start[ty * tiles_x + tx] = n;
-            for (int y = ty * LX_TILE; y < (ty + 1) * LX_TILE && y < h; y++)
-                for (int x = tx * LX_TILE; x < (tx + 1) * LX_TILE && x < w; x++) {
-                    size_t p = (size_t)y * w + x;
-                    if (r.owner[p] == UINT32_MAX)
-                        continue;
-                    uint32_t s = 0;
-                    while (s + 1 < slot_count && slots[s + 1].first_triangle <= r.owner[p])
-                        s++;
-                    const lx_mesh *m = slots[s].mesh;
-                    uint32_t t = r.owner[p] - slots[s].first_triangle;
-                    const uint32_t *i = &m->indices[3 * t];
-                    float w1 = r.b1[p], w2 = r.b2[p], w0 = 1.0f - w1 - w2;
-                    lx_texel *tx_ = &map->texels[n];
-                    tx_->pixel = (uint32_t)p;
-                    tx_->mesh = slots[s].mesh_index;
-                    tx_->triangle = t;
-                    lx_vec3 pa = m->positions[i[0]], pb = m->positions[i[1]],
-                            pc = m->positions[i[2]];
-                    lx_vec3 position =
-                        lx_add(lx_add(lx_scale(pa, w0), lx_scale(pb, w1)), lx_scale(pc, w2));
-                    lx_vec3 geometric = lx_normalize(lx_cross(lx_sub(pb, pa), lx_sub(pc, pa)));
-                    lx_vec3 nrm = lx_add(
-                        lx_add(lx_scale(m->normals[i[0]], w0), lx_scale(m->normals[i[1]], w1)),
-                        lx_scale(m->normals[i[2]], w2));
-                    nrm = lx_length(nrm) > 1e-12f ? lx_normalize(nrm) : geometric;
-                    const lx_material *mat = &scene->materials[m->material];
-                    if (tangents[s])
-                        sample_normal_map(mat, m, tangents[s], i, w0, w1, w2, &nrm);
-                    if (map->albedo)
-                        map->albedo[n] = sample_albedo(mat, m, i, w0, w1, w2);
-                    place_texel(map, n++, &node->world, &nm, position, nrm, geometric);
-                    map->mask[p] = 1;
-                }
-        }
-    map->tile_start[map->tile_count] = n;
+    /* texels in tile order: count each tile's, place the tiles, then fill
+     * them in parallel (every texel's slot is known, so any thread count
+     * writes the same arrays) */
+    int threads = lx_thread_count(desc->threads);
+    int tile_count = (int)map->tile_count;
+#pragma omp parallel for schedule(static) num_threads(threads)
+    for (int tile = 0; tile < tile_count; tile++) {
+        int ty = tile / tiles_x, tx = tile % tiles_x;
+        uint32_t c = 0;
+        for (int y = ty * LX_TILE; y < (ty + 1) * LX_TILE && y < h; y++)
+            for (int x = tx * LX_TILE; x < (tx + 1) * LX_TILE && x < w; x++)
+                c += r.owner[(size_t)y * w + x] != UINT32_MAX;
+        map->tile_start[tile + 1] = c;
+    }
+    map->tile_start[0] = 0;
+    for (int tile = 0; tile < tile_count; tile++)
+        map->tile_start[tile + 1] += map->tile_start[tile];
+    uint32_t n = map->tile_start[tile_count];
+#pragma omp parallel for schedule(dynamic, 16) num_threads(threads)
+    for (int tile = 0; tile < tile_count; tile++) {
+        if (st != LX_OK)
+            continue;
+        int ty = tile / tiles_x, tx = tile % tiles_x;
+        uint32_t k = map->tile_start[tile];
+        for (int y = ty * LX_TILE; y < (ty + 1) * LX_TILE && y < h; y++)
+            for (int x = tx * LX_TILE; x < (tx + 1) * LX_TILE && x < w; x++) {
+                size_t p = (size_t)y * w + x;
+                if (r.owner[p] == UINT32_MAX)
+                    continue;
+                uint32_t s = 0;
+                while (s + 1 < slot_count && slots[s + 1].first_triangle <= r.owner[p])
+                    s++;
+                const lx_mesh *m = slots[s].mesh;
+                uint32_t t = r.owner[p] - slots[s].first_triangle;
+                const uint32_t *i = &m->indices[3 * t];
+                float w1 = r.b1[p], w2 = r.b2[p], w0 = 1.0f - w1 - w2;
+                lx_texel *tx_ = &map->texels[k];
+                tx_->pixel = (uint32_t)p;
+                tx_->mesh = slots[s].mesh_index;
+                tx_->triangle = t;
+                lx_vec3 pa = m->positions[i[0]], pb = m->positions[i[1]], pc = m->positions[i[2]];
+                lx_vec3 position =
+                    lx_add(lx_add(lx_scale(pa, w0), lx_scale(pb, w1)), lx_scale(pc, w2));
+                lx_vec3 geometric = lx_normalize(lx_cross(lx_sub(pb, pa), lx_sub(pc, pa)));
+                lx_vec3 nrm =
+                    lx_add(lx_add(lx_scale(m->normals[i[0]], w0), lx_scale(m->normals[i[1]], w1)),
+                           lx_scale(m->normals[i[2]], w2));
+                nrm = lx_length(nrm) > 1e-12f ? lx_normalize(nrm) : geometric;
+                const lx_material *mat = &scene->materials[m->material];
+                if (tangents[s])
+                    sample_normal_map(mat, m, tangents[s], i, w0, w1, w2, &nrm);
+                if (map->albedo)
+                    map->albedo[k] = sample_albedo(mat, m, i, w0, w1, w2);
+                place_texel(map, k++, &node->world, &nm, position, nrm, geometric);
+                map->mask[p] = 1;
+            }
+    }
     map->info.used_texels = n;
     for (uint32_t s = 0; s < slot_count; s++)
         if (own_tangents[s])
