@@ -455,6 +455,7 @@ bad "a run that needs more memory than the machine" 1 "const:1|prefilter: a 1638
 # the run reaches its first progress report)
 pfm "$IN/small_eq.pfm" 16 8 $(repeat 128 0.5)
 out=$WORK/out_upsample
+: >"$ERR" # empty before the run starts: a stale "paused" line would send the signal too early
 LUXEL_TEST_PAUSE=environment "$LUXEL" ibl "$IN/small_eq.pfm" --size 64 --irradiance=sh -o "$out" >"$OUT" 2>"$ERR" &
 pid=$!
 if wait_for_pause environment; then
@@ -479,6 +480,7 @@ expect_stderr_has "--specular-size 8x: a warning" "^luxel: warning: prefilter: 1
 pfm "$IN/eq64.pfm" 64 32 $(repeat 2048 0.5)
 for phase in environment sh irradiance specular dfg write; do
     out=$WORK/out_phase_$phase
+    : >"$ERR" # empty before the run starts: a stale "paused" line would send the signal too early
     LUXEL_TEST_PAUSE=$phase "$LUXEL" ibl "$IN/eq64.pfm" --threads 1 -o "$out" >"$OUT" 2>"$ERR" &
     pid=$!
     if wait_for_pause "$phase"; then
@@ -499,6 +501,7 @@ done
 # --threads 2 bounds the process at two threads (whether OpenMP started
 # the second one for these small loops is its business)
 out=$WORK/out_threads2
+: >"$ERR" # empty before the run starts: a stale "paused" line would send the signal too early
 LUXEL_TEST_PAUSE=write "$LUXEL" ibl "$IN/eq64.pfm" --threads 2 -o "$out" >"$OUT" 2>"$ERR" &
 pid=$!
 if wait_for_pause write; then

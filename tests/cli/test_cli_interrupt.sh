@@ -33,6 +33,7 @@ wait_for_pause() {
 interrupt() {
     local label=$1 phase=$2 sig=$3 out=$4
     shift 4
+    : >"$ERR" # empty before the run starts: a stale "paused" line would send the signal too early
     LUXEL_TEST_PAUSE=$phase "$LUXEL" "$@" -o "$out" >"$OUT" 2>"$ERR" </dev/null &
     local pid=$!
     if ! wait_for_pause "$pid"; then
