@@ -75,11 +75,19 @@ struct lx_baker {
 void lx_texel_map_size(const lx_scene *scene, uint32_t node, const lx_bake_desc *desc, int *width,
                        int *height);
 
-/* Builds the texel map of scene node `node` into map (texel_map.c).
- * Returns LX_OK with map->info.used_texels == 0 and a warning when the
- * node has no UVs to bake. */
+/* The share of a long operation's progress one step reports in: it goes
+ * from `from` to `to`. */
+typedef struct lx_texel_progress {
+    float from, to;
+} lx_texel_progress;
+
+/* Builds the texel map of scene node `node` into map (texel_map.c),
+ * reporting its rasterization to desc->progress within `progress` (and
+ * stopping with LX_ERR_CANCELLED when it says so). Returns LX_OK with
+ * map->info.used_texels == 0 and a warning when the node has no UVs to
+ * bake. */
 lx_status lx_texel_map_build(const lx_scene *scene, uint32_t node, const lx_bake_desc *desc,
-                             lx_lightmap *map);
+                             lx_texel_progress progress, lx_lightmap *map);
 void lx_texel_map_free(lx_lightmap *map);
 /* Makes the object-space copies a move needs (a map built at the
  * identity has none); LX_ERR_NOMEM when they do not fit. */

@@ -133,7 +133,9 @@ lx_status lx_baker_create(const lx_scene *scene, const lx_bake_desc *in, lx_bake
         b->node_world[n] = scene->nodes[n].world;
         b->node_map[n] = UINT32_MAX;
         lx_lightmap *map = &b->maps[b->map_count];
-        st = lx_texel_map_build(scene, n, &desc, map);
+        lx_texel_progress share = {TEXEL_MAPS_SHARE * (float)n / (float)scene->node_count,
+                                   TEXEL_MAPS_SHARE * (float)(n + 1) / (float)scene->node_count};
+        st = lx_texel_map_build(scene, n, &desc, share, map);
         if (st != LX_OK) {
             lx_texel_map_free(map);
             lx_baker_destroy(b);

@@ -9,6 +9,8 @@
 
 #include "luxel/maps.h"
 
+#include <omp.h>
+#include <stdatomic.h>
 #include <stdio.h>
 #include <stdlib.h>
 #include <string.h>
@@ -221,9 +223,13 @@ static void raster_borders(raster_ctx *r, const double *v[3], uint32_t id)
  * thread count. Triangles are listed per band first (a counting sort in
  * triangle order), so a band skips the ones that miss it. */
 static lx_status raster_bands(raster_ctx *r, const slot *slots, uint32_t slot_count,
-                              const uint8_t *skip, uint32_t total_triangles, int threads,
+                              const uint8_t *skip, uint32_t total_triangles,
+                              const lx_bake_desc *desc, lx_texel_progress progress,
                               const char *what)
 {
+    int threads = desc->threads;
+    _Atomic int bands_done = 0;
+    _Atomic bool cancelled = false;
     int bands = (r->height + RASTER_BAND - 1) / RASTER_BAND;
     uint32_t *band_start = calloc((size_t)bands + 1, sizeof(uint32_t));
     uint32_t *band_fill = calloc((size_t)bands, sizeof(uint32_t));
@@ -279,6 +285,15 @@ static lx_status raster_bands(raster_ctx *r, const slot *slots, uint32_t slot_co
 
 #pragma omp parallel for schedule(dynamic, 1) num_threads(lx_thread_count(threads))
     for (int k = 0; k < bands; k++) {
+        if (atomic_load(&cancelled))
+            continue;
+        /* large maps take long enough to report and stop: the calling
+         * thread reports (one thread at a time, never backwards) */
+        if (desc->progress && omp_get_thread_num() == 0 &&
+            !desc->progress(desc->progress_user,
+                            progress.from + (progress.to - progress.from) *
+                                                (float)atomic_load(&bands_done) / (float)bands))
+            atomic_store(&cancelled, true);
         raster_ctx br = *r;
         br.row0 = k * RASTER_BAND;
         br.row1 = br.row0 + RASTER_BAND < r->height ? br.row0 + RASTER_BAND : r->height;
@@ -300,8 +315,13 @@ static lx_status raster_bands(raster_ctx *r, const slot *slots, uint32_t slot_co
                     raster_borders(&br, v, id);
             }
         br.slot_overlap[slot_count] = br.overlap;
+        atomic_fetch_add(&bands_done, 1);
     }
     free(list);
+    if (atomic_load(&cancelled)) {
+        st = lx_fail(LX_ERR_CANCELLED, "bake cancelled");
+        goto done;
+    }
     /* overlap counts summed in band order */
     for (int k = 0; k < bands; k++) {
         const uint32_t *c = counts + (size_t)k * (slot_count + 1);
@@ -488,7 +508,7 @@ static uint32_t collect_slots(const lx_scene *scene, const lx_node *node, slot *
 }
 
 lx_status lx_texel_map_build(const lx_scene *scene, uint32_t node_index, const lx_bake_desc *desc,
-                             lx_lightmap *map)
+                             lx_texel_progress progress, lx_lightmap *map)
 {
     const lx_node *node = &scene->nodes[node_index];
     memset(map, 0, sizeof *map);
@@ -550,7 +570,7 @@ lx_status lx_texel_map_build(const lx_scene *scene, uint32_t node_index, const l
     if (st != LX_OK)
         goto done;
 
-    st = raster_bands(&r, slots, slot_count, skip, total_triangles, desc->threads, what);
+    st = raster_bands(&r, slots, slot_count, skip, total_triangles, desc, progress, what);
     if (st != LX_OK)
         goto done;
     map->info.overlap_texels = r.overlap;
