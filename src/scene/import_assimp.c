@@ -188,9 +188,10 @@ static void load_texture(import_ctx *c, const struct aiString *tex_path, bool ra
  * when the scene has several root nodes), and a node with "mesh": m lists
  * one aiMesh per primitive of m, in primitive order, each with its
  * primitive's material. So the JSON nodes are walked alongside the aiNodes
- * and every pairing is checked: child and primitive counts, the node's
- * name (when the file gives one; assimp names an unnamed node itself) and
- * each primitive's type. Under a node that does not line up nothing is
+ * and every pairing is checked: child and primitive counts (a primitive
+ * assimp skipped shows as a count that differs), the node's name (when
+ * the file gives one; assimp names an unnamed node itself) and each
+ * primitive's type. Under a node that does not line up nothing is
  * paired: its aiMeshes are marked as not matched, and so is an aiMesh two
  * primitives claim. A mesh instanced by several nodes is paired at each.
  * The paired aiMeshes then give each aiMaterial its JSON material. */
