@@ -147,7 +147,11 @@ lx_scene_load_desc lx_scene_load_desc_defaults(const lx_scene_load_desc *desc);
  * fail with LX_ERR_UNSUPPORTED (assimp's other readers are not safe on
  * malformed files). desc may be NULL. Triangles of
  * zero area in space, non-finite values and out-of-range indices fail the
- * load with a message naming the mesh (see skip_degenerate). */
+ * load with a message naming the mesh (see skip_degenerate). A glTF
+ * material whose KHR_texture_transform cannot be told (assimp's material
+ * matches none of the file's through the scene's meshes, and the file's
+ * materials of its name state different transforms) fails the load with
+ * LX_ERR_UNSUPPORTED naming the material rather than take a wrong one. */
 lx_status lx_scene_load(const char *path, const lx_scene_load_desc *desc, lx_scene **out);
 
 /* An empty scene named name (used in messages). */

@@ -1,10 +1,10 @@
 /* A glTF 2.0 file's own JSON (cJSON): the whole of a .gltf, or the JSON
  * chunk of a .glb located through its 12-byte header per the glTF 2.0
  * binary container spec; typed reads shared by the readers of what assimp
- * drops (gltf_lights.c, gltf_textures.c); and the triangle count each mesh
- * primitive defines (glTF 2.0 spec, 3.7.2.1 Overview of primitive modes),
- * which lets the importer notice faces assimp dropped without watching its
- * process-wide log. */
+ * drops (gltf_lights.c, gltf_textures.c); and each mesh primitive's mode,
+ * material and the triangles it defines (glTF 2.0 spec, 3.7.2.1 Overview
+ * of primitive modes), which the importer matches to assimp's meshes to
+ * notice faces assimp dropped. */
 #include "gltf_json.h"
 #include "core/internal.h"
 
@@ -278,34 +278,49 @@ static bool accessor_count(const cJSON *const *accessors, size_t n, const cJSON 
     return true;
 }
 
-lx_status lx_gltf_primitive_triangles(const char *file, const cJSON *root, uint64_t **triangles,
-                                      uint32_t **mesh_of, size_t *count)
+void lx_gltf_primitives_free(lx_gltf_primitives *p)
 {
-    *triangles = NULL;
-    *mesh_of = NULL;
-    *count = 0;
+    free(p->first);
+    free(p->mesh);
+    free(p->triangles);
+    free(p->material);
+    free(p->mode);
+    memset(p, 0, sizeof *p);
+}
+
+static const cJSON *mesh_primitives(const cJSON *mesh)
+{
+    const cJSON *prims = lx_gltf_get(mesh, "primitives");
+    return cJSON_IsArray(prims) ? prims : NULL;
+}
+
+lx_status lx_gltf_primitives_read(const char *file, const cJSON *root, lx_gltf_primitives *out)
+{
+    memset(out, 0, sizeof *out);
     const cJSON *meshes = lx_gltf_get(root, "meshes");
     const cJSON *acc_list = lx_gltf_get(root, "accessors");
-    if (!cJSON_IsArray(meshes))
-        return LX_OK;
-    size_t n = 0;
-    for (const cJSON *m = meshes->child; m; m = m->next) {
-        const cJSON *prims = lx_gltf_get(m, "primitives");
-        n += cJSON_IsArray(prims) ? (size_t)cJSON_GetArraySize(prims) : 0;
+    const cJSON *mat_list = lx_gltf_get(root, "materials");
+    size_t nm = 0, n = 0;
+    for (const cJSON *m = cJSON_IsArray(meshes) ? meshes->child : NULL; m; m = m->next, nm++) {
+        const cJSON *prims = mesh_primitives(m);
+        n += prims ? (size_t)cJSON_GetArraySize(prims) : 0;
     }
-    if (n == 0)
-        return LX_OK;
+    size_t n_materials = cJSON_IsArray(mat_list) ? (size_t)cJSON_GetArraySize(mat_list) : 0;
     /* the accessors by index: cJSON's own lookup walks the list */
     size_t na = 0;
     for (const cJSON *a = cJSON_IsArray(acc_list) ? acc_list->child : NULL; a; a = a->next)
         na++;
-    uint64_t *tri = malloc(n * sizeof *tri);
-    uint32_t *owner = malloc(n * sizeof *owner);
+    size_t slots = n ? n : 1;
+    out->first = malloc((nm + 1) * sizeof *out->first);
+    out->mesh = malloc(slots * sizeof *out->mesh);
+    out->triangles = malloc(slots * sizeof *out->triangles);
+    out->material = malloc(slots * sizeof *out->material);
+    out->mode = malloc(slots * sizeof *out->mode);
     const cJSON **accessors = malloc((na ? na : 1) * sizeof *accessors);
-    if (!tri || !owner || !accessors) {
-        free(tri);
-        free(owner);
+    if (!out->first || !out->mesh || !out->triangles || !out->material || !out->mode ||
+        !accessors) {
         free(accessors);
+        lx_gltf_primitives_free(out);
         return failf(file, LX_ERR_NOMEM, "out of memory for %zu primitives", n);
     }
     na = 0;
@@ -313,28 +328,42 @@ lx_status lx_gltf_primitive_triangles(const char *file, const cJSON *root, uint6
         accessors[na++] = a;
     size_t k = 0;
     uint32_t mi = 0;
-    for (const cJSON *m = meshes->child; m; m = m->next, mi++) {
-        const cJSON *prims = lx_gltf_get(m, "primitives");
-        for (const cJSON *p = cJSON_IsArray(prims) ? prims->child : NULL; p; p = p->next, k++) {
-            owner[k] = mi;
-            tri[k] = UINT64_MAX;
+    for (const cJSON *m = cJSON_IsArray(meshes) ? meshes->child : NULL; m; m = m->next, mi++) {
+        out->first[mi] = k;
+        const cJSON *prims = mesh_primitives(m);
+        for (const cJSON *p = prims ? prims->child : NULL; p; p = p->next, k++) {
+            out->mesh[k] = mi;
+            out->triangles[k] = UINT64_MAX;
+            const cJSON *mat = lx_gltf_get(p, "material");
+            size_t mat_index;
+            if (!mat)
+                out->material[k] = LX_GLTF_NO_MATERIAL;
+            else if (lx_gltf_index(mat, n_materials, &mat_index))
+                out->material[k] = (int64_t)mat_index;
+            else
+                out->material[k] = LX_GLTF_BAD_MATERIAL;
             const cJSON *mode = lx_gltf_get(p, "mode");
-            double md = mode ? (cJSON_IsNumber(mode) ? mode->valuedouble : -1.0) : 4.0;
+            size_t md = 4; /* TRIANGLES when "mode" is left out */
+            if (mode && !lx_gltf_index(mode, 7, &md)) {
+                out->mode[k] = -1;
+                continue;
+            }
+            out->mode[k] = (int8_t)md;
             uint64_t c;
             const cJSON *indices = lx_gltf_get(p, "indices");
             const cJSON *ref =
                 indices ? indices : lx_gltf_get(lx_gltf_get(p, "attributes"), "POSITION");
             if (!accessor_count(accessors, na, ref, &c))
                 continue;
-            if (md == 4.0) /* TRIANGLES: a trailing partial triangle is no triangle */
-                tri[k] = c / 3;
-            else if ((md == 5.0 || md == 6.0) && c >= 3) /* TRIANGLE_STRIP, TRIANGLE_FAN */
-                tri[k] = c - 2;
+            if (md == 4) /* TRIANGLES: a trailing partial triangle is no triangle */
+                out->triangles[k] = c / 3;
+            else if ((md == 5 || md == 6) && c >= 3) /* TRIANGLE_STRIP, TRIANGLE_FAN */
+                out->triangles[k] = c - 2;
         }
     }
+    out->first[nm] = k;
+    out->mesh_count = nm;
+    out->count = n;
     free(accessors);
-    *triangles = tri;
-    *mesh_of = owner;
-    *count = n;
     return LX_OK;
 }

@@ -54,20 +54,36 @@ typedef struct lx_gltf_texture_ref {
     lx_uv_transform transform; /* KHR_texture_transform, enabled when given */
 } lx_gltf_texture_ref;
 
-/* The baseColorTexture and normalTexture of glTF material `index` (both
- * zeroed when the file has no such material). Malformed extension fields
- * fail naming the file, the material and the field. */
-lx_status lx_gltf_material_textures(const char *file, const cJSON *root, size_t index,
+/* The baseColorTexture and normalTexture of glTF material `index`, whose
+ * JSON object is material (both zeroed when it is not an object).
+ * Malformed extension fields fail naming the file, the material and the
+ * field. */
+lx_status lx_gltf_material_textures(const char *file, const cJSON *material, size_t index,
                                     lx_gltf_texture_ref *base_color, lx_gltf_texture_ref *normal);
 
-/* The triangles each primitive defines, in file order (meshes, then their
- * primitives: the order assimp's glTF 2.0 importer makes its meshes in):
- * *count entries, each the triangle count of a TRIANGLES, TRIANGLE_STRIP
- * or TRIANGLE_FAN primitive or UINT64_MAX when that cannot be told (other
- * modes, missing or malformed accessors: assimp reports those itself).
- * mesh_of[k] gets the glTF mesh index of entry k. Both arrays are the
- * caller's to free; on failure both are NULL. */
-lx_status lx_gltf_primitive_triangles(const char *file, const cJSON *root, uint64_t **triangles,
-                                      uint32_t **mesh_of, size_t *count);
+/* The primitives of the file's meshes as the JSON states them, flat in
+ * file order: mesh 0's primitives, then mesh 1's, ... (what matches them
+ * to assimp's meshes is the node hierarchy: import_assimp.c). */
+#define LX_GLTF_NO_MATERIAL (-1)  /* the primitive names no material */
+#define LX_GLTF_BAD_MATERIAL (-2) /* "material" is not a valid index */
+typedef struct lx_gltf_primitives {
+    size_t mesh_count; /* entries of "meshes" */
+    size_t *first;     /* mesh_count + 1 entries: mesh m holds first[m]..first[m+1]-1 */
+    size_t count;      /* primitives in all */
+    /* per primitive: */
+    uint32_t *mesh;      /* its mesh */
+    uint64_t *triangles; /* triangles of a TRIANGLES, TRIANGLE_STRIP or TRIANGLE_FAN
+                          * primitive (glTF 2.0 spec, 3.7.2.1), UINT64_MAX when that
+                          * cannot be told (other modes, missing or malformed
+                          * accessors: assimp reports those itself) */
+    int64_t *material;   /* material index, LX_GLTF_NO_MATERIAL or LX_GLTF_BAD_MATERIAL */
+    int8_t *mode;        /* 0..6, or -1 when "mode" is not one of them */
+} lx_gltf_primitives;
+
+/* Reads every mesh's primitives (a mesh that is not an object or has no
+ * "primitives" array has none). Free with lx_gltf_primitives_free, also
+ * after a failure (which leaves *out empty). */
+lx_status lx_gltf_primitives_read(const char *file, const cJSON *root, lx_gltf_primitives *out);
+void lx_gltf_primitives_free(lx_gltf_primitives *p);
 
 #endif

@@ -67,15 +67,13 @@ static lx_status read_ref(const char *file, const char *who, const cJSON *info,
     return LX_OK;
 }
 
-lx_status lx_gltf_material_textures(const char *file, const cJSON *root, size_t index,
+lx_status lx_gltf_material_textures(const char *file, const cJSON *m, size_t index,
                                     lx_gltf_texture_ref *base_color, lx_gltf_texture_ref *normal)
 {
     memset(base_color, 0, sizeof *base_color);
     memset(normal, 0, sizeof *normal);
-    const cJSON *materials = lx_gltf_get(root, "materials");
-    if (!cJSON_IsArray(materials) || index >= (size_t)cJSON_GetArraySize(materials))
+    if (!cJSON_IsObject(m))
         return LX_OK;
-    const cJSON *m = cJSON_GetArrayItem(materials, (int)index);
     char who[160], where[200];
     lx_gltf_label(who, sizeof who, "material", index, m);
     snprintf(where, sizeof where, "%s: baseColorTexture", who);

@@ -4,7 +4,9 @@
  * JSON (gltf_json.c) come what assimp drops or changes: KHR_lights_punctual
  * lights (gltf_lights.c), KHR_texture_transform and texCoord
  * (gltf_textures.c), and the triangle count of every primitive, so faces
- * assimp dropped for out-of-range indices are noticed without its log. */
+ * assimp dropped for out-of-range indices are noticed and named. Both need
+ * to know which of assimp's meshes and materials is which of the file's:
+ * gltf_map below finds that through the node hierarchy. */
 #include "luxel/scene.h"
 #include "core/internal.h"
 
@@ -27,6 +29,9 @@
 #include <sys/stat.h>
 
 #define LX_NAME_MAX 256
+#define LX_NODE_DEPTH_MAX 256
+
+typedef struct gltf_map gltf_map;
 
 typedef struct import_ctx {
     const char *path;
@@ -35,17 +40,19 @@ typedef struct import_ctx {
     const lx_scene_load_desc *desc;
     uint32_t *mesh_map; /* assimp mesh -> lx mesh index, UINT32_MAX if skipped */
     char *folder;
-    const cJSON *gltf; /* the file's glTF 2.0 JSON, or NULL */
+    const cJSON *gltf;   /* the file's glTF 2.0 JSON, or NULL */
+    const gltf_map *map; /* assimp's meshes and materials in it, with gltf */
 } import_ctx;
 
 /* assimp's C API keeps the last error in one process-wide string, which
  * every failed import assigns (aiImportFileExWithProperties), so imports
- * are serialized. Its glTF 1.0 importer reports faces it dropped for
- * out-of-range indices only through its log, also process-wide: for such
- * files the log is watched while the import runs. glTF 2.0 files are
- * checked against their JSON instead (check_dropped_faces) and no other
- * importer drops faces that way, so no other import attaches a log (which
- * would also make assimp format every message it logs). */
+ * are serialized. Its glTF importers report faces they dropped for
+ * out-of-range indices only through its log, also process-wide, and
+ * without naming the mesh: for glTF files the log is watched while the
+ * import runs. A glTF 2.0 file's primitives are checked against their JSON
+ * (check_dropped_faces), which names the primitive; the log decides only
+ * for meshes that cannot be matched to the JSON, and for glTF 1.0. No
+ * other importer drops faces that way, so no other import attaches it. */
 static pthread_mutex_t import_lock = PTHREAD_MUTEX_INITIALIZER;
 static bool dropped_faces;
 
@@ -171,28 +178,297 @@ static void load_texture(import_ctx *c, const struct aiString *tex_path, bool ra
     *out_path = full ? full : lx_strdup(p);
 }
 
+/* ---- assimp's glTF 2.0 meshes and materials in the file ----------------- */
+
+/* assimp's glTF 2.0 reader loads meshes and materials lazily, in the order
+ * the scene's nodes first reach them, so its mesh and material arrays
+ * follow neither the file's order nor any other luxel could rely on. What
+ * it keeps is the node hierarchy: each aiNode is one node of the imported
+ * scene with its children in the file's order (under a synthetic root
+ * when the scene has several root nodes), and a node with "mesh": m lists
+ * one aiMesh per primitive of m, in primitive order, each with its
+ * primitive's material. So the JSON nodes are walked alongside the aiNodes
+ * and every pairing is checked: child and primitive counts (a primitive
+ * assimp skipped shows as a count that differs), the node's name (when
+ * the file gives one; assimp names an unnamed node itself) and each
+ * primitive's type. Under a node that does not line up nothing is
+ * paired: its aiMeshes are marked as not matched, and so is an aiMesh two
+ * primitives claim. A mesh instanced by several nodes is paired at each.
+ * The paired aiMeshes then give each aiMaterial its JSON material. */
+#define PRIM_NONE SIZE_MAX         /* no paired node lists the aiMesh */
+#define PRIM_SPOILT (SIZE_MAX - 1) /* listed where the structure does not line up */
+#define MAT_UNKNOWN INT64_MIN      /* no paired aiMesh uses the aiMaterial */
+#define MAT_SPOILT (INT64_MIN + 1) /* paired aiMeshes disagree, or name a bad index */
+
+struct gltf_map {
+    lx_gltf_primitives prims;
+    const cJSON **nodes; /* the JSON nodes by index */
+    size_t node_count;
+    const cJSON **materials; /* the JSON materials by index */
+    size_t material_count;
+    size_t *prim_of;      /* per aiMesh: its primitive in prims, or PRIM_* */
+    int64_t *material_of; /* per aiMaterial: a JSON material index, LX_GLTF_NO_MATERIAL
+                           * (assimp's default material), or MAT_* */
+};
+
+static void gltf_map_free(gltf_map *g)
+{
+    lx_gltf_primitives_free(&g->prims);
+    free(g->nodes);
+    free(g->materials);
+    free(g->prim_of);
+    free(g->material_of);
+    memset(g, 0, sizeof *g);
+}
+
+/* The aiMeshes an aiNode and its descendants list cannot be matched. */
+static void map_spoil(gltf_map *g, const struct aiScene *ai, const struct aiNode *an, int depth)
+{
+    for (unsigned k = 0; k < an->mNumMeshes; k++)
+        if (an->mMeshes[k] < ai->mNumMeshes)
+            g->prim_of[an->mMeshes[k]] = PRIM_SPOILT;
+    /* deeper trees fail the import (import_node) */
+    for (unsigned k = 0; depth < LX_NODE_DEPTH_MAX && k < an->mNumChildren; k++)
+        map_spoil(g, ai, an->mChildren[k], depth + 1);
+}
+
+/* The node references of a "children" or scene "nodes" list as assimp
+ * reads them: entries that are not unsigned integers are skipped (it
+ * refuses the file over one out of range). */
+static size_t count_node_refs(const gltf_map *g, const cJSON *list)
+{
+    size_t n = 0, index;
+    for (const cJSON *e = cJSON_IsArray(list) ? list->child : NULL; e; e = e->next)
+        n += lx_gltf_index(e, g->node_count, &index);
+    return n;
+}
+
+/* Whether assimp's mesh has the primitive type of glTF mode (-1: unknown). */
+static bool mode_matches(int mode, const struct aiMesh *am)
+{
+    unsigned want = mode < 0    ? 0
+                    : mode == 0 ? aiPrimitiveType_POINT
+                    : mode <= 3 ? aiPrimitiveType_LINE
+                                : aiPrimitiveType_TRIANGLE;
+    return want == 0 || (am->mPrimitiveTypes & want) != 0;
+}
+
+static void map_node(gltf_map *g, const struct aiScene *ai, size_t jn, const struct aiNode *an,
+                     int depth)
+{
+    const cJSON *node = g->nodes[jn];
+    const char *name = lx_gltf_get_string(node, "name");
+    /* assimp keeps at most MAXLEN - 1 bytes of a name */
+    if (depth > LX_NODE_DEPTH_MAX ||
+        (name && name[0] && strncmp(name, an->mName.data, sizeof an->mName.data - 1) != 0)) {
+        map_spoil(g, ai, an, depth);
+        return;
+    }
+    const cJSON *mesh = lx_gltf_get(node, "mesh");
+    size_t m = 0;
+    bool lined_up = mesh ? lx_gltf_index(mesh, g->prims.mesh_count, &m) : an->mNumMeshes == 0;
+    if (mesh && lined_up) {
+        size_t first = g->prims.first[m], count = g->prims.first[m + 1] - first;
+        lined_up = an->mNumMeshes == count;
+        for (size_t p = 0; lined_up && p < count; p++)
+            lined_up = an->mMeshes[p] < ai->mNumMeshes &&
+                       mode_matches(g->prims.mode[first + p], ai->mMeshes[an->mMeshes[p]]);
+        for (size_t p = 0; lined_up && p < count; p++) {
+            size_t *slot = &g->prim_of[an->mMeshes[p]];
+            if (*slot == PRIM_NONE)
+                *slot = first + p;
+            else if (*slot != first + p)
+                *slot = PRIM_SPOILT;
+        }
+    }
+    if (!lined_up)
+        for (unsigned k = 0; k < an->mNumMeshes; k++)
+            if (an->mMeshes[k] < ai->mNumMeshes)
+                g->prim_of[an->mMeshes[k]] = PRIM_SPOILT;
+    const cJSON *children = lx_gltf_get(node, "children");
+    if (count_node_refs(g, children) != an->mNumChildren) {
+        for (unsigned k = 0; k < an->mNumChildren; k++)
+            map_spoil(g, ai, an->mChildren[k], depth + 1);
+        return;
+    }
+    unsigned k = 0;
+    size_t index;
+    for (const cJSON *e = cJSON_IsArray(children) ? children->child : NULL; e; e = e->next)
+        if (lx_gltf_index(e, g->node_count, &index))
+            map_node(g, ai, index, an->mChildren[k++], depth + 1);
+}
+
+/* Pairs the nodes of the scene assimp imports ("scene", else scene 0). */
+static void map_scene(gltf_map *g, const struct aiScene *ai, const cJSON *root)
+{
+    const struct aiNode *an = ai->mRootNode;
+    const cJSON *scenes = lx_gltf_get(root, "scenes");
+    size_t n_scenes = cJSON_IsArray(scenes) ? (size_t)cJSON_GetArraySize(scenes) : 0, si = 0;
+    const cJSON *scene = lx_gltf_get(root, "scene");
+    if ((scene && !lx_gltf_index(scene, n_scenes, &si)) || si >= n_scenes) {
+        map_spoil(g, ai, an, 0);
+        return;
+    }
+    const cJSON *list = lx_gltf_get(cJSON_GetArrayItem(scenes, (int)si), "nodes");
+    size_t n = count_node_refs(g, list), index = 0;
+    const cJSON *e = cJSON_IsArray(list) ? list->child : NULL;
+    while (e && !lx_gltf_index(e, g->node_count, &index))
+        e = e->next;
+    if (n == 1) {
+        map_node(g, ai, index, an, 0);
+        return;
+    }
+    /* no root nodes or several: assimp's own root holds them */
+    if (an->mNumMeshes != 0 || an->mNumChildren != n) {
+        map_spoil(g, ai, an, 0);
+        return;
+    }
+    unsigned k = 0;
+    for (; e; e = e->next)
+        if (lx_gltf_index(e, g->node_count, &index))
+            map_node(g, ai, index, an->mChildren[k++], 1);
+}
+
+static lx_status gltf_map_build(const import_ctx *c, gltf_map *g)
+{
+    memset(g, 0, sizeof *g);
+    const struct aiScene *ai = c->ai;
+    lx_status st = lx_gltf_primitives_read(c->path, c->gltf, &g->prims);
+    if (st != LX_OK)
+        return st;
+    const cJSON *nodes = lx_gltf_get(c->gltf, "nodes");
+    const cJSON *materials = lx_gltf_get(c->gltf, "materials");
+    for (const cJSON *e = cJSON_IsArray(nodes) ? nodes->child : NULL; e; e = e->next)
+        g->node_count++;
+    for (const cJSON *e = cJSON_IsArray(materials) ? materials->child : NULL; e; e = e->next)
+        g->material_count++;
+    g->nodes = malloc((g->node_count ? g->node_count : 1) * sizeof *g->nodes);
+    g->materials = malloc((g->material_count ? g->material_count : 1) * sizeof *g->materials);
+    g->prim_of = malloc((ai->mNumMeshes ? ai->mNumMeshes : 1) * sizeof *g->prim_of);
+    g->material_of = malloc((ai->mNumMaterials ? ai->mNumMaterials : 1) * sizeof *g->material_of);
+    if (!g->nodes || !g->materials || !g->prim_of || !g->material_of) {
+        size_t n = g->node_count;
+        gltf_map_free(g);
+        return lx_fail(LX_ERR_NOMEM, "%s: out of memory matching %zu glTF nodes", c->path, n);
+    }
+    size_t i = 0;
+    for (const cJSON *e = cJSON_IsArray(nodes) ? nodes->child : NULL; e; e = e->next)
+        g->nodes[i++] = e;
+    i = 0;
+    for (const cJSON *e = cJSON_IsArray(materials) ? materials->child : NULL; e; e = e->next)
+        g->materials[i++] = e;
+    for (unsigned k = 0; k < ai->mNumMeshes; k++)
+        g->prim_of[k] = PRIM_NONE;
+    for (unsigned k = 0; k < ai->mNumMaterials; k++)
+        g->material_of[k] = MAT_UNKNOWN;
+    map_scene(g, ai, c->gltf);
+    unsigned unmatched = 0;
+    for (unsigned k = 0; k < ai->mNumMeshes; k++)
+        unmatched += g->prim_of[k] >= g->prims.count;
+    if (unmatched)
+        lx_log(LX_LOG_INFO,
+               "%s: %u of %u meshes are not matched to the file's primitives through its nodes; "
+               "faces assimp drops from them are noticed through its log",
+               c->path, unmatched, ai->mNumMeshes);
+    for (unsigned k = 0; k < ai->mNumMeshes; k++) {
+        size_t f = g->prim_of[k];
+        unsigned a = ai->mMeshes[k]->mMaterialIndex;
+        if (f >= g->prims.count || a >= ai->mNumMaterials)
+            continue;
+        int64_t want = g->prims.material[f], *have = &g->material_of[a];
+        if (want == LX_GLTF_BAD_MATERIAL)
+            *have = MAT_SPOILT;
+        else if (*have == MAT_UNKNOWN)
+            *have = want;
+        else if (*have != want)
+            *have = MAT_SPOILT;
+    }
+    return LX_OK;
+}
+
+static bool ref_equal(const lx_gltf_texture_ref *a, const lx_gltf_texture_ref *b)
+{
+    const lx_uv_transform *s = &a->transform, *t = &b->transform;
+    return a->present == b->present && a->tex_coord == b->tex_coord && s->enabled == t->enabled &&
+           s->offset.x == t->offset.x && s->offset.y == t->offset.y && s->rotation == t->rotation &&
+           s->scale.x == t->scale.x && s->scale.y == t->scale.y;
+}
+
+/* The file's texture references (texCoord, KHR_texture_transform) for
+ * assimp's material i, whose base-colour and normal textures luxel reads
+ * when has_base / has_normal; both zeroed when assimp's own are right. A
+ * material matched through the nodes takes its JSON material's. One no
+ * paired mesh uses is matched by what assimp copies, its name: when every
+ * JSON material of that name (of any name if none has it) states the same
+ * references for those textures, they are its; when none of them has a
+ * KHR_texture_transform, assimp's texCoord is the file's. Otherwise its
+ * transform cannot be told and the load fails rather than guess. */
+static lx_status material_refs(const import_ctx *c, unsigned i, const char *label, bool has_base,
+                               bool has_normal, lx_gltf_texture_ref *base,
+                               lx_gltf_texture_ref *normal)
+{
+    memset(base, 0, sizeof *base);
+    memset(normal, 0, sizeof *normal);
+    if (!c->gltf || !c->map || (!has_base && !has_normal))
+        return LX_OK;
+    const gltf_map *g = c->map;
+    int64_t j = g->material_of[i];
+    if (j >= 0 && (size_t)j < g->material_count)
+        return lx_gltf_material_textures(c->path, g->materials[j], (size_t)j, base, normal);
+    struct aiString name;
+    bool named =
+        aiGetMaterialString(c->ai->mMaterials[i], AI_MATKEY_NAME, &name) == aiReturn_SUCCESS &&
+        name.length;
+    size_t candidates = 0;
+    bool any_transform = false, same = true;
+    lx_gltf_texture_ref b0 = {0}, n0 = {0};
+    for (int widen = 0; widen < 2 && candidates == 0; widen++) {
+        for (size_t k = 0; k < g->material_count && (same || !any_transform); k++) {
+            const char *jname = lx_gltf_get_string(g->materials[k], "name");
+            bool match = named ? jname && strncmp(jname, name.data, sizeof name.data - 1) == 0
+                               : !jname || !jname[0];
+            if (!widen && !match)
+                continue;
+            lx_gltf_texture_ref b, nm;
+            candidates++;
+            if (lx_gltf_material_textures(c->path, g->materials[k], k, &b, &nm) != LX_OK) {
+                /* a malformed candidate cannot vouch for anything */
+                any_transform = true;
+                same = false;
+                continue;
+            }
+            if (!has_base)
+                b = (lx_gltf_texture_ref){0};
+            if (!has_normal)
+                nm = (lx_gltf_texture_ref){0};
+            any_transform |= b.transform.enabled || nm.transform.enabled;
+            if (candidates == 1) {
+                b0 = b;
+                n0 = nm;
+            } else {
+                same &= ref_equal(&b, &b0) && ref_equal(&nm, &n0);
+            }
+        }
+    }
+    if (!any_transform)
+        return LX_OK;
+    if (same) {
+        *base = b0;
+        *normal = n0;
+        return LX_OK;
+    }
+    return lx_fail(LX_ERR_UNSUPPORTED,
+                   "%s: material '%s': its KHR_texture_transform cannot be told: no mesh matched "
+                   "to the file's primitives uses it, and the file's materials it may be (by "
+                   "name) differ in KHR_texture_transform or texCoord",
+                   c->path, label);
+}
+
 static lx_status import_materials(import_ctx *c)
 {
-    /* assimp's glTF 2.0 importer makes material i of glTF material i, and
-     * one default material after them */
-    const cJSON *gltf_materials = lx_gltf_get(c->gltf, "materials");
-    unsigned gltf_count =
-        cJSON_IsArray(gltf_materials) ? (unsigned)cJSON_GetArraySize(gltf_materials) : 0;
-    bool by_json = c->gltf && c->ai->mNumMaterials == gltf_count + 1;
-    if (c->gltf && gltf_count && !by_json)
-        lx_log(LX_LOG_WARN,
-               "%s: assimp made %u materials of the file's %u; texCoord and "
-               "KHR_texture_transform are taken from assimp",
-               c->path, c->ai->mNumMaterials, gltf_count);
     for (unsigned i = 0; i < c->ai->mNumMaterials; i++) {
         const struct aiMaterial *am = c->ai->mMaterials[i];
         lx_material m = {0};
-        lx_gltf_texture_ref ref_base = {0}, ref_normal = {0};
-        if (by_json && i < gltf_count) {
-            lx_status st = lx_gltf_material_textures(c->path, c->gltf, i, &ref_base, &ref_normal);
-            if (st != LX_OK)
-                return st;
-        }
         struct aiString name;
         char name_buf[LX_NAME_MAX];
         if (aiGetMaterialString(am, AI_MATKEY_NAME, &name) == aiReturn_SUCCESS && name.length)
@@ -212,6 +488,16 @@ static lx_status import_materials(import_ctx *c)
                            "non-negative colour",
                            c->path, name_buf);
         struct aiString tex;
+        bool has_normal = aiGetMaterialTexture(am, aiTextureType_NORMALS, 0, &tex, NULL, NULL, NULL,
+                                               NULL, NULL, NULL) == aiReturn_SUCCESS;
+        bool has_base = aiGetMaterialTexture(am, aiTextureType_BASE_COLOR, 0, &tex, NULL, NULL,
+                                             NULL, NULL, NULL, NULL) == aiReturn_SUCCESS ||
+                        aiGetMaterialTexture(am, aiTextureType_DIFFUSE, 0, &tex, NULL, NULL, NULL,
+                                             NULL, NULL, NULL) == aiReturn_SUCCESS;
+        lx_gltf_texture_ref ref_base = {0}, ref_normal = {0};
+        lx_status st = material_refs(c, i, name_buf, has_base, has_normal, &ref_base, &ref_normal);
+        if (st != LX_OK)
+            return st;
         unsigned uv = 0;
         if (aiGetMaterialTexture(am, aiTextureType_NORMALS, 0, &tex, NULL, &uv, NULL, NULL, NULL,
                                  NULL) == aiReturn_SUCCESS) {
@@ -260,7 +546,7 @@ static lx_status import_materials(import_ctx *c)
         }
         if (m.normal_scale == 0.0f)
             m.normal_scale = 1.0f;
-        lx_status st = lx_scene_add_material(c->scene, &m, NULL);
+        st = lx_scene_add_material(c->scene, &m, NULL);
         lx_image_free(&m.normal_map);
         lx_image_free(&m.base_color_map);
         free(m.normal_map_path);
@@ -414,8 +700,9 @@ static void unique_node_name(const lx_scene *s, const char *base, char *out, siz
 static lx_status import_node(import_ctx *c, const struct aiNode *node, const lx_mat4 *parent,
                              int depth, uint32_t *counter)
 {
-    if (depth > 256)
-        return lx_fail(LX_ERR_FORMAT, "%s: node hierarchy deeper than 256 levels", c->path);
+    if (depth > LX_NODE_DEPTH_MAX)
+        return lx_fail(LX_ERR_FORMAT, "%s: node hierarchy deeper than %d levels", c->path,
+                       LX_NODE_DEPTH_MAX);
     lx_mat4 local = mat4_from_ai(&node->mTransformation);
     lx_mat4 world = lx_mat4_mul(parent, &local);
     (*counter)++;
@@ -462,48 +749,61 @@ static lx_status import_node(import_ctx *c, const struct aiNode *node, const lx_
     return LX_OK;
 }
 
-/* Faces assimp's glTF 2.0 importer dropped: it makes one mesh per
- * primitive, in file order, and leaves out every triangle with a vertex
- * index past the primitive's vertices (it says so only in its log). A
- * triangle primitive that comes out with fewer faces than its accessor's
- * count defines fails the load. */
-static lx_status check_dropped_faces(const import_ctx *c)
+/* Faces assimp's glTF 2.0 importer dropped: it leaves out every triangle
+ * with a vertex index past its primitive's vertices and says so only in
+ * its log, without naming the mesh. A triangle aiMesh matched to its
+ * primitive (gltf_map) that has fewer faces than the primitive's accessor
+ * defines fails the load, naming the primitive (the first in file order).
+ * Where no such count vouches for a triangle mesh (not matched, or the
+ * accessor's count unknown), the log decides (log_dropped): it fails the
+ * load, naming such a mesh. Point and line meshes, which luxel skips, fail
+ * nothing. */
+static lx_status check_dropped_faces(const import_ctx *c, bool log_dropped)
 {
-    uint64_t *want;
-    uint32_t *mesh_of;
-    size_t n;
-    lx_status st = lx_gltf_primitive_triangles(c->path, c->gltf, &want, &mesh_of, &n);
-    if (st != LX_OK)
-        return st;
-    /* a count assimp does not match is a file it read some other way (it
-     * fails such files itself): nothing to compare */
-    if (n == c->ai->mNumMeshes) {
-        const cJSON *meshes = lx_gltf_get(c->gltf, "meshes");
-        size_t first = 0; /* entry of the current mesh's primitive 0 */
-        for (size_t k = 0; k < n && st == LX_OK; k++) {
-            if (k > 0 && mesh_of[k] != mesh_of[k - 1])
-                first = k;
-            const struct aiMesh *am = c->ai->mMeshes[k];
-            if (want[k] == UINT64_MAX || !(am->mPrimitiveTypes & aiPrimitiveType_TRIANGLE) ||
-                (uint64_t)am->mNumFaces >= want[k])
-                continue;
-            char who[128];
-            lx_gltf_label(who, sizeof who, "mesh", mesh_of[k],
-                          cJSON_GetArrayItem(meshes, (int)mesh_of[k]));
-            st = lx_fail(LX_ERR_FORMAT,
-                         "%s: %s: primitive %zu: %llu of %llu triangles have vertex indices out "
-                         "of range",
-                         c->path, who, k - first, (unsigned long long)(want[k] - am->mNumFaces),
-                         (unsigned long long)want[k]);
+    const gltf_map *g = c->map;
+    size_t worst = SIZE_MAX; /* the failing primitive first in file order */
+    uint64_t worst_faces = 0;
+    unsigned unproven = 0, first_unproven = 0;
+    for (unsigned k = 0; k < c->ai->mNumMeshes; k++) {
+        const struct aiMesh *am = c->ai->mMeshes[k];
+        if (!(am->mPrimitiveTypes & aiPrimitiveType_TRIANGLE))
+            continue;
+        size_t f = g->prim_of[k];
+        if (f < g->prims.count && g->prims.triangles[f] != UINT64_MAX) {
+            if ((uint64_t)am->mNumFaces < g->prims.triangles[f] &&
+                (worst == SIZE_MAX || f < worst)) {
+                worst = f;
+                worst_faces = am->mNumFaces;
+            }
+            continue;
         }
+        if (unproven++ == 0)
+            first_unproven = k;
     }
-    free(want);
-    free(mesh_of);
-    return st;
+    if (worst != SIZE_MAX) {
+        uint32_t m = g->prims.mesh[worst];
+        uint64_t want = g->prims.triangles[worst];
+        char who[128];
+        lx_gltf_label(who, sizeof who, "mesh", m,
+                      cJSON_GetArrayItem(lx_gltf_get(c->gltf, "meshes"), (int)m));
+        return lx_fail(LX_ERR_FORMAT,
+                       "%s: %s: primitive %zu: %llu of %llu triangles have vertex indices out "
+                       "of range",
+                       c->path, who, worst - g->prims.first[m],
+                       (unsigned long long)(want - worst_faces), (unsigned long long)want);
+    }
+    if (log_dropped && unproven) {
+        const struct aiMesh *am = c->ai->mMeshes[first_unproven];
+        return lx_fail(LX_ERR_FORMAT,
+                       "%s: some triangles have vertex indices out of range (assimp dropped them "
+                       "from mesh '%s'%s, which luxel could not match to the file's primitives)",
+                       c->path, am->mName.data, unproven > 1 ? " or another" : "");
+    }
+    return LX_OK;
 }
 
 /* True when assimp's glTF 2.0 importer read the file (it names itself in
- * the scene's metadata), so its meshes and materials follow the JSON's. */
+ * the scene's metadata), so its nodes follow the JSON's (gltf_map). */
 static bool read_by_gltf2(const struct aiScene *ai)
 {
     const struct aiMetadata *md = ai->mMetaData;
@@ -569,8 +869,8 @@ lx_status lx_scene_load(const char *path, const lx_scene_load_desc *in, lx_scene
             return st;
     }
     bool gltf2 = gltf && lx_gltf_is_v2(gltf);
-    /* only assimp's glTF 1.0 reader needs its log watched */
-    bool watch_log = gltf && !gltf2;
+    /* only assimp's glTF readers need their log watched */
+    bool watch_log = gltf != NULL;
     struct aiPropertyStore *props = aiCreatePropertyStore();
     /* Smooth normals where a file has none, but keep hard edges hard. */
     aiSetImportPropertyFloat(props, AI_CONFIG_PP_GSN_MAX_SMOOTHING_ANGLE, 60.0f);
@@ -595,7 +895,9 @@ lx_status lx_scene_load(const char *path, const lx_scene_load_desc *in, lx_scene
         return lx_fail(LX_ERR_FORMAT, "%s: cannot import: %s", path,
                        why[0] ? why : "unknown format or corrupt file");
     }
-    if (dropped) {
+    /* a glTF 2.0 file's primitives are checked one by one below */
+    bool by_gltf2 = gltf2 && read_by_gltf2(ai);
+    if (dropped && !by_gltf2) {
         aiReleaseImport(ai);
         cJSON_Delete(gltf);
         return lx_fail(LX_ERR_FORMAT, "%s: some faces have indices out of range", path);
@@ -606,8 +908,8 @@ lx_status lx_scene_load(const char *path, const lx_scene_load_desc *in, lx_scene
         cJSON_Delete(gltf);
         return lx_fail(LX_ERR_FORMAT, "%s: cannot import: the file has no scene", path);
     }
-    import_ctx c = {
-        .path = path, .ai = ai, .desc = desc, .gltf = gltf2 && read_by_gltf2(ai) ? gltf : NULL};
+    import_ctx c = {.path = path, .ai = ai, .desc = desc, .gltf = by_gltf2 ? gltf : NULL};
+    gltf_map map = {0};
     lx_status st = lx_scene_create(path, &c.scene);
     if (st != LX_OK) {
         aiReleaseImport(ai);
@@ -618,8 +920,12 @@ lx_status lx_scene_load(const char *path, const lx_scene_load_desc *in, lx_scene
     c.mesh_map = malloc(sizeof(uint32_t) * (ai->mNumMeshes ? ai->mNumMeshes : 1));
     if (!c.folder || !c.mesh_map)
         st = lx_fail(LX_ERR_NOMEM, "%s: out of memory", path);
+    if (st == LX_OK && c.gltf) {
+        st = gltf_map_build(&c, &map);
+        c.map = &map;
+    }
     if (st == LX_OK && c.gltf)
-        st = check_dropped_faces(&c);
+        st = check_dropped_faces(&c, dropped);
     if (st == LX_OK)
         st = import_materials(&c);
     for (unsigned i = 0; st == LX_OK && i < ai->mNumMeshes; i++)
@@ -633,6 +939,7 @@ lx_status lx_scene_load(const char *path, const lx_scene_load_desc *in, lx_scene
         st = lx_gltf_lights_from_json(c.scene, path, gltf);
     aiReleaseImport(ai);
     cJSON_Delete(gltf);
+    gltf_map_free(&map);
     free(c.mesh_map);
     free(c.folder);
     if (st != LX_OK) {

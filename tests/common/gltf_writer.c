@@ -25,9 +25,9 @@ typedef struct text {
 struct lx_test_gltf {
     unsigned char *bin;
     size_t bin_size, bin_cap;
-    text accessors, views, meshes, nodes, roots, materials, textures, images, used;
+    text accessors, views, meshes, nodes, roots, materials, textures, images, used, scenes, top;
     int accessor_count, view_count, mesh_count, node_count, material_count, texture_count,
-        used_count;
+        used_count, root_count;
 };
 
 static void add(text *t, const char *fmt, ...)
@@ -67,8 +67,8 @@ void lx_test_gltf_free(lx_test_gltf *g)
 {
     if (!g)
         return;
-    text *all[] = {&g->accessors, &g->views,    &g->meshes, &g->nodes, &g->roots,
-                   &g->materials, &g->textures, &g->images, &g->used};
+    text *all[] = {&g->accessors, &g->views,  &g->meshes, &g->nodes,  &g->roots, &g->materials,
+                   &g->textures,  &g->images, &g->used,   &g->scenes, &g->top};
     for (size_t i = 0; i < sizeof all / sizeof all[0]; i++)
         free(all[i]->s);
     free(g->bin);
@@ -147,22 +147,47 @@ int lx_test_gltf_mesh(lx_test_gltf *g, const char *name, const lx_test_primitive
         }
         if (pr->material >= 0)
             add(&g->meshes, ",\"material\":%d", pr->material);
-        add(&g->meshes, ",\"mode\":4}");
+        add(&g->meshes, ",\"mode\":%d}", pr->points ? 0 : 4);
     }
     add(&g->meshes, "]}");
     return g->mesh_count++;
 }
 
+int lx_test_gltf_node_ex(lx_test_gltf *g, const char *name, int mesh, const char *members,
+                         bool root)
+{
+    const char *sep = "";
+    add(&g->nodes, "%s{", g->node_count ? "," : "");
+    if (name) {
+        add(&g->nodes, "\"name\":\"%s\"", name);
+        sep = ",";
+    }
+    if (mesh >= 0) {
+        add(&g->nodes, "%s\"mesh\":%d", sep, mesh);
+        sep = ",";
+    }
+    if (members && members[0])
+        add(&g->nodes, "%s%s", sep, members);
+    add(&g->nodes, "}");
+    if (root)
+        add(&g->roots, "%s%d", g->root_count++ ? "," : "", g->node_count);
+    return g->node_count++;
+}
+
 int lx_test_gltf_node(lx_test_gltf *g, const char *name, int mesh, const char *members)
 {
-    add(&g->nodes, "%s{\"name\":\"%s\"", g->node_count ? "," : "", name);
-    if (mesh >= 0)
-        add(&g->nodes, ",\"mesh\":%d", mesh);
-    if (members && members[0])
-        add(&g->nodes, ",%s", members);
-    add(&g->nodes, "}");
-    add(&g->roots, "%s%d", g->node_count ? "," : "", g->node_count);
-    return g->node_count++;
+    return lx_test_gltf_node_ex(g, name, mesh, members, true);
+}
+
+void lx_test_gltf_scenes(lx_test_gltf *g, const char *members)
+{
+    g->scenes.len = 0;
+    add(&g->scenes, "%s", members);
+}
+
+void lx_test_gltf_top(lx_test_gltf *g, const char *members)
+{
+    add(&g->top, ",%s", members);
 }
 
 int lx_test_gltf_material(lx_test_gltf *g, const char *json)
@@ -204,8 +229,11 @@ void lx_test_gltf_write(const lx_test_gltf *g, const char *path)
     add(&j, "{\"asset\":{\"version\":\"2.0\",\"generator\":\"luxel tests\"}");
     if (g->used_count)
         add(&j, ",\"extensionsUsed\":[%s]", str(&g->used));
-    add(&j, ",\"scene\":0,\"scenes\":[{\"nodes\":[%s]}],\"nodes\":[%s]", str(&g->roots),
-        str(&g->nodes));
+    if (g->scenes.len)
+        add(&j, ",%s", str(&g->scenes));
+    else
+        add(&j, ",\"scene\":0,\"scenes\":[{\"nodes\":[%s]}]", str(&g->roots));
+    add(&j, ",\"nodes\":[%s]%s", str(&g->nodes), str(&g->top));
     add(&j, ",\"meshes\":[%s],\"accessors\":[%s],\"bufferViews\":[%s]", str(&g->meshes),
         str(&g->accessors), str(&g->views));
     if (g->material_count)

@@ -23,6 +23,7 @@ typedef struct lx_test_primitive {
     int index_count;
     const uint32_t *indices;
     int material; /* -1: none */
+    bool points;  /* mode 0 (POINTS) instead of 4 (TRIANGLES) */
 } lx_test_primitive;
 
 lx_test_gltf *lx_test_gltf_new(void);
@@ -33,6 +34,17 @@ int lx_test_gltf_mesh(lx_test_gltf *g, const char *name, const lx_test_primitive
 /* A root node carrying mesh (< 0: none); members is more JSON inside the
  * node's object ("" for none), e.g. "\"translation\":[0,1,0]". */
 int lx_test_gltf_node(lx_test_gltf *g, const char *name, int mesh, const char *members);
+/* A node named name (NULL: no name) carrying mesh (< 0: none), listed in
+ * the scene's nodes when root (else a child, through "children" in another
+ * node's members, or a node no scene lists); returns its index. */
+int lx_test_gltf_node_ex(lx_test_gltf *g, const char *name, int mesh, const char *members,
+                         bool root);
+/* Replaces the "scene" and "scenes" members written by default ("scene":0
+ * and one scene of the root nodes) by members, e.g.
+ * "\"scene\":1,\"scenes\":[{\"nodes\":[0]},{\"nodes\":[1,2]}]". */
+void lx_test_gltf_scenes(lx_test_gltf *g, const char *members);
+/* More top-level members, e.g. "\"skins\":[{\"joints\":[2]}]". */
+void lx_test_gltf_top(lx_test_gltf *g, const char *members);
 /* A material from the full text of its JSON object; returns its index. */
 int lx_test_gltf_material(lx_test_gltf *g, const char *json);
 /* An image at uri (relative to the .gltf) and a texture of it; returns the

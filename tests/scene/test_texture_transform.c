@@ -435,9 +435,9 @@ static void dropped_faces_named(void **state)
     static const uint32_t good[] = {0, 1, 2, 0, 2, 3};
     static const uint32_t bad[] = {0, 1, 2, 0, 2, 3, 0, 3, 9, 1, 7, 2};
     lx_test_gltf *g = lx_test_gltf_new();
-    lx_test_primitive p = {4, pos, NULL, NULL, uv, NULL, 6, good, -1};
+    lx_test_primitive p = {4, pos, NULL, NULL, uv, NULL, 6, good, -1, false};
     lx_test_gltf_node(g, "a", lx_test_gltf_mesh(g, "fine", &p, 1), "");
-    lx_test_primitive q[2] = {p, {4, pos, NULL, NULL, uv, NULL, 12, bad, -1}};
+    lx_test_primitive q[2] = {p, {4, pos, NULL, NULL, uv, NULL, 12, bad, -1, false}};
     lx_test_gltf_node(g, "b", lx_test_gltf_mesh(g, "broken", q, 2), "");
     char path[1024];
     snprintf(path, sizeof path, "%s/faces.gltf", dir);
