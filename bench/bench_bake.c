@@ -14,7 +14,7 @@
  *     Check: summing the lights over the rays lx_tracer_occluded finds
  *     unoccluded must rebuild the bake's lightmap exactly.
  *  2. Brute-force reference: tests/common/reference.h, the tests' oracle
- *     (seed 000's every-texel x every-triangle UV search, then every light x
+ *     (the per-texel lighting article's every-texel x every-triangle UV search, then every light x
  *     every triangle in double precision), on a ~2k-triangle scene at
  *     128x128 with the bake's OpenMP threads, against lx_baker_create +
  *     lx_baker_bake: the speed-up, and their agreement (texels within 1%,

@@ -149,7 +149,8 @@ static void run_irr(void *p)
         lx_bench_die("lx_irradiance_brute");
 }
 
-/* Seed 004's computeFilteredCubemap as written, one thread: for every
+/* Wikibooks' computeFilteredCubemap (Cg Programming/Unity/Many Light
+ * Sources) as written, one thread: for every
  * output texel, every source texel as a directional light along its
  * centre d (on the cube of half-size 0.5), weighted by
  * (1 / |d|^2) (face normal . d^) max(0, n . d^), the sum divided by the

@@ -1,6 +1,7 @@
 /* The baker: builds a texel map per node and the ray structures once, bakes
  * static lights, re-evaluates dynamic lights per update and combines the
- * two (seed 000's initial frame / update frame / Apply kernel). */
+ * two (the per-texel lighting article's initial frame / update frame /
+ * Apply kernel). */
 #include "bake_internal.h"
 #include "core/internal.h"
 

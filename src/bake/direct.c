@@ -1,7 +1,8 @@
-/* Direct lighting of texels: seed 000's DynamicLight kernel (every texel,
- * every light, shadow test toward the light, the "dynamic blur" from the
- * nearest occluder) with Filament's physical light model (seed 001), and
- * Embree occlusion queries in place of the seed's every-triangle loop.
+/* Direct lighting of texels: the per-texel lighting article's DynamicLight
+ * kernel (every texel, every light, shadow test toward the light, the
+ * "dynamic blur" from the nearest occluder) with Filament's physical light
+ * model, and Embree occlusion queries in place of the article's
+ * every-triangle loop.
  * Work is split into fixed tiles, so the sums are the same for any number
  * of threads. */
 #include "bake_internal.h"
@@ -118,7 +119,7 @@ static void light_tile(const lx_baker *b, uint32_t map_index, const lx_lightmap 
         rays[n] = lx_shadow_ray(b, map->world_position[i], map->world_geometric_normal[i], &e);
         pending[n] = (pending_ray){k, e.illuminance};
         if (light->shadow == LX_SHADOW_BLUR) {
-            /* seed 000: blur = nearest occluder distance / light distance */
+            /* the article's blur = nearest occluder distance / light distance */
             float d_occ = lx_tracer_nearest_distance(b->tracer, &rays[n]);
             float d_light = isfinite(e.distance) ? e.distance : b->scene_diagonal;
             float vis = isfinite(d_occ) ? lx_light_blur_visibility(light, d_occ, d_light) : 1.0f;

@@ -1,4 +1,4 @@
-/* Sky light in the baker (issue 4): the environment's irradiance at each
+/* Sky light in the baker: the environment's irradiance at each
  * texel, either unshadowed from its order-2 spherical harmonics
  * (Ramamoorthi & Hanrahan 2001, ibl/sh.c) or with sky visibility, by rays
  * that escape the scene bringing the environment they see.

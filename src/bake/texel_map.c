@@ -1,4 +1,5 @@
-/* Texel map: lightmap texels mapped to world space. Seed 000 searches every
+/* Texel map: lightmap texels mapped to world space. The per-texel lighting
+ * article (the method this baker follows) searches every
  * triangle for every texel; here each triangle is rasterized in UV space
  * instead, O(texels + triangles). Pass 1 gives each texel whose centre lies
  * in a triangle that triangle's barycentric point; pass 2 gives texels a

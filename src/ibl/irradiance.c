@@ -1,5 +1,5 @@
-/* Brute-force diffuse irradiance, seed 004 (Wikibooks, "Cg Programming/
- * Unity/Many Light Sources", computeFilteredCubemap): every texel of the
+/* Brute-force diffuse irradiance after Wikibooks' "Cg Programming/
+ * Unity/Many Light Sources", computeFilteredCubemap: every texel of the
  * source cube map is a directional light and the irradiance of a normal is
  * the sum of them all, weighted by the cosine. Differences from the seed,
  * all toward the exact integral E(n) = sum over texels of

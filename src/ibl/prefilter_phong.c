@@ -1,5 +1,5 @@
-/* Phong specular prefiltering, seed 004 (Wikibooks, "Cg Programming/
- * Unity/Many Light Sources", "Changes for Specular Reflection"): the
+/* Phong specular prefiltering after Wikibooks' "Cg Programming/
+ * Unity/Many Light Sources", "Changes for Specular Reflection": the
  * brute-force convolution of the environment with the lobe
  * w(R, L) = pow(max(0, R.L), n), every source texel a directional light,
  *     out(R) = sum_t L_t Omega_t w(R, l_t) / sum_t Omega_t w(R, l_t),

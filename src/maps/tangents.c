@@ -1,5 +1,5 @@
 /* Per-vertex tangent frames from UV gradients: Lengyel, "Foundations of Game
- * Engine Development" vol. 2 ch. 7 (seed 002): each triangle's tangent and
+ * Engine Development" vol. 2 ch. 7: each triangle's tangent and
  * bitangent are summed at its vertices, the tangent is made orthogonal to
  * the normal and the bitangent's side is kept as a handedness sign. */
 #include "luxel/maps.h"

@@ -1,8 +1,8 @@
 /* The luxel lights JSON (docs/lights-json.md): scene ambient plus a list of
- * lights in Filament's physical units (seed 001) or the seed-000 classic
- * model, with the seed's shadow modes and per-light ambient, and the area
- * lights of issue 3 (sphere, disk, rect; a point light with a radius is a
- * sphere, as in seed 001). Parsed with cJSON; every key, type, length and
+ * lights in Filament's physical units or the classic model of the
+ * per-texel lighting article, with its shadow modes and per-light ambient,
+ * and area lights (sphere, disk, rect, tube; a point light with a radius
+ * is a sphere, as in Filament). Parsed with cJSON; every key, type, length and
  * value is checked, and nothing changes in the scene unless the whole file
  * is valid. */
 #include "luxel/scene.h"

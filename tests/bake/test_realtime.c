@@ -1,4 +1,5 @@
-/* The real-time API (seed 000's update frame and Apply kernel): static lights
+/* The real-time API (the per-texel lighting article's update frame and
+ * Apply kernel): static lights
  * baked once, dynamic lights re-evaluated by lx_baker_update, apply = baked +
  * real-time; moving lights and nodes; the saturated 8-bit apply; bit-identical
  * results for any thread count. Expected values come from separate bakes of

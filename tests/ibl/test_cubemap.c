@@ -4,8 +4,8 @@
  * element dA / (1 + a^2 + b^2)^(3/2) and against 4 pi for the whole
  * sphere, direction <-> face coordinates round trips, bilinear sampling
  * that stays continuous across every cube edge (no jump larger than the
- * path's step can explain), and the equirect mapping against the issue's
- * formula d = (sin t sin p, cos t, -sin t cos p), p = 2 pi (u - 0.5),
+ * path's step can explain), and the equirect mapping against the
+ * documented formula d = (sin t sin p, cos t, -sin t cos p), p = 2 pi (u - 0.5),
  * t = pi v. */
 #include <stdarg.h>
 #include <stddef.h>

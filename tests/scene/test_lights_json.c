@@ -1,7 +1,7 @@
 /* Tests of the lights JSON reader (src/scene/lights_json.c, the schema of
  * docs/lights-json.md): the documented example with its unit and angle
- * conversions worked out here, issue 3's area lights with their luminance
- * computed here from the issue's formulas, overrides by name, and every
+ * conversions worked out here, area lights with their luminance computed
+ * here from the photometric formulas, overrides by name, and every
  * malformed input failing with a message that names the file, light and
  * field. */
 #define _POSIX_C_SOURCE 200809L
@@ -262,7 +262,7 @@ static const bad_case bad_cases[] = {
     {"{\"lights\": [{\"name\": \"0123456789012345678901234567890123456789012345678901234567890"
      "123456789\", \"type\": \"point\", \"position\": [0,0,0]}]}",
      LX_ERR_INVALID, "is longer than 63 bytes"},
-    /* area lights (issue 3) */
+    /* area lights */
     {"{\"lights\": [{\"type\": \"tube\", \"position\": [0, 2, 0], \"direction\": [1, 0, 0], "
      "\"length\": -1.2}]}",
      LX_ERR_INVALID, "lights.json: lights[0]: length -1.2 is negative"},
@@ -354,7 +354,7 @@ static const bad_case bad_cases[] = {
      LX_ERR_INVALID, "lights[0]: unit: directional lights take lux, not nt"},
     {"{\"lights\": [{\"type\": \"sphere\", \"position\": [0,0,0], \"intensity\": -5}]}",
      LX_ERR_INVALID, "lights[0]: intensity -5 is negative"},
-    /* the sky (issue 4) */
+    /* the sky */
     {"{\"sky\": {\"intensity\": 2}}", LX_ERR_FORMAT, "sky: missing 'environment'"},
     {"{\"sky\": \"sky.hdr\"}", LX_ERR_FORMAT, "sky: must be an object"},
     {"{\"sky\": {\"environment\": \"\"}}", LX_ERR_FORMAT, "sky: environment is an empty path"},
@@ -492,7 +492,7 @@ static void test_colour_forms(void **state)
     }
 }
 
-/* Issue 3's area lights: luminance from lumens and watts by the issue's
+/* Area lights: luminance from lumens and watts by the photometric
  * formulas (sphere P / (4 pi^2 r^2), disk P / (pi^2 r^2), rect P / (pi W
  * H), 683 lm/W), from candela through the area facing the axis, nits as
  * is. */
@@ -577,7 +577,7 @@ static void test_area_lights(void **state)
     lx_scene_destroy(s);
 }
 
-/* Tubes (issue 3's example): lumens through the capsule's area,
+/* Tubes: lumens through the capsule's area,
  * L = P / (pi (2 pi r len + 4 pi r^2)); candela across the axis through
  * 2 r len + pi r^2; a linear tube (radius 0) in candela per metre, P /
  * (pi^2 len) or I / len; the defaults (1 m, 2 cm) and soft shadows. */
@@ -639,7 +639,7 @@ static void test_tube_lights(void **state)
     lx_scene_destroy(s);
 }
 
-/* A point light is a sphere of radius 0 (seed 001): given a radius above 0
+/* A point light is a sphere of radius 0 (as in Filament): given a radius above 0
  * it becomes a sphere whose intensity keeps the point light's units (cd
  * by default: luminance I / (pi r^2); lumens: P / (4 pi^2 r^2)); a radius
  * of 0 leaves it a point light. */

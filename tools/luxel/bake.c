@@ -33,7 +33,7 @@ static const char *bake_usage =
     "  --format F              exr (default), hdr, pfm or png\n"
     "  --half                  EXR with 16-bit half floats\n"
     "  --pre-expose            store values times the exposure of --exposure\n"
-    "                          (seed 001's pre-exposure: sun-lit scenes fit in\n"
+    "                          (Filament's pre-exposure: sun-lit scenes fit in\n"
     "                          half floats); the manifest records the factor\n"
     "  --quantity Q            irradiance (lux, default) or radiance (nits:\n"
     "                          irradiance x base colour / pi)\n"
@@ -484,7 +484,7 @@ int cmd_bake(int argc, char **argv)
     double ev = a.has_exposure ? a.exposure_ev100 : metered;
     float exposure = lx_exposure_from_ev100((float)ev) * preview_scale(&a);
     cli_phase("apply and meter");
-    /* seed 001: pre-exposed values are the quantity times 1/(1.2 * 2^EV100) */
+    /* Filament: pre-exposed values are the quantity times 1/(1.2 * 2^EV100) */
     float pre_exposure = lx_exposure_from_ev100((float)ev);
 
     if (cli_interrupted()) {
