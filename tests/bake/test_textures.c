@@ -30,6 +30,7 @@
 
 #include "gltf_writer.h"
 #include "helpers.h"
+#include "reference.h"
 #include "texture_oracle.h"
 
 #include <math.h>
@@ -41,31 +42,12 @@
 
 static const double PI = 3.14159265358979323846;
 
-static void vnorm(double v[3])
-{
-    double l = sqrt(v[0] * v[0] + v[1] * v[1] + v[2] * v[2]);
-    for (int k = 0; k < 3; k++)
-        v[k] /= l;
-}
-
-static double vdot(const double a[3], const double b[3])
-{
-    return a[0] * b[0] + a[1] * b[1] + a[2] * b[2];
-}
-
-static void vcross(const double a[3], const double b[3], double out[3])
-{
-    out[0] = a[1] * b[2] - a[2] * b[1];
-    out[1] = a[2] * b[0] - a[0] * b[2];
-    out[2] = a[0] * b[1] - a[1] * b[0];
-}
-
 /* A directional light of `lux` shining along dir (normalized in double,
  * stored as the float the baker sees), no shadows. */
 static lx_light sun_along(const double dir_in[3], float lux, double dir_out[3])
 {
     double d[3] = {dir_in[0], dir_in[1], dir_in[2]};
-    vnorm(d);
+    lx_ref_normalize(d);
     lx_light sun = lx_light_defaults(LX_LIGHT_DIRECTIONAL);
     sun.direction = lx_v3((float)d[0], (float)d[1], (float)d[2]);
     sun.intensity = lux;
@@ -190,8 +172,8 @@ static void checker_radiance(void **state)
  * bitangent cross(n, t) * w with w chosen so it points along -dP/dv. */
 static void quad_frame(const lx_test_quad *q, double n[3], double t[3], double b[3], double *w)
 {
-    vcross(q->e1, q->e2, n);
-    vnorm(n);
+    lx_ref_cross(q->e1, q->e2, n);
+    lx_ref_normalize(n);
     /* J = d(u, v)/d(s, t); dP/du and dP/dv from its inverse */
     double bu = q->uv[0][1][0], bv = q->uv[0][1][1], cu = q->uv[0][2][0], cv = q->uv[0][2][1];
     double det = bu * cv - cu * bv;
@@ -203,10 +185,10 @@ static void quad_frame(const lx_test_quad *q, double n[3], double t[3], double b
     }
     for (int k = 0; k < 3; k++)
         t[k] = dpdu[k];
-    vnorm(t);
+    lx_ref_normalize(t);
     double c[3];
-    vcross(n, t, c);
-    *w = vdot(c, dpdv) > 0 ? -1.0 : 1.0;
+    lx_ref_cross(n, t, c);
+    *w = lx_ref_dot(c, dpdv) > 0 ? -1.0 : 1.0;
     for (int k = 0; k < 3; k++)
         b[k] = c[k] * *w;
 }
@@ -219,7 +201,7 @@ static void perturbed(const double raw[3], double scale, const double n[3], cons
     double m[3] = {(2 * raw[0] - 1) * scale, (2 * raw[1] - 1) * scale, 2 * raw[2] - 1};
     for (int k = 0; k < 3; k++)
         out[k] = m[0] * t[k] + m[1] * b[k] + m[2] * n[k];
-    vnorm(out);
+    lx_ref_normalize(out);
 }
 
 static void check_normal_map(const char *tag, const lx_test_quad *q, bool file_tangents)
@@ -228,14 +210,7 @@ static void check_normal_map(const char *tag, const lx_test_quad *q, bool file_t
     enum { W = 8 };
     uint8_t px[W * W * 3];
     double raw[W * W * 3];
-    for (int y = 0; y < W; y++)
-        for (int x = 0; x < W; x++) {
-            const int v[3] = {40 + 24 * x, 60 + 20 * y, 180 + 5 * (x + y)};
-            for (int c = 0; c < 3; c++) {
-                px[(y * W + x) * 3 + c] = (uint8_t)v[c];
-                raw[(y * W + x) * 3 + c] = v[c] / 255.0;
-            }
-        }
+    lx_test_gradient_normal_map(W, 180, 5, px, raw);
     char png[1024];
     snprintf(png, sizeof png, "%s/bumps.png", dir);
     lx_test_write_png(png, W, W, 3, px);
@@ -271,7 +246,7 @@ static void check_normal_map(const char *tag, const lx_test_quad *q, bool file_t
             lx_test_quad_uv(q, 0, s, tt, uv);
             lx_test_bilinear(raw, W, W, 3, uv[0], uv[1], m);
             perturbed(m, scale, n, t, b, np);
-            double want = 1000.0 * fmax(0.0, -vdot(np, d));
+            double want = 1000.0 * fmax(0.0, -lx_ref_dot(np, d));
             double got = img.data[(y * RES + x) * 3];
             worst = fmax(worst, fabs(got - want));
             if (first < 0)
@@ -344,12 +319,12 @@ static bool ray_hits(const double o[3], const double d[3], const double a[3], co
         e2[k] = c[k] - a[k];
         s[k] = o[k] - a[k];
     }
-    vcross(d, e2, p);
-    double det = vdot(e1, p);
-    double u = vdot(s, p) / det;
-    vcross(s, e1, qv);
-    double v = vdot(d, qv) / det;
-    double r = vdot(e2, qv) / det;
+    lx_ref_cross(d, e2, p);
+    double det = lx_ref_dot(e1, p);
+    double u = lx_ref_dot(s, p) / det;
+    lx_ref_cross(s, e1, qv);
+    double v = lx_ref_dot(d, qv) / det;
+    double r = lx_ref_dot(e2, qv) / det;
     *margin = fmin(u, fmin(v, 1 - u - v));
     return r > 0 && *margin >= 0;
 }

@@ -18,19 +18,19 @@ static void d_sub(const double a[3], const double b[3], double r[3])
 {
     r[0] = a[0] - b[0], r[1] = a[1] - b[1], r[2] = a[2] - b[2];
 }
-static double d_dot(const double a[3], const double b[3])
+double lx_ref_dot(const double a[3], const double b[3])
 {
     return a[0] * b[0] + a[1] * b[1] + a[2] * b[2];
 }
-static void d_cross(const double a[3], const double b[3], double r[3])
+void lx_ref_cross(const double a[3], const double b[3], double r[3])
 {
     r[0] = a[1] * b[2] - a[2] * b[1];
     r[1] = a[2] * b[0] - a[0] * b[2];
     r[2] = a[0] * b[1] - a[1] * b[0];
 }
-static void d_normalize(double a[3])
+void lx_ref_normalize(double a[3])
 {
-    double l = sqrt(d_dot(a, a));
+    double l = sqrt(lx_ref_dot(a, a));
     if (l > 0)
         a[0] /= l, a[1] /= l, a[2] /= l;
 }
@@ -115,7 +115,7 @@ void lx_ref_scene_build(const lx_scene *scene, lx_ref_scene *out)
     if (out->count) {
         double d[3];
         d_sub(out->hi, out->lo, d);
-        out->diagonal = (float)sqrt(d_dot(d, d));
+        out->diagonal = (float)sqrt(lx_ref_dot(d, d));
     }
     if (!(out->diagonal > 0.0f))
         out->diagonal = 1.0f;
@@ -136,8 +136,8 @@ bool lx_ref_intersect(const lx_ref_triangle *tri, const double o[3], const doubl
     double e1[3], e2[3], pv[3], tv[3], qv[3];
     d_sub(tri->p[1], tri->p[0], e1);
     d_sub(tri->p[2], tri->p[0], e2);
-    d_cross(d, e2, pv);
-    double det = d_dot(e1, pv);
+    lx_ref_cross(d, e2, pv);
+    double det = lx_ref_dot(e1, pv);
     if (margin)
         *margin = -INFINITY;
     *t = *u = *v = NAN;
@@ -145,10 +145,10 @@ bool lx_ref_intersect(const lx_ref_triangle *tri, const double o[3], const doubl
         return false;
     double inv = 1.0 / det;
     d_sub(o, tri->p[0], tv);
-    double uu = d_dot(tv, pv) * inv;
-    d_cross(tv, e1, qv);
-    double vv = d_dot(d, qv) * inv;
-    double tt = d_dot(e2, qv) * inv;
+    double uu = lx_ref_dot(tv, pv) * inv;
+    lx_ref_cross(tv, e1, qv);
+    double vv = lx_ref_dot(d, qv) * inv;
+    double tt = lx_ref_dot(e2, qv) * inv;
     *t = tt, *u = uu, *v = vv;
     double m = fmin(fmin(uu, vv), 1.0 - uu - vv);
     if (margin)
@@ -296,18 +296,18 @@ void lx_ref_texel_map(const lx_scene *scene, uint32_t node_index, int width, int
                         }
                     }
                     d_point(&node->world, p, pw);
-                    d_normalize(n);
+                    lx_ref_normalize(n);
                     d_apply3(nm, n, nw);
-                    d_normalize(nw);
+                    lx_ref_normalize(nw);
                     double a[3], b[3], c[3], e1[3], e2[3], g[3], gw[3];
                     from_vec(m->positions[i[0]], a);
                     from_vec(m->positions[i[1]], b);
                     from_vec(m->positions[i[2]], c);
                     d_sub(b, a, e1);
                     d_sub(c, a, e2);
-                    d_cross(e1, e2, g);
+                    lx_ref_cross(e1, e2, g);
                     d_apply3(nm, g, gw);
-                    d_normalize(gw);
+                    lx_ref_normalize(gw);
                     tx->position = to_vec(pw);
                     tx->normal = to_vec(nw);
                     tx->geometric_normal = to_vec(gw);
@@ -394,7 +394,7 @@ static ref_light_eval ref_light(const lx_light *l, lx_vec3 pf, lx_vec3 nf)
             r.to_light[c] = -(double)(&l->direction.x)[c];
             r.ambient[c] = amb[c];
         }
-        double ndotl = d_dot(n, r.to_light);
+        double ndotl = lx_ref_dot(n, r.to_light);
         if (ndotl > 0.0)
             scale = l->model == LX_MODEL_CLASSIC ? ndotl * ndotl * intensity : intensity * ndotl;
         unattenuated = intensity;
@@ -402,7 +402,7 @@ static ref_light_eval ref_light(const lx_light *l, lx_vec3 pf, lx_vec3 nf)
         double pos[3], v[3];
         from_vec(l->position, pos);
         d_sub(pos, p, v);
-        double d2 = d_dot(v, v), d = sqrt(d2);
+        double d2 = lx_ref_dot(v, v), d = sqrt(d2);
         double window = ref_window(d2, l->range);
         for (int c = 0; c < 3; c++)
             r.ambient[c] = amb[c] * window;
@@ -412,8 +412,8 @@ static ref_light_eval ref_light(const lx_light *l, lx_vec3 pf, lx_vec3 nf)
                 r.to_light[c] = v[c] / d;
             double dir[3];
             from_vec(l->direction, dir);
-            double ndotl = d_dot(n, r.to_light);
-            double spot = ref_spot(l, -d_dot(dir, r.to_light));
+            double ndotl = lx_ref_dot(n, r.to_light);
+            double spot = ref_spot(l, -lx_ref_dot(dir, r.to_light));
             if (ndotl > 0.0 && spot > 0.0) {
                 if (l->model == LX_MODEL_CLASSIC) {
                     /* the per-texel document's ((1 - d / range) |N.L|)^2 I */

@@ -138,4 +138,10 @@ lx_vec3 lx_ref_shade_scale(const lx_ref_scene *rs, const lx_light *lights, uint3
 /* Shadow-ray bias for point p in rs (the rule of src/bake/direct.c). */
 float lx_ref_bias(const lx_ref_scene *rs, lx_vec3 p);
 
+/* Double-precision vector helpers the oracle uses, for tests that need
+ * the same arithmetic outside the library. */
+double lx_ref_dot(const double a[3], const double b[3]);
+void lx_ref_cross(const double a[3], const double b[3], double r[3]);
+void lx_ref_normalize(double a[3]); /* leaves a zero vector as it is */
+
 #endif

@@ -119,3 +119,15 @@ void lx_test_quad_arrays(const lx_test_quad *q, float pos[12], float nrm[12], fl
     for (int k = 0; k < 6; k++)
         idx[k] = tri[k];
 }
+
+void lx_test_gradient_normal_map(int w, int blue0, int blue_step, uint8_t *px, double *raw)
+{
+    for (int y = 0; y < w; y++)
+        for (int x = 0; x < w; x++) {
+            const int v[3] = {40 + 24 * x, 60 + 20 * y, blue0 + blue_step * (x + y)};
+            for (int c = 0; c < 3; c++) {
+                px[(y * w + x) * 3 + c] = (uint8_t)v[c];
+                raw[(y * w + x) * 3 + c] = v[c] / 255.0;
+            }
+        }
+}

@@ -20,6 +20,11 @@ double lx_test_srgb_encode(double linear);
 void lx_test_bilinear(const double *texels, int w, int h, int channels, double u, double v,
                       double *out);
 
+/* A w x w normal-map gradient (so a flipped V or swapped channels fail):
+ * texel (x, y) holds the 8-bit codes (40 + 24 x, 60 + 20 y, blue0 +
+ * blue_step (x + y)), px as bytes and raw as code / 255. */
+void lx_test_gradient_normal_map(int w, int blue0, int blue_step, uint8_t *px, double *raw);
+
 /* uv' = M (u, v, 1) with M = translation(offset) * rotation(rotation) *
  * scale(scale), the 3x3 matrices of the KHR_texture_transform spec
  * multiplied out as written. */

@@ -372,14 +372,7 @@ static void normal_transforms(void **state)
     const char *dir = lx_test_dir("test_tt_normal");
     uint8_t px[TEX * TEX * 3];
     double raw[TEX * TEX * 3];
-    for (int y = 0; y < TEX; y++)
-        for (int x = 0; x < TEX; x++) {
-            const int v[3] = {40 + 24 * x, 60 + 20 * y, 200 + 3 * (x + y)};
-            for (int c = 0; c < 3; c++) {
-                px[(y * TEX + x) * 3 + c] = (uint8_t)v[c];
-                raw[(y * TEX + x) * 3 + c] = v[c] / 255.0;
-            }
-        }
+    lx_test_gradient_normal_map(TEX, 200, 3, px, raw);
     char png[1024];
     snprintf(png, sizeof png, "%s/bumps.png", dir);
     lx_test_write_png(png, TEX, TEX, 3, px);
