@@ -225,7 +225,8 @@ lx_mesh lx_test_cylinder(const char *name, double radius, double height, uint32_
 {
     /* a side of s x h quads and two caps of s triangles, each cap with
      * its own vertices (a hard edge, as files have) */
-    uint32_t s = (uint32_t)fmax(3.0, floor(sqrt(triangles / 2.0))), h = (uint32_t)fmax(1, s / 4);
+    /* s^2 / 2 side triangles (h = s / 4 rows) and 2 s in the caps */
+    uint32_t s = (uint32_t)fmax(3.0, floor(sqrt(2.0 * triangles))), h = (uint32_t)fmax(1, s / 4);
     uint32_t side_v = s * (h + 1), cap_v = s + 1;
     lx_mesh m = alloc_mesh(name, side_v + 2 * cap_v, 2 * s * h + 2 * s);
     for (uint32_t j = 0; j <= h; j++)
