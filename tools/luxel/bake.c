@@ -11,9 +11,6 @@
 #include <string.h>
 #include <strings.h>
 
-/* Face size the sky is loaded at: enough for its SH and ray lookup. */
-#define LX_SKY_LOAD_SIZE 256
-
 static const char *bake_usage =
     "usage: luxel bake SCENE [options]\n"
     "\n"
@@ -392,9 +389,10 @@ int cmd_bake(int argc, char **argv)
         }
         if (a.sky_samples)
             sky.samples = (uint32_t)a.sky_samples;
-        /* the SH need no more than 256 texels a side, sky shadows 64 */
-        int loaded = cli_load_environment_run("bake", sky.environment, 1.0f, LX_SKY_LOAD_SIZE,
-                                              a.desc.threads, a.quiet, &sky_env);
+        /* the sky's own intensity is the baker's (lx_sky_desc): loaded as is */
+        int loaded =
+            cli_load_environment_run("bake", sky.environment, 0.0f, LX_SKY_ENVIRONMENT_SIZE,
+                                     a.desc.threads, a.quiet, &sky_env);
         if (loaded != EXIT_OK) {
             status = loaded;
             goto done;
@@ -520,11 +518,13 @@ int cmd_bake(int argc, char **argv)
         char file[300], preview[300];
         snprintf(file, sizeof file, "%s.%s", stems[m], lx_image_format_extension(a.format));
         snprintf(preview, sizeof preview, "%s.png", stems[m]);
+        /* a PNG lightmap is its own preview; float files hold the values
+         * as they are (exposure 0, the default), or pre-exposed */
         lx_image_write_desc wd = {.format = a.format,
                                   .half = a.half,
                                   .exposure = a.format == LX_IMAGE_PNG ? exposure
                                               : a.pre_expose           ? pre_exposure
-                                                                       : 1.0f,
+                                                                       : 0.0f,
                                   .threads = a.desc.threads};
         double t = cli_now();
         failed = !cli_stage_image(&stage, file, &images[m], &wd);
