@@ -65,62 +65,97 @@ check "the bake again: the user's file stays" test -f "$WORK/out/notes.txt"
 
 # ---- a bad output folder fails before the work starts ----------------------------
 
-# bad_folder LABEL NEEDLE OUT ARGS...: the run fails naming NEEDLE, before
-# its first phase ("texel maps"; with PHASE=bake: before the bake, once the
-# texel maps have named the lightmaps)
+# state PATH: what is at PATH (type and mode), and a folder's snapshot.
+state() {
+    stat -c '%F %a' "$1" 2>/dev/null || echo "nothing"
+    if [ -d "$1" ]; then snapshot "$1"; fi
+}
+
+# bad_folder LABEL NEEDLE OUT ARGS...: `luxel ARGS -o OUT` fails with exit
+# status 1 and one error line naming NEEDLE, before its first long phase
+# (PHASE, default "texel maps": LUXEL_TEST_PAUSE would stop the run there
+# and say so), and leaves whatever was at OUT exactly as it was.
 bad_folder() {
-    local label=$1 needle=$2 out=$3
+    local label=$1 needle=$2 out=$3 phase=${PHASE:-texel maps}
     shift 3
-    LUXEL_TEST_PAUSE=${PHASE:-texel maps} run "$LUXEL" "$@" -o "$out"
+    local before after
+    before=$(state "$out")
+    : >"$ERR"
+    LUXEL_TEST_PAUSE=$phase run "$LUXEL" "$@" -o "$out"
     expect_rc 1 "$label"
     expect_error "$label" "$needle"
-    check "$label: fails before the ${PHASE:-texel maps} phase" \
+    check "$label: fails before the $phase phase" \
         test -z "$(grep '^luxel: test: paused' "$ERR")"
+    after=$(state "$out")
+    if [ "$before" = "$after" ]; then
+        pass "$label: $(basename "$out") is as it was"
+    else
+        fail "$label: $(basename "$out") changed" "$(diff <(echo "$before") <(echo "$after") | head -5)"
+    fi
 }
 
 : >"$WORK/a_file"
 bad_folder "bake -o a file" "a_file" "$WORK/a_file" bake "$RETRO" --resolution 32
 bad_folder "bake -o under a file" "a_file" "$WORK/a_file/sub" bake "$RETRO" --resolution 32
 check "bake -o a file: the file is untouched" test -f "$WORK/a_file" -a ! -s "$WORK/a_file"
+# with a sky, before the sky is loaded (its progress phase is "environment")
+PHASE=environment bad_folder "bake --sky -o a file" "a_file" "$WORK/a_file" \
+    bake "$RETRO" --resolution 32 --sky "$SKY"
+PHASE=environment bad_folder "bake --sky -o under a file" "a_file/sub" "$WORK/a_file/sub" \
+    bake "$RETRO" --resolution 32 --sky "$SKY"
 
 mkdir -p "$WORK/blocked/ground.exr"
-PHASE=bake bad_folder "bake with a folder where an output goes" "ground.exr" "$WORK/blocked" \
-    bake "$RETRO" --resolution 32
-check "bake with a folder in the way: the folder holds only what it held" \
-    test "$(ls -A "$WORK/blocked")" = "ground.exr"
+PHASE=bake bad_folder "bake with a folder where an output goes" "blocked/ground.exr" \
+    "$WORK/blocked" bake "$RETRO" --resolution 32
 
-mkdir -p "$WORK/readonly"
-chmod 555 "$WORK/readonly"
+# ibl: every output's name is known from the layout, the format and the
+# number of levels; each is checked before the environment is loaded (its
+# first phase, "environment"), or, for specular levels past 0 whose count
+# depends on the file's size, right after it, before the first filter ("sh")
+mkdir -p "$WORK/ibl_blocked/specular_m0_px.exr"
+PHASE=environment bad_folder "ibl with a folder where specular level 0 goes" \
+    "ibl_blocked/specular_m0_px.exr" "$WORK/ibl_blocked" ibl "$SKY"
+rmdir "$WORK/ibl_blocked/specular_m0_px.exr"
+mkdir -p "$WORK/ibl_blocked/specular_m6_nz.exr"
+PHASE=sh bad_folder "ibl with a folder where specular level 6 goes" \
+    "ibl_blocked/specular_m6_nz.exr" "$WORK/ibl_blocked" ibl "$SKY"
+PHASE=environment bad_folder "ibl --mips 7 with a folder where level 6 goes" \
+    "ibl_blocked/specular_m6_nz.exr" "$WORK/ibl_blocked" ibl "$SKY" --mips 7
+rmdir "$WORK/ibl_blocked/specular_m6_nz.exr"
+mkdir -p "$WORK/ibl_blocked/specular.ktx" "$WORK/ibl_blocked/irradiance.hdr"
+PHASE=environment bad_folder "ibl --layout ktx with a folder where specular.ktx goes" \
+    "ibl_blocked/specular.ktx" "$WORK/ibl_blocked" ibl "$SKY" --layout ktx
+PHASE=environment bad_folder "ibl --layout cross --format hdr with a folder in the way" \
+    "ibl_blocked/irradiance.hdr" "$WORK/ibl_blocked" ibl "$SKY" --layout cross --format hdr
+PHASE=environment bad_folder "ibl -o a file" "a_file" "$WORK/a_file" ibl "$SKY"
+
+# no write permission; as root (who writes anywhere) luxel runs as an
+# unprivileged user, from a copy of the binary in a place that user can reach
 if [ "$(id -u)" -eq 0 ]; then
-    # root writes anywhere: run luxel as an unprivileged user, from a copy
-    # of the binary in a place that user can reach
     priv=$(mktemp -d /tmp/luxel-publish.XXXXXX)
     chmod 755 "$priv"
     cp "$LUXEL" "$priv/luxel" && cp "$RETRO" "$priv/retro.glb"
     mkdir "$priv/readonly" && chmod 555 "$priv/readonly"
-    as_user=(setpriv --reuid=65534 --regid=65534 --clear-groups)
-    if "${as_user[@]}" "$priv/luxel" --version >/dev/null 2>&1; then
-        LUXEL_TEST_PAUSE="texel maps" run "${as_user[@]}" "$priv/luxel" bake \
-            "$priv/retro.glb" --resolution 32 -o "$priv/readonly/out"
-        expect_rc 1 "bake into a folder without write permission (as an unprivileged user)"
-        expect_error "bake into a folder without write permission" "readonly/out" \
-            "Permission denied"
-        check "bake into a folder without write permission: fails before the bake starts" \
-            test -z "$(grep '^luxel: test: paused' "$ERR")"
+    readonly_dir=$priv/readonly
+    printf '#!/bin/sh\nexec setpriv --reuid=65534 --regid=65534 --clear-groups %s "$@"\n' \
+        "$priv/luxel" >"$priv/as_user" && chmod 755 "$priv/as_user"
+    if "$priv/as_user" --version >/dev/null 2>&1; then
+        LUXEL=$priv/as_user bad_folder "bake into a folder without write permission (unprivileged)" \
+            "readonly/out: cannot create the output folder: Permission denied" \
+            "$readonly_dir/out" bake "$priv/retro.glb" --resolution 32
     else
         fail "cannot run luxel as an unprivileged user (setpriv) to test permissions"
     fi
-    rm -rf "$priv"
 else
-    bad_folder "bake into a folder without write permission" "Permission denied" \
-        "$WORK/readonly/out" bake "$RETRO" --resolution 32
+    readonly_dir=$WORK/readonly
+    mkdir -p "$readonly_dir" && chmod 555 "$readonly_dir"
+    bad_folder "bake into a folder without write permission" \
+        "readonly/out: cannot create the output folder: Permission denied" \
+        "$readonly_dir/out" bake "$RETRO" --resolution 32
 fi
-chmod 755 "$WORK/readonly"
 check "bake into a folder without write permission: nothing was made in it" \
-    test -z "$(ls -A "$WORK/readonly")"
-
-LUXEL_TEST_PAUSE=environment run "$LUXEL" ibl "$SKY" -o "$WORK/a_file"
-expect_rc 1 "ibl -o a file"
-expect_error "ibl -o a file" "a_file"
+    test -z "$(ls -A "$readonly_dir")"
+chmod 755 "$readonly_dir"
+[ -n "${priv:-}" ] && rm -rf "$priv"
 
 finish

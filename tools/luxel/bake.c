@@ -351,6 +351,11 @@ int cmd_bake(int argc, char **argv)
     lx_cubemap sky_env = {0};
     int status = EXIT_FAILED;
 
+    /* the output folder is checked (and made) before any long work: the
+     * import, the sky, the texel maps */
+    if (!cli_stage_begin(&stage, a.output))
+        goto done;
+
     lx_scene_load_desc ld = {.skip_degenerate = a.desc.skip_degenerate};
     if (lx_scene_load(a.scene, &ld, &scene) != LX_OK) {
         cli_error("%s", lx_last_error());
@@ -401,10 +406,6 @@ int cmd_bake(int argc, char **argv)
         a.desc.sky = lx_sky_desc_defaults(&given);
     }
     cli_phase(sky.environment ? "lights and sky" : "lights");
-
-    /* the output folder is checked (and made) before the long work */
-    if (!cli_stage_begin(&stage, a.output))
-        goto done;
 
     cli_progress progress;
     cli_progress_init(&progress, "texel maps", a.quiet);

@@ -414,6 +414,54 @@ static bool put_cube(writer *w, const char *stem, const lx_cubemap *levels, int 
     return cli_stage_finish(&w->stage, stem, s);
 }
 
+/* The DFG table's file name. */
+static void lut_name(const ibl_args *a, char *name, size_t size)
+{
+    snprintf(name, size, "dfg_lut.%s", lx_image_format_extension(a->format));
+}
+
+/* lx_env_write_names's on_file: nothing but a file may be in the way. */
+static bool check_name(void *user, const char *name)
+{
+    writer *w = user;
+    w->reported = w->reported || !cli_stage_check(&w->stage, name);
+    return !w->reported;
+}
+
+/* Checks every output name of the run (cli_stage_check) before the long
+ * work, so a folder in the way fails at once. spec_count: the number of
+ * specular levels, or 1 while it is not known (level 0's names are those
+ * of every run: specular levels always carry _m<L>). */
+static bool check_names(writer *w, int spec_count)
+{
+    const ibl_args *a = w->a;
+    const struct {
+        bool on;
+        const char *stem;
+        int count;
+        bool mip_names;
+    } cubes[] = {{a->irradiance, "irradiance", 1, false},
+                 {a->specular, "specular", spec_count, true},
+                 {a->environment, "environment", 1, false}};
+    for (size_t i = 0; i < sizeof cubes / sizeof cubes[0]; i++) {
+        if (!cubes[i].on)
+            continue;
+        lx_env_write_desc d = write_desc(a, cubes[i].mip_names);
+        d.on_file = check_name;
+        d.on_file_user = w;
+        lx_status s = lx_env_write_names(cubes[i].stem, cubes[i].count, &d);
+        if (s != LX_OK) {
+            if (!w->reported)
+                cli_error("%s: %s", cubes[i].stem, lx_last_error());
+            return false;
+        }
+    }
+    char name[32];
+    lut_name(a, name, sizeof name);
+    return (!a->sh || cli_stage_check(&w->stage, "sh.json")) &&
+           (!a->lut || cli_stage_check(&w->stage, name));
+}
+
 /* A JSON number with the fewest digits that read back as the same float. */
 static cJSON *float_number(float f)
 {
@@ -545,8 +593,16 @@ int cmd_ibl(int argc, char **argv)
     }
     if (known && !run_fits(&a, known))
         goto done;
-    /* the output folder is checked (and made) before the long work */
+    /* the output folder is checked (and made) before the long work, and
+     * every output name in it: the specular chain's when its length is
+     * known (the environment's size or the options tell it), else its
+     * level 0, and the rest once the environment is loaded */
     if (!cli_stage_begin(&w.stage, a.output))
+        goto done;
+    int levels_known = a.mips;
+    if (!levels_known && (known || a.specular_size))
+        levels_known = lx_cube_mip_count(specular_size(&a, known));
+    if (!check_names(&w, levels_known ? levels_known : 1))
         goto done;
     int loaded =
         cli_load_environment_run("ibl", a.env, a.intensity, a.size, a.threads, a.quiet, &env);
@@ -561,6 +617,8 @@ int cmd_ibl(int argc, char **argv)
         goto done;
     }
     if (!known && !run_fits(&a, env.size))
+        goto done;
+    if (a.specular && !levels_known && !check_names(&w, lx_cube_mip_count(spec_size)))
         goto done;
 
     cli_progress progress;
@@ -633,7 +691,7 @@ int cmd_ibl(int argc, char **argv)
         ok = put_cube(&w, "specular", spec, spec_count, true);
     if (ok && a.lut) {
         char name[32];
-        snprintf(name, sizeof name, "dfg_lut.%s", lx_image_format_extension(a.format));
+        lut_name(&a, name, sizeof name);
         lx_image_write_desc wd = {
             .format = a.format, .half = a.half && a.format == LX_IMAGE_EXR, .threads = a.threads};
         ok = cli_stage_image(&w.stage, name, &lut_rgb, &wd) && note(&w, name);
