@@ -3,7 +3,11 @@
 # folder together.
 # - A rename that fails half-way through publishing (injected with the test
 #   hook LUXEL_TEST_FAIL_RENAME=N) must not lose the files it already
-#   replaced: the folder ends exactly as it was before the run.
+#   replaced: the folder ends exactly as it was before the run - also when
+#   hard links are refused (LUXEL_TEST_FAIL_LINK=1: the replaced files are
+#   moved aside instead). When putting one back fails too
+#   (LUXEL_TEST_FAIL_RESTORE=N), that file is kept with its bytes where the
+#   error says.
 # - A bad output folder (a file in the way, a folder without write
 #   permission, something that is not a file where an output goes) is
 #   reported before the long work starts: the run never reaches its first
@@ -22,6 +26,17 @@ snapshot() { (cd "$1" && find . -mindepth 1 | LC_ALL=C sort | while read -r f; d
     if [ -f "$f" ]; then echo "$f $(cksum <"$f")"; else echo "$f"; fi
 done); }
 
+# expect_same LABEL BEFORE DIR: DIR's snapshot is BEFORE.
+expect_same() {
+    local after
+    after=$(snapshot "$3")
+    if [ "$2" = "$after" ]; then
+        pass "$1: the folder is exactly as before (old files restored)"
+    else
+        fail "$1: the folder changed" "$(diff <(echo "$2") <(echo "$after") | head -5)"
+    fi
+}
+
 # ---- a rename failing half-way: the replaced files come back ----------------------
 
 run "$LUXEL" bake "$RETRO" --resolution 32 -q -o "$WORK/out"
@@ -34,12 +49,7 @@ for n in 1 2 5 $((files - 1)); do
     LUXEL_TEST_FAIL_RENAME=$n run "$LUXEL" bake "$RETRO" --resolution 64 -q -o "$WORK/out"
     expect_rc 1 "$label"
     expect_error "$label" "cannot move into place"
-    after=$(snapshot "$WORK/out")
-    if [ "$before" = "$after" ]; then
-        pass "$label: the folder is exactly as before (old lightmaps restored)"
-    else
-        fail "$label: the folder changed" "$(diff <(echo "$before") <(echo "$after") | head -5)"
-    fi
+    expect_same "$label" "$before" "$WORK/out"
 done
 
 run "$LUXEL" ibl "$SKY" --irradiance --sh -q -o "$WORK/ibl"
@@ -62,6 +72,77 @@ expect_rc 0 "the bake again, no failure"
 check "the bake again: the lightmaps are the new size" \
     grep -q '"width":	64' "$WORK/out/manifest.json"
 check "the bake again: the user's file stays" test -f "$WORK/out/notes.txt"
+
+# ---- links refused: the replaced files are moved aside, and moved back ------------
+
+# LUXEL_TEST_FAIL_LINK=1 refuses every hard link, as a file system without
+# them does: publishing then moves each file it replaces aside (its name is
+# empty until the new file is renamed in), so a rename failing half-way
+# must move every one of them back.
+before=$(snapshot "$WORK/out")
+files=$(ls "$WORK/out" | wc -l)
+for n in 1 4 $((files - 1)); do
+    label="links refused, rename $n of publishing failing"
+    LUXEL_TEST_FAIL_LINK=1 LUXEL_TEST_FAIL_RENAME=$n run "$LUXEL" bake "$RETRO" \
+        --resolution 32 -q -o "$WORK/out"
+    expect_rc 1 "$label"
+    expect_error "$label" "cannot move into place"
+    expect_same "$label" "$before" "$WORK/out"
+done
+LUXEL_TEST_FAIL_LINK=1 run "$LUXEL" bake "$RETRO" --resolution 32 -q -o "$WORK/out"
+expect_rc 0 "links refused, nothing failing"
+check "links refused, nothing failing: the lightmaps are the new size" \
+    grep -q '"width":	32' "$WORK/out/manifest.json"
+check "links refused, nothing failing: the user's file stays, nothing else is added" \
+    test "$(ls -A "$WORK/out" | wc -l)" -eq "$files"
+
+# ---- a restore failing: the replaced file is kept where the error says ------------
+
+# LUXEL_TEST_FAIL_RESTORE=1 makes the first rename that puts a replaced file
+# back fail. With rename 3 failing, outputs 1 and 2 are in place and are
+# restored last first: output 2's old file cannot go back. It must be left
+# where the error says (in the staging folder) with its bytes, and every
+# other file restored. With links refused its name is then empty: the kept
+# file is its only copy.
+restore_fails() {
+    local label=$1 link=$2 line target kept name want
+    before=$(snapshot "$WORK/out")
+    LUXEL_TEST_FAIL_LINK=$link LUXEL_TEST_FAIL_RENAME=3 LUXEL_TEST_FAIL_RESTORE=1 \
+        run "$LUXEL" bake "$RETRO" --resolution 64 -q -o "$WORK/out"
+    expect_rc 1 "$label"
+    check "$label: two error lines, the failed move and the failed restore" \
+        test "$(grep -c '^luxel: error:' "$ERR")" -eq 2 -a \
+        "$(grep -c '^luxel: error: .*: cannot move into place' "$ERR")" -eq 1
+    line=$(grep '^luxel: error: .*: could not put the previous file back (it is in ' "$ERR")
+    if [ -z "$line" ]; then
+        fail "$label: no error names where the previous file is"
+        show_stderr
+        return
+    fi
+    target=${line#luxel: error: }
+    target=${target%%: could not put*}
+    kept=${line#*(it is in }
+    kept=${kept%%): *}
+    name=$(basename "$target")
+    want=$(echo "$before" | grep -F "./$name " | cut -d' ' -f2-)
+    check "$label: the error names the output ($name) and a kept copy in the staging folder" \
+        test "$target" = "$WORK/out/$name" -a "$(dirname "$(dirname "$kept")")" != "$WORK/out"
+    check "$label: the kept copy holds the replaced file's bytes" \
+        test -n "$want" -a "$(cksum <"$kept" 2>/dev/null)" = "$want"
+    if [ "$link" = 1 ]; then
+        check "$label: links refused: the output's name is empty (the kept file is the only copy)" \
+            test ! -e "$target"
+    else
+        check "$label: the output's name holds the new file" \
+            test -f "$target" -a "$(cksum <"$target")" != "$want"
+    fi
+    # every other file as before; with the kept copy moved back by hand and
+    # the staging folder it was left in removed, the whole folder is
+    mv "$kept" "$target" && rmdir "$(dirname "$kept")" "$(dirname "$(dirname "$kept")")"
+    expect_same "$label, the kept copy moved back" "$before" "$WORK/out"
+}
+restore_fails "a restore failing" 0
+restore_fails "links refused and a restore failing" 1
 
 # ---- a bad output folder fails before the work starts ----------------------------
 

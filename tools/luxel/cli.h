@@ -89,6 +89,12 @@ void cli_test_pause(const char *phase);
 /* LUXEL_TEST_FAIL_RENAME=N: true for the Nth rename cli_stage_publish
  * makes (1 = the first), which then fails as if the disk had. */
 bool cli_test_fail_rename(void);
+/* LUXEL_TEST_FAIL_LINK=1: true for every hard link cli_stage_publish asks
+ * for, which is then refused as on a file system without links. */
+bool cli_test_fail_link(void);
+/* LUXEL_TEST_FAIL_RESTORE=N: true for the Nth rename that puts a replaced
+ * file back after a failed publish (1 = the first), which then fails. */
+bool cli_test_fail_restore(void);
 
 /* Monotonic seconds. */
 double cli_now(void);
