@@ -75,6 +75,14 @@ expect_rc 0 "ibl --help"
 expect_stdout_has "ibl --help: usage on stdout" '^usage: luxel ibl ENV'
 expect_stdout_has "ibl --help documents const:" 'const:R,G,B'
 expect_stdout_has "ibl --help documents --layout" '--layout'
+expect_stdout_has "ibl --help documents --specular-size" '^ +--specular-size N'
+# the defaults it shows are the library's, as ibl.h documents them
+expect_stdout_has "ibl --help: the DFG table's default size" 'GGX table, 128x128'
+expect_stdout_has "ibl --help: the irradiance's default size" 'irradiance cube, 32x32 faces'
+expect_stdout_has "ibl --help: specular level 0 at most 256" "environment's, at most 256\)"
+expect_stdout_has "ibl --help: the default samples" '\(default 256 and 1024\)'
+expect_stdout_has "ibl --help: the default layout" 'default faces$'
+expect_stdout_has "ibl --help: the default format" 'default exr$'
 check "ibl --help: nothing on stderr" test ! -s "$ERR"
 run "$LUXEL" --help
 expect_stdout_has "luxel --help lists ibl" '^ +ibl ENV'

@@ -32,8 +32,8 @@ static const char *bake_usage =
     "  --pre-expose            store values times the exposure of --exposure\n"
     "                          (Filament's pre-exposure: sun-lit scenes fit in\n"
     "                          half floats); the manifest records the factor\n"
-    "  --quantity Q            irradiance (lux, default) or radiance (nits:\n"
-    "                          irradiance x base colour / pi)\n"
+    "  --quantity Q            irradiance (lux) or radiance (nits: irradiance x\n"
+    "                          base colour / pi); default %s\n"
     "  --ambient R,G,B         constant ambient illuminance in lux\n"
     "  --sky ENV               light by an environment (equirect, cross or\n"
     "                          <name>_px.<ext> faces, radiance in nits, or\n"
@@ -246,8 +246,9 @@ static int parse_args(int argc, char **argv, bake_args *a)
         case 'h': {
             /* the defaults shown are the library's */
             lx_bake_desc d = lx_bake_desc_defaults(NULL);
-            printf(bake_usage, d.resolution, d.max_resolution, (double)d.sky.intensity,
-                   d.sky.samples, LX_PADDING_RECOMMENDED);
+            printf(bake_usage, d.resolution, d.max_resolution,
+                   d.quantity == LX_QUANTITY_RADIANCE ? "radiance" : "irradiance",
+                   (double)d.sky.intensity, d.sky.samples, LX_PADDING_RECOMMENDED);
             return -1;
         }
         case ':':
