@@ -76,6 +76,11 @@ typedef enum lx_quantity {
  * each bringing the environment it sees (pi / N sum L). lx_baker_create
  * rejects an environment with NaN, infinite or negative texels, or whose
  * brightest texel times intensity exceeds 1e36 nits. */
+/* The face size a sky environment is worth loading at
+ * (lx_env_load_desc.size): enough for its order-2 spherical harmonics,
+ * and more than the 64 texels a side sky shadows look it up at. */
+#define LX_SKY_ENVIRONMENT_SIZE 256
+
 typedef struct lx_sky_desc {
     const lx_cubemap *environment; /* NULL = no sky; read by lx_baker_create only */
     float intensity;               /* multiplier, 0 = 1 */

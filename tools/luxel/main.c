@@ -270,6 +270,19 @@ bool cli_test_fail_rename(void)
     return nth && atol(nth) == ++renames;
 }
 
+bool cli_test_fail_link(void)
+{
+    const char *on = getenv("LUXEL_TEST_FAIL_LINK");
+    return on && strcmp(on, "1") == 0;
+}
+
+bool cli_test_fail_restore(void)
+{
+    static _Atomic long restores;
+    const char *nth = getenv("LUXEL_TEST_FAIL_RESTORE");
+    return nth && atol(nth) == ++restores;
+}
+
 /* ---- progress bar -------------------------------------------------------- */
 
 void cli_progress_init(cli_progress *p, const char *label, bool quiet)
