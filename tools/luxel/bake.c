@@ -469,9 +469,19 @@ int cmd_bake(int argc, char **argv)
         goto done;
     }
 
+    /* the padding is long work on large maps: one bar over every map, and
+     * an interrupt stops it */
+    cli_progress_init(&progress, "apply", a.quiet);
+    progress.phase = "apply and meter";
     for (uint32_t m = 0; m < maps; m++) {
-        if (lx_baker_apply_alloc(baker, m, &images[m]) != LX_OK) {
-            cli_error("%s", lx_last_error());
+        progress.base = (float)m / (float)maps;
+        progress.span = 1.0f / (float)maps;
+        if ((st = lx_baker_apply_alloc(baker, m, &images[m])) != LX_OK) {
+            cli_progress_finish(&progress);
+            if (st == LX_ERR_CANCELLED)
+                cli_report_interrupt(false);
+            else
+                cli_error("%s", lx_last_error());
             goto done;
         }
     }
@@ -483,7 +493,7 @@ int cmd_bake(int argc, char **argv)
                scene->light_count ? " where it has texels" : " (it has no lights)");
     double ev = a.has_exposure ? a.exposure_ev100 : metered;
     float exposure = lx_exposure_from_ev100((float)ev) * preview_scale(&a);
-    cli_phase("apply and meter");
+    cli_progress_finish(&progress); /* the phase "apply and meter" */
     /* Filament: pre-exposed values are the quantity times 1/(1.2 * 2^EV100) */
     float pre_exposure = lx_exposure_from_ev100((float)ev);
 

@@ -56,6 +56,8 @@ int cli_environment_size(const char *env, int size);
 typedef struct cli_progress {
     const char *label; /* also the phase name of LUXEL_TEST_PAUSE */
     const char *phase; /* what --verbose calls the phase; NULL = the label */
+    float base, span;  /* the bar shows base + span * fraction (0 and 1 from
+                          init): one bar over several library calls */
     bool enabled;
     bool drawn;
     double start;
