@@ -18,13 +18,17 @@
  * MEMORY  lx_baker_create copies what it needs from the scene (the scene
  *   may be destroyed afterwards). Info structs are borrowed until
  *   lx_baker_destroy.
- * THREADING  lx_baker_create, lx_dilate and the *_desc_defaults are
- *   thread-safe; several bakers may run on different threads at once. One
- *   baker is used from one thread at a time (every lx_baker_* call on it,
- *   the read-only ones included, while another may change it); it runs
- *   OpenMP over texel tiles internally, at most desc.threads threads, and
- *   its results are bit-identical for any thread count. The progress
- *   callback is called from one thread at a time, not always the caller's.
+ * THREADING  lx_baker_create, lx_dilate (on distinct images) and the
+ *   *_desc_defaults are thread-safe; several bakers may run on different
+ *   threads at once. One baker is used from one thread at a time (every
+ *   lx_baker_* call on it, the read-only ones included, while another may
+ *   change it); it runs OpenMP over texel tiles internally, at most
+ *   desc.threads threads, and its results are bit-identical for any thread
+ *   count. lx_dilate runs at most its desc's threads, bit-identical too.
+ *   The long calls (lx_baker_create, _bake, _update, _apply, lx_dilate)
+ *   report to their progress callback, which is called from one thread at
+ *   a time, not always the caller's, and returning false cancels
+ *   (LX_ERR_CANCELLED; what each call leaves is said at the call).
  *
  * USAGE
  *   lx_scene *scene;
@@ -76,6 +80,11 @@ typedef enum lx_quantity {
  * each bringing the environment it sees (pi / N sum L). lx_baker_create
  * rejects an environment with NaN, infinite or negative texels, or whose
  * brightest texel times intensity exceeds 1e36 nits. */
+/* The face size a sky environment is worth loading at
+ * (lx_env_load_desc.size): enough for its order-2 spherical harmonics,
+ * and more than the 64 texels a side sky shadows look it up at. */
+#define LX_SKY_ENVIRONMENT_SIZE 256
+
 typedef struct lx_sky_desc {
     const lx_cubemap *environment; /* NULL = no sky; read by lx_baker_create only */
     float intensity;               /* multiplier, 0 = 1 */
@@ -150,8 +159,11 @@ lx_status lx_baker_set_node_transform(lx_baker *baker, uint32_t node, const lx_m
  * desc.progress like lx_baker_bake (leave it NULL for per-frame use). */
 lx_status lx_baker_update(lx_baker *baker);
 
-/* baked + real-time for one lightmap, in the desc's quantity, padded.
- * out must be a 3-channel image of the lightmap's size. */
+/* baked + real-time for one lightmap, in the desc's quantity, padded by
+ * desc.padding passes of lx_dilate. out must be a 3-channel image of the
+ * lightmap's size. Reports the dilation to desc.progress (0 to 1 for this
+ * map) and stops when told (LX_ERR_CANCELLED); on any failure out's
+ * pixels are zeroed. */
 lx_status lx_baker_apply(const lx_baker *baker, uint32_t map, lx_image *out);
 /* Same into a newly allocated image (free with lx_image_free). */
 lx_status lx_baker_apply_alloc(const lx_baker *baker, uint32_t map, lx_image *out);
@@ -178,10 +190,32 @@ bool lx_baker_texel(const lx_baker *baker, uint32_t map, int x, int y, lx_texel_
  * is 0: every lightmap is black. */
 void lx_baker_meter_ev100(const lx_baker *baker, float *ev100, bool *lit);
 
+/* Threads and progress of lx_dilate. desc may be NULL (all cores, no
+ * progress). */
+typedef struct lx_dilate_desc {
+    int threads;             /* at most this many threads, 0 = all cores */
+    lx_progress_fn progress; /* may be NULL; returning false cancels */
+    void *progress_user;
+} lx_dilate_desc;
+
+/* A copy of desc (or of zeros when NULL) with every default filled in. */
+lx_dilate_desc lx_dilate_desc_defaults(const lx_dilate_desc *desc);
+
 /* Fills unused texels (mask 0) from used neighbours, one ring per pass, so
- * bilinear sampling and mips do not bleed black. mask is updated.
- * channels must be 1..4 (otherwise nothing happens). */
-void lx_dilate(float *data, uint8_t *mask, int width, int height, int channels, int passes);
+ * bilinear sampling and mips do not bleed black: each pass gives every
+ * empty texel with a filled 8-neighbour the average of those neighbours
+ * as the previous pass left them (summed in float, rows dy = -1..1, then
+ * dx = -1..1), and marks it 1 in mask. Stops early when nothing grows.
+ * Bit-identical for any thread count; the time follows the texels filled
+ * (plus one scan of the mask), not passes x image.
+ * data holds width*height*channels floats, mask width*height bytes
+ * (nonzero = filled); channels 1..4, passes >= 0 (0 does nothing), at most
+ * 2^32 - 1 texels, else LX_ERR_INVALID. Scratch memory is a byte a texel
+ * plus the frontiers (and a copy of the empty texels it fills whose value
+ * was not zero). desc->progress hears the passes; on LX_ERR_CANCELLED or
+ * LX_ERR_NOMEM data and mask are left as they were. */
+lx_status lx_dilate(float *data, uint8_t *mask, int width, int height, int channels, int passes,
+                    const lx_dilate_desc *desc);
 
 #ifdef __cplusplus
 }

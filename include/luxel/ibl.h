@@ -263,6 +263,13 @@ lx_status lx_env_write(const char *folder, const char *stem, const lx_cubemap *l
  * (the levels and the image each is written from). */
 lx_status lx_env_write_check(int size, int count, const lx_env_write_desc *desc);
 
+/* Tells desc->on_file the name of every file lx_env_write(folder, stem,
+ * levels, count, desc) would write, in the order it would write them, and
+ * writes nothing: a caller checks (or reserves) every name before the work
+ * that makes the levels. Fails as lx_env_write does on a bad stem, count or
+ * desc; LX_ERR_CANCELLED when on_file returns false. */
+lx_status lx_env_write_names(const char *stem, int count, const lx_env_write_desc *desc);
+
 /* Writes levels[0..count) (a cube map and its mips, each half the size of
  * the one before) as one KTX 1.1 file at path, RGBA16F when half else
  * RGBA32F, atomically (lx_env_write with LX_ENV_KTX, at a path of the
@@ -271,16 +278,22 @@ lx_status lx_ktx_write_cubemap(const char *path, const lx_cubemap *levels, int c
 
 /* ---- diffuse irradiance --------------------------------------------- */
 
+/* The face size of an irradiance cube when none is asked for (size 0), and
+ * what lx_irradiance_brute reduces its source to (source_size 0):
+ * irradiance varies slowly, so 32 x 32 faces hold it. */
+#define LX_IRRADIANCE_DEFAULT_SIZE 32
+
 /* The seed's brute force: every source texel a directional light of
  * radiance * exact solid angle, weighted by the cosine. The cosine is
  * integrated exactly over each texel (its irradiance vector, Lambert's
  * formula); a texel the horizon cuts is split into sub-texels, so a
  * constant environment L gives pi L to ~2e-5. The source is first
  * downsampled (lx_cubemap_downsample, in one pass) to its size halved
- * until it is at most source_size (0 = 32). out gets a cube map of size
- * texels per side (0 = 32), irradiance in lux. Cost: 6 size^2 x 6
- * source^2 texel pairs. Rejects NaN or infinite texels. desc may be NULL.
- * On failure or cancellation out is left zeroed. */
+ * until it is at most source_size (0 = LX_IRRADIANCE_DEFAULT_SIZE). out
+ * gets a cube map of size texels per side (0 = LX_IRRADIANCE_DEFAULT_SIZE),
+ * irradiance in lux. Cost: 6 size^2 x 6 source^2 texel pairs. Rejects NaN
+ * or infinite texels. desc may be NULL. On failure or cancellation out is
+ * left zeroed. */
 lx_status lx_irradiance_brute(const lx_cubemap *src, int size, int source_size,
                               const lx_ibl_desc *desc, lx_cubemap *out);
 
@@ -311,10 +324,10 @@ lx_status lx_sh_project(const lx_cubemap *c, const lx_ibl_desc *desc, lx_sh9 *ou
 void lx_sh_irradiance(const lx_sh9 *sh, lx_vec3 n, float out[3]);
 /* The paper's constants c1..c5. */
 extern const float lx_sh_irradiance_constants[5];
-/* lx_sh_irradiance at every texel centre of a size^2 cube map (allocated;
- * free with lx_cubemap_free). Not clamped either: negative texels are
- * kept, and a warning counting them goes to the log callback. desc may be
- * NULL. */
+/* lx_sh_irradiance at every texel centre of a size^2 cube map (size 0 =
+ * LX_IRRADIANCE_DEFAULT_SIZE; allocated, free with lx_cubemap_free). Not
+ * clamped either: negative texels are kept, and a warning counting them
+ * goes to the log callback. desc may be NULL. */
 lx_status lx_sh_irradiance_cube(const lx_sh9 *sh, int size, const lx_ibl_desc *desc,
                                 lx_cubemap *out);
 
@@ -322,12 +335,20 @@ lx_status lx_sh_irradiance_cube(const lx_sh9 *sh, int size, const lx_ibl_desc *d
 
 typedef enum lx_specular_filter { LX_SPECULAR_GGX = 0, LX_SPECULAR_PHONG } lx_specular_filter;
 
+/* Level 0's face size when none is asked for: the source's, at most this
+ * (lx_prefilter_size). */
+#define LX_PREFILTER_DEFAULT_SIZE 256
+/* The most GGX samples per texel lx_prefilter_desc.samples may ask. */
+#define LX_PREFILTER_MAX_SAMPLES 65536
+
 typedef struct lx_prefilter_desc {
     lx_specular_filter filter;
-    int size;                     /* level 0 face size, 0 = the source's (at most 256) */
+    int size;                     /* level 0 face size, 0 = the source's, at most
+                                     LX_PREFILTER_DEFAULT_SIZE (lx_prefilter_size) */
     int mips;                     /* levels, 0 = down to 1x1; at most log2(size) + 1 */
     int samples;                  /* GGX: importance samples per texel where sampled, and the
-                                     per-texel budget that picks convolution (1..65536), 0 = 256 */
+                                     per-texel budget that picks convolution
+                                     (1..LX_PREFILTER_MAX_SAMPLES), 0 = 256 */
     const float *phong_exponents; /* PHONG: one per level, each in (0, 1e6];
                                      NULL = lx_phong_level_exponent */
     int threads;                  /* 0 = all cores */
@@ -339,6 +360,12 @@ typedef struct lx_prefilter_desc {
  * depend on the source filled in (size and mips are chosen by
  * lx_prefilter from the source). */
 lx_prefilter_desc lx_prefilter_desc_defaults(const lx_prefilter_desc *desc);
+
+/* The face size of level 0 that lx_prefilter makes from a source of face
+ * size source_size: desc->size when set, else the source's, at most
+ * LX_PREFILTER_DEFAULT_SIZE. desc may be NULL. The levels it makes, when
+ * desc->mips is 0, are lx_cube_mip_count of that size. */
+int lx_prefilter_size(int source_size, const lx_prefilter_desc *desc);
 
 /* The GGX roughness (perceptual, alpha = roughness^2) of mip level of
  * count levels: level / (count - 1). */
@@ -383,14 +410,22 @@ lx_status lx_prefilter(const lx_cubemap *src, const lx_prefilter_desc *desc,
  * desc and the peak memory, with lx_prefilter's messages. */
 lx_status lx_prefilter_check(int source_size, const lx_prefilter_desc *desc);
 
+/* The DFG table's side and samples per texel when none are asked for (0),
+ * and the most lx_dfg_lut takes. */
+#define LX_DFG_DEFAULT_SIZE 128
+#define LX_DFG_MAX_SIZE 4096
+#define LX_DFG_DEFAULT_SAMPLES 1024
+#define LX_DFG_MAX_SAMPLES (1 << 20)
+
 /* The split-sum DFG table for GGX (Karis 2013): texel (x, y), row 0 at the
  * top, holds N.V = (x + 0.5) / size and perceptual roughness
  * (y + 0.5) / size (alpha = roughness^2); channel 0 is the scale A and
  * channel 1 the bias B on F0 (specular = F0 * A + B). G is Smith's
  * height-correlated masking-shadowing (Heitz 2014); the integrals are
  * estimated from samples Hammersley-placed visible normals (Heitz 2018),
- * the same for every texel. size 0 = 128 (1..4096), samples 0 = 1024
- * (1..2^20). out is allocated (size*size*2 floats); free with
+ * the same for every texel. size 0 = LX_DFG_DEFAULT_SIZE
+ * (1..LX_DFG_MAX_SIZE), samples 0 = LX_DFG_DEFAULT_SAMPLES
+ * (1..LX_DFG_MAX_SAMPLES). out is allocated (size*size*2 floats); free with
  * lx_image_free. desc may be NULL. */
 lx_status lx_dfg_lut(int size, int samples, const lx_ibl_desc *desc, lx_image *out);
 

@@ -319,6 +319,14 @@ lx_status lx_baker_apply(const lx_baker *b, uint32_t map_index, lx_image *out)
     size_t pixels = (size_t)w * h;
     const float *rt = map->realtime; /* NULL: no dynamic light yet, zero */
     int threads = lx_thread_count(b->desc.threads);
+    /* lx_dilate writes the mask it grows: a copy, made before out is */
+    uint8_t *mask = NULL;
+    if (b->desc.padding > 0) {
+        if (!(mask = malloc(pixels)))
+            return lx_fail(LX_ERR_NOMEM, "lightmap '%s': out of memory for the %dx%d padding mask",
+                           map->name, w, h);
+        memcpy(mask, map->mask, pixels);
+    }
     /* rows, then tiles, in parallel: each pixel is written by one
      * iteration */
 #pragma omp parallel num_threads(threads)
@@ -341,15 +349,27 @@ lx_status lx_baker_apply(const lx_baker *b, uint32_t map_index, lx_image *out)
                 out->data[3 * p + 2] = e.z;
             }
     }
-    if (b->desc.padding > 0) {
-        uint8_t *mask = malloc(pixels);
-        if (!mask)
-            return lx_fail(LX_ERR_NOMEM, "out of memory");
-        memcpy(mask, map->mask, pixels);
-        lx_dilate(out->data, mask, w, h, 3, b->desc.padding);
+    lx_status st = LX_OK;
+    if (mask) {
+        lx_dilate_desc dd = {.threads = b->desc.threads,
+                             .progress = b->desc.progress,
+                             .progress_user = b->desc.progress_user};
+        st = lx_dilate(out->data, mask, w, h, 3, b->desc.padding, &dd);
         free(mask);
+    } else if (b->desc.progress && !b->desc.progress(b->desc.progress_user, 1.0f)) {
+        st = lx_fail(LX_ERR_CANCELLED, "apply cancelled");
     }
-    return LX_OK;
+    if (st != LX_OK) {
+        if (st != LX_ERR_CANCELLED) {
+            char what[300];
+            snprintf(what, sizeof what, "lightmap '%s'", map->name);
+            lx_error_prefix(what);
+        }
+#pragma omp parallel for schedule(static) num_threads(threads)
+        for (int y = 0; y < h; y++)
+            memset(out->data + (size_t)y * w * 3, 0, (size_t)w * 3 * sizeof(float));
+    }
+    return st;
 }
 
 lx_status lx_baker_apply_alloc(const lx_baker *b, uint32_t map, lx_image *out)

@@ -116,13 +116,14 @@ lx_status lx_dfg_lut(int size, int samples, const lx_ibl_desc *in, lx_image *out
         return lx_fail(LX_ERR_INVALID, "DFG table: no output image (NULL)");
     memset(out, 0, sizeof *out);
     lx_ibl_desc desc = lx_ibl_desc_defaults(in);
-    size = size ? size : 128;
-    samples = samples ? samples : 1024;
-    if (size < 1 || size > 4096)
-        return lx_fail(LX_ERR_INVALID, "DFG table: size %d is outside 1..4096", size);
-    if (samples < 1 || samples > 1 << 20)
+    size = size ? size : LX_DFG_DEFAULT_SIZE;
+    samples = samples ? samples : LX_DFG_DEFAULT_SAMPLES;
+    if (size < 1 || size > LX_DFG_MAX_SIZE)
+        return lx_fail(LX_ERR_INVALID, "DFG table: size %d is outside 1..%d", size,
+                       LX_DFG_MAX_SIZE);
+    if (samples < 1 || samples > LX_DFG_MAX_SAMPLES)
         return lx_fail(LX_ERR_INVALID, "DFG table: %d samples per texel is outside 1..%d", samples,
-                       1 << 20);
+                       LX_DFG_MAX_SAMPLES);
     lx_status st = lx_ibl_check_threads(desc.threads);
     if (st != LX_OK)
         return st;

@@ -115,6 +115,44 @@ lx_status lx_env_write_check(int size, int count, const lx_env_write_desc *desc)
     return check_memory("environment", sizes, count, &d);
 }
 
+/* The name of file `face` (ignored but for FACES) of `level` of count
+ * levels: <stem>.ktx, else <stem>[_m<L>][_<face>].<ext>. */
+static void file_name(char *name, size_t size, const char *stem, int level, int count, int face,
+                      const lx_env_write_desc *d)
+{
+    if (d->layout == LX_ENV_KTX) {
+        snprintf(name, size, "%s.ktx", stem);
+        return;
+    }
+    char base[MAX_NAME - 16];
+    if (count > 1 || d->mip_names)
+        snprintf(base, sizeof base, "%s_m%d", stem, level);
+    else
+        snprintf(base, sizeof base, "%s", stem);
+    const char *ext = lx_image_format_extension(d->format);
+    if (d->layout == LX_ENV_FACES)
+        snprintf(name, size, "%s_%s.%s", base, lx_cube_face_name(face), ext);
+    else
+        snprintf(name, size, "%s.%s", base, ext);
+}
+
+lx_status lx_env_write_names(const char *stem, int count, const lx_env_write_desc *desc)
+{
+    lx_env_write_desc d = lx_env_write_desc_defaults(desc);
+    lx_status st = check_desc(stem, count, &d);
+    if (st != LX_OK || !d.on_file)
+        return st;
+    int per_level = d.layout == LX_ENV_FACES ? 6 : 1;
+    int files = d.layout == LX_ENV_KTX ? 1 : count * per_level;
+    for (int i = 0; i < files; i++) {
+        char name[MAX_NAME];
+        file_name(name, sizeof name, stem, i / per_level, count, i % per_level, &d);
+        if (!d.on_file(d.on_file_user, name))
+            return lx_fail(LX_ERR_CANCELLED, "%s: cancelled", name);
+    }
+    return LX_OK;
+}
+
 /* What one call has written so far: the paths, to remove them again. */
 typedef struct written {
     int count;
@@ -189,7 +227,7 @@ lx_status lx_env_write(const char *folder, const char *stem, const lx_cubemap *l
     lx_ibl_run run = lx_ibl_run_make(d.threads, d.progress, d.progress_user);
     char name[MAX_NAME];
     if (d.layout == LX_ENV_KTX) {
-        snprintf(name, sizeof name, "%s.ktx", stem);
+        file_name(name, sizeof name, stem, 0, count, 0, &d);
         char *path;
         if ((st = file_path(folder, name, &d, &path)) != LX_OK)
             return st;
@@ -197,7 +235,6 @@ lx_status lx_env_write(const char *folder, const char *stem, const lx_cubemap *l
         free(path);
         return st;
     }
-    const char *ext = lx_image_format_extension(d.format);
     written w = {0};
     /* progress by texels, a level's conversion and writing each half of it */
     double total = 0.0, done = 0.0;
@@ -206,14 +243,9 @@ lx_status lx_env_write(const char *folder, const char *stem, const lx_cubemap *l
     for (int l = 0; l < count && st == LX_OK; l++) {
         const lx_cubemap *c = &levels[l];
         double part = (double)c->size * c->size;
-        char base[MAX_NAME - 16];
-        if (count > 1 || d.mip_names)
-            snprintf(base, sizeof base, "%s_m%d", stem, l);
-        else
-            snprintf(base, sizeof base, "%s", stem);
         if (d.layout == LX_ENV_FACES) {
             for (int f = 0; f < 6 && st == LX_OK; f++) {
-                snprintf(name, sizeof name, "%s_%s.%s", base, lx_cube_face_name(f), ext);
+                file_name(name, sizeof name, stem, l, count, f, &d);
                 lx_image face = lx_cubemap_face_image(c, f);
                 st = put_image(folder, name, &face, &d, &w);
                 if (st == LX_OK && run.progress &&
@@ -227,7 +259,7 @@ lx_status lx_env_write(const char *folder, const char *stem, const lx_cubemap *l
                      ? lx_ibl_cube_to_equirect(c, 4 * c->size, &conv, &img)
                      : lx_ibl_cube_to_cross(c, d.layout == LX_ENV_CROSS_VERTICAL, &conv, &img);
             if (st == LX_OK) {
-                snprintf(name, sizeof name, "%s.%s", base, ext);
+                file_name(name, sizeof name, stem, l, count, 0, &d);
                 st = put_image(folder, name, &img, &d, &w);
                 lx_image_free(&img);
             }

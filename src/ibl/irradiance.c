@@ -227,8 +227,8 @@ lx_status lx_irradiance_brute(const lx_cubemap *src, int size, int source_size,
         return lx_fail(LX_ERR_INVALID, "irradiance: no output cube map (NULL)");
     memset(out, 0, sizeof *out);
     lx_ibl_desc desc = lx_ibl_desc_defaults(in);
-    size = size ? size : 32;
-    source_size = source_size ? source_size : 32;
+    size = size ? size : LX_IRRADIANCE_DEFAULT_SIZE;
+    source_size = source_size ? source_size : LX_IRRADIANCE_DEFAULT_SIZE;
     if (size < 1 || size > LX_MAX_CUBE_SIZE)
         return lx_fail(LX_ERR_INVALID, "irradiance: face size %d is outside 1..%d", size,
                        LX_MAX_CUBE_SIZE);

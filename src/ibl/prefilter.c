@@ -43,6 +43,13 @@ lx_prefilter_desc lx_prefilter_desc_defaults(const lx_prefilter_desc *desc)
     return d;
 }
 
+int lx_prefilter_size(int source_size, const lx_prefilter_desc *desc)
+{
+    if (desc && desc->size)
+        return desc->size;
+    return source_size < LX_PREFILTER_DEFAULT_SIZE ? source_size : LX_PREFILTER_DEFAULT_SIZE;
+}
+
 /* Checks desc against a source of face size source_size and fills size
  * and mips. */
 static lx_status validate(int source_size, lx_prefilter_desc *d)
@@ -52,8 +59,7 @@ static lx_status validate(int source_size, lx_prefilter_desc *d)
                        source_size, LX_MAX_CUBE_SIZE);
     if (d->filter != LX_SPECULAR_GGX && d->filter != LX_SPECULAR_PHONG)
         return lx_fail(LX_ERR_INVALID, "prefilter: unknown filter %d", (int)d->filter);
-    if (d->size == 0)
-        d->size = source_size < 256 ? source_size : 256;
+    d->size = lx_prefilter_size(source_size, d);
     if (d->size < 1 || d->size > LX_MAX_CUBE_SIZE)
         return lx_fail(LX_ERR_INVALID, "prefilter: face size %d is outside 1..%d", d->size,
                        LX_MAX_CUBE_SIZE);
@@ -64,9 +70,9 @@ static lx_status validate(int source_size, lx_prefilter_desc *d)
         return lx_fail(LX_ERR_INVALID,
                        "prefilter: %d mip levels asked; a %d x %d face has 1..%d (down to 1x1)",
                        d->mips, d->size, d->size, most);
-    if (d->samples < 1 || d->samples > 65536)
-        return lx_fail(LX_ERR_INVALID, "prefilter: %d samples per texel is outside 1..65536",
-                       d->samples);
+    if (d->samples < 1 || d->samples > LX_PREFILTER_MAX_SAMPLES)
+        return lx_fail(LX_ERR_INVALID, "prefilter: %d samples per texel is outside 1..%d",
+                       d->samples, LX_PREFILTER_MAX_SAMPLES);
     if (d->filter == LX_SPECULAR_PHONG && d->phong_exponents)
         for (int i = 0; i < d->mips; i++) {
             float e = d->phong_exponents[i];

@@ -269,6 +269,7 @@ lx_status lx_sh_irradiance_cube(const lx_sh9 *sh, int size, const lx_ibl_desc *i
         st = lx_ibl_check_threads(desc.threads);
     if (st != LX_OK)
         return st;
+    size = size ? size : LX_IRRADIANCE_DEFAULT_SIZE;
     if (size < 1 || size > LX_MAX_CUBE_SIZE)
         return lx_fail(LX_ERR_INVALID, "SH irradiance: face size %d is outside 1..%d", size,
                        LX_MAX_CUBE_SIZE);

@@ -1,6 +1,7 @@
 /* The baker at the edges of its inputs (cases a review found): enormous
  * node scales, UVs far outside [0,1], texel densities whose size does not
- * fit an int, and lx_dilate given a channel count it does not handle. */
+ * fit an int, and lx_dilate given a channel count it does not handle
+ * (rejected, nothing touched). */
 #include <setjmp.h>
 #include <stdarg.h>
 #include <stddef.h>
@@ -86,12 +87,12 @@ static void density_beyond_int_caps(void **state)
     lx_scene_destroy(scene);
 }
 
-static void dilate_ignores_bad_channel_counts(void **state)
+static void dilate_rejects_bad_channel_counts(void **state)
 {
     (void)state;
     float data[2 * 8] = {1, 2, 3, 4, 5, 6, 7, 8};
     uint8_t mask[2] = {1, 0};
-    lx_dilate(data, mask, 2, 1, 8, 1);
+    assert_int_equal(lx_dilate(data, mask, 2, 1, 8, 1, NULL), LX_ERR_INVALID);
     assert_int_equal(mask[1], 0);
     assert_true(data[8] == 0.0f);
 }
@@ -102,7 +103,7 @@ int main(void)
         cmocka_unit_test(huge_scale_keeps_normals),
         cmocka_unit_test(far_uvs_cover_nothing),
         cmocka_unit_test(density_beyond_int_caps),
-        cmocka_unit_test(dilate_ignores_bad_channel_counts),
+        cmocka_unit_test(dilate_rejects_bad_channel_counts),
     };
     return cmocka_run_group_tests(tests, NULL, NULL);
 }

@@ -75,6 +75,14 @@ expect_rc 0 "ibl --help"
 expect_stdout_has "ibl --help: usage on stdout" '^usage: luxel ibl ENV'
 expect_stdout_has "ibl --help documents const:" 'const:R,G,B'
 expect_stdout_has "ibl --help documents --layout" '--layout'
+expect_stdout_has "ibl --help documents --specular-size" '^ +--specular-size N'
+# the defaults it shows are the library's, as ibl.h documents them
+expect_stdout_has "ibl --help: the DFG table's default size" 'GGX table, 128x128'
+expect_stdout_has "ibl --help: the irradiance's default size" 'irradiance cube, 32x32 faces'
+expect_stdout_has "ibl --help: specular level 0 at most 256" "environment's, at most 256\)"
+expect_stdout_has "ibl --help: the default samples" '\(default 256 and 1024\)'
+expect_stdout_has "ibl --help: the default layout" 'default faces$'
+expect_stdout_has "ibl --help: the default format" 'default exr$'
 check "ibl --help: nothing on stderr" test ! -s "$ERR"
 run "$LUXEL" --help
 expect_stdout_has "luxel --help lists ibl" '^ +ibl ENV'
@@ -419,23 +427,37 @@ run "$LUXEL" ibl const:1 --size 4 --sh -o "$WORK/afile"
 expect_rc 1 "-o names a file"
 expect_error "-o names a file" "afile"
 
-wait_for() { # polls every 10 ms for up to 30 s
-    local i
-    for ((i = 0; i < 3000; i++)); do
-        "$@" && return 0
+# paused LABEL PHASE SIGNAL OUTDIR ARGS...: runs `luxel ibl ARGS -o OUTDIR`
+# stopped at PHASE by the test hook LUXEL_TEST_PAUSE, runs the function
+# named by AT_PAUSE (if set; $pid is the run) there, sends SIGNAL and
+# requires the run to end by it (exit status 128 + N) saying it was
+# interrupted, with no output folder left.
+paused() {
+    local label=$1 phase=$2 sig=$3 out=$4 i
+    shift 4
+    : >"$ERR" # empty before the run starts: a stale "paused" line would send the signal too early
+    LUXEL_TEST_PAUSE=$phase "$LUXEL" ibl "$@" -o "$out" >"$OUT" 2>"$ERR" </dev/null &
+    pid=$!
+    for ((i = 0; i < 6000; i++)); do
+        grep -q "^luxel: test: paused at $phase\$" "$ERR" && break
+        kill -0 "$pid" 2>/dev/null || break
         sleep 0.01
     done
-    return 1
-}
-# wait_for_pause PHASE: until the run says it paused there (or ends)
-wait_for_pause() {
-    local i
-    for ((i = 0; i < 3000; i++)); do
-        grep -q "^luxel: test: paused at $1" "$ERR" && return 0
-        kill -0 "$pid" 2>/dev/null || return 1
-        sleep 0.01
-    done
-    return 1
+    if ! grep -q "^luxel: test: paused at $phase\$" "$ERR"; then
+        kill -KILL "$pid" 2>/dev/null
+        wait "$pid"
+        fail "$label: the run never reached '$phase' (exit $?)"
+        show_stderr
+        return 1
+    fi
+    pass "$label: reaches '$phase'"
+    [ -n "${AT_PAUSE:-}" ] && "$AT_PAUSE"
+    kill -"$sig" "$pid"
+    wait "$pid"
+    RC=$?
+    expect_rc $((128 + $(kill -l "$sig"))) "$label: ended by SIG$sig"
+    expect_error "$label" "interrupted"
+    expect_no_output "$label" "$out"
 }
 
 # ---- memory: a run that cannot fit fails before it starts ---------------------------
@@ -454,18 +476,11 @@ bad "a run that needs more memory than the machine" 1 "const:1|prefilter: a 1638
 # 16x; the warning comes before the resampling starts (it is on stderr when
 # the run reaches its first progress report)
 pfm "$IN/small_eq.pfm" 16 8 $(repeat 128 0.5)
-out=$WORK/out_upsample
-: >"$ERR" # empty before the run starts: a stale "paused" line would send the signal too early
-LUXEL_TEST_PAUSE=environment "$LUXEL" ibl "$IN/small_eq.pfm" --size 64 --irradiance=sh -o "$out" >"$OUT" 2>"$ERR" &
-pid=$!
-if wait_for_pause environment; then
+upsample_warned() {
     expect_stderr_has "upsampling: warned before the work" "^luxel: warning: .*small_eq.pfm: 64 x 64 faces from a 16 x 8 equirect upsample it 16x: the .*MiB cube map"
-    kill -INT "$pid"
-fi
-wait "$pid"
-RC=$?
-check "upsampling: interrupted at the pause" test "$RC" -ne 0
-expect_no_output "upsampling, interrupted" "$out"
+}
+AT_PAUSE=upsample_warned paused "upsampling, interrupted" environment INT "$WORK/out_upsample" \
+    "$IN/small_eq.pfm" --size 64 --irradiance=sh
 run "$LUXEL" ibl const:1 --size 16 --specular ggx --specular-size 128 --samples 16 -q -o "$WORK/up_spec"
 expect_rc 0 "--specular-size 8x the environment"
 expect_stderr_has "--specular-size 8x: a warning" "^luxel: warning: prefilter: 128 x 128 specular faces from a 16 x 16 source upsample it 8x"
@@ -478,76 +493,34 @@ expect_stderr_has "--specular-size 8x: a warning" "^luxel: warning: prefilter: 1
 # is staged) every phase has run: with --threads 1 the process must never
 # have started a second thread (OpenMP keeps the threads it starts).
 pfm "$IN/eq64.pfm" 64 32 $(repeat 2048 0.5)
+# threads_now: the run's thread count at the pause
+threads_now() { awk '/^Threads:/ { print $2 }' "/proc/$pid/status" 2>/dev/null; }
+one_thread() {
+    local n
+    n=$(threads_now)
+    check "--threads 1: one thread through every phase (now $n)" test "$n" = 1
+}
+two_threads() {
+    local n
+    n=$(threads_now)
+    check "--threads 2: at most two threads (now $n)" test "$n" -le 2
+}
 for phase in environment sh irradiance specular dfg write; do
-    out=$WORK/out_phase_$phase
-    : >"$ERR" # empty before the run starts: a stale "paused" line would send the signal too early
-    LUXEL_TEST_PAUSE=$phase "$LUXEL" ibl "$IN/eq64.pfm" --threads 1 -o "$out" >"$OUT" 2>"$ERR" &
-    pid=$!
-    if wait_for_pause "$phase"; then
-        pass "phase $phase: reports progress"
-        threads=$(awk '/^Threads:/ { print $2 }' "/proc/$pid/status" 2>/dev/null)
-        [ "$phase" = write ] && check "--threads 1: one thread through every phase (now $threads)" test "$threads" = 1
-        kill -INT "$pid"
-    else
-        fail "phase $phase: never reported progress"
-        kill -KILL "$pid" 2>/dev/null
-    fi
-    wait "$pid"
-    RC=$?
-    check "phase $phase: interrupted (status $RC)" test "$RC" -ne 0
-    expect_stderr_has "phase $phase: says it was interrupted" '^luxel: error: .*interrupt'
-    expect_no_output "phase $phase, interrupted" "$out"
+    hook=
+    [ "$phase" = write ] && hook=one_thread
+    AT_PAUSE=$hook paused "phase $phase, SIGINT" "$phase" INT "$WORK/out_phase_$phase" \
+        "$IN/eq64.pfm" --threads 1
 done
 # --threads 2 bounds the process at two threads (whether OpenMP started
 # the second one for these small loops is its business)
-out=$WORK/out_threads2
-: >"$ERR" # empty before the run starts: a stale "paused" line would send the signal too early
-LUXEL_TEST_PAUSE=write "$LUXEL" ibl "$IN/eq64.pfm" --threads 2 -o "$out" >"$OUT" 2>"$ERR" &
-pid=$!
-if wait_for_pause write; then
-    threads=$(awk '/^Threads:/ { print $2 }' "/proc/$pid/status" 2>/dev/null)
-    check "--threads 2: at most two threads (now $threads)" test "$threads" -le 2
-    kill -INT "$pid"
-else
-    fail "--threads 2: never reached the write phase"
-    kill -KILL "$pid" 2>/dev/null
-fi
-wait "$pid"
+AT_PAUSE=two_threads paused "--threads 2, SIGINT at write" write INT "$WORK/out_threads2" \
+    "$IN/eq64.pfm" --threads 2
 
-# ---- interrupts: nothing left behind ------------------------------------------------------
+# ---- interrupts while writing many files: nothing left behind ----------------------------
 
-has_files() { [ -d "$1" ] && [ "$(find "$1" -type f | wc -l)" -ge "$2" ]; }
-# interrupted LABEL OUTDIR ALL: after a signal, a non-zero exit, a message
-# and an empty folder - or, if the run won the race, all ALL files.
-interrupted() {
-    if [ "$RC" -eq 0 ]; then
-        check "$1: finished before the signal, with all $3 files" test "$(ls -A "$2" | wc -l)" -eq "$3"
-        return
-    fi
-    pass "$1: exit status $RC (non-zero)"
-    expect_stderr_has "$1: says it was interrupted" '^luxel: error: .*interrupt'
-    expect_no_output "$1" "$2"
-}
-out=$WORK/out_int_compute
-"$LUXEL" ibl const:1 --size 256 --specular ggx --samples 65536 --threads 2 -o "$out" >"$OUT" 2>"$ERR" &
-pid=$!
-sleep 0.3
-kill -INT "$pid"
-wait "$pid"
-RC=$?
-interrupted "SIGINT while filtering" "$out" 54
-out=$WORK/out_int_write
-"$LUXEL" ibl const:1 --size 1024 --environment --irradiance=sh --layout faces -o "$out" >"$OUT" 2>"$ERR" &
-pid=$!
-if wait_for has_files "$out" 3; then
-    kill -TERM "$pid" 2>/dev/null
-    wait "$pid"
-    RC=$?
-    interrupted "SIGTERM while writing (after 3 files)" "$out" 12
-else
-    kill -KILL "$pid" 2>/dev/null
-    wait "$pid"
-    fail "SIGTERM while writing: luxel ibl never started writing"
-fi
+# six faces per cube: SIGTERM once the first is staged removes them all and
+# the folder the run made (a SIGINT while filtering is in test_cli_interrupt.sh)
+paused "SIGTERM while writing faces" write TERM "$WORK/out_int_write" \
+    const:1 --size 64 --environment --irradiance=sh --layout faces
 
 finish

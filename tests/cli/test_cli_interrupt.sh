@@ -42,9 +42,11 @@ interrupt() {
         show_stderr
         return 1
     fi
+    local t0=${EPOCHREALTIME/./}
     kill -"$sig" "$pid"
     wait "$pid"
     RC=$?
+    STOP_MS=$(((${EPOCHREALTIME/./} - t0) / 1000)) # from the signal to the exit
     local want=$((128 + $(kill -l "$sig")))
     if [ "$RC" -eq "$want" ]; then
         pass "$label: ended by SIG$sig (exit status $want)"
@@ -67,6 +69,19 @@ expect_no_output "SIGTERM while baking" "$WORK/o2"
 
 interrupt "SIGHUP while evaluating dynamic lights" "dynamic lights" HUP "$WORK/o3" "${BAKE[@]}"
 expect_no_output "SIGHUP while evaluating dynamic lights" "$WORK/o3"
+
+# Padding reports each dilation pass: the signal stops it within a pass, not
+# after every lightmap is padded (64 passes over 8 maps of 512 x 512).
+interrupt "SIGINT while padding the lightmaps" apply INT "$WORK/o7" bake "$RETRO" \
+    --resolution 512 --padding 64 --threads 2
+expect_no_output "SIGINT while padding the lightmaps" "$WORK/o7"
+check "SIGINT while padding the lightmaps: says nothing was written" \
+    grep -q 'interrupted; nothing written' "$ERR"
+if [ "$STOP_MS" -lt 2000 ]; then
+    pass "SIGINT while padding the lightmaps: ended ${STOP_MS} ms after the signal"
+else
+    fail "SIGINT while padding the lightmaps: ended ${STOP_MS} ms after the signal, want < 2000"
+fi
 
 interrupt "ibl: SIGINT while filtering specular" specular INT "$WORK/o4" ibl "$SKY"
 expect_no_output "ibl: SIGINT while filtering specular" "$WORK/o4"

@@ -5,7 +5,7 @@
  *   64-byte header, key/value data, per level imageSize and six faces of
  *   RGBA32F), the equirect of a constant exactly constant;
  * - the file names (stem, _m<L>, _<face>, extension), told to on_file
- *   before each file is made;
+ *   before each file is made, and by lx_env_write_names without writing;
  * - a failure part-way (a NaN in a later level, the caller stopping,
  *   progress cancelling) leaves the folder as it was;
  * - bad stems, counts, layouts and formats, with their messages;
@@ -141,6 +141,58 @@ static void image_layouts_read_back_exactly(void **state)
     assert_int_equal(lx_env_write(dir, "eq", levels, 1, &d), LX_OK);
     assert_int_equal(h.count, 1);
     assert_string_equal(h.name[0], "eq_m0.hdr");
+    free_chain(levels, 3);
+}
+
+/* lx_env_write_names tells the names lx_env_write then writes, in its
+ * order, for every layout, one level or several, with and without
+ * mip_names; it creates nothing, refuses what lx_env_write refuses and
+ * stops when the caller does. */
+static void names_told_before_writing(void **state)
+{
+    (void)state;
+    const char *dir = lx_test_dir("ibl_env_write/names");
+    lx_cubemap levels[3];
+    make_chain(levels, 4, 3, 5);
+    const lx_env_layout layouts[] = {LX_ENV_FACES, LX_ENV_CROSS, LX_ENV_CROSS_VERTICAL,
+                                     LX_ENV_EQUIRECT, LX_ENV_KTX};
+    int files = 0;
+    for (int k = 0; k < 5; k++)
+        for (int count = 1; count <= 3; count += 2)
+            for (int mip_names = 0; mip_names < 2; mip_names++) {
+                char stem[32];
+                snprintf(stem, sizeof stem, "s%d_%d_%d", k, count, mip_names);
+                heard told = {.stop_at = -1}, made = {.stop_at = -1};
+                lx_env_write_desc d = {.layout = layouts[k],
+                                       .format = LX_IMAGE_PFM,
+                                       .mip_names = mip_names,
+                                       .on_file = on_file,
+                                       .on_file_user = &told};
+                assert_int_equal(lx_env_write_names(stem, count, &d), LX_OK);
+                assert_int_equal(lx_test_count_files(dir), files);
+                d.on_file_user = &made;
+                assert_int_equal(lx_env_write(dir, stem, levels, count, &d), LX_OK);
+                assert_int_equal(told.count, made.count);
+                for (int i = 0; i < told.count; i++)
+                    assert_string_equal(told.name[i], made.name[i]);
+                files += made.count;
+                assert_int_equal(lx_test_count_files(dir), files);
+            }
+    /* the names of the cases read back above */
+    heard h = {.stop_at = -1};
+    lx_env_write_desc d = {.mip_names = true, .on_file = on_file, .on_file_user = &h};
+    assert_int_equal(lx_env_write_names("specular", 2, &d), LX_OK);
+    assert_int_equal(h.count, 12);
+    assert_string_equal(h.name[0], "specular_m0_px.exr");
+    assert_string_equal(h.name[11], "specular_m1_nz.exr");
+    /* what lx_env_write refuses, and a caller that stops */
+    assert_int_equal(lx_env_write_names("a/b", 1, &d), LX_ERR_INVALID);
+    assert_error_mentions("without '/'");
+    assert_int_equal(lx_env_write_names("x", LX_MAX_CUBE_MIPS + 1, &d), LX_ERR_INVALID);
+    h = (heard){.stop_at = 2};
+    assert_int_equal(lx_env_write_names("stop", 1, &d), LX_ERR_CANCELLED);
+    assert_int_equal(h.count, 2);
+    assert_int_equal(lx_env_write_names("quiet", 1, NULL), LX_OK);
     free_chain(levels, 3);
 }
 
@@ -557,6 +609,7 @@ int main(void)
     lx_test_watchdog(120);
     const struct CMUnitTest tests[] = {
         cmocka_unit_test(image_layouts_read_back_exactly),
+        cmocka_unit_test(names_told_before_writing),
         cmocka_unit_test(equirect_of_a_constant),
         cmocka_unit_test(ktx_holds_the_levels),
         cmocka_unit_test(failures_leave_nothing),

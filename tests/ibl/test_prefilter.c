@@ -189,6 +189,15 @@ static void ggx_level0_is_the_source(void **state)
     free_levels(levels, count);
     lx_cubemap_free(&half);
     lx_cubemap_free(&env);
+
+    /* the size lx_prefilter picks, told before: the source's up to 256
+     * (the header's default), else the one asked */
+    assert_int_equal(LX_PREFILTER_DEFAULT_SIZE, 256);
+    assert_int_equal(lx_prefilter_size(16, NULL), 16);
+    assert_int_equal(lx_prefilter_size(1024, NULL), 256);
+    assert_int_equal(lx_prefilter_size(1024, &d), 8);
+    d.size = 0;
+    assert_int_equal(lx_prefilter_size(300, &d), 256);
 }
 
 /* A convolution with a normalised, rotationally symmetric kernel keeps the

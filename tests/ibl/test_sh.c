@@ -357,9 +357,13 @@ static void bad_input(void **state)
 
     memset(&sh, 0, sizeof sh);
     lx_cubemap out;
-    assert_int_equal(lx_sh_irradiance_cube(&sh, 0, NULL, &out), LX_ERR_INVALID);
-    assert_non_null(strstr(lx_last_error(), "face size 0"));
+    assert_int_equal(lx_sh_irradiance_cube(&sh, -1, NULL, &out), LX_ERR_INVALID);
+    assert_non_null(strstr(lx_last_error(), "face size -1"));
     assert_null(out.data);
+    /* 0 is the default size */
+    assert_int_equal(lx_sh_irradiance_cube(&sh, 0, NULL, &out), LX_OK);
+    assert_int_equal(out.size, LX_IRRADIANCE_DEFAULT_SIZE);
+    lx_cubemap_free(&out);
     sh.c[3][2] = NAN;
     assert_int_equal(lx_sh_irradiance_cube(&sh, 4, NULL, &out), LX_ERR_INVALID);
     assert_non_null(strstr(lx_last_error(), "coefficient 3 channel 2"));

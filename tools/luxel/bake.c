@@ -11,9 +11,6 @@
 #include <string.h>
 #include <strings.h>
 
-/* Face size the sky is loaded at: enough for its SH and ray lookup. */
-#define LX_SKY_LOAD_SIZE 256
-
 static const char *bake_usage =
     "usage: luxel bake SCENE [options]\n"
     "\n"
@@ -35,8 +32,8 @@ static const char *bake_usage =
     "  --pre-expose            store values times the exposure of --exposure\n"
     "                          (Filament's pre-exposure: sun-lit scenes fit in\n"
     "                          half floats); the manifest records the factor\n"
-    "  --quantity Q            irradiance (lux, default) or radiance (nits:\n"
-    "                          irradiance x base colour / pi)\n"
+    "  --quantity Q            irradiance (lux) or radiance (nits: irradiance x\n"
+    "                          base colour / pi); default %s\n"
     "  --ambient R,G,B         constant ambient illuminance in lux\n"
     "  --sky ENV               light by an environment (equirect, cross or\n"
     "                          <name>_px.<ext> faces, radiance in nits, or\n"
@@ -249,8 +246,9 @@ static int parse_args(int argc, char **argv, bake_args *a)
         case 'h': {
             /* the defaults shown are the library's */
             lx_bake_desc d = lx_bake_desc_defaults(NULL);
-            printf(bake_usage, d.resolution, d.max_resolution, (double)d.sky.intensity,
-                   d.sky.samples, LX_PADDING_RECOMMENDED);
+            printf(bake_usage, d.resolution, d.max_resolution,
+                   d.quantity == LX_QUANTITY_RADIANCE ? "radiance" : "irradiance",
+                   (double)d.sky.intensity, d.sky.samples, LX_PADDING_RECOMMENDED);
             return -1;
         }
         case ':':
@@ -354,6 +352,11 @@ int cmd_bake(int argc, char **argv)
     lx_cubemap sky_env = {0};
     int status = EXIT_FAILED;
 
+    /* the output folder is checked (and made) before any long work: the
+     * import, the sky, the texel maps */
+    if (!cli_stage_begin(&stage, a.output))
+        goto done;
+
     lx_scene_load_desc ld = {.skip_degenerate = a.desc.skip_degenerate};
     if (lx_scene_load(a.scene, &ld, &scene) != LX_OK) {
         cli_error("%s", lx_last_error());
@@ -392,9 +395,10 @@ int cmd_bake(int argc, char **argv)
         }
         if (a.sky_samples)
             sky.samples = (uint32_t)a.sky_samples;
-        /* the SH need no more than 256 texels a side, sky shadows 64 */
-        int loaded = cli_load_environment_run("bake", sky.environment, 1.0f, LX_SKY_LOAD_SIZE,
-                                              a.desc.threads, a.quiet, &sky_env);
+        /* the sky's own intensity is the baker's (lx_sky_desc): loaded as is */
+        int loaded =
+            cli_load_environment_run("bake", sky.environment, 0.0f, LX_SKY_ENVIRONMENT_SIZE,
+                                     a.desc.threads, a.quiet, &sky_env);
         if (loaded != EXIT_OK) {
             status = loaded;
             goto done;
@@ -403,10 +407,6 @@ int cmd_bake(int argc, char **argv)
         a.desc.sky = lx_sky_desc_defaults(&given);
     }
     cli_phase(sky.environment ? "lights and sky" : "lights");
-
-    /* the output folder is checked (and made) before the long work */
-    if (!cli_stage_begin(&stage, a.output))
-        goto done;
 
     cli_progress progress;
     cli_progress_init(&progress, "texel maps", a.quiet);
@@ -469,9 +469,19 @@ int cmd_bake(int argc, char **argv)
         goto done;
     }
 
+    /* the padding is long work on large maps: one bar over every map, and
+     * an interrupt stops it */
+    cli_progress_init(&progress, "apply", a.quiet);
+    progress.phase = "apply and meter";
     for (uint32_t m = 0; m < maps; m++) {
-        if (lx_baker_apply_alloc(baker, m, &images[m]) != LX_OK) {
-            cli_error("%s", lx_last_error());
+        progress.base = (float)m / (float)maps;
+        progress.span = 1.0f / (float)maps;
+        if ((st = lx_baker_apply_alloc(baker, m, &images[m])) != LX_OK) {
+            cli_progress_finish(&progress);
+            if (st == LX_ERR_CANCELLED)
+                cli_report_interrupt(false);
+            else
+                cli_error("%s", lx_last_error());
             goto done;
         }
     }
@@ -483,7 +493,7 @@ int cmd_bake(int argc, char **argv)
                scene->light_count ? " where it has texels" : " (it has no lights)");
     double ev = a.has_exposure ? a.exposure_ev100 : metered;
     float exposure = lx_exposure_from_ev100((float)ev) * preview_scale(&a);
-    cli_phase("apply and meter");
+    cli_progress_finish(&progress); /* the phase "apply and meter" */
     /* Filament: pre-exposed values are the quantity times 1/(1.2 * 2^EV100) */
     float pre_exposure = lx_exposure_from_ev100((float)ev);
 
@@ -520,11 +530,13 @@ int cmd_bake(int argc, char **argv)
         char file[300], preview[300];
         snprintf(file, sizeof file, "%s.%s", stems[m], lx_image_format_extension(a.format));
         snprintf(preview, sizeof preview, "%s.png", stems[m]);
+        /* a PNG lightmap is its own preview; float files hold the values
+         * as they are (exposure 0, the default), or pre-exposed */
         lx_image_write_desc wd = {.format = a.format,
                                   .half = a.half,
                                   .exposure = a.format == LX_IMAGE_PNG ? exposure
                                               : a.pre_expose           ? pre_exposure
-                                                                       : 1.0f,
+                                                                       : 0.0f,
                                   .threads = a.desc.threads};
         double t = cli_now();
         failed = !cli_stage_image(&stage, file, &images[m], &wd);

@@ -28,9 +28,16 @@ bool cli_parse_format(const char *s, lx_image_format *out);
 /* "R,G,B" with finite components >= 0. */
 bool cli_parse_rgb(const char *s, lx_vec3 *out);
 
+/* Face size of a constant environment when none is asked for: it is the
+ * same everywhere, so small is exact (the CLI's choice: lx_env_constant
+ * takes a size). */
+#define CLI_CONSTANT_ENV_SIZE 64
+
 /* Loads the environment argument ENV of `command` (ibl, bake --sky): an
  * image (lx_env_load, at face size `size`, 0 = the input's) or a constant
- * colour const:R,G,B / const:L in nits, times intensity. Prints the error
+ * colour const:R,G,B / const:L in nits (at CLI_CONSTANT_ENV_SIZE unless
+ * size is given), times intensity (0 = lx_env_load_desc's default, as
+ * lx_env_load reads it). Prints the error
  * and returns EXIT_FAILED (a bad file) or EXIT_USAGE (a bad const:); *out
  * is zeroed on failure. */
 int cli_load_environment(const char *command, const char *env, float intensity, int size,
@@ -49,6 +56,8 @@ int cli_environment_size(const char *env, int size);
 typedef struct cli_progress {
     const char *label; /* also the phase name of LUXEL_TEST_PAUSE */
     const char *phase; /* what --verbose calls the phase; NULL = the label */
+    float base, span;  /* the bar shows base + span * fraction (0 and 1 from
+                          init): one bar over several library calls */
     bool enabled;
     bool drawn;
     double start;
@@ -82,6 +91,12 @@ void cli_test_pause(const char *phase);
 /* LUXEL_TEST_FAIL_RENAME=N: true for the Nth rename cli_stage_publish
  * makes (1 = the first), which then fails as if the disk had. */
 bool cli_test_fail_rename(void);
+/* LUXEL_TEST_FAIL_LINK=1: true for every hard link cli_stage_publish asks
+ * for, which is then refused as on a file system without links. */
+bool cli_test_fail_link(void);
+/* LUXEL_TEST_FAIL_RESTORE=N: true for the Nth rename that puts a replaced
+ * file back after a failed publish (1 = the first), which then fails. */
+bool cli_test_fail_restore(void);
 
 /* Monotonic seconds. */
 double cli_now(void);

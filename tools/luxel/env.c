@@ -5,10 +5,6 @@
 
 #include <string.h>
 
-/* Face size of a constant environment when none is asked for: it is the
- * same everywhere, so small is exact. */
-#define CONSTANT_SIZE 64
-
 /* "const:R,G,B" or "const:L": true and *rgb when env names a constant;
  * *bad when it starts with const: but does not parse. */
 static bool parse_constant(const char *env, lx_vec3 *rgb, bool *bad)
@@ -35,12 +31,13 @@ int cli_load_environment_run(const char *command, const char *env, float intensi
     lx_vec3 constant;
     bool bad_constant;
     if (parse_constant(env, &constant, &bad_constant)) {
-        constant = lx_scale(constant, intensity);
+        lx_env_load_desc given = {.intensity = intensity};
+        constant = lx_scale(constant, lx_env_load_desc_defaults(&given).intensity);
         if (!lx_vec3_finite(constant)) {
             cli_error("%s: intensity %g overflows", env, (double)intensity);
             return EXIT_FAILED;
         }
-        if (lx_env_constant(constant, size ? size : CONSTANT_SIZE, out) != LX_OK) {
+        if (lx_env_constant(constant, size ? size : CLI_CONSTANT_ENV_SIZE, out) != LX_OK) {
             cli_error("%s: %s", env, lx_last_error());
             return EXIT_FAILED;
         }
@@ -83,5 +80,5 @@ int cli_environment_size(const char *env, int size)
         return size;
     lx_vec3 constant;
     bool bad;
-    return parse_constant(env, &constant, &bad) ? CONSTANT_SIZE : 0;
+    return parse_constant(env, &constant, &bad) ? CLI_CONSTANT_ENV_SIZE : 0;
 }

@@ -28,7 +28,7 @@ static const char *ibl_usage =
     "  sh.json          order-2 spherical harmonics of the radiance (--sh)\n"
     "  specular_mL.*    prefiltered specular mip L = 0, 1, ... (--specular),\n"
     "                   or specular.ktx holding them all\n"
-    "  dfg_lut.*        split-sum GGX table, 128x128: R scale, G bias (--lut)\n"
+    "  dfg_lut.*        split-sum GGX table, %dx%d: R scale, G bias (--lut)\n"
     "  environment.*    the environment itself in the output layout (--environment)\n"
     "With none of --irradiance, --sh, --specular, --lut, --environment, the\n"
     "first four are written. Cube faces are in the OpenGL/KTX order and\n"
@@ -36,28 +36,31 @@ static const char *ibl_usage =
     "\n"
     "options:\n"
     "  -o, --output DIR         output folder (default ./ibl)\n"
-    "  --irradiance[=METHOD]    irradiance cube, 32x32 faces: brute (default; every\n"
-    "                           source texel a light) or sh (from the 9 SH terms)\n"
+    "  --irradiance[=METHOD]    irradiance cube, %dx%d faces (at most the\n"
+    "                           environment's): brute (default; every source\n"
+    "                           texel a light) or sh (from the 9 SH terms)\n"
     "  --sh                     write sh.json\n"
-    "  --specular FILTER        ggx (default) or phong\n"
+    "  --specular FILTER        ggx or phong (default %s)\n"
     "  --mips N                 specular levels (default: down to 1x1)\n"
-    "  --phong-exponents A,B,.. Phong exponent per level (default 2048/4^level)\n"
-    "  --samples N              GGX importance samples per texel of the specular\n"
-    "                           levels and the DFG table (default 256 and 1024)\n"
+    "  --phong-exponents A,B,.. Phong exponent per level (default %g/4^level, at\n"
+    "                           least 1)\n"
+    "  --samples N              GGX importance samples per texel (1..%d) of the\n"
+    "                           specular levels and the DFG table (default %d and %d)\n"
     "  --lut                    write the DFG table\n"
     "  --environment            write the environment in the output layout\n"
-    "  --size N                 face size the environment is resampled to, and of\n"
-    "                           specular level 0 (default: the input's, specular at\n"
-    "                           most 256; a constant: 64)\n"
-    "  --layout L               faces (default: NAME_px.EXT ... NAME_nz.EXT), cross,\n"
-    "                           vcross (vertical cross), equirect (4N x 2N) or ktx\n"
-    "                           (one KTX 1.1 file per cube, mips included)\n"
-    "  --format F               exr (default), hdr, pfm or png (png clamps to 0..1)\n"
+    "  --size N                 face size the environment is resampled to (default:\n"
+    "                           the input's; a constant: %d)\n"
+    "  --specular-size N        face size of specular level 0 (default: the\n"
+    "                           environment's, at most %d)\n"
+    "  --layout L               faces (NAME_px.EXT ... NAME_nz.EXT), cross, vcross\n"
+    "                           (vertical cross), equirect (4N x 2N) or ktx (one\n"
+    "                           KTX 1.1 file per cube, mips included); default %s\n"
+    "  --format F               exr, hdr, pfm or png (png clamps to 0..1); default %s\n"
     "  --half                   16-bit floats: EXR half, KTX RGBA16F (else RGBA32F)\n"
     "  --no-seam-fix            keep cube edges as filtered (for engines that sample\n"
     "                           cube maps seamlessly); by default edge texels are\n"
     "                           averaged across faces (the seed's seam fix)\n"
-    "  --intensity X            multiply the environment by X (default 1)\n"
+    "  --intensity X            multiply the environment by X (default %g)\n"
     "  --threads N              worker threads (default: all cores)\n"
     "  -v, --verbose            the time of each phase, and notes\n"
     "  -q, --quiet              no progress bar, no list of files\n"
@@ -82,9 +85,36 @@ enum {
     OPT_THREADS
 };
 
-#define LUT_SIZE 128
-#define IRRADIANCE_SIZE 32
-#define MAX_SAMPLES 65536
+/* The output layouts by their option names. */
+static const struct {
+    const char *name;
+    lx_env_layout layout;
+} layouts[] = {{"faces", LX_ENV_FACES},
+               {"cross", LX_ENV_CROSS},
+               {"vcross", LX_ENV_CROSS_VERTICAL},
+               {"equirect", LX_ENV_EQUIRECT},
+               {"ktx", LX_ENV_KTX}};
+
+static const char *layout_name(lx_env_layout layout)
+{
+    for (size_t i = 0; i < sizeof layouts / sizeof layouts[0]; i++)
+        if (layouts[i].layout == layout)
+            return layouts[i].name;
+    return "?";
+}
+
+/* The help, its defaults the library's. */
+static void print_usage(void)
+{
+    lx_env_write_desc w = lx_env_write_desc_defaults(NULL);
+    lx_prefilter_desc p = lx_prefilter_desc_defaults(NULL);
+    printf(ibl_usage, LX_DFG_DEFAULT_SIZE, LX_DFG_DEFAULT_SIZE, LX_IRRADIANCE_DEFAULT_SIZE,
+           LX_IRRADIANCE_DEFAULT_SIZE, p.filter == LX_SPECULAR_PHONG ? "phong" : "ggx",
+           (double)lx_phong_level_exponent(0), LX_PREFILTER_MAX_SAMPLES, p.samples,
+           LX_DFG_DEFAULT_SAMPLES, CLI_CONSTANT_ENV_SIZE, LX_PREFILTER_DEFAULT_SIZE,
+           layout_name(w.layout), lx_image_format_extension(w.format),
+           (double)lx_env_load_desc_defaults(NULL).intensity);
+}
 
 typedef struct ibl_args {
     const char *env;
@@ -154,10 +184,12 @@ static int parse_args(int argc, char **argv, ibl_args *a)
         {NULL, 0, NULL, 0}};
     memset(a, 0, sizeof *a);
     a->output = "ibl";
-    a->format = LX_IMAGE_EXR;
-    a->layout = LX_ENV_FACES;
+    /* the library's defaults, filled in so that names and checks see them */
+    lx_env_write_desc w = lx_env_write_desc_defaults(NULL);
+    a->format = w.format;
+    a->layout = w.layout;
+    a->filter = lx_prefilter_desc_defaults(NULL).filter;
     a->seam_fix = true;
-    a->intensity = 1.0f;
     opterr = 0;
     optind = 1;
     int c;
@@ -206,9 +238,9 @@ static int parse_args(int argc, char **argv, ibl_args *a)
                                        LX_MAX_CUBE_MIPS, optarg);
             break;
         case OPT_SAMPLES:
-            if (!cli_parse_int(optarg, 1, MAX_SAMPLES, &n))
+            if (!cli_parse_int(optarg, 1, LX_PREFILTER_MAX_SAMPLES, &n))
                 return cli_usage_error("ibl", "--samples must be an integer in 1..%d, not '%s'",
-                                       MAX_SAMPLES, optarg);
+                                       LX_PREFILTER_MAX_SAMPLES, optarg);
             a->samples = (int)n;
             break;
         case OPT_LUT:
@@ -230,22 +262,17 @@ static int parse_args(int argc, char **argv, ibl_args *a)
                                        LX_MAX_CUBE_SIZE, optarg);
             a->specular_size = (int)n;
             break;
-        case OPT_LAYOUT:
-            if (strcmp(optarg, "faces") == 0)
-                a->layout = LX_ENV_FACES;
-            else if (strcmp(optarg, "cross") == 0)
-                a->layout = LX_ENV_CROSS;
-            else if (strcmp(optarg, "vcross") == 0)
-                a->layout = LX_ENV_CROSS_VERTICAL;
-            else if (strcmp(optarg, "equirect") == 0)
-                a->layout = LX_ENV_EQUIRECT;
-            else if (strcmp(optarg, "ktx") == 0)
-                a->layout = LX_ENV_KTX;
-            else
+        case OPT_LAYOUT: {
+            size_t i = 0, count = sizeof layouts / sizeof layouts[0];
+            while (i < count && strcmp(optarg, layouts[i].name) != 0)
+                i++;
+            if (i == count)
                 return cli_usage_error(
                     "ibl", "--layout must be faces, cross, vcross, equirect or ktx, not '%s'",
                     optarg);
+            a->layout = layouts[i].layout;
             break;
+        }
         case OPT_FORMAT:
             if (!cli_parse_format(optarg, &a->format))
                 return cli_usage_error("ibl", "--format must be exr, hdr, pfm or png, not '%s'",
@@ -276,7 +303,7 @@ static int parse_args(int argc, char **argv, ibl_args *a)
             cli_set_verbose(true);
             break;
         case 'h':
-            fputs(ibl_usage, stdout);
+            print_usage();
             return -1;
         case ':':
             return cli_usage_error("ibl", "option '%s' needs a value", argv[optind - 1]);
@@ -387,6 +414,54 @@ static bool put_cube(writer *w, const char *stem, const lx_cubemap *levels, int 
     return cli_stage_finish(&w->stage, stem, s);
 }
 
+/* The DFG table's file name. */
+static void lut_name(const ibl_args *a, char *name, size_t size)
+{
+    snprintf(name, size, "dfg_lut.%s", lx_image_format_extension(a->format));
+}
+
+/* lx_env_write_names's on_file: nothing but a file may be in the way. */
+static bool check_name(void *user, const char *name)
+{
+    writer *w = user;
+    w->reported = w->reported || !cli_stage_check(&w->stage, name);
+    return !w->reported;
+}
+
+/* Checks every output name of the run (cli_stage_check) before the long
+ * work, so a folder in the way fails at once. spec_count: the number of
+ * specular levels, or 1 while it is not known (level 0's names are those
+ * of every run: specular levels always carry _m<L>). */
+static bool check_names(writer *w, int spec_count)
+{
+    const ibl_args *a = w->a;
+    const struct {
+        bool on;
+        const char *stem;
+        int count;
+        bool mip_names;
+    } cubes[] = {{a->irradiance, "irradiance", 1, false},
+                 {a->specular, "specular", spec_count, true},
+                 {a->environment, "environment", 1, false}};
+    for (size_t i = 0; i < sizeof cubes / sizeof cubes[0]; i++) {
+        if (!cubes[i].on)
+            continue;
+        lx_env_write_desc d = write_desc(a, cubes[i].mip_names);
+        d.on_file = check_name;
+        d.on_file_user = w;
+        lx_status s = lx_env_write_names(cubes[i].stem, cubes[i].count, &d);
+        if (s != LX_OK) {
+            if (!w->reported)
+                cli_error("%s: %s", cubes[i].stem, lx_last_error());
+            return false;
+        }
+    }
+    char name[32];
+    lut_name(a, name, sizeof name);
+    return (!a->sh || cli_stage_check(&w->stage, "sh.json")) &&
+           (!a->lut || cli_stage_check(&w->stage, name));
+}
+
 /* A JSON number with the fewest digits that read back as the same float. */
 static cJSON *float_number(float f)
 {
@@ -426,28 +501,31 @@ static char *sh_json(const lx_sh9 *sh)
 
 /* ---- the command ----------------------------------------------------------- */
 
-/* The face size of specular level 0 for an environment of env_size. */
-static int specular_size(const ibl_args *a, int env_size)
-{
-    if (a->specular_size)
-        return a->specular_size;
-    return env_size < 256 ? env_size : 256;
-}
-
-static int irradiance_size(int env_size)
-{
-    return env_size < IRRADIANCE_SIZE ? env_size : IRRADIANCE_SIZE;
-}
-
-static lx_prefilter_desc prefilter_desc(const ibl_args *a, int env_size)
+/* The run's prefilter desc: what the options say, zeros for the rest
+ * (the library's defaults). */
+static lx_prefilter_desc prefilter_desc(const ibl_args *a)
 {
     lx_prefilter_desc d = {.filter = a->filter,
-                           .size = specular_size(a, env_size),
+                           .size = a->specular_size,
                            .mips = a->mips,
                            .samples = a->samples,
                            .phong_exponents = a->phong_count ? a->phong : NULL,
                            .threads = a->threads};
     return d;
+}
+
+/* The face size of specular level 0 for an environment of env_size. */
+static int specular_size(const ibl_args *a, int env_size)
+{
+    lx_prefilter_desc d = prefilter_desc(a);
+    return lx_prefilter_size(env_size, &d);
+}
+
+/* The irradiance cube's size argument: the library's default, or the
+ * environment's size when that is smaller (no finer than its source). */
+static int irradiance_size(int env_size)
+{
+    return env_size < LX_IRRADIANCE_DEFAULT_SIZE ? env_size : 0;
 }
 
 /* Whether the library would take every step of the run for an environment
@@ -458,7 +536,7 @@ static bool run_fits(const ibl_args *a, int env_size)
 {
     lx_status st = LX_OK;
     if (a->specular) {
-        lx_prefilter_desc d = prefilter_desc(a, env_size);
+        lx_prefilter_desc d = prefilter_desc(a);
         st = lx_prefilter_check(env_size, &d);
         if (st == LX_OK && a->layout != LX_ENV_KTX) {
             lx_env_write_desc w = write_desc(a, true);
@@ -515,8 +593,16 @@ int cmd_ibl(int argc, char **argv)
     }
     if (known && !run_fits(&a, known))
         goto done;
-    /* the output folder is checked (and made) before the long work */
+    /* the output folder is checked (and made) before the long work, and
+     * every output name in it: the specular chain's when its length is
+     * known (the environment's size or the options tell it), else its
+     * level 0, and the rest once the environment is loaded */
     if (!cli_stage_begin(&w.stage, a.output))
+        goto done;
+    int levels_known = a.mips;
+    if (!levels_known && (known || a.specular_size))
+        levels_known = lx_cube_mip_count(specular_size(&a, known));
+    if (!check_names(&w, levels_known ? levels_known : 1))
         goto done;
     int loaded =
         cli_load_environment_run("ibl", a.env, a.intensity, a.size, a.threads, a.quiet, &env);
@@ -531,6 +617,8 @@ int cmd_ibl(int argc, char **argv)
         goto done;
     }
     if (!known && !run_fits(&a, env.size))
+        goto done;
+    if (a.specular && !levels_known && !check_names(&w, lx_cube_mip_count(spec_size)))
         goto done;
 
     cli_progress progress;
@@ -556,7 +644,7 @@ int cmd_ibl(int argc, char **argv)
     }
     if (a.specular) {
         cli_progress_init(&progress, "specular", a.quiet);
-        lx_prefilter_desc d = prefilter_desc(&a, env.size);
+        lx_prefilter_desc d = prefilter_desc(&a);
         d.progress = cli_progress_update;
         d.progress_user = &progress;
         lx_status s = lx_prefilter(&env, &d, spec, &spec_count);
@@ -569,7 +657,7 @@ int cmd_ibl(int argc, char **argv)
     }
     if (a.lut) {
         cli_progress_init(&progress, "dfg", a.quiet);
-        lx_status s = lx_dfg_lut(LUT_SIZE, a.samples, &run, &lut);
+        lx_status s = lx_dfg_lut(0, a.samples, &run, &lut);
         cli_progress_finish(&progress);
         if (cancelled_or_failed(s, "DFG table"))
             goto done;
@@ -603,7 +691,7 @@ int cmd_ibl(int argc, char **argv)
         ok = put_cube(&w, "specular", spec, spec_count, true);
     if (ok && a.lut) {
         char name[32];
-        snprintf(name, sizeof name, "dfg_lut.%s", lx_image_format_extension(a.format));
+        lut_name(&a, name, sizeof name);
         lx_image_write_desc wd = {
             .format = a.format, .half = a.half && a.format == LX_IMAGE_EXR, .threads = a.threads};
         ok = cli_stage_image(&w.stage, name, &lut_rgb, &wd) && note(&w, name);

@@ -111,8 +111,7 @@ static lx_status plot(const lx_ies_profile *p, const char *path)
             py = y;
         }
     }
-    lx_image_write_desc wd = {.exposure = 1.0f};
-    st = lx_image_write(path, &img, &wd);
+    st = lx_image_write(path, &img, NULL); /* PNG from the name, values as they are */
     lx_image_free(&img);
     return st;
 }

@@ -270,12 +270,27 @@ bool cli_test_fail_rename(void)
     return nth && atol(nth) == ++renames;
 }
 
+bool cli_test_fail_link(void)
+{
+    const char *on = getenv("LUXEL_TEST_FAIL_LINK");
+    return on && strcmp(on, "1") == 0;
+}
+
+bool cli_test_fail_restore(void)
+{
+    static _Atomic long restores;
+    const char *nth = getenv("LUXEL_TEST_FAIL_RESTORE");
+    return nth && atol(nth) == ++restores;
+}
+
 /* ---- progress bar -------------------------------------------------------- */
 
 void cli_progress_init(cli_progress *p, const char *label, bool quiet)
 {
     p->label = label;
     p->phase = NULL;
+    p->base = 0.0f;
+    p->span = 1.0f;
     p->enabled = !quiet && isatty(2);
     p->drawn = false;
     p->start = cli_now();
@@ -290,6 +305,7 @@ bool cli_progress_update(void *user, float fraction)
         return false;
     if (!p->enabled)
         return true;
+    fraction = p->base + p->span * fraction;
     double elapsed = cli_now() - p->start;
     /* appear after a second, redraw at most ten times a second */
     if (elapsed < 1.0 || (elapsed - p->last_draw < 0.1 && fraction < 1.0f))

@@ -234,7 +234,8 @@ static void restore(const cli_stage *st, const published *done, uint32_t n, cons
         char *kept = cli_path_join(previous, st->names[i]);
         if (to && kept) {
             if (done[i].had_old && (done[i].placed || done[i].old_gone)) {
-                if (rename(kept, to) != 0)
+                errno = EIO; /* what an injected failure reports */
+                if (cli_test_fail_restore() || rename(kept, to) != 0)
                     cli_error("%s: could not put the previous file back (it is in %s): %s", to,
                               kept, strerror(errno));
             } else if (done[i].placed) {
@@ -275,7 +276,8 @@ bool cli_stage_publish(cli_stage *st)
             /* keep the old file: a second name for it (the output stays in
              * place meanwhile), or the file itself where links are refused */
             done[i].had_old = true;
-            if (link(to, kept) != 0) {
+            errno = EPERM; /* what an injected refusal reports */
+            if (cli_test_fail_link() || link(to, kept) != 0) {
                 done[i].old_gone = rename(to, kept) == 0;
                 if (!done[i].old_gone) {
                     cli_error("%s: cannot set the previous file aside: %s", to, strerror(errno));
