@@ -147,6 +147,15 @@ typedef struct lx_unwrap {
 lx_status lx_unwrap_scene(const lx_scene *scene, const lx_unwrap_desc *desc, lx_unwrap **out);
 void lx_unwrap_destroy(lx_unwrap *unwrap);
 
+/* Puts the generated UVs into the scene the unwrap was made from: every
+ * generated node gets its own copy of each of its meshes, vertices split
+ * as the unwrap says, with TEXCOORD_1 = the page UVs (the other attributes
+ * copied); the node then points to the copies. Instances stop sharing
+ * meshes; the originals stay in the scene. Kept and skipped nodes are
+ * untouched. LX_ERR_INVALID when the unwrap was made for another scene;
+ * not thread-safe with other users of the scene (it changes it). */
+lx_status lx_unwrap_apply(lx_scene *scene, const lx_unwrap *unwrap);
+
 #ifdef __cplusplus
 }
 #endif

@@ -777,3 +777,69 @@ fail:
     plan_free(&p);
     return st;
 }
+
+lx_status lx_unwrap_apply(lx_scene *scene, const lx_unwrap *u)
+{
+    if (u->node_count != scene->node_count)
+        return lx_fail(LX_ERR_INVALID, "%s: the unwrap places %u nodes, the scene has %u",
+                       scene->path, u->node_count, scene->node_count);
+    uint32_t *slot_of = calloc(scene->node_count ? scene->node_count : 1, sizeof(uint32_t));
+    if (!slot_of)
+        return lx_fail(LX_ERR_NOMEM, "%s: out of memory applying lightmap UVs", scene->path);
+    lx_status st = LX_OK;
+    for (uint32_t k = 0; k < u->mesh_count && st == LX_OK; k++) {
+        const lx_unwrap_mesh *um = &u->meshes[k];
+        if (um->node >= scene->node_count || um->mesh >= scene->mesh_count ||
+            slot_of[um->node] >= scene->nodes[um->node].mesh_count ||
+            scene->nodes[um->node].meshes[slot_of[um->node]] != um->mesh) {
+            st = lx_fail(LX_ERR_INVALID, "%s: the unwrap was made for another scene", scene->path);
+            break;
+        }
+        const lx_mesh *src = &scene->meshes[um->mesh];
+        if (um->vertex_count && um->vertex_source[0] >= src->vertex_count) {
+            st = lx_fail(LX_ERR_INVALID, "%s: the unwrap was made for another scene", scene->path);
+            break;
+        }
+        /* the node's own copy: split vertices, TEXCOORD_1 the page's */
+        lx_mesh m = {.name = src->name,
+                     .vertex_count = um->vertex_count,
+                     .triangle_count = src->triangle_count,
+                     .indices = um->indices,
+                     .material = src->material};
+        size_t nv = um->vertex_count ? um->vertex_count : 1;
+        m.positions = malloc(sizeof(lx_vec3) * nv);
+        m.normals = src->normals ? malloc(sizeof(lx_vec3) * nv) : NULL;
+        m.tangents = src->tangents ? malloc(sizeof(lx_vec4) * nv) : NULL;
+        m.uv[0] = src->uv[0] ? malloc(sizeof(lx_vec2) * nv) : NULL;
+        m.uv[1] = um->uv;
+        bool ok = m.positions && (!src->normals || m.normals) && (!src->tangents || m.tangents) &&
+                  (!src->uv[0] || m.uv[0]);
+        for (uint32_t v = 0; ok && v < um->vertex_count; v++) {
+            uint32_t from = um->vertex_source[v];
+            if (from >= src->vertex_count) {
+                ok = false;
+                break;
+            }
+            m.positions[v] = src->positions[from];
+            if (m.normals)
+                m.normals[v] = src->normals[from];
+            if (m.tangents)
+                m.tangents[v] = src->tangents[from];
+            if (m.uv[0])
+                m.uv[0][v] = src->uv[0][from];
+        }
+        uint32_t index = 0;
+        if (!ok)
+            st = lx_fail(LX_ERR_NOMEM, "%s: out of memory applying lightmap UVs", scene->path);
+        else
+            st = lx_scene_add_mesh(scene, &m, &index);
+        free(m.positions);
+        free(m.normals);
+        free(m.tangents);
+        free(m.uv[0]);
+        if (st == LX_OK)
+            scene->nodes[um->node].meshes[slot_of[um->node]++] = index;
+    }
+    free(slot_of);
+    return st;
+}

@@ -31,6 +31,43 @@ bool lx_uv_overlaps_texel(const double uv[3][2], int x, int y)
     return true;
 }
 
+/* Keeps the part of polygon in (n points) where sign * (p[axis] - at) >= 0. */
+static int clip(const double (*in)[2], int n, int axis, double at, double sign, double (*out)[2])
+{
+    int m = 0;
+    for (int i = 0; i < n; i++) {
+        const double *a = in[i], *b = in[(i + 1) % n];
+        double da = sign * (a[axis] - at), db = sign * (b[axis] - at);
+        if (da >= 0) {
+            out[m][0] = a[0], out[m][1] = a[1];
+            m++;
+        }
+        if ((da >= 0) != (db >= 0)) {
+            double t = da / (da - db);
+            out[m][0] = a[0] + t * (b[0] - a[0]);
+            out[m][1] = a[1] + t * (b[1] - a[1]);
+            m++;
+        }
+    }
+    return m;
+}
+
+double lx_uv_texel_coverage(const double uv[3][2], int x, int y)
+{
+    double a[8][2], b[8][2];
+    int n = 3;
+    for (int k = 0; k < 3; k++)
+        a[k][0] = uv[k][0], a[k][1] = uv[k][1];
+    n = clip((const double(*)[2])a, n, 0, x, 1.0, b);
+    n = clip((const double(*)[2])b, n, 0, x + 1.0, -1.0, a);
+    n = clip((const double(*)[2])a, n, 1, y, 1.0, b);
+    n = clip((const double(*)[2])b, n, 1, y + 1.0, -1.0, a);
+    double area = 0.0;
+    for (int i = 0; i < n; i++)
+        area += a[i][0] * a[(i + 1) % n][1] - a[(i + 1) % n][0] * a[i][1];
+    return fabs(0.5 * area);
+}
+
 typedef struct corner_key {
     double u, v;
     uint32_t tri;

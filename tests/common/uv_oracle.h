@@ -38,6 +38,10 @@ void lx_uv_check(const lx_uv_triangle *tris, uint32_t n, int width, int height, 
  * area? Separating axes, in double. */
 bool lx_uv_overlaps_texel(const double uv[3][2], int x, int y);
 
+/* The area of triangle uv (texel units) inside texel (x, y), 0..1: the
+ * triangle clipped by the texel's four sides (Sutherland-Hodgman). */
+double lx_uv_texel_coverage(const double uv[3][2], int x, int y);
+
 /* Generated meshes (indexed, with normals; no UVs): a torus of radii R, r
  * with about `triangles` triangles; a closed cylinder (radius, height) with
  * caps; a bumpy height field of side `size`. */
