@@ -418,6 +418,21 @@ static lx_status check_uv_triangles(const lx_scene *scene, const slot *s, const 
     return LX_OK;
 }
 
+/* The slot holding page-local triangle id (slots ascend by first
+ * triangle; an atlas page has many). */
+static uint32_t slot_of(const slot *slots, uint32_t count, uint32_t id)
+{
+    uint32_t lo = 0, hi = count - 1;
+    while (lo < hi) {
+        uint32_t mid = (lo + hi + 1) / 2;
+        if (slots[mid].first_triangle <= id)
+            lo = mid;
+        else
+            hi = mid - 1;
+    }
+    return lo;
+}
+
 /* A mesh's material; a scene built without materials bakes as white. */
 static const lx_material *material_of(const lx_scene *scene, const lx_mesh *m)
 {
@@ -722,9 +737,7 @@ lx_status lx_texel_map_build(const lx_scene *scene, const lx_page_spec *page,
                 size_t p = (size_t)y * w + x;
                 if (r.owner[p] == UINT32_MAX)
                     continue;
-                uint32_t s = 0;
-                while (s + 1 < slot_count && slots[s + 1].first_triangle <= r.owner[p])
-                    s++;
+                uint32_t s = slot_of(slots, slot_count, r.owner[p]);
                 const lx_mesh *m = slots[s].mesh;
                 uint32_t t = r.owner[p] - slots[s].first_triangle;
                 const uint32_t *i = &m->indices[3 * t];
