@@ -192,7 +192,7 @@ static lx_cubemap sun_env(int *sun_x, int *sun_y)
         env.data[i] = 100.0f;
     *sun_x = 9;
     *sun_y = 8;
-    float *t = lx_cubemap_texel(&env, LX_FACE_PY, *sun_x, *sun_y);
+    float *t = lx_test_cube_texel(&env, LX_FACE_PY, *sun_x, *sun_y);
     t[0] = t[1] = t[2] = 1e7f;
     return env;
 }

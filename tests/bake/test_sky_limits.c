@@ -82,7 +82,7 @@ static void negative_texel_is_an_error(void **state)
     lx_cubemap env = lx_test_constant_env(4, 1.0f);
     /* one texel far below zero: the mean luminance (and with it the peak
      * threshold) goes negative */
-    float *t = lx_cubemap_texel(&env, LX_FACE_NY, 1, 2);
+    float *t = lx_test_cube_texel(&env, LX_FACE_NY, 1, 2);
     t[0] = t[1] = t[2] = -1e6f;
     expect_rejected(&env, 1.0f, false, "negative");
     expect_rejected(&env, 1.0f, true, "negative");

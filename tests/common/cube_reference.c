@@ -60,16 +60,23 @@ double lx_test_texel_omega(int size, int x, int y, int m)
     return sum * h * h;
 }
 
+float *lx_test_cube_texel(const lx_cubemap *c, int face, int x, int y)
+{
+    size_t n = (size_t)c->size;
+    return c->data + 3 * ((size_t)face * n * n + (size_t)y * n + (size_t)x);
+}
+
 lx_cubemap lx_test_make_env(int size, lx_test_env_fn fn)
 {
     lx_cubemap c;
     assert_int_equal(lx_cubemap_alloc(&c, size), LX_OK);
+    assert_int_equal(c.size, size);
     for (int f = 0; f < 6; f++)
         for (int y = 0; y < size; y++)
             for (int x = 0; x < size; x++) {
                 double d[3];
                 lx_test_texel_dir(f, size, x, y, d);
-                fn(d[0], d[1], d[2], lx_cubemap_texel(&c, f, x, y));
+                fn(d[0], d[1], d[2], lx_test_cube_texel(&c, f, x, y));
             }
     return c;
 }
@@ -78,6 +85,7 @@ lx_cubemap lx_test_constant_env(int size, float value)
 {
     lx_cubemap c;
     assert_int_equal(lx_cubemap_alloc(&c, size), LX_OK);
+    assert_int_equal(c.size, size);
     for (size_t i = 0; i < (size_t)6 * size * size * 3; i++)
         c.data[i] = value;
     return c;

@@ -17,6 +17,7 @@
 #include <stdio.h>
 #include <string.h>
 
+#include "cube_reference.h"
 #include "luxel/ibl.h"
 #include "core/internal.h"
 
@@ -249,10 +250,26 @@ static void test_sampling_texel_centres(void **state)
             for (int x = 0; x < 5; x++) {
                 float v[3];
                 lx_cubemap_sample(&c, lx_cube_direction(f, (x + 0.5f) / 5, (y + 0.5f) / 5), v);
-                const float *t = lx_cubemap_texel(&c, f, x, y);
+                const float *t = lx_test_cube_texel(&c, f, x, y);
                 for (int k = 0; k < 3; k++)
                     assert_true(fabsf(v[k] - t[k]) < 1e-5f);
             }
+    lx_cubemap_free(&c);
+}
+
+/* lx_cubemap_texel addresses the layout ibl.h documents (faces in order,
+ * rows top to bottom, 3 floats a texel), which the tests' own
+ * lx_test_cube_texel writes out. */
+static void test_texel_layout(void **state)
+{
+    (void)state;
+    lx_cubemap c;
+    assert_int_equal(lx_cubemap_alloc(&c, 3), LX_OK);
+    for (int f = 0; f < 6; f++)
+        for (int y = 0; y < 3; y++)
+            for (int x = 0; x < 3; x++)
+                assert_ptr_equal(lx_cubemap_texel(&c, f, x, y), lx_test_cube_texel(&c, f, x, y));
+    assert_ptr_equal(lx_test_cube_texel(&c, 5, 2, 2) + 3, c.data + 6 * 3 * 3 * 3);
     lx_cubemap_free(&c);
 }
 
@@ -299,6 +316,7 @@ int main(void)
         cmocka_unit_test(test_face_coords_round_trip),
         cmocka_unit_test(test_sampling_continuous_across_edges),
         cmocka_unit_test(test_sampling_texel_centres),
+        cmocka_unit_test(test_texel_layout),
         cmocka_unit_test(test_equirect_formula),
     };
     return cmocka_run_group_tests(tests, NULL, NULL);

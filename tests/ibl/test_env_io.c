@@ -22,6 +22,7 @@
 
 #include <stb/stb_image_write.h>
 
+#include "cube_reference.h"
 #include "helpers.h"
 #include "core/internal.h"
 #include "luxel/ibl.h"
@@ -193,7 +194,7 @@ static void test_cross_layout_continuous(void **state)
             for (int x = 0; x < n; x++) {
                 v3d d = table_vec(f, 2.0 * (x + 0.5) / n - 1.0, 2.0 * (y + 0.5) / n - 1.0);
                 double len = sqrt(dot3(d, d));
-                float *t = lx_cubemap_texel(&c, f, x, y);
+                float *t = lx_test_cube_texel(&c, f, x, y);
                 t[0] = (float)(d.x / len + 2.0);
                 t[1] = (float)(d.y / len + 2.0);
                 t[2] = (float)(d.z / len + 2.0);
@@ -330,7 +331,7 @@ static void test_equirect_round_trip(void **state)
                 double len = sqrt(dot3(d, d)), want[3];
                 smooth_env((v3d){d.x / len, d.y / len, d.z / len}, want);
                 for (int k = 0; k < 3; k++) {
-                    double e = fabs(lx_cubemap_texel(&c, f, x, y)[k] - want[k]) / want[k];
+                    double e = fabs(lx_test_cube_texel(&c, f, x, y)[k] - want[k]) / want[k];
                     worst = e > worst ? e : worst;
                 }
             }
@@ -479,8 +480,8 @@ static void test_seams_agree(void **state)
                             continue;
                         int g, gx, gy;
                         across(n, f, x, y, offs[o][0], offs[o][1], &g, &gx, &gy);
-                        const float *a = lx_cubemap_texel(&c, f, x, y);
-                        const float *b = lx_cubemap_texel(&c, g, gx, gy);
+                        const float *a = lx_test_cube_texel(&c, f, x, y);
+                        const float *b = lx_test_cube_texel(&c, g, gx, gy);
                         for (int k = 0; k < 3; k++)
                             if (a[k] != b[k])
                                 fail_msg("size %d: face %s (%d, %d) = %g but across the edge "
@@ -495,20 +496,21 @@ static void test_seams_agree(void **state)
                         }
                         nb++;
                     }
-                    const float *now = lx_cubemap_texel(&c, f, x, y);
-                    const float *was = lx_cubemap_texel(&orig, f, x, y);
+                    const float *now = lx_test_cube_texel(&c, f, x, y);
+                    const float *was = lx_test_cube_texel(&orig, f, x, y);
                     for (int k = 0; k < 3; k++) {
                         double want = was[k];
                         if (n == 1) {
                             want = 0.0;
                             for (int h = 0; h < 6; h++)
-                                want += lx_cubemap_texel(&orig, h, 0, 0)[k];
+                                want += lx_test_cube_texel(&orig, h, 0, 0)[k];
                             want /= 6.0;
                         } else if (nb == 1) {
-                            want = 0.5 * (was[k] + lx_cubemap_texel(&orig, nf[0], nx[0], ny[0])[k]);
+                            want =
+                                0.5 * (was[k] + lx_test_cube_texel(&orig, nf[0], nx[0], ny[0])[k]);
                         } else if (nb == 2) {
-                            want = (was[k] + lx_cubemap_texel(&orig, nf[0], nx[0], ny[0])[k] +
-                                    lx_cubemap_texel(&orig, nf[1], nx[1], ny[1])[k]) /
+                            want = (was[k] + lx_test_cube_texel(&orig, nf[0], nx[0], ny[0])[k] +
+                                    lx_test_cube_texel(&orig, nf[1], nx[1], ny[1])[k]) /
                                    3.0;
                         }
                         if (fabs(now[k] - want) > 1e-6 * (1.0 + fabs(want)))
@@ -635,7 +637,7 @@ static void test_ktx_float_structure(void **state)
                 for (int x = 0; x < s; x++) {
                     const unsigned char *p =
                         k.level_data[l] + (size_t)face * k.image_size[l] + ((size_t)y * s + x) * 16;
-                    const float *want = lx_cubemap_texel(&levels[l], face, x, y);
+                    const float *want = lx_test_cube_texel(&levels[l], face, x, y);
                     for (int ch = 0; ch < 4; ch++) {
                         uint32_t bits = rd32(p + 4 * ch);
                         float v;
@@ -739,7 +741,7 @@ static void test_ktx_bad(void **state)
     lx_cubemap levels[4];
     make_chain(levels, 8, 4, 3);
     /* above the half range: rejected, not clamped, nothing written */
-    lx_cubemap_texel(&levels[2], LX_FACE_NY, 1, 0)[1] = 70000.0f;
+    lx_test_cube_texel(&levels[2], LX_FACE_NY, 1, 0)[1] = 70000.0f;
     assert_int_equal(lx_ktx_write_cubemap(path, levels, 4, true), LX_ERR_INVALID);
     assert_error_mentions("bad.ktx");
     assert_error_mentions("level 2 face ny texel (1, 0)");
@@ -748,10 +750,10 @@ static void test_ktx_bad(void **state)
     /* fine as 32-bit floats */
     assert_int_equal(lx_ktx_write_cubemap(path, levels, 4, false), LX_OK);
     remove(path);
-    lx_cubemap_texel(&levels[0], LX_FACE_PZ, 3, 3)[0] = NAN;
+    lx_test_cube_texel(&levels[0], LX_FACE_PZ, 3, 3)[0] = NAN;
     assert_int_equal(lx_ktx_write_cubemap(path, levels, 4, false), LX_ERR_INVALID);
     assert_error_mentions("NaN");
-    lx_cubemap_texel(&levels[0], LX_FACE_PZ, 3, 3)[0] = 1.0f;
+    lx_test_cube_texel(&levels[0], LX_FACE_PZ, 3, 3)[0] = 1.0f;
     /* mip counts and sizes that make no sense */
     assert_int_equal(lx_ktx_write_cubemap(path, levels, 0, false), LX_ERR_INVALID);
     assert_int_equal(lx_ktx_write_cubemap(path, levels, 5, false), LX_ERR_INVALID);
@@ -908,7 +910,7 @@ static void test_bad_values(void **state)
     free(p);
     /* a NaN in one of six faces names that file */
     assert_int_equal(lx_env_constant(lx_v3(1, 1, 1), 4, &c), LX_OK);
-    lx_cubemap_texel(&c, LX_FACE_PY, 2, 3)[0] = NAN;
+    lx_test_cube_texel(&c, LX_FACE_PY, 2, 3)[0] = NAN;
     write_faces(dir, "sky", &c, "pfm");
     expect_env_error(path_in(dir, "sky_px.pfm"), NULL, LX_ERR_FORMAT, "sky_py.pfm",
                      "1 texel is NaN or infinite (the first at pixel (2, 3))");

@@ -80,7 +80,7 @@ static void single_texel_follows_cosine_law(void **state)
     const int n = 16, out_size = 8, face = LX_FACE_PY, tx = 5, ty = 9;
     const float L = 1000.0f;
     lx_cubemap env = constant_env(n, 0.0f, 0.0f, 0.0f), irr;
-    float *t = lx_cubemap_texel(&env, face, tx, ty);
+    float *t = lx_test_cube_texel(&env, face, tx, ty);
     t[0] = t[1] = t[2] = L;
     assert_int_equal(lx_irradiance_brute(&env, out_size, n, NULL, &irr), LX_OK);
 
@@ -95,7 +95,7 @@ static void single_texel_follows_cosine_law(void **state)
                 double nv[3];
                 lx_test_texel_dir(f, out_size, x, y, nv);
                 double want = L * texel_cosine_integral(face, n, tx, ty, nv, 64);
-                const float *e = lx_cubemap_texel(&irr, f, x, y);
+                const float *e = lx_test_cube_texel(&irr, f, x, y);
                 if (fabs(e[1] - want) > 1e-3 * peak)
                     fail_msg("face %d texel (%d, %d): %.6f, expected %.6f", f, x, y, e[1], want);
                 assert_true(e[0] == e[1] && e[1] == e[2]);
@@ -132,8 +132,8 @@ static void downsample_keeps_flux(void **state)
         for (int f = 0; f < 6; f++)
             for (int y = 0; y < n; y++)
                 for (int x = 0; x < n; x++)
-                    flux[m] +=
-                        lx_cube_texel_solid_angle(n, x, y) * lx_cubemap_texel(maps[m], f, x, y)[0];
+                    flux[m] += lx_cube_texel_solid_angle(n, x, y) *
+                               lx_test_cube_texel(maps[m], f, x, y)[0];
     }
     assert_true(fabs(flux[1] / flux[0] - 1.0) < 1e-6);
     lx_cubemap_free(&half);
@@ -209,7 +209,7 @@ static void bad_input(void **state)
     assert_non_null(strstr(lx_last_error(), "thread count -2"));
     assert_int_equal(lx_irradiance_brute(&env, 8, 0, NULL, NULL), LX_ERR_INVALID);
     assert_int_equal(lx_irradiance_brute(NULL, 8, 0, NULL, &out), LX_ERR_INVALID);
-    lx_cubemap_texel(&env, 3, 2, 2)[2] = NAN;
+    lx_test_cube_texel(&env, 3, 2, 2)[2] = NAN;
     assert_int_equal(lx_irradiance_brute(&env, 8, 0, NULL, &out), LX_ERR_INVALID);
     assert_non_null(strstr(lx_last_error(), "1 of 288 values are NaN or infinite"));
     assert_null(out.data);

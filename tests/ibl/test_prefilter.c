@@ -137,7 +137,8 @@ static double flux(const lx_cubemap *c, int ch)
     for (int f = 0; f < 6; f++)
         for (int y = 0; y < c->size; y++)
             for (int x = 0; x < c->size; x++)
-                sum += lx_cube_texel_solid_angle(c->size, x, y) * lx_cubemap_texel(c, f, x, y)[ch];
+                sum +=
+                    lx_cube_texel_solid_angle(c->size, x, y) * lx_test_cube_texel(c, f, x, y)[ch];
     return sum;
 }
 
@@ -248,7 +249,7 @@ static void brute_ggx(const lx_cubemap *env, double roughness, const double n[3]
                 double nh2 = (1.0 + nl) / 2.0; /* cos^2 of half the angle */
                 double q = nh2 * (a2 - 1.0) + 1.0;
                 double w = a2 / (PI_D * q * q) * nl * omega[y * s + x];
-                const float *v = lx_cubemap_texel(env, f, x, y);
+                const float *v = lx_test_cube_texel(env, f, x, y);
                 for (int c = 0; c < 3; c++)
                     num[c] += w * v[c];
                 den += w;
@@ -270,7 +271,7 @@ static void brute_phong(const lx_cubemap *env, double e, const double r[3], doub
                 if (c <= 0.0)
                     continue;
                 double w = pow(c, e) * omega[y * s + x];
-                const float *v = lx_cubemap_texel(env, f, x, y);
+                const float *v = lx_test_cube_texel(env, f, x, y);
                 for (int k = 0; k < 3; k++)
                     num[k] += w * v[k];
                 den += w;
@@ -298,7 +299,7 @@ static diff level_vs_brute(const lx_cubemap *env, const lx_cubemap *level, int f
                     brute_ggx(env, param, n, want);
                 else
                     brute_phong(env, param, n, want);
-                const float *v = lx_cubemap_texel(level, f, x, y);
+                const float *v = lx_test_cube_texel(level, f, x, y);
                 bool edge = x == 0 || y == 0 || x == m - 1 || y == m - 1;
                 for (int c = 0; c < 3; c++) {
                     double rel = fabs(v[c] - want[c]) / want[c];
@@ -384,7 +385,7 @@ static void ggx_small_bright_light_matches_brute_force(void **state)
     (void)state;
     lx_cubemap env = lx_test_make_env(32, env_smooth);
     for (int k = 0; k < 4; k++) {
-        float *t = lx_cubemap_texel(&env, LX_FACE_PY, 19 + k % 2, 11 + k / 2);
+        float *t = lx_test_cube_texel(&env, LX_FACE_PY, 19 + k % 2, 11 + k / 2);
         t[0] = t[1] = t[2] = 5e3f;
     }
     check_ggx_levels(&env, 256, "a small bright light", 0.005, 0.015);
@@ -426,7 +427,7 @@ static void phong_matches_brute_force(void **state)
      * it falls in: the downsampled source keeps it where it is */
     env = lx_test_make_env(32, env_constant);
     for (int k = 0; k < 3; k++)
-        lx_cubemap_texel(&env, LX_FACE_PY, 21, 10)[k] = 1e4f;
+        lx_test_cube_texel(&env, LX_FACE_PY, 21, 10)[k] = 1e4f;
     const float exps8[1] = {8.0f};
     lx_prefilter_desc d8 = {
         .filter = LX_SPECULAR_PHONG, .size = 8, .mips = 1, .phong_exponents = exps8};
@@ -561,7 +562,7 @@ static void bad_input(void **state)
         &env, &(lx_prefilter_desc){.filter = LX_SPECULAR_PHONG, .mips = 1, .phong_exponents = nan},
         "Phong exponent nan of level 0");
     expect_invalid(NULL, NULL, "missing");
-    lx_cubemap_texel(&env, 1, 3, 3)[0] = INFINITY;
+    lx_test_cube_texel(&env, 1, 3, 3)[0] = INFINITY;
     expect_invalid(&env, NULL, "1 of 4608 values are NaN or infinite");
     lx_cubemap levels[LX_MAX_CUBE_MIPS];
     assert_int_equal(lx_prefilter(&env, NULL, levels, NULL), LX_ERR_INVALID);
