@@ -66,6 +66,19 @@ float *lx_test_cube_texel(const lx_cubemap *c, int face, int x, int y)
     return c->data + 3 * ((size_t)face * n * n + (size_t)y * n + (size_t)x);
 }
 
+static double corner_solid_angle(double a, double b)
+{
+    return atan2(a * b, sqrt(a * a + b * b + 1.0));
+}
+
+double lx_test_texel_solid_angle(int size, int x, int y)
+{
+    double a0 = 2.0 * x / size - 1.0, a1 = 2.0 * (x + 1) / size - 1.0;
+    double b0 = 2.0 * y / size - 1.0, b1 = 2.0 * (y + 1) / size - 1.0;
+    return corner_solid_angle(a1, b1) - corner_solid_angle(a0, b1) - corner_solid_angle(a1, b0) +
+           corner_solid_angle(a0, b0);
+}
+
 lx_cubemap lx_test_make_env(int size, lx_test_env_fn fn)
 {
     lx_cubemap c;

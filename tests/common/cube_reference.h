@@ -30,6 +30,12 @@ double lx_test_texel_omega(int size, int x, int y, int m);
  * lx_cubemap_texel. */
 float *lx_test_cube_texel(const lx_cubemap *c, int face, int x, int y);
 
+/* The exact solid angle of texel (x, y) of a size x size face: the
+ * rectangle [a0, a1] x [b0, b1] of the face at distance 1 subtends
+ * S(a1, b1) - S(a0, b1) - S(a1, b0) + S(a0, b0) with
+ * S(a, b) = atan2(a b, sqrt(a^2 + b^2 + 1)). */
+double lx_test_texel_solid_angle(int size, int x, int y);
+
 /* Radiance (3 channels) at unit direction (x, y, z). */
 typedef void (*lx_test_env_fn)(double x, double y, double z, float out[3]);
 

@@ -138,7 +138,7 @@ static double flux(const lx_cubemap *c, int ch)
         for (int y = 0; y < c->size; y++)
             for (int x = 0; x < c->size; x++)
                 sum +=
-                    lx_cube_texel_solid_angle(c->size, x, y) * lx_test_cube_texel(c, f, x, y)[ch];
+                    lx_test_texel_solid_angle(c->size, x, y) * lx_test_cube_texel(c, f, x, y)[ch];
     return sum;
 }
 
@@ -156,8 +156,10 @@ static void constant_stays_constant(void **state)
         assert_int_equal(count, 6); /* 32, 16, 8, 4, 2, 1 */
         for (int l = 0; l < count; l++) {
             assert_int_equal(levels[l].size, 32 >> l);
+            /* measured: exactly L on every level of both filters; bound one
+             * float ulp (L's mantissas are all 1.5: 2^-23 / 1.5 = 8e-8) */
             for (size_t i = 0; i < (size_t)6 * levels[l].size * levels[l].size * 3; i++)
-                if (fabsf(levels[l].data[i] / L[i % 3] - 1.0f) > 1e-5f)
+                if (fabs(levels[l].data[i] / (double)L[i % 3] - 1.0) > 1.2e-7)
                     fail_msg("%s level %d value %zu: %.7f, expected %.7f", filter ? "Phong" : "GGX",
                              l, i, levels[l].data[i], L[i % 3]);
         }
@@ -203,11 +205,14 @@ static void ggx_level0_is_the_source(void **state)
  * lights (second order in their size, ~1e-4 here); for importance
  * sampling, the 64-sample Hammersley estimate of a smooth integrand (~1e-3
  * on a single texel, averaging out over the sphere) and trilinear mip
- * reads (a symmetric widening of the kernel: none); float rounding. We
- * allow 0.1%. */
+ * reads (a symmetric widening of the kernel: none); float rounding. */
 static void levels_keep_the_flux(void **state)
 {
     (void)state;
+    /* Measured, worst over levels and channels: 1.2e-4 (GGX, convolved),
+     * 7.3e-4 (GGX with 32 samples: levels 1-3 importance sampled) and
+     * 3.2e-4 (Phong). Bounds about 3x each. */
+    const double bounds[3] = {4e-4, 2e-3, 1e-3};
     lx_cubemap env = lx_test_make_env(64, env_band2), levels[LX_MAX_CUBE_MIPS];
     double want[3];
     for (int c = 0; c < 3; c++)
@@ -220,7 +225,7 @@ static void levels_keep_the_flux(void **state)
         for (int l = 0; l < count; l++)
             for (int c = 0; c < 3; c++) {
                 double rel = flux(&levels[l], c) / want[c] - 1.0;
-                if (fabs(rel) > 1e-3)
+                if (fabs(rel) > bounds[k])
                     fail_msg("%s level %d channel %d: flux off by %.3f%%", g_filters[k].name, l, c,
                              100.0 * rel);
             }
@@ -396,9 +401,11 @@ static void ggx_small_bright_light_matches_brute_force(void **state)
  * (the lobe's half-width is 2.3 texels there): the brute-force definition
  * but for the texels below 1e-4 of the peak. Those carry a share
  * delta ~ 1e-4 of the lobe's weight, so they move the result by at most
- * delta (max L - min L) / min L = 1e-3 on env_pattern (values 1 to 11).
- * Exponent 4 reads a downsampled source: a smooth environment moves by
- * well under 1%. */
+ * delta (max L - min L) / min L = 1e-3 on env_pattern (values 1 to 11);
+ * measured worst 5.6e-4, bound 1.2e-3. Exponent 4 reads a downsampled
+ * source: measured worst 0.70% on a smooth environment, bound 2%. A small
+ * light in a downsampled source: measured mean 0.084%, worst 1.2%; bounds
+ * 0.3% and 4%. */
 static void phong_matches_brute_force(void **state)
 {
     (void)state;
@@ -419,7 +426,7 @@ static void phong_matches_brute_force(void **state)
     e = level_vs_brute(&env, &levels[1], LX_SPECULAR_PHONG, 4.0);
     printf("Phong n = 4 from a downsampled source: mean %.2g, worst %.2g from brute force\n",
            e.mean, e.worst);
-    assert_true(e.worst < 0.01);
+    assert_true(e.worst < 0.02);
     free_levels(levels, count);
     lx_cubemap_free(&env);
 
@@ -435,8 +442,8 @@ static void phong_matches_brute_force(void **state)
     e = level_vs_brute(&env, &levels[0], LX_SPECULAR_PHONG, 8.0);
     printf("Phong n = 8, a small bright light: mean %.2g, worst %.2g from brute force\n", e.mean,
            e.worst);
-    assert_true(e.mean < 0.015);
-    assert_true(e.worst < 0.08);
+    assert_true(e.mean < 0.003);
+    assert_true(e.worst < 0.04);
     free_levels(levels, count);
     lx_cubemap_free(&env);
 
