@@ -464,8 +464,9 @@ static void downsample_to_a_size(void **state)
     assert_int_equal(half.size, 8);
     assert_int_equal(lx_cubemap_downsample(&half, 0, NULL, &quarter), LX_OK);
     assert_int_equal(lx_cubemap_downsample(&c, 4, NULL, &direct), LX_OK);
+    /* measured: within 1.1e-7 relative (float rounding), bound 3e-7 */
     for (size_t i = 0; i < (size_t)18 * 4 * 4; i++)
-        assert_float_equal(direct.data[i], quarter.data[i], 1e-6f * fabsf(quarter.data[i]));
+        assert_float_equal(direct.data[i], quarter.data[i], 3e-7f * fabsf(quarter.data[i]));
     lx_cubemap_free(&half);
     lx_cubemap_free(&quarter);
     lx_cubemap_free(&direct);
