@@ -110,8 +110,9 @@ static void bright_sky_still_bakes_pi_l(void **state)
         for (int i = 0; i < 8 * 8 * 3; i++)
             worst = fmax(worst, fabs(img.data[i] / (PI_D * 1e30) - 1.0));
         printf("1e30 nits, shadows %d: worst relative error %.2g\n", shadows, worst);
-        /* measured: 8.5e-7 (SH) and 8.3e-8 (rays), float rounding */
-        assert_true(worst < 5e-6);
+        /* measured: 8.5e-7 (SH) and 8.3e-8 (rays), float rounding; bounds
+         * 3e-6 and 3e-7 */
+        assert_true(worst < (shadows ? 3e-7 : 3e-6));
         lx_image_free(&img);
         lx_baker_destroy(b);
     }
