@@ -243,7 +243,7 @@ static void ktx_holds_the_levels(void **state)
                 for (int x = 0; x < n; x++, pos += 16) {
                     float v[4];
                     memcpy(v, u + pos, 16);
-                    const float *t = lx_cubemap_texel(&levels[l], f, x, y);
+                    const float *t = lx_test_cube_texel(&levels[l], f, x, y);
                     assert_true(v[0] == t[0] && v[1] == t[1] && v[2] == t[2] && v[3] == 1.0f);
                 }
     }
@@ -261,7 +261,7 @@ static void failures_leave_nothing(void **state)
     lx_cubemap levels[3];
     make_chain(levels, 4, 3, 3);
     /* a NaN in level 2, after 12 faces are written */
-    lx_cubemap_texel(&levels[2], LX_FACE_NY, 0, 0)[1] = NAN;
+    lx_test_cube_texel(&levels[2], LX_FACE_NY, 0, 0)[1] = NAN;
     lx_env_write_desc d = {.format = LX_IMAGE_EXR};
     assert_int_equal(lx_env_write(dir, "bad", levels, 3, &d), LX_ERR_INVALID);
     assert_error_mentions("bad_m2_ny.exr: pixel (0, 0) channel 1 is NaN");
@@ -270,7 +270,7 @@ static void failures_leave_nothing(void **state)
     assert_int_equal(lx_env_write(dir, "bad", levels, 3, &d), LX_ERR_INVALID);
     assert_error_mentions("mip level 2 face ny texel (0, 0)");
     assert_int_equal(lx_test_count_files(dir), 0);
-    lx_cubemap_texel(&levels[2], LX_FACE_NY, 0, 0)[1] = 1.0f;
+    lx_test_cube_texel(&levels[2], LX_FACE_NY, 0, 0)[1] = 1.0f;
 
     /* the caller stops before the fourth file */
     heard h = {.stop_at = 3};
@@ -516,8 +516,9 @@ static void downsample_to_a_size(void **state)
     assert_int_equal(half.size, 8);
     assert_int_equal(lx_cubemap_downsample(&half, 0, NULL, &quarter), LX_OK);
     assert_int_equal(lx_cubemap_downsample(&c, 4, NULL, &direct), LX_OK);
+    /* measured: within 1.1e-7 relative (float rounding), bound 3e-7 */
     for (size_t i = 0; i < (size_t)18 * 4 * 4; i++)
-        assert_float_equal(direct.data[i], quarter.data[i], 1e-6f * fabsf(quarter.data[i]));
+        assert_float_equal(direct.data[i], quarter.data[i], 3e-7f * fabsf(quarter.data[i]));
     lx_cubemap_free(&half);
     lx_cubemap_free(&quarter);
     lx_cubemap_free(&direct);
