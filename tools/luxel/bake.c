@@ -515,6 +515,9 @@ int cmd_bake(int argc, char **argv)
     cJSON *list = cJSON_AddArrayToObject(manifest, "lightmaps");
     bool failed = false;
     double t_maps = 0.0, t_previews = 0.0;
+    /* one bar over every file; Ctrl-C stops the file being written */
+    cli_progress_init(&progress, "write", a.quiet);
+    progress.parts = (int)maps * (a.format != LX_IMAGE_PNG ? 2 : 1);
     for (uint32_t m = 0; m < maps && !failed; m++) {
         const lx_lightmap_info *info = lx_baker_lightmap_info(baker, m);
         char file[300], preview[300];
@@ -525,16 +528,23 @@ int cmd_bake(int argc, char **argv)
                                   .exposure = a.format == LX_IMAGE_PNG ? exposure
                                               : a.pre_expose           ? pre_exposure
                                                                        : 1.0f,
-                                  .threads = a.desc.threads};
+                                  .threads = a.desc.threads,
+                                  .progress = cli_progress_update,
+                                  .progress_user = &progress};
         double t = cli_now();
         failed = !cli_stage_image(&stage, file, &images[m], &wd);
+        progress.part++;
         t_maps += cli_now() - t;
         bool want_preview = a.format != LX_IMAGE_PNG;
         if (!failed && want_preview) {
-            lx_image_write_desc pd = {
-                .format = LX_IMAGE_PNG, .exposure = exposure, .threads = a.desc.threads};
+            lx_image_write_desc pd = {.format = LX_IMAGE_PNG,
+                                      .exposure = exposure,
+                                      .threads = a.desc.threads,
+                                      .progress = cli_progress_update,
+                                      .progress_user = &progress};
             t = cli_now();
             failed = !cli_stage_image(&stage, preview, &images[m], &pd);
+            progress.part++;
             t_previews += cli_now() - t;
         }
         cJSON_AddItemToArray(list, manifest_entry(scene, info, file, want_preview ? preview : NULL,
@@ -547,6 +557,7 @@ int cmd_bake(int argc, char **argv)
             cli_error("out of memory");
         free(text);
     }
+    cli_progress_clear(&progress);
     cJSON_Delete(manifest);
     if (!failed && !cli_stage_publish(&stage))
         failed = true;

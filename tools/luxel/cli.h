@@ -49,6 +49,7 @@ int cli_environment_size(const char *env, int size);
 typedef struct cli_progress {
     const char *label; /* also the phase name of LUXEL_TEST_PAUSE */
     const char *phase; /* what --verbose calls the phase; NULL = the label */
+    int part, parts;   /* parts > 0: one bar over parts calls, this is call part */
     bool enabled;
     bool drawn;
     double start;
@@ -56,6 +57,8 @@ typedef struct cli_progress {
 } cli_progress;
 void cli_progress_init(cli_progress *p, const char *label, bool quiet);
 bool cli_progress_update(void *user, float fraction);
+/* Clears the bar (without ending a phase). */
+void cli_progress_clear(cli_progress *p);
 /* Clears the bar and ends the phase named by the label (cli_phase). */
 void cli_progress_finish(cli_progress *p);
 
@@ -75,8 +78,9 @@ void cli_report_interrupt(bool removed_outputs);
 
 /* Test hooks, read from the environment (never set outside tests):
  * LUXEL_TEST_PAUSE=PHASE stops the run the first time it reaches PHASE (a
- * progress label such as "bake", or "write" once the first output file is
- * staged), says "luxel: test: paused at PHASE" on stderr and waits up to a
+ * progress label such as "bake", or "write": the first progress report
+ * while an output is written, or the first output staged), says
+ * "luxel: test: paused at PHASE" on stderr and waits up to a
  * minute for a signal, so a test can interrupt a run at a known point. */
 void cli_test_pause(const char *phase);
 /* LUXEL_TEST_FAIL_RENAME=N: true for the Nth rename cli_stage_publish

@@ -276,6 +276,7 @@ void cli_progress_init(cli_progress *p, const char *label, bool quiet)
 {
     p->label = label;
     p->phase = NULL;
+    p->part = p->parts = 0;
     p->enabled = !quiet && isatty(2);
     p->drawn = false;
     p->start = cli_now();
@@ -290,6 +291,8 @@ bool cli_progress_update(void *user, float fraction)
         return false;
     if (!p->enabled)
         return true;
+    if (p->parts > 0)
+        fraction = ((float)p->part + fraction) / (float)p->parts;
     double elapsed = cli_now() - p->start;
     /* appear after a second, redraw at most ten times a second */
     if (elapsed < 1.0 || (elapsed - p->last_draw < 0.1 && fraction < 1.0f))
@@ -309,11 +312,16 @@ bool cli_progress_update(void *user, float fraction)
     return true;
 }
 
-void cli_progress_finish(cli_progress *p)
+void cli_progress_clear(cli_progress *p)
 {
     if (p->drawn)
         fprintf(stderr, "\r%*s\r", 70, "");
     p->drawn = false;
+}
+
+void cli_progress_finish(cli_progress *p)
+{
+    cli_progress_clear(p);
     cli_phase(p->phase ? p->phase : p->label);
 }
 
