@@ -8,9 +8,9 @@
  * once serially, then by four threads at once in rotated orders, three
  * rounds each: every concurrent load must give exactly the serial result
  * (the same bytes of every mesh, node and material, or the same status
- * and message). A forked child with an address-space limit below the
- * post-processing estimate takes the one-call exclusive path and must
- * give the serial result too. Timings are bench material, not tested. */
+ * and message). Failed reads on every thread at once must each report
+ * their own file's message. (The one-call exclusive path taken when
+ * memory is short: test_import_exclusive.c.) */
 #define _GNU_SOURCE /* pthread barriers */
 #include <stdarg.h>
 #include <stddef.h>
@@ -22,13 +22,10 @@
 #include <stdio.h>
 #include <stdlib.h>
 #include <string.h>
-#include <sys/resource.h>
-#include <sys/wait.h>
-#include <unistd.h>
 
-#include "core/internal.h"
 #include "gltf_writer.h"
 #include "helpers.h"
+#include "scene_files.h"
 #include "luxel/scene.h"
 
 #define MAX_FILES 16
@@ -36,28 +33,6 @@
 #define ROUNDS 3
 
 /* ---- inputs ------------------------------------------------------------------ */
-
-/* An n x n grid of quads as an OBJ: positions with a little relief so the
- * generated normals vary, texture coordinates, no normals. */
-static void write_obj_grid(const char *path, const char *name, int n)
-{
-    FILE *f = fopen(path, "w");
-    assert_non_null(f);
-    fprintf(f, "o %s\n", name);
-    for (int y = 0; y <= n; y++)
-        for (int x = 0; x <= n; x++)
-            fprintf(f, "v %g %g %g\n", x * 0.1, 0.02 * ((x * 7 + y * 13) % 5), y * 0.1);
-    for (int y = 0; y <= n; y++)
-        for (int x = 0; x <= n; x++)
-            fprintf(f, "vt %g %g\n", x / (double)n, y / (double)n);
-    for (int y = 0; y < n; y++)
-        for (int x = 0; x < n; x++) {
-            int a = y * (n + 1) + x + 1, b = a + 1, c = a + n + 1, d = c + 1;
-            fprintf(f, "f %d/%d %d/%d %d/%d\nf %d/%d %d/%d %d/%d\n", a, a, c, c, b, b, b, b, c, c,
-                    d, d);
-        }
-    assert_int_equal(fclose(f), 0);
-}
 
 /* The same kind of grid as a glTF mesh (POSITION, TEXCOORD_0, indices). */
 static void grid_arrays(int n, float **pos, float **uv, uint32_t **idx)
@@ -154,59 +129,13 @@ typedef struct outcome {
     char message[512];
 } outcome;
 
-static uint64_t fnv(uint64_t h, const void *data, size_t size)
-{
-    const unsigned char *p = data;
-    for (size_t i = 0; i < size; i++)
-        h = (h ^ p[i]) * 0x100000001b3ull;
-    return h;
-}
-
-static uint64_t fnv_str(uint64_t h, const char *s)
-{
-    return s ? fnv(h, s, strlen(s) + 1) : fnv(h, "", 1);
-}
-
-static uint64_t scene_digest(const lx_scene *s)
-{
-    uint64_t h = 0xcbf29ce484222325ull;
-    h = fnv(h, &s->mesh_count, sizeof s->mesh_count);
-    for (uint32_t i = 0; i < s->mesh_count; i++) {
-        const lx_mesh *m = &s->meshes[i];
-        size_t nv = m->vertex_count;
-        h = fnv_str(h, m->name);
-        h = fnv(h, &m->vertex_count, sizeof m->vertex_count);
-        h = fnv(h, &m->triangle_count, sizeof m->triangle_count);
-        h = fnv(h, m->positions, nv * sizeof *m->positions);
-        h = fnv(h, m->normals, nv * sizeof *m->normals);
-        if (m->tangents)
-            h = fnv(h, m->tangents, nv * sizeof *m->tangents);
-        for (int k = 0; k < LX_MAX_UV_SETS; k++)
-            if (m->uv[k])
-                h = fnv(h, m->uv[k], nv * sizeof *m->uv[k]);
-        h = fnv(h, m->indices, 3 * (size_t)m->triangle_count * sizeof *m->indices);
-        h = fnv(h, &m->material, sizeof m->material);
-    }
-    h = fnv(h, &s->node_count, sizeof s->node_count);
-    for (uint32_t i = 0; i < s->node_count; i++) {
-        const lx_node *n = &s->nodes[i];
-        h = fnv_str(h, n->name);
-        h = fnv(h, &n->world, sizeof n->world);
-        h = fnv(h, n->meshes, n->mesh_count * sizeof *n->meshes);
-    }
-    h = fnv(h, &s->material_count, sizeof s->material_count);
-    for (uint32_t i = 0; i < s->material_count; i++)
-        h = fnv_str(h, s->materials[i].name);
-    return h;
-}
-
 static void load_one(const char *path, outcome *out)
 {
     memset(out, 0, sizeof *out);
     lx_scene *s = NULL;
     out->status = lx_scene_load(path, NULL, &s);
     if (out->status == LX_OK) {
-        out->digest = scene_digest(s);
+        out->digest = lx_test_scene_digest(s);
         lx_scene_destroy(s);
     } else {
         snprintf(out->message, sizeof out->message, "%s", lx_last_error());
@@ -231,7 +160,7 @@ static void make_inputs(files *fs, const char *dir)
     for (int k = 0; k < 4; k++) {
         snprintf(name, sizeof name, "grid%d.obj", k);
         add_file(fs, dir, name);
-        write_obj_grid(fs->path[fs->count - 1], name, 30 + 10 * k);
+        lx_test_write_obj_grid(fs->path[fs->count - 1], name, 30 + 10 * k);
     }
     for (int k = 0; k < 2; k++) {
         snprintf(name, sizeof name, "grid%d.gltf", k);
@@ -395,78 +324,12 @@ static void failures_at_once(void **state)
                      FAIL_ROUNDS, workers[t].example);
 }
 
-/* ---- the exclusive path --------------------------------------------------------- */
-
-/* With less memory left than the post-processing estimate (import_assimp.c:
- * 512 bytes a vertex and 384 a face as assimp reads the file; a 150 x 150
- * OBJ grid reads as 135000 vertices and 45000 faces, 86.4 MB), the file is
- * imported again in one assimp call holding the lock alone. A child
- * process whose address-space limit leaves 1 MiB less than the estimate
- * takes that path; the import needs about 70 MiB there, so it must give
- * the serial scene. Under AddressSanitizer, whose allocator holds freed
- * memory back, the limit may be too tight: the load must then fail
- * cleanly (no crash), naming the file. */
-#if defined(__SANITIZE_ADDRESS__)
-#define LX_ASAN 1
-#elif defined(__has_feature)
-#if __has_feature(address_sanitizer)
-#define LX_ASAN 1
-#endif
-#endif
-
-static void exclusive_path_equals_serial(void **state)
-{
-    (void)state;
-    const char *dir = lx_test_dir("test_import_threads_exclusive");
-    char path[512];
-    snprintf(path, sizeof path, "%s/grid.obj", dir);
-    write_obj_grid(path, "grid", 150);
-    uint64_t estimate = 135000ull * 512u + 45000ull * 384u;
-    outcome serial;
-    load_one(path, &serial);
-    if (serial.status != LX_OK)
-        fail_msg("%s: %s", path, serial.message);
-    fflush(NULL);
-    pid_t pid = fork();
-    assert_true(pid >= 0);
-    if (pid == 0) {
-        FILE *statm = fopen("/proc/self/statm", "r");
-        unsigned long long pages = 0;
-        if (!statm || fscanf(statm, "%llu", &pages) != 1)
-            _exit(3);
-        fclose(statm);
-        uint64_t vm = (uint64_t)pages * (uint64_t)sysconf(_SC_PAGESIZE);
-        rlim_t limit = (rlim_t)(vm + estimate - (1u << 20));
-        struct rlimit rl = {limit, limit};
-        if (setrlimit(RLIMIT_AS, &rl) != 0)
-            _exit(4);
-        if (lx_memory_available(NULL) >= estimate)
-            _exit(5); /* not the exclusive path */
-        outcome got;
-        load_one(path, &got);
-#ifdef LX_ASAN
-        if (got.status != LX_OK)
-            _exit(got.status == LX_ERR_FORMAT && strstr(got.message, path) ? 0 : 6);
-#endif
-        if (got.status != LX_OK) {
-            fprintf(stderr, "exclusive path: %s\n", got.message);
-            _exit(6);
-        }
-        _exit(got.digest == serial.digest ? 0 : 7);
-    }
-    int status = 0;
-    assert_int_equal(waitpid(pid, &status, 0), pid);
-    assert_true(WIFEXITED(status));
-    assert_int_equal(WEXITSTATUS(status), 0);
-}
-
 int main(void)
 {
     lx_test_watchdog(240);
     const struct CMUnitTest tests[] = {
         cmocka_unit_test(concurrent_equals_serial),
         cmocka_unit_test(failures_at_once),
-        cmocka_unit_test(exclusive_path_equals_serial),
     };
     return cmocka_run_group_tests(tests, NULL, NULL);
 }
