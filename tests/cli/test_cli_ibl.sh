@@ -478,7 +478,7 @@ paused() {
 # refuses it on the sizes alone, so the run fails at once, naming the GiB,
 # before the 18 GiB environment is made.
 E15=1e6$(for i in $(seq 14); do printf ',1e6'; done)
-bad "a run that needs more memory than the machine" 1 "const:1|prefilter: a 16384 x 16384 source (18.0 GiB)|GiB of memory, the machine has" \
+bad "a run that needs more memory than the machine" 1 "const:1|prefilter: a 16384 x 16384 source (18.0 GiB)|GiB of memory, " \
     const:1 --size 16384 --specular phong --phong-exponents "$E15" --specular-size 16384
 
 # ---- upsampling: a warning at once, naming the memory ----------------------------------
