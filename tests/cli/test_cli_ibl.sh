@@ -4,7 +4,7 @@
 # every specular level of a constant environment is L), exact round trips
 # cross -> faces -> cross and cross -> vertical cross -> faces, KTX headers
 # against the KTX 1.1 specification, bit-identical results for any thread
-# count, and every bad input of the issue: exit status 1 (failed run) or 2
+# count, and every bad input: exit status 1 (failed run) or 2
 # (usage error), one "luxel: error:" line naming the file or option, and
 # no file left behind (an existing output folder keeps its old files).
 #

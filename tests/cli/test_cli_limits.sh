@@ -1,7 +1,6 @@
 # cases: bake_nodes bake_retro bake_density ibl_run
-# End-to-end tests of requests too large for the memory (DESIGN.md section
-# 4: "a 100000^2 lightmap fails up front with a message that says how much
-# was asked"). The bake cases run under a 2 GiB address-space limit, which
+# End-to-end tests of requests too large for the memory (a 100000^2
+# lightmap fails up front with a message that says how much was asked). The bake cases run under a 2 GiB address-space limit, which
 # the library counts as the memory it may use, so they fail up front on any
 # machine, naming that limit; a build that cannot run under such a limit
 # (a sanitizer's) reports them skipped. The ibl case runs without a limit

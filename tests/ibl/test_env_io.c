@@ -5,7 +5,7 @@
  * the seam fix checked against neighbours found here from the face table,
  * KTX files read back by a minimal parser written from the KTX 1.1
  * specification with half floats decoded by their definition, and every
- * bad input the issue names (message, status, nothing written). Input files
+ * bad environment input (message, status, nothing written). Input files
  * are written here: PFM by hand (so they can hold NaN), PNG with
  * stb_image_write, others with lx_image_write. */
 #define _POSIX_C_SOURCE 200809L

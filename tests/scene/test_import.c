@@ -1,7 +1,7 @@
 /* Tests of scene import (src/scene/import_assimp.c through lx_scene_load):
  * small .gltf / .glb / .obj files written here by code, with values worked
  * out by hand in the comments: the UV origin convention (glTF's top-left
- * kept, OBJ's bottom-left flipped: DESIGN.md section 3), node transforms
+ * kept, OBJ's bottom-left flipped, as docs/ARCHITECTURE.md says), node transforms
  * (TRS, "matrix" and a parent/child chain) in lx_node.world, a scene shaped
  * like examples/gen_scenes' room (three nodes with TEXCOORD_1, two
  * KHR_lights_punctual lights), and bad input: missing, unreadable, garbage,
