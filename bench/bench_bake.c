@@ -1,4 +1,4 @@
-/* bench_bake - the static bake's speed (DESIGN.md section 8), each figure
+/* bench_bake - the static bake's speed, each figure
  * with its baseline measured in the same run:
  *
  *  1. Full bake of a generated ~100k-triangle scene (tests/common/scenes.h),

@@ -1,4 +1,4 @@
-/* bench_ibl - the IBL filters' speed (DESIGN.md section 8), each figure with
+/* bench_ibl - the IBL filters' speed, each figure with
  * a baseline measured in the same run on the same synthetic environment (a
  * sky gradient, a textured ground, a sun of 0.5 degrees radius at 2e4
  * nits):

@@ -1,4 +1,4 @@
-/* bench_realtime - the real-time lightmap update rate (DESIGN.md section 8)
+/* bench_realtime - the real-time lightmap update rate
  * with its baseline measured in the same run.
  *
  * Scene: a generated ~10k-triangle scene (tests/common/scenes.h: a

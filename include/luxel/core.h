@@ -136,10 +136,12 @@ lx_status lx_image_load_memory(const void *bytes, size_t size, const char *name,
                                const lx_image_load_desc *desc, lx_image *out);
 
 typedef struct lx_image_write_desc {
-    lx_image_format format; /* 0 = from the path's extension */
-    float exposure;         /* multiplier applied to values, 0 = 1 */
-    bool half;              /* EXR: 16-bit half floats instead of 32-bit */
-    int threads;            /* encoding threads, 0 = all cores */
+    lx_image_format format;  /* 0 = from the path's extension */
+    float exposure;          /* multiplier applied to values, 0 = 1 */
+    bool half;               /* EXR: 16-bit half floats instead of 32-bit */
+    int threads;             /* encoding threads, 0 = all cores */
+    lx_progress_fn progress; /* may be NULL; returning false cancels */
+    void *progress_user;
 } lx_image_write_desc;
 
 /* A copy of desc (or of zeros when NULL) with every default filled in
@@ -149,7 +151,12 @@ lx_image_write_desc lx_image_write_desc_defaults(const lx_image_write_desc *desc
 /* Writes img to path atomically (temporary file in the same folder, renamed
  * when complete). 8-bit formats are exposed, clamped to [0,1] and sRGB
  * encoded; float formats store linear values. NaN/Inf values are rejected.
- * desc may be NULL. */
+ * desc->progress hears the encoding (between EXR chunks or scanlines, PNG
+ * deflate strips, HDR and PFM rows; JPEG and TGA before and after their
+ * encoder) and a last 1.0 before the file is committed; when it returns
+ * false the call ends with LX_ERR_CANCELLED and no file (neither the
+ * target nor a temporary one). The bytes written do not depend on
+ * desc->threads. desc may be NULL. */
 lx_status lx_image_write(const char *path, const lx_image *img, const lx_image_write_desc *desc);
 
 /* Bilinear sample at UV (origin top-left, texel centres at (x+0.5)/W),

@@ -273,7 +273,8 @@ lx_status lx_env_write_names(const char *stem, int count, const lx_env_write_des
 /* Writes levels[0..count) (a cube map and its mips, each half the size of
  * the one before) as one KTX 1.1 file at path, RGBA16F when half else
  * RGBA32F, atomically (lx_env_write with LX_ENV_KTX, at a path of the
- * caller's choosing). */
+ * caller's choosing, on all cores and without progress: lx_env_write
+ * takes threads and a progress callback). */
 lx_status lx_ktx_write_cubemap(const char *path, const lx_cubemap *levels, int count, bool half);
 
 /* ---- diffuse irradiance --------------------------------------------- */

@@ -1,5 +1,4 @@
-/* luxel/maps.h - texture-space tools: tangent frames (and, as later issues
- * add them, normal, horizon, occlusion and parallax maps).
+/* luxel/maps.h - texture-space tools: tangent frames.
  *
  * CONVENTIONS  UV origin at the top-left (glTF). Tangents are xyz + w
  *   handedness with bitangent = cross(normal, tangent.xyz) * w, the glTF

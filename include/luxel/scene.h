@@ -19,10 +19,16 @@
  *   the scene and everything it points to. Pointers into a scene are
  *   borrowed until lx_scene_destroy.
  * THREADING  lx_scene_load, lx_gltf_lights_load and lx_triangle_degenerate
- *   are thread-safe (loads of different files may run at once). A scene is
- *   read-only once built: reading one from several threads is safe, but the
- *   functions that change a scene (lx_scene_add_*, lx_scene_adopt_profile,
- *   lx_lights_json_apply*) must not run while another thread uses it.
+ *   are thread-safe. Loads on several threads run at once except while
+ *   assimp reads a file (one file at a time: assimp keeps its last error in
+ *   one process-wide string); a glTF file whose meshes cannot all be
+ *   matched to the file's primitives is imported alone, with assimp's
+ *   process-wide log attached. A program that calls assimp's C API itself
+ *   must not import or attach log streams while lx_scene_load runs. A scene
+ *   is read-only once built: reading one from several threads is safe, but
+ *   the functions that change a scene (lx_scene_add_*,
+ *   lx_scene_adopt_profile, lx_lights_json_apply*) must not run while
+ *   another thread uses it.
  *
  * USAGE
  *   lx_scene *scene;

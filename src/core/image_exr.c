@@ -403,6 +403,7 @@ typedef struct exr_job {
     int index[4];
     int count;
     exr_chunk_bytes *chunks;
+    lx_img_progress *progress;
     int failed_chunk; /* INT32_MAX: none */
     exr_result_t failed_rv;
     char failed_detail[512];
@@ -459,7 +460,7 @@ static void encode_chunks(exr_job *job, int chunk_count, int threads)
         uint8_t *planes = malloc(row_bytes * (size_t)job->lines * (size_t)job->count);
 #pragma omp for schedule(dynamic, 1)
         for (int c = 0; c < chunk_count; c++) {
-            if (job->failed_chunk != INT32_MAX)
+            if (job->failed_chunk != INT32_MAX || lx_img_progress_stopped(job->progress))
                 continue;
             if (!planes) {
                 note_failure(job, c, EXR_ERR_OUT_OF_MEMORY);
@@ -502,6 +503,8 @@ static void encode_chunks(exr_job *job, int chunk_count, int threads)
                 rv = exr_encoding_run(job->ctx, 0, &enc);
             if (rv != EXR_ERR_SUCCESS)
                 note_failure(job, c, rv);
+            else
+                lx_img_progress_add(job->progress, 1);
         }
         if (started || enc.channels)
             exr_encoding_destroy(job->ctx, &enc);
@@ -518,13 +521,22 @@ static void encode_chunks(exr_job *job, int chunk_count, int threads)
  * third of its time. */
 #define LX_EXR_ZIP_LEVEL 1
 
+/* Progress: the chunks encoded cover [0, LX_EXR_ENCODED], writing them in
+ * order the rest; uncompressed scanlines, each packed and written, all of
+ * it. */
+#define LX_EXR_ENCODED 0.9f
+
 lx_status lx_img_write_exr(FILE *fp, const char *path, const lx_image *img, float exposure,
-                           bool half, int threads)
+                           bool half, int threads, lx_img_progress *progress)
 {
     if ((int64_t)img->width * 4 > INT32_MAX)
         return lx_fail(LX_ERR_UNSUPPORTED, "%s: %d pixels per row is too wide for EXR", path,
                        img->width);
-    exr_job job = {.img = img, .exposure = exposure, .half = half, .failed_chunk = INT32_MAX};
+    exr_job job = {.img = img,
+                   .exposure = exposure,
+                   .half = half,
+                   .progress = progress,
+                   .failed_chunk = INT32_MAX};
     job.count = exr_channel_layout(img->channels, job.names, job.index);
 
     exr_out o = {fp, (uint64_t)ftello(fp), false};
@@ -567,20 +579,28 @@ lx_status lx_img_write_exr(FILE *fp, const char *path, const lx_image *img, floa
         uint8_t *buf = malloc(line);
         if (!buf)
             s = lx_fail(LX_ERR_NOMEM, "%s: cannot allocate %zu bytes", path, line);
+        lx_img_progress_phase(progress, 0.0f, 1.0f, (uint64_t)img->height);
         for (int y = 0; y < img->height && s == LX_OK; y++) {
             pack_planes(&job, y, 1, buf);
             rv = exr_write_scanline_chunk(job.ctx, part, y, buf, line);
             if (rv != EXR_ERR_SUCCESS)
                 s = exr_failure(rv, LX_ERR_IO, path, "writing");
+            else if (!lx_img_progress_add(progress, 1))
+                s = lx_img_cancelled(path);
         }
         free(buf);
         chunk_count = 0;
     } else if (s == LX_OK) {
         int n = lx_thread_count(threads);
+        lx_img_progress_phase(progress, 0.0f, LX_EXR_ENCODED, (uint64_t)chunk_count);
         encode_chunks(&job, chunk_count, n < chunk_count ? n : chunk_count);
         if (job.failed_chunk != INT32_MAX)
             s = lx_fail(job.failed_rv == EXR_ERR_OUT_OF_MEMORY ? LX_ERR_NOMEM : LX_ERR_IO,
                         "%s: writing chunk %d: %s", path, job.failed_chunk, job.failed_detail);
+        else if (lx_img_progress_stopped(progress))
+            s = lx_img_cancelled(path);
+        lx_img_progress_phase(progress, LX_EXR_ENCODED, 1.0f - LX_EXR_ENCODED,
+                              (uint64_t)chunk_count);
     }
     /* the chunks in order, as the file's increasing-y line order wants */
     for (int c = 0; c < chunk_count && s == LX_OK; c++) {
@@ -588,6 +608,8 @@ lx_status lx_img_write_exr(FILE *fp, const char *path, const lx_image *img, floa
                                       job.chunks[c].size);
         if (rv != EXR_ERR_SUCCESS)
             s = exr_failure(rv, LX_ERR_IO, path, "writing");
+        else if (!lx_img_progress_add(progress, 1))
+            s = lx_img_cancelled(path);
     }
     for (int c = 0; c < chunk_count && job.chunks; c++)
         free(job.chunks[c].data);

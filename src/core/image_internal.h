@@ -5,6 +5,7 @@
 
 #include "internal.h"
 
+#include <stdatomic.h>
 #include <stdio.h>
 
 #if defined(__GNUC__)
@@ -12,6 +13,36 @@
 #else
 #define LX_IMG_HIDDEN
 #endif
+
+/* Progress of one lx_image_write: work is counted in units (rows, chunks,
+ * strips) of the phase under way, which maps them onto [base, base +
+ * span] of the frame, itself [frame_base, frame_base + frame_span] of the
+ * whole (the writers' [0, 1] after the values are checked). Any thread
+ * may add units; the one that does calls
+ * the callback unless another is in it, so calls come one at a time and
+ * never go back. Once the callback returns false every later call of
+ * lx_img_progress_add returns false too (the writer stops and its caller
+ * returns LX_ERR_CANCELLED). */
+typedef struct lx_img_progress {
+    lx_progress_fn fn; /* NULL: nothing reported, never stopped */
+    void *user;
+    _Atomic bool stop;
+    _Atomic bool busy;
+    _Atomic uint64_t done;
+    uint64_t total;
+    float base, span;
+    float frame_base, frame_span;
+    float last; /* the last fraction reported (under busy) */
+} lx_img_progress;
+
+/* Starts a phase of `total` units covering [base, base + span]. Call
+ * between parallel loops, not inside one. */
+LX_IMG_HIDDEN void lx_img_progress_phase(lx_img_progress *p, float base, float span,
+                                         uint64_t total);
+/* Adds units done in the current phase and reports; false once stopped. */
+LX_IMG_HIDDEN bool lx_img_progress_add(lx_img_progress *p, uint64_t units);
+/* Whether the callback has asked to stop. */
+LX_IMG_HIDDEN bool lx_img_progress_stopped(lx_img_progress *p);
 
 /* Readers. name is used in messages only; data holds size bytes; is_tga
  * says the stb reader got a TGA (which has no signature). Each fills
@@ -27,20 +58,29 @@ LX_IMG_HIDDEN lx_status lx_img_load_exr(const unsigned char *data, size_t size, 
 /* Writers to an open temporary file. The caller has checked img (1..4
  * channels, finite values, exposed values in the format's range) and
  * commits or aborts the file. exposure is the multiplier (never 0);
- * threads bounds the encoding threads (0 = all cores). */
+ * threads bounds the encoding threads (0 = all cores). Each reports on
+ * progress over [0, 1] and returns LX_ERR_CANCELLED ("<path>: writing
+ * cancelled") when it stops. */
 LX_IMG_HIDDEN lx_status lx_img_write_stb(FILE *fp, const char *path, const lx_image *img,
-                                         lx_image_format format, float exposure, int threads);
+                                         lx_image_format format, float exposure, int threads,
+                                         lx_img_progress *progress);
 LX_IMG_HIDDEN lx_status lx_img_write_pfm(FILE *fp, const char *path, const lx_image *img,
-                                         float exposure);
+                                         float exposure, lx_img_progress *progress);
 LX_IMG_HIDDEN lx_status lx_img_write_exr(FILE *fp, const char *path, const lx_image *img,
-                                         float exposure, bool half, int threads);
+                                         float exposure, bool half, int threads,
+                                         lx_img_progress *progress);
+
+/* The LX_ERR_CANCELLED of a writer that stopped. */
+LX_IMG_HIDDEN lx_status lx_img_cancelled(const char *path);
 
 /* A PNG file of 8-bit pixels (channels 1..4, rows top to bottom) in memory
- * from malloc, *out_len bytes; NULL when out of memory. Deflates on up to
- * `threads` threads (0 = all cores); the bytes do not depend on it
- * (image_png.c). */
+ * from malloc, *out_len bytes; NULL when out of memory or stopped by
+ * progress (whose current phase it reports on, by deflate strip).
+ * Deflates on up to `threads` threads (0 = all cores); the bytes do not
+ * depend on it (image_png.c). */
 LX_IMG_HIDDEN unsigned char *lx_img_png_encode(const unsigned char *pixels, int width, int height,
-                                               int channels, int threads, int *out_len);
+                                               int channels, int threads, lx_img_progress *progress,
+                                               int *out_len);
 
 /* The bound below which stb's RGBE encoder keeps its exponent byte in
  * range (2^127). */

@@ -169,7 +169,8 @@ static void float_to_le(float f, unsigned char *b)
     b[3] = (unsigned char)(u >> 24);
 }
 
-lx_status lx_img_write_pfm(FILE *fp, const char *path, const lx_image *img, float exposure)
+lx_status lx_img_write_pfm(FILE *fp, const char *path, const lx_image *img, float exposure,
+                           lx_img_progress *progress)
 {
     /* PFM holds grey or RGB: grey+alpha keeps the grey, RGBA the colour. */
     int in_c = img->channels;
@@ -179,16 +180,21 @@ lx_status lx_img_write_pfm(FILE *fp, const char *path, const lx_image *img, floa
     if (!row)
         return lx_fail(LX_ERR_NOMEM, "%s: cannot allocate %zu bytes", path, row_bytes);
     fprintf(fp, "%s\n%d %d\n-1.0\n", out_c == 3 ? "PF" : "Pf", img->width, img->height);
-    for (int y = img->height - 1; y >= 0 && !ferror(fp); y--) {
+    lx_img_progress_phase(progress, 0.0f, 1.0f, (uint64_t)img->height);
+    bool stopped = false;
+    for (int y = img->height - 1; y >= 0 && !ferror(fp) && !stopped; y--) {
         const float *src = img->data + (size_t)y * (size_t)img->width * (size_t)in_c;
         unsigned char *b = row;
         for (int x = 0; x < img->width; x++, src += in_c)
             for (int c = 0; c < out_c; c++, b += 4)
                 float_to_le(src[c] * exposure, b);
         fwrite(row, 1, row_bytes, fp);
+        stopped = !lx_img_progress_add(progress, 1);
     }
     free(row);
     if (ferror(fp))
         return lx_fail(LX_ERR_IO, "%s: write failed", path);
+    if (stopped)
+        return lx_img_cancelled(path);
     return LX_OK;
 }

@@ -45,9 +45,10 @@ static unsigned int lx_png_crc32(unsigned char *buffer, int len);
 #define LX_PNG_LEVEL 1
 #define LX_PNG_STRATEGY Z_RLE
 
-/* Threads for the encoder running on this thread (stb's hook has no
- * context argument). */
+/* Threads and progress for the encoder running on this thread (stb's
+ * hook has no context argument). */
 static _Thread_local int png_threads = 1;
+static _Thread_local lx_img_progress *png_progress;
 
 typedef struct png_strip {
     unsigned char *out;
@@ -102,14 +103,22 @@ static unsigned char *lx_png_deflate(unsigned char *data, int data_len, int *out
         return NULL;
     int level = LX_PNG_LEVEL;
     int threads = png_threads < (int)count ? png_threads : (int)count;
+    /* the strips are the current phase's units */
+    lx_img_progress *progress = png_progress;
+    if (progress)
+        lx_img_progress_phase(progress, progress->base, progress->span, count);
 #pragma omp parallel for schedule(dynamic, 1) num_threads(threads)
     for (long k = 0; k < (long)count; k++) {
+        if (progress && lx_img_progress_stopped(progress))
+            continue;
         size_t at = (size_t)k * LX_PNG_STRIP;
         size_t len = n - at < LX_PNG_STRIP ? n - at : LX_PNG_STRIP;
         deflate_strip(data, at, len, k == (long)count - 1, level, &strips[k]);
+        if (progress)
+            lx_img_progress_add(progress, 1);
     }
     size_t total = 2 + 4;
-    bool failed = false;
+    bool failed = progress && lx_img_progress_stopped(progress);
     for (size_t k = 0; k < count; k++) {
         total += strips[k].size;
         failed |= strips[k].failed;
@@ -151,12 +160,14 @@ static unsigned int lx_png_crc32(unsigned char *buffer, int len)
 #define LX_PNG_FILTER 2
 
 unsigned char *lx_img_png_encode(const unsigned char *pixels, int width, int height, int channels,
-                                 int threads, int *out_len)
+                                 int threads, lx_img_progress *progress, int *out_len)
 {
     png_threads = lx_thread_count(threads);
+    png_progress = progress;
     stbi_write_force_png_filter = LX_PNG_FILTER;
     unsigned char *png =
         stbi_write_png_to_mem(pixels, width * channels, width, height, channels, out_len);
     png_threads = 1;
+    png_progress = NULL;
     return png;
 }

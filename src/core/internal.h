@@ -34,8 +34,41 @@ bool lx_size_mul(size_t a, size_t b, size_t c, size_t *out);
 /* Physical memory of the machine in bytes (0 when unknown). */
 uint64_t lx_physical_memory(void);
 
-/* Fails with LX_ERR_NOMEM and a message "<what> needs N GiB of memory, the
- * machine has M GiB" when bytes exceed the machine's physical memory. */
+/* What bounds the memory a request may take (memory.c). */
+typedef enum lx_memory_bound {
+    LX_MEMORY_UNKNOWN = 0,   /* nothing known: no bound */
+    LX_MEMORY_PHYSICAL,      /* the machine's physical memory */
+    LX_MEMORY_CGROUP,        /* the memory limit of the process's control group */
+    LX_MEMORY_ADDRESS_SPACE, /* RLIMIT_AS less the address space in use */
+    LX_MEMORY_DATA           /* RLIMIT_DATA less the data in use */
+} lx_memory_bound;
+
+typedef struct lx_memory_limit {
+    uint64_t available; /* what a new request may take (UINT64_MAX: unbounded) */
+    uint64_t limit;     /* the bound's limit */
+    uint64_t used;      /* of it already in use (the rlimits; 0 for the others) */
+    lx_memory_bound bound;
+} lx_memory_limit;
+
+/* The memory a new request may take: the smallest of the machine's
+ * physical memory, its control group's limit (cgroup v2 and v1, the
+ * group and the groups above it), and RLIMIT_AS and RLIMIT_DATA less what
+ * the process has of them. Fills *out (may be NULL) with the bound that
+ * decided. Reads /proc on every call: limits may change. */
+uint64_t lx_memory_available(lx_memory_limit *out);
+
+/* "the machine has 23.5 GiB", "the address-space limit (RLIMIT_AS, ulimit
+ * -v) is 8.0 GiB, 1.2 GiB of it in use", ... into buf. */
+void lx_memory_limit_describe(const lx_memory_limit *m, char *buf, size_t size);
+
+/* The smallest memory limit of the control groups a /proc/<pid>/cgroup
+ * file names, found through a /proc/<pid>/mountinfo file (paths, for
+ * tests); UINT64_MAX when there is none. */
+uint64_t lx_cgroup_memory_limit(const char *cgroup_file, const char *mountinfo_file);
+
+/* Fails with LX_ERR_NOMEM and a message "<what> needs N GiB of memory,
+ * <the bound>" ("the machine has M GiB", "the address-space limit ...")
+ * when bytes exceed lx_memory_available. */
 lx_status lx_check_memory(uint64_t bytes, const char *what);
 
 /* "1.5 GiB" or "12.0 MiB" into buf. */

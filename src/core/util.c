@@ -1,4 +1,4 @@
-/* Sizes and memory checks, thread counts, atomic output files, counter-based
+/* Sizes, thread counts, atomic output files, counter-based
  * hashing, whole-file reads and path helpers (declared in internal.h). */
 #define _POSIX_C_SOURCE 200809L
 #include "internal.h"
@@ -21,35 +21,6 @@ bool lx_size_mul(size_t a, size_t b, size_t c, size_t *out)
         return false;
     *out = abc;
     return true;
-}
-
-uint64_t lx_physical_memory(void)
-{
-    long pages = sysconf(_SC_PHYS_PAGES);
-    long page_size = sysconf(_SC_PAGESIZE);
-    if (pages <= 0 || page_size <= 0)
-        return 0;
-    return (uint64_t)pages * (uint64_t)page_size;
-}
-
-void lx_format_bytes(uint64_t bytes, char *buf, size_t size)
-{
-    const double gib = 1024.0 * 1024.0 * 1024.0;
-    if (bytes >= (uint64_t)gib / 4)
-        snprintf(buf, size, "%.1f GiB", (double)bytes / gib);
-    else
-        snprintf(buf, size, "%.1f MiB", (double)bytes / (1024.0 * 1024.0));
-}
-
-lx_status lx_check_memory(uint64_t bytes, const char *what)
-{
-    uint64_t have = lx_physical_memory();
-    if (have == 0 || bytes <= have)
-        return LX_OK;
-    char need_s[32], have_s[32];
-    lx_format_bytes(bytes, need_s, sizeof need_s);
-    lx_format_bytes(have, have_s, sizeof have_s);
-    return lx_fail(LX_ERR_NOMEM, "%s needs %s of memory, the machine has %s", what, need_s, have_s);
 }
 
 int lx_thread_count(int requested)

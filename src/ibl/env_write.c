@@ -185,15 +185,43 @@ static lx_status file_path(const char *folder, const char *name, const lx_env_wr
     return LX_OK;
 }
 
-/* Writes one image file and records it. */
+/* The caller's callback, never told a smaller fraction than before: the
+ * parts of the run are computed in float, and where one ends and the
+ * next begins may differ by a rounding. Calls come one at a time. */
+typedef struct monotonic {
+    lx_progress_fn fn;
+    void *user;
+    float last;
+} monotonic;
+
+static bool monotonic_progress(void *user, float fraction)
+{
+    monotonic *m = user;
+    m->last = fraction > m->last ? fraction : m->last;
+    return m->fn(m->user, m->last);
+}
+
+/* An image's writing as the part [run->base, run->base + run->span] of
+ * the whole. */
+static bool image_progress(void *user, float fraction)
+{
+    const lx_ibl_run *run = user;
+    return run->progress(run->user, run->base + run->span * fraction);
+}
+
+/* Writes one image file, reporting on `part` of the run, and records it. */
 static lx_status put_image(const char *folder, const char *name, const lx_image *img,
-                           const lx_env_write_desc *d, written *w)
+                           const lx_env_write_desc *d, const lx_ibl_run *part, written *w)
 {
     char *path;
     lx_status st = file_path(folder, name, d, &path);
     if (st != LX_OK)
         return st;
-    lx_image_write_desc wd = {.format = d->format, .half = d->half, .threads = d->threads};
+    lx_image_write_desc wd = {.format = d->format,
+                              .half = d->half,
+                              .threads = d->threads,
+                              .progress = part->progress ? image_progress : NULL,
+                              .progress_user = (void *)part};
     st = lx_image_write(path, img, &wd);
     if (st != LX_OK) {
         free(path);
@@ -224,7 +252,8 @@ lx_status lx_env_write(const char *folder, const char *stem, const lx_cubemap *l
     }
     if ((st = check_memory(stem, sizes, count, &d)) != LX_OK)
         return st;
-    lx_ibl_run run = lx_ibl_run_make(d.threads, d.progress, d.progress_user);
+    monotonic mono = {d.progress, d.progress_user, 0.0f};
+    lx_ibl_run run = lx_ibl_run_make(d.threads, d.progress ? monotonic_progress : NULL, &mono);
     char name[MAX_NAME];
     if (d.layout == LX_ENV_KTX) {
         file_name(name, sizeof name, stem, 0, count, 0, &d);
@@ -247,7 +276,9 @@ lx_status lx_env_write(const char *folder, const char *stem, const lx_cubemap *l
             for (int f = 0; f < 6 && st == LX_OK; f++) {
                 file_name(name, sizeof name, stem, l, count, f, &d);
                 lx_image face = lx_cubemap_face_image(c, f);
-                st = put_image(folder, name, &face, &d, &w);
+                lx_ibl_run file = lx_ibl_run_part(&run, (done + part * f / 6.0) / total,
+                                                  (done + part * (f + 1) / 6.0) / total);
+                st = put_image(folder, name, &face, &d, &file, &w);
                 if (st == LX_OK && run.progress &&
                     !run.progress(run.user, (float)((done + part * (f + 1) / 6.0) / total)))
                     st = lx_fail(LX_ERR_CANCELLED, "%s: writing cancelled", stem);
@@ -260,7 +291,9 @@ lx_status lx_env_write(const char *folder, const char *stem, const lx_cubemap *l
                      : lx_ibl_cube_to_cross(c, d.layout == LX_ENV_CROSS_VERTICAL, &conv, &img);
             if (st == LX_OK) {
                 file_name(name, sizeof name, stem, l, count, 0, &d);
-                st = put_image(folder, name, &img, &d, &w);
+                lx_ibl_run file =
+                    lx_ibl_run_part(&run, (done + 0.5 * part) / total, (done + part) / total);
+                st = put_image(folder, name, &img, &d, &file, &w);
                 lx_image_free(&img);
             }
             if (st == LX_OK && run.progress &&

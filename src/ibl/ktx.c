@@ -81,8 +81,37 @@ static lx_status check_levels(const char *path, const lx_cubemap *levels, int co
 
 lx_status lx_ktx_write_cubemap(const char *path, const lx_cubemap *levels, int count, bool half)
 {
-    lx_ibl_run run = lx_ibl_run_make(1, NULL, NULL);
+    lx_ibl_run run = lx_ibl_run_make(0, NULL, NULL);
     return lx_ibl_ktx_write(path, levels, count, half, &run);
+}
+
+/* Face rows [y0, y0 + rows) as RGBA texels (A = 1) in the file's type. */
+static void convert_rows(const lx_cubemap *c, int face, int y0, int rows, bool half,
+                         unsigned char *out, int threads)
+{
+    size_t texel_bytes = half ? 8 : 16;
+    size_t row_bytes = (size_t)c->size * texel_bytes;
+    /* a block of a few thousand texels is not worth a thread */
+#pragma omp parallel for schedule(static) num_threads(threads) if ((size_t)rows * c->size > 16384)
+    for (int r = 0; r < rows; r++) {
+        const float *src = lx_cubemap_texel(c, face, 0, y0 + r);
+        unsigned char *p = out + (size_t)r * row_bytes;
+        for (int x = 0; x < c->size; x++) {
+            float rgba[4] = {src[3 * x], src[3 * x + 1], src[3 * x + 2], 1.0f};
+            for (int k = 0; k < 4; k++) {
+                if (half) {
+                    uint16_t h = lx_float_to_half(rgba[k]);
+                    *p++ = (unsigned char)h;
+                    *p++ = (unsigned char)(h >> 8);
+                } else {
+                    uint32_t bits;
+                    memcpy(&bits, &rgba[k], sizeof bits);
+                    put_u32(p, bits);
+                    p += 4;
+                }
+            }
+        }
+    }
 }
 
 lx_status lx_ibl_ktx_write(const char *path, const lx_cubemap *levels, int count, bool half,
@@ -99,7 +128,11 @@ lx_status lx_ibl_ktx_write(const char *path, const lx_cubemap *levels, int count
     if (face_bytes0 > 0xffffffffu)
         return lx_fail(LX_ERR_INVALID, "%s: a %d face is too large for KTX's 32-bit imageSize",
                        path, size0);
-    unsigned char *row = malloc((size_t)size0 * texel_bytes);
+    /* rows are converted in blocks of about KTX_BLOCK texels on the run's
+     * threads and written in order; progress after each block */
+    enum { KTX_BLOCK = 1 << 18 };
+    size_t block_texels = (size_t)size0 > KTX_BLOCK ? (size_t)size0 : KTX_BLOCK;
+    unsigned char *row = malloc(block_texels * texel_bytes);
     if (!row)
         return lx_fail(LX_ERR_NOMEM, "%s: out of memory", path);
 
@@ -154,31 +187,15 @@ lx_status lx_ibl_ktx_write(const char *path, const lx_cubemap *levels, int count
         put_u32(size_field, (uint32_t)face_bytes);
         ok = fwrite(size_field, 1, 4, fp) == 4;
         /* face_bytes is a multiple of 8: no cube or mip padding is needed */
+        int block_rows = (int)(block_texels / (size_t)c->size);
         for (int face = 0; face < 6 && ok && !cancelled; face++)
-            for (int y = 0; y < c->size && ok && !cancelled; y++) {
-                const float *src = lx_cubemap_texel(c, face, 0, y);
-                unsigned char *p = row;
-                for (int x = 0; x < c->size; x++) {
-                    float rgba[4] = {src[3 * x], src[3 * x + 1], src[3 * x + 2], 1.0f};
-                    for (int k = 0; k < 4; k++) {
-                        if (half) {
-                            uint16_t h = lx_float_to_half(rgba[k]);
-                            *p++ = (unsigned char)h;
-                            *p++ = (unsigned char)(h >> 8);
-                        } else {
-                            uint32_t bits;
-                            memcpy(&bits, &rgba[k], sizeof bits);
-                            put_u32(p, bits);
-                            p += 4;
-                        }
-                    }
-                }
-                size_t n = (size_t)(p - row);
+            for (int y = 0; y < c->size && ok && !cancelled; y += block_rows) {
+                int rows = c->size - y < block_rows ? c->size - y : block_rows;
+                convert_rows(c, face, y, rows, half, row, run->threads);
+                size_t n = (size_t)rows * (size_t)c->size * texel_bytes;
                 ok = fwrite(row, 1, n, fp) == n;
-                done += c->size;
-                /* a few times a second: every 2^20 texels and at each level's end */
-                if (run->progress && ok &&
-                    ((y + 1) % (1 + (1 << 20) / c->size) == 0 || (face == 5 && y == c->size - 1)))
+                done += (double)rows * c->size;
+                if (run->progress && ok)
                     cancelled =
                         !run->progress(run->user, run->base + run->span * (float)(done / total));
             }

@@ -7,6 +7,7 @@
  * assimp dropped for out-of-range indices are noticed and named. Both need
  * to know which of assimp's meshes and materials is which of the file's:
  * gltf_map below finds that through the node hierarchy. */
+#define _GNU_SOURCE /* glibc's writer-preferring rwlock initializer */
 #include "luxel/scene.h"
 #include "core/internal.h"
 
@@ -22,6 +23,7 @@
 #include <errno.h>
 #include <float.h>
 #include <pthread.h>
+#include <stdatomic.h>
 #include <stdio.h>
 #include <stdlib.h>
 #include <string.h>
@@ -42,25 +44,178 @@ typedef struct import_ctx {
     char *folder;
     const cJSON *gltf;   /* the file's glTF 2.0 JSON, or NULL */
     const gltf_map *map; /* assimp's meshes and materials in it, with gltf */
+    bool log_watched;    /* assimp's log was watched during the import ... */
+    bool log_dropped;    /* ... and told of faces dropped for bad indices */
 } import_ctx;
 
-/* assimp's C API keeps the last error in one process-wide string, which
- * every failed import assigns (aiImportFileExWithProperties), so imports
- * are serialized. Its glTF importers report faces they dropped for
- * out-of-range indices only through its log, also process-wide, and
- * without naming the mesh: for glTF files the log is watched while the
- * import runs. A glTF 2.0 file's primitives are checked against their JSON
- * (check_dropped_faces), which names the primitive; the log decides only
- * for meshes that cannot be matched to the JSON, and for glTF 1.0. No
- * other importer drops faces that way, so no other import attaches it. */
-static pthread_mutex_t import_lock = PTHREAD_MUTEX_INITIALIZER;
-static bool dropped_faces;
+/* ---- running assimp ------------------------------------------------------ */
+
+/* What assimp 5.2.5 shares between imports (its source: code/Common/
+ * Assimp.cpp, DefaultLogger.cpp, Importer.cpp). aiImportFileExWithProperties
+ * makes a fresh Assimp::Importer, with its own readers, post-processing
+ * steps and IO system, for every call; the readers and steps luxel uses
+ * keep no mutable static state. Two things are process-wide:
+ *
+ * - the last error: a failed aiImportFile* call assigns a static
+ *   std::string that aiGetErrorString returns, with no lock. Two failed
+ *   calls at once would assign it together (a data race that can free its
+ *   buffer twice), so every call that can fail, which is every file read,
+ *   runs under reader_lock, and the message is copied before it is let go.
+ *   aiApplyPostProcessing does not touch the string.
+ * - the logger: every log call in assimp (readers, steps, aiGetMaterial*
+ *   on a property of the wrong type) reads DefaultLogger's global pointer
+ *   without a lock, while aiAttachLogStream and aiDetachLogStream replace
+ *   and delete the logger under a lock of assimp's own. An attached stream
+ *   also hears every import running at the time. So every use of assimp
+ *   holds assimp_lock shared, and an import that attaches a stream holds
+ *   it exclusively, from before the attach to after the detach.
+ *
+ * Reading a file is the smaller part of an import: on a 180k-triangle OBJ
+ * the reader took 0.7 s and luxel's post-processing (smooth normals,
+ * joining vertices) 3.0 s; on the same mesh as glTF 32 ms and 0.52 s. An
+ * import therefore reads the file under reader_lock with validation only
+ * and post-processes with aiApplyPostProcessing outside it, so imports on
+ * several threads overlap everywhere but in their readers. That call has
+ * one flaw: when a step fails it releases the scene the step has already
+ * deleted. With luxel's steps only an allocation fails, so before the
+ * post-processing the memory it may take is compared with what the
+ * process may use (lx_memory_available); a scene too large for that is
+ * imported again in one aiImportFileExWithProperties call holding
+ * assimp_lock exclusively, where a failure is reported as assimp's error.
+ *
+ * The one importer that reports dropped faces, assimp's glTF 2.0 reader
+ * (faces with out-of-range indices), says so only through the log,
+ * without naming the mesh; luxel checks each primitive against the
+ * file's JSON instead (check_dropped_faces). Only when a triangle mesh
+ * cannot be matched to its primitive is the file imported a second time,
+ * exclusively, with a log stream attached (import_watched). */
+#if defined(PTHREAD_RWLOCK_WRITER_NONRECURSIVE_INITIALIZER_NP)
+/* a waiting exclusive import is not overtaken by new shared ones */
+static pthread_rwlock_t assimp_lock = PTHREAD_RWLOCK_WRITER_NONRECURSIVE_INITIALIZER_NP;
+#else
+static pthread_rwlock_t assimp_lock = PTHREAD_RWLOCK_INITIALIZER;
+#endif
+static pthread_mutex_t reader_lock = PTHREAD_MUTEX_INITIALIZER;
+
+#define POST_FLAGS                                                                                 \
+    (aiProcess_Triangulate | aiProcess_SortByPType | aiProcess_FlipUVs |                           \
+     aiProcess_GenSmoothNormals | aiProcess_JoinIdenticalVertices)
+
+/* An assimp scene and how assimp_lock is held for it (until
+ * assimp_release). */
+typedef struct assimp_import {
+    const struct aiScene *ai;
+    bool exclusive;
+    bool dropped; /* watched: the glTF 2.0 reader logged dropped faces */
+} assimp_import;
 
 static void on_assimp_log(const char *message, char *user)
 {
-    (void)user;
     if (strstr(message, "out-of-range indices"))
-        dropped_faces = true;
+        *(bool *)(void *)user = true;
+}
+
+/* Bytes the post-processing of ai may add at its peak: about twice the
+ * address space it was measured to add (a 180k-triangle grid as OBJ,
+ * 540k vertices as read, and as glTF, 91k: 300 bytes a vertex and 180 a
+ * face, joining vertices keeping a 272-byte copy of each). */
+static uint64_t post_processing_bytes(const struct aiScene *ai)
+{
+    uint64_t bytes = 0;
+    for (unsigned i = 0; i < ai->mNumMeshes; i++) {
+        const struct aiMesh *m = ai->mMeshes[i];
+        bytes += (uint64_t)m->mNumVertices * 512u + (uint64_t)m->mNumFaces * 384u;
+    }
+    return bytes;
+}
+
+/* The estimates of the post-processing running now: a new one must fit
+ * beside them. */
+static _Atomic uint64_t post_processing_reserved;
+
+static lx_status import_failed(const char *path, const char *why)
+{
+    return lx_fail(LX_ERR_FORMAT, "%s: cannot import: %s", path,
+                   why[0] ? why : "unknown format or corrupt file");
+}
+
+static struct aiPropertyStore *import_properties(void)
+{
+    struct aiPropertyStore *props = aiCreatePropertyStore();
+    /* Smooth normals where a file has none, but keep hard edges hard. */
+    aiSetImportPropertyFloat(props, AI_CONFIG_PP_GSN_MAX_SMOOTHING_ANGLE, 60.0f);
+    return props;
+}
+
+/* The whole import in one call holding assimp_lock exclusively, with the
+ * log watched for dropped faces when watch_log. */
+static lx_status import_exclusive(const char *path, bool watch_log, assimp_import *im)
+{
+    struct aiPropertyStore *props = import_properties();
+    struct aiLogStream log = {on_assimp_log, (char *)(void *)&im->dropped};
+    pthread_rwlock_wrlock(&assimp_lock);
+    im->exclusive = true;
+    if (watch_log)
+        aiAttachLogStream(&log);
+    im->ai = aiImportFileExWithProperties(path, POST_FLAGS | aiProcess_ValidateDataStructure, NULL,
+                                          props);
+    if (watch_log)
+        aiDetachLogStream(&log);
+    char why[512];
+    snprintf(why, sizeof why, "%s", im->ai ? "" : aiGetErrorString());
+    aiReleasePropertyStore(props);
+    if (!im->ai) {
+        pthread_rwlock_unlock(&assimp_lock);
+        return import_failed(path, why);
+    }
+    return LX_OK;
+}
+
+/* Imports path with luxel's post-processing into im->ai, holding
+ * assimp_lock until assimp_release (also on failure, when im->ai is
+ * NULL and the lock is already let go). */
+static lx_status assimp_import_file(const char *path, bool watch_log, assimp_import *im)
+{
+    memset(im, 0, sizeof *im);
+    if (watch_log)
+        return import_exclusive(path, true, im);
+    struct aiPropertyStore *props = import_properties();
+    pthread_rwlock_rdlock(&assimp_lock);
+    pthread_mutex_lock(&reader_lock);
+    const struct aiScene *ai =
+        aiImportFileExWithProperties(path, aiProcess_ValidateDataStructure, NULL, props);
+    char why[512];
+    snprintf(why, sizeof why, "%s", ai ? "" : aiGetErrorString());
+    pthread_mutex_unlock(&reader_lock);
+    aiReleasePropertyStore(props);
+    if (!ai) {
+        pthread_rwlock_unlock(&assimp_lock);
+        return import_failed(path, why);
+    }
+    uint64_t need = post_processing_bytes(ai);
+    uint64_t others = atomic_fetch_add(&post_processing_reserved, need);
+    if (need + others > lx_memory_available(NULL)) {
+        atomic_fetch_sub(&post_processing_reserved, need);
+        aiReleaseImport(ai);
+        pthread_rwlock_unlock(&assimp_lock);
+        return import_exclusive(path, false, im);
+    }
+    im->ai = aiApplyPostProcessing(ai, POST_FLAGS);
+    atomic_fetch_sub(&post_processing_reserved, need);
+    if (!im->ai) {
+        pthread_rwlock_unlock(&assimp_lock);
+        return lx_fail(LX_ERR_NOMEM, "%s: cannot import: assimp's post-processing failed", path);
+    }
+    return LX_OK;
+}
+
+static void assimp_release(assimp_import *im)
+{
+    if (!im->ai)
+        return;
+    aiReleaseImport(im->ai);
+    im->ai = NULL;
+    pthread_rwlock_unlock(&assimp_lock);
 }
 
 /* OBJ text numbers that assimp would silently read as 0 ("nan", "inf",
@@ -365,7 +520,7 @@ static lx_status gltf_map_build(const import_ctx *c, gltf_map *g)
     unsigned unmatched = 0;
     for (unsigned k = 0; k < ai->mNumMeshes; k++)
         unmatched += g->prim_of[k] >= g->prims.count;
-    if (unmatched)
+    if (unmatched && c->log_watched)
         lx_log(LX_LOG_INFO,
                "%s: %u of %u meshes are not matched to the file's primitives through its nodes; "
                "faces assimp drops from them are noticed through its log",
@@ -755,10 +910,11 @@ static lx_status import_node(import_ctx *c, const struct aiNode *node, const lx_
  * primitive (gltf_map) that has fewer faces than the primitive's accessor
  * defines fails the load, naming the primitive (the first in file order).
  * Where no such count vouches for a triangle mesh (not matched, or the
- * accessor's count unknown), the log decides (log_dropped): it fails the
- * load, naming such a mesh. Point and line meshes, which luxel skips, fail
- * nothing. */
-static lx_status check_dropped_faces(const import_ctx *c, bool log_dropped)
+ * accessor's count unknown), the log decides: an import that did not
+ * watch it sets *need_log (the file is imported again, watched); a
+ * watched one fails the load when the log told of dropped faces, naming
+ * such a mesh. Point and line meshes, which luxel skips, fail nothing. */
+static lx_status check_dropped_faces(const import_ctx *c, bool *need_log)
 {
     const gltf_map *g = c->map;
     size_t worst = SIZE_MAX; /* the failing primitive first in file order */
@@ -792,7 +948,11 @@ static lx_status check_dropped_faces(const import_ctx *c, bool log_dropped)
                        c->path, who, worst - g->prims.first[m],
                        (unsigned long long)(want - worst_faces), (unsigned long long)want);
     }
-    if (log_dropped && unproven) {
+    if (unproven && !c->log_watched) {
+        *need_log = true;
+        return LX_OK;
+    }
+    if (c->log_dropped && unproven) {
         const struct aiMesh *am = c->ai->mMeshes[first_unproven];
         return lx_fail(LX_ERR_FORMAT,
                        "%s: some triangles have vertex indices out of range (assimp dropped them "
@@ -812,6 +972,91 @@ static bool read_by_gltf2(const struct aiScene *ai)
             md->mValues[i].mType == AI_AISTRING && md->mValues[i].mData)
             return strncmp(((const struct aiString *)md->mValues[i].mData)->data, "glTF2", 5) == 0;
     return false;
+}
+
+/* One import of path; gltf is its JSON or NULL. Unwatched (the first
+ * try), a glTF 2.0 triangle mesh whose faces the JSON cannot vouch for
+ * sets *need_log and ends the import early with LX_OK and no scene; the
+ * caller then imports the file again with assimp's log watched. */
+static lx_status import_scene(const char *path, const lx_scene_load_desc *desc, const cJSON *gltf,
+                              bool gltf2, bool watch_log, bool *need_log, lx_scene **out)
+{
+    *need_log = false;
+    assimp_import im;
+    lx_status st = assimp_import_file(path, watch_log, &im);
+    if (st != LX_OK)
+        return st;
+    const struct aiScene *ai = im.ai;
+    /* a glTF 2.0 file's primitives are checked one by one below; one its
+     * JSON does not declare 2.x (assimp reads a version "2") only through
+     * the log */
+    bool read_gltf2 = read_by_gltf2(ai);
+    bool by_gltf2 = gltf2 && read_gltf2;
+    if (read_gltf2 && !by_gltf2 && !watch_log) {
+        assimp_release(&im);
+        *need_log = true;
+        return LX_OK;
+    }
+    if (im.dropped && !by_gltf2) {
+        assimp_release(&im);
+        return lx_fail(LX_ERR_FORMAT, "%s: some faces have indices out of range", path);
+    }
+    /* assimp flags a scene without meshes incomplete; lights alone are fine */
+    if (!ai->mRootNode) {
+        assimp_release(&im);
+        return lx_fail(LX_ERR_FORMAT, "%s: cannot import: the file has no scene", path);
+    }
+    import_ctx c = {.path = path,
+                    .ai = ai,
+                    .desc = desc,
+                    .gltf = by_gltf2 ? gltf : NULL,
+                    .log_watched = watch_log,
+                    .log_dropped = im.dropped};
+    gltf_map map = {0};
+    st = lx_scene_create(path, &c.scene);
+    if (st != LX_OK) {
+        assimp_release(&im);
+        return st;
+    }
+    c.folder = lx_path_dirname(path);
+    c.mesh_map = malloc(sizeof(uint32_t) * (ai->mNumMeshes ? ai->mNumMeshes : 1));
+    if (!c.folder || !c.mesh_map)
+        st = lx_fail(LX_ERR_NOMEM, "%s: out of memory", path);
+    if (st == LX_OK && c.gltf) {
+        st = gltf_map_build(&c, &map);
+        c.map = &map;
+    }
+    if (st == LX_OK && c.gltf)
+        st = check_dropped_faces(&c, need_log);
+    if (st == LX_OK && *need_log) {
+        assimp_release(&im);
+        gltf_map_free(&map);
+        free(c.mesh_map);
+        free(c.folder);
+        lx_scene_destroy(c.scene);
+        return LX_OK;
+    }
+    if (st == LX_OK)
+        st = import_materials(&c);
+    for (unsigned i = 0; st == LX_OK && i < ai->mNumMeshes; i++)
+        st = import_mesh(&c, i);
+    if (st == LX_OK) {
+        lx_mat4 root = lx_mat4_identity();
+        uint32_t counter = 0;
+        st = import_node(&c, ai->mRootNode, &root, 0, &counter);
+    }
+    if (st == LX_OK && gltf)
+        st = lx_gltf_lights_from_json(c.scene, path, gltf);
+    assimp_release(&im);
+    gltf_map_free(&map);
+    free(c.mesh_map);
+    free(c.folder);
+    if (st != LX_OK) {
+        lx_scene_destroy(c.scene);
+        return st;
+    }
+    *out = c.scene;
+    return LX_OK;
 }
 
 lx_scene_load_desc lx_scene_load_desc_defaults(const lx_scene_load_desc *desc)
@@ -869,83 +1114,11 @@ lx_status lx_scene_load(const char *path, const lx_scene_load_desc *in, lx_scene
             return st;
     }
     bool gltf2 = gltf && lx_gltf_is_v2(gltf);
-    /* only assimp's glTF readers need their log watched */
-    bool watch_log = gltf != NULL;
-    struct aiPropertyStore *props = aiCreatePropertyStore();
-    /* Smooth normals where a file has none, but keep hard edges hard. */
-    aiSetImportPropertyFloat(props, AI_CONFIG_PP_GSN_MAX_SMOOTHING_ANGLE, 60.0f);
-    unsigned flags = aiProcess_Triangulate | aiProcess_SortByPType | aiProcess_FlipUVs |
-                     aiProcess_GenSmoothNormals | aiProcess_JoinIdenticalVertices |
-                     aiProcess_ValidateDataStructure;
-    struct aiLogStream log = {on_assimp_log, NULL};
-    pthread_mutex_lock(&import_lock);
-    dropped_faces = false;
-    if (watch_log)
-        aiAttachLogStream(&log);
-    const struct aiScene *ai = aiImportFileExWithProperties(path, flags, NULL, props);
-    if (watch_log)
-        aiDetachLogStream(&log);
-    bool dropped = dropped_faces;
-    char why[512];
-    snprintf(why, sizeof why, "%s", ai ? "" : aiGetErrorString());
-    pthread_mutex_unlock(&import_lock);
-    aiReleasePropertyStore(props);
-    if (!ai) {
-        cJSON_Delete(gltf);
-        return lx_fail(LX_ERR_FORMAT, "%s: cannot import: %s", path,
-                       why[0] ? why : "unknown format or corrupt file");
-    }
-    /* a glTF 2.0 file's primitives are checked one by one below */
-    bool by_gltf2 = gltf2 && read_by_gltf2(ai);
-    if (dropped && !by_gltf2) {
-        aiReleaseImport(ai);
-        cJSON_Delete(gltf);
-        return lx_fail(LX_ERR_FORMAT, "%s: some faces have indices out of range", path);
-    }
-    /* assimp flags a scene without meshes incomplete; lights alone are fine */
-    if (!ai->mRootNode) {
-        aiReleaseImport(ai);
-        cJSON_Delete(gltf);
-        return lx_fail(LX_ERR_FORMAT, "%s: cannot import: the file has no scene", path);
-    }
-    import_ctx c = {.path = path, .ai = ai, .desc = desc, .gltf = by_gltf2 ? gltf : NULL};
-    gltf_map map = {0};
-    lx_status st = lx_scene_create(path, &c.scene);
-    if (st != LX_OK) {
-        aiReleaseImport(ai);
-        cJSON_Delete(gltf);
-        return st;
-    }
-    c.folder = lx_path_dirname(path);
-    c.mesh_map = malloc(sizeof(uint32_t) * (ai->mNumMeshes ? ai->mNumMeshes : 1));
-    if (!c.folder || !c.mesh_map)
-        st = lx_fail(LX_ERR_NOMEM, "%s: out of memory", path);
-    if (st == LX_OK && c.gltf) {
-        st = gltf_map_build(&c, &map);
-        c.map = &map;
-    }
-    if (st == LX_OK && c.gltf)
-        st = check_dropped_faces(&c, dropped);
-    if (st == LX_OK)
-        st = import_materials(&c);
-    for (unsigned i = 0; st == LX_OK && i < ai->mNumMeshes; i++)
-        st = import_mesh(&c, i);
-    if (st == LX_OK) {
-        lx_mat4 root = lx_mat4_identity();
-        uint32_t counter = 0;
-        st = import_node(&c, ai->mRootNode, &root, 0, &counter);
-    }
-    if (st == LX_OK && gltf)
-        st = lx_gltf_lights_from_json(c.scene, path, gltf);
-    aiReleaseImport(ai);
+    bool need_log = false;
+    lx_status st = import_scene(path, desc, gltf, gltf2, false, &need_log, out);
+    /* a mesh the JSON cannot vouch for: assimp's log must tell */
+    if (st == LX_OK && need_log)
+        st = import_scene(path, desc, gltf, gltf2, true, &need_log, out);
     cJSON_Delete(gltf);
-    gltf_map_free(&map);
-    free(c.mesh_map);
-    free(c.folder);
-    if (st != LX_OK) {
-        lx_scene_destroy(c.scene);
-        return st;
-    }
-    *out = c.scene;
-    return LX_OK;
+    return st;
 }

@@ -82,7 +82,7 @@ static void negative_texel_is_an_error(void **state)
     lx_cubemap env = lx_test_constant_env(4, 1.0f);
     /* one texel far below zero: the mean luminance (and with it the peak
      * threshold) goes negative */
-    float *t = lx_cubemap_texel(&env, LX_FACE_NY, 1, 2);
+    float *t = lx_test_cube_texel(&env, LX_FACE_NY, 1, 2);
     t[0] = t[1] = t[2] = -1e6f;
     expect_rejected(&env, 1.0f, false, "negative");
     expect_rejected(&env, 1.0f, true, "negative");
@@ -110,8 +110,9 @@ static void bright_sky_still_bakes_pi_l(void **state)
         for (int i = 0; i < 8 * 8 * 3; i++)
             worst = fmax(worst, fabs(img.data[i] / (PI_D * 1e30) - 1.0));
         printf("1e30 nits, shadows %d: worst relative error %.2g\n", shadows, worst);
-        /* measured: 8.5e-7 (SH) and 8.3e-8 (rays), float rounding */
-        assert_true(worst < 5e-6);
+        /* measured: 8.5e-7 (SH) and 8.3e-8 (rays), float rounding; bounds
+         * 3e-6 and 3e-7 */
+        assert_true(worst < (shadows ? 3e-7 : 3e-6));
         lx_image_free(&img);
         lx_baker_destroy(b);
     }

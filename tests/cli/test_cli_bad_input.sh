@@ -1,5 +1,5 @@
-# End-to-end tests of `luxel bake` / `luxel info` on bad input (DESIGN.md
-# section 4): missing, unreadable and corrupt files,
+# End-to-end tests of `luxel bake` / `luxel info` on bad input: missing,
+# unreadable and corrupt files,
 # non-finite coordinates, zero-area triangles in space and in UV, overlapping
 # lightmap UVs, impossible resolutions and memory requests, unknown options
 # and malformed lights JSON. Every failure must exit with the exact status

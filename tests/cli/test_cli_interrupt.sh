@@ -1,5 +1,5 @@
-# End-to-end tests of interrupting luxel (DESIGN.md section 4: "an error or
-# Ctrl-C never leaves a partial or corrupt file"). Each run is stopped at a
+# End-to-end tests of interrupting luxel (an error or Ctrl-C never leaves
+# a partial or corrupt file). Each run is stopped at a
 # known phase by the test hook LUXEL_TEST_PAUSE=PHASE (the CLI says
 # "luxel: test: paused at PHASE" and waits for a signal), so the signal
 # lands mid-run every time. An interrupted run must end by its signal (exit

@@ -1,5 +1,5 @@
-# End-to-end checks of the CLI's output folders and sky limits (DESIGN.md section 4:
-# a failed run leaves nothing behind, every bad input gets one error line):
+# End-to-end checks of the CLI's output folders and sky limits (a failed
+# run leaves nothing behind, every bad input gets one error line):
 # - an empty -o is a usage error for bake as for ibl (it read past the end
 #   of the folder name);
 # - a failed run removes every folder it created, missing parents of the

@@ -60,16 +60,36 @@ double lx_test_texel_omega(int size, int x, int y, int m)
     return sum * h * h;
 }
 
+float *lx_test_cube_texel(const lx_cubemap *c, int face, int x, int y)
+{
+    size_t n = (size_t)c->size;
+    return c->data + 3 * ((size_t)face * n * n + (size_t)y * n + (size_t)x);
+}
+
+static double corner_solid_angle(double a, double b)
+{
+    return atan2(a * b, sqrt(a * a + b * b + 1.0));
+}
+
+double lx_test_texel_solid_angle(int size, int x, int y)
+{
+    double a0 = 2.0 * x / size - 1.0, a1 = 2.0 * (x + 1) / size - 1.0;
+    double b0 = 2.0 * y / size - 1.0, b1 = 2.0 * (y + 1) / size - 1.0;
+    return corner_solid_angle(a1, b1) - corner_solid_angle(a0, b1) - corner_solid_angle(a1, b0) +
+           corner_solid_angle(a0, b0);
+}
+
 lx_cubemap lx_test_make_env(int size, lx_test_env_fn fn)
 {
     lx_cubemap c;
     assert_int_equal(lx_cubemap_alloc(&c, size), LX_OK);
+    assert_int_equal(c.size, size);
     for (int f = 0; f < 6; f++)
         for (int y = 0; y < size; y++)
             for (int x = 0; x < size; x++) {
                 double d[3];
                 lx_test_texel_dir(f, size, x, y, d);
-                fn(d[0], d[1], d[2], lx_cubemap_texel(&c, f, x, y));
+                fn(d[0], d[1], d[2], lx_test_cube_texel(&c, f, x, y));
             }
     return c;
 }
@@ -78,6 +98,7 @@ lx_cubemap lx_test_constant_env(int size, float value)
 {
     lx_cubemap c;
     assert_int_equal(lx_cubemap_alloc(&c, size), LX_OK);
+    assert_int_equal(c.size, size);
     for (size_t i = 0; i < (size_t)6 * size * size * 3; i++)
         c.data[i] = value;
     return c;

@@ -24,11 +24,25 @@ void lx_test_texel_dir(int face, int size, int x, int y, double d[3]);
  * midpoint rule. */
 double lx_test_texel_omega(int size, int x, int y, int m);
 
+/* The 3 floats of texel (x, y) of face `face`, from lx_cubemap's documented
+ * layout written out here (faces in lx_cube_face order, each size x size
+ * texels, rows top to bottom, 3 floats a texel), not from
+ * lx_cubemap_texel. */
+float *lx_test_cube_texel(const lx_cubemap *c, int face, int x, int y);
+
+/* The exact solid angle of texel (x, y) of a size x size face: the
+ * rectangle [a0, a1] x [b0, b1] of the face at distance 1 subtends
+ * S(a1, b1) - S(a0, b1) - S(a1, b0) + S(a0, b0) with
+ * S(a, b) = atan2(a b, sqrt(a^2 + b^2 + 1)). */
+double lx_test_texel_solid_angle(int size, int x, int y);
+
 /* Radiance (3 channels) at unit direction (x, y, z). */
 typedef void (*lx_test_env_fn)(double x, double y, double z, float out[3]);
 
 /* A cube map whose every texel holds fn at its centre's direction; fails
- * the test when it cannot be allocated. Free with lx_cubemap_free. */
+ * the test when it cannot be allocated. Free with lx_cubemap_free. Its
+ * memory comes from lx_cubemap_alloc (so that lx_cubemap_free releases
+ * it), the only library call here; every value in it is written here. */
 lx_cubemap lx_test_make_env(int size, lx_test_env_fn fn);
 
 /* A progress callback's record for the IBL tests: how many calls, the

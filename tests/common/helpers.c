@@ -208,7 +208,8 @@ lx_scene *lx_test_new_scene(const char *name)
 
 void lx_test_assert_vec3(lx_vec3 v, double x, double y, double z)
 {
-    if (!(fabs(v.x - x) < 1e-5 && fabs(v.y - y) < 1e-5 && fabs(v.z - z) < 1e-5))
+    if (!(fabs(v.x - x) <= 4e-7 * fmax(1.0, fabs(x)) &&
+          fabs(v.y - y) <= 4e-7 * fmax(1.0, fabs(y)) && fabs(v.z - z) <= 4e-7 * fmax(1.0, fabs(z))))
         fail_msg("got [%g, %g, %g], want [%g, %g, %g]", v.x, v.y, v.z, x, y, z);
 }
 

@@ -511,3 +511,22 @@ lx_vec3 lx_ref_shade_scale(const lx_ref_scene *rs, const lx_light *lights, uint3
         *scale = to_vec(big);
     return to_vec(sum);
 }
+
+/* ---- a parallel rectangle's illuminance, from the form-factor catalogue ---- */
+
+/* The corner case's F for the rectangle [0, X] x [0, Y] (in units of the
+ * height), signed: odd in X and in Y. */
+static double corner_form_factor(double X, double Y)
+{
+    double sx = sqrt(1.0 + X * X), sy = sqrt(1.0 + Y * Y);
+    return (X / sx * atan(Y / sx) + Y / sy * atan(X / sy)) / (2.0 * 3.14159265358979323846);
+}
+
+double lx_ref_rect_parallel_illuminance(double a0, double a1, double b0, double b1, double h,
+                                        double luminance)
+{
+    a0 /= h, a1 /= h, b0 /= h, b1 /= h;
+    double f = corner_form_factor(a1, b1) - corner_form_factor(a0, b1) -
+               corner_form_factor(a1, b0) + corner_form_factor(a0, b0);
+    return 3.14159265358979323846 * luminance * f;
+}

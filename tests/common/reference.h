@@ -138,6 +138,20 @@ lx_vec3 lx_ref_shade_scale(const lx_ref_scene *rs, const lx_light *lights, uint3
 /* Shadow-ray bias for point p in rs (the rule of src/bake/direct.c). */
 float lx_ref_bias(const lx_ref_scene *rs, lx_vec3 p);
 
+/* Illuminance at a point from a Lambertian rectangle of luminance L in a
+ * plane parallel to the receiving surface, at height h > 0 above it along
+ * the receiver's normal: the rectangle spans [a0, a1] x [b0, b1] in that
+ * plane's coordinates, measured from the point's foot (the point moved h
+ * along its normal). E = pi L F, F by superposition of the form-factor
+ * catalogue's corner case (a receiver parallel to an a x b rectangle at
+ * distance c, below one of its corners:
+ *   F = 1/(2 pi) (X/sqrt(1+X^2) atan(Y/sqrt(1+X^2))
+ *                 + Y/sqrt(1+Y^2) atan(X/sqrt(1+Y^2))),  X = a/c, Y = b/c,
+ * odd in X and in Y, so the four corners add with signs wherever the foot
+ * is). In double; not Lambert's edge sum, which src/light/area.c uses. */
+double lx_ref_rect_parallel_illuminance(double a0, double a1, double b0, double b1, double h,
+                                        double luminance);
+
 /* Double-precision vector helpers the oracle uses, for tests that need
  * the same arithmetic outside the library. */
 double lx_ref_dot(const double a[3], const double b[3]);

@@ -131,24 +131,27 @@ static void smooth_limit_and_energy(void **state)
     lx_image_free(&lut);
 
     /* energy: A + B is the mean of the weights G2 / G1(V), each in [0, 1],
-     * so it is at most 1 but for float rounding */
+     * so it is at most 1 but for float rounding: measured 1 + 1.7e-7 at
+     * most, bound 1 + 5e-7 */
     const int n = 32;
     assert_int_equal(lx_dfg_lut(n, 2048, NULL, &lut), LX_OK);
     for (int i = 0; i < n * n; i++) {
         float a = lut.data[2 * i], b = lut.data[2 * i + 1];
         assert_true(a >= 0.0f && b >= 0.0f);
-        if (a + b > 1.0f + 1e-6f)
+        if ((double)a + b > 1.0 + 5e-7)
             fail_msg("N.V %.3f roughness %.3f: A + B = %.8f", (i % n + 0.5) / n, (i / n + 0.5) / n,
                      a + b);
     }
     /* away from grazing view, single scattering loses more energy to
      * masking the rougher the surface: A + B falls with roughness for
      * N.V >= 0.3 (below, it need not: reference_dfg shows A + B rising
-     * from 0.888 to 0.908 between roughness 0.3 and 0.5 at N.V = 0.08) */
+     * from 0.888 to 0.908 between roughness 0.3 and 0.5 at N.V = 0.08).
+     * Measured: it always falls, by 6e-8 at least (toward N.V = 1, where
+     * A + B stays near 1); slack two float ulps at 1 (2.4e-7). */
     for (int x = 10; x < n; x += 3)
         for (int y = 1; y < n; y++) {
             const float *a = lut.data + 2 * ((y - 1) * n + x), *b = lut.data + 2 * (y * n + x);
-            assert_true(b[0] + b[1] < a[0] + a[1] + 2e-4f);
+            assert_true((double)b[0] + b[1] < (double)a[0] + a[1] + 2.4e-7);
         }
     assert_true(lut.data[2 * ((n - 1) * n + 16)] + lut.data[2 * ((n - 1) * n + 16) + 1] < 0.85f);
     lx_image_free(&lut);

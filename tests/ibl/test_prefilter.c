@@ -137,7 +137,8 @@ static double flux(const lx_cubemap *c, int ch)
     for (int f = 0; f < 6; f++)
         for (int y = 0; y < c->size; y++)
             for (int x = 0; x < c->size; x++)
-                sum += lx_cube_texel_solid_angle(c->size, x, y) * lx_cubemap_texel(c, f, x, y)[ch];
+                sum +=
+                    lx_test_texel_solid_angle(c->size, x, y) * lx_test_cube_texel(c, f, x, y)[ch];
     return sum;
 }
 
@@ -155,8 +156,10 @@ static void constant_stays_constant(void **state)
         assert_int_equal(count, 6); /* 32, 16, 8, 4, 2, 1 */
         for (int l = 0; l < count; l++) {
             assert_int_equal(levels[l].size, 32 >> l);
+            /* measured: exactly L on every level of both filters; bound one
+             * float ulp (L's mantissas are all 1.5: 2^-23 / 1.5 = 8e-8) */
             for (size_t i = 0; i < (size_t)6 * levels[l].size * levels[l].size * 3; i++)
-                if (fabsf(levels[l].data[i] / L[i % 3] - 1.0f) > 1e-5f)
+                if (fabs(levels[l].data[i] / (double)L[i % 3] - 1.0) > 1.2e-7)
                     fail_msg("%s level %d value %zu: %.7f, expected %.7f", filter ? "Phong" : "GGX",
                              l, i, levels[l].data[i], L[i % 3]);
         }
@@ -211,11 +214,14 @@ static void ggx_level0_is_the_source(void **state)
  * lights (second order in their size, ~1e-4 here); for importance
  * sampling, the 64-sample Hammersley estimate of a smooth integrand (~1e-3
  * on a single texel, averaging out over the sphere) and trilinear mip
- * reads (a symmetric widening of the kernel: none); float rounding. We
- * allow 0.1%. */
+ * reads (a symmetric widening of the kernel: none); float rounding. */
 static void levels_keep_the_flux(void **state)
 {
     (void)state;
+    /* Measured, worst over levels and channels: 1.2e-4 (GGX, convolved),
+     * 7.3e-4 (GGX with 32 samples: levels 1-3 importance sampled) and
+     * 3.2e-4 (Phong). Bounds about 3x each. */
+    const double bounds[3] = {4e-4, 2e-3, 1e-3};
     lx_cubemap env = lx_test_make_env(64, env_band2), levels[LX_MAX_CUBE_MIPS];
     double want[3];
     for (int c = 0; c < 3; c++)
@@ -228,7 +234,7 @@ static void levels_keep_the_flux(void **state)
         for (int l = 0; l < count; l++)
             for (int c = 0; c < 3; c++) {
                 double rel = flux(&levels[l], c) / want[c] - 1.0;
-                if (fabs(rel) > 1e-3)
+                if (fabs(rel) > bounds[k])
                     fail_msg("%s level %d channel %d: flux off by %.3f%%", g_filters[k].name, l, c,
                              100.0 * rel);
             }
@@ -257,7 +263,7 @@ static void brute_ggx(const lx_cubemap *env, double roughness, const double n[3]
                 double nh2 = (1.0 + nl) / 2.0; /* cos^2 of half the angle */
                 double q = nh2 * (a2 - 1.0) + 1.0;
                 double w = a2 / (PI_D * q * q) * nl * omega[y * s + x];
-                const float *v = lx_cubemap_texel(env, f, x, y);
+                const float *v = lx_test_cube_texel(env, f, x, y);
                 for (int c = 0; c < 3; c++)
                     num[c] += w * v[c];
                 den += w;
@@ -279,7 +285,7 @@ static void brute_phong(const lx_cubemap *env, double e, const double r[3], doub
                 if (c <= 0.0)
                     continue;
                 double w = pow(c, e) * omega[y * s + x];
-                const float *v = lx_cubemap_texel(env, f, x, y);
+                const float *v = lx_test_cube_texel(env, f, x, y);
                 for (int k = 0; k < 3; k++)
                     num[k] += w * v[k];
                 den += w;
@@ -307,7 +313,7 @@ static diff level_vs_brute(const lx_cubemap *env, const lx_cubemap *level, int f
                     brute_ggx(env, param, n, want);
                 else
                     brute_phong(env, param, n, want);
-                const float *v = lx_cubemap_texel(level, f, x, y);
+                const float *v = lx_test_cube_texel(level, f, x, y);
                 bool edge = x == 0 || y == 0 || x == m - 1 || y == m - 1;
                 for (int c = 0; c < 3; c++) {
                     double rel = fabs(v[c] - want[c]) / want[c];
@@ -393,7 +399,7 @@ static void ggx_small_bright_light_matches_brute_force(void **state)
     (void)state;
     lx_cubemap env = lx_test_make_env(32, env_smooth);
     for (int k = 0; k < 4; k++) {
-        float *t = lx_cubemap_texel(&env, LX_FACE_PY, 19 + k % 2, 11 + k / 2);
+        float *t = lx_test_cube_texel(&env, LX_FACE_PY, 19 + k % 2, 11 + k / 2);
         t[0] = t[1] = t[2] = 5e3f;
     }
     check_ggx_levels(&env, 256, "a small bright light", 0.005, 0.015);
@@ -404,9 +410,11 @@ static void ggx_small_bright_light_matches_brute_force(void **state)
  * (the lobe's half-width is 2.3 texels there): the brute-force definition
  * but for the texels below 1e-4 of the peak. Those carry a share
  * delta ~ 1e-4 of the lobe's weight, so they move the result by at most
- * delta (max L - min L) / min L = 1e-3 on env_pattern (values 1 to 11).
- * Exponent 4 reads a downsampled source: a smooth environment moves by
- * well under 1%. */
+ * delta (max L - min L) / min L = 1e-3 on env_pattern (values 1 to 11);
+ * measured worst 5.6e-4, bound 1.2e-3. Exponent 4 reads a downsampled
+ * source: measured worst 0.70% on a smooth environment, bound 2%. A small
+ * light in a downsampled source: measured mean 0.084%, worst 1.2%; bounds
+ * 0.3% and 4%. */
 static void phong_matches_brute_force(void **state)
 {
     (void)state;
@@ -427,7 +435,7 @@ static void phong_matches_brute_force(void **state)
     e = level_vs_brute(&env, &levels[1], LX_SPECULAR_PHONG, 4.0);
     printf("Phong n = 4 from a downsampled source: mean %.2g, worst %.2g from brute force\n",
            e.mean, e.worst);
-    assert_true(e.worst < 0.01);
+    assert_true(e.worst < 0.02);
     free_levels(levels, count);
     lx_cubemap_free(&env);
 
@@ -435,7 +443,7 @@ static void phong_matches_brute_force(void **state)
      * it falls in: the downsampled source keeps it where it is */
     env = lx_test_make_env(32, env_constant);
     for (int k = 0; k < 3; k++)
-        lx_cubemap_texel(&env, LX_FACE_PY, 21, 10)[k] = 1e4f;
+        lx_test_cube_texel(&env, LX_FACE_PY, 21, 10)[k] = 1e4f;
     const float exps8[1] = {8.0f};
     lx_prefilter_desc d8 = {
         .filter = LX_SPECULAR_PHONG, .size = 8, .mips = 1, .phong_exponents = exps8};
@@ -443,8 +451,8 @@ static void phong_matches_brute_force(void **state)
     e = level_vs_brute(&env, &levels[0], LX_SPECULAR_PHONG, 8.0);
     printf("Phong n = 8, a small bright light: mean %.2g, worst %.2g from brute force\n", e.mean,
            e.worst);
-    assert_true(e.mean < 0.015);
-    assert_true(e.worst < 0.08);
+    assert_true(e.mean < 0.003);
+    assert_true(e.worst < 0.04);
     free_levels(levels, count);
     lx_cubemap_free(&env);
 
@@ -570,7 +578,7 @@ static void bad_input(void **state)
         &env, &(lx_prefilter_desc){.filter = LX_SPECULAR_PHONG, .mips = 1, .phong_exponents = nan},
         "Phong exponent nan of level 0");
     expect_invalid(NULL, NULL, "missing");
-    lx_cubemap_texel(&env, 1, 3, 3)[0] = INFINITY;
+    lx_test_cube_texel(&env, 1, 3, 3)[0] = INFINITY;
     expect_invalid(&env, NULL, "1 of 4608 values are NaN or infinite");
     lx_cubemap levels[LX_MAX_CUBE_MIPS];
     assert_int_equal(lx_prefilter(&env, NULL, levels, NULL), LX_ERR_INVALID);

@@ -56,17 +56,18 @@ static void constant_environment_gives_pi_l(void **state)
     lx_sh9 sh;
     assert_int_equal(lx_sh_project(&env, NULL, &sh), LX_OK);
     const double L[3] = {0.5, 1.0, 2.0};
+    /* measured: within 8.6e-7 relative (float rounding), bound 3e-6 */
     for (int i = 0; i < 200; i++) {
         float e[3];
         lx_sh_irradiance(&sh, spiral(i, 200), e);
         for (int c = 0; c < 3; c++)
-            assert_true(fabs(e[c] / (PI_D * L[c]) - 1.0) < 1e-4);
+            assert_true(fabs(e[c] / (PI_D * L[c]) - 1.0) < 3e-6);
     }
     lx_cubemap irr;
     assert_int_equal(lx_sh_irradiance_cube(&sh, 8, NULL, &irr), LX_OK);
     assert_int_equal(irr.size, 8);
     for (size_t i = 0; i < 6 * 8 * 8 * 3; i++)
-        assert_true(fabs(irr.data[i] / (PI_D * L[i % 3]) - 1.0) < 1e-4);
+        assert_true(fabs(irr.data[i] / (PI_D * L[i % 3]) - 1.0) < 3e-6);
     lx_cubemap_free(&irr);
     lx_cubemap_free(&env);
 }
@@ -93,6 +94,8 @@ static void polynomial_environment_coefficients(void **state)
     lx_cubemap env = lx_test_make_env(64, env_poly);
     lx_sh9 sh;
     assert_int_equal(lx_sh_project(&env, NULL, &sh), LX_OK);
+    /* measured: within 4.7e-5 (1 + |want|) (the 64^2 faces' texel-centre
+     * values against the exact moments), bound 2e-4 */
     for (int k = 0; k < 9; k++)
         for (int c = 0; c < 3; c++) {
             double err = fabs(sh.c[k][c] - want[k][c]);
@@ -112,6 +115,8 @@ static void band_limited_irradiance_closed_form(void **state)
     lx_cubemap env = lx_test_make_env(64, env_poly);
     lx_sh9 sh;
     assert_int_equal(lx_sh_project(&env, NULL, &sh), LX_OK);
+    /* measured: within 2.0e-5 (1 + |want|) (the projection's discretisation,
+     * as above), bound 6e-5 */
     for (int i = 0; i < 300; i++) {
         lx_vec3 n = spiral(i, 300);
         double want[3] = {PI_D + 2.0 * PI_D / 3.0 * n.y,
@@ -120,7 +125,7 @@ static void band_limited_irradiance_closed_form(void **state)
         float e[3];
         lx_sh_irradiance(&sh, n, e);
         for (int c = 0; c < 3; c++)
-            if (fabs(e[c] - want[c]) > 2e-4 * (1.0 + fabs(want[c])))
+            if (fabs(e[c] - want[c]) > 6e-5 * (1.0 + fabs(want[c])))
                 fail_msg("n (%.3f %.3f %.3f) channel %d: %.6f, expected %.6f", n.x, n.y, n.z, c,
                          e[c], want[c]);
     }
@@ -128,7 +133,8 @@ static void band_limited_irradiance_closed_form(void **state)
 }
 
 /* sum over a fine cube of Y_i Y_j dOmega = delta_ij (to the constants' six
- * digits); solid angles from a midpoint rule of dA / (1+a^2+b^2)^(3/2). */
+ * digits); solid angles from a midpoint rule of dA / (1+a^2+b^2)^(3/2).
+ * Measured: within 1.6e-4 (the midpoint rule on 48^2 faces), bound 5e-4. */
 static void basis_is_orthonormal(void **state)
 {
     (void)state;
@@ -148,7 +154,7 @@ static void basis_is_orthonormal(void **state)
             }
     for (int i = 0; i < 9; i++)
         for (int j = 0; j < 9; j++)
-            if (fabs(g[i][j] - (i == j)) > 1e-3)
+            if (fabs(g[i][j] - (i == j)) > 5e-4)
                 fail_msg("<Y%d, Y%d> = %.6f", i, j, g[i][j]);
     /* and the paper's values at +z: Y10 = 0.488603, Y20 = 2 * 0.315392 */
     float yv[9];
@@ -300,7 +306,7 @@ static void ringing_is_kept_and_reported(void **state)
     assert_int_equal(lx_cubemap_alloc(&env, n), LX_OK);
     /* the four texels around +Y's centre: a small light straight up */
     for (int k = 0; k < 4; k++) {
-        float *t = lx_cubemap_texel(&env, LX_FACE_PY, 3 + k % 2, 3 + k / 2);
+        float *t = lx_test_cube_texel(&env, LX_FACE_PY, 3 + k % 2, 3 + k / 2);
         t[0] = t[1] = t[2] = 1e4f;
     }
     lx_sh9 sh;
@@ -316,6 +322,7 @@ static void ringing_is_kept_and_reported(void **state)
         }
         float e[3];
         lx_sh_irradiance(&sh, nrm, e);
+        /* measured: within 0.125 (5e-5 of the peak, near 2500), bound 0.3 */
         if (fabs(e[0] - want) > 1e-4 * 1e4 * 0.3)
             fail_msg("n (%.3f %.3f %.3f): %.4f, expected %.4f", nrm.x, nrm.y, nrm.z, e[0], want);
     }
@@ -345,8 +352,8 @@ static void bad_input(void **state)
     lx_sh9 sh;
     assert_int_equal(lx_sh_project(&env, NULL, NULL), LX_ERR_INVALID);
     assert_int_equal(lx_sh_project(NULL, NULL, &sh), LX_ERR_INVALID);
-    lx_cubemap_texel(&env, 2, 1, 1)[1] = NAN;
-    lx_cubemap_texel(&env, 4, 0, 3)[0] = INFINITY;
+    lx_test_cube_texel(&env, 2, 1, 1)[1] = NAN;
+    lx_test_cube_texel(&env, 4, 0, 3)[0] = INFINITY;
     assert_int_equal(lx_sh_project(&env, NULL, &sh), LX_ERR_INVALID);
     assert_non_null(strstr(lx_last_error(), "2 of 288 values are NaN or infinite"));
     for (int k = 0; k < 9; k++)
@@ -373,8 +380,8 @@ static void bad_input(void **state)
     assert_int_equal(lx_sh_irradiance_cube(&sh, 4, &d, &out), LX_ERR_INVALID);
     assert_non_null(strstr(lx_last_error(), "thread count -3"));
     assert_null(out.data);
-    lx_cubemap_texel(&env, 2, 1, 1)[1] = 0.0f;
-    lx_cubemap_texel(&env, 4, 0, 3)[0] = 0.0f;
+    lx_test_cube_texel(&env, 2, 1, 1)[1] = 0.0f;
+    lx_test_cube_texel(&env, 4, 0, 3)[0] = 0.0f;
     assert_int_equal(lx_sh_project(&env, &d, &sh), LX_ERR_INVALID);
     assert_non_null(strstr(lx_last_error(), "thread count -3"));
     lx_cubemap_free(&env);

@@ -1,7 +1,7 @@
 /* Tests of scene import (src/scene/import_assimp.c through lx_scene_load):
  * small .gltf / .glb / .obj files written here by code, with values worked
  * out by hand in the comments: the UV origin convention (glTF's top-left
- * kept, OBJ's bottom-left flipped: DESIGN.md section 3), node transforms
+ * kept, OBJ's bottom-left flipped, as docs/ARCHITECTURE.md says), node transforms
  * (TRS, "matrix" and a parent/child chain) in lx_node.world, a scene shaped
  * like examples/gen_scenes' room (three nodes with TEXCOORD_1, two
  * KHR_lights_punctual lights), and bad input: missing, unreadable, garbage,
@@ -335,10 +335,21 @@ static const lx_light *light_named(const lx_scene *s, const char *name)
     return NULL;
 }
 
+/* Values read back from the files are floats: measured exactly what was
+ * written, or one rounding off where a transform or a normalisation made
+ * them (6e-8). The bound: one float ulp of the value, or of `floor` where
+ * the value is smaller (an ulp of 1, of the scene's size). */
+static void assert_ulp(double got, double want, double floor)
+{
+    if (!(fabs(got - want) <= 1.2e-7 * fmax(fabs(want), floor)))
+        fail_msg("got %.9g, want %.9g (one ulp of %g)", got, want, fmax(fabs(want), floor));
+}
+
+/* World matrices: measured within 6e-8 of the elements; bound two ulps. */
 static void assert_mat(const lx_mat4 *m, const float want[16])
 {
     for (int i = 0; i < 16; i++)
-        if (!(fabsf(m->m[i] - want[i]) < 1e-5f))
+        if (!(fabsf(m->m[i] - want[i]) <= 2.4e-7f * fmaxf(fabsf(want[i]), 1.0f)))
             fail_msg("world.m[%d] = %g, want %g (column-major)", i, m->m[i], want[i]);
 }
 
@@ -371,13 +382,13 @@ static void test_gltf_uv_origin_kept(void **state)
     for (int i = 0; i < 4; i++) {
         uint32_t v = vertex_at(m, QUAD_POS[3 * i], QUAD_POS[3 * i + 1], QUAD_POS[3 * i + 2]);
         for (int k = 0; k < 2; k++) {
-            assert_float_equal(m->uv[k][v].x, QUAD_UV[2 * i], 1e-6);
-            assert_float_equal(m->uv[k][v].y, QUAD_UV[2 * i + 1], 1e-6);
+            assert_ulp(m->uv[k][v].x, QUAD_UV[2 * i], 1.0);
+            assert_ulp(m->uv[k][v].y, QUAD_UV[2 * i + 1], 1.0);
         }
     }
     /* vertex 0 explicitly: the brief's v = 0.25 */
     uint32_t v0 = vertex_at(m, 0, 0, 0);
-    assert_float_equal(m->uv[0][v0].y, 0.25f, 1e-6);
+    assert_ulp(m->uv[0][v0].y, 0.25f, 1.0);
     lx_scene_destroy(s);
 }
 
@@ -402,8 +413,8 @@ static void test_obj_uv_origin_flipped(void **state)
     static const float want_v[] = {0.75f, 0.125f, 0.125f, 0.75f}; /* 1 - vt's v */
     for (int i = 0; i < 4; i++) {
         uint32_t v = vertex_at(m, QUAD_POS[3 * i], QUAD_POS[3 * i + 1], QUAD_POS[3 * i + 2]);
-        assert_float_equal(m->uv[0][v].x, want_u[i], 1e-6);
-        assert_float_equal(m->uv[0][v].y, want_v[i], 1e-6);
+        assert_ulp(m->uv[0][v].x, want_u[i], 1.0);
+        assert_ulp(m->uv[0][v].y, want_v[i], 1.0);
     }
     lx_scene_destroy(s);
 }
@@ -452,12 +463,12 @@ static void test_node_transforms(void **state)
      *   child: x in [10,12], y = 2, z in [0,2] */
     lx_vec3 lo, hi;
     assert_true(lx_scene_bounds(s, &lo, &hi));
-    assert_float_equal(lo.x, 0, 1e-5);
-    assert_float_equal(lo.y, 0, 1e-5);
-    assert_float_equal(lo.z, -5, 1e-5);
-    assert_float_equal(hi.x, 12, 1e-5);
-    assert_float_equal(hi.y, 2, 1e-5);
-    assert_float_equal(hi.z, 3, 1e-5);
+    assert_ulp(lo.x, 0, 12.0);
+    assert_ulp(lo.y, 0, 12.0);
+    assert_ulp(lo.z, -5, 12.0);
+    assert_ulp(hi.x, 12, 12.0);
+    assert_ulp(hi.y, 2, 12.0);
+    assert_ulp(hi.z, 3, 12.0);
     lx_scene_destroy(s);
 }
 
@@ -503,26 +514,26 @@ static void check_room_like(const lx_scene *s)
         assert_non_null(m->uv[0]);
         assert_non_null(m->uv[1]);
         uint32_t v = vertex_at(m, 0, 0, 1); /* vertex 1: uv1 (1/16, 15/16) */
-        assert_float_equal(m->uv[1][v].x, 0.0625f, 1e-6);
-        assert_float_equal(m->uv[1][v].y, 0.9375f, 1e-6);
+        assert_ulp(m->uv[1][v].x, 0.0625f, 1.0);
+        assert_ulp(m->uv[1][v].y, 0.9375f, 1.0);
     }
-    assert_float_equal(node_named(s, "short_box")->world.m[12], 0.5f, 1e-6);
+    assert_ulp(node_named(s, "short_box")->world.m[12], 0.5f, 1.0);
     assert_int_equal(s->light_count, 2);
     const lx_light *lamp = light_named(s, "ceiling_lamp");
     assert_int_equal(lamp->type, LX_LIGHT_POINT);
-    assert_float_equal(lamp->intensity, 150.0f, 1e-4);
-    assert_float_equal(lamp->range, 12.0f, 1e-6);
-    assert_float_equal(lamp->position.y, 2.5f, 1e-6);
+    assert_ulp(lamp->intensity, 150.0f, 1.0);
+    assert_ulp(lamp->range, 12.0f, 1.0);
+    assert_ulp(lamp->position.y, 2.5f, 1.0);
     const lx_light *spot = light_named(s, "spot");
     assert_int_equal(spot->type, LX_LIGHT_SPOT);
-    assert_float_equal(spot->position.x, 1.0f, 1e-6);
-    assert_float_equal(spot->position.y, 2.0f, 1e-6);
-    assert_float_equal(spot->position.z, 1.0f, 1e-6);
-    assert_float_equal(spot->direction.x, 0.0f, 1e-5);
-    assert_float_equal(spot->direction.y, -1.0f, 1e-5);
-    assert_float_equal(spot->direction.z, 0.0f, 1e-5);
-    assert_float_equal(spot->inner_angle, 0.25f, 1e-6);
-    assert_float_equal(spot->outer_angle, 0.5f, 1e-6);
+    assert_ulp(spot->position.x, 1.0f, 1.0);
+    assert_ulp(spot->position.y, 2.0f, 1.0);
+    assert_ulp(spot->position.z, 1.0f, 1.0);
+    assert_ulp(spot->direction.x, 0.0f, 1.0);
+    assert_ulp(spot->direction.y, -1.0f, 1.0);
+    assert_ulp(spot->direction.z, 0.0f, 1.0);
+    assert_ulp(spot->inner_angle, 0.25f, 1.0);
+    assert_ulp(spot->outer_angle, 0.5f, 1.0);
 }
 
 static void test_room_like_gltf(void **state)
@@ -610,8 +621,8 @@ static void test_lights_only_gltf(void **state)
     assert_int_equal(s->mesh_count, 0);
     assert_int_equal(s->light_count, 1);
     const lx_light *l = light_named(s, "bulb");
-    assert_float_equal(l->position.y, 2.0f, 1e-6);
-    assert_float_equal(l->intensity, 5.0f, 1e-6);
+    assert_ulp(l->position.y, 2.0f, 1.0);
+    assert_ulp(l->intensity, 5.0f, 1.0);
     lx_scene_destroy(s);
 }
 

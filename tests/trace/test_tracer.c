@@ -25,6 +25,10 @@
 
 #define RAYS 1000
 #define EDGE_EPS 1e-4
+/* Embree's hits against the double-precision reference: measured within
+ * 2.6e-6 relative in t (2.1e-6 on the aimed rays) and 1.3e-5 in u, v */
+#define T_TOL 8e-6
+#define UV_TOL 4e-5
 
 /* ---- a small deterministic generator (xorshift64*) -------------------------- */
 
@@ -187,11 +191,11 @@ static void compare_single(const lx_tracer *tr, const ray_case *rc, const char *
         if (h.node != w->node || h.mesh != w->mesh || h.triangle != w->triangle)
             fail_msg("%s: ray %d hits node %u mesh %u triangle %u, reference %u %u %u", what, i,
                      h.node, h.mesh, h.triangle, w->node, w->mesh, w->triangle);
-        if (!(fabs(h.t - w->t) <= 1e-4 * fabs(w->t) + 1e-5))
+        if (!(fabs(h.t - w->t) <= T_TOL * fabs(w->t)))
             fail_msg("%s: ray %d t %.9g, reference %.9g", what, i, h.t, w->t);
-        assert_true(fabs(h.u - w->u) <= 1e-3);
-        assert_true(fabs(h.v - w->v) <= 1e-3);
-        assert_true(fabs(nd - w->t) <= 1e-4 * fabs(w->t) + 1e-5);
+        assert_true(fabs(h.u - w->u) <= UV_TOL);
+        assert_true(fabs(h.v - w->v) <= UV_TOL);
+        assert_true(fabs(nd - w->t) <= T_TOL * fabs(w->t));
     }
     print_message("%s: %d hits, %d misses, %d rays skipped near edges\n", what, hits, misses,
                   skipped);
@@ -332,7 +336,7 @@ static void test_random_rays(void **state)
         assert_int_equal(h.node, w.node);
         assert_int_equal(h.mesh, w.mesh);
         assert_int_equal(h.triangle, w.triangle);
-        assert_true(fabs(h.t - w.t) <= 1e-4 * w.t + 1e-6);
+        assert_true(fabs(h.t - w.t) <= T_TOL * w.t);
         seen[h.node]++;
     }
     for (int n = 0; n < 5; n++)
@@ -354,7 +358,7 @@ static void test_move_node_and_commit(void **state)
     lx_hit h;
     assert_true(lx_tracer_closest(tr, &down, &h));
     assert_int_equal(h.node, 0);
-    assert_true(fabsf(h.t - 2.7f) < 1e-5f);
+    assert_true(fabsf(h.t - 2.7f) <= T_TOL * 2.7); /* measured exact */
 
     /* move the box: 2 m along +x and 0.5 m down, with a turn */
     lx_mat4 moved =
@@ -368,7 +372,7 @@ static void test_move_node_and_commit(void **state)
     lx_ray down2 = {lx_v3(0.85f, 4.0f, 0.32f), 0.0f, lx_v3(0, -1, 0), INFINITY};
     assert_true(lx_tracer_closest(tr, &down2, &h));
     assert_int_equal(h.node, 0);
-    assert_true(fabsf(h.t - 3.2f) < 1e-5f);
+    assert_true(fabsf(h.t - 3.2f) <= T_TOL * 3.2); /* measured exact */
 
     /* the whole random comparison on the moved scene */
     s->nodes[0].world = moved;
@@ -524,8 +528,8 @@ static void test_build_progress_and_cancel(void **state)
 int main(void)
 {
     const struct CMUnitTest tests[] = {
-        cmocka_unit_test(test_build_progress_and_cancel),
-        cmocka_unit_test(test_random_rays), cmocka_unit_test(test_move_node_and_commit),
+        cmocka_unit_test(test_build_progress_and_cancel), cmocka_unit_test(test_random_rays),
+        cmocka_unit_test(test_move_node_and_commit),
         cmocka_unit_test(test_coherent_batch), /* last: a hang ends the program */
     };
     lx_test_watchdog(30);

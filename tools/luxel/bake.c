@@ -474,8 +474,7 @@ int cmd_bake(int argc, char **argv)
     cli_progress_init(&progress, "apply", a.quiet);
     progress.phase = "apply and meter";
     for (uint32_t m = 0; m < maps; m++) {
-        progress.base = (float)m / (float)maps;
-        progress.span = 1.0f / (float)maps;
+        cli_progress_part(&progress, (int)m, (int)maps);
         if ((st = lx_baker_apply_alloc(baker, m, &images[m])) != LX_OK) {
             cli_progress_finish(&progress);
             if (st == LX_ERR_CANCELLED)
@@ -525,6 +524,9 @@ int cmd_bake(int argc, char **argv)
     cJSON *list = cJSON_AddArrayToObject(manifest, "lightmaps");
     bool failed = false;
     double t_maps = 0.0, t_previews = 0.0;
+    /* one bar over every file; Ctrl-C stops the file being written */
+    cli_progress_init(&progress, "write", a.quiet);
+    int parts = (int)maps * (a.format != LX_IMAGE_PNG ? 2 : 1), part = 0;
     for (uint32_t m = 0; m < maps && !failed; m++) {
         const lx_lightmap_info *info = lx_baker_lightmap_info(baker, m);
         char file[300], preview[300];
@@ -537,15 +539,22 @@ int cmd_bake(int argc, char **argv)
                                   .exposure = a.format == LX_IMAGE_PNG ? exposure
                                               : a.pre_expose           ? pre_exposure
                                                                        : 0.0f,
-                                  .threads = a.desc.threads};
+                                  .threads = a.desc.threads,
+                                  .progress = cli_progress_update,
+                                  .progress_user = &progress};
         double t = cli_now();
+        cli_progress_part(&progress, part++, parts);
         failed = !cli_stage_image(&stage, file, &images[m], &wd);
         t_maps += cli_now() - t;
         bool want_preview = a.format != LX_IMAGE_PNG;
         if (!failed && want_preview) {
-            lx_image_write_desc pd = {
-                .format = LX_IMAGE_PNG, .exposure = exposure, .threads = a.desc.threads};
+            lx_image_write_desc pd = {.format = LX_IMAGE_PNG,
+                                      .exposure = exposure,
+                                      .threads = a.desc.threads,
+                                      .progress = cli_progress_update,
+                                      .progress_user = &progress};
             t = cli_now();
+            cli_progress_part(&progress, part++, parts);
             failed = !cli_stage_image(&stage, preview, &images[m], &pd);
             t_previews += cli_now() - t;
         }
@@ -559,6 +568,7 @@ int cmd_bake(int argc, char **argv)
             cli_error("out of memory");
         free(text);
     }
+    cli_progress_clear(&progress);
     cJSON_Delete(manifest);
     if (!failed && !cli_stage_publish(&stage))
         failed = true;

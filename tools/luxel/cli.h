@@ -64,7 +64,12 @@ typedef struct cli_progress {
     double last_draw;
 } cli_progress;
 void cli_progress_init(cli_progress *p, const char *label, bool quiet);
+/* The bar's next library call is call `part` of `parts` (one bar over
+ * several calls). */
+void cli_progress_part(cli_progress *p, int part, int parts);
 bool cli_progress_update(void *user, float fraction);
+/* Clears the bar (without ending a phase). */
+void cli_progress_clear(cli_progress *p);
 /* Clears the bar and ends the phase named by the label (cli_phase). */
 void cli_progress_finish(cli_progress *p);
 
@@ -84,8 +89,9 @@ void cli_report_interrupt(bool removed_outputs);
 
 /* Test hooks, read from the environment (never set outside tests):
  * LUXEL_TEST_PAUSE=PHASE stops the run the first time it reaches PHASE (a
- * progress label such as "bake", or "write" once the first output file is
- * staged), says "luxel: test: paused at PHASE" on stderr and waits up to a
+ * progress label such as "bake", or "write": the first progress report
+ * while an output is written, or the first output staged), says
+ * "luxel: test: paused at PHASE" on stderr and waits up to a
  * minute for a signal, so a test can interrupt a run at a known point. */
 void cli_test_pause(const char *phase);
 /* LUXEL_TEST_FAIL_RENAME=N: true for the Nth rename cli_stage_publish

@@ -692,9 +692,14 @@ int cmd_ibl(int argc, char **argv)
     if (ok && a.lut) {
         char name[32];
         lut_name(&a, name, sizeof name);
-        lx_image_write_desc wd = {
-            .format = a.format, .half = a.half && a.format == LX_IMAGE_EXR, .threads = a.threads};
+        cli_progress_init(&progress, "write", a.quiet);
+        lx_image_write_desc wd = {.format = a.format,
+                                  .half = a.half && a.format == LX_IMAGE_EXR,
+                                  .threads = a.threads,
+                                  .progress = cli_progress_update,
+                                  .progress_user = &progress};
         ok = cli_stage_image(&w.stage, name, &lut_rgb, &wd) && note(&w, name);
+        cli_progress_clear(&progress);
     }
     if (ok && a.environment)
         ok = put_cube(&w, "environment", &env, 1, false);

@@ -297,6 +297,12 @@ void cli_progress_init(cli_progress *p, const char *label, bool quiet)
     p->last_draw = 0.0;
 }
 
+void cli_progress_part(cli_progress *p, int part, int parts)
+{
+    p->base = parts > 0 ? (float)part / (float)parts : 0.0f;
+    p->span = parts > 0 ? 1.0f / (float)parts : 1.0f;
+}
+
 bool cli_progress_update(void *user, float fraction)
 {
     cli_progress *p = user;
@@ -325,11 +331,16 @@ bool cli_progress_update(void *user, float fraction)
     return true;
 }
 
-void cli_progress_finish(cli_progress *p)
+void cli_progress_clear(cli_progress *p)
 {
     if (p->drawn)
         fprintf(stderr, "\r%*s\r", 70, "");
     p->drawn = false;
+}
+
+void cli_progress_finish(cli_progress *p)
+{
+    cli_progress_clear(p);
     cli_phase(p->phase ? p->phase : p->label);
 }
 

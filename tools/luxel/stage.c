@@ -177,6 +177,10 @@ char *cli_stage_path(cli_stage *st, const char *name)
 
 bool cli_stage_finish(cli_stage *st, const char *name, lx_status s)
 {
+    if (s == LX_ERR_CANCELLED) { /* the progress callback saw a signal */
+        cli_report_interrupt(true);
+        return false;
+    }
     if (s != LX_OK) {
         /* the writer's message names the staging path: show the final one */
         const char *msg = lx_last_error();
