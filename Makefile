@@ -44,6 +44,7 @@ bench: all
 	$(BUILD)/bin/bench_bake --only cli --cli-res 4096 --skip-raw --reps 1
 	$(BUILD)/bin/bench_realtime
 	$(BUILD)/bin/bench_ibl
+	$(BUILD)/bin/bench_unwrap
 
 fuzz: all
 	@test -f $(BUILD_FUZZ)/CMakeCache.txt || CC=clang cmake -S . -B $(BUILD_FUZZ) -DCMAKE_BUILD_TYPE=Debug -DLX_FUZZ=ON

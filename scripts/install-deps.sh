@@ -11,6 +11,7 @@ packages=(
     libstb-dev         # PNG/JPEG/TGA/HDR codecs
     zlib1g-dev         # checks PNG data before stb decodes it
     libopenexr-dev     # OpenEXR (OpenEXRCore C API)
+    libsuitesparse-dev # sparse Cholesky (CHOLMOD) for lightmap UV flattening
     libcmocka-dev      # unit tests
     clang libclang-rt-14-dev libomp-dev  # sanitizer and fuzzer builds (clang)
 )

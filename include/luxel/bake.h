@@ -55,6 +55,7 @@
 #include "luxel/light.h"
 #include "luxel/math.h"
 #include "luxel/scene.h"
+#include "luxel/unwrap.h"
 
 #ifdef __cplusplus
 extern "C" {
@@ -66,6 +67,16 @@ typedef enum lx_quantity {
     LX_QUANTITY_IRRADIANCE = 0, /* lux */
     LX_QUANTITY_RADIANCE        /* nits, irradiance * base colour / pi */
 } lx_quantity;
+
+/* Which UV set holds a node's lightmap UVs. */
+typedef enum lx_uv_choice {
+    LX_UV_SET_AUTO = 0, /* TEXCOORD_1 when every mesh with UVs has it, else TEXCOORD_0 */
+    LX_UV_SET_0,        /* TEXCOORD_0 */
+    LX_UV_SET_1         /* TEXCOORD_1 */
+} lx_uv_choice;
+
+/* lx_lightmap_info.uv_set of an atlas page whose nodes use different sets. */
+#define LX_UV_SET_MIXED (-1)
 
 /* Dilation around the charts: none (the library's default), or the texels
  * `luxel bake` uses unless told otherwise. */
@@ -101,13 +112,19 @@ typedef struct lx_bake_desc {
                             world and UV areas, rounded to a multiple of 4 */
     int max_resolution;  /* cap for texel_density sizes, 0 = 4096 */
     lx_quantity quantity;
-    int padding;          /* texels of dilation around the charts, 0..64; 0 = none
-                             (the one field whose zero is a value, not a default;
-                             luxel bake uses LX_PADDING_RECOMMENDED) */
-    int threads;          /* 0 = all cores */
-    bool skip_degenerate; /* zero-UV-area triangles: warn and skip, not fail */
-    float shadow_bias;    /* ray origin offset in metres, 0 = scale-aware auto */
-    lx_sky_desc sky;      /* baked with the static lights */
+    int padding;            /* texels of dilation around the charts, 0..64; 0 = none
+                               (the one field whose zero is a value, not a default;
+                               luxel bake uses LX_PADDING_RECOMMENDED) */
+    int threads;            /* 0 = all cores */
+    bool skip_degenerate;   /* zero-UV-area triangles: warn and skip, not fail */
+    float shadow_bias;      /* ray origin offset in metres, 0 = scale-aware auto */
+    lx_uv_choice uv_set;    /* the lightmap UV set of every node (without an atlas) */
+    const lx_unwrap *atlas; /* NULL: a lightmap per node; else one per page of
+                               this layout (lx_unwrap_scene, applied to the
+                               scene with lx_unwrap_apply), each node's UVs
+                               placed by its scale_offset; borrowed by
+                               lx_baker_create only */
+    lx_sky_desc sky;        /* baked with the static lights */
     lx_progress_fn progress;
     void *progress_user;
 } lx_bake_desc;
@@ -117,10 +134,11 @@ typedef struct lx_bake_desc {
 lx_bake_desc lx_bake_desc_defaults(const lx_bake_desc *desc);
 
 typedef struct lx_lightmap_info {
-    uint32_t node;    /* scene node index */
-    const char *name; /* node name */
+    uint32_t node;    /* scene node index; UINT32_MAX for an atlas page of
+                         several nodes */
+    const char *name; /* node name, or "lightmap-<k>" for atlas page k */
     int width, height;
-    int uv_set;              /* 1 = TEXCOORD_1, 0 = TEXCOORD_0 */
+    int uv_set;              /* 1 = TEXCOORD_1, 0 = TEXCOORD_0, LX_UV_SET_MIXED */
     uint32_t used_texels;    /* texels covered by triangles */
     uint32_t overlap_texels; /* texels claimed by two triangles' interiors */
 } lx_lightmap_info;
@@ -136,6 +154,13 @@ void lx_baker_destroy(lx_baker *baker);
 uint32_t lx_baker_lightmap_count(const lx_baker *baker);
 /* Borrowed until lx_baker_destroy. */
 const lx_lightmap_info *lx_baker_lightmap_info(const lx_baker *baker, uint32_t map);
+/* The lightmap holding scene node `node` and the scale and offset that
+ * take the node's lightmap UVs into it (Unity's lightmapScaleOffset: uv *
+ * xy + zw; (1, 1, 0, 0) for a lightmap of its own). false when the node
+ * has none (no UVs, no meshes). */
+bool lx_baker_node_lightmap(const lx_baker *baker, uint32_t node, uint32_t *map,
+                            float scale_offset[4]);
+
 /* width*height bytes, 1 where a texel is covered. Borrowed. */
 const uint8_t *lx_baker_mask(const lx_baker *baker, uint32_t map);
 
@@ -178,6 +203,7 @@ typedef struct lx_texel_sample {
     lx_vec3 geometric_normal;
     uint32_t mesh;     /* scene mesh index */
     uint32_t triangle; /* triangle in that mesh */
+    uint32_t node;     /* scene node that places the mesh */
 } lx_texel_sample;
 
 /* The world-space sample of texel (x, y); false when it is not covered. */

@@ -1,6 +1,7 @@
 /* luxel/luxel.h - the whole public API of libluxel, a lighting toolkit:
  * core (errors, images), scene import, the physical light model, ray
- * queries, texture-space maps and the per-texel lightmap baker.
+ * queries, texture-space maps, lightmap UV generation and the per-texel
+ * lightmap baker.
  * Each header documents its units, errors, memory and threading rules. */
 #ifndef LUXEL_H
 #define LUXEL_H
@@ -13,5 +14,6 @@
 #include "luxel/maps.h"
 #include "luxel/bake.h"
 #include "luxel/ibl.h"
+#include "luxel/unwrap.h"
 
 #endif

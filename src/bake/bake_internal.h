@@ -16,6 +16,7 @@ typedef struct lx_texel {
     uint32_t pixel;    /* y * width + x */
     uint32_t mesh;     /* scene mesh index */
     uint32_t triangle; /* in that mesh */
+    uint32_t node;     /* scene node placing the mesh (a page holds several) */
 } lx_texel;
 
 typedef struct lx_lightmap {
@@ -45,7 +46,8 @@ struct lx_baker {
     lx_bake_desc desc;
     lx_lightmap *maps;
     uint32_t map_count;
-    uint32_t *node_map; /* scene node -> map index or UINT32_MAX */
+    uint32_t *node_map;            /* scene node -> map index or UINT32_MAX */
+    float (*node_scale_offset)[4]; /* scene node -> its UVs into its map */
     uint32_t node_count;
     lx_mat4 *node_world;
     lx_light *lights;
@@ -70,10 +72,24 @@ struct lx_baker {
  * copies and its albedo. */
 #define LX_BYTES_PER_TEXEL (4 * 4 + 2 + 2 * 12 + sizeof(lx_texel) + 2 * 3 * 12 + 12)
 
-/* The size of node's lightmap under desc (texel_map.c); 0 x 0 when the node
- * has no UVs. */
+/* The size of node's own lightmap under desc (texel_map.c); 0 x 0 when
+ * the node has no UVs. */
 void lx_texel_map_size(const lx_scene *scene, uint32_t node, const lx_bake_desc *desc, int *width,
                        int *height);
+
+/* A lightmap page: the nodes it holds and where their UVs land in it. */
+typedef struct lx_page_node {
+    uint32_t node;
+    int uv_set;            /* -1: the automatic choice */
+    float scale_offset[4]; /* page uv = uv * xy + zw */
+} lx_page_node;
+
+typedef struct lx_page_spec {
+    const char *name;
+    int width, height; /* 0: the node's own size (one node) */
+    const lx_page_node *nodes;
+    uint32_t node_count;
+} lx_page_spec;
 
 /* The share of a long operation's progress one step reports in: it goes
  * from `from` to `to`. */
@@ -81,20 +97,21 @@ typedef struct lx_texel_progress {
     float from, to;
 } lx_texel_progress;
 
-/* Builds the texel map of scene node `node` into map (texel_map.c),
- * reporting its rasterization to desc->progress within `progress` (and
- * stopping with LX_ERR_CANCELLED when it says so). Returns LX_OK with
- * map->info.used_texels == 0 and a warning when the node has no UVs to
- * bake. */
-lx_status lx_texel_map_build(const lx_scene *scene, uint32_t node, const lx_bake_desc *desc,
-                             lx_texel_progress progress, lx_lightmap *map);
+/* Builds the texel map of a page into map (texel_map.c), reporting its
+ * rasterization to desc->progress within `progress` (and stopping with
+ * LX_ERR_CANCELLED when it says so). Returns LX_OK with map->info.width
+ * == 0 and a warning when no node of it has UVs to bake. */
+lx_status lx_texel_map_build(const lx_scene *scene, const lx_page_spec *page,
+                             const lx_bake_desc *desc, lx_texel_progress progress,
+                             lx_lightmap *map);
 void lx_texel_map_free(lx_lightmap *map);
 /* Makes the object-space copies a move needs (a map built at the
  * identity has none); LX_ERR_NOMEM when they do not fit. */
 lx_status lx_texel_map_keep_object_space(lx_lightmap *map);
-/* Recomputes world positions and normals from a node transform; the map
- * has its object-space copies (lx_texel_map_keep_object_space). */
-void lx_texel_map_transform(lx_lightmap *map, const lx_mat4 *world);
+/* Recomputes the world positions and normals of node's texels from its
+ * transform; the map has its object-space copies
+ * (lx_texel_map_keep_object_space). */
+void lx_texel_map_transform(lx_lightmap *map, uint32_t node, const lx_mat4 *world);
 
 /* Adds the given lights (indices into baker->lights) into target
  * (width*height*3 floats per map), plus `ambient` at every texel

@@ -52,6 +52,8 @@ static lx_status validate_desc(const lx_bake_desc *d)
         return lx_fail(LX_ERR_INVALID, "shadow bias must be finite and >= 0");
     if (d->quantity != LX_QUANTITY_IRRADIANCE && d->quantity != LX_QUANTITY_RADIANCE)
         return lx_fail(LX_ERR_INVALID, "unknown quantity %d", (int)d->quantity);
+    if (d->uv_set != LX_UV_SET_AUTO && d->uv_set != LX_UV_SET_0 && d->uv_set != LX_UV_SET_1)
+        return lx_fail(LX_ERR_INVALID, "unknown UV set choice %d", (int)d->uv_set);
     return LX_OK;
 }
 
@@ -62,6 +64,115 @@ static bool bvh_progress(void *user, float fraction)
 {
     const lx_bake_desc *d = user;
     return d->progress(d->progress_user, TEXEL_MAPS_SHARE + (1.0f - TEXEL_MAPS_SHARE) * fraction);
+}
+
+/* A lightmap per node with UVs, sized by the resolution or the density. */
+static lx_status build_node_maps(lx_baker *b, const lx_scene *scene, const lx_bake_desc *desc)
+{
+    /* memory for every lightmap together, before allocating any */
+    uint64_t bytes = 0;
+    int largest = 0;
+    uint32_t with_uvs = 0;
+    for (uint32_t n = 0; n < scene->node_count; n++) {
+        int w, h;
+        lx_texel_map_size(scene, n, desc, &w, &h);
+        bytes += (uint64_t)w * (uint64_t)h * LX_BYTES_PER_TEXEL;
+        largest = w > largest ? w : largest;
+        with_uvs += w > 0;
+    }
+    char what[400];
+    snprintf(what, sizeof what, "%s: baking %u lightmaps (the largest %dx%d)", scene->path,
+             with_uvs, largest, largest);
+    lx_status st = lx_check_memory(bytes, what);
+    for (uint32_t n = 0; n < scene->node_count && st == LX_OK; n++) {
+        lx_lightmap *map = &b->maps[b->map_count];
+        lx_texel_progress share = {TEXEL_MAPS_SHARE * (float)n / (float)scene->node_count,
+                                   TEXEL_MAPS_SHARE * (float)(n + 1) / (float)scene->node_count};
+        lx_page_node pn = {n, (int)desc->uv_set - 1, {1.0f, 1.0f, 0.0f, 0.0f}};
+        lx_page_spec page = {scene->nodes[n].name, 0, 0, &pn, 1};
+        st = lx_texel_map_build(scene, &page, desc, share, map);
+        if (st != LX_OK) {
+            lx_texel_map_free(map);
+            break;
+        }
+        if (map->info.width == 0) {
+            lx_texel_map_free(map); /* no UVs: nothing to bake */
+            continue;
+        }
+        b->node_map[n] = b->map_count++;
+        /* building large texel maps takes long enough to report and stop */
+        if (desc->progress && !desc->progress(desc->progress_user, share.to))
+            st = lx_fail(LX_ERR_CANCELLED, "bake cancelled");
+    }
+    return st;
+}
+
+/* A lightmap per page of the atlas, holding the nodes placed on it. */
+static lx_status build_pages(lx_baker *b, const lx_scene *scene, const lx_bake_desc *desc)
+{
+    const lx_unwrap *atlas = desc->atlas;
+    if (atlas->node_count != scene->node_count)
+        return lx_fail(LX_ERR_INVALID, "%s: the atlas places %u nodes, the scene has %u",
+                       scene->path, atlas->node_count, scene->node_count);
+    uint64_t bytes = 0;
+    for (uint32_t p = 0; p < atlas->page_count; p++) {
+        const lx_unwrap_page *pg = &atlas->pages[p];
+        if (pg->width < 1 || pg->height < 1 || pg->width > LX_MAX_LIGHTMAP_SIZE ||
+            pg->height > LX_MAX_LIGHTMAP_SIZE)
+            return lx_fail(LX_ERR_INVALID, "%s: atlas page %u is %dx%d (1..%d a side)", scene->path,
+                           p, pg->width, pg->height, LX_MAX_LIGHTMAP_SIZE);
+        bytes += (uint64_t)pg->width * (uint64_t)pg->height * LX_BYTES_PER_TEXEL;
+    }
+    for (uint32_t n = 0; n < scene->node_count; n++) {
+        const lx_unwrap_node *un = &atlas->nodes[n];
+        if (un->page != UINT32_MAX && un->page >= atlas->page_count)
+            return lx_fail(LX_ERR_INVALID, "%s: node '%s': atlas page %u out of range (count %u)",
+                           scene->path, scene->nodes[n].name, un->page, atlas->page_count);
+    }
+    char what[400];
+    snprintf(what, sizeof what, "%s: baking %u atlas pages", scene->path, atlas->page_count);
+    lx_status st = lx_check_memory(bytes, what);
+    lx_page_node *nodes = malloc(sizeof *nodes * (scene->node_count + 1));
+    if (st == LX_OK && !nodes)
+        st = lx_fail(LX_ERR_NOMEM, "out of memory creating a baker");
+    for (uint32_t p = 0; p < atlas->page_count && st == LX_OK; p++) {
+        uint32_t count = 0;
+        for (uint32_t n = 0; n < scene->node_count; n++) {
+            const lx_unwrap_node *un = &atlas->nodes[n];
+            if (un->page != p)
+                continue;
+            lx_page_node *pn = &nodes[count++];
+            pn->node = n;
+            /* generated UVs are TEXCOORD_1 once applied, in page coordinates */
+            pn->uv_set = un->mode == LX_UNWRAP_KEEP ? un->uv_set : 1;
+            memcpy(pn->scale_offset, un->scale_offset, sizeof pn->scale_offset);
+        }
+        char name[32];
+        snprintf(name, sizeof name, "lightmap-%u", p);
+        lx_page_spec page = {name, atlas->pages[p].width, atlas->pages[p].height, nodes, count};
+        lx_texel_progress share = {TEXEL_MAPS_SHARE * (float)p / (float)atlas->page_count,
+                                   TEXEL_MAPS_SHARE * (float)(p + 1) / (float)atlas->page_count};
+        lx_lightmap *map = &b->maps[b->map_count];
+        st = lx_texel_map_build(scene, &page, desc, share, map);
+        if (st != LX_OK) {
+            lx_texel_map_free(map);
+            break;
+        }
+        if (map->info.width == 0) {
+            lx_texel_map_free(map);
+            continue;
+        }
+        for (uint32_t k = 0; k < count; k++) {
+            b->node_map[nodes[k].node] = b->map_count;
+            memcpy(b->node_scale_offset[nodes[k].node], nodes[k].scale_offset,
+                   sizeof nodes[k].scale_offset);
+        }
+        b->map_count++;
+        if (desc->progress && !desc->progress(desc->progress_user, share.to))
+            st = lx_fail(LX_ERR_CANCELLED, "bake cancelled");
+    }
+    free(nodes);
+    return st;
 }
 
 lx_status lx_baker_create(const lx_scene *scene, const lx_bake_desc *in, lx_baker **out)
@@ -86,7 +197,10 @@ lx_status lx_baker_create(const lx_scene *scene, const lx_bake_desc *in, lx_bake
     b->node_count = scene->node_count;
     b->node_map = malloc(sizeof(uint32_t) * (scene->node_count + 1));
     b->node_world = malloc(sizeof(lx_mat4) * (scene->node_count + 1));
-    b->maps = calloc(scene->node_count + 1, sizeof(lx_lightmap));
+    uint32_t max_maps = scene->node_count;
+    if (desc.atlas && desc.atlas->page_count > max_maps)
+        max_maps = desc.atlas->page_count;
+    b->maps = calloc(max_maps + 1, sizeof(lx_lightmap));
     b->light_count = scene->light_count;
     b->lights = malloc(sizeof(lx_light) * (scene->light_count + 1));
     if (!b->node_map || !b->node_world || !b->maps || !b->lights) {
@@ -112,47 +226,21 @@ lx_status lx_baker_create(const lx_scene *scene, const lx_bake_desc *in, lx_bake
         b->scene_diagonal = 1.0f;
     b->bias = desc.shadow_bias > 0.0f ? desc.shadow_bias : 1e-5f * b->scene_diagonal;
 
-    /* memory for every lightmap together, before allocating any */
-    uint64_t bytes = 0;
-    int largest = 0;
-    uint32_t with_uvs = 0;
-    for (uint32_t n = 0; n < scene->node_count; n++) {
-        int w, h;
-        lx_texel_map_size(scene, n, &desc, &w, &h);
-        bytes += (uint64_t)w * (uint64_t)h * LX_BYTES_PER_TEXEL;
-        largest = w > largest ? w : largest;
-        with_uvs += w > 0;
-    }
-    char what[400];
-    snprintf(what, sizeof what, "%s: baking %u lightmaps (the largest %dx%d)", scene->path,
-             with_uvs, largest, largest);
-    if ((st = lx_check_memory(bytes, what)) != LX_OK) {
+    b->node_scale_offset = malloc(sizeof *b->node_scale_offset * (scene->node_count + 1));
+    if (!b->node_scale_offset) {
         lx_baker_destroy(b);
-        return st;
+        return lx_fail(LX_ERR_NOMEM, "out of memory creating a baker");
     }
     for (uint32_t n = 0; n < scene->node_count; n++) {
         b->node_world[n] = scene->nodes[n].world;
         b->node_map[n] = UINT32_MAX;
-        lx_lightmap *map = &b->maps[b->map_count];
-        lx_texel_progress share = {TEXEL_MAPS_SHARE * (float)n / (float)scene->node_count,
-                                   TEXEL_MAPS_SHARE * (float)(n + 1) / (float)scene->node_count};
-        st = lx_texel_map_build(scene, n, &desc, share, map);
-        if (st != LX_OK) {
-            lx_texel_map_free(map);
-            lx_baker_destroy(b);
-            return st;
-        }
-        if (map->info.width == 0) {
-            lx_texel_map_free(map); /* no UVs: nothing to bake */
-            continue;
-        }
-        b->node_map[n] = b->map_count++;
-        /* building large texel maps takes long enough to report and stop */
-        if (desc.progress && !desc.progress(desc.progress_user, TEXEL_MAPS_SHARE * (float)(n + 1) /
-                                                                    (float)scene->node_count)) {
-            lx_baker_destroy(b);
-            return lx_fail(LX_ERR_CANCELLED, "bake cancelled");
-        }
+        b->node_scale_offset[n][0] = b->node_scale_offset[n][1] = 1.0f;
+        b->node_scale_offset[n][2] = b->node_scale_offset[n][3] = 0.0f;
+    }
+    st = desc.atlas ? build_pages(b, scene, &desc) : build_node_maps(b, scene, &desc);
+    if (st != LX_OK) {
+        lx_baker_destroy(b);
+        return st;
     }
     lx_tracer_desc td = {.threads = desc.threads,
                          .progress = desc.progress ? bvh_progress : NULL,
@@ -176,6 +264,7 @@ void lx_baker_destroy(lx_baker *b)
     lx_sky_free(b);
     free(b->maps);
     free(b->node_map);
+    free(b->node_scale_offset);
     free(b->node_world);
     for (uint32_t l = 0; b->lights && l < b->light_count; l++)
         lx_ies_free((lx_ies_profile *)b->lights[l].profile);
@@ -191,6 +280,15 @@ uint32_t lx_baker_lightmap_count(const lx_baker *b)
 const lx_lightmap_info *lx_baker_lightmap_info(const lx_baker *b, uint32_t map)
 {
     return map < b->map_count ? &b->maps[map].info : NULL;
+}
+
+bool lx_baker_node_lightmap(const lx_baker *b, uint32_t node, uint32_t *map, float scale_offset[4])
+{
+    if (node >= b->node_count || b->node_map[node] == UINT32_MAX)
+        return false;
+    *map = b->node_map[node];
+    memcpy(scale_offset, b->node_scale_offset[node], sizeof(float) * 4);
+    return true;
 }
 
 const uint8_t *lx_baker_mask(const lx_baker *b, uint32_t map)
@@ -236,7 +334,7 @@ lx_status lx_baker_set_node_transform(lx_baker *b, uint32_t node, const lx_mat4 
     b->node_world[node] = *world;
     b->tracer_dirty = true;
     if (b->node_map[node] != UINT32_MAX)
-        lx_texel_map_transform(&b->maps[b->node_map[node]], world);
+        lx_texel_map_transform(&b->maps[b->node_map[node]], node, world);
     return LX_OK;
 }
 
@@ -457,6 +555,7 @@ bool lx_baker_texel(const lx_baker *b, uint32_t map_index, int x, int y, lx_texe
             out->geometric_normal = map->world_geometric_normal[i];
             out->mesh = map->texels[i].mesh;
             out->triangle = map->texels[i].triangle;
+            out->node = map->texels[i].node;
             return true;
         }
     return false;

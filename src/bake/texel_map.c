@@ -19,7 +19,7 @@
 typedef struct raster_ctx {
     int width, height;
     int row0, row1;  /* the band of rows this rasterization writes, [row0, row1) */
-    uint32_t *owner; /* per pixel: node-local triangle id, UINT32_MAX = none */
+    uint32_t *owner; /* per pixel: page-local triangle id, UINT32_MAX = none */
     float *b1, *b2;  /* barycentrics of vertices 1 and 2 */
     float *distance; /* 0 for centre coverage, else texel-space distance */
     uint8_t *strict; /* centre strictly inside the owner */
@@ -27,11 +27,14 @@ typedef struct raster_ctx {
     uint32_t *slot_overlap; /* overlapping texels counted by the later mesh */
 } raster_ctx;
 
+/* One mesh of one node on the page. */
 typedef struct slot {
     const lx_mesh *mesh;
     uint32_t mesh_index;
-    uint32_t first_triangle; /* node-local id of the mesh's triangle 0 */
+    uint32_t node;
+    uint32_t first_triangle; /* page-local id of the mesh's triangle 0 */
     const lx_vec2 *uv;
+    double scale_offset[4]; /* the node's UVs into the page: uv * so.xy + so.zw */
 } slot;
 
 /* Barycentrics (w0, w1, w2) of point p in triangle abc, in double so edge
@@ -125,10 +128,10 @@ static bool triangle_overlaps_texel(const double *v[3], double x0, double y0)
     return true;
 }
 
-static void uv_to_texel(const raster_ctx *r, lx_vec2 uv, double out[2])
+static void uv_to_texel(const raster_ctx *r, const slot *s, lx_vec2 uv, double out[2])
 {
-    out[0] = (double)uv.x * r->width;
-    out[1] = (double)uv.y * r->height;
+    out[0] = ((double)uv.x * s->scale_offset[0] + s->scale_offset[2]) * r->width;
+    out[1] = ((double)uv.y * s->scale_offset[1] + s->scale_offset[3]) * r->height;
 }
 
 /* The texel rectangle a triangle may touch, grown by pad, within the
@@ -255,9 +258,9 @@ static lx_status raster_bands(raster_ctx *r, const slot *slots, uint32_t slot_co
                 continue;
             const uint32_t *i = &m->indices[3 * t];
             double a[2], b[2], c[2];
-            uv_to_texel(r, slots[s].uv[i[0]], a);
-            uv_to_texel(r, slots[s].uv[i[1]], b);
-            uv_to_texel(r, slots[s].uv[i[2]], c);
+            uv_to_texel(r, &slots[s], slots[s].uv[i[0]], a);
+            uv_to_texel(r, &slots[s], slots[s].uv[i[1]], b);
+            uv_to_texel(r, &slots[s], slots[s].uv[i[2]], c);
             const double *v[3] = {a, b, c};
             int x0, y0, x1, y1;
             if (!bbox(v, 1, r, &x0, &y0, &x1, &y1))
@@ -306,9 +309,9 @@ static lx_status raster_bands(raster_ctx *r, const slot *slots, uint32_t slot_co
                 const lx_mesh *m = slots[s].mesh;
                 const uint32_t *i = &m->indices[3 * (id - slots[s].first_triangle)];
                 double a[2], b[2], c[2];
-                uv_to_texel(&br, slots[s].uv[i[0]], a);
-                uv_to_texel(&br, slots[s].uv[i[1]], b);
-                uv_to_texel(&br, slots[s].uv[i[2]], c);
+                uv_to_texel(&br, &slots[s], slots[s].uv[i[0]], a);
+                uv_to_texel(&br, &slots[s], slots[s].uv[i[1]], b);
+                uv_to_texel(&br, &slots[s], slots[s].uv[i[2]], c);
                 const double *v[3] = {a, b, c};
                 if (pass == 0)
                     raster_centres(&br, v, id, s);
@@ -375,8 +378,9 @@ static int size_from_density(const lx_scene *scene, const lx_node *node, const s
 }
 
 static lx_status check_uv_triangles(const lx_scene *scene, const slot *s, const lx_node *node,
-                                    const lx_bake_desc *desc, int uv_set, uint8_t *skip)
+                                    const lx_bake_desc *desc, uint8_t *skip)
 {
+    int uv_set = s->uv == s->mesh->uv[1] ? 1 : 0;
     uint32_t degenerate = 0, outside = 0;
     const lx_mesh *m = s->mesh;
     for (uint32_t t = 0; t < m->triangle_count; t++) {
@@ -412,6 +416,29 @@ static lx_status check_uv_triangles(const lx_scene *scene, const slot *s, const 
                "the parts outside get no texels",
                scene->path, node->name, m->name, outside);
     return LX_OK;
+}
+
+/* The slot holding page-local triangle id (slots ascend by first
+ * triangle; an atlas page has many). */
+static uint32_t slot_of(const slot *slots, uint32_t count, uint32_t id)
+{
+    uint32_t lo = 0, hi = count - 1;
+    while (lo < hi) {
+        uint32_t mid = (lo + hi + 1) / 2;
+        if (slots[mid].first_triangle <= id)
+            lo = mid;
+        else
+            hi = mid - 1;
+    }
+    return lo;
+}
+
+/* A mesh's material; a scene built without materials bakes as white. */
+static const lx_material *material_of(const lx_scene *scene, const lx_mesh *m)
+{
+    static const lx_material white = {
+        .name = "default", .base_color = {1, 1, 1, 1}, .normal_scale = 1.0f};
+    return m->material < scene->material_count ? &scene->materials[m->material] : &white;
 }
 
 static void sample_normal_map(const lx_material *mat, const lx_mesh *m, const lx_vec4 *tangents,
@@ -467,18 +494,29 @@ static void place_texel(lx_lightmap *map, uint32_t n, const lx_mat4 *world, cons
     }
 }
 
-/* Choose the node's lightmap UV set and its meshes with UVs. */
-static uint32_t collect_slots(const lx_scene *scene, const lx_node *node, slot *slots, int *uv_set,
-                              bool warn)
+/* The lightmap UV set of a node: TEXCOORD_1 when every mesh with UVs has
+ * it, else TEXCOORD_0. */
+static int auto_uv_set(const lx_scene *scene, const lx_node *node)
 {
-    bool all_have_uv1 = true;
     for (uint32_t k = 0; k < node->mesh_count; k++) {
         const lx_mesh *m = &scene->meshes[node->meshes[k]];
         if ((m->uv[0] || m->uv[1]) && !m->uv[1])
-            all_have_uv1 = false;
+            return 0;
     }
-    *uv_set = all_have_uv1 ? 1 : 0;
-    uint32_t n = 0, first = 0;
+    return 1;
+}
+
+/* Appends the node's meshes that have UV set `uv_set` (a negative one:
+ * the automatic choice, put in *uv_set) to slots, from triangle id
+ * *first on. Returns how many. */
+static uint32_t collect_slots(const lx_scene *scene, uint32_t node_index, const float so[4],
+                              int *uv_set, slot *slots, uint32_t *first, bool warn)
+{
+    const lx_node *node = &scene->nodes[node_index];
+    bool chosen = *uv_set < 0;
+    if (chosen)
+        *uv_set = auto_uv_set(scene, node);
+    uint32_t n = 0;
     for (uint32_t k = 0; k < node->mesh_count; k++) {
         const lx_mesh *m = &scene->meshes[node->meshes[k]];
         const lx_vec2 *uv = m->uv[*uv_set];
@@ -490,53 +528,67 @@ static uint32_t collect_slots(const lx_scene *scene, const lx_node *node, slot *
                        scene->path, node->name, m->name);
             continue;
         }
-        if (*uv_set == 0 && warn && !m->uv[1])
+        if (chosen && *uv_set == 0 && warn && !m->uv[1])
             lx_log(LX_LOG_WARN,
                    "%s: node '%s': mesh '%s' has no TEXCOORD_1; its lightmap "
                    "uses TEXCOORD_0",
                    scene->path, node->name, m->name);
-        else if (*uv_set == 0 && warn)
+        else if (chosen && *uv_set == 0 && warn)
             /* a node has one lightmap UV set: one mesh without TEXCOORD_1
              * sends all of them to TEXCOORD_0 */
             lx_log(LX_LOG_WARN,
                    "%s: node '%s': mesh '%s': its TEXCOORD_1 is not used: another mesh of "
                    "the node has none, so the node's lightmap uses TEXCOORD_0",
                    scene->path, node->name, m->name);
-        slots[n++] = (slot){m, node->meshes[k], first, uv};
-        first += m->triangle_count;
+        slot *sl = &slots[n++];
+        *sl = (slot){m, node->meshes[k], node_index, *first, uv, {so[0], so[1], so[2], so[3]}};
+        *first += m->triangle_count;
     }
     return n;
 }
 
-lx_status lx_texel_map_build(const lx_scene *scene, uint32_t node_index, const lx_bake_desc *desc,
-                             lx_texel_progress progress, lx_lightmap *map)
+lx_status lx_texel_map_build(const lx_scene *scene, const lx_page_spec *page,
+                             const lx_bake_desc *desc, lx_texel_progress progress, lx_lightmap *map)
 {
-    const lx_node *node = &scene->nodes[node_index];
     memset(map, 0, sizeof *map);
-    map->info.node = node_index;
-    map->name = lx_strdup(node->name);
+    map->info.node = page->node_count == 1 ? page->nodes[0].node : UINT32_MAX;
+    map->name = lx_strdup(page->name);
     map->info.name = map->name;
-    slot *slots = calloc(node->mesh_count ? node->mesh_count : 1, sizeof *slots);
+    uint32_t mesh_slots = 0;
+    for (uint32_t k = 0; k < page->node_count; k++)
+        mesh_slots += scene->nodes[page->nodes[k].node].mesh_count;
+    slot *slots = calloc(mesh_slots ? mesh_slots : 1, sizeof *slots);
     if (!slots || !map->name) {
         free(slots);
         return lx_fail(LX_ERR_NOMEM, "out of memory");
     }
-    int uv_set;
-    uint32_t slot_count = collect_slots(scene, node, slots, &uv_set, true);
+    uint32_t slot_count = 0, first = 0;
+    int uv_set = -1;
+    for (uint32_t k = 0; k < page->node_count; k++) {
+        int set = page->nodes[k].uv_set;
+        slot_count += collect_slots(scene, page->nodes[k].node, page->nodes[k].scale_offset, &set,
+                                    slots + slot_count, &first, true);
+        uv_set = k == 0 || set == uv_set ? set : LX_UV_SET_MIXED;
+    }
     map->info.uv_set = uv_set;
     if (slot_count == 0) {
         free(slots);
         return LX_OK;
     }
-    int size = desc->texel_density > 0
-                   ? size_from_density(scene, node, slots, slot_count, desc, true)
-                   : desc->resolution;
-    int w = size, h = size;
+    /* the node's own size when it has the page to itself and no size is
+     * given */
+    int w = page->width, h = page->height;
+    if (w <= 0 || h <= 0) {
+        const lx_node *node = &scene->nodes[page->nodes[0].node];
+        w = h = desc->texel_density > 0
+                    ? size_from_density(scene, node, slots, slot_count, desc, true)
+                    : desc->resolution;
+    }
     map->info.width = w;
     map->info.height = h;
     uint64_t pixels = (uint64_t)w * (uint64_t)h;
     char what[400];
-    snprintf(what, sizeof what, "%s: lightmap '%s' (%dx%d)", scene->path, node->name, w, h);
+    snprintf(what, sizeof what, "%s: lightmap '%s' (%dx%d)", scene->path, page->name, w, h);
     lx_status st = lx_check_memory(pixels * LX_BYTES_PER_TEXEL, what);
     if (st != LX_OK) {
         free(slots);
@@ -566,7 +618,7 @@ lx_status lx_texel_map_build(const lx_scene *scene, uint32_t node_index, const l
     }
     memset(r.owner, 0xFF, sizeof(uint32_t) * pixels);
     for (uint32_t s = 0; s < slot_count && st == LX_OK; s++)
-        st = check_uv_triangles(scene, &slots[s], node, desc, uv_set,
+        st = check_uv_triangles(scene, &slots[s], &scene->nodes[slots[s].node], desc,
                                 skip + slots[s].first_triangle);
     if (st != LX_OK)
         goto done;
@@ -579,7 +631,8 @@ lx_status lx_texel_map_build(const lx_scene *scene, uint32_t node_index, const l
         if (r.slot_overlap[s])
             lx_log(LX_LOG_WARN,
                    "%s: mesh '%s' (node '%s'): %u texels are covered by overlapping lightmap UVs",
-                   scene->path, slots[s].mesh->name, node->name, r.slot_overlap[s]);
+                   scene->path, slots[s].mesh->name, scene->nodes[slots[s].node].name,
+                   r.slot_overlap[s]);
 
     /* gather covered texels tile by tile */
     uint32_t used = 0;
@@ -615,7 +668,7 @@ lx_status lx_texel_map_build(const lx_scene *scene, uint32_t node_index, const l
     }
     for (uint32_t s = 0; s < slot_count && st == LX_OK; s++) {
         const lx_mesh *m = slots[s].mesh;
-        const lx_material *mat = &scene->materials[m->material];
+        const lx_material *mat = material_of(scene, m);
         if (mat->normal_map.width <= 0 || !m->uv[mat->normal_uv_set])
             continue;
         if (m->tangents) {
@@ -628,14 +681,26 @@ lx_status lx_texel_map_build(const lx_scene *scene, uint32_t node_index, const l
                          : lx_fail(LX_ERR_NOMEM, "%s: out of memory", what);
     }
     /* world space as lx_texel_map_transform computes it; object space kept
-     * only for a node away from the identity (the world arrays are object
-     * space otherwise, up to the rounding of a renormalization) */
-    lx_mat4 nm, id = lx_mat4_identity();
-    if (!lx_mat4_normal_matrix(&node->world, &nm))
-        nm = node->world;
+     * only for a page with a node away from the identity (the world arrays
+     * are object space otherwise, up to the rounding of a renormalization) */
+    lx_mat4 *nms = malloc(sizeof(lx_mat4) * page->node_count);
+    uint32_t *slot_node = malloc(sizeof(uint32_t) * slot_count); /* index into page->nodes */
+    if (!nms || !slot_node)
+        st = lx_fail(LX_ERR_NOMEM, "%s: out of memory", what);
     bool identity = true;
-    for (int k = 0; k < 16; k++)
-        identity &= node->world.m[k] == id.m[k];
+    lx_mat4 id = lx_mat4_identity();
+    for (uint32_t k = 0; k < page->node_count && st == LX_OK; k++) {
+        const lx_mat4 *world = &scene->nodes[page->nodes[k].node].world;
+        if (!lx_mat4_normal_matrix(world, &nms[k]))
+            nms[k] = *world;
+        for (int e = 0; e < 16; e++)
+            identity &= world->m[e] == id.m[e];
+    }
+    for (uint32_t s = 0, k = 0; s < slot_count && st == LX_OK; s++) {
+        while (page->nodes[k].node != slots[s].node)
+            k++;
+        slot_node[s] = k;
+    }
     if (!identity && st == LX_OK) {
         map->object_position = malloc(sizeof(lx_vec3) * (used ? used : 1));
         map->object_normal = malloc(sizeof(lx_vec3) * (used ? used : 1));
@@ -672,9 +737,7 @@ lx_status lx_texel_map_build(const lx_scene *scene, uint32_t node_index, const l
                 size_t p = (size_t)y * w + x;
                 if (r.owner[p] == UINT32_MAX)
                     continue;
-                uint32_t s = 0;
-                while (s + 1 < slot_count && slots[s + 1].first_triangle <= r.owner[p])
-                    s++;
+                uint32_t s = slot_of(slots, slot_count, r.owner[p]);
                 const lx_mesh *m = slots[s].mesh;
                 uint32_t t = r.owner[p] - slots[s].first_triangle;
                 const uint32_t *i = &m->indices[3 * t];
@@ -683,6 +746,7 @@ lx_status lx_texel_map_build(const lx_scene *scene, uint32_t node_index, const l
                 tx_->pixel = (uint32_t)p;
                 tx_->mesh = slots[s].mesh_index;
                 tx_->triangle = t;
+                tx_->node = slots[s].node;
                 lx_vec3 pa = m->positions[i[0]], pb = m->positions[i[1]], pc = m->positions[i[2]];
                 lx_vec3 position =
                     lx_add(lx_add(lx_scale(pa, w0), lx_scale(pb, w1)), lx_scale(pc, w2));
@@ -691,12 +755,13 @@ lx_status lx_texel_map_build(const lx_scene *scene, uint32_t node_index, const l
                     lx_add(lx_add(lx_scale(m->normals[i[0]], w0), lx_scale(m->normals[i[1]], w1)),
                            lx_scale(m->normals[i[2]], w2));
                 nrm = lx_length(nrm) > 1e-12f ? lx_normalize(nrm) : geometric;
-                const lx_material *mat = &scene->materials[m->material];
+                const lx_material *mat = material_of(scene, m);
                 if (tangents[s])
                     sample_normal_map(mat, m, tangents[s], i, w0, w1, w2, &nrm);
                 if (map->albedo)
                     map->albedo[k] = sample_albedo(mat, m, i, w0, w1, w2);
-                place_texel(map, k++, &node->world, &nm, position, nrm, geometric);
+                place_texel(map, k++, &scene->nodes[slots[s].node].world, &nms[slot_node[s]],
+                            position, nrm, geometric);
                 map->mask[p] = 1;
             }
     }
@@ -706,6 +771,8 @@ lx_status lx_texel_map_build(const lx_scene *scene, uint32_t node_index, const l
             free(tangents[s]);
     free(tangents);
     free(own_tangents);
+    free(nms);
+    free(slot_node);
     if (st == LX_OK) {
         /* the raster is done with: its block is the (zeroed) baked buffer */
         map->baked = (float *)block;
@@ -728,8 +795,10 @@ void lx_texel_map_size(const lx_scene *scene, uint32_t node_index, const lx_bake
     slot *slots = calloc(node->mesh_count ? node->mesh_count : 1, sizeof *slots);
     if (!slots)
         return;
-    int uv_set;
-    uint32_t n = collect_slots(scene, node, slots, &uv_set, false);
+    int uv_set = desc->uv_set - 1; /* LX_UV_SET_AUTO (0) -> -1 */
+    uint32_t first = 0;
+    const float identity[4] = {1.0f, 1.0f, 0.0f, 0.0f};
+    uint32_t n = collect_slots(scene, node_index, identity, &uv_set, slots, &first, false);
     if (n)
         *width = *height = desc->texel_density > 0
                                ? size_from_density(scene, node, slots, n, desc, false)
@@ -760,12 +829,14 @@ lx_status lx_texel_map_keep_object_space(lx_lightmap *map)
     return LX_OK;
 }
 
-void lx_texel_map_transform(lx_lightmap *map, const lx_mat4 *world)
+void lx_texel_map_transform(lx_lightmap *map, uint32_t node, const lx_mat4 *world)
 {
     lx_mat4 nm;
     if (!lx_mat4_normal_matrix(world, &nm))
         nm = *world;
     for (uint32_t i = 0; i < map->info.used_texels; i++) {
+        if (map->texels[i].node != node)
+            continue;
         map->world_position[i] = lx_mat4_point(world, map->object_position[i]);
         map->world_normal[i] = lx_normalize(lx_mat4_vector(&nm, map->object_normal[i]));
         map->world_geometric_normal[i] =
