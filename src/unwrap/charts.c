@@ -493,7 +493,7 @@ static double distance2(const double a[3], const double b[3])
     return d0 * d0 + d1 * d1 + d2 * d2;
 }
 
-static uint32_t local_index(const uw_chart *c, uint32_t t)
+uint32_t uw_chart_find(const uw_chart *c, uint32_t t)
 {
     uint32_t lo = 0, hi = c->triangle_count;
     while (lo < hi) {
@@ -566,7 +566,7 @@ bool uw_split_chart(const uw_mesh *m, const uw_chart *c, uw_chart *a, uw_chart *
         uint32_t t = c->triangles[f.region];
         for (int k = 0; k < 3 && ok; k++) {
             uint32_t u = m->adjacent[3 * t + k];
-            uint32_t j = u == UW_NONE ? UW_NONE : local_index(c, u);
+            uint32_t j = u == UW_NONE ? UW_NONE : uw_chart_find(c, u);
             if (j == UW_NONE || label[j] != UW_NONE)
                 continue;
             double d = f.cost + sqrt(distance2(cen[f.region], cen[j]));

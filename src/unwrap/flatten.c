@@ -364,22 +364,24 @@ static bool segments_touch(const double *a, const double *b, const double *c, co
            (o3 == 0 && on_segment(c, d, a)) || (o4 == 0 && on_segment(c, d, b));
 }
 
-static uint32_t chart_local(const uw_chart *c, uint32_t t)
-{
-    uint32_t lo = 0, hi = c->triangle_count;
-    while (lo < hi) {
-        uint32_t mid = (lo + hi) / 2;
-        if (c->triangles[mid] < t)
-            lo = mid + 1;
-        else
-            hi = mid;
-    }
-    return lo < c->triangle_count && c->triangles[lo] == t ? lo : UW_NONE;
-}
-
 typedef struct segment {
     uint32_t a, b; /* chart vertices */
 } segment;
+
+typedef struct grid {
+    double lo[2], scale[2];
+    uint32_t nx, ny;
+} grid;
+
+/* The cells [x0, x1] x [y0, y1] segment s's box covers. */
+static void cells_of(const grid *g, const double *uv, segment s, uint32_t r[4])
+{
+    const double *pa = &uv[2 * s.a], *pb = &uv[2 * s.b];
+    r[0] = (uint32_t)fmin((fmin(pa[0], pb[0]) - g->lo[0]) * g->scale[0], g->nx - 1);
+    r[1] = (uint32_t)fmin((fmax(pa[0], pb[0]) - g->lo[0]) * g->scale[0], g->nx - 1);
+    r[2] = (uint32_t)fmin((fmin(pa[1], pb[1]) - g->lo[1]) * g->scale[1], g->ny - 1);
+    r[3] = (uint32_t)fmin((fmax(pa[1], pb[1]) - g->lo[1]) * g->scale[1], g->ny - 1);
+}
 
 /* Does the chart's border cross or touch itself (other than at shared
  * vertices)? Border edges are binned in a uniform grid. */
@@ -394,7 +396,7 @@ static int border_crosses(const uw_mesh *m, const uw_chart *c)
         uint32_t t = c->triangles[i];
         for (int k = 0; k < 3; k++) {
             uint32_t u = m->adjacent[3 * t + k];
-            if (u != UW_NONE && chart_local(c, u) != UW_NONE)
+            if (u != UW_NONE && uw_chart_find(c, u) != UW_NONE)
                 continue;
             segment s = {c->corners[3 * i + k], c->corners[3 * i + (k + 1) % 3]};
             seg[n++] = s;
@@ -427,14 +429,12 @@ static int border_crosses(const uw_mesh *m, const uw_chart *c)
         return -1;
     }
     size_t refs = 0;
+    grid g = {{lo[0], lo[1]}, {sx, sy}, gx, gy};
     for (size_t i = 0; i < n; i++) {
-        const double *pa = &c->uv[2 * seg[i].a], *pb = &c->uv[2 * seg[i].b];
-        uint32_t x0 = (uint32_t)fmin((fmin(pa[0], pb[0]) - lo[0]) * sx, gx - 1);
-        uint32_t x1 = (uint32_t)fmin((fmax(pa[0], pb[0]) - lo[0]) * sx, gx - 1);
-        uint32_t y0 = (uint32_t)fmin((fmin(pa[1], pb[1]) - lo[1]) * sy, gy - 1);
-        uint32_t y1 = (uint32_t)fmin((fmax(pa[1], pb[1]) - lo[1]) * sy, gy - 1);
-        for (uint32_t y = y0; y <= y1; y++)
-            for (uint32_t x = x0; x <= x1; x++) {
+        uint32_t r[4];
+        cells_of(&g, c->uv, seg[i], r);
+        for (uint32_t y = r[2]; y <= r[3]; y++)
+            for (uint32_t x = r[0]; x <= r[1]; x++) {
                 start[(size_t)y * gx + x + 1]++;
                 refs++;
             }
@@ -452,13 +452,10 @@ static int border_crosses(const uw_mesh *m, const uw_chart *c)
     }
     memcpy(fill, start, sizeof(uint32_t) * (size_t)gx * gy);
     for (size_t i = 0; i < n; i++) {
-        const double *pa = &c->uv[2 * seg[i].a], *pb = &c->uv[2 * seg[i].b];
-        uint32_t x0 = (uint32_t)fmin((fmin(pa[0], pb[0]) - lo[0]) * sx, gx - 1);
-        uint32_t x1 = (uint32_t)fmin((fmax(pa[0], pb[0]) - lo[0]) * sx, gx - 1);
-        uint32_t y0 = (uint32_t)fmin((fmin(pa[1], pb[1]) - lo[1]) * sy, gy - 1);
-        uint32_t y1 = (uint32_t)fmin((fmax(pa[1], pb[1]) - lo[1]) * sy, gy - 1);
-        for (uint32_t y = y0; y <= y1; y++)
-            for (uint32_t x = x0; x <= x1; x++)
+        uint32_t r[4];
+        cells_of(&g, c->uv, seg[i], r);
+        for (uint32_t y = r[2]; y <= r[3]; y++)
+            for (uint32_t x = r[0]; x <= r[1]; x++)
                 items[fill[(size_t)y * gx + x]++] = (uint32_t)i;
     }
     int crosses = 0;

@@ -51,6 +51,9 @@ typedef struct uw_chart {
 
 void uw_chart_free(uw_chart *c);
 
+/* Where mesh triangle t is in c->triangles, or UW_NONE. */
+uint32_t uw_chart_find(const uw_chart *c, uint32_t t);
+
 /* Grows charts over m's non-degenerate faces: planar regions first, then
  * regions join the chart they cost least to join (normal deviation, seams
  * crossed, shape), no face turning more than max_angle_cos away from its
