@@ -75,6 +75,12 @@ typedef enum lx_uv_choice {
     LX_UV_SET_1         /* TEXCOORD_1 */
 } lx_uv_choice;
 
+/* The lightmap UV set (0 or 1) of scene node `node` under `choice`: the
+ * set named, or for LX_UV_SET_AUTO TEXCOORD_1 when every mesh of the node
+ * that has UVs has it, else TEXCOORD_0. Whether the meshes have it is
+ * the caller's to check. */
+int lx_bake_uv_set(const lx_scene *scene, uint32_t node, lx_uv_choice choice);
+
 /* lx_lightmap_info.uv_set of an atlas page whose nodes use different sets. */
 #define LX_UV_SET_MIXED (-1)
 

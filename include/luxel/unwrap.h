@@ -84,6 +84,8 @@ typedef struct lx_unwrap_desc {
                                     al.; 1 = isometric), 0 = 1.15; charts above it
                                     are cut again */
     const lx_unwrap_mode *modes; /* per scene node, NULL = generate for all */
+    bool page_per_node;          /* no two nodes share a page: a lightmap per node
+                                    (pages then hold one node's charts) */
     const int *keep_uv_sets;     /* per node, the UV set LX_UNWRAP_KEEP places
                                     (NULL = TEXCOORD_1 when the meshes have it,
                                     else TEXCOORD_0) */

@@ -496,8 +496,11 @@ static void place_texel(lx_lightmap *map, uint32_t n, const lx_mat4 *world, cons
 
 /* The lightmap UV set of a node: TEXCOORD_1 when every mesh with UVs has
  * it, else TEXCOORD_0. */
-static int auto_uv_set(const lx_scene *scene, const lx_node *node)
+int lx_bake_uv_set(const lx_scene *scene, uint32_t node_index, lx_uv_choice choice)
 {
+    if (choice == LX_UV_SET_0 || choice == LX_UV_SET_1)
+        return choice == LX_UV_SET_1 ? 1 : 0;
+    const lx_node *node = &scene->nodes[node_index];
     for (uint32_t k = 0; k < node->mesh_count; k++) {
         const lx_mesh *m = &scene->meshes[node->meshes[k]];
         if ((m->uv[0] || m->uv[1]) && !m->uv[1])
@@ -515,7 +518,7 @@ static uint32_t collect_slots(const lx_scene *scene, uint32_t node_index, const 
     const lx_node *node = &scene->nodes[node_index];
     bool chosen = *uv_set < 0;
     if (chosen)
-        *uv_set = auto_uv_set(scene, node);
+        *uv_set = lx_bake_uv_set(scene, node_index, LX_UV_SET_AUTO);
     uint32_t n = 0;
     for (uint32_t k = 0; k < node->mesh_count; k++) {
         const lx_mesh *m = &scene->meshes[node->meshes[k]];

@@ -591,8 +591,9 @@ lx_status uw_pack(uw_item *items, uint32_t item_count, const uw_pack_desc *desc,
     double capacity = FILL_ESTIMATE * (double)k.size * k.size;
     for (uint32_t i = 0; i < nn; i++) {
         uint32_t n = nodes[i], p = 0;
-        while (p < k.page_count && k.pages[p].planned > 0.0 &&
-               k.pages[p].planned + node_area[n] > capacity)
+        while (p < k.page_count && (desc->page_per_node || (k.pages[p].planned > 0.0 &&
+                                                            k.pages[p].planned + node_area[n] >
+                                                                capacity)))
             p++;
         if (p == k.page_count && !add_page(&k)) {
             free(nodes);

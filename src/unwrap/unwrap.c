@@ -497,11 +497,13 @@ static void items_free(uw_item *items, uint32_t count)
     free(items);
 }
 
-/* Texels a square metre gets at `density` texels a metre. */
-static double total_area(const lx_scene *scene, const plan *p)
+/* The surface the unwrap places for node n (all nodes: UW_NONE), m^2. */
+static double placed_area(const lx_scene *scene, const plan *p, uint32_t only)
 {
     double area = 0.0;
     for (uint32_t n = 0; n < scene->node_count; n++) {
+        if (only != UW_NONE && n != only)
+            continue;
         if (p->mode[n] == LX_UNWRAP_KEEP)
             area += p->kept_world[n];
         for (uint32_t r = p->ref_first[n]; r < p->ref_first[n + 1]; r++) {
@@ -513,10 +515,9 @@ static double total_area(const lx_scene *scene, const plan *p)
     return area;
 }
 
-/* Packs at the density, scaling down nodes that do not fit a page. */
 static lx_status pack_at(const lx_scene *scene, plan *p, double density, const uw_pack_desc *pd,
-                         uw_item **items_out, uint32_t *item_count, lx_unwrap_page **pages,
-                         uint32_t *page_count)
+                         bool may_scale, uw_item **items_out, uint32_t *item_count,
+                         lx_unwrap_page **pages, uint32_t *page_count)
 {
     for (int attempt = 0;; attempt++) {
         uw_item *items;
@@ -532,7 +533,7 @@ static lx_status pack_at(const lx_scene *scene, plan *p, double density, const u
             return LX_OK;
         }
         items_free(items, count);
-        if (st != LX_ERR_UNSUPPORTED || too_big == UW_NONE || attempt > 64)
+        if (st != LX_ERR_UNSUPPORTED || too_big == UW_NONE || attempt > 64 || !may_scale)
             return st;
         if (p->node_scale[too_big] == 1.0)
             lx_log(LX_LOG_WARN,
@@ -642,16 +643,23 @@ lx_status lx_unwrap_scene(const lx_scene *scene, const lx_unwrap_desc *desc, lx_
         st = lx_fail(LX_ERR_CANCELLED, "cancelled");
     if (st != LX_OK)
         goto fail;
-    uw_pack_desc pd = {d.padding, d.atlas_size, threads, d.progress, d.progress_user, 0.6f, 0.95f};
+    uw_pack_desc pd = {d.padding,   d.atlas_size,       d.page_per_node, threads,
+                       d.progress, d.progress_user, 0.6f,            0.95f};
     double density = d.texel_density;
     if (density > 0.0) {
-        st = pack_at(scene, &p, density, &pd, &items, &item_count, &pages, &page_count);
+        st = pack_at(scene, &p, density, &pd, true, &items, &item_count, &pages, &page_count);
     } else {
-        /* the density that fills one page of `resolution`: from the area,
-         * then down while it takes more than a page, up while it leaves
-         * much of it empty (a few packs at most) */
+        /* the density that fills one page of `resolution` (with
+         * page_per_node: at which the largest node fills its page): from
+         * the area, then down while it takes more than a page, up while
+         * it leaves much of it empty (a few packs at most) */
         pd.atlas_size = d.resolution < d.atlas_size ? d.resolution : d.atlas_size;
-        double area = total_area(scene, &p);
+        double area = placed_area(scene, &p, UW_NONE);
+        if (d.page_per_node) { /* the largest node fills its page */
+            area = 0.0;
+            for (uint32_t n = 0; n < scene->node_count; n++)
+                area = fmax(area, placed_area(scene, &p, n));
+        }
         density = area > 0.0 ? sqrt(0.5 * (double)pd.atlas_size * pd.atlas_size / area) : 1.0;
         double fits = 0.0, fails = INFINITY;
         for (int attempt = 0; attempt < DENSITY_TRIES; attempt++) {
@@ -659,13 +667,18 @@ lx_status lx_unwrap_scene(const lx_scene *scene, const lx_unwrap_desc *desc, lx_
             uint32_t ic;
             lx_unwrap_page *pg;
             uint32_t pc;
-            for (uint32_t n = 0; n < scene->node_count; n++)
-                p.node_scale[n] = 1.0;
-            st = pack_at(scene, &p, density, &pd, &it, &ic, &pg, &pc);
-            if (st != LX_OK)
+            st = pack_at(scene, &p, density, &pd, false, &it, &ic, &pg, &pc);
+            if (st != LX_OK && st != LX_ERR_UNSUPPORTED)
                 goto fail;
-            bool one = pc <= 1;
-            int side = pc ? (pg[0].width > pg[0].height ? pg[0].width : pg[0].height) : 0;
+            bool one = st == LX_OK && (d.page_per_node || pc <= 1);
+            if (st != LX_OK)
+                it = NULL, ic = 0, pg = NULL, pc = 0;
+            st = LX_OK;
+            int side = 0;
+            for (uint32_t k = 0; k < pc; k++) {
+                side = pg[k].width > side ? pg[k].width : side;
+                side = pg[k].height > side ? pg[k].height : side;
+            }
             if (one) {
                 fits = density;
                 items_free(items, item_count);

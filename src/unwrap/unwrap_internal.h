@@ -95,6 +95,7 @@ typedef struct uw_item {
 typedef struct uw_pack_desc {
     int padding;
     int atlas_size;
+    bool page_per_node; /* no two nodes share a page */
     int threads;
     lx_progress_fn progress;
     void *progress_user;

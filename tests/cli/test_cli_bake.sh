@@ -18,15 +18,35 @@ ROOM=$WORK/scenes/room.glb
 RETRO=$WORK/scenes/retro.glb
 NODES="room tall_box short_box"
 
-# manifest_get FILE NODE KEY: the value of KEY in NODE's manifest entry
-# (cJSON prints one key per line; entries start with "node").
+# manifest_get FILE NODE KEY: the value of KEY for NODE (docs/manifest.md):
+# from its entry in "nodes", or, for a key of its page (file, preview,
+# width, height, used_texels, overlap_texels), from "pages"[its page].
+# cJSON prints one key per line; node entries start with "node", pages
+# with "file".
 manifest_get() {
-    awk -v node="$2" -v key="$3" '
-        /"node":/ { cur = $0; sub(/.*"node":[ \t]*"/, "", cur); sub(/".*/, "", cur) }
-        cur == node && $0 ~ "\"" key "\":" {
-            v = $0; sub(/^[^:]*:[ \t]*/, "", v); sub(/,?[ \t]*$/, "", v); gsub(/"/, "", v)
-            print v; exit
-        }' "$1"
+    case $3 in
+    file | preview | width | height | used_texels | overlap_texels)
+        local page
+        page=$(manifest_get "$1" "$2" page)
+        [ -n "$page" ] || return 0
+        awk -v want="$page" -v key="$3" '
+            /"pages":/ { inside = 1; k = -1 }
+            /"nodes":/ { inside = 0 }
+            inside && /"file":/ { k++ }
+            inside && k == want && $0 ~ "\"" key "\":" {
+                v = $0; sub(/^[^:]*:[ \t]*/, "", v); sub(/,?[ \t]*$/, "", v); gsub(/"/, "", v)
+                print v; exit
+            }' "$1"
+        ;;
+    *)
+        awk -v node="$2" -v key="$3" '
+            /"node":/ { cur = $0; sub(/.*"node":[ \t]*"/, "", cur); sub(/".*/, "", cur) }
+            cur == node && $0 ~ "\"" key "\":" {
+                v = $0; sub(/^[^:]*:[ \t]*/, "", v); sub(/,?[ \t]*$/, "", v); gsub(/"/, "", v)
+                print v; exit
+            }' "$1"
+        ;;
+    esac
 }
 
 # ---- the default: EXR plus PNG previews plus manifest --------------------
@@ -360,5 +380,68 @@ run "$LUXEL" bake "$RETRO" --texel-density 4 --format pfm -q -o "$WORK/sky4" \
     --lights "$WORK/skycfg/day.json" --no-sky-shadows
 expect_rc 0 "bake with --no-sky-shadows over the file's shadows"
 check "sky bake: --no-sky-shadows wins" grep -q '"shadows":.*false' "$WORK/sky4/manifest.json"
+
+# ---- lightmap UVs made by luxel, atlas pages -----------------------------------
+# --unwrap always: every node on luxel's UVs, packed into one atlas page;
+# the manifest's nodes say so and point at page 0 with the identity
+# scale/offset (the generated UVs are page UVs).
+run "$LUXEL" bake "$ROOM" --unwrap always -q -o "$WORK/atlas"
+expect_rc 0 "bake --unwrap always"
+expect_files "--unwrap always: one atlas page, its preview and the manifest" "$WORK/atlas" \
+    lightmap-0.exr lightmap-0.png manifest.json
+M=$WORK/atlas/manifest.json
+for n in $NODES; do
+    check "atlas: $n's UVs are generated" test "$(manifest_get "$M" "$n" uvs)" = generated
+    check "atlas: $n is on page 0" test "$(manifest_get "$M" "$n" page)" = 0
+    check "atlas: $n reads TEXCOORD_1" test "$(manifest_get "$M" "$n" uv_set)" = TEXCOORD_1
+    check "atlas: $n's page is lightmap-0.exr" test "$(manifest_get "$M" "$n" file)" = lightmap-0.exr
+done
+w=$(manifest_get "$M" room width)
+h=$(manifest_get "$M" room height)
+check "atlas: the page is a multiple of 4 and at most 1024 (${w}x${h})" \
+    test $((w % 4)) -eq 0 -a $((h % 4)) -eq 0 -a "$w" -le 1024 -a "$h" -le 1024
+check "atlas: the page fills most of 1024 on one side (${w}x${h})" \
+    test "$w" -ge 768 -o "$h" -ge 768
+check "atlas: the manifest records the density it used" grep -Eq '"texel_density":' "$M"
+# the same bytes for any thread count
+run "$LUXEL" bake "$ROOM" --unwrap always -q --threads 1 -o "$WORK/atlas1"
+check "atlas: the same page with 1 thread" cmp -s "$WORK/atlas/lightmap-0.exr" \
+    "$WORK/atlas1/lightmap-0.exr"
+
+# --atlas with the file's own UVs: each node's square on a shared page,
+# placed by a scale and offset
+run "$LUXEL" bake "$ROOM" --atlas --texel-density 20 -q -o "$WORK/atlas_own"
+expect_rc 0 "bake --atlas with the file's UVs"
+M=$WORK/atlas_own/manifest.json
+for n in $NODES; do
+    check "own-UV atlas: $n keeps its UVs" test "$(manifest_get "$M" "$n" uvs)" = own
+done
+check "own-UV atlas: one page" test "$(grep -c '"file":' "$M")" -eq 1
+check "own-UV atlas: a scale/offset other than the identity" \
+    grep -Eq '"scale_offset":.*0\.[0-9]' "$M"
+
+# --unwrap always --no-atlas: a lightmap per node, named after it
+run "$LUXEL" bake "$ROOM" --unwrap always --no-atlas -q -o "$WORK/noatlas"
+expect_rc 0 "bake --unwrap always --no-atlas"
+expect_files "--no-atlas: a lightmap per node" "$WORK/noatlas" room.exr room.png tall_box.exr \
+    tall_box.png short_box.exr short_box.png manifest.json
+check "--no-atlas: the room's UVs are generated" \
+    test "$(manifest_get "$WORK/noatlas/manifest.json" room uvs)" = generated
+
+# --uv-set 0 reads TEXCOORD_0
+run "$LUXEL" bake "$ROOM" --uv-set 0 -q -o "$WORK/uv0"
+expect_rc 0 "bake --uv-set 0"
+check "--uv-set 0: the manifest says TEXCOORD_0" \
+    test "$(manifest_get "$WORK/uv0/manifest.json" room uv_set)" = TEXCOORD_0
+
+# usage errors name the option
+for args in "--unwrap sometimes" "--uv-set 2" "--atlas --no-atlas" "--atlas-size 3" \
+    "--resolution 64 --texel-density 8" "--no-atlas --atlas-size 512"; do
+    # shellcheck disable=SC2086
+    run "$LUXEL" bake "$ROOM" $args -o "$WORK/usage"
+    expect_rc 2 "bake $args"
+    expect_error "bake $args" "bake"
+    expect_no_output "bake $args" "$WORK/usage"
+done
 
 finish

@@ -16,12 +16,16 @@ static const char *bake_usage =
     "\n"
     "Bakes a lightmap for every node that carries a mesh of SCENE (glTF 2.0\n"
     ".gltf/.glb or OBJ), lit by the scene's KHR_lights_punctual lights and\n"
-    "those of --lights. Writes DIR/<node>.<format>, DIR/<node>.png (preview)\n"
-    "and DIR/manifest.json.\n"
+    "those of --lights. Nodes whose lightmap UVs are missing or unusable get\n"
+    "UVs made by luxel, packed with the others into shared atlas pages:\n"
+    "DIR/lightmap-<k>.<format>; a scene whose own UVs all serve keeps a\n"
+    "lightmap per node, DIR/<node>.<format>. Each has a PNG preview, and\n"
+    "DIR/manifest.json says where every node's lightmap is (docs/manifest.md).\n"
     "\n"
     "options:\n"
     "  -o, --output DIR        output folder (default ./lightmaps)\n"
-    "  --resolution N          texels per side of every lightmap (default %d)\n"
+    "  --resolution N          texels per side of every lightmap (default %d), or\n"
+    "                          of the atlas page to fill (default %d)\n"
     "  --texel-density T       texels per metre instead: each lightmap sized from\n"
     "                          its world and UV areas, a multiple of 4\n"
     "  --max-resolution N      cap for --texel-density sizes (default %d)\n"
@@ -47,7 +51,15 @@ static const char *bake_usage =
     "  --sky-samples N         rays per texel with sky shadows (default %u)\n"
     "  --exposure EV100        exposure of the PNG preview (default: automatic)\n"
     "  --padding N             texels of dilation around charts, 0 for none\n"
-    "                          (default %d)\n"
+    "                          (default %d); charts luxel packs own as many\n"
+    "  --unwrap MODE           auto (default): make lightmap UVs for the nodes\n"
+    "                          whose UVs are missing, outside [0,1] or of zero\n"
+    "                          area; always; or never\n"
+    "  --uv-set S              the lightmap UV set: 0, 1 or auto (default: 1 when\n"
+    "                          every mesh of a node has TEXCOORD_1, else 0)\n"
+    "  --atlas, --no-atlas     share pages between nodes, or a lightmap per node\n"
+    "                          (default: pages whenever luxel makes UVs)\n"
+    "  --atlas-size N          largest atlas page side (default %d)\n"
     "  --threads N             worker threads (default: all cores)\n"
     "  --skip-degenerate       skip zero-area triangles with a warning instead of\n"
     "                          failing\n"
@@ -73,8 +85,20 @@ enum {
     OPT_SKY_INTENSITY,
     OPT_SKY_SHADOWS,
     OPT_NO_SKY_SHADOWS,
-    OPT_SKY_SAMPLES
+    OPT_SKY_SAMPLES,
+    OPT_UNWRAP,
+    OPT_UV_SET,
+    OPT_ATLAS,
+    OPT_NO_ATLAS,
+    OPT_ATLAS_SIZE
 };
+
+typedef enum unwrap_choice { UNWRAP_AUTO, UNWRAP_ALWAYS, UNWRAP_NEVER } unwrap_choice;
+
+/* The page an atlas fills when neither --resolution nor --texel-density
+ * sizes it: the CLI's own choice (a lightmap per node keeps the library's
+ * resolution). */
+#define CLI_ATLAS_RESOLUTION 1024
 
 typedef struct bake_args {
     const char *scene;
@@ -92,6 +116,10 @@ typedef struct bake_args {
     double sky_intensity; /* < 0: not given */
     int sky_shadows;      /* 1 on, 0 off, -1 not given */
     long sky_samples;     /* 0: not given */
+    bool has_resolution;
+    unwrap_choice unwrap;
+    int atlas;      /* 1 --atlas, 0 --no-atlas, -1 not given */
+    int atlas_size; /* 0: the unwrapper's default */
     lx_bake_desc desc;
 } bake_args;
 
@@ -117,6 +145,11 @@ static int parse_args(int argc, char **argv, bake_args *a)
         {"sky-shadows", no_argument, NULL, OPT_SKY_SHADOWS},
         {"no-sky-shadows", no_argument, NULL, OPT_NO_SKY_SHADOWS},
         {"sky-samples", required_argument, NULL, OPT_SKY_SAMPLES},
+        {"unwrap", required_argument, NULL, OPT_UNWRAP},
+        {"uv-set", required_argument, NULL, OPT_UV_SET},
+        {"atlas", no_argument, NULL, OPT_ATLAS},
+        {"no-atlas", no_argument, NULL, OPT_NO_ATLAS},
+        {"atlas-size", required_argument, NULL, OPT_ATLAS_SIZE},
         {"quiet", no_argument, NULL, 'q'},
         {"verbose", no_argument, NULL, 'v'},
         {"help", no_argument, NULL, 'h'},
@@ -128,6 +161,7 @@ static int parse_args(int argc, char **argv, bake_args *a)
     a->format = LX_IMAGE_EXR;
     a->sky_intensity = -1.0;
     a->sky_shadows = -1;
+    a->atlas = -1;
     opterr = 0;
     optind = 1;
     int c;
@@ -145,6 +179,7 @@ static int parse_args(int argc, char **argv, bake_args *a)
                 return cli_usage_error("bake", "--resolution must be an integer in 1..%d, not '%s'",
                                        LX_MAX_LIGHTMAP_SIZE, optarg);
             a->desc.resolution = (int)n;
+            a->has_resolution = true;
             break;
         case OPT_TEXEL_DENSITY:
             if (!cli_parse_float(optarg, 1e-6, 1e6, &f))
@@ -237,6 +272,39 @@ static int parse_args(int argc, char **argv, bake_args *a)
                                        LX_MAX_SKY_SAMPLES, optarg);
             a->sky_samples = n;
             break;
+        case OPT_UNWRAP:
+            if (strcmp(optarg, "auto") == 0)
+                a->unwrap = UNWRAP_AUTO;
+            else if (strcmp(optarg, "always") == 0)
+                a->unwrap = UNWRAP_ALWAYS;
+            else if (strcmp(optarg, "never") == 0)
+                a->unwrap = UNWRAP_NEVER;
+            else
+                return cli_usage_error("bake", "--unwrap must be auto, always or never, not '%s'",
+                                       optarg);
+            break;
+        case OPT_UV_SET:
+            if (strcmp(optarg, "auto") == 0)
+                a->desc.uv_set = LX_UV_SET_AUTO;
+            else if (strcmp(optarg, "0") == 0)
+                a->desc.uv_set = LX_UV_SET_0;
+            else if (strcmp(optarg, "1") == 0)
+                a->desc.uv_set = LX_UV_SET_1;
+            else
+                return cli_usage_error("bake", "--uv-set must be 0, 1 or auto, not '%s'", optarg);
+            break;
+        case OPT_ATLAS:
+        case OPT_NO_ATLAS:
+            if (a->atlas >= 0 && a->atlas != (c == OPT_ATLAS))
+                return cli_usage_error("bake", "--atlas and --no-atlas contradict");
+            a->atlas = c == OPT_ATLAS;
+            break;
+        case OPT_ATLAS_SIZE:
+            if (!cli_parse_int(optarg, 4, LX_UNWRAP_MAX_ATLAS_SIZE, &n))
+                return cli_usage_error("bake", "--atlas-size must be an integer in 4..%d, not '%s'",
+                                       LX_UNWRAP_MAX_ATLAS_SIZE, optarg);
+            a->atlas_size = (int)n;
+            break;
         case 'q':
             a->quiet = true;
             break;
@@ -246,9 +314,10 @@ static int parse_args(int argc, char **argv, bake_args *a)
         case 'h': {
             /* the defaults shown are the library's */
             lx_bake_desc d = lx_bake_desc_defaults(NULL);
-            printf(bake_usage, d.resolution, d.max_resolution,
+            lx_unwrap_desc u = lx_unwrap_desc_defaults(NULL);
+            printf(bake_usage, d.resolution, CLI_ATLAS_RESOLUTION, d.max_resolution,
                    d.quantity == LX_QUANTITY_RADIANCE ? "radiance" : "irradiance",
-                   (double)d.sky.intensity, d.sky.samples, LX_PADDING_RECOMMENDED);
+                   (double)d.sky.intensity, d.sky.samples, LX_PADDING_RECOMMENDED, u.atlas_size);
             return -1;
         }
         case ':':
@@ -264,6 +333,11 @@ static int parse_args(int argc, char **argv, bake_args *a)
     a->scene = argv[optind];
     if (a->half && a->format != LX_IMAGE_EXR)
         return cli_usage_error("bake", "--half applies to --format exr only");
+    if (a->has_resolution && a->desc.texel_density > 0.0f)
+        return cli_usage_error("bake", "--resolution and --texel-density both size the "
+                                       "lightmaps: give one");
+    if (a->atlas_size && a->atlas == 0)
+        return cli_usage_error("bake", "--atlas-size needs atlas pages, not --no-atlas");
     if (a->pre_expose && !a->has_exposure)
         return cli_usage_error("bake", "--pre-expose needs --exposure EV100");
     if (a->pre_expose && a->format == LX_IMAGE_PNG)
@@ -307,33 +381,183 @@ static float preview_scale(const bake_args *a)
     return a->desc.quantity == LX_QUANTITY_RADIANCE ? 1.0f : 1.0f / LX_PI;
 }
 
-static cJSON *manifest_entry(const lx_scene *scene, const lx_lightmap_info *info, const char *file,
-                             const char *preview, lx_quantity quantity)
+static cJSON *page_entry(const lx_lightmap_info *info, const char *file, const char *preview)
 {
     cJSON *e = cJSON_CreateObject();
-    cJSON_AddStringToObject(e, "node", info->name);
-    const lx_node *node = &scene->nodes[info->node];
-    /* the node's meshes: one name, or a list when assimp split primitives */
-    if (node->mesh_count == 1) {
-        cJSON_AddStringToObject(e, "mesh", scene->meshes[node->meshes[0]].name);
-    } else {
-        cJSON *arr = cJSON_AddArrayToObject(e, "mesh");
-        for (uint32_t k = 0; k < node->mesh_count; k++)
-            cJSON_AddItemToArray(arr, cJSON_CreateString(scene->meshes[node->meshes[k]].name));
-    }
     cJSON_AddStringToObject(e, "file", file);
     if (preview)
         cJSON_AddStringToObject(e, "preview", preview);
     cJSON_AddNumberToObject(e, "width", info->width);
     cJSON_AddNumberToObject(e, "height", info->height);
-    cJSON_AddStringToObject(e, "uv_set", info->uv_set == 1 ? "TEXCOORD_1" : "TEXCOORD_0");
-    cJSON_AddStringToObject(e, "quantity",
-                            quantity == LX_QUANTITY_RADIANCE ? "radiance" : "irradiance");
-    cJSON_AddStringToObject(e, "unit", quantity == LX_QUANTITY_RADIANCE ? "nt" : "lx");
     cJSON_AddNumberToObject(e, "used_texels", info->used_texels);
-    if (info->overlap_texels)
-        cJSON_AddNumberToObject(e, "overlapping_texels", info->overlap_texels);
+    cJSON_AddNumberToObject(e, "overlap_texels", info->overlap_texels);
     return e;
+}
+
+/* Every node with a lightmap: its meshes, page, scale/offset, UV set and
+ * whose UVs they are (docs/manifest.md). */
+static cJSON *node_entries(const lx_scene *scene, const lx_baker *baker, const lx_unwrap *unwrap,
+                           const bake_args *a)
+{
+    cJSON *list = cJSON_CreateArray();
+    for (uint32_t n = 0; n < scene->node_count; n++) {
+        uint32_t page;
+        float so[4];
+        if (!lx_baker_node_lightmap(baker, n, &page, so))
+            continue;
+        const lx_node *node = &scene->nodes[n];
+        cJSON *e = cJSON_CreateObject();
+        cJSON_AddStringToObject(e, "node", node->name);
+        cJSON *meshes = cJSON_AddArrayToObject(e, "meshes");
+        for (uint32_t k = 0; k < node->mesh_count; k++)
+            cJSON_AddItemToArray(meshes, cJSON_CreateString(scene->meshes[node->meshes[k]].name));
+        cJSON_AddNumberToObject(e, "page", page);
+        cJSON *sov = cJSON_AddArrayToObject(e, "scale_offset");
+        for (int k = 0; k < 4; k++)
+            cJSON_AddItemToArray(sov, cJSON_CreateNumber(so[k]));
+        bool generated = unwrap && unwrap->nodes[n].mode == LX_UNWRAP_GENERATE;
+        int set = generated ? 1
+                  : unwrap  ? unwrap->nodes[n].uv_set
+                            : lx_bake_uv_set(scene, n, a->desc.uv_set);
+        cJSON_AddStringToObject(e, "uv_set", set == 1 ? "TEXCOORD_1" : "TEXCOORD_0");
+        cJSON_AddStringToObject(e, "uvs", generated ? "generated" : "own");
+        cJSON_AddItemToArray(list, e);
+    }
+    return list;
+}
+
+/* Why node n's lightmap UVs (set `set`) cannot serve, or NULL when they
+ * can: a mesh lacks them, they reach outside [0,1] (texels there are
+ * lost), or a triangle has no area in them. */
+static const char *uvs_problem(const lx_scene *scene, uint32_t n, int set)
+{
+    const lx_node *node = &scene->nodes[n];
+    for (uint32_t k = 0; k < node->mesh_count; k++) {
+        const lx_mesh *m = &scene->meshes[node->meshes[k]];
+        const lx_vec2 *uv = m->uv[set];
+        if (!uv)
+            return "missing";
+        for (uint32_t v = 0; v < m->vertex_count; v++)
+            if (uv[v].x < 0.0f || uv[v].x > 1.0f || uv[v].y < 0.0f || uv[v].y > 1.0f)
+                return "outside [0,1]";
+        for (uint32_t t = 0; t < m->triangle_count; t++) {
+            const uint32_t *i = &m->indices[3 * t];
+            lx_vec2 p = uv[i[0]], q = uv[i[1]], r = uv[i[2]];
+            double area = ((double)q.x - p.x) * ((double)r.y - p.y) -
+                          ((double)r.x - p.x) * ((double)q.y - p.y);
+            if (area == 0.0)
+                return "zero-area triangles";
+        }
+    }
+    return NULL;
+}
+
+/* Decides which nodes keep their lightmap UVs and which get luxel's, and
+ * when the lightmaps share atlas pages; makes the UVs and puts them into
+ * the scene. *out stays NULL when every node keeps its own lightmap. */
+static int plan_lightmaps(bake_args *a, lx_scene *scene, lx_unwrap **out, bool *atlas)
+{
+    *out = NULL;
+    uint32_t nn = scene->node_count;
+    lx_unwrap_mode *modes = calloc(nn ? nn : 1, sizeof *modes);
+    int *sets = calloc(nn ? nn : 1, sizeof *sets);
+    if (!modes || !sets) {
+        free(modes);
+        free(sets);
+        cli_error("out of memory");
+        return EXIT_FAILED;
+    }
+    static const char *reasons[] = {"missing", "outside [0,1]", "zero-area triangles"};
+    uint32_t count[3] = {0, 0, 0}, generate = 0, skipped = 0;
+    for (uint32_t n = 0; n < nn; n++) {
+        sets[n] = lx_bake_uv_set(scene, n, a->desc.uv_set);
+        const char *why = scene->nodes[n].mesh_count ? uvs_problem(scene, n, sets[n]) : NULL;
+        if (scene->nodes[n].mesh_count == 0) {
+            modes[n] = LX_UNWRAP_SKIP;
+        } else if (a->unwrap == UNWRAP_ALWAYS || (a->unwrap == UNWRAP_AUTO && why)) {
+            modes[n] = LX_UNWRAP_GENERATE;
+            generate++;
+            for (int r = 0; r < 3; r++)
+                count[r] += why && strcmp(why, reasons[r]) == 0;
+        } else if (why && strcmp(why, "missing") == 0) {
+            modes[n] = LX_UNWRAP_SKIP; /* --unwrap never: no lightmap */
+            skipped++;
+        } else {
+            modes[n] = LX_UNWRAP_KEEP;
+        }
+    }
+    *atlas = a->atlas == 1 || (a->atlas < 0 && generate > 0);
+    if (generate && a->unwrap == UNWRAP_AUTO) {
+        char detail[160] = "";
+        for (int r = 0, first = 1; r < 3; r++)
+            if (count[r]) {
+                size_t len = strlen(detail);
+                snprintf(detail + len, sizeof detail - len, "%s%s %u", first ? "" : ", ",
+                         reasons[r], count[r]);
+                first = 0;
+            }
+        lx_log(LX_LOG_WARN,
+               "%s: %u of %u nodes have no usable TEXCOORD lightmap UVs (%s): luxel makes "
+               "theirs%s (--unwrap never keeps the file's)",
+               a->scene, generate, nn, detail, *atlas ? " and packs every node into atlas pages" : "");
+    }
+    if (skipped)
+        lx_log(LX_LOG_WARN,
+               "%s: %u nodes have no lightmap UVs and get no lightmap (--unwrap auto makes them)",
+               a->scene, skipped);
+    int status = EXIT_OK;
+    if (*atlas || generate) {
+        lx_unwrap_desc ud = lx_unwrap_desc_defaults(NULL);
+        ud.padding = a->desc.padding;
+        ud.threads = a->desc.threads;
+        if (a->atlas_size)
+            ud.atlas_size = a->atlas_size;
+        ud.modes = modes;
+        ud.keep_uv_sets = sets;
+        ud.page_per_node = !*atlas;
+        if (a->desc.texel_density > 0.0f)
+            ud.texel_density = a->desc.texel_density;
+        else
+            ud.resolution = *atlas && !a->has_resolution ? CLI_ATLAS_RESOLUTION : a->desc.resolution;
+        cli_progress progress;
+        cli_progress_init(&progress, "unwrap", a->quiet);
+        ud.progress = cli_progress_update;
+        ud.progress_user = &progress;
+        lx_status st = lx_unwrap_scene(scene, &ud, out);
+        cli_progress_finish(&progress);
+        if (st == LX_OK && (st = lx_unwrap_apply(scene, *out)) != LX_OK) {
+            lx_unwrap_destroy(*out);
+            *out = NULL;
+        }
+        if (st != LX_OK) {
+            if (st == LX_ERR_CANCELLED)
+                cli_report_interrupt(false);
+            else
+                cli_error("%s: %s", a->scene, lx_last_error());
+            status = EXIT_FAILED;
+        } else {
+            const lx_unwrap *u = *out;
+            lx_log(LX_LOG_INFO, "unwrap: %u charts (%u cut again), %u pages, %.0f%% of their texels covered, "
+                     "stretch %.3f (worst %.3f), %g texels/m",
+                     u->stats.charts, u->stats.recut_charts, u->page_count,
+                     100.0 * u->stats.efficiency, u->stats.stretch_mean, u->stats.stretch_max,
+                     (double)u->texel_density);
+            lx_vec3 lo, hi;
+            if (lx_scene_bounds(scene, &lo, &hi)) {
+                double across = lx_length(lx_sub(hi, lo)) * u->texel_density;
+                if (across < 16.0)
+                    lx_log(LX_LOG_WARN,
+                           "%s: the scene is %.3g m across: at %g texels/m it gets about %.0f "
+                           "texels across; are its units metres?",
+                           a->scene, (double)lx_length(lx_sub(hi, lo)), (double)u->texel_density,
+                           across);
+            }
+            a->desc.atlas = u;
+        }
+    }
+    free(modes);
+    free(sets);
+    return status;
 }
 
 int cmd_bake(int argc, char **argv)
@@ -350,6 +574,8 @@ int cmd_bake(int argc, char **argv)
     uint32_t maps = 0;
     cli_stage stage = {0};
     lx_cubemap sky_env = {0};
+    lx_unwrap *unwrap = NULL;
+    bool atlas = false;
     int status = EXIT_FAILED;
 
     /* the output folder is checked (and made) before any long work: the
@@ -407,6 +633,14 @@ int cmd_bake(int argc, char **argv)
         a.desc.sky = lx_sky_desc_defaults(&given);
     }
     cli_phase(sky.environment ? "lights and sky" : "lights");
+    /* lightmap UVs: the file's, or luxel's where those do not serve */
+    int planned = plan_lightmaps(&a, scene, &unwrap, &atlas);
+    if (planned != EXIT_OK) {
+        status = planned;
+        goto done;
+    }
+    if (unwrap)
+        cli_phase("unwrap");
 
     cli_progress progress;
     cli_progress_init(&progress, "texel maps", a.quiet);
@@ -437,7 +671,12 @@ int cmd_bake(int argc, char **argv)
     }
     for (uint32_t m = 0; m < maps; m++) {
         char stem[256], name[300];
-        file_stem(lx_baker_lightmap_info(baker, m)->name, stems, m, stem, sizeof stem);
+        /* atlas pages are lightmap-<k>; a lightmap of one node is named
+         * after it */
+        const lx_lightmap_info *info = lx_baker_lightmap_info(baker, m);
+        const char *base = !atlas && info->node != UINT32_MAX ? scene->nodes[info->node].name
+                                                               : info->name;
+        file_stem(base, stems, m, stem, sizeof stem);
         if (!(stems[m] = cli_strdup(stem))) {
             cli_error("out of memory");
             goto done;
@@ -521,7 +760,10 @@ int cmd_bake(int argc, char **argv)
         if (sky.shadows)
             cJSON_AddNumberToObject(sk, "samples", a.desc.sky.samples);
     }
-    cJSON *list = cJSON_AddArrayToObject(manifest, "lightmaps");
+    if (a.desc.texel_density > 0.0f || unwrap)
+        cJSON_AddNumberToObject(manifest, "texel_density",
+                                unwrap ? unwrap->texel_density : a.desc.texel_density);
+    cJSON *list = cJSON_AddArrayToObject(manifest, "pages");
     bool failed = false;
     double t_maps = 0.0, t_previews = 0.0;
     /* one bar over every file; Ctrl-C stops the file being written */
@@ -558,9 +800,9 @@ int cmd_bake(int argc, char **argv)
             failed = !cli_stage_image(&stage, preview, &images[m], &pd);
             t_previews += cli_now() - t;
         }
-        cJSON_AddItemToArray(list, manifest_entry(scene, info, file, want_preview ? preview : NULL,
-                                                  a.desc.quantity));
+        cJSON_AddItemToArray(list, page_entry(info, file, want_preview ? preview : NULL));
     }
+    cJSON_AddItemToObject(manifest, "nodes", node_entries(scene, baker, unwrap, &a));
     if (!failed) {
         char *text = cJSON_Print(manifest);
         failed = !text || !cli_stage_text(&stage, "manifest.json", text);
@@ -575,7 +817,8 @@ int cmd_bake(int argc, char **argv)
     if (failed)
         goto done;
     char what[64];
-    snprintf(what, sizeof what, "%u lightmaps (%s)", maps, lx_image_format_extension(a.format));
+    snprintf(what, sizeof what, "%u %s%s (%s)", maps, atlas ? "page" : "lightmap", maps == 1 ? "" : "s",
+             lx_image_format_extension(a.format));
     cli_phase_part(what, t_maps);
     if (a.format != LX_IMAGE_PNG) {
         snprintf(what, sizeof what, "%u previews (png)", maps);
@@ -587,9 +830,10 @@ int cmd_bake(int argc, char **argv)
         for (uint32_t m = 0; m < maps; m++)
             texels += lx_baker_lightmap_info(baker, m)->used_texels;
         fprintf(stderr,
-                "luxel: baked %u lightmaps (%llu texels, %u lights) in %.2f s; preview EV100 "
+                "luxel: baked %u %s%s (%llu texels, %u lights) in %.2f s; preview EV100 "
                 "%.2f%s\n",
-                maps, (unsigned long long)texels, scene->light_count, cli_elapsed(), ev,
+                maps, atlas ? "atlas page" : "lightmap", maps == 1 ? "" : "s",
+                (unsigned long long)texels, scene->light_count, cli_elapsed(), ev,
                 a.has_exposure ? "" : " (auto)");
         printf("%s/manifest.json\n", a.output);
     }
@@ -605,6 +849,7 @@ done:
     free(images);
     free(stems);
     lx_baker_destroy(baker);
+    lx_unwrap_destroy(unwrap);
     lx_cubemap_free(&sky_env);
     lx_scene_destroy(scene);
     return status;
