@@ -296,6 +296,36 @@ static void full_pages_spill_to_new_ones(void **state)
     lx_scene_destroy(scene);
 }
 
+/* page_per_node: every node on pages of its own; without a density, the
+ * largest node fills its page of the resolution. */
+static void pages_of_their_own(void **state)
+{
+    (void)state;
+    lx_mesh torus = lx_test_torus("torus", 1.0, 0.4, 1500);
+    lx_scene *scene = scene_of(&torus, 3, 3.0f);
+    free(torus.positions);
+    free(torus.indices);
+    lx_unwrap_desc d = desc_at(0.0f);
+    d.resolution = 128;
+    d.page_per_node = true;
+    lx_unwrap *u;
+    /* measured: efficiency 0.54 (one torus a page) */
+    check(scene, &d, (expect){0.04, 1.2e-7, 0.48}, &u);
+    assert_int_equal(u->page_count, 3);
+    for (uint32_t n = 0; n < 3; n++)
+        for (uint32_t m = 0; m < n; m++)
+            assert_int_not_equal(u->nodes[n].page, u->nodes[m].page);
+    int side = 0;
+    for (uint32_t p = 0; p < 3; p++) {
+        assert_true(u->pages[p].width <= 128 && u->pages[p].height <= 128);
+        side = u->pages[p].width > side ? u->pages[p].width : side;
+        side = u->pages[p].height > side ? u->pages[p].height : side;
+    }
+    assert_true(side >= 100);
+    lx_unwrap_destroy(u);
+    lx_scene_destroy(scene);
+}
+
 /* Without a density, the one that fills a page of the resolution. */
 static void resolution_fills_one_page(void **state)
 {
@@ -431,6 +461,7 @@ int main(void)
         cmocka_unit_test(threads_give_the_same_uvs),
         cmocka_unit_test(full_pages_spill_to_new_ones),
         cmocka_unit_test(resolution_fills_one_page),
+        cmocka_unit_test(pages_of_their_own),
         cmocka_unit_test(kept_node_square_is_placed),
         cmocka_unit_test(progress_can_cancel),
         cmocka_unit_test(bad_options_are_refused),
