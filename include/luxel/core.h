@@ -135,9 +135,31 @@ lx_status lx_image_load(const char *path, const lx_image_load_desc *desc, lx_ima
 lx_status lx_image_load_memory(const void *bytes, size_t size, const char *name,
                                const lx_image_load_desc *desc, lx_image *out);
 
+/* Tone curves map scene-referred linear values (after exposure) to display
+ * values in [0,1], still linear (the sRGB encoding comes after):
+ * CLAMP cuts at 1; ACES is Stephen Hill's fit of the ACES reference
+ * rendering and output transforms (sRGB primaries in and out, mid grey
+ * 0.18 -> 0.14); FILMIC is John Hable's curve (shoulder A 0.15, B 0.5,
+ * C 0.1, toe D 0.2, E 0.02, F 0.3) with white point 11.2 and the input
+ * doubled, as it is usually shown. Both keep shadows from crushing to
+ * black and highlights from clipping abruptly. */
+typedef enum lx_tonemap { LX_TONEMAP_CLAMP = 0, LX_TONEMAP_ACES, LX_TONEMAP_FILMIC } lx_tonemap;
+
+/* rgb (3 linear values) through curve, in place; the result lies in [0,1]
+ * (NaN stays NaN). Thread-safe. */
+void lx_tonemap_rgb(lx_tonemap curve, float rgb[3]);
+/* One grey value through curve (the same as lx_tonemap_rgb on v, v, v). */
+float lx_tonemap_grey(lx_tonemap curve, float v);
+/* "aces", "filmic" or "clamp"; NULL for another value. */
+const char *lx_tonemap_name(lx_tonemap curve);
+/* The curve named name (as lx_tonemap_name writes it); false when none. */
+bool lx_tonemap_parse(const char *name, lx_tonemap *out);
+
 typedef struct lx_image_write_desc {
     lx_image_format format;  /* 0 = from the path's extension */
     float exposure;          /* multiplier applied to values, 0 = 1 */
+    lx_tonemap tonemap;      /* 8-bit formats: the curve after exposure
+                                (CLAMP by default); float formats ignore it */
     bool half;               /* EXR: 16-bit half floats instead of 32-bit */
     int threads;             /* encoding threads, 0 = all cores */
     lx_progress_fn progress; /* may be NULL; returning false cancels */

@@ -443,6 +443,8 @@ lx_status lx_image_write(const char *path, const lx_image *img, const lx_image_w
     if (!path || !img)
         return lx_fail(LX_ERR_INVALID, "lx_image_write: path and img must not be NULL");
     lx_image_write_desc d = lx_image_write_desc_defaults(desc);
+    if (!lx_tonemap_name(d.tonemap))
+        return lx_fail(LX_ERR_INVALID, "%s: unknown tone curve %d", path, (int)d.tonemap);
     size_t count;
     if (!img->data || img->width < 1 || img->height < 1 || img->channels < 1 || img->channels > 4 ||
         !lx_size_mul((size_t)img->width, (size_t)img->height, (size_t)img->channels, &count))
@@ -485,7 +487,7 @@ lx_status lx_image_write(const char *path, const lx_image *img, const lx_image_w
         s = lx_img_write_exr(f.fp, path, img, exposure, d.half, d.threads, &progress);
         break;
     default:
-        s = lx_img_write_stb(f.fp, path, img, format, exposure, d.threads, &progress);
+        s = lx_img_write_stb(f.fp, path, img, format, exposure, d.tonemap, d.threads, &progress);
         break;
     }
     /* the last word before the file is committed: 1.0, which may still

@@ -492,7 +492,8 @@ static unsigned char encode_unorm8(float v)
 #define LX_PNG_DEFLATE_TO 0.87f
 
 static lx_status write_8bit(FILE *fp, const char *path, const lx_image *img, lx_image_format format,
-                            float exposure, int threads, lx_img_progress *progress)
+                            float exposure, lx_tonemap tonemap, int threads,
+                            lx_img_progress *progress)
 {
     int c = img->channels;
     /* stb_image_write sizes its buffers with int arithmetic */
@@ -516,8 +517,14 @@ static lx_status write_8bit(FILE *fp, const char *path, const lx_image *img, lx_
         for (size_t p = first; p < first + (size_t)img->width; p++) {
             const float *v = img->data + p * (size_t)c;
             unsigned char *b = bytes + p * (size_t)c;
-            for (int k = 0; k < colour; k++)
-                b[k] = encode_srgb8(&enc, v[k] * exposure);
+            if (colour == 3) {
+                float rgb[3] = {v[0] * exposure, v[1] * exposure, v[2] * exposure};
+                lx_tonemap_rgb(tonemap, rgb);
+                for (int k = 0; k < 3; k++)
+                    b[k] = encode_srgb8(&enc, rgb[k]);
+            } else {
+                b[0] = encode_srgb8(&enc, lx_tonemap_grey(tonemap, v[0] * exposure));
+            }
             if (colour < c)
                 b[colour] = encode_unorm8(v[colour]);
         }
@@ -684,9 +691,10 @@ static lx_status write_hdr(FILE *fp, const char *path, const lx_image *img, floa
 }
 
 lx_status lx_img_write_stb(FILE *fp, const char *path, const lx_image *img, lx_image_format format,
-                           float exposure, int threads, lx_img_progress *progress)
+                           float exposure, lx_tonemap tonemap, int threads,
+                           lx_img_progress *progress)
 {
     if (format == LX_IMAGE_HDR)
         return write_hdr(fp, path, img, exposure, threads, progress);
-    return write_8bit(fp, path, img, format, exposure, threads, progress);
+    return write_8bit(fp, path, img, format, exposure, tonemap, threads, progress);
 }
