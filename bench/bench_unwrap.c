@@ -221,7 +221,7 @@ int main(int argc, char **argv)
         lx_scene_destroy(s);
     }
     for (int i = 0; i < model_count; i++) {
-        lx_scene_load_desc ld = {.skip_degenerate = true, .skip_textures = true};
+        lx_scene_load_desc ld = {.skip_textures = true};
         lx_scene *s;
         if (lx_scene_load(models[i], &ld, &s) != LX_OK) {
             printf("  %s: %s\n", models[i], lx_last_error());

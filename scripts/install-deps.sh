@@ -12,6 +12,7 @@ packages=(
     zlib1g-dev         # checks PNG data before stb decodes it
     libopenexr-dev     # OpenEXR (OpenEXRCore C API)
     libsuitesparse-dev # sparse Cholesky (CHOLMOD) for lightmap UV flattening
+    libmeshoptimizer-dev # EXT_meshopt_compression glTF buffers
     libcmocka-dev      # unit tests
     clang libclang-rt-14-dev libomp-dev  # sanitizer and fuzzer builds (clang)
 )

@@ -122,7 +122,8 @@ typedef struct lx_bake_desc {
                                (the one field whose zero is a value, not a default;
                                luxel bake uses LX_PADDING_RECOMMENDED) */
     int threads;            /* 0 = all cores */
-    bool skip_degenerate;   /* zero-UV-area triangles: warn and skip, not fail */
+    bool strict;            /* zero-UV-area triangles fail the bake instead of
+                               being left out with one warning per mesh */
     float shadow_bias;      /* ray origin offset in metres, 0 = scale-aware auto */
     lx_uv_choice uv_set;    /* the lightmap UV set of every node (without an atlas) */
     const lx_unwrap *atlas; /* NULL: a lightmap per node; else one per page of

@@ -62,6 +62,15 @@ typedef struct lx_mesh {
     lx_vec2 *uv[LX_MAX_UV_SETS]; /* vertex_count each, or NULL */
     uint32_t *indices;           /* 3 * triangle_count */
     uint32_t material;           /* index into scene->materials */
+    /* Where the mesh came from, so a writer can map it back to the file.
+     * dropped_triangles: zero-area triangles the importer left out (they
+     * are not in indices). source_mesh, source_primitive: the glTF mesh
+     * and primitive index it is (assimp makes one mesh per primitive,
+     * shared by every node that instances it), -1 when not glTF or not
+     * matched to the file's primitives. lx_scene_add_mesh copies these as
+     * given: set -1 when building meshes by hand. */
+    uint32_t dropped_triangles;
+    int32_t source_mesh, source_primitive;
 } lx_mesh;
 
 /* A texture's KHR_texture_transform (Khronos extension spec): the texture
@@ -103,6 +112,10 @@ typedef struct lx_material {
     int normal_uv_set;                    /* UV set the normal map uses */
     char *normal_map_path;                /* where it came from (for messages), or NULL */
     lx_uv_transform normal_transform;     /* KHR_texture_transform of the map */
+    lx_vec3 emissive; /* linear emitted colour: glTF emissiveFactor times
+                       * KHR_materials_emissive_strength (OBJ's Ke); 0 = none.
+                       * Read for writers and viewers; the baker does not
+                       * treat surfaces as lights. */
 } lx_material;
 
 typedef struct lx_node {
@@ -110,6 +123,8 @@ typedef struct lx_node {
     lx_mat4 world;    /* object to world */
     uint32_t *meshes; /* indices into scene->meshes */
     uint32_t mesh_count;
+    int32_t source_node; /* the glTF node index, -1 when not glTF, not matched
+                          * or added with lx_scene_add_node */
 } lx_node;
 
 #define LX_MAX_SKY_SAMPLES 65536u
@@ -140,20 +155,29 @@ typedef struct lx_scene {
 } lx_scene;
 
 typedef struct lx_scene_load_desc {
-    bool skip_degenerate; /* warn and drop zero-area triangles instead of failing */
-    bool skip_textures;   /* name textures (the *_map_path fields) without
-                             decoding them: the maps stay empty (luxel info) */
+    bool strict;        /* fail (LX_ERR_FORMAT) on zero-area triangles instead
+                           of dropping them with one warning */
+    bool skip_textures; /* name textures (the *_map_path fields) without
+                           decoding them: the maps stay empty (luxel info) */
 } lx_scene_load_desc;
 
 /* A copy of desc (or of zeros when NULL) with every default filled in. */
 lx_scene_load_desc lx_scene_load_desc_defaults(const lx_scene_load_desc *desc);
 
-/* Imports a scene file through assimp: glTF 2.0 (.gltf, .glb) or OBJ
- * (.obj), plus the KHR_lights_punctual lights of glTF files. Other names
- * fail with LX_ERR_UNSUPPORTED (assimp's other readers are not safe on
- * malformed files). desc may be NULL. Triangles of
- * zero area in space, non-finite values and out-of-range indices fail the
- * load with a message naming the mesh (see skip_degenerate). A glTF
+/* Imports a scene file through assimp: glTF 2.0 (.gltf, .glb), OBJ (.obj),
+ * and Collada (.dae), FBX (.fbx), PLY and STL, plus the
+ * KHR_lights_punctual lights of glTF files (other formats' lights are not
+ * read: one warning when a file has some; the lights JSON adds them).
+ * Other names fail with LX_ERR_UNSUPPORTED. desc may be NULL.
+ * glTF extensions: KHR_mesh_quantization, EXT_meshopt_compression (decoded
+ * by luxel before assimp reads the file), KHR_texture_transform,
+ * KHR_materials_emissive_strength and KHR_lights_punctual are read; a file
+ * whose extensionsRequired names any other fails with LX_ERR_UNSUPPORTED
+ * naming it. A scene, buffer or texture that is a Git LFS pointer is named
+ * as one. Triangles of zero area in space are dropped with one warning per
+ * load that counts them (lx_mesh.dropped_triangles), or fail the load with
+ * desc->strict; non-finite values and out-of-range indices fail it with a
+ * message naming the mesh. A glTF
  * material whose KHR_texture_transform cannot be told (assimp's material
  * matches none of the file's through the scene's meshes, and the file's
  * materials of its name state different transforms) fails the load with

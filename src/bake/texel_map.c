@@ -393,10 +393,8 @@ static lx_status check_uv_triangles(const lx_scene *scene, const slot *s, const 
                                                               (c.y - b.y) * (double)(c.y - b.y)));
         skip[t] = 0;
         if (!(fabs(cross) > 1e-7 * longest) || longest == 0.0) {
-            if (!desc->skip_degenerate)
-                return lx_fail(LX_ERR_FORMAT,
-                               "%s: mesh '%s': triangle %u has zero area in TEXCOORD_%d "
-                               "(--skip-degenerate skips such triangles)",
+            if (desc->strict)
+                return lx_fail(LX_ERR_FORMAT, "%s: mesh '%s': triangle %u has zero area in TEXCOORD_%d",
                                scene->path, m->name, t, uv_set);
             skip[t] = 1;
             degenerate++;

@@ -61,6 +61,11 @@ typedef struct lx_gltf_texture_ref {
 lx_status lx_gltf_material_textures(const char *file, const cJSON *material, size_t index,
                                     lx_gltf_texture_ref *base_color, lx_gltf_texture_ref *normal);
 
+/* emissiveFactor times KHR_materials_emissive_strength of glTF material
+ * `index` (zero when it states none). */
+lx_status lx_gltf_material_emissive(const char *file, const cJSON *material, size_t index,
+                                    lx_vec3 *out);
+
 /* The primitives of the file's meshes as the JSON states them, flat in
  * file order: mesh 0's primitives, then mesh 1's, ... (what matches them
  * to assimp's meshes is the node hierarchy: import_assimp.c). */
@@ -85,5 +90,23 @@ typedef struct lx_gltf_primitives {
  * after a failure (which leaves *out empty). */
 lx_status lx_gltf_primitives_read(const char *file, const cJSON *root, lx_gltf_primitives *out);
 void lx_gltf_primitives_free(lx_gltf_primitives *p);
+
+/* ---- what assimp cannot read (gltf_rewrite.c) ---------------------------- */
+
+/* Fails with LX_ERR_UNSUPPORTED naming the first extension in
+ * extensionsRequired that luxel does not read. */
+lx_status lx_gltf_check_required(const char *file, const cJSON *root);
+/* Whether bytes (or the start of the file at path) are a Git LFS pointer. */
+bool lx_lfs_pointer(const void *bytes, size_t size);
+bool lx_lfs_pointer_file(const char *path);
+/* Fails naming the first buffer or image file (uri) that is a Git LFS
+ * pointer. */
+lx_status lx_gltf_check_lfs(const char *path, const cJSON *root);
+/* When the file uses EXT_meshopt_compression or quantized vertex
+ * attributes (KHR_mesh_quantization), decodes them: root is changed in
+ * place (the same nodes, meshes, accessors and materials; new buffers and
+ * bufferViews) and *glb receives the whole file as a GLB (malloc'd) for
+ * assimp. Otherwise *glb is NULL and root unchanged. */
+lx_status lx_gltf_rewrite(const char *path, cJSON *root, uint8_t **glb, size_t *glb_size);
 
 #endif

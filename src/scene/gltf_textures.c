@@ -85,3 +85,31 @@ lx_status lx_gltf_material_textures(const char *file, const cJSON *m, size_t ind
     snprintf(where, sizeof where, "%s: normalTexture", who);
     return read_ref(file, where, lx_gltf_get(m, "normalTexture"), normal);
 }
+
+lx_status lx_gltf_material_emissive(const char *file, const cJSON *m, size_t index, lx_vec3 *out)
+{
+    *out = lx_v3(0, 0, 0);
+    if (!cJSON_IsObject(m))
+        return LX_OK;
+    char who[160];
+    lx_gltf_label(who, sizeof who, "material", index, m);
+    float f[3] = {0, 0, 0}, strength = 1.0f;
+    const cJSON *it = lx_gltf_get(m, "emissiveFactor");
+    if (it && (!lx_gltf_numbers(it, f, 3) || f[0] < 0 || f[1] < 0 || f[2] < 0))
+        return lx_json_fail(LX_ERR_FORMAT, file, who,
+                            "emissiveFactor must be 3 finite numbers >= 0");
+    const cJSON *ext =
+        lx_gltf_get(lx_gltf_get(m, "extensions"), "KHR_materials_emissive_strength");
+    if (ext) {
+        it = lx_gltf_get(ext, "emissiveStrength");
+        if (!cJSON_IsObject(ext) || (it && (!lx_gltf_number(it, &strength) || strength < 0)))
+            return lx_json_fail(LX_ERR_FORMAT, file, who,
+                                "KHR_materials_emissive_strength: emissiveStrength must be a "
+                                "finite number >= 0");
+    }
+    *out = lx_v3(f[0] * strength, f[1] * strength, f[2] * strength);
+    if (!lx_vec3_finite(*out))
+        return lx_json_fail(LX_ERR_FORMAT, file, who,
+                            "emissiveFactor times emissiveStrength overflows a float");
+    return LX_OK;
+}

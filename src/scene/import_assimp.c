@@ -14,6 +14,7 @@
 #include "gltf_json.h"
 #include "json_text.h"
 
+#include <assimp/cfileio.h>
 #include <assimp/cimport.h>
 #include <assimp/GltfMaterial.h>
 #include <assimp/config.h>
@@ -46,6 +47,9 @@ typedef struct import_ctx {
     const gltf_map *map; /* assimp's meshes and materials in it, with gltf */
     bool log_watched;    /* assimp's log was watched during the import ... */
     bool log_dropped;    /* ... and told of faces dropped for bad indices */
+    uint32_t dropped, dropped_meshes; /* zero-area triangles left out, and their meshes */
+    char first_dropped[LX_NAME_MAX];  /* the first mesh with one ... */
+    unsigned first_dropped_face;      /* ... and its face */
 } import_ctx;
 
 /* ---- running assimp ------------------------------------------------------ */
@@ -133,6 +137,149 @@ static uint64_t post_processing_bytes(const struct aiScene *ai)
  * beside them. */
 static _Atomic uint64_t post_processing_reserved;
 
+/* ---- the files assimp opens ---------------------------------------------- */
+
+/* Every import reads through these callbacks: one name may be served from
+ * memory (a glTF file luxel has rewritten, gltf_rewrite.c), and a path
+ * written with Windows backslashes (an OBJ's mtllib, a relative uri) that
+ * does not exist as written is tried with slashes. */
+typedef struct import_source {
+    const char *read_path; /* the name assimp is given */
+    const uint8_t *bytes;  /* served for read_path when not NULL */
+    size_t size;
+} import_source;
+
+typedef struct io_file {
+    FILE *fp;
+    const uint8_t *bytes;
+    size_t size, pos;
+} io_file;
+
+static size_t io_read(struct aiFile *f, char *buf, size_t size, size_t count)
+{
+    io_file *h = (io_file *)(void *)f->UserData;
+    if (h->fp)
+        return size ? fread(buf, size, count, h->fp) : 0;
+    if (!size || h->pos >= h->size)
+        return 0;
+    size_t n = (h->size - h->pos) / size;
+    if (n > count)
+        n = count;
+    memcpy(buf, h->bytes + h->pos, n * size);
+    h->pos += n * size;
+    return n;
+}
+
+static size_t io_write(struct aiFile *f, const char *buf, size_t size, size_t count)
+{
+    (void)f, (void)buf, (void)size, (void)count;
+    return 0;
+}
+
+static size_t io_tell(struct aiFile *f)
+{
+    io_file *h = (io_file *)(void *)f->UserData;
+    if (h->fp) {
+        long at = ftell(h->fp);
+        return at < 0 ? 0 : (size_t)at;
+    }
+    return h->pos;
+}
+
+static size_t io_size(struct aiFile *f)
+{
+    return ((io_file *)(void *)f->UserData)->size;
+}
+
+static enum aiReturn io_seek(struct aiFile *f, size_t offset, enum aiOrigin origin)
+{
+    io_file *h = (io_file *)(void *)f->UserData;
+    size_t base = origin == aiOrigin_SET ? 0 : origin == aiOrigin_CUR ? io_tell(f) : h->size;
+    if (offset > SIZE_MAX - base || base + offset > h->size)
+        return aiReturn_FAILURE;
+    if (h->fp)
+        return fseek(h->fp, (long)(base + offset), SEEK_SET) == 0 ? aiReturn_SUCCESS
+                                                                  : aiReturn_FAILURE;
+    h->pos = base + offset;
+    return aiReturn_SUCCESS;
+}
+
+static void io_flush(struct aiFile *f)
+{
+    (void)f;
+}
+
+static FILE *open_slashed(const char *path)
+{
+    FILE *fp = fopen(path, "rb");
+    if (fp || !strchr(path, '\\'))
+        return fp;
+    char *alt = lx_strdup(path);
+    if (!alt)
+        return NULL;
+    for (char *p = alt; *p; p++)
+        if (*p == '\\')
+            *p = '/';
+    fp = fopen(alt, "rb");
+    free(alt);
+    return fp;
+}
+
+static struct aiFile *io_open(struct aiFileIO *io, const char *path, const char *mode)
+{
+    const import_source *src = (const import_source *)(void *)io->UserData;
+    if (!path || (mode && (strchr(mode, 'w') || strchr(mode, 'a'))))
+        return NULL;
+    io_file *h = calloc(1, sizeof *h);
+    struct aiFile *f = calloc(1, sizeof *f);
+    if (!h || !f) {
+        free(h);
+        free(f);
+        return NULL;
+    }
+    if (src->bytes && strcmp(path, src->read_path) == 0) {
+        h->bytes = src->bytes;
+        h->size = src->size;
+    } else {
+        struct stat sb;
+        h->fp = open_slashed(path);
+        if (!h->fp || fstat(fileno(h->fp), &sb) != 0 || !S_ISREG(sb.st_mode)) {
+            if (h->fp)
+                fclose(h->fp);
+            free(h);
+            free(f);
+            return NULL;
+        }
+        h->size = (size_t)sb.st_size;
+    }
+    f->ReadProc = io_read;
+    f->WriteProc = io_write;
+    f->TellProc = io_tell;
+    f->FileSizeProc = io_size;
+    f->SeekProc = io_seek;
+    f->FlushProc = io_flush;
+    f->UserData = (aiUserData)(void *)h;
+    return f;
+}
+
+static void io_close(struct aiFileIO *io, struct aiFile *f)
+{
+    (void)io;
+    if (!f)
+        return;
+    io_file *h = (io_file *)(void *)f->UserData;
+    if (h && h->fp)
+        fclose(h->fp);
+    free(h);
+    free(f);
+}
+
+static struct aiFileIO io_for(const import_source *src)
+{
+    struct aiFileIO io = {io_open, io_close, (aiUserData)(void *)src};
+    return io;
+}
+
 static lx_status import_failed(const char *path, const char *why)
 {
     return lx_fail(LX_ERR_FORMAT, "%s: cannot import: %s", path,
@@ -149,16 +296,18 @@ static struct aiPropertyStore *import_properties(void)
 
 /* The whole import in one call holding assimp_lock exclusively, with the
  * log watched for dropped faces when watch_log. */
-static lx_status import_exclusive(const char *path, bool watch_log, assimp_import *im)
+static lx_status import_exclusive(const char *path, const import_source *src, bool watch_log,
+                                  assimp_import *im)
 {
+    struct aiFileIO io = io_for(src);
     struct aiPropertyStore *props = import_properties();
     struct aiLogStream log = {on_assimp_log, (char *)(void *)&im->dropped};
     pthread_rwlock_wrlock(&assimp_lock);
     im->exclusive = true;
     if (watch_log)
         aiAttachLogStream(&log);
-    im->ai = aiImportFileExWithProperties(path, POST_FLAGS | aiProcess_ValidateDataStructure, NULL,
-                                          props);
+    im->ai = aiImportFileExWithProperties(src->read_path,
+                                          POST_FLAGS | aiProcess_ValidateDataStructure, &io, props);
     if (watch_log)
         aiDetachLogStream(&log);
     char why[512];
@@ -174,16 +323,18 @@ static lx_status import_exclusive(const char *path, bool watch_log, assimp_impor
 /* Imports path with luxel's post-processing into im->ai, holding
  * assimp_lock until assimp_release (also on failure, when im->ai is
  * NULL and the lock is already let go). */
-static lx_status assimp_import_file(const char *path, bool watch_log, assimp_import *im)
+static lx_status assimp_import_file(const char *path, const import_source *src, bool watch_log,
+                                   assimp_import *im)
 {
     memset(im, 0, sizeof *im);
     if (watch_log)
-        return import_exclusive(path, true, im);
+        return import_exclusive(path, src, true, im);
+    struct aiFileIO io = io_for(src);
     struct aiPropertyStore *props = import_properties();
     pthread_rwlock_rdlock(&assimp_lock);
     pthread_mutex_lock(&reader_lock);
     const struct aiScene *ai =
-        aiImportFileExWithProperties(path, aiProcess_ValidateDataStructure, NULL, props);
+        aiImportFileExWithProperties(src->read_path, aiProcess_ValidateDataStructure, &io, props);
     char why[512];
     snprintf(why, sizeof why, "%s", ai ? "" : aiGetErrorString());
     pthread_mutex_unlock(&reader_lock);
@@ -198,7 +349,7 @@ static lx_status assimp_import_file(const char *path, bool watch_log, assimp_imp
         atomic_fetch_sub(&post_processing_reserved, need);
         aiReleaseImport(ai);
         pthread_rwlock_unlock(&assimp_lock);
-        return import_exclusive(path, false, im);
+        return import_exclusive(path, src, false, im);
     }
     im->ai = aiApplyPostProcessing(ai, POST_FLAGS);
     atomic_fetch_sub(&post_processing_reserved, need);
@@ -321,6 +472,21 @@ static void load_texture(import_ctx *c, const struct aiString *tex_path, bool ra
         full = lx_path_join(c->folder, p);
         if (!full)
             return;
+        struct stat sb;
+        if (stat(full, &sb) != 0 && strchr(full, '\\')) {
+            /* written on Windows: textures\\wood.png */
+            for (char *q = full + strlen(c->folder); *q; q++)
+                if (*q == '\\')
+                    *q = '/';
+        }
+        if (lx_lfs_pointer_file(full)) {
+            lx_log(LX_LOG_WARN,
+                   "%s: material '%s': %s texture %s is a Git LFS pointer, not the file: run git "
+                   "lfs pull; ignored",
+                   c->path, material, what, full);
+            free(full);
+            return;
+        }
         st = lx_image_load(full, &ld, out);
     }
     if (st != LX_OK) {
@@ -364,6 +530,13 @@ struct gltf_map {
     size_t *prim_of;      /* per aiMesh: its primitive in prims, or PRIM_* */
     int64_t *material_of; /* per aiMaterial: a JSON material index, LX_GLTF_NO_MATERIAL
                            * (assimp's default material), or MAT_* */
+    struct node_pair *pairs; /* aiNode -> JSON node, sorted by aiNode once built */
+    size_t pair_count, pair_cap;
+};
+
+struct node_pair {
+    const struct aiNode *ai;
+    size_t json;
 };
 
 static void gltf_map_free(gltf_map *g)
@@ -373,6 +546,7 @@ static void gltf_map_free(gltf_map *g)
     free(g->materials);
     free(g->prim_of);
     free(g->material_of);
+    free(g->pairs);
     memset(g, 0, sizeof *g);
 }
 
@@ -419,6 +593,16 @@ static void map_node(gltf_map *g, const struct aiScene *ai, size_t jn, const str
         map_spoil(g, ai, an, depth);
         return;
     }
+    if (g->pair_count == g->pair_cap) {
+        size_t cap = g->pair_cap ? 2 * g->pair_cap : 64;
+        struct node_pair *p = realloc(g->pairs, cap * sizeof *p);
+        if (p) {
+            g->pairs = p;
+            g->pair_cap = cap;
+        }
+    }
+    if (g->pair_count < g->pair_cap) /* out of memory: the node stays unmatched */
+        g->pairs[g->pair_count++] = (struct node_pair){an, jn};
     const cJSON *mesh = lx_gltf_get(node, "mesh");
     size_t m = 0;
     bool lined_up = mesh ? lx_gltf_index(mesh, g->prims.mesh_count, &m) : an->mNumMeshes == 0;
@@ -484,6 +668,32 @@ static void map_scene(gltf_map *g, const struct aiScene *ai, const cJSON *root)
             map_node(g, ai, index, an->mChildren[k++], 1);
 }
 
+static int pair_order(const void *a, const void *b)
+{
+    uintptr_t x = (uintptr_t)((const struct node_pair *)a)->ai;
+    uintptr_t y = (uintptr_t)((const struct node_pair *)b)->ai;
+    return x < y ? -1 : x > y;
+}
+
+/* The JSON node an aiNode is, or -1 (unmatched, or paired twice). */
+static int32_t map_node_index(const gltf_map *g, const struct aiNode *an)
+{
+    if (!g || !g->pair_count)
+        return -1;
+    size_t lo = 0, hi = g->pair_count;
+    while (lo < hi) {
+        size_t mid = lo + (hi - lo) / 2;
+        if ((uintptr_t)g->pairs[mid].ai < (uintptr_t)an)
+            lo = mid + 1;
+        else
+            hi = mid;
+    }
+    if (lo == g->pair_count || g->pairs[lo].ai != an ||
+        (lo + 1 < g->pair_count && g->pairs[lo + 1].ai == an))
+        return -1;
+    return g->pairs[lo].json <= INT32_MAX ? (int32_t)g->pairs[lo].json : -1;
+}
+
 static lx_status gltf_map_build(const import_ctx *c, gltf_map *g)
 {
     memset(g, 0, sizeof *g);
@@ -517,6 +727,7 @@ static lx_status gltf_map_build(const import_ctx *c, gltf_map *g)
     for (unsigned k = 0; k < ai->mNumMaterials; k++)
         g->material_of[k] = MAT_UNKNOWN;
     map_scene(g, ai, c->gltf);
+    qsort(g->pairs, g->pair_count, sizeof *g->pairs, pair_order);
     unsigned unmatched = 0;
     for (unsigned k = 0; k < ai->mNumMeshes; k++)
         unmatched += g->prim_of[k] >= g->prims.count;
@@ -642,6 +853,19 @@ static lx_status import_materials(import_ctx *c)
                            "%s: material '%s': base colour is not a finite "
                            "non-negative colour",
                            c->path, name_buf);
+        if (aiGetMaterialColor(am, AI_MATKEY_COLOR_EMISSIVE, &col) == aiReturn_SUCCESS &&
+            isfinite(col.r) && isfinite(col.g) && isfinite(col.b) && col.r >= 0 && col.g >= 0 &&
+            col.b >= 0)
+            m.emissive = lx_v3(col.r, col.g, col.b);
+        if (c->map && c->map->material_of[i] >= 0 &&
+            (size_t)c->map->material_of[i] < c->map->material_count) {
+            /* assimp 5.2.5 drops KHR_materials_emissive_strength */
+            size_t j = (size_t)c->map->material_of[i];
+            lx_status est =
+                lx_gltf_material_emissive(c->path, c->map->materials[j], j, &m.emissive);
+            if (est != LX_OK)
+                return est;
+        }
         struct aiString tex;
         bool has_normal = aiGetMaterialTexture(am, aiTextureType_NORMALS, 0, &tex, NULL, NULL, NULL,
                                                NULL, NULL, NULL) == aiReturn_SUCCESS;
@@ -803,21 +1027,19 @@ static lx_status import_mesh(import_ctx *c, unsigned i)
             goto done;
         }
         if (lx_triangle_degenerate(m.positions[dst[0]], m.positions[dst[1]], m.positions[dst[2]])) {
-            if (!c->desc->skip_degenerate) {
-                st = lx_fail(LX_ERR_FORMAT,
-                             "%s: mesh '%s': triangle %u has zero area "
-                             "(--skip-degenerate drops such triangles)",
-                             c->path, name, f);
-                goto done;
+            if (c->dropped == 0 && skipped == 0) {
+                snprintf(c->first_dropped, sizeof c->first_dropped, "%s", name);
+                c->first_dropped_face = f;
             }
             skipped++;
             continue;
         }
         tri++;
     }
-    if (skipped)
-        lx_log(LX_LOG_WARN, "%s: mesh '%s': %u zero-area triangles skipped", c->path, name,
-               skipped);
+    if (skipped) {
+        c->dropped += skipped;
+        c->dropped_meshes++;
+    }
     if (not_tri)
         lx_log(LX_LOG_WARN, "%s: mesh '%s': %u point/line primitives skipped", c->path, name,
                not_tri);
@@ -826,6 +1048,15 @@ static lx_status import_mesh(import_ctx *c, unsigned i)
         goto done;
     }
     m.triangle_count = tri;
+    m.dropped_triangles = skipped;
+    m.source_mesh = m.source_primitive = -1;
+    if (c->map && c->map->prim_of[i] < c->map->prims.count) {
+        size_t f = c->map->prim_of[i];
+        m.source_mesh = (int32_t)c->map->prims.mesh[f];
+        m.source_primitive = (int32_t)(f - c->map->prims.first[m.source_mesh]);
+    }
+    if (c->desc->strict && c->dropped)
+        goto done; /* the load fails once every mesh is counted */
     st = lx_scene_add_mesh(c->scene, &m, &c->mesh_map[i]);
 done:
     free(m.positions);
@@ -890,7 +1121,10 @@ static lx_status import_node(import_ctx *c, const struct aiNode *node, const lx_
             else
                 snprintf(base, sizeof base, "node%u", *counter - 1);
             unique_node_name(c->scene, base, name, sizeof name);
-            st = lx_scene_add_node(c->scene, name, &world, meshes, n, NULL);
+            uint32_t index;
+            st = lx_scene_add_node(c->scene, name, &world, meshes, n, &index);
+            if (st == LX_OK)
+                c->scene->nodes[index].source_node = map_node_index(c->map, node);
         }
         free(meshes);
         if (st != LX_OK)
@@ -978,12 +1212,13 @@ static bool read_by_gltf2(const struct aiScene *ai)
  * try), a glTF 2.0 triangle mesh whose faces the JSON cannot vouch for
  * sets *need_log and ends the import early with LX_OK and no scene; the
  * caller then imports the file again with assimp's log watched. */
-static lx_status import_scene(const char *path, const lx_scene_load_desc *desc, const cJSON *gltf,
-                              bool gltf2, bool watch_log, bool *need_log, lx_scene **out)
+static lx_status import_scene(const char *path, const import_source *src,
+                              const lx_scene_load_desc *desc, const cJSON *gltf, bool gltf2,
+                              bool watch_log, bool *need_log, lx_scene **out)
 {
     *need_log = false;
     assimp_import im;
-    lx_status st = assimp_import_file(path, watch_log, &im);
+    lx_status st = assimp_import_file(path, src, watch_log, &im);
     if (st != LX_OK)
         return st;
     const struct aiScene *ai = im.ai;
@@ -1040,6 +1275,13 @@ static lx_status import_scene(const char *path, const lx_scene_load_desc *desc, 
         st = import_materials(&c);
     for (unsigned i = 0; st == LX_OK && i < ai->mNumMeshes; i++)
         st = import_mesh(&c, i);
+    if (st == LX_OK && c.dropped && desc->strict)
+        st = lx_fail(LX_ERR_FORMAT,
+                     "%s: %u zero-area triangles in %u meshes, the first in mesh '%s' (face %u)",
+                     path, c.dropped, c.dropped_meshes, c.first_dropped, c.first_dropped_face);
+    else if (st == LX_OK && c.dropped)
+        lx_log(LX_LOG_WARN, "%s: %u zero-area triangles left out (of %u meshes)", path, c.dropped,
+               c.dropped_meshes);
     if (st == LX_OK) {
         lx_mat4 root = lx_mat4_identity();
         uint32_t counter = 0;
@@ -1047,6 +1289,11 @@ static lx_status import_scene(const char *path, const lx_scene_load_desc *desc, 
     }
     if (st == LX_OK && gltf)
         st = lx_gltf_lights_from_json(c.scene, path, gltf);
+    else if (st == LX_OK && ai->mNumLights)
+        lx_log(LX_LOG_WARN,
+               "%s: %u lights left out: luxel reads lights from glTF files only (give them with "
+               "--lights)",
+               path, ai->mNumLights);
     assimp_release(&im);
     gltf_map_free(&map);
     free(c.mesh_map);
@@ -1081,14 +1328,22 @@ lx_status lx_scene_load(const char *path, const lx_scene_load_desc *in, lx_scene
     if (!probe)
         return lx_fail(LX_ERR_IO, "%s: cannot open: permission denied or unreadable", path);
     fclose(probe);
+    if (lx_lfs_pointer_file(path))
+        return lx_fail(LX_ERR_FORMAT, "%s is a Git LFS pointer, not the file: run git lfs pull",
+                       path);
     /* assimp picks a reader by the name and, failing that, by sniffing the
      * bytes, and some of its readers overrun buffers on malformed input
      * (OpenGEX on 20 bytes of "vertexarray (attrib)"): it only gets the
-     * formats luxel supports, each checked below before assimp reads it */
-    if (!has_extension(path, ".gltf") && !has_extension(path, ".glb") &&
-        !has_extension(path, ".obj"))
+     * formats luxel lists, the glTF and OBJ ones checked below first */
+    static const char *const formats[] = {".gltf", ".glb", ".obj", ".dae", ".fbx", ".ply", ".stl"};
+    bool listed = false;
+    for (size_t i = 0; i < sizeof formats / sizeof formats[0] && !listed; i++)
+        listed = has_extension(path, formats[i]);
+    if (!listed)
         return lx_fail(LX_ERR_UNSUPPORTED,
-                       "%s: not a scene luxel reads (it reads .gltf, .glb and .obj files)", path);
+                       "%s: not a scene luxel reads (it reads .gltf, .glb, .obj, .dae, .fbx, .ply "
+                       "and .stl files)",
+                       path);
 
     if (has_extension(path, ".obj")) {
         lx_status st = check_obj_numbers(path);
@@ -1108,17 +1363,40 @@ lx_status lx_scene_load(const char *path, const lx_scene_load_desc *in, lx_scene
     if (kind == LX_GLTF_NONE && has_extension(path, ".gltf"))
         return lx_fail(LX_ERR_FORMAT, "%s: not glTF: the file is not JSON text", path);
     cJSON *gltf = NULL;
+    uint8_t *glb = NULL;
+    size_t glb_size = 0;
+    char *read_path = NULL;
     if (kind != LX_GLTF_NONE) {
         lx_status st = lx_gltf_json_read(path, &gltf);
-        if (st != LX_OK)
+        if (st == LX_OK)
+            st = lx_gltf_check_required(path, gltf);
+        if (st == LX_OK)
+            st = lx_gltf_check_lfs(path, gltf);
+        if (st == LX_OK && lx_gltf_is_v2(gltf))
+            st = lx_gltf_rewrite(path, gltf, &glb, &glb_size);
+        /* assimp tells GLB from glTF text by the name */
+        if (st == LX_OK && glb && !has_extension(path, ".glb")) {
+            size_t n = strlen(path);
+            if ((read_path = malloc(n + 5)) != NULL)
+                memcpy(read_path, path, n), memcpy(read_path + n, ".glb", 5);
+            else
+                st = lx_fail(LX_ERR_NOMEM, "%s: out of memory", path);
+        }
+        if (st != LX_OK) {
+            cJSON_Delete(gltf);
+            free(glb);
             return st;
+        }
     }
+    import_source src = {.read_path = read_path ? read_path : path, .bytes = glb, .size = glb_size};
     bool gltf2 = gltf && lx_gltf_is_v2(gltf);
     bool need_log = false;
-    lx_status st = import_scene(path, desc, gltf, gltf2, false, &need_log, out);
+    lx_status st = import_scene(path, &src, desc, gltf, gltf2, false, &need_log, out);
     /* a mesh the JSON cannot vouch for: assimp's log must tell */
     if (st == LX_OK && need_log)
-        st = import_scene(path, desc, gltf, gltf2, true, &need_log, out);
+        st = import_scene(path, &src, desc, gltf, gltf2, true, &need_log, out);
     cJSON_Delete(gltf);
+    free(glb);
+    free(read_path);
     return st;
 }

@@ -6,7 +6,7 @@
  * like examples/gen_scenes' room (three nodes with TEXCOORD_1, two
  * KHR_lights_punctual lights), and bad input: missing, unreadable, garbage,
  * empty or truncated files, non-finite positions, zero-area triangles with
- * and without skip_degenerate, out-of-range indices. Every failure must name
+ * (dropped and counted; refused in strict mode), out-of-range indices. Every failure must name
  * the file. */
 #define _GNU_SOURCE /* setresuid, setgroups */
 #include <stdarg.h>
@@ -728,9 +728,9 @@ static void test_nonfinite_obj(void **state)
                  values[i]);
         write_text(path, text);
         load_fails(path, NULL, LX_ERR_FORMAT, "not finite", "tri");
-        /* skipping degenerate triangles does not let it through */
-        lx_scene_load_desc skip = {.skip_degenerate = true};
-        load_fails(path, &skip, LX_ERR_FORMAT, "not finite", NULL);
+        /* neither does strict mode change the message */
+        lx_scene_load_desc strict = {.strict = true};
+        load_fails(path, &strict, LX_ERR_FORMAT, "not finite", NULL);
     }
 }
 
@@ -814,11 +814,13 @@ static void test_degenerate_obj(void **state)
     char path[1024];
     path_in(path, sizeof path, dir, "degenerate.obj");
     write_text(path, degenerate_obj);
-    load_fails(path, NULL, LX_ERR_FORMAT, "zero area", "floor");
-    lx_scene_load_desc skip = {.skip_degenerate = true};
-    lx_scene *s = load_ok(path, &skip);
+    /* dropped by default (counted), refused in strict mode */
+    lx_scene_load_desc strict = {.strict = true};
+    load_fails(path, &strict, LX_ERR_FORMAT, "1 zero-area triangles", "floor");
+    lx_scene *s = load_ok(path, NULL);
     assert_int_equal(s->mesh_count, 1);
     assert_int_equal(s->meshes[0].triangle_count, 2);
+    assert_int_equal(s->meshes[0].dropped_triangles, 1);
     lx_scene_destroy(s);
 }
 
@@ -842,11 +844,13 @@ static void test_degenerate_gltf(void **state)
     char path[1024];
     path_in(path, sizeof path, dir, "degenerate.gltf");
     gb_write_gltf(&g, path);
-    load_fails(path, NULL, LX_ERR_FORMAT, "zero area", "sliver");
-    lx_scene_load_desc skip = {.skip_degenerate = true};
-    lx_scene *s = load_ok(path, &skip);
+    /* dropped by default (counted), refused in strict mode */
+    lx_scene_load_desc strict = {.strict = true};
+    load_fails(path, &strict, LX_ERR_FORMAT, "1 zero-area triangles", "sliver");
+    lx_scene *s = load_ok(path, NULL);
     assert_int_equal(s->mesh_count, 1);
     assert_int_equal(s->meshes[0].triangle_count, 2);
+    assert_int_equal(s->meshes[0].dropped_triangles, 1);
     lx_scene_destroy(s);
 }
 

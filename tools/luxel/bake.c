@@ -61,8 +61,8 @@ static const char *bake_usage =
     "                          (default: pages whenever luxel makes UVs)\n"
     "  --atlas-size N          largest atlas page side (default %d)\n"
     "  --threads N             worker threads (default: all cores)\n"
-    "  --skip-degenerate       skip zero-area triangles with a warning instead of\n"
-    "                          failing\n"
+    "  --skip-degenerate       accepted for old scripts: zero-area triangles are\n"
+    "                          always left out with a warning\n"
     "  -v, --verbose           the time of each phase, and notes\n"
     "  -q, --quiet             no progress bar or summary\n"
     "  -h, --help              show this help\n";
@@ -247,8 +247,7 @@ static int parse_args(int argc, char **argv, bake_args *a)
                                        optarg);
             a->desc.threads = (int)n;
             break;
-        case OPT_SKIP_DEGENERATE:
-            a->desc.skip_degenerate = true;
+        case OPT_SKIP_DEGENERATE: /* the default now */
             break;
         case OPT_SKY:
             a->sky = optarg;
@@ -583,7 +582,7 @@ int cmd_bake(int argc, char **argv)
     if (!cli_stage_begin(&stage, a.output))
         goto done;
 
-    lx_scene_load_desc ld = {.skip_degenerate = a.desc.skip_degenerate};
+    lx_scene_load_desc ld = {.strict = a.desc.strict};
     if (lx_scene_load(a.scene, &ld, &scene) != LX_OK) {
         cli_error("%s", lx_last_error());
         goto done;
