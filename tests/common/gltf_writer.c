@@ -25,9 +25,10 @@ typedef struct text {
 struct lx_test_gltf {
     unsigned char *bin;
     size_t bin_size, bin_cap;
-    text accessors, views, meshes, nodes, roots, materials, textures, images, used, scenes, top;
+    text accessors, views, meshes, nodes, roots, materials, textures, images, used, scenes, top,
+        required, buffers;
     int accessor_count, view_count, mesh_count, node_count, material_count, texture_count,
-        used_count, root_count;
+        used_count, root_count, required_count, buffer_count;
 };
 
 static void add(text *t, const char *fmt, ...)
@@ -68,15 +69,15 @@ void lx_test_gltf_free(lx_test_gltf *g)
     if (!g)
         return;
     text *all[] = {&g->accessors, &g->views,  &g->meshes, &g->nodes,  &g->roots, &g->materials,
-                   &g->textures,  &g->images, &g->used,   &g->scenes, &g->top};
+                   &g->textures,  &g->images, &g->used,   &g->scenes, &g->top, &g->required,
+                   &g->buffers};
     for (size_t i = 0; i < sizeof all / sizeof all[0]; i++)
         free(all[i]->s);
     free(g->bin);
     free(g);
 }
 
-/* Appends bytes as a bufferView (4-byte aligned); returns its index. */
-static int view(lx_test_gltf *g, const void *bytes, size_t size)
+size_t lx_test_gltf_bytes(lx_test_gltf *g, const void *bytes, size_t size)
 {
     size_t start = (g->bin_size + 3) / 4 * 4;
     if (start + size > g->bin_cap) {
@@ -89,9 +90,54 @@ static int view(lx_test_gltf *g, const void *bytes, size_t size)
     memset(g->bin + g->bin_size, 0, start - g->bin_size);
     memcpy(g->bin + start, bytes, size);
     g->bin_size = start + size;
-    add(&g->views, "%s{\"buffer\":0,\"byteOffset\":%zu,\"byteLength\":%zu}",
-        g->view_count ? "," : "", start, size);
+    return start;
+}
+
+int lx_test_gltf_view(lx_test_gltf *g, const void *bytes, size_t size, int stride)
+{
+    size_t start = lx_test_gltf_bytes(g, bytes, size);
+    add(&g->views, "%s{\"buffer\":0,\"byteOffset\":%zu,\"byteLength\":%zu", g->view_count ? "," : "",
+        start, size);
+    if (stride > 0)
+        add(&g->views, ",\"byteStride\":%d", stride);
+    add(&g->views, "}");
     return g->view_count++;
+}
+
+int lx_test_gltf_view_json(lx_test_gltf *g, const char *json)
+{
+    add(&g->views, "%s%s", g->view_count ? "," : "", json);
+    return g->view_count++;
+}
+
+int lx_test_gltf_accessor_json(lx_test_gltf *g, const char *json)
+{
+    add(&g->accessors, "%s%s", g->accessor_count ? "," : "", json);
+    return g->accessor_count++;
+}
+
+int lx_test_gltf_mesh_json(lx_test_gltf *g, const char *json)
+{
+    add(&g->meshes, "%s%s", g->mesh_count ? "," : "", json);
+    return g->mesh_count++;
+}
+
+int lx_test_gltf_buffer_json(lx_test_gltf *g, const char *json)
+{
+    add(&g->buffers, ",%s", json);
+    return ++g->buffer_count;
+}
+
+void lx_test_gltf_require_extension(lx_test_gltf *g, const char *name)
+{
+    lx_test_gltf_use_extension(g, name);
+    add(&g->required, "%s\"%s\"", g->required_count++ ? "," : "", name);
+}
+
+/* Appends bytes as a bufferView (4-byte aligned); returns its index. */
+static int view(lx_test_gltf *g, const void *bytes, size_t size)
+{
+    return lx_test_gltf_view(g, bytes, size, 0);
 }
 
 static int float_accessor(lx_test_gltf *g, const float *data, int count, int comps, bool minmax)
@@ -223,32 +269,78 @@ static void base64(text *out, const unsigned char *in, size_t n)
     }
 }
 
-void lx_test_gltf_write(const lx_test_gltf *g, const char *path)
+/* The JSON of the file; buffer 0 as a data: URI unless glb. */
+static void json_text(const lx_test_gltf *g, text *j, bool glb)
 {
-    text j = {0};
-    add(&j, "{\"asset\":{\"version\":\"2.0\",\"generator\":\"luxel tests\"}");
+    add(j, "{\"asset\":{\"version\":\"2.0\",\"generator\":\"luxel tests\"}");
     if (g->used_count)
-        add(&j, ",\"extensionsUsed\":[%s]", str(&g->used));
+        add(j, ",\"extensionsUsed\":[%s]", str(&g->used));
+    if (g->required_count)
+        add(j, ",\"extensionsRequired\":[%s]", str(&g->required));
     if (g->scenes.len)
-        add(&j, ",%s", str(&g->scenes));
+        add(j, ",%s", str(&g->scenes));
     else
-        add(&j, ",\"scene\":0,\"scenes\":[{\"nodes\":[%s]}]", str(&g->roots));
-    add(&j, ",\"nodes\":[%s]%s", str(&g->nodes), str(&g->top));
-    add(&j, ",\"meshes\":[%s],\"accessors\":[%s],\"bufferViews\":[%s]", str(&g->meshes),
+        add(j, ",\"scene\":0,\"scenes\":[{\"nodes\":[%s]}]", str(&g->roots));
+    add(j, ",\"nodes\":[%s]%s", str(&g->nodes), str(&g->top));
+    add(j, ",\"meshes\":[%s],\"accessors\":[%s],\"bufferViews\":[%s]", str(&g->meshes),
         str(&g->accessors), str(&g->views));
     if (g->material_count)
-        add(&j, ",\"materials\":[%s]", str(&g->materials));
+        add(j, ",\"materials\":[%s]", str(&g->materials));
     if (g->texture_count)
-        add(&j, ",\"textures\":[%s],\"images\":[%s]", str(&g->textures), str(&g->images));
-    add(&j, ",\"buffers\":[{\"byteLength\":%zu,\"uri\":\"data:application/octet-stream;base64,",
-        g->bin_size);
-    base64(&j, g->bin, g->bin_size);
-    add(&j, "\"}]}");
+        add(j, ",\"textures\":[%s],\"images\":[%s]", str(&g->textures), str(&g->images));
+    add(j, ",\"buffers\":[{\"byteLength\":%zu", g->bin_size);
+    if (!glb) {
+        add(j, ",\"uri\":\"data:application/octet-stream;base64,");
+        base64(j, g->bin, g->bin_size);
+        add(j, "\"");
+    }
+    add(j, "}%s]}", str(&g->buffers));
+}
+
+static void write_bytes(const char *path, const void *bytes, size_t size)
+{
     FILE *fp = fopen(path, "wb");
     if (!fp)
         fail_msg("cannot write %s", path);
-    assert_int_equal(fwrite(j.s, 1, j.len, fp), j.len);
+    assert_int_equal(fwrite(bytes, 1, size, fp), size);
     assert_int_equal(fclose(fp), 0);
+}
+
+void lx_test_gltf_write(const lx_test_gltf *g, const char *path)
+{
+    text j = {0};
+    json_text(g, &j, false);
+    write_bytes(path, j.s, j.len);
+    free(j.s);
+}
+
+static void le32(unsigned char *p, uint32_t v)
+{
+    for (int i = 0; i < 4; i++)
+        p[i] = (unsigned char)(v >> (8 * i));
+}
+
+void lx_test_gltf_write_glb(const lx_test_gltf *g, const char *path)
+{
+    text j = {0};
+    json_text(g, &j, true);
+    size_t jpad = (j.len + 3) / 4 * 4, bpad = (g->bin_size + 3) / 4 * 4;
+    size_t total = 12 + 8 + jpad + 8 + bpad;
+    unsigned char *out = calloc(1, total);
+    assert_non_null(out);
+    memcpy(out, "glTF", 4);
+    le32(out + 4, 2);
+    le32(out + 8, (uint32_t)total);
+    le32(out + 12, (uint32_t)jpad);
+    memcpy(out + 16, "JSON", 4);
+    memcpy(out + 20, j.s, j.len);
+    memset(out + 20 + j.len, ' ', jpad - j.len);
+    le32(out + 20 + jpad, (uint32_t)bpad);
+    memcpy(out + 24 + jpad, "BIN\0", 4);
+    if (g->bin_size)
+        memcpy(out + 28 + jpad, g->bin, g->bin_size);
+    write_bytes(path, out, total);
+    free(out);
     free(j.s);
 }
 

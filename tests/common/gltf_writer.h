@@ -7,6 +7,7 @@
 #define LX_TEST_GLTF_WRITER_H
 
 #include <stdbool.h>
+#include <stddef.h>
 #include <stdint.h>
 
 typedef struct lx_test_gltf lx_test_gltf;
@@ -52,8 +53,29 @@ int lx_test_gltf_material(lx_test_gltf *g, const char *json);
 int lx_test_gltf_texture(lx_test_gltf *g, const char *uri);
 /* Lists an extension in extensionsUsed. */
 void lx_test_gltf_use_extension(lx_test_gltf *g, const char *name);
-/* Writes the .gltf. */
+/* Lists an extension in extensionsRequired (and extensionsUsed). */
+void lx_test_gltf_require_extension(lx_test_gltf *g, const char *name);
+
+/* Raw pieces, for layouts the primitive writer does not make (quantized
+ * or compressed data). Bytes appended to buffer 0 (4-byte aligned);
+ * returns their offset. */
+size_t lx_test_gltf_bytes(lx_test_gltf *g, const void *bytes, size_t size);
+/* A bufferView over bytes appended to buffer 0, with byteStride when
+ * stride > 0; returns its index. */
+int lx_test_gltf_view(lx_test_gltf *g, const void *bytes, size_t size, int stride);
+/* A bufferView, accessor or mesh from the full text of its JSON object;
+ * returns its index. */
+int lx_test_gltf_view_json(lx_test_gltf *g, const char *json);
+int lx_test_gltf_accessor_json(lx_test_gltf *g, const char *json);
+int lx_test_gltf_mesh_json(lx_test_gltf *g, const char *json);
+/* A buffer after buffer 0 from the full text of its JSON object; returns
+ * its index. */
+int lx_test_gltf_buffer_json(lx_test_gltf *g, const char *json);
+
+/* Writes the .gltf (buffer 0 as a base64 data: URI). */
 void lx_test_gltf_write(const lx_test_gltf *g, const char *path);
+/* Writes a .glb: the same JSON with buffer 0 as the binary chunk. */
+void lx_test_gltf_write_glb(const lx_test_gltf *g, const char *path);
 
 struct lx_test_quad;
 /* A .gltf of quad q (texture_oracle.h) as one node "quad" with mesh
