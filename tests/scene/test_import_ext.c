@@ -17,6 +17,7 @@
 #include "gltf_writer.h"
 #include "helpers.h"
 #include "luxel/scene.h"
+#include "scene/gltf_json.h" /* lx_gltf_rewrite, to read what it decoded */
 
 #include <math.h>
 #include <meshoptimizer.h>
@@ -464,6 +465,87 @@ static void test_meshopt(void **state)
     lx_scene_destroy(f);
 }
 
+/* The QUATERNION filter (no mesh attribute uses it: animations and
+ * instances do) and EXPONENTIAL on two components, read back from the
+ * GLB lx_gltf_rewrite makes against the values encoded. */
+static void test_meshopt_filters(void **state)
+{
+    (void)state;
+    const char *dir = lx_test_dir("test_import_ext_meshopt_filters");
+    enum { N = 16 };
+    float quat[N * 4], vec2[N * 2];
+    for (int i = 0; i < N; i++) {
+        double a = 0.37 * i, len;
+        double q[4] = {sin(a) * 0.6, cos(a * 1.3) * 0.5, 0.3 + 0.05 * i, cos(a)};
+        len = sqrt(q[0] * q[0] + q[1] * q[1] + q[2] * q[2] + q[3] * q[3]);
+        for (int k = 0; k < 4; k++)
+            quat[4 * i + k] = (float)(q[k] / len);
+        vec2[2 * i] = (float)(1000.0 * sin(a));
+        vec2[2 * i + 1] = (float)(0.001 * cos(a));
+    }
+    int16_t qenc[N * 4];
+    meshopt_encodeFilterQuat(qenc, N, 8, 16, quat);
+    uint32_t eenc[N * 2];
+    meshopt_encodeFilterExp(eenc, N, 8, 20, vec2);
+    lx_test_gltf *g = lx_test_gltf_new();
+    lx_test_gltf_require_extension(g, "EXT_meshopt_compression");
+    size_t fb = 0;
+    int vq = meshopt_view(g, qenc, N, 8, "ATTRIBUTES", "QUATERNION", true, &fb);
+    int ve = meshopt_view(g, eenc, N, 8, "ATTRIBUTES", "EXPONENTIAL", true, &fb);
+    char json[256];
+    snprintf(json, sizeof json,
+             "{\"byteLength\":%zu,\"extensions\":{\"EXT_meshopt_compression\":{\"fallback\":true}}}",
+             fb);
+    lx_test_gltf_buffer_json(g, json);
+    char path[1024];
+    path_in(path, sizeof path, dir, "filters.glb");
+    lx_test_gltf_write_glb(g, path);
+    lx_test_gltf_free(g);
+
+    cJSON *root = NULL;
+    assert_int_equal(lx_gltf_json_read(path, &root), LX_OK);
+    uint8_t *glb = NULL;
+    size_t size = 0;
+    if (lx_gltf_rewrite(path, root, &glb, &size) != LX_OK)
+        fail_msg("%s", lx_last_error());
+    assert_non_null(glb);
+    /* the GLB's binary chunk follows the JSON chunk */
+    uint32_t jlen = (uint32_t)glb[12] | (uint32_t)glb[13] << 8 | (uint32_t)glb[14] << 16 |
+                    (uint32_t)glb[15] << 24;
+    const uint8_t *bin = glb + 20 + jlen + 8;
+    const cJSON *views = cJSON_GetObjectItem(root, "bufferViews");
+    const cJSON *v = cJSON_GetArrayItem(views, vq), *w = cJSON_GetArrayItem(views, ve);
+    assert_int_equal((int)cJSON_GetNumberValue(cJSON_GetObjectItem(v, "buffer")), 0);
+    assert_null(cJSON_GetObjectItem(v, "extensions"));
+    const uint8_t *qd = bin + (size_t)cJSON_GetNumberValue(cJSON_GetObjectItem(v, "byteOffset"));
+    const uint8_t *ed = bin + (size_t)cJSON_GetNumberValue(cJSON_GetObjectItem(w, "byteOffset"));
+    for (int i = 0; i < N; i++) {
+        int16_t c[4];
+        memcpy(c, qd + 8 * i, 8);
+        /* a quaternion and its negation are the same rotation */
+        double dot = 0;
+        for (int k = 0; k < 4; k++)
+            dot += c[k] / 32767.0 * quat[4 * i + k];
+        assert_true(fabs(fabs(dot) - 1.0) < 1e-4);
+        float e[2];
+        memcpy(e, ed + 8 * i, 8);
+        for (int k = 0; k < 2; k++) {
+            /* the spec's decoding: 2^E * M, E the top byte and M the
+             * low 24 bits, both signed */
+            uint32_t word = eenc[2 * i + k];
+            int32_t m = (int32_t)(word << 8) >> 8;
+            int exponent = (int8_t)(word >> 24);
+            float want = (float)ldexp((double)m, exponent);
+            if (e[k] != want)
+                fail_msg("element %d.%d: %.9g, the word says %.9g", i, k, e[k], want);
+        }
+    }
+    const cJSON *req = cJSON_GetObjectItem(root, "extensionsRequired");
+    assert_int_equal(cJSON_GetArraySize(req), 0);
+    free(glb);
+    cJSON_Delete(root);
+}
+
 /* ---- extensionsRequired ------------------------------------------------------------ */
 
 static void write_quad(const char *path, const char *required, const char *material)
@@ -720,6 +802,7 @@ int main(void)
     const struct CMUnitTest tests[] = {
         cmocka_unit_test(test_zero_area_counted),    cmocka_unit_test(test_zero_uv_area_loads),
         cmocka_unit_test(test_quantized),            cmocka_unit_test(test_meshopt),
+        cmocka_unit_test(test_meshopt_filters),
         cmocka_unit_test(test_required_extensions),  cmocka_unit_test(test_emissive_strength),
         cmocka_unit_test(test_lfs_pointers),         cmocka_unit_test(test_backslash_obj),
         cmocka_unit_test(test_source_mapping),       cmocka_unit_test(test_collada_lights_warned),
