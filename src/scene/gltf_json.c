@@ -172,7 +172,15 @@ lx_status lx_glb_check_file(const char *path)
         return failf(path, LX_ERR_FORMAT, "truncated GLB: %ld bytes, the header needs 12",
                      total < 0 ? 0L : total);
     }
-    if (le32(head) != LX_GLB_MAGIC)
+    size_t lead = 0; /* white space before a web page's '<' */
+    while (lead < sizeof head - 1 && (head[lead] == ' ' || head[lead] == '\n' || head[lead] == '\r' ||
+                                      head[lead] == '\t'))
+        lead++;
+    if (le32(head) != LX_GLB_MAGIC && head[lead] == '<')
+        st = failf(path, LX_ERR_FORMAT,
+                   "not a GLB file: it starts with '<', as a web page does (a download that "
+                   "saved the page, not the model?)");
+    else if (le32(head) != LX_GLB_MAGIC)
         st = failf(path, LX_ERR_FORMAT, "not a GLB file (bad magic)");
     else if (le32(head + 4) != 2)
         st = failf(path, LX_ERR_UNSUPPORTED, "GLB version %u (only version 2 is supported)",

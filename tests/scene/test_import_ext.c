@@ -613,6 +613,10 @@ static void test_lfs_pointers(void **state)
     path_in(path, sizeof path, dir, "scene.glb");
     write_text(path, LFS);
     load_fails(path, NULL, LX_ERR_FORMAT, "is a Git LFS pointer, not the file", "git lfs pull");
+    /* a web page saved under the model's name */
+    path_in(path, sizeof path, dir, "page.glb");
+    write_text(path, "\n\n<!DOCTYPE html>\n<html><body>Not found</body></html>\n");
+    load_fails(path, NULL, LX_ERR_FORMAT, "not a GLB file", "web page");
 
     /* a .gltf whose buffer file is a pointer */
     char bin[1024];
