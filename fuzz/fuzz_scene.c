@@ -1,6 +1,7 @@
-/* libFuzzer harness for scene import: the bytes become a .glb, .gltf or
- * .obj file (chosen by the first byte) loaded through lx_scene_load, which
- * runs assimp plus luxel's own validation and KHR_lights_punctual reader. */
+/* libFuzzer harness for scene import: the bytes become a .glb, .gltf,
+ * .obj, .dae, .fbx, .ply or .stl file (chosen by the first byte) loaded
+ * through lx_scene_load, which runs assimp plus luxel's own validation,
+ * its glTF rewrite (meshopt, quantization) and KHR_lights_punctual reader. */
 #define _POSIX_C_SOURCE 200809L
 #include "luxel/scene.h"
 
@@ -12,9 +13,9 @@ int LLVMFuzzerTestOneInput(const uint8_t *data, size_t size)
 {
     if (size < 1)
         return 0;
-    static const char *ext[] = {".glb", ".gltf", ".obj"};
+    static const char *ext[] = {".glb", ".gltf", ".obj", ".dae", ".fbx", ".ply", ".stl"};
     char path[64];
-    snprintf(path, sizeof path, "/tmp/lx_fuzz_scene_%d%s", (int)getpid(), ext[data[0] % 3]);
+    snprintf(path, sizeof path, "/tmp/lx_fuzz_scene_%d%s", (int)getpid(), ext[data[0] % 7]);
     FILE *fp = fopen(path, "wb");
     if (!fp)
         return 0;
