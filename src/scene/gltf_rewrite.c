@@ -546,31 +546,43 @@ static lx_status convert_accessor(rewrite *r, size_t a, cJSON *acc)
     return LX_OK;
 }
 
-/* Marks the accessors that primitives use as POSITION, NORMAL, TANGENT or
- * TEXCOORD_n with an integer componentType. */
+/* Marks the quantized (integer componentType) accessors of one attributes
+ * object: POSITION, NORMAL, TANGENT, TEXCOORD_n and COLOR_n. */
+static size_t mark_attributes(const cJSON *attrs, const cJSON *const *accessors, size_t n,
+                              bool *mark)
+{
+    static const char *const names[] = {"POSITION", "NORMAL", "TANGENT"};
+    size_t found = 0;
+    for (const cJSON *at = cJSON_IsObject(attrs) ? attrs->child : NULL; at; at = at->next) {
+        bool wanted = strncmp(at->string, "TEXCOORD_", 9) == 0 || strncmp(at->string, "COLOR_", 6) == 0;
+        for (int k = 0; k < 3 && !wanted; k++)
+            wanted = strcmp(at->string, names[k]) == 0;
+        size_t a;
+        if (!wanted || !lx_gltf_index(at, n, &a) || mark[a])
+            continue;
+        const cJSON *ct = lx_gltf_get(accessors[a], "componentType");
+        if (cJSON_IsNumber(ct) && ct->valuedouble != 5126) {
+            mark[a] = true;
+            found++;
+        }
+    }
+    return found;
+}
+
+/* Marks the quantized accessors primitives and their morph targets use
+ * (assimp reads all of them). */
 static size_t find_quantized(const cJSON *root, const cJSON *const *accessors, size_t n,
                              bool *mark)
 {
-    static const char *const names[] = {"POSITION", "NORMAL", "TANGENT"};
     size_t found = 0;
     const cJSON *meshes = lx_gltf_get(root, "meshes");
     for (const cJSON *m = cJSON_IsArray(meshes) ? meshes->child : NULL; m; m = m->next) {
         const cJSON *prims = lx_gltf_get(m, "primitives");
         for (const cJSON *p = cJSON_IsArray(prims) ? prims->child : NULL; p; p = p->next) {
-            const cJSON *attrs = lx_gltf_get(p, "attributes");
-            for (const cJSON *at = cJSON_IsObject(attrs) ? attrs->child : NULL; at; at = at->next) {
-                bool wanted = strncmp(at->string, "TEXCOORD_", 9) == 0;
-                for (int k = 0; k < 3 && !wanted; k++)
-                    wanted = strcmp(at->string, names[k]) == 0;
-                size_t a;
-                if (!wanted || !lx_gltf_index(at, n, &a) || mark[a])
-                    continue;
-                const cJSON *ct = lx_gltf_get(accessors[a], "componentType");
-                if (cJSON_IsNumber(ct) && ct->valuedouble != 5126) {
-                    mark[a] = true;
-                    found++;
-                }
-            }
+            found += mark_attributes(lx_gltf_get(p, "attributes"), accessors, n, mark);
+            const cJSON *targets = lx_gltf_get(p, "targets");
+            for (const cJSON *t = cJSON_IsArray(targets) ? targets->child : NULL; t; t = t->next)
+                found += mark_attributes(t, accessors, n, mark);
         }
     }
     return found;

@@ -277,11 +277,20 @@ static void test_quantized(void **state)
              "{\"bufferView\":%d,\"componentType\":5123,\"count\":%d,\"type\":\"SCALAR\"}", vi,
              NT * 3);
     int ai = lx_test_gltf_accessor_json(g, json);
+    /* vertex colours as normalized bytes (core glTF): read, not used */
+    uint8_t rgba[NV * 4];
+    for (int i = 0; i < NV * 4; i++)
+        rgba[i] = (uint8_t)(40 * i);
+    snprintf(json, sizeof json,
+             "{\"bufferView\":%d,\"componentType\":5121,\"normalized\":true,\"count\":%d,"
+             "\"type\":\"VEC4\"}",
+             lx_test_gltf_view(g, rgba, sizeof rgba, 4), NV);
+    int acol = lx_test_gltf_accessor_json(g, json);
     for (int k = 0; k < 2; k++) {
         snprintf(json, sizeof json,
                  "{\"name\":\"%s\",\"primitives\":[{\"attributes\":{\"POSITION\":%d,\"NORMAL\":%d,"
-                 "\"TEXCOORD_0\":%d},\"indices\":%d}]}",
-                 k ? "m8" : "m16", k ? ap8 : ap16, an, auv, ai);
+                 "\"TEXCOORD_0\":%d,\"COLOR_0\":%d},\"indices\":%d}]}",
+                 k ? "m8" : "m16", k ? ap8 : ap16, an, auv, acol, ai);
         int mesh = lx_test_gltf_mesh_json(g, json);
         snprintf(json, sizeof json, "\"scale\":[%g,%g,%g]", k ? s8 : s16, k ? s8 : s16,
                  k ? s8 : s16);
