@@ -264,10 +264,10 @@ static bool get_size(const cJSON *obj, const char *key, size_t def, size_t *out)
 static void set_number(cJSON *obj, const char *key, double v)
 {
     cJSON *n = cJSON_CreateNumber(v);
-    if (cJSON_HasObjectItem(obj, key))
-        cJSON_ReplaceItemInObjectCaseSensitive(obj, key, n);
-    else
-        cJSON_AddItemToObject(obj, key, n);
+    bool kept = cJSON_HasObjectItem(obj, key) ? cJSON_ReplaceItemInObjectCaseSensitive(obj, key, n)
+                                              : cJSON_AddItemToObject(obj, key, n);
+    if (!kept)
+        cJSON_Delete(n);
 }
 
 /* Appends size bytes (16-byte aligned) to the new binary chunk. */
@@ -462,6 +462,8 @@ static lx_status convert_accessor(rewrite *r, size_t a, cJSON *acc)
 {
     char who[48];
     snprintf(who, sizeof who, "accessor %zu", a);
+    if (!cJSON_IsObject(acc))
+        return lx_json_fail(LX_ERR_FORMAT, r->file, who, "is not an object");
     int type = (int)cJSON_GetNumberValue(lx_gltf_get(acc, "componentType"));
     int comps = type_components(lx_gltf_get_string(acc, "type"));
     size_t count, offset, view;
@@ -518,11 +520,20 @@ static lx_status convert_accessor(rewrite *r, size_t a, cJSON *acc)
     }
     /* a new bufferView, tightly packed, in the new chunk */
     cJSON *views = cJSON_GetObjectItemCaseSensitive(r->root, "bufferViews");
+    if (!cJSON_IsArray(views)) {
+        /* accessors without views (all zeros): the list starts here */
+        cJSON_DeleteItemFromObjectCaseSensitive(r->root, "bufferViews");
+        views = cJSON_AddArrayToObject(r->root, "bufferViews");
+    }
     cJSON *nv = cJSON_CreateObject();
     cJSON_AddNumberToObject(nv, "buffer", 0);
     cJSON_AddNumberToObject(nv, "byteOffset", (double)at);
     cJSON_AddNumberToObject(nv, "byteLength", (double)floats);
-    cJSON_AddItemToArray(views, nv);
+    if (!views || !cJSON_AddItemToArray(views, nv)) {
+        cJSON_Delete(nv);
+        free(out);
+        return lx_json_fail(LX_ERR_NOMEM, r->file, who, "out of memory");
+    }
     set_number(acc, "bufferView", (double)(r->view_count + r->added++));
     set_number(acc, "byteOffset", 0);
     set_number(acc, "componentType", 5126);

@@ -327,6 +327,28 @@ static void test_quantized(void **state)
     lx_scene_destroy(q);
 }
 
+/* Found by fuzz_scene: a quantized accessor with no bufferView (all
+ * zeros) in a file whose "bufferViews" is not a list. The load ends with a
+ * message or a scene, and leaks nothing (make check-asan). */
+static void test_quantized_without_views(void **state)
+{
+    (void)state;
+    const char *dir = lx_test_dir("test_import_ext_quantized_noviews");
+    char path[1024];
+    path_in(path, sizeof path, dir, "noviews.gltf");
+    write_text(path, "{\"asset\":{\"version\":\"2.0\"},\"extensionsRequired\":["
+                     "\"KHR_mesh_quantization\"],\"scene\":0,\"scenes\":[{\"nodes\":[0]}],"
+                     "\"nodes\":[{\"mesh\":0}],\"meshes\":[{\"primitives\":[{\"attributes\":{"
+                     "\"POSITION\":0}}]}],\"accessors\":[{\"componentType\":5122,"
+                     "\"normalized\":true,\"count\":3,\"type\":\"VEC3\"}],\"bufferViews\":7,"
+                     "\"buffers\":[]}");
+    lx_scene *s = NULL;
+    if (lx_scene_load(path, NULL, &s) == LX_OK)
+        lx_scene_destroy(s);
+    else
+        assert_non_null(strstr(lx_last_error(), "noviews.gltf"));
+}
+
 /* ---- EXT_meshopt_compression ------------------------------------------------------ */
 
 /* A bufferView of count elements of stride bytes compressed into buffer 0,
@@ -815,7 +837,7 @@ int main(void)
     const struct CMUnitTest tests[] = {
         cmocka_unit_test(test_zero_area_counted),    cmocka_unit_test(test_zero_uv_area_loads),
         cmocka_unit_test(test_quantized),            cmocka_unit_test(test_meshopt),
-        cmocka_unit_test(test_meshopt_filters),
+        cmocka_unit_test(test_meshopt_filters),   cmocka_unit_test(test_quantized_without_views),
         cmocka_unit_test(test_required_extensions),  cmocka_unit_test(test_emissive_strength),
         cmocka_unit_test(test_lfs_pointers),         cmocka_unit_test(test_backslash_obj),
         cmocka_unit_test(test_source_mapping),       cmocka_unit_test(test_collada_lights_warned),
