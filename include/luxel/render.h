@@ -176,12 +176,14 @@ typedef struct lx_render_desc {
     int samples;               /* per pixel, 1..4096, 0 = 4 */
     lx_lightmap_filter filter; /* lightmap lookups */
     bool two_sided;            /* false: back faces are culled (rays go through) */
-    lx_vec3 background;        /* radiance (nits) of rays that miss; all zero = a
-                                  neutral grey, half the middle grey of the
-                                  lightmaps' preview exposure */
+    lx_vec3 background;        /* radiance (nits) of rays that miss (default black;
+                                  coverage lets a caller compose its own) */
     const lx_cubemap *sky;     /* when set, rays that miss see it (radiance, nits) */
     float sky_intensity;       /* multiplier on sky, 0 = 1 */
     uint32_t seed;             /* sample pattern */
+    float *coverage;           /* NULL, or width*height floats (the caller's) that
+                                  get the fraction of each pixel's samples that
+                                  hit the scene (for metering, masks) */
     int threads;               /* 0 = all cores */
     lx_progress_fn progress;   /* fraction of tiles done; false cancels */
     void *progress_user;

@@ -98,24 +98,29 @@ lx_camera lx_camera_frame(lx_vec3 lo, lx_vec3 hi, lx_view view, float fov, float
     b.tan_x = b.tan_y * aspect;
     const float margin = 0.95f;
     float tx = b.tan_x * margin, ty = b.tan_y * margin;
-    float extent = lx_length(lx_sub(hi, lo));
-    /* corner k at depth z + D from an eye D behind the centre needs
-     * |x| <= (z + D) tx and |y| <= (z + D) ty */
-    float dist = 1e-3f * (extent > 0.0f ? extent : 1.0f);
+    /* The eye sits at c + sx right + sy up - D fwd. Corner k (image-plane
+     * offsets x, y and depth z from c) is inside when |x - sx| <= (z + D) tx
+     * and |y - sy| <= (z + D) ty: per axis D >= max(a - s / t, b + s / t)
+     * with a = max(x / t - z), b = max(-x / t - z), least at s = t (a - b) / 2
+     * where D = (a + b) / 2. */
+    double ax = -INFINITY, bx = -INFINITY, ay = -INFINITY, by = -INFINITY, zmin = INFINITY;
     for (int k = 0; k < 8; k++) {
         lx_vec3 p = lx_v3(k & 1 ? hi.x : lo.x, k & 2 ? hi.y : lo.y, k & 4 ? hi.z : lo.z);
         lx_vec3 r = lx_sub(p, c);
-        float x = fabsf(lx_dot(r, b.right)), y = fabsf(lx_dot(r, b.up)), z = lx_dot(r, b.fwd);
-        float need = fmaxf(x / tx, y / ty) - z;
-        if (need > dist)
-            dist = need;
-        /* the eye stays in front of every corner */
-        if (-z + 1e-3f * extent > dist)
-            dist = -z + 1e-3f * extent;
+        double x = lx_dot(r, b.right), y = lx_dot(r, b.up), z = lx_dot(r, b.fwd);
+        ax = fmax(ax, x / tx - z), bx = fmax(bx, -x / tx - z);
+        ay = fmax(ay, y / ty - z), by = fmax(by, -y / ty - z);
+        zmin = fmin(zmin, z);
     }
-    if (extent == 0.0f)
-        dist = 1.0f;
-    cam.eye = lx_sub(c, lx_scale(b.fwd, dist));
+    double sx = tx * (ax - bx) / 2.0, sy = ty * (ay - by) / 2.0;
+    double dist = fmax((ax + bx) / 2.0, (ay + by) / 2.0);
+    float extent = lx_length(lx_sub(hi, lo));
+    /* the eye stays in front of every corner */
+    dist = fmax(dist, -zmin + 1e-3 * extent);
+    if (!(extent > 0.0f))
+        dist = 1.0, sx = 0.0, sy = 0.0;
+    cam.target = lx_add(c, lx_add(lx_scale(b.right, (float)sx), lx_scale(b.up, (float)sy)));
+    cam.eye = lx_sub(cam.target, lx_scale(b.fwd, (float)dist));
     cam.up = b.up;
     return cam;
 }

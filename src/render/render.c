@@ -135,9 +135,11 @@ static lx_vec3 albedo(const lx_scene *scene, const lx_mesh *m, const uint32_t *i
     return a;
 }
 
-/* Radiance seen along ray r (dir unit length). */
-static lx_vec3 shade(const render_ctx *c, lx_ray r)
+/* Radiance seen along ray r (dir unit length); *hit tells whether it
+ * met the scene. */
+static lx_vec3 shade(const render_ctx *c, lx_ray r, bool *hit)
 {
+    *hit = true;
     const lx_scene *scene = c->scene;
     for (int pass = 0; pass < MAX_CULLED; pass++) {
         lx_hit h;
@@ -185,6 +187,7 @@ static lx_vec3 shade(const render_ctx *c, lx_ray r)
             return value;
         return lx_scale(lx_mul(value, albedo(scene, m, i, w0, w1, w2)), 1.0f / LX_PI);
     }
+    *hit = false;
     if (c->d->sky) {
         float s[3];
         lx_cubemap_sample(c->d->sky, r.dir, s);
@@ -209,6 +212,7 @@ static void render_tile(const render_ctx *c, int tile, int tiles_x, lx_image *ou
         for (int x = x0; x < x1; x++) {
             uint32_t pixel = (uint32_t)y * (uint32_t)d->width + (uint32_t)x;
             double acc[3] = {0, 0, 0};
+            int hits = 0;
             for (int s = 0; s < d->samples; s++) {
                 float jx = ((float)(s % sx) + lx_random(d->seed, pixel, (uint32_t)s, 0)) / (float)sx;
                 float jy = ((float)(s / sx) + lx_random(d->seed, pixel, (uint32_t)s, 1)) / (float)sy;
@@ -218,12 +222,16 @@ static void render_tile(const render_ctx *c, int tile, int tiles_x, lx_image *ou
                                                         lx_scale(c->cam.up, py)));
                 lx_ray r = {.origin = c->cam.eye, .tmin = 0.0f, .dir = lx_normalize(dir),
                             .tmax = INFINITY};
-                lx_vec3 L = shade(c, r);
+                bool hit;
+                lx_vec3 L = shade(c, r, &hit);
+                hits += hit;
                 acc[0] += L.x, acc[1] += L.y, acc[2] += L.z;
             }
             float *o = out->data + (size_t)pixel * 3;
             for (int k = 0; k < 3; k++)
                 o[k] = (float)(acc[k] / (double)d->samples);
+            if (d->coverage)
+                d->coverage[pixel] = (float)hits / (float)d->samples;
         }
 }
 
@@ -315,11 +323,6 @@ lx_status lx_render_view(const lx_scene *scene, const lx_lightmaps *lm, const lx
                     .det_sign = det_sign, .inv_pre_exposure = 1.0f / lm->pre_exposure};
     lx_camera_basis(&d.camera, d.width, d.height, &c.cam);
     c.background = d.background;
-    if (d.background.x == 0.0f && d.background.y == 0.0f && d.background.z == 0.0f) {
-        /* half of middle grey at the previews' exposure */
-        float grey = 0.5f * 0.18f / lx_exposure_from_ev100(lm->preview_ev100);
-        c.background = lx_v3(grey, grey, grey);
-    }
 
     int tiles_x = (d.width + TILE - 1) / TILE, tiles_y = (d.height + TILE - 1) / TILE;
     int tiles = tiles_x * tiles_y;

@@ -31,7 +31,10 @@ static const char *render_usage =
     "                          framed on the scene's bounds\n"
     "  --fov DEG               vertical field of view (default %g)\n"
     "  --size WxH              image size in pixels (default %dx%d)\n"
-    "  --exposure EV100        exposure (default: the bake's preview_ev100)\n"
+    "  --exposure EV100        exposure (default: metered on the view, the\n"
+    "                          log-average luminance of what the camera sees\n"
+    "                          made 0.18, Reinhard's key; 'bake' takes the\n"
+    "                          bake's preview_ev100)\n"
     "  --tonemap T             aces (default), filmic or clamp\n"
     "  --filter F              lightmap lookups: bilinear (default) or bicubic\n"
     "  --samples N             rays per pixel, stratified (default %d)\n"
@@ -66,7 +69,7 @@ typedef struct render_args {
     const char *scene;
     const char *lightmaps;
     const char *output;
-    bool has_camera, has_view, has_exposure, quiet;
+    bool has_camera, has_view, has_exposure, bake_exposure, quiet;
     lx_view view;
     double fov_degrees;
     double exposure_ev100;
@@ -190,9 +193,17 @@ static int parse_args(int argc, char **argv, render_args *a)
                                        optarg);
             break;
         case OPT_EXPOSURE:
+            if (strcmp(optarg, "bake") == 0) {
+                a->bake_exposure = true;
+                a->has_exposure = false;
+                break;
+            }
+            a->bake_exposure = false;
             if (!cli_parse_float(optarg, -64, 64, &f))
                 return cli_usage_error("render",
-                                       "--exposure must be an EV100 in -64..64, not '%s'", optarg);
+                                       "--exposure must be an EV100 in -64..64 or 'bake', not "
+                                       "'%s'",
+                                       optarg);
             a->exposure_ev100 = f;
             a->has_exposure = true;
             break;
@@ -376,6 +387,31 @@ static bool any_generated(const lx_lightmaps *lm)
     return false;
 }
 
+/* Reinhard's key: the log-average luminance of what the view sees is
+ * exposed to this. */
+#define CLI_RENDER_KEY 0.18
+
+/* The EV100 that exposes the log-average luminance of the pixels wholly
+ * on the scene to CLI_RENDER_KEY; false when none is lit. */
+static bool meter_view(const lx_image *img, const float *coverage, double *ev100)
+{
+    double sum = 0.0;
+    size_t n = 0, count = (size_t)img->width * (size_t)img->height;
+    for (size_t i = 0; i < count; i++) {
+        double l = lx_luminance(img->data + 3 * i);
+        if (coverage[i] == 1.0f && l > 0.0) {
+            sum += log(l);
+            n++;
+        }
+    }
+    if (n == 0)
+        return false;
+    double avg = exp(sum / (double)n);
+    /* lx_exposure_from_ev100: exposure = 1 / (1.2 * 2^EV100) = key / avg */
+    *ev100 = log2(avg / (1.2 * CLI_RENDER_KEY));
+    return isfinite(*ev100);
+}
+
 /* Renders scene (already carrying the lightmaps' UVs) and writes output. */
 static int render_and_write(render_args *a, const lx_lightmaps *lm, const lx_scene *scene)
 {
@@ -403,6 +439,7 @@ static int render_and_write(render_args *a, const lx_lightmaps *lm, const lx_sce
     }
     /* the sky the bake was lit by, as the background */
     lx_cubemap sky = {0};
+    bool have_sky = false;
     if (lm->sky) {
         bool constant = strncmp(lm->sky, "const:", 6) == 0;
         if (constant || file_exists(lm->sky)) {
@@ -412,6 +449,7 @@ static int render_and_write(render_args *a, const lx_lightmaps *lm, const lx_sce
                 return loaded;
             a->desc.sky = &sky;
             a->desc.sky_intensity = lm->sky_intensity;
+            have_sky = true;
         } else {
             lx_log(LX_LOG_WARN, "%s: the sky the bake used is not here: a grey background",
                    lm->sky);
@@ -423,10 +461,40 @@ static int render_and_write(render_args *a, const lx_lightmaps *lm, const lx_sce
     a->desc.progress = cli_progress_update;
     a->desc.progress_user = &progress;
     lx_image img = {0};
+    bool meter = !a->has_exposure && !a->bake_exposure;
+    float *coverage = NULL;
+    if (!(coverage = malloc((size_t)a->desc.width * (size_t)a->desc.height *
+                                     sizeof *coverage))) {
+        lx_cubemap_free(&sky);
+        cli_error("out of memory");
+        return EXIT_FAILED;
+    }
+    a->desc.coverage = coverage;
     lx_status st = lx_render_view(scene, lm, NULL, &a->desc, &img);
     cli_progress_finish(&progress);
     lx_cubemap_free(&sky);
     a->desc.sky = NULL;
+    a->desc.coverage = NULL;
+    double ev = a->has_exposure ? a->exposure_ev100 : lm->preview_ev100;
+    const char *ev_from = a->has_exposure ? "" : " (the bake's)";
+    if (st == LX_OK && meter) {
+        if (meter_view(&img, coverage, &ev)) {
+            ev_from = " (metered)";
+        } else {
+            lx_log(LX_LOG_WARN, "%s: the view sees nothing lit: exposed as the bake's previews",
+                   a->output);
+        }
+    }
+    /* without a sky, a neutral grey behind the scene at half the key: it
+     * follows the exposure, so it never outshines the view */
+    if (st == LX_OK && !have_sky) {
+        float grey = (float)(0.5 * CLI_RENDER_KEY) / lx_exposure_from_ev100((float)ev);
+        size_t count = (size_t)img.width * (size_t)img.height;
+        for (size_t i = 0; i < count; i++)
+            for (int k = 0; k < 3; k++)
+                img.data[3 * i + k] += (1.0f - coverage[i]) * grey;
+    }
+    free(coverage);
     if (st != LX_OK) {
         if (st == LX_ERR_CANCELLED)
             cli_report_interrupt(false);
@@ -434,7 +502,6 @@ static int render_and_write(render_args *a, const lx_lightmaps *lm, const lx_sce
             cli_error("%s", lx_last_error());
         return EXIT_FAILED;
     }
-    double ev = a->has_exposure ? a->exposure_ev100 : lm->preview_ev100;
     lx_image_format format = lx_image_format_from_path(a->output);
     bool eight_bit = format == LX_IMAGE_PNG || format == LX_IMAGE_JPG || format == LX_IMAGE_TGA;
     cli_progress_init(&progress, "write", a->quiet);
@@ -457,7 +524,7 @@ static int render_and_write(render_args *a, const lx_lightmaps *lm, const lx_sce
         if (eight_bit)
             fprintf(stderr, "luxel: rendered %dx%d, %d samples a pixel, in %.2f s; EV100 %.2f%s, %s\n",
                     a->desc.width, a->desc.height, a->desc.samples, cli_elapsed(), ev,
-                    a->has_exposure ? "" : " (the bake's)", lx_tonemap_name(a->tonemap));
+                    ev_from, lx_tonemap_name(a->tonemap));
         else
             fprintf(stderr, "luxel: rendered %dx%d, %d samples a pixel, in %.2f s (radiance, nits)\n",
                     a->desc.width, a->desc.height, a->desc.samples, cli_elapsed());
