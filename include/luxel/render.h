@@ -147,7 +147,9 @@ typedef struct lx_lightmaps_load_desc {
 lx_lightmaps_load_desc lx_lightmaps_load_desc_defaults(const lx_lightmaps_load_desc *desc);
 
 /* Reads dir/manifest.json and the pages it lists (EXR, HDR, PFM or PNG,
- * lx_image_load), checking that each page has the size the manifest says
+ * lx_image_load; 8-bit pages hold the previews' exposed values, E / pi
+ * for irradiance, and are scaled back by the manifest's preview_ev100 -
+ * to within their 8 bits and the clipping at 1), checking that each page has the size the manifest says
  * and finite, non-negative values, that node pages and UV sets exist and
  * scale_offsets are finite. desc may be NULL. On failure *out is zeroed
  * and the message names the file: "dir/manifest.json: nodes[2]: page 7

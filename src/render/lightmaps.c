@@ -221,7 +221,16 @@ static lx_status parse_manifest(const char *file, const char *dir, const cJSON *
     return st;
 }
 
-static lx_status load_page(const char *manifest, uint32_t i, lx_lightmap_page *p)
+/* 8-bit pages hold what the bake's previews show: the quantity times
+ * the preview exposure (irradiance as E / pi), sRGB-encoded; scale is
+ * what takes the decoded values back to the manifest's units. */
+static float eight_bit_scale(const lx_lightmaps *lm)
+{
+    float e = lx_exposure_from_ev100(lm->preview_ev100);
+    return lm->quantity == LX_QUANTITY_RADIANCE ? 1.0f / e : LX_PI / e;
+}
+
+static lx_status load_page(const char *manifest, uint32_t i, lx_lightmap_page *p, float scale8)
 {
     lx_image_load_desc ld = {.channels = 3};
     lx_status st = lx_image_load(p->file, &ld, &p->image);
@@ -233,6 +242,10 @@ static lx_status load_page(const char *manifest, uint32_t i, lx_lightmap_page *p
         return lx_fail(LX_ERR_FORMAT, "%s: page %u: %s is %dx%d, the manifest says %dx%d", manifest,
                        i, p->file, p->image.width, p->image.height, p->width, p->height);
     size_t n = (size_t)p->width * (size_t)p->height * 3;
+    lx_image_format f = lx_image_format_from_path(p->file);
+    if (f == LX_IMAGE_PNG || f == LX_IMAGE_JPG || f == LX_IMAGE_TGA)
+        for (size_t k = 0; k < n; k++)
+            p->image.data[k] *= scale8;
     for (size_t k = 0; k < n; k++)
         if (!(p->image.data[k] >= 0.0f))
             return lx_fail(LX_ERR_FORMAT, "%s: page %u: %s: texel (%zu, %zu) is negative", manifest,
@@ -270,7 +283,7 @@ lx_status lx_lightmaps_load(const char *dir, const lx_lightmaps_load_desc *desc,
         st = parse_manifest(file, dir, root, &lm);
     cJSON_Delete(root);
     for (uint32_t i = 0; st == LX_OK && !d.skip_images && i < lm.page_count; i++)
-        st = load_page(file, i, &lm.pages[i]);
+        st = load_page(file, i, &lm.pages[i], eight_bit_scale(&lm));
     free(file);
     if (st != LX_OK) {
         lx_lightmaps_free(&lm);

@@ -209,6 +209,46 @@ static void test_plane_constant(void **state)
     lx_scene_destroy(s);
 }
 
+/* An 8-bit page (bake --format png) holds E / pi at the preview exposure:
+ * the render takes it back to lux. */
+static void test_png_page(void **state)
+{
+    (void)state;
+    const char *dir = lx_test_dir("render_png");
+    const double E = 150.0, ev = 6.3, exposure = 1.0 / (1.2 * pow(2.0, ev));
+    lx_image page;
+    assert_int_equal(lx_image_alloc(&page, 8, 8, 3), LX_OK);
+    for (int i = 0; i < 8 * 8 * 3; i++)
+        page.data[i] = (float)E;
+    lx_image_write_desc w = {.exposure = (float)(exposure / PI_D)};
+    assert_int_equal(lx_image_write(join(dir, "floor.png"), &page, &w), LX_OK);
+    lx_image_free(&page);
+    char text[1024];
+    snprintf(text, sizeof text,
+             "{\"scene\":\"plane\",\"format\":\"png\",\"preview_ev100\":%g,"
+             "\"pages\":[{\"file\":\"floor.png\",\"width\":8,\"height\":8}],"
+             "\"nodes\":[{\"node\":\"floor\",\"meshes\":[\"floor\"],\"page\":0,"
+             "\"scale_offset\":[1,1,0,0],\"uv_set\":\"TEXCOORD_1\"}]}",
+             ev);
+    write_text(join(dir, "manifest.json"), text);
+    lx_scene *s = plane_scene(lx_v4(0.5f, 0.5f, 0.5f, 1.0f));
+    lx_lightmaps lm;
+    assert_int_equal(lx_lightmaps_load(dir, NULL, &lm), LX_OK);
+    lx_render_desc d = {.width = 16, .height = 16, .samples = 1};
+    d.camera = (lx_camera){.eye = {0, 2, 0}, .target = {0, 0, 0}, .up = {0, 0, -1},
+                           .fov = 20.0f * LX_PI / 180.0f};
+    lx_image img;
+    assert_int_equal(lx_render_view(s, &lm, NULL, &d, &img), LX_OK);
+    double want = 0.5 * E / PI_D;
+    /* the stored value E / pi x exposure = 0.50 is within half an sRGB
+     * code step of 0.50: 0.7% at most */
+    for (int k = 0; k < 16 * 16 * 3; k++)
+        assert_true(fabs(img.data[k] - want) < 0.007 * want);
+    lx_image_free(&img);
+    lx_lightmaps_free(&lm);
+    lx_scene_destroy(s);
+}
+
 /* ---- a cube baked under uniform light, through generated UVs -------------- */
 
 #define AMBIENT 50.0f
@@ -456,7 +496,8 @@ int main(void)
 {
     lx_test_watchdog(600);
     const struct CMUnitTest tests[] = {
-        cmocka_unit_test(test_plane_constant), cmocka_unit_test(test_cube_no_seams),
+        cmocka_unit_test(test_plane_constant), cmocka_unit_test(test_png_page),
+        cmocka_unit_test(test_cube_no_seams),
         cmocka_unit_test(test_framing),        cmocka_unit_test(test_threads_identical),
         cmocka_unit_test(test_other_scene),    cmocka_unit_test(test_cancel),
     };

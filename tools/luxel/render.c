@@ -70,6 +70,7 @@ typedef struct render_args {
     const char *lightmaps;
     const char *output;
     bool has_camera, has_view, has_exposure, bake_exposure, quiet;
+    bool no_summary; /* bake --render: the bake prints its own */
     lx_view view;
     double fov_degrees;
     double exposure_ev100;
@@ -520,7 +521,7 @@ static int render_and_write(render_args *a, const lx_lightmaps *lm, const lx_sce
             cli_error("%s", lx_last_error());
         return EXIT_FAILED;
     }
-    if (!a->quiet) {
+    if (!a->quiet && !a->no_summary) {
         if (eight_bit)
             fprintf(stderr, "luxel: rendered %dx%d, %d samples a pixel, in %.2f s; EV100 %.2f%s, %s\n",
                     a->desc.width, a->desc.height, a->desc.samples, cli_elapsed(), ev,
@@ -576,7 +577,8 @@ int cli_render_bake(const char *dir, const lx_scene *scene, int threads, bool qu
     a.tonemap = CLI_RENDER_TONEMAP;
     a.scene = scene->path;
     a.lightmaps = dir;
-    a.quiet = true; /* the bake prints its own summary */
+    a.quiet = quiet;
+    a.no_summary = true;
     char *out = cli_path_join(dir, "view.png");
     if (!out) {
         cli_error("out of memory");
@@ -589,7 +591,8 @@ int cli_render_bake(const char *dir, const lx_scene *scene, int threads, bool qu
         cli_error("%s", lx_last_error());
     else
         status = render_and_write(&a, &lm, scene);
-    (void)quiet;
+    if (status == EXIT_OK && !quiet)
+        printf("%s\n", out);
     lx_lightmaps_free(&lm);
     free(out);
     return status;
