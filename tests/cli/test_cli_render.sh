@@ -1,8 +1,8 @@
 # End-to-end tests of `luxel render` and `luxel bake --render`: a view of
 # the room baked here (a PNG of the asked size, the same bytes on 1 and 2
 # threads), the view bake --render leaves beside the
-# lightmaps, luxel's own UVs made again when the scene with them is not
-# there, and bad input - no manifest, the lightmaps of another scene, a
+# lightmaps, the manifest's scene_with_uvs taken over SCENE, luxel's own
+# UVs made again when the scene with them is not there, and bad input - no manifest, the lightmaps of another scene, a
 # missing page, a malformed --camera or --size - failing with the exact
 # status, one error line naming the problem, and no image.
 #
@@ -41,6 +41,15 @@ swu=$(awk -F'"' '/"scene_with_uvs"/ {print $4}' "$WORK/gen/manifest.json")
 run "$LUXEL" render "$ROOM" --lightmaps "$WORK/gen" -o "$WORK/gen.png" --size 64x36
 expect_rc 0 "render of generated UVs, made again"
 check "generated-UV view written" test -s "$WORK/gen.png"
+
+# the manifest's scene_with_uvs is rendered instead of SCENE when it is there
+cp -r "$WORK/room" "$WORK/room-swu"
+cp "$ROOM" "$WORK/room-swu/with_uvs.glb"
+awk '{print} /"quantity"/ && !done {print "\t\"scene_with_uvs\":\t\"with_uvs.glb\","; done=1}' \
+    "$WORK/room/manifest.json" >"$WORK/room-swu/manifest.json"
+run "$LUXEL" render "$RETRO" --lightmaps "$WORK/room-swu" -o "$WORK/swu.png" --size 64x36 -q
+expect_rc 0 "scene_with_uvs used instead of SCENE"
+check "scene_with_uvs view written" test -s "$WORK/swu.png"
 
 # bad input: status, one error line, no image
 badr() {

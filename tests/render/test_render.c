@@ -249,6 +249,37 @@ static void test_png_page(void **state)
     lx_scene_destroy(s);
 }
 
+/* Radiance pages (--quantity radiance) already hold E x albedo / pi: shown
+ * as stored, not multiplied by the base colour again. */
+static void test_radiance_page(void **state)
+{
+    (void)state;
+    const char *dir = lx_test_dir("render_radiance");
+    write_constant_page(join(dir, "floor.exr"), 8, 8, 12.0f, 6.0f, 3.0f);
+    char text[1024];
+    snprintf(text, sizeof text, plane_manifest, 1.0);
+    char *q = strstr(text, "\"irradiance\"");
+    assert_non_null(q);
+    memcpy(q, "\"radiance\"  ", 12); /* same length: "irradiance" in quotes */
+    write_text(join(dir, "manifest.json"), text);
+    lx_scene *s = plane_scene(lx_v4(0.5f, 0.25f, 0.125f, 1.0f));
+    lx_lightmaps lm;
+    assert_int_equal(lx_lightmaps_load(dir, NULL, &lm), LX_OK);
+    assert_int_equal(lm.quantity, LX_QUANTITY_RADIANCE);
+    lx_render_desc d = {.width = 8, .height = 8, .samples = 2};
+    d.camera = (lx_camera){.eye = {0, 2, 0}, .target = {0, 0, 0}, .up = {0, 0, -1},
+                           .fov = 20.0f * LX_PI / 180.0f};
+    lx_image img;
+    assert_int_equal(lx_render_view(s, &lm, NULL, &d, &img), LX_OK);
+    const float want[3] = {12.0f, 6.0f, 3.0f};
+    /* bilinear weights of equal texels: exact to a few ulps */
+    for (int k = 0; k < 8 * 8 * 3; k++)
+        assert_true(fabsf(img.data[k] - want[k % 3]) < 4e-6f * want[k % 3]);
+    lx_image_free(&img);
+    lx_lightmaps_free(&lm);
+    lx_scene_destroy(s);
+}
+
 /* ---- a cube baked under uniform light, through generated UVs -------------- */
 
 #define AMBIENT 50.0f
@@ -497,7 +528,7 @@ int main(void)
     lx_test_watchdog(600);
     const struct CMUnitTest tests[] = {
         cmocka_unit_test(test_plane_constant), cmocka_unit_test(test_png_page),
-        cmocka_unit_test(test_cube_no_seams),
+        cmocka_unit_test(test_radiance_page),  cmocka_unit_test(test_cube_no_seams),
         cmocka_unit_test(test_framing),        cmocka_unit_test(test_threads_identical),
         cmocka_unit_test(test_other_scene),    cmocka_unit_test(test_cancel),
     };
