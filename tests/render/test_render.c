@@ -407,6 +407,12 @@ static void test_framing(void **state)
                     assert_int_equal(lx_camera_check(&c), LX_OK);
                     basis b = make_basis(&c, W, H);
                     double margin = INFINITY;
+                    double far = 0.0, extent = sqrt((bx[3] - bx[0]) * (bx[3] - bx[0]) +
+                                                    (bx[4] - bx[1]) * (bx[4] - bx[1]) +
+                                                    (bx[5] - bx[2]) * (bx[5] - bx[2]));
+                    for (int k = 0; k < 6; k++)
+                        far = fmax(far, fabs(bx[k]));
+                    double tol = 1e-5 + 4e-7 * far / extent;
                     for (int k = 0; k < 8; k++) {
                         double p[3] = {k & 1 ? bx[3] : bx[0], k & 2 ? bx[4] : bx[1],
                                        k & 4 ? bx[5] : bx[2]};
@@ -423,9 +429,14 @@ static void test_framing(void **state)
                                                       &lxp, &lyp));
                         assert_true(fabs(lxp - x) < 1e-3 * W && fabs(lyp - y) < 1e-3 * H);
                     }
-                    /* tight: some corner reaches the 5% margin (plus the
-                     * centring's slack) */
-                    assert_true(margin < 0.2);
+                    /* tight: the eye is as close as the corners allow, so
+                     * on the binding axis a corner sits on the 5% border
+                     * (2.5% of the image a side); float rounding measured
+                     * 3e-6, and 1.7e-4 on the 1 mm box 3.5 m out, whose
+                     * corners floats place to 2e-7 of their distance */
+                    if (fabs(margin - 0.025) > tol)
+                        fail_msg("box %zu view %d: nearest corner %g from the edge", bi, view,
+                                 margin);
                 }
 }
 
