@@ -393,13 +393,18 @@ static bool any_generated(const lx_lightmaps *lm)
 #define CLI_RENDER_KEY 0.18
 
 /* The EV100 that exposes the log-average luminance of the pixels wholly
- * on the scene to CLI_RENDER_KEY; false when none is lit. */
-static bool meter_view(const lx_image *img, const float *coverage, double *ev100)
+ * on the scene to CLI_RENDER_KEY; *seen counts the pixels with any of the
+ * scene, *lit those with light. False when none is lit. */
+static bool meter_view(const lx_image *img, const float *coverage, double *ev100, size_t *seen,
+                       size_t *lit)
 {
     double sum = 0.0;
     size_t n = 0, count = (size_t)img->width * (size_t)img->height;
+    *seen = *lit = 0;
     for (size_t i = 0; i < count; i++) {
         double l = lx_luminance(img->data + 3 * i);
+        *seen += coverage[i] > 0.0f;
+        *lit += coverage[i] > 0.0f && l > 0.0;
         if (coverage[i] == 1.0f && l > 0.0) {
             sum += log(l);
             n++;
@@ -478,11 +483,19 @@ static int render_and_write(render_args *a, const lx_lightmaps *lm, const lx_sce
     a->desc.coverage = NULL;
     double ev = a->has_exposure ? a->exposure_ev100 : lm->preview_ev100;
     const char *ev_from = a->has_exposure ? "" : " (the bake's)";
-    if (st == LX_OK && meter) {
-        if (meter_view(&img, coverage, &ev)) {
+    if (st == LX_OK) {
+        double metered;
+        size_t seen, lit_pixels;
+        bool ok = meter_view(&img, coverage, &metered, &seen, &lit_pixels);
+        if (seen == 0)
+            lx_log(LX_LOG_WARN, "%s: the camera sees none of the scene", a->output);
+        else if (lit_pixels == 0)
+            lx_log(LX_LOG_WARN, "%s: all the camera sees of the scene is black", a->output);
+        if (meter && ok) {
+            ev = metered;
             ev_from = " (metered)";
-        } else {
-            lx_log(LX_LOG_WARN, "%s: the view sees nothing lit: exposed as the bake's previews",
+        } else if (meter && seen) {
+            lx_log(LX_LOG_WARN, "%s: nothing lit to meter: exposed as the bake's previews",
                    a->output);
         }
     }
