@@ -153,8 +153,7 @@ int main(int argc, char **argv)
         else if (!strcmp(argv[i], "--scene") && i + 1 < argc)
             scene_path = argv[++i];
         else {
-            fprintf(stderr,
-                    "usage: %s [--threads N] [--reps N] [--samples N] [--scene FILE.glb]\n",
+            fprintf(stderr, "usage: %s [--threads N] [--reps N] [--samples N] [--scene FILE.glb]\n",
                     argv[0]);
             return 2;
         }

@@ -107,9 +107,9 @@ lx_status lx_camera_check(const lx_camera *cam);
 /* ---- lightmaps of a bake (manifest.json) ------------------------------ */
 
 typedef struct lx_lightmap_page {
-    char *file;      /* path of the page (the manifest's folder joined) */
+    char *file; /* path of the page (the manifest's folder joined) */
     int width, height;
-    lx_image image;  /* linear RGB as stored (width 0 when not loaded) */
+    lx_image image; /* linear RGB as stored (width 0 when not loaded) */
 } lx_lightmap_page;
 
 typedef struct lx_lightmap_node {
@@ -149,11 +149,10 @@ lx_lightmaps_load_desc lx_lightmaps_load_desc_defaults(const lx_lightmaps_load_d
 /* Reads dir/manifest.json and the pages it lists (EXR, HDR, PFM or PNG,
  * lx_image_load; 8-bit pages hold the previews' exposed values, E / pi
  * for irradiance, and are scaled back by the manifest's preview_ev100 -
- * to within their 8 bits and the clipping at 1), checking that each page has the size the manifest says
- * and finite, non-negative values, that node pages and UV sets exist and
- * scale_offsets are finite. desc may be NULL. On failure *out is zeroed
- * and the message names the file: "dir/manifest.json: nodes[2]: page 7
- * out of range (3 pages)". */
+ * to within their 8 bits and the clipping at 1), checking that each page has the size the manifest
+ * says and finite, non-negative values, that node pages and UV sets exist and scale_offsets are
+ * finite. desc may be NULL. On failure *out is zeroed and the message names the file:
+ * "dir/manifest.json: nodes[2]: page 7 out of range (3 pages)". */
 lx_status lx_lightmaps_load(const char *dir, const lx_lightmaps_load_desc *desc, lx_lightmaps *out);
 void lx_lightmaps_free(lx_lightmaps *lm);
 

@@ -43,7 +43,8 @@ lx_status lx_camera_check(const lx_camera *cam)
         return lx_fail(LX_ERR_INVALID, "camera: eye, target, up and fov must be finite");
     float fov = camera_fov(cam);
     if (fov >= LX_PI)
-        return lx_fail(LX_ERR_INVALID, "camera: the field of view must be below 180 degrees, not %g",
+        return lx_fail(LX_ERR_INVALID,
+                       "camera: the field of view must be below 180 degrees, not %g",
                        (double)LX_RAD2DEG(fov));
     lx_vec3 d = lx_sub(cam->target, cam->eye);
     float len = lx_length(d);
@@ -82,8 +83,10 @@ bool lx_camera_project(const lx_camera *cam, int width, int height, lx_vec3 p, f
 
 lx_camera lx_camera_frame(lx_vec3 lo, lx_vec3 hi, lx_view view, float fov, float aspect)
 {
-    static const float dirs[][3] = {{1, 1, 1}, {0, 0, 1}, {0, 0, -1}, {-1, 0, 0}, {1, 0, 0}, {0, 1, 0}};
-    lx_camera cam = {.fov = fov > 0.0f && fov < LX_PI ? fov : LX_DEG2RAD(LX_RENDER_DEFAULT_FOV_DEGREES)};
+    static const float dirs[][3] = {{1, 1, 1},  {0, 0, 1}, {0, 0, -1},
+                                    {-1, 0, 0}, {1, 0, 0}, {0, 1, 0}};
+    lx_camera cam = {.fov = fov > 0.0f && fov < LX_PI ? fov
+                                                      : LX_DEG2RAD(LX_RENDER_DEFAULT_FOV_DEGREES)};
     if (!(aspect > 0.0f) || !isfinite(aspect))
         aspect = 16.0f / 9.0f;
     unsigned v = (unsigned)view < 6 ? (unsigned)view : 0;

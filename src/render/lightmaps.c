@@ -137,8 +137,7 @@ static lx_status parse_nodes(const char *file, const cJSON *root, lx_lightmaps *
                            ln->name);
         for (int k = 0; k < 4; k++) {
             const cJSON *v = cJSON_GetArrayItem(so, k);
-            if (!cJSON_IsNumber(v) || !isfinite(v->valuedouble) ||
-                !isfinite((float)v->valuedouble))
+            if (!cJSON_IsNumber(v) || !isfinite(v->valuedouble) || !isfinite((float)v->valuedouble))
                 return lx_fail(LX_ERR_FORMAT,
                                "%s: nodes[%d] ('%s'): \"scale_offset\" must be 4 finite numbers",
                                file, i, ln->name);
@@ -313,9 +312,10 @@ lx_status lx_lightmaps_bind(const lx_lightmaps *lm, const lx_scene *scene, uint3
     for (uint32_t n = 0; n < scene->node_count; n++)
         with_meshes += scene->nodes[n].mesh_count > 0;
     if (lm->node_count > with_meshes)
-        return lx_fail(LX_ERR_INVALID,
-                       "%s/manifest.json lists %u nodes, %s has %u: the lightmaps of another scene?",
-                       m, lm->node_count, scene_name(scene), with_meshes);
+        return lx_fail(
+            LX_ERR_INVALID,
+            "%s/manifest.json lists %u nodes, %s has %u: the lightmaps of another scene?", m,
+            lm->node_count, scene_name(scene), with_meshes);
     /* manifest nodes sorted by name, each name followed by its index */
     struct entry {
         const char *name;
@@ -364,17 +364,18 @@ lx_status lx_lightmaps_bind(const lx_lightmaps *lm, const lx_scene *scene, uint3
             const lx_mesh *mesh = &scene->meshes[node->meshes[k]];
             if (!mesh->uv[ln->uv_set])
                 st = lx_fail(LX_ERR_INVALID,
-                             "%s/manifest.json: node '%s': mesh '%s' of %s has no TEXCOORD_%d%s",
-                             m, key, mesh->name ? mesh->name : "?", scene_name(scene), ln->uv_set,
+                             "%s/manifest.json: node '%s': mesh '%s' of %s has no TEXCOORD_%d%s", m,
+                             key, mesh->name ? mesh->name : "?", scene_name(scene), ln->uv_set,
                              ln->generated ? " (luxel made them: use the scene_with_uvs file)"
                                            : ": the lightmaps of another scene?");
         }
     }
     for (uint32_t i = 0; i < lm->node_count && st == LX_OK; i++)
         if (!used[i])
-            st = lx_fail(LX_ERR_INVALID,
-                         "%s/manifest.json: node '%s' is not in %s: the lightmaps of another scene?",
-                         m, lm->nodes[i].name, scene_name(scene));
+            st =
+                lx_fail(LX_ERR_INVALID,
+                        "%s/manifest.json: node '%s' is not in %s: the lightmaps of another scene?",
+                        m, lm->nodes[i].name, scene_name(scene));
     free(sorted);
     free(used);
     return st;

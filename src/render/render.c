@@ -119,8 +119,8 @@ static const lx_material white = {.name = "default", .base_color = {1, 1, 1, 1}}
 static lx_vec3 albedo(const lx_scene *scene, const lx_mesh *m, const uint32_t *i, float w0,
                       float w1, float w2)
 {
-    const lx_material *mat = m->material < scene->material_count ? &scene->materials[m->material]
-                                                                  : &white;
+    const lx_material *mat =
+        m->material < scene->material_count ? &scene->materials[m->material] : &white;
     lx_vec3 a = lx_v3(mat->base_color.x, mat->base_color.y, mat->base_color.z);
     int set = mat->base_color_uv_set;
     const lx_vec2 *uv = set >= 0 && set < LX_MAX_UV_SETS ? m->uv[set] : NULL;
@@ -214,14 +214,16 @@ static void render_tile(const render_ctx *c, int tile, int tiles_x, lx_image *ou
             double acc[3] = {0, 0, 0};
             int hits = 0;
             for (int s = 0; s < d->samples; s++) {
-                float jx = ((float)(s % sx) + lx_random(d->seed, pixel, (uint32_t)s, 0)) / (float)sx;
-                float jy = ((float)(s / sx) + lx_random(d->seed, pixel, (uint32_t)s, 1)) / (float)sy;
+                float jx =
+                    ((float)(s % sx) + lx_random(d->seed, pixel, (uint32_t)s, 0)) / (float)sx;
+                float jy =
+                    ((float)(s / sx) + lx_random(d->seed, pixel, (uint32_t)s, 1)) / (float)sy;
                 float px = (2.0f * ((float)x + jx) * inv_w - 1.0f) * c->cam.tan_x;
                 float py = (1.0f - 2.0f * ((float)y + jy) * inv_h) * c->cam.tan_y;
-                lx_vec3 dir = lx_add(c->cam.fwd, lx_add(lx_scale(c->cam.right, px),
-                                                        lx_scale(c->cam.up, py)));
-                lx_ray r = {.origin = c->cam.eye, .tmin = 0.0f, .dir = lx_normalize(dir),
-                            .tmax = INFINITY};
+                lx_vec3 dir =
+                    lx_add(c->cam.fwd, lx_add(lx_scale(c->cam.right, px), lx_scale(c->cam.up, py)));
+                lx_ray r = {
+                    .origin = c->cam.eye, .tmin = 0.0f, .dir = lx_normalize(dir), .tmax = INFINITY};
                 bool hit;
                 lx_vec3 L = shade(c, r, &hit);
                 hits += hit;
@@ -238,8 +240,9 @@ static void render_tile(const render_ctx *c, int tile, int tiles_x, lx_image *ou
 static lx_status check_desc(const lx_render_desc *d)
 {
     if (d->width < 1 || d->height < 1 || d->width > MAX_SIDE || d->height > MAX_SIDE)
-        return lx_fail(LX_ERR_INVALID, "render: the image size must be 1..%d pixels a side, not %dx%d",
-                       MAX_SIDE, d->width, d->height);
+        return lx_fail(LX_ERR_INVALID,
+                       "render: the image size must be 1..%d pixels a side, not %dx%d", MAX_SIDE,
+                       d->width, d->height);
     if (d->samples < 1 || d->samples > MAX_SAMPLES)
         return lx_fail(LX_ERR_INVALID, "render: samples must be 1..%d, not %d", MAX_SAMPLES,
                        d->samples);
@@ -273,7 +276,8 @@ lx_status lx_render_view(const lx_scene *scene, const lx_lightmaps *lm, const lx
     for (uint32_t n = 0; n < lm->node_count; n++)
         if (lm->nodes[n].page >= lm->page_count || lm->nodes[n].uv_set < 0 ||
             lm->nodes[n].uv_set >= LX_MAX_UV_SETS)
-            return lx_fail(LX_ERR_INVALID, "render: lightmap node '%s': page or UV set out of range",
+            return lx_fail(LX_ERR_INVALID,
+                           "render: lightmap node '%s': page or UV set out of range",
                            lm->nodes[n].name);
     if (d.camera.eye.x == d.camera.target.x && d.camera.eye.y == d.camera.target.y &&
         d.camera.eye.z == d.camera.target.z) {
@@ -281,8 +285,8 @@ lx_status lx_render_view(const lx_scene *scene, const lx_lightmaps *lm, const lx
         if (!lx_scene_bounds(scene, &lo, &hi))
             return lx_fail(LX_ERR_INVALID, "%s: the scene is empty: nothing to frame",
                            scene->path ? scene->path : "render");
-        d.camera = lx_camera_frame(lo, hi, LX_VIEW_ISO, d.camera.fov,
-                                   (float)d.width / (float)d.height);
+        d.camera =
+            lx_camera_frame(lo, hi, LX_VIEW_ISO, d.camera.fov, (float)d.width / (float)d.height);
     }
     if ((st = lx_camera_check(&d.camera)) != LX_OK)
         return st;
@@ -319,8 +323,13 @@ lx_status lx_render_view(const lx_scene *scene, const lx_lightmaps *lm, const lx
         return st;
     }
 
-    render_ctx c = {.scene = scene, .lm = lm, .tracer = tracer, .node_map = map, .d = &d,
-                    .det_sign = det_sign, .inv_pre_exposure = 1.0f / lm->pre_exposure};
+    render_ctx c = {.scene = scene,
+                    .lm = lm,
+                    .tracer = tracer,
+                    .node_map = map,
+                    .d = &d,
+                    .det_sign = det_sign,
+                    .inv_pre_exposure = 1.0f / lm->pre_exposure};
     lx_camera_basis(&d.camera, d.width, d.height, &c.cam);
     c.background = d.background;
 

@@ -89,7 +89,8 @@ static basis make_basis(const lx_camera *c, int w, int h)
 }
 
 /* Image position of p (pixels from the top-left corner). */
-static void project(const basis *b, const double p[3], int w, int h, double *x, double *y, double *z)
+static void project(const basis *b, const double p[3], int w, int h, double *x, double *y,
+                    double *z)
 {
     double d[3] = {p[0] - b->eye[0], p[1] - b->eye[1], p[2] - b->eye[2]};
     *z = d[0] * b->f[0] + d[1] * b->f[1] + d[2] * b->f[2];
@@ -172,8 +173,8 @@ static void test_plane_constant(void **state)
         lx_render_desc d = lx_render_desc_defaults(NULL);
         d.width = 64, d.height = 36;
         d.filter = (lx_lightmap_filter)filter;
-        d.camera = (lx_camera){.eye = {0, 2, 0}, .target = {0, 0, 0}, .up = {0, 0, -1},
-                               .fov = 40.0f * LX_PI / 180.0f};
+        d.camera = (lx_camera){
+            .eye = {0, 2, 0}, .target = {0, 0, 0}, .up = {0, 0, -1}, .fov = 40.0f * LX_PI / 180.0f};
         lx_image img;
         assert_int_equal(lx_render_view(s, &lm, NULL, &d, &img), LX_OK);
         assert_int_equal(img.channels, 3);
@@ -188,8 +189,7 @@ static void test_plane_constant(void **state)
         if (filter == 0) {
             /* the 8-bit file: exposure, Hable's curve, sRGB */
             const double ev = 7.0, exposure = 1.0 / (1.2 * pow(2.0, ev));
-            lx_image_write_desc w = {.tonemap = LX_TONEMAP_FILMIC,
-                                     .exposure = (float)exposure};
+            lx_image_write_desc w = {.tonemap = LX_TONEMAP_FILMIC, .exposure = (float)exposure};
             const char *png = join(dir, "view.png");
             assert_int_equal(lx_image_write(png, &img, &w), LX_OK);
             lx_image back;
@@ -235,8 +235,8 @@ static void test_png_page(void **state)
     lx_lightmaps lm;
     assert_int_equal(lx_lightmaps_load(dir, NULL, &lm), LX_OK);
     lx_render_desc d = {.width = 16, .height = 16, .samples = 1};
-    d.camera = (lx_camera){.eye = {0, 2, 0}, .target = {0, 0, 0}, .up = {0, 0, -1},
-                           .fov = 20.0f * LX_PI / 180.0f};
+    d.camera = (lx_camera){
+        .eye = {0, 2, 0}, .target = {0, 0, 0}, .up = {0, 0, -1}, .fov = 20.0f * LX_PI / 180.0f};
     lx_image img;
     assert_int_equal(lx_render_view(s, &lm, NULL, &d, &img), LX_OK);
     double want = 0.5 * E / PI_D;
@@ -267,8 +267,8 @@ static void test_radiance_page(void **state)
     assert_int_equal(lx_lightmaps_load(dir, NULL, &lm), LX_OK);
     assert_int_equal(lm.quantity, LX_QUANTITY_RADIANCE);
     lx_render_desc d = {.width = 8, .height = 8, .samples = 2};
-    d.camera = (lx_camera){.eye = {0, 2, 0}, .target = {0, 0, 0}, .up = {0, 0, -1},
-                           .fov = 20.0f * LX_PI / 180.0f};
+    d.camera = (lx_camera){
+        .eye = {0, 2, 0}, .target = {0, 0, 0}, .up = {0, 0, -1}, .fov = 20.0f * LX_PI / 180.0f};
     lx_image img;
     assert_int_equal(lx_render_view(s, &lm, NULL, &d, &img), LX_OK);
     const float want[3] = {12.0f, 6.0f, 3.0f};
@@ -316,16 +316,19 @@ static void bake_cube(lx_scene *s, const char *dir)
     assert_int_equal(lx_baker_create(s, &bd, &b), LX_OK);
     assert_int_equal(lx_baker_bake(b), LX_OK);
     char text[4096];
-    int n = snprintf(text, sizeof text, "{\"scene\":\"cube\",\"quantity\":\"irradiance\","
-                                        "\"preview_ev100\":5,\"pages\":[");
+    int n = snprintf(text, sizeof text,
+                     "{\"scene\":\"cube\",\"quantity\":\"irradiance\","
+                     "\"preview_ev100\":5,\"pages\":[");
     for (uint32_t p = 0; p < lx_baker_lightmap_count(b); p++) {
         lx_image img;
         assert_int_equal(lx_baker_apply_alloc(b, p, &img), LX_OK);
         char name[64];
         snprintf(name, sizeof name, "lightmap-%u.exr", p);
         assert_int_equal(lx_image_write(join(dir, name), &img, NULL), LX_OK);
-        n += snprintf(text + n, sizeof text - (size_t)n, "%s{\"file\":\"%s\",\"width\":%d,"
-                      "\"height\":%d}", p ? "," : "", name, img.width, img.height);
+        n += snprintf(text + n, sizeof text - (size_t)n,
+                      "%s{\"file\":\"%s\",\"width\":%d,"
+                      "\"height\":%d}",
+                      p ? "," : "", name, img.width, img.height);
         lx_image_free(&img);
     }
     assert_int_equal(s->node_count, 1);
@@ -378,7 +381,8 @@ static void test_cube_no_seams(void **state)
              * rounding in the bake and the lookups measured 2.4e-7 */
             assert_true(inside > 2000);
             if (worst > 1e-6)
-                fail_msg("view %d filter %d: a pixel on the cube is off by %g", view, filter, worst);
+                fail_msg("view %d filter %d: a pixel on the cube is off by %g", view, filter,
+                         worst);
             lx_image_free(&img);
         }
     lx_lightmaps_free(&lm);
@@ -390,8 +394,10 @@ static void test_cube_no_seams(void **state)
 static void test_framing(void **state)
 {
     (void)state;
-    const float boxes[][6] = {{-1, 0, -1, 1, 2, 1},       {0, 0, 0, 10, 0.1f, 4},
-                              {-50, -3, 7, -20, 30, 9},    {2, 2, 2, 2.001f, 2.001f, 2.001f},
+    const float boxes[][6] = {{-1, 0, -1, 1, 2, 1},
+                              {0, 0, 0, 10, 0.1f, 4},
+                              {-50, -3, 7, -20, 30, 9},
+                              {2, 2, 2, 2.001f, 2.001f, 2.001f},
                               {-0.2f, 0, -5, 0.2f, 0.3f, 5}};
     const int sizes[][2] = {{1280, 720}, {400, 800}, {100, 100}};
     const float fovs[] = {0.0f, 20.0f, 90.0f};
@@ -401,9 +407,9 @@ static void test_framing(void **state)
                 for (int fi = 0; fi < 3; fi++) {
                     const float *bx = boxes[bi];
                     int W = sizes[si][0], H = sizes[si][1];
-                    lx_camera c = lx_camera_frame(lx_v3(bx[0], bx[1], bx[2]),
-                                                  lx_v3(bx[3], bx[4], bx[5]), (lx_view)view,
-                                                  fovs[fi] * LX_PI / 180.0f, (float)W / H);
+                    lx_camera c =
+                        lx_camera_frame(lx_v3(bx[0], bx[1], bx[2]), lx_v3(bx[3], bx[4], bx[5]),
+                                        (lx_view)view, fovs[fi] * LX_PI / 180.0f, (float)W / H);
                     assert_int_equal(lx_camera_check(&c), LX_OK);
                     basis b = make_basis(&c, W, H);
                     double margin = INFINITY;
@@ -420,13 +426,12 @@ static void test_framing(void **state)
                         project(&b, p, W, H, &x, &y, &z);
                         assert_true(z > 0.0);
                         assert_true(x >= 0.0 && x <= W && y >= 0.0 && y <= H);
-                        margin = fmin(margin, fmin(fmin(x / W, 1.0 - x / W),
-                                                   fmin(y / H, 1.0 - y / H)));
+                        margin =
+                            fmin(margin, fmin(fmin(x / W, 1.0 - x / W), fmin(y / H, 1.0 - y / H)));
                         /* the library's projection agrees with this one */
                         float lxp, lyp;
-                        assert_true(lx_camera_project(&c, W, H, lx_v3((float)p[0], (float)p[1],
-                                                                         (float)p[2]),
-                                                      &lxp, &lyp));
+                        assert_true(lx_camera_project(
+                            &c, W, H, lx_v3((float)p[0], (float)p[1], (float)p[2]), &lxp, &lyp));
                         assert_true(fabs(lxp - x) < 1e-3 * W && fabs(lyp - y) < 1e-3 * H);
                     }
                     /* tight: the eye is as close as the corners allow, so
@@ -523,7 +528,8 @@ static void test_cancel(void **state)
     assert_int_equal(lx_lightmaps_load(dir, NULL, &lm), LX_OK);
     lx_scene *s = plane_scene(lx_v4(1, 1, 1, 1));
     int calls = 0;
-    lx_render_desc d = {.width = 256, .height = 256, .progress = stop_early, .progress_user = &calls};
+    lx_render_desc d = {
+        .width = 256, .height = 256, .progress = stop_early, .progress_user = &calls};
     lx_image img;
     assert_int_equal(lx_render_view(s, &lm, NULL, &d, &img), LX_ERR_CANCELLED);
     assert_null(img.data);

@@ -189,9 +189,8 @@ static int parse_args(int argc, char **argv, render_args *a)
             break;
         case OPT_SIZE:
             if (!parse_size(optarg, &a->desc.width, &a->desc.height))
-                return cli_usage_error("render",
-                                       "--size must be WxH with each side in 1..16384, not '%s'",
-                                       optarg);
+                return cli_usage_error(
+                    "render", "--size must be WxH with each side in 1..16384, not '%s'", optarg);
             break;
         case OPT_EXPOSURE:
             if (strcmp(optarg, "bake") == 0) {
@@ -210,8 +209,8 @@ static int parse_args(int argc, char **argv, render_args *a)
             break;
         case OPT_TONEMAP:
             if (!lx_tonemap_parse(optarg, &a->tonemap))
-                return cli_usage_error("render", "--tonemap must be aces, filmic or clamp, not '%s'",
-                                       optarg);
+                return cli_usage_error("render",
+                                       "--tonemap must be aces, filmic or clamp, not '%s'", optarg);
             break;
         case OPT_FILTER:
             if (strcmp(optarg, "bilinear") == 0)
@@ -224,8 +223,8 @@ static int parse_args(int argc, char **argv, render_args *a)
             break;
         case OPT_SAMPLES:
             if (!cli_parse_int(optarg, 1, 4096, &n))
-                return cli_usage_error("render", "--samples must be an integer in 1..4096, not '%s'",
-                                       optarg);
+                return cli_usage_error("render",
+                                       "--samples must be an integer in 1..4096, not '%s'", optarg);
             a->desc.samples = (int)n;
             break;
         case OPT_TWO_SIDED:
@@ -233,8 +232,8 @@ static int parse_args(int argc, char **argv, render_args *a)
             break;
         case OPT_THREADS:
             if (!cli_parse_int(optarg, 1, 1024, &n))
-                return cli_usage_error("render", "--threads must be an integer in 1..1024, not '%s'",
-                                       optarg);
+                return cli_usage_error("render",
+                                       "--threads must be an integer in 1..1024, not '%s'", optarg);
             a->desc.threads = (int)n;
             break;
         case 'q':
@@ -268,8 +267,9 @@ static int parse_args(int argc, char **argv, render_args *a)
     if (a->has_camera && lx_camera_check(&a->desc.camera) != LX_OK)
         return cli_usage_error("render", "--camera: %s", lx_last_error());
     if (lx_image_format_from_path(a->output) == LX_IMAGE_AUTO)
-        return cli_usage_error("render", "%s: the output must end in .png, .jpg, .tga, .exr, .hdr "
-                                         "or .pfm",
+        return cli_usage_error("render",
+                               "%s: the output must end in .png, .jpg, .tga, .exr, .hdr "
+                               "or .pfm",
                                a->output);
     return 0;
 }
@@ -353,7 +353,8 @@ static int unwrap_again(const lx_lightmaps *lm, lx_scene *scene, const char *sce
             snprintf(diff, sizeof diff, "%u pages, the manifest lists %u", u->page_count,
                      lm->page_count);
         for (uint32_t p = 0; !diff[0] && p < u->page_count; p++)
-            if (u->pages[p].width != lm->pages[p].width || u->pages[p].height != lm->pages[p].height)
+            if (u->pages[p].width != lm->pages[p].width ||
+                u->pages[p].height != lm->pages[p].height)
                 snprintf(diff, sizeof diff, "page %u is %dx%d, the manifest says %dx%d", p,
                          u->pages[p].width, u->pages[p].height, lm->pages[p].width,
                          lm->pages[p].height);
@@ -469,8 +470,7 @@ static int render_and_write(render_args *a, const lx_lightmaps *lm, const lx_sce
     lx_image img = {0};
     bool meter = !a->has_exposure && !a->bake_exposure;
     float *coverage = NULL;
-    if (!(coverage = malloc((size_t)a->desc.width * (size_t)a->desc.height *
-                                     sizeof *coverage))) {
+    if (!(coverage = malloc((size_t)a->desc.width * (size_t)a->desc.height * sizeof *coverage))) {
         lx_cubemap_free(&sky);
         cli_error("out of memory");
         return EXIT_FAILED;
@@ -536,11 +536,13 @@ static int render_and_write(render_args *a, const lx_lightmaps *lm, const lx_sce
     }
     if (!a->quiet && !a->no_summary) {
         if (eight_bit)
-            fprintf(stderr, "luxel: rendered %dx%d, %d samples a pixel, in %.2f s; EV100 %.2f%s, %s\n",
-                    a->desc.width, a->desc.height, a->desc.samples, cli_elapsed(), ev,
-                    ev_from, lx_tonemap_name(a->tonemap));
+            fprintf(stderr,
+                    "luxel: rendered %dx%d, %d samples a pixel, in %.2f s; EV100 %.2f%s, %s\n",
+                    a->desc.width, a->desc.height, a->desc.samples, cli_elapsed(), ev, ev_from,
+                    lx_tonemap_name(a->tonemap));
         else
-            fprintf(stderr, "luxel: rendered %dx%d, %d samples a pixel, in %.2f s (radiance, nits)\n",
+            fprintf(stderr,
+                    "luxel: rendered %dx%d, %d samples a pixel, in %.2f s (radiance, nits)\n",
                     a->desc.width, a->desc.height, a->desc.samples, cli_elapsed());
         printf("%s\n", a->output);
     }
