@@ -18,16 +18,17 @@ configure: deps
 	@test -f $(BUILD)/CMakeCache.txt || cmake -S . -B $(BUILD) -DCMAKE_BUILD_TYPE=Release $(CMAKE_FLAGS)
 
 # Generate the example scenes and sky, bake the room and the courtyard by
-# night and by day (sky light), and filter the sky for image-based lighting.
+# night and by day (sky light), each with a view of the lit scene
+# (view.png, bake --render), and filter the sky for image-based lighting.
 demo: all
 	$(BUILD)/bin/gen_scenes examples/scenes
-	$(BUILD)/bin/luxel bake examples/scenes/room.glb -o lightmaps/room
+	$(BUILD)/bin/luxel bake examples/scenes/room.glb -o lightmaps/room --render
 	$(BUILD)/bin/luxel bake examples/scenes/retro.glb --texel-density 8 \
-		--lights examples/retro-night.json -o lightmaps/retro
+		--lights examples/retro-night.json -o lightmaps/retro --render
 	$(BUILD)/bin/luxel bake examples/scenes/retro.glb --texel-density 8 \
-		--lights examples/retro-day.json -o lightmaps/retro-day
+		--lights examples/retro-day.json -o lightmaps/retro-day --render
 	$(BUILD)/bin/luxel ibl examples/scenes/sky.pfm -o ibl/sky
-	@echo "demo: lightmaps, PNG previews and manifest.json are in lightmaps/room/, lightmaps/retro/ and lightmaps/retro-day/; the sky's irradiance, SH, specular mips and DFG table in ibl/sky/"
+	@echo "demo: lightmaps, PNG previews, manifest.json and view.png are in lightmaps/room/, lightmaps/retro/ and lightmaps/retro-day/; the sky's irradiance, SH, specular mips and DFG table in ibl/sky/"
 
 check: all
 	cd $(BUILD) && ctest --output-on-failure -j $(JOBS)
@@ -45,6 +46,7 @@ bench: all
 	$(BUILD)/bin/bench_realtime
 	$(BUILD)/bin/bench_ibl
 	$(BUILD)/bin/bench_unwrap
+	$(BUILD)/bin/bench_render
 
 fuzz: all
 	@test -f $(BUILD_FUZZ)/CMakeCache.txt || CC=clang cmake -S . -B $(BUILD_FUZZ) -DCMAKE_BUILD_TYPE=Debug -DLX_FUZZ=ON

@@ -15,5 +15,6 @@
 #include "luxel/bake.h"
 #include "luxel/ibl.h"
 #include "luxel/unwrap.h"
+#include "luxel/render.h"
 
 #endif

@@ -60,6 +60,8 @@ static const char *bake_usage =
     "  --atlas, --no-atlas     share pages between nodes, or a lightmap per node\n"
     "                          (default: pages whenever luxel makes UVs)\n"
     "  --atlas-size N          largest atlas page side (default %d)\n"
+    "  --render                also DIR/view.png: the scene with its lightmaps from\n"
+    "                          the default camera (luxel render)\n"
     "  --threads N             worker threads (default: all cores)\n"
     "  --skip-degenerate       accepted for old scripts: zero-area triangles are\n"
     "                          always left out with a warning\n"
@@ -90,7 +92,8 @@ enum {
     OPT_UV_SET,
     OPT_ATLAS,
     OPT_NO_ATLAS,
-    OPT_ATLAS_SIZE
+    OPT_ATLAS_SIZE,
+    OPT_RENDER
 };
 
 typedef enum unwrap_choice { UNWRAP_AUTO, UNWRAP_ALWAYS, UNWRAP_NEVER } unwrap_choice;
@@ -120,6 +123,7 @@ typedef struct bake_args {
     unwrap_choice unwrap;
     int atlas;      /* 1 --atlas, 0 --no-atlas, -1 not given */
     int atlas_size; /* 0: the unwrapper's default */
+    bool render;    /* --render: DIR/view.png after the bake */
     lx_bake_desc desc;
 } bake_args;
 
@@ -150,6 +154,7 @@ static int parse_args(int argc, char **argv, bake_args *a)
         {"atlas", no_argument, NULL, OPT_ATLAS},
         {"no-atlas", no_argument, NULL, OPT_NO_ATLAS},
         {"atlas-size", required_argument, NULL, OPT_ATLAS_SIZE},
+        {"render", no_argument, NULL, OPT_RENDER},
         {"quiet", no_argument, NULL, 'q'},
         {"verbose", no_argument, NULL, 'v'},
         {"help", no_argument, NULL, 'h'},
@@ -303,6 +308,9 @@ static int parse_args(int argc, char **argv, bake_args *a)
                 return cli_usage_error("bake", "--atlas-size must be an integer in 4..%d, not '%s'",
                                        LX_UNWRAP_MAX_ATLAS_SIZE, optarg);
             a->atlas_size = (int)n;
+            break;
+        case OPT_RENDER:
+            a->render = true;
             break;
         case 'q':
             a->quiet = true;
@@ -824,6 +832,8 @@ int cmd_bake(int argc, char **argv)
         cli_phase_part(what, t_previews);
     }
     cli_phase("write and publish");
+    if (a.render && cli_render_bake(a.output, scene, a.desc.threads, a.quiet) != EXIT_OK)
+        goto done;
     if (!a.quiet) {
         uint64_t texels = 0;
         for (uint32_t m = 0; m < maps; m++)

@@ -13,6 +13,9 @@ int cmd_bake(int argc, char **argv);
 int cmd_info(int argc, char **argv);
 int cmd_ies(int argc, char **argv);
 int cmd_ibl(int argc, char **argv);
+int cmd_render(int argc, char **argv);
+/* bake --render: DIR/view.png of DIR's lightmaps on scene (default camera). */
+int cli_render_bake(const char *dir, const lx_scene *scene, int threads, bool quiet);
 
 /* "luxel: error: <message>" on stderr. */
 void cli_error(const char *fmt, ...) __attribute__((format(printf, 1, 2)));

@@ -1,0 +1,209 @@
+/* luxel/render.h - camera views of a scene with its baked lightmaps
+ * applied: one primary ray per pixel sample (Embree, through lx_tracer),
+ * each hit shaded as a Lambertian surface, base colour x irradiance / pi,
+ * the irradiance looked up in the node's lightmap page through the bake's
+ * manifest (docs/manifest.md). This is what `luxel render` draws.
+ *
+ * CONVENTIONS  World space, metres, +Y up (scene.h). A camera looks from
+ *   eye toward target with a vertical field of view in radians; pixel (x,
+ *   y), row 0 at the top, covers [x, x+1] x [y, y+1]. The rendered image is
+ *   linear radiance in nits (cd/m^2): RGB, Rec.709 primaries; expose it
+ *   with lx_exposure_from_ev100 and tone map it when writing (core.h).
+ *   Lightmaps in lux are shaded as base colour x E / pi; lightmaps of
+ *   outgoing radiance (quantity "radiance") are shown as they are; values
+ *   are divided by the manifest's pre_exposure. Pages are read with
+ *   clamp-to-edge addressing at the UVs the manifest says: page_uv = uv *
+ *   scale_offset.xy + scale_offset.zw (Unity's lightmapScaleOffset).
+ *   Back faces are culled unless desc.two_sided (glTF materials are
+ *   single-sided by default); the base colour is the material's factor
+ *   times its texture read at its own UV set under KHR_texture_transform.
+ * ERRORS  lx_lightmaps_load names the manifest and the field or page that
+ *   is wrong; lx_render_view fails with LX_ERR_INVALID when the lightmaps
+ *   belong to another scene (a node the scene lacks, a node count or a
+ *   mesh count that differs, a UV set a mesh lacks), LX_ERR_CANCELLED when
+ *   the progress callback says stop.
+ * MEMORY  lx_lightmaps_load fills a caller-owned struct; lx_lightmaps_free
+ *   releases what it allocated. lx_render_view allocates out (free it with
+ *   lx_image_free); nothing else outlives the call.
+ * THREADING  Every function is thread-safe on distinct outputs.
+ *   lx_render_view runs OpenMP over tiles of pixels, at most desc.threads
+ *   threads, and gives the same bits for any thread count: each pixel's
+ *   samples are stratified and jittered by a counter-based generator keyed
+ *   by (seed, pixel, sample).
+ *
+ * USAGE
+ *   lx_scene *scene;
+ *   lx_lightmaps lm;
+ *   if (lx_scene_load("room.glb", NULL, &scene) != LX_OK) return 1;
+ *   if (lx_lightmaps_load("lightmaps/room", NULL, &lm) == LX_OK) {
+ *       lx_image img;
+ *       lx_render_desc d = lx_render_desc_defaults(NULL); // 1280x720, iso framing
+ *       if (lx_render_view(scene, &lm, NULL, &d, &img) == LX_OK) {
+ *           lx_image_write_desc w = {.tonemap = LX_TONEMAP_ACES,
+ *                                    .exposure = lx_exposure_from_ev100(lm.preview_ev100)};
+ *           lx_image_write("view.png", &img, &w);
+ *           lx_image_free(&img);
+ *       }
+ *       lx_lightmaps_free(&lm);
+ *   }
+ *   lx_scene_destroy(scene);
+ */
+#ifndef LUXEL_RENDER_H
+#define LUXEL_RENDER_H
+
+#include "luxel/bake.h"
+#include "luxel/core.h"
+#include "luxel/ibl.h"
+#include "luxel/math.h"
+#include "luxel/scene.h"
+#include "luxel/trace.h"
+
+#ifdef __cplusplus
+extern "C" {
+#endif
+
+/* ---- cameras --------------------------------------------------------- */
+
+typedef struct lx_camera {
+    lx_vec3 eye;    /* where the camera is */
+    lx_vec3 target; /* the point at the centre of the image */
+    lx_vec3 up;     /* roughly up in the image; zero = +Y (-Z looking straight
+                       up or down) */
+    float fov;      /* vertical field of view in radians, 0 = 50 degrees */
+} lx_camera;
+
+#define LX_RENDER_DEFAULT_FOV_DEGREES 50.0f
+
+/* Directions lx_camera_frame looks from. */
+typedef enum lx_view {
+    LX_VIEW_ISO = 0, /* from +X +Y +Z (above, front right), looking at the centre */
+    LX_VIEW_FRONT,   /* from +Z toward -Z */
+    LX_VIEW_BACK,    /* from -Z toward +Z */
+    LX_VIEW_LEFT,    /* from -X toward +X */
+    LX_VIEW_RIGHT,   /* from +X toward -X */
+    LX_VIEW_TOP      /* from +Y down, -Z up in the image */
+} lx_view;
+
+/* "iso", "front", ... ; NULL for another value. */
+const char *lx_view_name(lx_view view);
+/* The view named name; false when none. */
+bool lx_view_parse(const char *name, lx_view *out);
+
+/* A camera that looks at the box [lo, hi] from `view`, at the centre of
+ * the box, as close as it can while all 8 corners stay inside the image
+ * (with a 5% margin). fov: vertical, radians (0 = 50 degrees); aspect:
+ * width / height (0 = 16/9). */
+lx_camera lx_camera_frame(lx_vec3 lo, lx_vec3 hi, lx_view view, float fov, float aspect);
+
+/* Where world point p lands in an image of width x height (pixel units,
+ * (0, 0) the top-left corner of the image) seen by cam; false when p is
+ * behind the camera. */
+bool lx_camera_project(const lx_camera *cam, int width, int height, lx_vec3 p, float *x, float *y);
+
+/* LX_OK when the camera can make an image: finite, eye != target, up not
+ * along the view, fov in (0, pi). The message names the problem. */
+lx_status lx_camera_check(const lx_camera *cam);
+
+/* ---- lightmaps of a bake (manifest.json) ------------------------------ */
+
+typedef struct lx_lightmap_page {
+    char *file; /* path of the page (the manifest's folder joined) */
+    int width, height;
+    lx_image image; /* linear RGB as stored (width 0 when not loaded) */
+} lx_lightmap_page;
+
+typedef struct lx_lightmap_node {
+    char *name;            /* scene node name */
+    uint32_t mesh_count;   /* meshes the manifest lists for it */
+    uint32_t page;         /* index into pages */
+    int uv_set;            /* 0 = TEXCOORD_0, 1 = TEXCOORD_1 */
+    bool generated;        /* luxel made the UVs ("uvs": "generated") */
+    float scale_offset[4]; /* node UV -> page UV */
+} lx_lightmap_node;
+
+typedef struct lx_lightmaps {
+    char *dir;            /* the folder given */
+    char *scene;          /* the manifest's "scene", as the bake was given it */
+    char *scene_with_uvs; /* the scene with generated UVs, joined to dir; NULL when none */
+    lx_quantity quantity; /* irradiance (lux) or radiance (nits) */
+    float pre_exposure;   /* factor the stored values carry (1 without --pre-expose) */
+    float preview_ev100;  /* the previews' exposure (0 when absent) */
+    float texel_density;  /* texels per metre, 0 when absent */
+    int padding;          /* texel rings each chart owns (-1 when absent) */
+    int atlas_size;       /* largest page side asked for (0 when absent) */
+    char *sky;            /* the sky environment as the bake was given it, or NULL */
+    float sky_intensity;  /* its multiplier (1 when absent) */
+    lx_lightmap_page *pages;
+    uint32_t page_count;
+    lx_lightmap_node *nodes;
+    uint32_t node_count;
+} lx_lightmaps;
+
+typedef struct lx_lightmaps_load_desc {
+    bool skip_images; /* read the manifest only: pages keep width 0 images */
+} lx_lightmaps_load_desc;
+
+/* A copy of desc (or of zeros when NULL) with every default filled in. */
+lx_lightmaps_load_desc lx_lightmaps_load_desc_defaults(const lx_lightmaps_load_desc *desc);
+
+/* Reads dir/manifest.json and the pages it lists (EXR, HDR, PFM or PNG,
+ * lx_image_load; 8-bit pages hold the previews' exposed values, E / pi
+ * for irradiance, and are scaled back by the manifest's preview_ev100 -
+ * to within their 8 bits and the clipping at 1), checking that each page has the size the manifest
+ * says and finite, non-negative values, that node pages and UV sets exist and scale_offsets are
+ * finite. desc may be NULL. On failure *out is zeroed and the message names the file:
+ * "dir/manifest.json: nodes[2]: page 7 out of range (3 pages)". */
+lx_status lx_lightmaps_load(const char *dir, const lx_lightmaps_load_desc *desc, lx_lightmaps *out);
+void lx_lightmaps_free(lx_lightmaps *lm);
+
+/* LX_OK when lm fits scene: every manifest node is a scene node with as
+ * many meshes, each with the UV set named; and the scene nodes the
+ * manifest leaves out have no UVs in any set (they could not be baked).
+ * Else LX_ERR_INVALID: "lightmaps/room/manifest.json: node 'floor' is not
+ * in scene.glb: the lightmaps of another scene?". */
+lx_status lx_lightmaps_check(const lx_lightmaps *lm, const lx_scene *scene);
+
+/* ---- rendering -------------------------------------------------------- */
+
+typedef enum lx_lightmap_filter {
+    LX_LIGHTMAP_BILINEAR = 0, /* 2x2 texels */
+    LX_LIGHTMAP_BICUBIC       /* 4x4 texels, cubic B-spline (smooth, never negative) */
+} lx_lightmap_filter;
+
+typedef struct lx_render_desc {
+    int width, height;         /* pixels, 0 = 1280 x 720 */
+    lx_camera camera;          /* eye == target (zeroed): lx_camera_frame of the
+                                  scene's bounds, LX_VIEW_ISO, at camera.fov */
+    int samples;               /* per pixel, 1..4096, 0 = 4 */
+    lx_lightmap_filter filter; /* lightmap lookups */
+    bool two_sided;            /* false: back faces are culled (rays go through) */
+    lx_vec3 background;        /* radiance (nits) of rays that miss (default black;
+                                  coverage lets a caller compose its own) */
+    const lx_cubemap *sky;     /* when set, rays that miss see it (radiance, nits) */
+    float sky_intensity;       /* multiplier on sky, 0 = 1 */
+    uint32_t seed;             /* sample pattern */
+    float *coverage;           /* NULL, or width*height floats (the caller's) that
+                                  get the fraction of each pixel's samples that
+                                  hit the scene (for metering, masks) */
+    int threads;               /* 0 = all cores */
+    lx_progress_fn progress;   /* fraction of tiles done; false cancels */
+    void *progress_user;
+} lx_render_desc;
+
+/* A copy of desc (or of zeros when NULL) with every default filled in;
+ * the camera stays zeroed (framed at render time). */
+lx_render_desc lx_render_desc_defaults(const lx_render_desc *desc);
+
+/* Renders scene with lightmaps lm into out (3 channels, linear radiance in
+ * nits, allocated here). tracer may be NULL (one is built and destroyed
+ * here), else it must have been made from scene. Checks lm against the
+ * scene first (lx_lightmaps_check), and lm must have its images loaded.
+ * Scene nodes without a lightmap are drawn black. On failure out is
+ * zeroed. desc may be NULL. */
+lx_status lx_render_view(const lx_scene *scene, const lx_lightmaps *lm, const lx_tracer *tracer,
+                         const lx_render_desc *desc, lx_image *out);
+
+#ifdef __cplusplus
+}
+#endif
+#endif

@@ -1,0 +1,361 @@
+/* Camera views with lightmaps applied: a primary ray per stratified,
+ * jittered pixel sample (box filter over the pixel), the hit shaded as a
+ * Lambertian surface lit by its lightmap, E * albedo / pi. Lightmaps are
+ * read bilinearly or with the cubic B-spline (the smooth 4x4 kernel of
+ * "bicubic lightmap sampling" in engines; weights as in Mitchell &
+ * Netravali's B = 1, C = 0 family member). */
+#include "render_internal.h"
+
+#include <math.h>
+#include <omp.h>
+#include <stdatomic.h>
+#include <stdlib.h>
+#include <string.h>
+
+#define TILE 16
+#define MAX_SIDE 16384
+#define MAX_SAMPLES 4096
+/* back faces a ray may pass through before it gives up (drawn as a miss) */
+#define MAX_CULLED 64
+
+lx_render_desc lx_render_desc_defaults(const lx_render_desc *desc)
+{
+    lx_render_desc d = desc ? *desc : (lx_render_desc){0};
+    if (d.width == 0 && d.height == 0) {
+        d.width = 1280;
+        d.height = 720;
+    }
+    if (d.samples == 0)
+        d.samples = 4;
+    if (d.sky_intensity == 0.0f)
+        d.sky_intensity = 1.0f;
+    return d;
+}
+
+/* ---- lightmap lookups ------------------------------------------------------ */
+
+static const float *texel(const lx_image *img, int x, int y)
+{
+    x = x < 0 ? 0 : (x >= img->width ? img->width - 1 : x);
+    y = y < 0 ? 0 : (y >= img->height ? img->height - 1 : y);
+    return img->data + ((size_t)y * (size_t)img->width + (size_t)x) * 3;
+}
+
+/* Page coordinates of uv: texel centres at half-integers, clamped to
+ * something an int holds (clamp-to-edge does the rest). */
+static void page_coords(const lx_image *img, float u, float v, float *x, float *y)
+{
+    *x = lx_clampf(u * (float)img->width - 0.5f, -4.0f, (float)img->width + 4.0f);
+    *y = lx_clampf(v * (float)img->height - 0.5f, -4.0f, (float)img->height + 4.0f);
+    if (!isfinite(*x))
+        *x = 0.0f;
+    if (!isfinite(*y))
+        *y = 0.0f;
+}
+
+static void sample_bilinear(const lx_image *img, float u, float v, float out[3])
+{
+    float x, y;
+    page_coords(img, u, v, &x, &y);
+    float fx = floorf(x), fy = floorf(y), tx = x - fx, ty = y - fy;
+    int x0 = (int)fx, y0 = (int)fy;
+    const float *a = texel(img, x0, y0), *b = texel(img, x0 + 1, y0);
+    const float *c = texel(img, x0, y0 + 1), *d = texel(img, x0 + 1, y0 + 1);
+    for (int k = 0; k < 3; k++) {
+        float top = a[k] + (b[k] - a[k]) * tx, bottom = c[k] + (d[k] - c[k]) * tx;
+        out[k] = top + (bottom - top) * ty;
+    }
+}
+
+/* Uniform cubic B-spline weights for the taps at -1, 0, 1, 2 around t. */
+static void bspline(float t, float w[4])
+{
+    float s = 1.0f - t, t2 = t * t, t3 = t2 * t;
+    w[0] = s * s * s / 6.0f;
+    w[1] = (3.0f * t3 - 6.0f * t2 + 4.0f) / 6.0f;
+    w[2] = (-3.0f * t3 + 3.0f * t2 + 3.0f * t + 1.0f) / 6.0f;
+    w[3] = t3 / 6.0f;
+}
+
+static void sample_bicubic(const lx_image *img, float u, float v, float out[3])
+{
+    float x, y;
+    page_coords(img, u, v, &x, &y);
+    float fx = floorf(x), fy = floorf(y), wx[4], wy[4];
+    bspline(x - fx, wx);
+    bspline(y - fy, wy);
+    int x0 = (int)fx - 1, y0 = (int)fy - 1;
+    float acc[3] = {0, 0, 0};
+    for (int j = 0; j < 4; j++) {
+        float row[3] = {0, 0, 0};
+        for (int i = 0; i < 4; i++) {
+            const float *t = texel(img, x0 + i, y0 + j);
+            for (int k = 0; k < 3; k++)
+                row[k] += wx[i] * t[k];
+        }
+        for (int k = 0; k < 3; k++)
+            acc[k] += wy[j] * row[k];
+    }
+    for (int k = 0; k < 3; k++)
+        out[k] = acc[k] > 0.0f ? acc[k] : 0.0f;
+}
+
+/* ---- shading --------------------------------------------------------------- */
+
+typedef struct render_ctx {
+    const lx_scene *scene;
+    const lx_lightmaps *lm;
+    const lx_tracer *tracer;
+    const uint32_t *node_map; /* scene node -> manifest node */
+    const lx_render_desc *d;
+    lx_camera_basis_t cam;
+    float *det_sign; /* per scene node: the sign of its world matrix's determinant */
+    lx_vec3 background;
+    float inv_pre_exposure;
+} render_ctx;
+
+static const lx_material white = {.name = "default", .base_color = {1, 1, 1, 1}};
+
+static lx_vec3 albedo(const lx_scene *scene, const lx_mesh *m, const uint32_t *i, float w0,
+                      float w1, float w2)
+{
+    const lx_material *mat =
+        m->material < scene->material_count ? &scene->materials[m->material] : &white;
+    lx_vec3 a = lx_v3(mat->base_color.x, mat->base_color.y, mat->base_color.z);
+    int set = mat->base_color_uv_set;
+    const lx_vec2 *uv = set >= 0 && set < LX_MAX_UV_SETS ? m->uv[set] : NULL;
+    if (mat->base_color_map.width > 0 && uv) {
+        lx_vec2 t = lx_v2(uv[i[0]].x * w0 + uv[i[1]].x * w1 + uv[i[2]].x * w2,
+                          uv[i[0]].y * w0 + uv[i[1]].y * w1 + uv[i[2]].y * w2);
+        t = lx_uv_transform_apply(&mat->base_color_transform, t);
+        float c[4] = {1, 1, 1, 1};
+        lx_image_sample_bilinear(&mat->base_color_map, t.x, t.y, c);
+        a = lx_mul(a, lx_v3(c[0], c[1], c[2]));
+    }
+    return a;
+}
+
+/* Radiance seen along ray r (dir unit length); *hit tells whether it
+ * met the scene. */
+static lx_vec3 shade(const render_ctx *c, lx_ray r, bool *hit)
+{
+    *hit = true;
+    const lx_scene *scene = c->scene;
+    for (int pass = 0; pass < MAX_CULLED; pass++) {
+        lx_hit h;
+        if (!lx_tracer_closest(c->tracer, &r, &h))
+            break;
+        if (h.node >= scene->node_count || h.mesh >= scene->mesh_count)
+            break;
+        const lx_node *node = &scene->nodes[h.node];
+        const lx_mesh *m = &scene->meshes[h.mesh];
+        if (h.triangle >= m->triangle_count)
+            break;
+        const uint32_t *i = &m->indices[3 * (size_t)h.triangle];
+        if (!c->d->two_sided) {
+            lx_vec3 p0 = lx_mat4_point(&node->world, m->positions[i[0]]);
+            lx_vec3 p1 = lx_mat4_point(&node->world, m->positions[i[1]]);
+            lx_vec3 p2 = lx_mat4_point(&node->world, m->positions[i[2]]);
+            lx_vec3 n = lx_cross(lx_sub(p1, p0), lx_sub(p2, p0));
+            /* a mirroring transform turns counter-clockwise faces around (glTF) */
+            if (lx_dot(n, r.dir) * c->det_sign[h.node] > 0.0f) {
+                float next = h.t * (1.0f + 1e-6f) + 1e-6f;
+                if (!(next > r.tmin) || !(next < r.tmax))
+                    break;
+                r.tmin = next;
+                continue;
+            }
+        }
+        float w1 = h.u, w2 = h.v, w0 = 1.0f - w1 - w2;
+        uint32_t ln_index = c->node_map[h.node];
+        if (ln_index == UINT32_MAX)
+            return lx_v3(0, 0, 0);
+        const lx_lightmap_node *ln = &c->lm->nodes[ln_index];
+        const lx_vec2 *uv = m->uv[ln->uv_set];
+        float u = uv[i[0]].x * w0 + uv[i[1]].x * w1 + uv[i[2]].x * w2;
+        float v = uv[i[0]].y * w0 + uv[i[1]].y * w1 + uv[i[2]].y * w2;
+        u = u * ln->scale_offset[0] + ln->scale_offset[2];
+        v = v * ln->scale_offset[1] + ln->scale_offset[3];
+        const lx_image *page = &c->lm->pages[ln->page].image;
+        float e[3];
+        if (c->d->filter == LX_LIGHTMAP_BICUBIC)
+            sample_bicubic(page, u, v, e);
+        else
+            sample_bilinear(page, u, v, e);
+        lx_vec3 value = lx_scale(lx_v3(e[0], e[1], e[2]), c->inv_pre_exposure);
+        if (c->lm->quantity == LX_QUANTITY_RADIANCE)
+            return value;
+        return lx_scale(lx_mul(value, albedo(scene, m, i, w0, w1, w2)), 1.0f / LX_PI);
+    }
+    *hit = false;
+    if (c->d->sky) {
+        float s[3];
+        lx_cubemap_sample(c->d->sky, r.dir, s);
+        return lx_scale(lx_v3(s[0], s[1], s[2]), c->d->sky_intensity);
+    }
+    return c->background;
+}
+
+static void render_tile(const render_ctx *c, int tile, int tiles_x, lx_image *out)
+{
+    const lx_render_desc *d = c->d;
+    int x0 = (tile % tiles_x) * TILE, y0 = (tile / tiles_x) * TILE;
+    int x1 = x0 + TILE < d->width ? x0 + TILE : d->width;
+    int y1 = y0 + TILE < d->height ? y0 + TILE : d->height;
+    /* strata: the most square sx x sy grid with sx * sy = samples */
+    int sx = (int)floorf(sqrtf((float)d->samples));
+    while (d->samples % sx)
+        sx--;
+    int sy = d->samples / sx;
+    float inv_w = 1.0f / (float)d->width, inv_h = 1.0f / (float)d->height;
+    for (int y = y0; y < y1; y++)
+        for (int x = x0; x < x1; x++) {
+            uint32_t pixel = (uint32_t)y * (uint32_t)d->width + (uint32_t)x;
+            double acc[3] = {0, 0, 0};
+            int hits = 0;
+            for (int s = 0; s < d->samples; s++) {
+                float jx =
+                    ((float)(s % sx) + lx_random(d->seed, pixel, (uint32_t)s, 0)) / (float)sx;
+                float jy =
+                    ((float)(s / sx) + lx_random(d->seed, pixel, (uint32_t)s, 1)) / (float)sy;
+                float px = (2.0f * ((float)x + jx) * inv_w - 1.0f) * c->cam.tan_x;
+                float py = (1.0f - 2.0f * ((float)y + jy) * inv_h) * c->cam.tan_y;
+                lx_vec3 dir =
+                    lx_add(c->cam.fwd, lx_add(lx_scale(c->cam.right, px), lx_scale(c->cam.up, py)));
+                lx_ray r = {
+                    .origin = c->cam.eye, .tmin = 0.0f, .dir = lx_normalize(dir), .tmax = INFINITY};
+                bool hit;
+                lx_vec3 L = shade(c, r, &hit);
+                hits += hit;
+                acc[0] += L.x, acc[1] += L.y, acc[2] += L.z;
+            }
+            float *o = out->data + (size_t)pixel * 3;
+            for (int k = 0; k < 3; k++)
+                o[k] = (float)(acc[k] / (double)d->samples);
+            if (d->coverage)
+                d->coverage[pixel] = (float)hits / (float)d->samples;
+        }
+}
+
+static lx_status check_desc(const lx_render_desc *d)
+{
+    if (d->width < 1 || d->height < 1 || d->width > MAX_SIDE || d->height > MAX_SIDE)
+        return lx_fail(LX_ERR_INVALID,
+                       "render: the image size must be 1..%d pixels a side, not %dx%d", MAX_SIDE,
+                       d->width, d->height);
+    if (d->samples < 1 || d->samples > MAX_SAMPLES)
+        return lx_fail(LX_ERR_INVALID, "render: samples must be 1..%d, not %d", MAX_SAMPLES,
+                       d->samples);
+    if ((unsigned)d->filter > LX_LIGHTMAP_BICUBIC)
+        return lx_fail(LX_ERR_INVALID, "render: unknown lightmap filter %d", (int)d->filter);
+    if (!lx_vec3_finite(d->background) || d->background.x < 0 || d->background.y < 0 ||
+        d->background.z < 0)
+        return lx_fail(LX_ERR_INVALID, "render: the background must be finite and >= 0");
+    if (!isfinite(d->sky_intensity) || d->sky_intensity < 0)
+        return lx_fail(LX_ERR_INVALID, "render: the sky intensity must be finite and >= 0");
+    if (d->sky && (d->sky->size < 1 || !d->sky->data))
+        return lx_fail(LX_ERR_INVALID, "render: the sky cube map is empty");
+    return LX_OK;
+}
+
+lx_status lx_render_view(const lx_scene *scene, const lx_lightmaps *lm, const lx_tracer *tracer,
+                         const lx_render_desc *desc, lx_image *out)
+{
+    memset(out, 0, sizeof *out);
+    lx_render_desc d = lx_render_desc_defaults(desc);
+    lx_status st = check_desc(&d);
+    if (st != LX_OK)
+        return st;
+    for (uint32_t p = 0; p < lm->page_count; p++)
+        if (lm->pages[p].image.width != lm->pages[p].width ||
+            lm->pages[p].image.height != lm->pages[p].height || lm->pages[p].image.channels != 3)
+            return lx_fail(LX_ERR_INVALID, "render: page %u (%s) is not loaded as 3 channels", p,
+                           lm->pages[p].file);
+    if (lm->pre_exposure <= 0.0f || !isfinite(lm->pre_exposure))
+        return lx_fail(LX_ERR_INVALID, "render: pre_exposure must be above 0");
+    for (uint32_t n = 0; n < lm->node_count; n++)
+        if (lm->nodes[n].page >= lm->page_count || lm->nodes[n].uv_set < 0 ||
+            lm->nodes[n].uv_set >= LX_MAX_UV_SETS)
+            return lx_fail(LX_ERR_INVALID,
+                           "render: lightmap node '%s': page or UV set out of range",
+                           lm->nodes[n].name);
+    if (d.camera.eye.x == d.camera.target.x && d.camera.eye.y == d.camera.target.y &&
+        d.camera.eye.z == d.camera.target.z) {
+        lx_vec3 lo, hi;
+        if (!lx_scene_bounds(scene, &lo, &hi))
+            return lx_fail(LX_ERR_INVALID, "%s: the scene is empty: nothing to frame",
+                           scene->path ? scene->path : "render");
+        d.camera =
+            lx_camera_frame(lo, hi, LX_VIEW_ISO, d.camera.fov, (float)d.width / (float)d.height);
+    }
+    if ((st = lx_camera_check(&d.camera)) != LX_OK)
+        return st;
+
+    uint32_t nn = scene->node_count;
+    uint32_t *map = malloc((nn ? nn : 1) * sizeof *map);
+    float *det_sign = malloc((nn ? nn : 1) * sizeof *det_sign);
+    if (!map || !det_sign) {
+        free(map);
+        free(det_sign);
+        return lx_fail(LX_ERR_NOMEM, "render: out of memory");
+    }
+    st = lx_lightmaps_bind(lm, scene, map);
+    uint32_t unlit = 0;
+    for (uint32_t n = 0; n < nn; n++) {
+        det_sign[n] = lx_mat4_det3(&scene->nodes[n].world) < 0.0f ? -1.0f : 1.0f;
+        unlit += map[n] == UINT32_MAX && scene->nodes[n].mesh_count > 0;
+    }
+    if (st == LX_OK && unlit)
+        lx_log(LX_LOG_WARN, "%s: %u nodes have no lightmap and are drawn black",
+               scene->path ? scene->path : "render", unlit);
+    lx_tracer *own = NULL;
+    if (st == LX_OK && !tracer) {
+        lx_tracer_desc td = {.threads = d.threads};
+        if ((st = lx_tracer_create(scene, &td, &own)) == LX_OK)
+            tracer = own;
+    }
+    if (st == LX_OK)
+        st = lx_image_alloc(out, d.width, d.height, 3);
+    if (st != LX_OK) {
+        free(map);
+        free(det_sign);
+        lx_tracer_destroy(own);
+        return st;
+    }
+
+    render_ctx c = {.scene = scene,
+                    .lm = lm,
+                    .tracer = tracer,
+                    .node_map = map,
+                    .d = &d,
+                    .det_sign = det_sign,
+                    .inv_pre_exposure = 1.0f / lm->pre_exposure};
+    lx_camera_basis(&d.camera, d.width, d.height, &c.cam);
+    c.background = d.background;
+
+    int tiles_x = (d.width + TILE - 1) / TILE, tiles_y = (d.height + TILE - 1) / TILE;
+    int tiles = tiles_x * tiles_y;
+    atomic_int done = 0;
+    atomic_bool cancel = false;
+#pragma omp parallel for schedule(dynamic, 1) num_threads(lx_thread_count(d.threads))
+    for (int t = 0; t < tiles; t++) {
+        if (atomic_load_explicit(&cancel, memory_order_relaxed))
+            continue;
+        render_tile(&c, t, tiles_x, out);
+        int k = atomic_fetch_add(&done, 1) + 1;
+        /* only the first thread reports: calls never overlap */
+        if (d.progress && omp_get_thread_num() == 0 &&
+            !d.progress(d.progress_user, (float)k / (float)tiles))
+            atomic_store(&cancel, true);
+    }
+    if (!atomic_load(&cancel) && d.progress && !d.progress(d.progress_user, 1.0f))
+        atomic_store(&cancel, true);
+    free(map);
+    free(det_sign);
+    lx_tracer_destroy(own);
+    if (atomic_load(&cancel)) {
+        lx_image_free(out);
+        return lx_fail(LX_ERR_CANCELLED, "render: cancelled");
+    }
+    return LX_OK;
+}

@@ -1,0 +1,21 @@
+/* Private to src/render: the camera basis and node binding the renderer
+ * shares between its files. */
+#ifndef LX_RENDER_INTERNAL_H
+#define LX_RENDER_INTERNAL_H
+
+#include "luxel/render.h"
+#include "core/internal.h"
+
+typedef struct lx_camera_basis_t {
+    lx_vec3 eye, fwd, right, up; /* orthonormal, right-handed */
+    float tan_x, tan_y;          /* half-extent of the image plane at depth 1 */
+} lx_camera_basis_t;
+
+/* The basis of a checked camera (lx_camera_check) for a width x height image. */
+void lx_camera_basis(const lx_camera *cam, int width, int height, lx_camera_basis_t *b);
+
+/* lx_lightmaps_check, filling map[scene node] with the manifest node that
+ * lights it (UINT32_MAX: none). map may be NULL. */
+lx_status lx_lightmaps_bind(const lx_lightmaps *lm, const lx_scene *scene, uint32_t *map);
+
+#endif
