@@ -362,6 +362,7 @@ struct gltf_map {
     const cJSON **materials; /* the JSON materials by index */
     size_t material_count;
     size_t *prim_of;      /* per aiMesh: its primitive in prims, or PRIM_* */
+    const struct aiNode **node_an; /* per JSON node: the aiNode paired with it, or NULL */
     int64_t *material_of; /* per aiMaterial: a JSON material index, LX_GLTF_NO_MATERIAL
                            * (assimp's default material), or MAT_* */
 };
@@ -372,6 +373,7 @@ static void gltf_map_free(gltf_map *g)
     free(g->nodes);
     free(g->materials);
     free(g->prim_of);
+    free(g->node_an);
     free(g->material_of);
     memset(g, 0, sizeof *g);
 }
@@ -419,6 +421,7 @@ static void map_node(gltf_map *g, const struct aiScene *ai, size_t jn, const str
         map_spoil(g, ai, an, depth);
         return;
     }
+    g->node_an[jn] = an;
     const cJSON *mesh = lx_gltf_get(node, "mesh");
     size_t m = 0;
     bool lined_up = mesh ? lx_gltf_index(mesh, g->prims.mesh_count, &m) : an->mNumMeshes == 0;
@@ -500,8 +503,9 @@ static lx_status gltf_map_build(const import_ctx *c, gltf_map *g)
     g->nodes = malloc((g->node_count ? g->node_count : 1) * sizeof *g->nodes);
     g->materials = malloc((g->material_count ? g->material_count : 1) * sizeof *g->materials);
     g->prim_of = malloc((ai->mNumMeshes ? ai->mNumMeshes : 1) * sizeof *g->prim_of);
+    g->node_an = calloc(g->node_count ? g->node_count : 1, sizeof *g->node_an);
     g->material_of = malloc((ai->mNumMaterials ? ai->mNumMaterials : 1) * sizeof *g->material_of);
-    if (!g->nodes || !g->materials || !g->prim_of || !g->material_of) {
+    if (!g->nodes || !g->materials || !g->prim_of || !g->node_an || !g->material_of) {
         size_t n = g->node_count;
         gltf_map_free(g);
         return lx_fail(LX_ERR_NOMEM, "%s: out of memory matching %zu glTF nodes", c->path, n);
@@ -735,6 +739,12 @@ static lx_status import_mesh(import_ctx *c, unsigned i)
     m.name = name;
     m.vertex_count = nv;
     m.material = am->mMaterialIndex < c->scene->material_count ? am->mMaterialIndex : 0;
+    m.source_mesh = m.source_primitive = -1;
+    if (c->map && c->map->prim_of[i] < c->map->prims.count) {
+        size_t f = c->map->prim_of[i], gm = c->map->prims.mesh[f];
+        m.source_mesh = (int32_t)gm;
+        m.source_primitive = (int32_t)(f - c->map->prims.first[gm]);
+    }
     lx_status st = LX_OK;
     m.positions = malloc(sizeof(lx_vec3) * (nv ? nv : 1));
     m.indices = malloc(sizeof(uint32_t) * 3 * (size_t)am->mNumFaces);
@@ -890,7 +900,14 @@ static lx_status import_node(import_ctx *c, const struct aiNode *node, const lx_
             else
                 snprintf(base, sizeof base, "node%u", *counter - 1);
             unique_node_name(c->scene, base, name, sizeof name);
-            st = lx_scene_add_node(c->scene, name, &world, meshes, n, NULL);
+            uint32_t index = 0;
+            st = lx_scene_add_node(c->scene, name, &world, meshes, n, &index);
+            /* the JSON node paired with this aiNode (gltf_map), if any */
+            for (size_t j = 0; st == LX_OK && c->map && j < c->map->node_count; j++)
+                if (c->map->node_an[j] == node) {
+                    c->scene->nodes[index].source_node = (int32_t)j;
+                    break;
+                }
         }
         free(meshes);
         if (st != LX_OK)
