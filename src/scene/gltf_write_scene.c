@@ -13,6 +13,7 @@
 #include <stdio.h>
 #include <stdlib.h>
 #include <string.h>
+#include <strings.h>
 
 lx_glb_write_desc lx_glb_write_desc_defaults(const lx_glb_write_desc *desc)
 {
@@ -285,7 +286,10 @@ lx_status lx_scene_write_glb(const lx_scene *scene, const char *path, const lx_g
     lx_status st = check_uvs(scene, path, &d);
     if (st != LX_OK)
         return st;
-    if (scene->path && lx_gltf_sniff(scene->path) != LX_GLTF_NONE)
+    /* a glTF scene (by name or by content) goes back through its file */
+    const char *dot = scene->path ? strrchr(scene->path, '.') : NULL;
+    bool gltf_name = dot && (strcasecmp(dot, ".gltf") == 0 || strcasecmp(dot, ".glb") == 0);
+    if (scene->path && (gltf_name || lx_gltf_sniff(scene->path) != LX_GLTF_NONE))
         return lx_gltf_write_with_uvs(scene, path, &d);
     return write_built(scene, path, &d);
 }
