@@ -207,6 +207,11 @@ static lx_status rebuild_primitive(wctx *c, cJSON *prim, const job *jb, const ch
     const lx_scene_uvs *e = jb->uvs;
     const lx_mesh *m = &c->scene->meshes[e->mesh];
     cJSON *attrs = cJSON_GetObjectItemCaseSensitive(prim, "attributes");
+    if (lx_gltf_get(lx_gltf_get(prim, "extensions"), "KHR_draco_mesh_compression"))
+        return lx_fail(LX_ERR_UNSUPPORTED,
+                       "%s: %s: compressed geometry (KHR_draco_mesh_compression) cannot be "
+                       "written again",
+                       c->f->path, where);
     size_t pa = accessor_at(c->f, attrs, "POSITION");
     if (pa == SIZE_MAX)
         return lx_fail(LX_ERR_FORMAT, "%s: %s: no POSITION accessor", c->f->path, where);
@@ -332,9 +337,10 @@ static lx_status rebuild_primitive(wctx *c, cJSON *prim, const job *jb, const ch
     int view = lx_glb_add_view(c->f->root, &c->bin, uv, sizeof(lx_vec2) * nv, 0,
                                LX_GL_ARRAY_BUFFER);
     int acc = lx_glb_add_accessor(c->f->root, view, LX_GL_FLOAT, nv, "VEC2", false, NULL, NULL);
-    cJSON_AddNumberToObject(attrs, set, acc);
+    /* TEXCOORD_0 before the set: readers (assimp) want sets in order */
     if (!lx_gltf_get(attrs, "TEXCOORD_0"))
         cJSON_AddNumberToObject(attrs, "TEXCOORD_0", acc);
+    cJSON_AddNumberToObject(attrs, set, acc);
     /* indices: 16 bits when they fit below the restart value */
     bool small = nv < 65535;
     size_t isz = small ? 2 : 4;
