@@ -147,18 +147,33 @@ static uint32_t check_round_trip(const lx_scene *s, const lx_unwrap *u, const ch
         assert_string_equal(r->materials[rm->material].name, s->materials[m->material].name);
         vertices += rm->vertex_count;
         for (uint32_t c = 0; c < 3 * m->triangle_count; c++) {
+            /* the same triangle; assimp may start a strip's triangle at
+             * another corner (same winding): the corner read back */
+            uint32_t t = c / 3, rot = 0, rc = c;
+            for (; rot < 3; rot++) {
+                bool all = true;
+                for (uint32_t q = 0; q < 3; q++) {
+                    lx_vec3 w = m->positions[m->indices[3 * t + q]];
+                    lx_vec3 g = rm->positions[rm->indices[3 * t + (q + rot) % 3]];
+                    all = all && w.x == g.x && w.y == g.y && w.z == g.z;
+                }
+                if (all)
+                    break;
+            }
+            if (rot < 3)
+                rc = 3 * t + (c % 3 + rot) % 3;
             lx_vec3 want = lx_mat4_point(&n->world, m->positions[m->indices[c]]);
-            lx_vec3 got = lx_mat4_point(&rn->world, rm->positions[rm->indices[c]]);
+            lx_vec3 got = lx_mat4_point(&rn->world, rm->positions[rm->indices[rc]]);
             assert_close3(got, want);
             /* assimp turns V over and back (1 - (1 - v)): two float roundings
              * of values in [0, 1], at most 2^-24 each */
-            lx_vec2 uv = rm->uv[1][rm->indices[c]], w = um->uv[um->indices[c]];
+            lx_vec2 uv = rm->uv[1][rm->indices[rc]], w = um->uv[um->indices[c]];
             if (!(fabsf(uv.x - w.x) <= 0x1p-23f && fabsf(uv.y - w.y) <= 0x1p-23f))
                 fail_msg("mesh '%s' corner %u: TEXCOORD_1 (%.9g, %.9g), the unwrapper's (%.9g, "
                          "%.9g)",
                          m->name, c, uv.x, uv.y, w.x, w.y);
             if (m->uv[0]) {
-                lx_vec2 a = rm->uv[0][rm->indices[c]], b = m->uv[0][m->indices[c]];
+                lx_vec2 a = rm->uv[0][rm->indices[rc]], b = m->uv[0][m->indices[c]];
                 assert_true(a.x == b.x && a.y == b.y);
             }
         }
@@ -357,18 +372,19 @@ static void test_instances_get_meshes_of_their_own(void **state)
         const lx_unwrap_mesh *um = &u->meshes[k];
         assert_int_equal(u->nodes[um->node].page, u->nodes[u->meshes[0].node].page);
         for (uint32_t t = 0; t < s->meshes[um->mesh].triangle_count; t++) {
-            lx_vec2 a = um->uv[um->indices[3 * t]], b = um->uv[um->indices[3 * t + 1]],
+            lx_vec2 a = um->uv[um->indices[3 * t]], bb = um->uv[um->indices[3 * t + 1]],
                     c = um->uv[um->indices[3 * t + 2]];
-            double area = (double)(b.x - a.x) * (c.y - a.y) - (double)(b.y - a.y) * (c.x - a.x);
+            double area =
+                (double)(bb.x - a.x) * (c.y - a.y) - (double)(bb.y - a.y) * (c.x - a.x);
             for (int y = 0; y < G; y++)
                 for (int x = 0; x < G; x++) {
                     double px = (x + 0.5) / G, py = (y + 0.5) / G;
-                    double w0 = (b.x - px) * (c.y - py) - (b.y - py) * (c.x - px);
+                    double w0 = (bb.x - px) * (c.y - py) - (bb.y - py) * (c.x - px);
                     double w1 = (c.x - px) * (a.y - py) - (c.y - py) * (a.x - px);
-                    double w2 = (a.x - px) * (b.y - py) - (a.y - py) * (b.x - px);
-                    bool in = area > 0 ? (w0 > 0 && w1 > 0 && w2 > 0)
-                                       : (w0 < 0 && w1 < 0 && w2 < 0);
-                    if (!in)
+                    double w2 = (a.x - px) * (bb.y - py) - (a.y - py) * (bb.x - px);
+                    bool inside = area > 0 ? (w0 > 0 && w1 > 0 && w2 > 0)
+                                           : (w0 < 0 && w1 < 0 && w2 < 0);
+                    if (!inside)
                         continue;
                     uint8_t *o = &owner[(size_t)y * G + (size_t)x];
                     assert_true(*o == 0 || *o == k + 1);
@@ -516,6 +532,83 @@ static void test_validator_accepts_outputs(void **state)
     }
 }
 
+/* Triangle strips and fans (glTF 2.0 spec, 3.7.2.1) come out as lists of
+ * the same triangles in the same order and winding. */
+static void test_strips_and_fans(void **state)
+{
+    (void)state;
+    const char *dir = lx_test_dir("gltfw_strip");
+    char in[512], out[512];
+    snprintf(in, sizeof in, "%s/strip.gltf", dir);
+    snprintf(out, sizeof out, "%s/strip_uv.glb", dir);
+    enum { NS = 12, NF = 10 };
+    float sp[3 * NS], sn[3 * NS], fp[3 * NF], fn[3 * NF];
+    for (int i = 0; i < NS; i++) { /* a zigzag along x on the floor */
+        sp[3 * i] = 0.5f * (float)(i / 2), sp[3 * i + 1] = 0.0f, sp[3 * i + 2] = (float)(i % 2);
+        sn[3 * i] = 0.0f, sn[3 * i + 1] = 1.0f, sn[3 * i + 2] = 0.0f;
+    }
+    fp[0] = 5.0f, fp[1] = 0.0f, fp[2] = 0.0f; /* a fan: centre, then the rim (+Y up) */
+    for (int i = 1; i < NF; i++) {
+        double a = -2.0 * 3.14159265358979 * (i - 1) / 12.0;
+        fp[3 * i] = 5.0f + (float)cos(a), fp[3 * i + 1] = 0.0f, fp[3 * i + 2] = (float)sin(a);
+    }
+    for (int i = 0; i < NF; i++)
+        fn[3 * i] = 0.0f, fn[3 * i + 1] = 1.0f, fn[3 * i + 2] = 0.0f;
+    lx_test_primitive p[2] = {
+        {.vertex_count = NS, .position = sp, .normal = sn, .material = -1},
+        {.vertex_count = NF, .position = fp, .normal = fn, .material = -1}};
+    lx_test_gltf *g = lx_test_gltf_new();
+    lx_test_gltf_mesh(g, "sf", p, 2);
+    lx_test_gltf_node(g, "sf", 0, "");
+    lx_test_gltf_write(g, in);
+    lx_test_gltf_free(g);
+    /* the test writer writes lists: make the first a strip, the second a fan */
+    FILE *f = fopen(in, "rb");
+    assert_non_null(f);
+    static char text[1 << 16];
+    size_t n = fread(text, 1, sizeof text - 1, f);
+    fclose(f);
+    text[n] = '\0';
+    char *m1 = strstr(text, "\"mode\":4");
+    assert_non_null(m1);
+    m1[7] = '5';
+    char *m2 = strstr(m1, "\"mode\":4");
+    assert_non_null(m2);
+    m2[7] = '6';
+    f = fopen(in, "wb");
+    assert_non_null(f);
+    fwrite(text, 1, n, f);
+    fclose(f);
+    lx_scene *s;
+    lx_unwrap *u;
+    unwrap_and_write(in, out, &s, &u);
+    assert_int_equal(u->mesh_count, 2);
+    check_round_trip(s, u, out);
+    /* the triangles by the spec's rule, against what was written */
+    lx_scene *r;
+    assert_int_equal(lx_scene_load(out, NULL, &r), LX_OK);
+    const lx_node *rn = &r->nodes[0];
+    const lx_mesh *rs = &r->meshes[rn->meshes[0]], *rf = &r->meshes[rn->meshes[1]];
+    assert_int_equal(rs->triangle_count, NS - 2);
+    assert_int_equal(rf->triangle_count, NF - 2);
+    for (int t = 0; t < NS - 2; t++) {
+        int k[3] = {t, t + 1 + t % 2, t + 2 - t % 2};
+        for (int q = 0; q < 3; q++)
+            lx_test_assert_vec3(rs->positions[rs->indices[3 * t + q]], sp[3 * k[q]],
+                                sp[3 * k[q] + 1], sp[3 * k[q] + 2]);
+    }
+    for (int t = 0; t < NF - 2; t++) {
+        int k[3] = {t + 1, t + 2, 0};
+        for (int q = 0; q < 3; q++)
+            lx_test_assert_vec3(rf->positions[rf->indices[3 * t + q]], fp[3 * k[q]],
+                                fp[3 * k[q] + 1], fp[3 * k[q] + 2]);
+    }
+    lx_scene_destroy(r);
+    lx_unwrap_destroy(u);
+    lx_scene_destroy(s);
+    validate(out);
+}
+
 static void test_bad_inputs(void **state)
 {
     (void)state;
@@ -582,6 +675,7 @@ int main(void)
         cmocka_unit_test(test_obj_scene_round_trip),
         cmocka_unit_test(test_material_uv1_kept),
         cmocka_unit_test(test_validator_accepts_outputs),
+        cmocka_unit_test(test_strips_and_fans),
         cmocka_unit_test(test_bad_inputs),
     };
     return cmocka_run_group_tests(tests, NULL, NULL);
