@@ -31,11 +31,13 @@ demo: all
 	@echo "demo: lightmaps, PNG previews, manifest.json and view.png are in lightmaps/room/, lightmaps/retro/ and lightmaps/retro-day/; the sky's irradiance, SH, specular mips and DFG table in ibl/sky/"
 
 check: all
+	@bash scripts/install-test-oracles.sh $(BUILD)
 	cd $(BUILD) && ctest --output-on-failure -j $(JOBS)
 
 check-asan: deps
 	@test -f $(BUILD_ASAN)/CMakeCache.txt || cmake -S . -B $(BUILD_ASAN) -DCMAKE_BUILD_TYPE=Debug -DLX_SANITIZE=ON
 	cmake --build $(BUILD_ASAN) -j $(JOBS)
+	@bash scripts/install-test-oracles.sh $(BUILD_ASAN)
 	cd $(BUILD_ASAN) && ASAN_OPTIONS=detect_leaks=1 UBSAN_OPTIONS=halt_on_error=1:print_stacktrace=1 ctest --output-on-failure -j $(JOBS)
 
 bench: all

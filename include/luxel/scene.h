@@ -229,6 +229,51 @@ lx_status lx_gltf_lights_load(lx_scene *scene, const char *path);
 lx_status lx_gltf_lights_load_memory(lx_scene *scene, const void *bytes, size_t size,
                                      const char *name);
 
+/* ---- writing a scene with lightmap UVs (glTF binary) ---------------------- */
+
+/* The lightmap UVs of one mesh as one node places it: new vertices, each a
+ * copy of mesh vertex vertex_source[v] with UV uv[v], and the mesh's
+ * triangles over them in the same order (lx_unwrap_mesh in unwrap.h has
+ * these fields). */
+typedef struct lx_scene_uvs {
+    uint32_t node, mesh; /* scene indices; the node places the mesh */
+    uint32_t vertex_count;
+    const uint32_t *vertex_source; /* vertex_count */
+    const lx_vec2 *uv;             /* vertex_count, top-left origin */
+    const uint32_t *indices;       /* 3 * the mesh's triangle_count */
+} lx_scene_uvs;
+
+typedef struct lx_glb_write_desc {
+    const lx_scene_uvs *uvs; /* uv_count entries, at most one per (node, mesh) */
+    uint32_t uv_count;
+} lx_glb_write_desc;
+
+/* A copy of desc (or of zeros when NULL) with every default filled in. */
+lx_glb_write_desc lx_glb_write_desc_defaults(const lx_glb_write_desc *desc);
+
+/* Writes scene as a .glb at path (atomically: a temporary file renamed
+ * when complete) with the UVs desc gives as the lightmap set.
+ * A scene loaded from glTF is written from its file, read again:
+ * everything stays as it was (materials, nodes, animations, skins,
+ * extensions, extras) except that each primitive with new UVs gets every
+ * vertex attribute and morph target rebuilt per new vertex, new indices
+ * (mode TRIANGLES, triangles in the file's order) and the UVs as
+ * TEXCOORD_1 - or, when TEXCOORD_1 exists and the primitive's material
+ * reads a texture through it, as the next free TEXCOORD_n. A primitive
+ * without TEXCOORD_0 gets the UVs as TEXCOORD_0 too (sets are numbered
+ * from 0). A mesh that several nodes place with new UVs is copied for
+ * every node after the first. All buffers become the GLB's binary chunk
+ * and images are embedded in it; the old accessors stay (unused).
+ * Other scenes (OBJ, built ones) are written from luxel's data: one node
+ * per scene node (its world matrix), one primitive per mesh with POSITION,
+ * NORMAL, TANGENT, TEXCOORD_0 and the lightmap TEXCOORD_1, materials with
+ * their base colour factor and PNG/JPEG textures embedded.
+ * Fails (nothing written) with LX_ERR_INVALID when an entry names a node
+ * or mesh the scene does not pair, LX_ERR_UNSUPPORTED for compressed
+ * glTF (Draco, meshopt) or a mesh luxel could not match to the file's
+ * primitives, LX_ERR_IO / LX_ERR_FORMAT naming the file and the part. */
+lx_status lx_scene_write_glb(const lx_scene *scene, const char *path, const lx_glb_write_desc *desc);
+
 #ifdef __cplusplus
 }
 #endif

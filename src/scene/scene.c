@@ -296,6 +296,7 @@ lx_status lx_scene_add_node(lx_scene *s, const char *name, const lx_mat4 *world,
     n.world = *world;
     n.source_node = -1;
     n.mesh_count = mesh_count;
+    n.source_node = -1;
     n.meshes = mesh_count ? dup_array(meshes, mesh_count, sizeof(uint32_t)) : NULL;
     if (!n.name || (mesh_count && !n.meshes)) {
         free(n.name);

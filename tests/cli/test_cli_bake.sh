@@ -387,8 +387,8 @@ check "sky bake: --no-sky-shadows wins" grep -q '"shadows":.*false' "$WORK/sky4/
 # scale/offset (the generated UVs are page UVs).
 run "$LUXEL" bake "$ROOM" --unwrap always -q -o "$WORK/atlas"
 expect_rc 0 "bake --unwrap always"
-expect_files "--unwrap always: one atlas page, its preview and the manifest" "$WORK/atlas" \
-    lightmap-0.exr lightmap-0.png manifest.json
+expect_files "--unwrap always: one atlas page, its preview, the manifest and the scene with UVs" \
+    "$WORK/atlas" lightmap-0.exr lightmap-0.png manifest.json room.glb
 M=$WORK/atlas/manifest.json
 for n in $NODES; do
     check "atlas: $n's UVs are generated" test "$(manifest_get "$M" "$n" uvs)" = generated
@@ -423,8 +423,8 @@ check "own-UV atlas: a scale/offset other than the identity" \
 # --unwrap always --no-atlas: a lightmap per node, named after it
 run "$LUXEL" bake "$ROOM" --unwrap always --no-atlas -q -o "$WORK/noatlas"
 expect_rc 0 "bake --unwrap always --no-atlas"
-expect_files "--no-atlas: a lightmap per node" "$WORK/noatlas" room.exr room.png tall_box.exr \
-    tall_box.png short_box.exr short_box.png manifest.json
+expect_files "--no-atlas: a lightmap per node, the scene with UVs" "$WORK/noatlas" room.exr \
+    room.png tall_box.exr tall_box.png short_box.exr short_box.png manifest.json room.glb
 check "--no-atlas: the room's UVs are generated" \
     test "$(manifest_get "$WORK/noatlas/manifest.json" room uvs)" = generated
 

@@ -697,6 +697,12 @@ int cmd_bake(int argc, char **argv)
     }
     if (!cli_stage_check(&stage, "manifest.json"))
         goto done;
+    /* the scene with luxel's UVs: DIR/<scene's name>.glb */
+    char uvs_name[300] = "";
+    if (unwrap && unwrap->mesh_count &&
+        (!cli_scene_glb_name(a.scene, uvs_name, sizeof uvs_name) ||
+         !cli_stage_check(&stage, uvs_name)))
+        goto done;
 
     cli_progress_init(&progress, "bake", a.quiet);
     lx_status st = lx_baker_bake(baker);
@@ -810,6 +816,11 @@ int cmd_bake(int argc, char **argv)
         cJSON_AddItemToArray(list, page_entry(info, file, want_preview ? preview : NULL));
     }
     cJSON_AddItemToObject(manifest, "nodes", node_entries(scene, baker, unwrap, &a));
+    int with_uvs = !failed && uvs_name[0] ? cli_stage_scene_with_uvs(&stage, uvs_name, scene, unwrap)
+                                          : 0;
+    if (with_uvs > 0)
+        cJSON_AddStringToObject(manifest, "scene_with_uvs", uvs_name);
+    failed = failed || with_uvs < 0;
     if (!failed) {
         char *text = cJSON_Print(manifest);
         failed = !text || !cli_stage_text(&stage, "manifest.json", text);

@@ -16,6 +16,22 @@ int cmd_ibl(int argc, char **argv);
 int cmd_render(int argc, char **argv);
 /* bake --render: DIR/view.png of DIR's lightmaps on scene (default camera). */
 int cli_render_bake(const char *dir, const lx_scene *scene, int threads, bool quiet);
+int cmd_unwrap(int argc, char **argv);
+
+/* Writes scene as a .glb at path with u's generated UVs in TEXCOORD_1
+ * (lx_scene_write_glb; unwrap.c). The scene is the one u was made from,
+ * before or after lx_unwrap_apply. */
+lx_status cli_write_scene_with_uvs(const lx_scene *scene, const lx_unwrap *u, const char *path);
+/* "<scene's file name without its extension>.glb" into out; false (error
+ * printed) when it does not fit. */
+bool cli_scene_glb_name(const char *scene, char *out, size_t size);
+struct cli_stage;
+/* Stages the scene with u's UVs as `name` (bake's scene_with_uvs): 1 when
+ * written, 0 when the scene cannot be written again (a warning says why:
+ * compressed glTF, meshes not matched to the file), -1 on failure (error
+ * printed). */
+int cli_stage_scene_with_uvs(struct cli_stage *st, const char *name, const lx_scene *scene,
+                             const lx_unwrap *u);
 
 /* "luxel: error: <message>" on stderr. */
 void cli_error(const char *fmt, ...) __attribute__((format(printf, 1, 2)));
