@@ -296,8 +296,11 @@ lx_status lx_ies_beam_field(const lx_ies_profile *profile, float horizontal_deg,
 lx_status lx_ies_plane_peak(const lx_ies_profile *profile, float horizontal_deg, float *candela);
 /* The horizontal angle in [0, 180) of a plane that carries the peak: the
  * first of the profile's horizontal angles (increasing) toward which some
- * vertical angle reaches lx_ies_peak_candela, folded into [0, 180) (the
- * plane through h is the plane through h + 180). 0 for a dark profile.
+ * vertical angle reaches the largest candela of the distribution as
+ * lx_ies_candela interpolates it (a type A or B file's resampled grid may
+ * stay a little below the file's own lx_ies_peak_candela), folded into
+ * [0, 180) (the plane through h is the plane through h + 180). 0 for a
+ * dark profile.
  * Fails with LX_ERR_INVALID for a NULL pointer. */
 lx_status lx_ies_peak_plane(const lx_ies_profile *profile, float *horizontal_deg);
 

@@ -177,18 +177,18 @@ lx_status lx_ies_peak_plane(const lx_ies_profile *profile, float *horizontal_deg
         return lx_fail(LX_ERR_INVALID, "ies peak plane: NULL %s",
                        profile ? "horizontal_deg" : "profile");
     /* bilinear interpolation peaks at a grid point: the first horizontal
-     * angle whose column holds the peak, folded into one plane */
+     * angle whose column holds the grid's largest value (a type A/B file's
+     * resampled grid may stay below the file's own peak), folded into one
+     * plane */
     const lx_ies_profile *p = profile;
-    float h = 0.0f;
+    float h = 0.0f, best = 0.0f;
     for (int j = 0; j < p->nh; j++) {
         const float *col = p->cd + (size_t)j * p->nv;
-        bool found = false;
-        for (int i = 0; i < p->nv && !found; i++)
-            found = col[i] >= p->peak;
-        if (found) {
-            h = p->horiz[j];
-            break;
-        }
+        for (int i = 0; i < p->nv; i++)
+            if (col[i] > best) {
+                best = col[i];
+                h = p->horiz[j];
+            }
     }
     h = fmodf(h, 180.0f);
     *horizontal_deg = h < 0.0f ? h + 180.0f : h;

@@ -8,6 +8,11 @@
 #include <stdlib.h>
 #include <string.h>
 
+static bool json_space(char c)
+{
+    return c == ' ' || c == '\t' || c == '\n' || c == '\r';
+}
+
 /* Reports a cJSON syntax error at pos with its line and column. */
 static lx_status syntax_error(const char *file, const char *text, size_t size, const char *pos)
 {
@@ -20,6 +25,20 @@ static lx_status syntax_error(const char *file, const char *text, size_t size, c
         } else {
             col++;
         }
+    }
+    /* cJSON stops at the '}' or ']' after a trailing comma: name it, at
+     * the comma's line */
+    size_t q = off, c = off;
+    while (q < size && json_space(text[q]))
+        q++;
+    while (c > 0 && json_space(text[c - 1]))
+        c--;
+    if (q < size && (text[q] == '}' || text[q] == ']') && c > 0 && text[c - 1] == ',') {
+        size_t comma_line = 1;
+        for (size_t i = 0; i < c - 1; i++)
+            comma_line += text[i] == '\n';
+        return lx_fail(LX_ERR_FORMAT, "%s: line %zu: trailing comma before '%c'", file, comma_line,
+                       text[q]);
     }
     if (off >= size)
         return lx_fail(LX_ERR_FORMAT, "%s: line %zu, column %zu: malformed JSON: unexpected end",
