@@ -905,6 +905,12 @@ int cmd_bake(int argc, char **argv)
         cJSON_AddItemToArray(list, page_entry(info, file, want_preview ? preview : NULL));
     }
     cJSON_AddItemToObject(manifest, "nodes", node_entries(scene, baker, unwrap, &a));
+    /* files of earlier bakes left in place: a later --clean still finds them */
+    if (stale.count && !a.clean) {
+        cJSON *earlier = cJSON_AddArrayToObject(manifest, "earlier_files");
+        for (uint32_t i = 0; i < stale.count; i++)
+            cJSON_AddItemToArray(earlier, cJSON_CreateString(stale.names[i]));
+    }
     if (!failed) {
         char *text = cJSON_Print(manifest);
         failed = !text || !cli_stage_text(&stage, "manifest.json", text);

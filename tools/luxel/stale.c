@@ -28,23 +28,42 @@ static bool json_space(char c)
     return c == ' ' || c == '\t' || c == '\n' || c == '\r';
 }
 
-bool cli_json_trailing_comma(const char *text, size_t size, size_t error_at, size_t *line,
-                             char *closer)
+/* The '}' or ']' right after a comma at q, when there is one: *comma is
+ * the comma's offset. */
+static bool closer_after_comma(const char *text, size_t q, size_t *comma)
 {
-    if (error_at > size)
-        return false;
-    size_t q = error_at;
-    while (q < size && json_space(text[q]))
-        q++;
-    if (q >= size || (text[q] != '}' && text[q] != ']'))
+    if (text[q] != '}' && text[q] != ']')
         return false;
     size_t p = q;
     while (p > 0 && json_space(text[p - 1]))
         p--;
     if (p == 0 || text[p - 1] != ',')
         return false;
-    *line = line_of(text, p - 1);
-    *closer = text[q];
+    *comma = p - 1;
+    return true;
+}
+
+bool cli_json_trailing_comma(const char *text, size_t size, size_t error_at, size_t *line,
+                             char *closer)
+{
+    if (error_at > size)
+        return false;
+    /* cJSON stops at the closer, or just past it */
+    size_t q = error_at, comma;
+    while (q < size && json_space(text[q]))
+        q++;
+    size_t b = error_at;
+    while (b > 0 && json_space(text[b - 1]))
+        b--;
+    size_t at;
+    if (q < size && closer_after_comma(text, q, &comma))
+        at = q;
+    else if (b > 0 && closer_after_comma(text, b - 1, &comma))
+        at = b - 1;
+    else
+        return false;
+    *line = line_of(text, comma);
+    *closer = text[at];
     return true;
 }
 
@@ -198,6 +217,13 @@ bool cli_stale_find(const char *dir, const char *scene, const char *const *outpu
                     ok = ok && add(out, f->valuestring);
             }
         }
+    }
+    const cJSON *e;
+    cJSON_ArrayForEach(e, cJSON_GetObjectItemCaseSensitive(root, "earlier_files"))
+    {
+        if (cJSON_IsString(e) && plain_name(e->valuestring) &&
+            !listed(e->valuestring, outputs, output_count))
+            ok = ok && add(out, e->valuestring);
     }
     const cJSON *uvs = cJSON_GetObjectItemCaseSensitive(root, "scene_with_uvs");
     if (cJSON_IsString(uvs) && plain_name(uvs->valuestring) &&
