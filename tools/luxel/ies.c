@@ -1,7 +1,7 @@
 /* luxel ies: what an IES LM-63 photometric file holds (header fields, total
  * lumens integrated over the sphere, peak candela, beam and field angles of
- * the main planes) and, with --plot, the polar candela curve of the C0-C180
- * and C90-C270 planes. Beam and field angle: the full angle between the two
+ * the planes that carry the peak) and, with --plot, a labelled polar
+ * candela plot. Beam and field angle: the full angle between the two
  * directions of a plane where the intensity falls to 50% and 10% of that
  * plane's maximum (IES/CIE; lx_ies_beam_field). Type A and B files are shown
  * as the library converts them to type C (docs/ies.md): their C0-C180 plane
@@ -21,12 +21,13 @@ static const char *ies_usage =
     "Prints the header of an IES LM-63 photometric file (1986, 1991, 1995 or\n"
     "2002), its total lumens (integrated over the sphere), peak candela and the\n"
     "beam and field angles (full angles at 50% and 10% of the maximum) of the\n"
-    "C0-C180 and C90-C270 planes.\n"
+    "planes that carry the peak: C0-C180 and C90-C270 when their maximum is\n"
+    "within 1% of it, else the plane through the peak.\n"
     "\n"
     "options:\n"
-    "  --plot OUT.png   draw the polar candela curve of the main planes\n"
-    "                   (C0-C180 red, C90-C270 blue; rings at 25/50/75/100%\n"
-    "                   of the peak; vertical angle 0 points down)\n"
+    "  --plot OUT.png   draw the polar candela curve of those planes (C0-C180\n"
+    "                   red, C90-C270 blue, the peak's plane green), rings\n"
+    "                   labelled in candela, angles from the nadir (down)\n"
     "  -h, --help       show this help\n";
 
 /* Intensity at angle a (degrees, -180..180) in the plane through
