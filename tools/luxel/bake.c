@@ -601,7 +601,7 @@ static int plan_lightmaps(bake_args *a, lx_scene *scene, lx_unwrap **out, bool *
 }
 
 /* Half floats end at 65504: a lightmap beyond it (sun-lit scenes in lux)
- * fails up front, saying what would fit. */
+ * fails, saying what would fit. */
 static bool half_fits(const bake_args *a, const lx_image *images, uint32_t maps, char **stems,
                       float scale)
 {
@@ -614,11 +614,13 @@ static bool half_fits(const bake_args *a, const lx_image *images, uint32_t maps,
         if (peak > 65504.0f) {
             const char *unit = a->desc.quantity == LX_QUANTITY_RADIANCE ? "nt" : "lx";
             if (a->pre_expose)
-                cli_error("%s.exr: pre-exposed values reach %s, beyond half floats' 65504: "
+                cli_error("%s.exr: pre-exposed values reach %s, beyond the half-float range "
+                          "(65504): "
                           "give a higher --exposure, or leave out --half",
                           stems[m], cli_num_digits(peak, 3));
             else
-                cli_error("%s.exr: values reach %s %s, beyond half floats' 65504: --pre-expose "
+                cli_error("%s.exr: values reach %s %s, beyond the half-float range (65504): "
+                          "--pre-expose "
                           "stores them times the exposure (the manifest records it), or leave "
                           "out --half for 32-bit floats",
                           stems[m], cli_num_digits(peak, 3), unit);
@@ -836,8 +838,6 @@ int cmd_bake(int argc, char **argv)
         cli_report_interrupt(false);
         goto done;
     }
-    if (a.half && !half_fits(&a, images, maps, stems, a.pre_expose ? pre_exposure : 1.0f))
-        goto done;
     /* Everything goes to the staging folder first and is moved into place
      * only when every file is written: a failure leaves the folder as it
      * was, old lightmaps included. */
@@ -887,7 +887,11 @@ int cmd_bake(int argc, char **argv)
                                   .progress_user = &progress};
         double t = cli_now();
         cli_progress_part(&progress, part++, parts);
-        failed = !cli_stage_image(&stage, file, &images[m], &wd);
+        /* where the library would fail on the file: the same place, with
+         * what would fit named */
+        failed = a.half && !half_fits(&a, &images[m], 1, &stems[m],
+                                      a.pre_expose ? pre_exposure : 1.0f);
+        failed = failed || !cli_stage_image(&stage, file, &images[m], &wd);
         t_maps += cli_now() - t;
         bool want_preview = a.format != LX_IMAGE_PNG;
         if (!failed && want_preview) {
