@@ -225,8 +225,8 @@ static lx_status put_image(const char *folder, const char *name, const lx_image 
     lx_status st = file_path(folder, name, d, &path);
     if (st != LX_OK)
         return st;
-    bool eight = d->format != LX_IMAGE_EXR && d->format != LX_IMAGE_HDR &&
-                 d->format != LX_IMAGE_PFM;
+    bool eight =
+        d->format != LX_IMAGE_EXR && d->format != LX_IMAGE_HDR && d->format != LX_IMAGE_PFM;
     lx_image_write_desc wd = {.format = d->format,
                               .exposure = eight ? d->exposure : 1.0f,
                               .tonemap = d->tonemap,

@@ -141,14 +141,14 @@ static void curves_and_exposure(void **state)
     check_faces("filmic", pi / 1.2, filmic);
 
     snprintf(out, sizeof out, "%s/aces", dir);
-    const char *a2[] = {"--irradiance", "--format", "png",  "--exposure", "1",
-                        "--tonemap",    "aces",     "-o",   out,          NULL};
+    const char *a2[] = {"--irradiance", "--format", "png", "--exposure", "1",
+                        "--tonemap",    "aces",     "-o",  out,          NULL};
     assert_int_equal(run_ibl(a2), 0);
     check_faces("aces", pi / 2.4, aces);
 
     snprintf(out, sizeof out, "%s/clamp", dir);
-    const char *a3[] = {"--irradiance", "--format", "png",  "--exposure", "2",
-                        "--tonemap",    "clamp",    "-o",   out,          NULL};
+    const char *a3[] = {"--irradiance", "--format", "png", "--exposure", "2",
+                        "--tonemap",    "clamp",    "-o",  out,          NULL};
     assert_int_equal(run_ibl(a3), 0);
     check_faces("clamp", pi / 4.8, clamp_curve);
 

@@ -577,11 +577,10 @@ static int plan_lightmaps(bake_args *a, lx_scene *scene, lx_unwrap **out, bool *
                    "unwrap: %u %s (%u cut again), %u %s, %s%% of their texels covered, "
                    "stretch %s (worst %s), %s texels/m",
                    u->stats.charts, cli_plural(u->stats.charts, "chart", "charts"),
-                   u->stats.recut_charts, u->page_count,
-                   cli_plural(u->page_count, "page", "pages"),
+                   u->stats.recut_charts, u->page_count, cli_plural(u->page_count, "page", "pages"),
                    cli_num_digits(100.0 * u->stats.efficiency, 3),
-                   cli_num_digits(u->stats.stretch_mean, 4), cli_num_digits(u->stats.stretch_max, 4),
-                   cli_num((double)u->texel_density));
+                   cli_num_digits(u->stats.stretch_mean, 4),
+                   cli_num_digits(u->stats.stretch_max, 4), cli_num((double)u->texel_density));
             lx_vec3 lo, hi;
             if (lx_scene_bounds(scene, &lo, &hi)) {
                 double across = lx_length(lx_sub(hi, lo)) * u->texel_density;
@@ -944,14 +943,13 @@ int cmd_bake(int argc, char **argv)
         uint64_t texels = 0;
         for (uint32_t m = 0; m < maps; m++)
             texels += lx_baker_lightmap_info(baker, m)->used_texels;
-        fprintf(stderr,
-                "luxel: baked %u %s (%llu %s, %u %s) in %s s; preview EV100 %s%s, %s\n", maps,
-                atlas ? cli_plural(maps, "atlas page", "atlas pages")
-                      : cli_plural(maps, "lightmap", "lightmaps"),
-                (unsigned long long)texels, cli_plural(texels, "texel", "texels"),
-                scene->light_count, cli_plural(scene->light_count, "light", "lights"),
-                cli_num_digits(cli_elapsed(), 3), cli_num_digits(ev, 3),
-                a.has_exposure ? "" : " (auto)", lx_tonemap_name(a.tonemap));
+        fprintf(
+            stderr, "luxel: baked %u %s (%llu %s, %u %s) in %s s; preview EV100 %s%s, %s\n", maps,
+            atlas ? cli_plural(maps, "atlas page", "atlas pages")
+                  : cli_plural(maps, "lightmap", "lightmaps"),
+            (unsigned long long)texels, cli_plural(texels, "texel", "texels"), scene->light_count,
+            cli_plural(scene->light_count, "light", "lights"), cli_num_digits(cli_elapsed(), 3),
+            cli_num_digits(ev, 3), a.has_exposure ? "" : " (auto)", lx_tonemap_name(a.tonemap));
         printf("%s/manifest.json\n", a.output);
     }
     status = EXIT_OK;

@@ -52,7 +52,8 @@ static void print_light(const lx_light *l)
         lx_ies_info ies;
         lx_ies_get_info(l->profile, &ies);
         printf("  profile %s %s, %s lm, peak %s cd x %s", ies.version,
-               lx_ies_symmetry_name(ies.symmetry), cli_num_digits(lx_ies_total_lumens(l->profile), 4),
+               lx_ies_symmetry_name(ies.symmetry),
+               cli_num_digits(lx_ies_total_lumens(l->profile), 4),
                cli_num_digits(lx_ies_peak_candela(l->profile), 4),
                cli_num_digits(l->profile_scale, 4));
     }

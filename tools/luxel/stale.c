@@ -184,8 +184,9 @@ bool cli_stale_find(const char *dir, const char *scene, const char *const *outpu
     size_t size = 0;
     char *text = read_text(path, &size);
     if (!text) {
-        lx_log(LX_LOG_WARN, "%s: cannot read the earlier bake's manifest (%s): stale files "
-                            "not checked",
+        lx_log(LX_LOG_WARN,
+               "%s: cannot read the earlier bake's manifest (%s): stale files "
+               "not checked",
                path, strerror(errno));
         free(path);
         return true;
@@ -261,8 +262,7 @@ void cli_stale_warn(const cli_stale *s, const char *dir, bool clean)
         size_t need = strlen(s->names[i]) + 2;
         if (len + need + 16 >= sizeof list)
             break;
-        len += (size_t)snprintf(list + len, sizeof list - len, "%s%s", i ? ", " : "",
-                                s->names[i]);
+        len += (size_t)snprintf(list + len, sizeof list - len, "%s%s", i ? ", " : "", s->names[i]);
         shown++;
     }
     if (shown < s->count)
@@ -276,8 +276,9 @@ void cli_stale_warn(const cli_stale *s, const char *dir, bool clean)
         lx_log(LX_LOG_INFO, "%s: removing %u %s%s that this bake does not write (%s)", dir,
                s->count, cli_plural(s->count, "file", "files"), from, list);
     else
-        lx_log(LX_LOG_WARN, "%s holds %u %s%s that this bake does not write (%s); --clean "
-                            "removes them",
+        lx_log(LX_LOG_WARN,
+               "%s holds %u %s%s that this bake does not write (%s); --clean "
+               "removes them",
                dir, s->count, cli_plural(s->count, "file", "files"), from, list);
 }
 
