@@ -160,6 +160,9 @@ typedef struct lx_image_write_desc {
     float exposure;          /* multiplier applied to values, 0 = 1 */
     lx_tonemap tonemap;      /* 8-bit formats: the curve after exposure
                                 (CLAMP by default); float formats ignore it */
+    bool linear;             /* 8-bit formats: codes round(255 v) without the
+                                sRGB transfer, for data such as lookup
+                                tables (default: sRGB encoded) */
     bool half;               /* EXR: 16-bit half floats instead of 32-bit */
     int threads;             /* encoding threads, 0 = all cores */
     lx_progress_fn progress; /* may be NULL; returning false cancels */
@@ -171,8 +174,9 @@ typedef struct lx_image_write_desc {
 lx_image_write_desc lx_image_write_desc_defaults(const lx_image_write_desc *desc);
 
 /* Writes img to path atomically (temporary file in the same folder, renamed
- * when complete). 8-bit formats are exposed, clamped to [0,1] and sRGB
- * encoded; float formats store linear values. NaN/Inf values are rejected.
+ * when complete). 8-bit formats are exposed, put through desc->tonemap
+ * (a clamp to [0,1] by default) and sRGB encoded (or, with desc->linear,
+ * stored as linear unorm codes); float formats store linear values. NaN/Inf values are rejected.
  * desc->progress hears the encoding (between EXR chunks or scanlines, PNG
  * deflate strips, HDR and PFM rows; JPEG and TGA before and after their
  * encoder) and a last 1.0 before the file is committed; when it returns

@@ -235,6 +235,11 @@ typedef struct lx_env_write_desc {
     lx_image_format format;  /* of the images (not KTX); AUTO = EXR */
     bool half;               /* 16-bit floats: EXR half, KTX RGBA16F (else RGBA32F) */
     bool mip_names;          /* name levels <stem>_m<L> even when there is one */
+    float exposure;          /* 8-bit formats (PNG, JPEG, TGA): multiplier on the
+                                values, 0 = 1; float formats and KTX store the
+                                values as they are */
+    lx_tonemap tonemap;      /* 8-bit formats: the curve after exposure
+                                (lx_image_write_desc.tonemap; CLAMP by default) */
     int threads;             /* conversion and encoding threads, 0 = all cores */
     lx_progress_fn progress; /* may be NULL; returning false cancels */
     void *progress_user;

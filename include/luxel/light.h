@@ -287,6 +287,22 @@ lx_status lx_ies_spread_angle(const lx_ies_profile *profile, float horizontal_de
  * lx_ies_spread_angle gives them. */
 lx_status lx_ies_beam_field(const lx_ies_profile *profile, float horizontal_deg, double *beam_deg,
                             double *field_deg);
+/* The largest candela of the plane through horizontal angles h and
+ * h + 180 (both halves), as lx_ies_candela interpolates it: the maximum
+ * lx_ies_spread_angle measures that plane's fractions from. A beam angle
+ * describes the beam only in a plane that carries the profile's peak
+ * (lx_ies_peak_candela); elsewhere it measures a side lobe. Fails with
+ * LX_ERR_INVALID for a NULL pointer or a horizontal angle not finite. */
+lx_status lx_ies_plane_peak(const lx_ies_profile *profile, float horizontal_deg, float *candela);
+/* The horizontal angle in [0, 180) of a plane that carries the peak: the
+ * first of the profile's horizontal angles (increasing) toward which some
+ * vertical angle reaches the largest candela of the distribution as
+ * lx_ies_candela interpolates it (a type A or B file's resampled grid may
+ * stay a little below the file's own lx_ies_peak_candela), folded into
+ * [0, 180) (the plane through h is the plane through h + 180). 0 for a
+ * dark profile.
+ * Fails with LX_ERR_INVALID for a NULL pointer. */
+lx_status lx_ies_peak_plane(const lx_ies_profile *profile, float *horizontal_deg);
 
 /* Horizontal symmetry of a profile, from its first and last horizontal
  * angles: 0 only; 0-90; 0-180; 90-270; 0 to more than 180 (full, the

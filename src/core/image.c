@@ -487,7 +487,8 @@ lx_status lx_image_write(const char *path, const lx_image *img, const lx_image_w
         s = lx_img_write_exr(f.fp, path, img, exposure, d.half, d.threads, &progress);
         break;
     default:
-        s = lx_img_write_stb(f.fp, path, img, format, exposure, d.tonemap, d.threads, &progress);
+        s = lx_img_write_stb(f.fp, path, img, format, exposure, d.tonemap, d.linear, d.threads,
+                                 &progress);
         break;
     }
     /* the last word before the file is committed: 1.0, which may still

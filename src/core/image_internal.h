@@ -58,13 +58,14 @@ LX_IMG_HIDDEN lx_status lx_img_load_exr(const unsigned char *data, size_t size, 
 /* Writers to an open temporary file. The caller has checked img (1..4
  * channels, finite values, exposed values in the format's range) and
  * commits or aborts the file. exposure is the multiplier (never 0);
- * tonemap the curve of the 8-bit formats;
+ * tonemap the curve of the 8-bit formats, linear their codes without
+ * the sRGB transfer;
  * threads bounds the encoding threads (0 = all cores). Each reports on
  * progress over [0, 1] and returns LX_ERR_CANCELLED ("<path>: writing
  * cancelled") when it stops. */
 LX_IMG_HIDDEN lx_status lx_img_write_stb(FILE *fp, const char *path, const lx_image *img,
                                          lx_image_format format, float exposure,
-                                         lx_tonemap tonemap, int threads,
+                                         lx_tonemap tonemap, bool linear, int threads,
                                          lx_img_progress *progress);
 LX_IMG_HIDDEN lx_status lx_img_write_pfm(FILE *fp, const char *path, const lx_image *img,
                                          float exposure, lx_img_progress *progress);

@@ -492,7 +492,7 @@ static unsigned char encode_unorm8(float v)
 #define LX_PNG_DEFLATE_TO 0.87f
 
 static lx_status write_8bit(FILE *fp, const char *path, const lx_image *img, lx_image_format format,
-                            float exposure, lx_tonemap tonemap, int threads,
+                            float exposure, lx_tonemap tonemap, bool linear, int threads,
                             lx_img_progress *progress)
 {
     int c = img->channels;
@@ -521,9 +521,10 @@ static lx_status write_8bit(FILE *fp, const char *path, const lx_image *img, lx_
                 float rgb[3] = {v[0] * exposure, v[1] * exposure, v[2] * exposure};
                 lx_tonemap_rgb(tonemap, rgb);
                 for (int k = 0; k < 3; k++)
-                    b[k] = encode_srgb8(&enc, rgb[k]);
+                    b[k] = linear ? encode_unorm8(rgb[k]) : encode_srgb8(&enc, rgb[k]);
             } else {
-                b[0] = encode_srgb8(&enc, lx_tonemap_grey(tonemap, v[0] * exposure));
+                float g = lx_tonemap_grey(tonemap, v[0] * exposure);
+                b[0] = linear ? encode_unorm8(g) : encode_srgb8(&enc, g);
             }
             if (colour < c)
                 b[colour] = encode_unorm8(v[colour]);
@@ -691,10 +692,10 @@ static lx_status write_hdr(FILE *fp, const char *path, const lx_image *img, floa
 }
 
 lx_status lx_img_write_stb(FILE *fp, const char *path, const lx_image *img, lx_image_format format,
-                           float exposure, lx_tonemap tonemap, int threads,
+                           float exposure, lx_tonemap tonemap, bool linear, int threads,
                            lx_img_progress *progress)
 {
     if (format == LX_IMAGE_HDR)
         return write_hdr(fp, path, img, exposure, threads, progress);
-    return write_8bit(fp, path, img, format, exposure, tonemap, threads, progress);
+    return write_8bit(fp, path, img, format, exposure, tonemap, linear, threads, progress);
 }

@@ -7,6 +7,7 @@
 #include "ibl_internal.h"
 #include "core/internal.h"
 
+#include <math.h>
 #include <stdio.h>
 #include <stdlib.h>
 #include <string.h>
@@ -24,6 +25,8 @@ lx_env_write_desc lx_env_write_desc_defaults(const lx_env_write_desc *desc)
         d.layout = LX_ENV_FACES;
     if (d.format == LX_IMAGE_AUTO)
         d.format = LX_IMAGE_EXR;
+    if (d.exposure == 0.0f)
+        d.exposure = 1.0f;
     return d;
 }
 
@@ -64,6 +67,11 @@ static lx_status check_desc(const char *stem, int count, const lx_env_write_desc
         return lx_fail(LX_ERR_INVALID,
                        "%s: half floats are for EXR images and KTX files, not %s images", stem,
                        lx_image_format_extension(d->format));
+    if (!isfinite(d->exposure) || d->exposure < 0.0f)
+        return lx_fail(LX_ERR_INVALID, "%s: exposure %g must be a finite value >= 0", stem,
+                       (double)d->exposure);
+    if (!lx_tonemap_name(d->tonemap))
+        return lx_fail(LX_ERR_INVALID, "%s: unknown tone curve %d", stem, (int)d->tonemap);
     return lx_ibl_check_threads(d->threads);
 }
 
@@ -217,7 +225,11 @@ static lx_status put_image(const char *folder, const char *name, const lx_image 
     lx_status st = file_path(folder, name, d, &path);
     if (st != LX_OK)
         return st;
+    bool eight =
+        d->format != LX_IMAGE_EXR && d->format != LX_IMAGE_HDR && d->format != LX_IMAGE_PFM;
     lx_image_write_desc wd = {.format = d->format,
+                              .exposure = eight ? d->exposure : 1.0f,
+                              .tonemap = d->tonemap,
                               .half = d->half,
                               .threads = d->threads,
                               .progress = part->progress ? image_progress : NULL,

@@ -153,3 +153,44 @@ lx_status lx_ies_beam_field(const lx_ies_profile *profile, float horizontal_deg,
         st = lx_ies_spread_angle(profile, horizontal_deg, LX_IES_FIELD_FRACTION, field_deg);
     return st;
 }
+
+lx_status lx_ies_plane_peak(const lx_ies_profile *profile, float horizontal_deg, float *candela)
+{
+    if (!profile || !candela)
+        return lx_fail(LX_ERR_INVALID, "ies plane peak: NULL %s", profile ? "candela" : "profile");
+    if (!isfinite(horizontal_deg))
+        return lx_fail(LX_ERR_INVALID, "ies plane peak: horizontal angle is not finite");
+    /* the chain is linear between its knots: its maximum is at one */
+    plane_knots k = knots_of(profile);
+    double best = 0.0;
+    for (int s = 0; s < 2 * (k.count - 1); s++) {
+        segment g = segment_at(&k, horizontal_deg, s);
+        best = fmax(best, fmax(g.f0, g.f1));
+    }
+    *candela = (float)best;
+    return LX_OK;
+}
+
+lx_status lx_ies_peak_plane(const lx_ies_profile *profile, float *horizontal_deg)
+{
+    if (!profile || !horizontal_deg)
+        return lx_fail(LX_ERR_INVALID, "ies peak plane: NULL %s",
+                       profile ? "horizontal_deg" : "profile");
+    /* bilinear interpolation peaks at a grid point: the first horizontal
+     * angle whose column holds the grid's largest value (a type A/B file's
+     * resampled grid may stay below the file's own peak), folded into one
+     * plane */
+    const lx_ies_profile *p = profile;
+    float h = 0.0f, best = 0.0f;
+    for (int j = 0; j < p->nh; j++) {
+        const float *col = p->cd + (size_t)j * p->nv;
+        for (int i = 0; i < p->nv; i++)
+            if (col[i] > best) {
+                best = col[i];
+                h = p->horiz[j];
+            }
+    }
+    h = fmodf(h, 180.0f);
+    *horizontal_deg = h < 0.0f ? h + 180.0f : h;
+    return LX_OK;
+}

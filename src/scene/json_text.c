@@ -4,9 +4,30 @@
 #include "core/internal.h"
 
 #include <stdarg.h>
+#include <stdint.h>
 #include <stdio.h>
 #include <stdlib.h>
 #include <string.h>
+
+static bool json_space(char c)
+{
+    return c == ' ' || c == '\t' || c == '\n' || c == '\r';
+}
+
+/* Whether text[q] is a '}' or ']' right after a comma (white space
+ * between); *comma gets the comma's offset. */
+static bool closer_after_comma(const char *text, size_t q, size_t *comma)
+{
+    if (text[q] != '}' && text[q] != ']')
+        return false;
+    size_t p = q;
+    while (p > 0 && json_space(text[p - 1]))
+        p--;
+    if (p == 0 || text[p - 1] != ',')
+        return false;
+    *comma = p - 1;
+    return true;
+}
 
 /* Reports a cJSON syntax error at pos with its line and column. */
 static lx_status syntax_error(const char *file, const char *text, size_t size, const char *pos)
@@ -20,6 +41,25 @@ static lx_status syntax_error(const char *file, const char *text, size_t size, c
         } else {
             col++;
         }
+    }
+    /* a trailing comma: cJSON stops at the '}' or ']' after it, or just
+     * past it; named at the comma's line */
+    size_t q = off, b = off, comma = 0;
+    while (q < size && json_space(text[q]))
+        q++;
+    while (b > 0 && json_space(text[b - 1]))
+        b--;
+    size_t at = SIZE_MAX;
+    if (q < size && closer_after_comma(text, q, &comma))
+        at = q;
+    else if (b > 0 && closer_after_comma(text, b - 1, &comma))
+        at = b - 1;
+    if (at != SIZE_MAX) {
+        size_t comma_line = 1;
+        for (size_t i = 0; i < comma; i++)
+            comma_line += text[i] == '\n';
+        return lx_fail(LX_ERR_FORMAT, "%s: line %zu: trailing comma before '%c'", file, comma_line,
+                       text[at]);
     }
     if (off >= size)
         return lx_fail(LX_ERR_FORMAT, "%s: line %zu, column %zu: malformed JSON: unexpected end",

@@ -492,7 +492,7 @@ upsample_warned() {
 }
 AT_PAUSE=upsample_warned paused "upsampling, interrupted" environment INT "$WORK/out_upsample" \
     "$IN/small_eq.pfm" --size 64 --irradiance=sh
-run "$LUXEL" ibl const:1 --size 16 --specular ggx --specular-size 128 --samples 16 -q -o "$WORK/up_spec"
+run "$LUXEL" ibl const:1 --size 16 --specular ggx --specular-size 128 --samples 16 -o "$WORK/up_spec"
 expect_rc 0 "--specular-size 8x the environment"
 expect_stderr_has "--specular-size 8x: a warning" "^luxel: warning: prefilter: 128 x 128 specular faces from a 16 x 16 source upsample it 8x"
 

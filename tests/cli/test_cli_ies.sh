@@ -113,7 +113,7 @@ expect_rc 0 "info with a profiled light"
 expect_stdout_has "info: the profile" 'downlight .* profile LM-63-2002 rotational, '
 flux=$(awk 'BEGIN { pi = atan2(0, -1); a = 20 * pi / 180; b = 40 * pi / 180;
     printf "%.6f", 2 * pi * 1000 * ((1 - cos(a)) + cos(a) - (sin(b) - sin(a)) / (b - a)) }')
-got=$(sed -n 's/.*profile LM-63-2002 rotational, [0-9.e+]* lm x \([0-9.e+-]*\).*/\1/p' "$OUT")
+got=$(sed -n 's/.*profile LM-63-2002 rotational, [0-9.e+]* lm, peak [0-9.e+]* cd x \([0-9.e+-]*\).*/\1/p' "$OUT")
 want=$(awk -v f="$flux" 'BEGIN { printf "%.6f", 1500 / f }')
 # printed to four digits: half the last one is 2.9e-4 of 1.725 (measured
 # 2.2e-4, the rounding)
@@ -158,9 +158,9 @@ run "$LUXEL" ies quad.ies --plot plots/quad.png
 expect_rc 0 "ies --plot"
 expect_files "ies --plot writes only the PNG" plots quad.png
 check "plot has the PNG signature" test "$(magic plots/quad.png 8)" = 89504e470d0a1a0a
-# IHDR: 512 x 512
-check "plot is 512 x 512" test "$(head -c 24 plots/quad.png | tail -c 8 | od -An -tx1 | tr -d ' \n')" \
-    = 0000020000000200
+# IHDR: 600 x 660
+check "plot is 600 x 660" test "$(head -c 24 plots/quad.png | tail -c 8 | od -An -tx1 | tr -d ' \n')" \
+    = 0000025800000294
 
 # ---- bad files: exit 1, one error line, no plot --------------------------------
 

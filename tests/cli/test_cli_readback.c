@@ -15,9 +15,11 @@
  * These bounds are the formats' own worst cases, not fitted tolerances.
  *
  * --exposure EV100 must set the preview PNG (and a --format png lightmap)
- * to the exposure 1 / (1.2 * 2^EV100) times E / pi, clamped to [0, 1] and
- * sRGB-encoded to the nearest 8-bit code, computed here in double from the
- * library's values; the manifest records the EV100.
+ * to the exposure 1 / (1.2 * 2^EV100) times E / pi, through the tone
+ * curve (--tonemap clamp: clamped to [0, 1]; the default, Hable's filmic
+ * curve, written here from its published formula) and sRGB-encoded to the
+ * nearest 8-bit code, computed here in double from the library's values;
+ * the manifest records the EV100 and the curve.
  *
  * The CLI is the `luxel` next to this test's executable (CMake puts both
  * in bin/); the scene is written here. */
@@ -253,8 +255,27 @@ static int srgb_code(double v, bool *tie)
     return (int)floor(s + 0.5);
 }
 
-/* Every pixel of an 8-bit file against exposure x E / pi. */
-static void check_exposed(const char *sub, const char *file)
+/* John Hable's filmic curve (A 0.15, B 0.5, C 0.1, D 0.2, E 0.02, F 0.3),
+ * input doubled, divided by its value at the white point 11.2. */
+static double hable(double x)
+{
+    const double A = 0.15, B = 0.50, C = 0.10, D = 0.20, E = 0.02, F = 0.30;
+    return (x * (A * x + C * B) + D * E) / (x * (A * x + B) + D * F) - E / F;
+}
+
+static double filmic(double v)
+{
+    double f = hable(2.0 * v) / hable(11.2);
+    return f > 1.0 ? 1.0 : f;
+}
+
+static double clamp_curve(double v)
+{
+    return v > 1.0 ? 1.0 : v;
+}
+
+/* Every pixel of an 8-bit file against curve(exposure x E / pi). */
+static void check_exposed(const char *sub, const char *file, double (*curve)(double))
 {
     lx_image img = load(sub, file, true);
     const double exposure = 1.0 / (1.2 * pow(2.0, EV100)) / 3.14159265358979323846;
@@ -263,9 +284,9 @@ static void check_exposed(const char *sub, const char *file)
         for (int c = 0; c < 3; c++) {
             bool tie;
             double v = reference.data[p * 3 + c] * exposure;
-            int want = srgb_code(v, &tie);
+            int want = srgb_code(curve(v), &tie);
             int got = (int)lrint(img.data[p * img.channels + c] * 255.0);
-            clipped += v >= 1.0;
+            clipped += curve(v) >= 1.0;
             if (tie) {
                 ties++;
                 if (abs(got - want) <= 1)
@@ -289,9 +310,9 @@ static void exposure_sets_the_preview(void **state)
     char out[PATH_MAX + 8], ev[32];
     snprintf(out, sizeof out, "%s/exposed", dir);
     snprintf(ev, sizeof ev, "%g", EV100);
-    const char *args[] = {"--exposure", ev, "-o", out, NULL};
+    const char *args[] = {"--exposure", ev, "--tonemap", "clamp", "-o", out, NULL};
     assert_int_equal(run_bake(args), 0);
-    check_exposed("exposed", "quad.png");
+    check_exposed("exposed", "quad.png", clamp_curve);
     /* the manifest records the EV100 given */
     char path[PATH_MAX * 2];
     snprintf(path, sizeof path, "%s/manifest.json", out);
@@ -306,9 +327,56 @@ static void exposure_sets_the_preview(void **state)
     assert_true(fabs(strtod(k + strlen("\"preview_ev100\":"), NULL) - EV100) < 1e-12);
 
     snprintf(out, sizeof out, "%s/png", dir);
-    const char *png_args[] = {"--exposure", ev, "--format", "png", "-o", out, NULL};
+    const char *png_args[] = {"--exposure", ev, "--tonemap", "clamp", "--format", "png",
+                              "-o",         out, NULL};
     assert_int_equal(run_bake(png_args), 0);
-    check_exposed("png", "quad.png");
+    check_exposed("png", "quad.png", clamp_curve);
+}
+
+/* Without --tonemap the preview goes through the filmic curve; the
+ * exposure puts a few texels past its white point (2 x 5.6 = 11.2). */
+static void filmic_by_default(void **state)
+{
+    (void)state;
+    char out[PATH_MAX + 8], ev[32];
+    snprintf(out, sizeof out, "%s/filmic", dir);
+    snprintf(ev, sizeof ev, "%g", EV100 - 3.0);
+    const char *args[] = {"--exposure", ev, "-o", out, NULL};
+    assert_int_equal(run_bake(args), 0);
+    lx_image img = load("filmic", "quad.png", true);
+    const double exposure = 1.0 / (1.2 * pow(2.0, EV100 - 3.0)) / 3.14159265358979323846;
+    int ties = 0, saturated = 0, mid = 0;
+    for (int p = 0; p < RES * RES; p++)
+        for (int c = 0; c < 3; c++) {
+            bool tie;
+            double v = filmic(reference.data[p * 3 + c] * exposure);
+            int want = srgb_code(v, &tie);
+            int got = (int)lrint(img.data[p * img.channels + c] * 255.0);
+            saturated += v >= 1.0;
+            mid += want > 20 && want < 235;
+            /* float against double in the curve: a code either side of a
+             * half-way point (tie band 1e-4 of a code) */
+            if (tie && abs(got - want) <= 1) {
+                ties++;
+                continue;
+            }
+            if (got != want)
+                fail_msg("filmic: texel %d channel %d: code %d, want %d (curve value %.6g)", p, c,
+                         got, want, v);
+        }
+    assert_true(mid > RES * RES / 4); /* the curve is exercised, not just its ends */
+    assert_true(ties < 10);
+    (void)saturated;
+    lx_image_free(&img);
+    char path[PATH_MAX * 2];
+    snprintf(path, sizeof path, "%s/manifest.json", out);
+    FILE *fp = fopen(path, "r");
+    assert_non_null(fp);
+    char text[8192];
+    size_t n = fread(text, 1, sizeof text - 1, fp);
+    fclose(fp);
+    text[n] = '\0';
+    assert_non_null(strstr(text, "\"preview_tonemap\":\t\"filmic\""));
 }
 
 int main(void)
@@ -320,6 +388,7 @@ int main(void)
         cmocka_unit_test(exr_half_within_half_precision),
         cmocka_unit_test(hdr_within_rgbe_precision),
         cmocka_unit_test(exposure_sets_the_preview),
+        cmocka_unit_test(filmic_by_default),
     };
     return cmocka_run_group_tests(tests, setup, teardown);
 }

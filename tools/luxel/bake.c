@@ -33,12 +33,14 @@ static const char *bake_usage =
     "                          scene's (docs/lights-json.md)\n"
     "  --format F              exr (default), hdr, pfm or png\n"
     "  --half                  EXR with 16-bit half floats\n"
-    "  --pre-expose            store values times the exposure of --exposure\n"
-    "                          (Filament's pre-exposure: sun-lit scenes fit in\n"
-    "                          half floats); the manifest records the factor\n"
+    "  --pre-expose            store values times the exposure of --exposure, or\n"
+    "                          of the metered EV100 without it (Filament's\n"
+    "                          pre-exposure: sun-lit scenes fit in half floats);\n"
+    "                          the manifest records the factor\n"
     "  --quantity Q            irradiance (lux) or radiance (nits: irradiance x\n"
     "                          base colour / pi); default %s\n"
-    "  --ambient R,G,B         constant ambient illuminance in lux\n"
+    "  --ambient L|R,G,B       constant ambient illuminance in lux: one value for\n"
+    "                          white, or a colour (const:L and const:R,G,B too)\n"
     "  --sky ENV               light by an environment (equirect, cross or\n"
     "                          <name>_px.<ext> faces, radiance in nits, or\n"
     "                          const:R,G,B; see docs/ibl.md), unshadowed through\n"
@@ -50,6 +52,11 @@ static const char *bake_usage =
     "                          for shadows\n"
     "  --sky-samples N         rays per texel with sky shadows (default %u)\n"
     "  --exposure EV100        exposure of the PNG preview (default: automatic)\n"
+    "  --tonemap C             tone curve of the PNG preview: filmic (default),\n"
+    "                          aces or clamp\n"
+    "  --clean                 remove the files an earlier bake left in DIR that\n"
+    "                          this one does not write (only those its manifest\n"
+    "                          lists)\n"
     "  --padding N             texels of dilation around charts, 0 for none\n"
     "                          (default %d); charts luxel packs own as many\n"
     "  --unwrap MODE           auto (default): make lightmap UVs for the nodes\n"
@@ -93,7 +100,9 @@ enum {
     OPT_ATLAS,
     OPT_NO_ATLAS,
     OPT_ATLAS_SIZE,
-    OPT_RENDER
+    OPT_RENDER,
+    OPT_TONEMAP,
+    OPT_CLEAN
 };
 
 typedef enum unwrap_choice { UNWRAP_AUTO, UNWRAP_ALWAYS, UNWRAP_NEVER } unwrap_choice;
@@ -124,8 +133,25 @@ typedef struct bake_args {
     int atlas;      /* 1 --atlas, 0 --no-atlas, -1 not given */
     int atlas_size; /* 0: the unwrapper's default */
     bool render;    /* --render: DIR/view.png after the bake */
+    lx_tonemap tonemap;
+    bool clean;
     lx_bake_desc desc;
 } bake_args;
+
+/* --ambient: lux as L (white) or R,G,B, optionally written const:... as an
+ * environment's constant is. */
+static bool parse_ambient(const char *s, lx_vec3 *out)
+{
+    double l;
+    if (strncmp(s, "const:", 6) == 0)
+        s += 6;
+    if (cli_parse_rgb(s, out))
+        return true;
+    if (!cli_parse_float(s, 0.0, 3.4e38, &l))
+        return false;
+    *out = lx_v3((float)l, (float)l, (float)l);
+    return true;
+}
 
 static int parse_args(int argc, char **argv, bake_args *a)
 {
@@ -155,6 +181,8 @@ static int parse_args(int argc, char **argv, bake_args *a)
         {"no-atlas", no_argument, NULL, OPT_NO_ATLAS},
         {"atlas-size", required_argument, NULL, OPT_ATLAS_SIZE},
         {"render", no_argument, NULL, OPT_RENDER},
+        {"tonemap", required_argument, NULL, OPT_TONEMAP},
+        {"clean", no_argument, NULL, OPT_CLEAN},
         {"quiet", no_argument, NULL, 'q'},
         {"verbose", no_argument, NULL, 'v'},
         {"help", no_argument, NULL, 'h'},
@@ -167,6 +195,7 @@ static int parse_args(int argc, char **argv, bake_args *a)
     a->sky_intensity = -1.0;
     a->sky_shadows = -1;
     a->atlas = -1;
+    a->tonemap = CLI_PREVIEW_TONEMAP;
     opterr = 0;
     optind = 1;
     int c;
@@ -226,10 +255,10 @@ static int parse_args(int argc, char **argv, bake_args *a)
                                        optarg);
             break;
         case OPT_AMBIENT:
-            if (!cli_parse_rgb(optarg, &a->ambient))
+            if (!parse_ambient(optarg, &a->ambient))
                 return cli_usage_error("bake",
-                                       "--ambient must be R,G,B with finite values >= 0, "
-                                       "not '%s'",
+                                       "--ambient must be lux as L or R,G,B (or const:L, "
+                                       "const:R,G,B) with finite values >= 0, not '%s'",
                                        optarg);
             a->has_ambient = true;
             break;
@@ -312,8 +341,17 @@ static int parse_args(int argc, char **argv, bake_args *a)
         case OPT_RENDER:
             a->render = true;
             break;
+        case OPT_TONEMAP:
+            if (!lx_tonemap_parse(optarg, &a->tonemap))
+                return cli_usage_error("bake", "--tonemap must be filmic, aces or clamp, not '%s'",
+                                       optarg);
+            break;
+        case OPT_CLEAN:
+            a->clean = true;
+            break;
         case 'q':
             a->quiet = true;
+            cli_set_quiet(true);
             break;
         case 'v':
             cli_set_verbose(true);
@@ -345,8 +383,6 @@ static int parse_args(int argc, char **argv, bake_args *a)
                                        "lightmaps: give one");
     if (a->atlas_size && a->atlas == 0)
         return cli_usage_error("bake", "--atlas-size needs atlas pages, not --no-atlas");
-    if (a->pre_expose && !a->has_exposure)
-        return cli_usage_error("bake", "--pre-expose needs --exposure EV100");
     if (a->pre_expose && a->format == LX_IMAGE_PNG)
         return cli_usage_error("bake", "--pre-expose applies to float formats, not png");
     return 0;
@@ -544,20 +580,23 @@ static int plan_lightmaps(bake_args *a, lx_scene *scene, lx_unwrap **out, bool *
             status = EXIT_FAILED;
         } else {
             const lx_unwrap *u = *out;
-            lx_log(LX_LOG_INFO, "unwrap: %u charts (%u cut again), %u pages, %.0f%% of their texels covered, "
-                     "stretch %.3f (worst %.3f), %g texels/m",
-                     u->stats.charts, u->stats.recut_charts, u->page_count,
-                     100.0 * u->stats.efficiency, u->stats.stretch_mean, u->stats.stretch_max,
-                     (double)u->texel_density);
+            lx_log(LX_LOG_INFO,
+                   "unwrap: %u %s (%u cut again), %u %s, %s%% of their texels covered, "
+                   "stretch %s (worst %s), %s texels/m",
+                   u->stats.charts, cli_plural(u->stats.charts, "chart", "charts"),
+                   u->stats.recut_charts, u->page_count, cli_plural(u->page_count, "page", "pages"),
+                   cli_num_digits(100.0 * u->stats.efficiency, 3),
+                   cli_num_digits(u->stats.stretch_mean, 4),
+                   cli_num_digits(u->stats.stretch_max, 4), cli_num((double)u->texel_density));
             lx_vec3 lo, hi;
             if (lx_scene_bounds(scene, &lo, &hi)) {
                 double across = lx_length(lx_sub(hi, lo)) * u->texel_density;
                 if (across < 16.0)
                     lx_log(LX_LOG_WARN,
-                           "%s: the scene is %.3g m across: at %g texels/m it gets about %.0f "
+                           "%s: the scene is %s m across: at %s texels/m it gets about %s "
                            "texels across; are its units metres?",
-                           a->scene, (double)lx_length(lx_sub(hi, lo)), (double)u->texel_density,
-                           across);
+                           a->scene, cli_num_digits(lx_length(lx_sub(hi, lo)), 3),
+                           cli_num((double)u->texel_density), cli_num_digits(across, 2));
             }
             a->desc.atlas = u;
         }
@@ -565,6 +604,63 @@ static int plan_lightmaps(bake_args *a, lx_scene *scene, lx_unwrap **out, bool *
     free(modes);
     free(sets);
     return status;
+}
+
+/* Half floats end at 65504: a lightmap beyond it (sun-lit scenes in lux)
+ * fails, saying what would fit. */
+static bool half_fits(const bake_args *a, const lx_image *images, uint32_t maps, char **stems,
+                      float scale)
+{
+    for (uint32_t m = 0; m < maps; m++) {
+        const lx_image *img = &images[m];
+        size_t n = (size_t)img->width * img->height * img->channels;
+        float peak = 0.0f;
+        for (size_t i = 0; i < n; i++)
+            peak = img->data[i] * scale > peak ? img->data[i] * scale : peak;
+        if (peak > 65504.0f) {
+            const char *unit = a->desc.quantity == LX_QUANTITY_RADIANCE ? "nt" : "lx";
+            if (a->pre_expose)
+                cli_error("%s.exr: pre-exposed values reach %s, beyond the half-float range "
+                          "(65504): "
+                          "give a higher --exposure, or leave out --half",
+                          stems[m], cli_num_digits(peak, 3));
+            else
+                cli_error("%s.exr: values reach %s %s, beyond the half-float range (65504): "
+                          "--pre-expose "
+                          "stores them times the exposure (the manifest records it), or leave "
+                          "out --half for 32-bit floats",
+                          stems[m], cli_num_digits(peak, 3), unit);
+            return false;
+        }
+    }
+    return true;
+}
+
+/* The earlier bake's files in the output folder that this one does not
+ * write (cli_stale_find), from the stems of this bake's outputs. */
+static bool find_stale(const bake_args *a, char **stems, uint32_t maps, const char *uvs_name,
+                       cli_stale *out)
+{
+    uint32_t n = 0;
+    char **names = calloc(2 * (size_t)maps + 2, sizeof *names);
+    bool ok = names != NULL;
+    if (ok && uvs_name[0]) /* the scene with luxel's UVs, written again */
+        ok = (names[n++] = cli_strdup(uvs_name)) != NULL;
+    for (uint32_t m = 0; ok && m < maps; m++) {
+        char name[300];
+        snprintf(name, sizeof name, "%s.%s", stems[m], lx_image_format_extension(a->format));
+        ok = (names[n++] = cli_strdup(name)) != NULL;
+        snprintf(name, sizeof name, "%s.png", stems[m]);
+        ok = ok && (names[n++] = cli_strdup(name)) != NULL;
+    }
+    if (!ok)
+        cli_error("out of memory");
+    else
+        ok = cli_stale_find(a->output, a->scene, (const char *const *)names, n, out);
+    for (uint32_t i = 0; i < n; i++)
+        free(names[i]);
+    free(names);
+    return ok;
 }
 
 int cmd_bake(int argc, char **argv)
@@ -580,6 +676,7 @@ int cmd_bake(int argc, char **argv)
     char **stems = NULL;
     uint32_t maps = 0;
     cli_stage stage = {0};
+    cli_stale stale = {0};
     lx_cubemap sky_env = {0};
     lx_unwrap *unwrap = NULL;
     bool atlas = false;
@@ -703,6 +800,10 @@ int cmd_bake(int argc, char **argv)
         (!cli_scene_glb_name(a.scene, uvs_name, sizeof uvs_name) ||
          !cli_stage_check(&stage, uvs_name)))
         goto done;
+    /* an earlier bake's files that this one will not replace */
+    if (!find_stale(&a, stems, maps, uvs_name, &stale))
+        goto done;
+    cli_stale_warn(&stale, a.output, a.clean);
 
     cli_progress_init(&progress, "bake", a.quiet);
     lx_status st = lx_baker_bake(baker);
@@ -763,6 +864,7 @@ int cmd_bake(int argc, char **argv)
                             a.desc.quantity == LX_QUANTITY_RADIANCE ? "nt" : "lx");
     cJSON_AddStringToObject(manifest, "format", lx_image_format_extension(a.format));
     cJSON_AddNumberToObject(manifest, "preview_ev100", ev);
+    cJSON_AddStringToObject(manifest, "preview_tonemap", lx_tonemap_name(a.tonemap));
     /* values in the files are (quantity) x pre_exposure */
     cJSON_AddNumberToObject(manifest, "pre_exposure", a.pre_expose ? pre_exposure : 1.0);
     if (sky.environment) {
@@ -791,6 +893,7 @@ int cmd_bake(int argc, char **argv)
          * as they are (exposure 0, the default), or pre-exposed */
         lx_image_write_desc wd = {.format = a.format,
                                   .half = a.half,
+                                  .tonemap = a.tonemap,
                                   .exposure = a.format == LX_IMAGE_PNG ? exposure
                                               : a.pre_expose           ? pre_exposure
                                                                        : 0.0f,
@@ -799,12 +902,17 @@ int cmd_bake(int argc, char **argv)
                                   .progress_user = &progress};
         double t = cli_now();
         cli_progress_part(&progress, part++, parts);
-        failed = !cli_stage_image(&stage, file, &images[m], &wd);
+        /* where the library would fail on the file: the same place, with
+         * what would fit named */
+        failed = a.half && !half_fits(&a, &images[m], 1, &stems[m],
+                                      a.pre_expose ? pre_exposure : 1.0f);
+        failed = failed || !cli_stage_image(&stage, file, &images[m], &wd);
         t_maps += cli_now() - t;
         bool want_preview = a.format != LX_IMAGE_PNG;
         if (!failed && want_preview) {
             lx_image_write_desc pd = {.format = LX_IMAGE_PNG,
                                       .exposure = exposure,
+                                      .tonemap = a.tonemap,
                                       .threads = a.desc.threads,
                                       .progress = cli_progress_update,
                                       .progress_user = &progress};
@@ -821,6 +929,12 @@ int cmd_bake(int argc, char **argv)
     if (with_uvs > 0)
         cJSON_AddStringToObject(manifest, "scene_with_uvs", uvs_name);
     failed = failed || with_uvs < 0;
+    /* files of earlier bakes left in place: a later --clean still finds them */
+    if (stale.count && !a.clean) {
+        cJSON *earlier = cJSON_AddArrayToObject(manifest, "earlier_files");
+        for (uint32_t i = 0; i < stale.count; i++)
+            cJSON_AddItemToArray(earlier, cJSON_CreateString(stale.names[i]));
+    }
     if (!failed) {
         char *text = cJSON_Print(manifest);
         failed = !text || !cli_stage_text(&stage, "manifest.json", text);
@@ -834,12 +948,15 @@ int cmd_bake(int argc, char **argv)
         failed = true;
     if (failed)
         goto done;
+    if (a.clean && !cli_stale_remove(&stale, a.output))
+        goto done;
     char what[64];
-    snprintf(what, sizeof what, "%u %s%s (%s)", maps, atlas ? "page" : "lightmap", maps == 1 ? "" : "s",
+    snprintf(what, sizeof what, "%u %s (%s)", maps,
+             atlas ? cli_plural(maps, "page", "pages") : cli_plural(maps, "lightmap", "lightmaps"),
              lx_image_format_extension(a.format));
     cli_phase_part(what, t_maps);
     if (a.format != LX_IMAGE_PNG) {
-        snprintf(what, sizeof what, "%u previews (png)", maps);
+        snprintf(what, sizeof what, "%u %s (png)", maps, cli_plural(maps, "preview", "previews"));
         cli_phase_part(what, t_previews);
     }
     cli_phase("write and publish");
@@ -849,17 +966,19 @@ int cmd_bake(int argc, char **argv)
         uint64_t texels = 0;
         for (uint32_t m = 0; m < maps; m++)
             texels += lx_baker_lightmap_info(baker, m)->used_texels;
-        fprintf(stderr,
-                "luxel: baked %u %s%s (%llu texels, %u lights) in %.2f s; preview EV100 "
-                "%.2f%s\n",
-                maps, atlas ? "atlas page" : "lightmap", maps == 1 ? "" : "s",
-                (unsigned long long)texels, scene->light_count, cli_elapsed(), ev,
-                a.has_exposure ? "" : " (auto)");
+        fprintf(
+            stderr, "luxel: baked %u %s (%llu %s, %u %s) in %s s; preview EV100 %s%s, %s\n", maps,
+            atlas ? cli_plural(maps, "atlas page", "atlas pages")
+                  : cli_plural(maps, "lightmap", "lightmaps"),
+            (unsigned long long)texels, cli_plural(texels, "texel", "texels"), scene->light_count,
+            cli_plural(scene->light_count, "light", "lights"), cli_num_digits(cli_elapsed(), 3),
+            cli_num_digits(ev, 3), a.has_exposure ? "" : " (auto)", lx_tonemap_name(a.tonemap));
         printf("%s/manifest.json\n", a.output);
     }
     status = EXIT_OK;
 done:
     cli_stage_clear(&stage);
+    cli_stale_free(&stale);
     if (images)
         for (uint32_t m = 0; m < maps; m++)
             lx_image_free(&images[m]);

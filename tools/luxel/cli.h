@@ -4,6 +4,8 @@
 
 #include "luxel/luxel.h"
 
+#include <cjson/cJSON.h>
+
 #include <stdbool.h>
 
 /* Exit statuses: 0 every output written, 1 a failed run, 2 a usage error. */
@@ -46,6 +48,34 @@ bool cli_parse_float(const char *s, double lo, double hi, double *out);
 bool cli_parse_format(const char *s, lx_image_format *out);
 /* "R,G,B" with finite components >= 0. */
 bool cli_parse_rgb(const char *s, lx_vec3 *out);
+
+/* ---- numbers for humans (text.c) -----------------------------------------
+ * v with at most `digits` significant digits (the integer part always
+ * whole), fixed notation from 1e-4 to 1e15 with trailing zeros cut, %g
+ * beyond; |v| below CLI_NUM_ZERO is float noise around zero and prints as
+ * "0". The string lives in one of 16 rotating thread-local buffers: a
+ * printf may hold up to 16 of them. cli_num: 6 digits. */
+#define CLI_NUM_ZERO 1e-6
+const char *cli_num_digits(double v, int digits);
+const char *cli_num(double v);
+/* one when n == 1, else many: "%u %s", n, cli_plural(n, "map", "maps"). */
+const char *cli_plural(uint64_t n, const char *one, const char *many);
+
+/* ---- quiet and strict (main.c) --------------------------------------------
+ * Warnings print unless --quiet is given without --strict (with --strict a
+ * warning matters, so it is always shown); errors always print. Each
+ * command sets these from its own options before any work. */
+void cli_set_quiet(bool quiet);
+void cli_set_strict(bool strict);
+bool cli_quiet(void);
+bool cli_strict(void);
+
+/* The tone curve of 8-bit previews and outputs (bake's PNG previews, ibl's
+ * PNG files) when --tonemap does not choose: Hable's filmic curve keeps a
+ * metered mid grey near where a clamp puts it (code 78 against 91 for the
+ * meter's 0.104) and rolls highlights off up to 5.6 instead of clipping
+ * at 1; Hill's ACES fit darkens mid grey more (code 60). */
+#define CLI_PREVIEW_TONEMAP LX_TONEMAP_FILMIC
 
 /* Face size of a constant environment when none is asked for: it is the
  * same everywhere, so small is exact (the CLI's choice: lx_env_constant
@@ -188,5 +218,36 @@ bool cli_stage_publish(cli_stage *st);
 /* Removes whatever is still staged, the staging folder, and, unless the
  * outputs were published, the folders the run created. */
 void cli_stage_clear(cli_stage *st);
+
+/* ---- JSON and stale outputs (stale.c) -------------------------------------
+ * cJSON reports only where it stopped: true when that place is a '}' or
+ * ']' right after a ',' (white space between), with the comma's line and
+ * the closer. */
+bool cli_json_trailing_comma(const char *text, size_t size, size_t error_at, size_t *line,
+                             char *closer);
+/* Parses size bytes of JSON named `name`; NULL with "<name>: line L: ..."
+ * in err (a trailing comma named as such) on failure. */
+cJSON *cli_json_parse(const char *name, const char *text, size_t size, char *err,
+                             size_t err_size);
+
+/* Files of an earlier bake in the output folder that this bake does not
+ * write: the names its DIR/manifest.json lists (pages' files and previews,
+ * scene_with_uvs) that are not among `outputs` and are still regular
+ * files. other_scene: the earlier bake's scene when it is another. */
+typedef struct cli_stale {
+    char **names;
+    uint32_t count;
+    char *other_scene;
+} cli_stale;
+/* Warns (and finds nothing) when the old manifest cannot be read; false
+ * only when out of memory (error printed). */
+bool cli_stale_find(const char *dir, const char *scene, const char *const *outputs,
+                    uint32_t output_count, cli_stale *out);
+/* One warning naming them, when there are any (with clean, an INFO line
+ * saying they are being removed). */
+void cli_stale_warn(const cli_stale *s, const char *dir, bool clean);
+/* Removes them (regular files only); prints an error per failure. */
+bool cli_stale_remove(const cli_stale *s, const char *dir);
+void cli_stale_free(cli_stale *s);
 
 #endif

@@ -55,7 +55,11 @@ static const char *ibl_usage =
     "  --layout L               faces (NAME_px.EXT ... NAME_nz.EXT), cross, vcross\n"
     "                           (vertical cross), equirect (4N x 2N) or ktx (one\n"
     "                           KTX 1.1 file per cube, mips included); default %s\n"
-    "  --format F               exr, hdr, pfm or png (png clamps to 0..1); default %s\n"
+    "  --format F               exr, hdr, pfm or png; default %s\n"
+    "  --exposure EV100         exposure of 8-bit (png) outputs: values times\n"
+    "                           1/(1.2 x 2^EV100); default: values as they are\n"
+    "  --tonemap C              tone curve of 8-bit outputs: filmic (default), aces\n"
+    "                           or clamp; the DFG table is data, never tone mapped\n"
     "  --half                   16-bit floats: EXR half, KTX RGBA16F (else RGBA32F)\n"
     "  --no-seam-fix            keep cube edges as filtered (for engines that sample\n"
     "                           cube maps seamlessly); by default edge texels are\n"
@@ -82,7 +86,9 @@ enum {
     OPT_HALF,
     OPT_NO_SEAM_FIX,
     OPT_INTENSITY,
-    OPT_THREADS
+    OPT_THREADS,
+    OPT_EXPOSURE,
+    OPT_TONEMAP
 };
 
 /* The output layouts by their option names. */
@@ -135,6 +141,9 @@ typedef struct ibl_args {
     float intensity;
     int threads;
     bool quiet;
+    bool has_exposure;
+    double exposure_ev100;
+    lx_tonemap tonemap;
 } ibl_args;
 
 static bool parse_exponents(const char *s, ibl_args *a)
@@ -178,6 +187,8 @@ static int parse_args(int argc, char **argv, ibl_args *a)
         {"no-seam-fix", no_argument, NULL, OPT_NO_SEAM_FIX},
         {"intensity", required_argument, NULL, OPT_INTENSITY},
         {"threads", required_argument, NULL, OPT_THREADS},
+        {"exposure", required_argument, NULL, OPT_EXPOSURE},
+        {"tonemap", required_argument, NULL, OPT_TONEMAP},
         {"quiet", no_argument, NULL, 'q'},
         {"verbose", no_argument, NULL, 'v'},
         {"help", no_argument, NULL, 'h'},
@@ -190,6 +201,8 @@ static int parse_args(int argc, char **argv, ibl_args *a)
     a->layout = w.layout;
     a->filter = lx_prefilter_desc_defaults(NULL).filter;
     a->seam_fix = true;
+    a->tonemap = CLI_PREVIEW_TONEMAP;
+    bool tonemap_given = false;
     opterr = 0;
     optind = 1;
     int c;
@@ -296,8 +309,22 @@ static int parse_args(int argc, char **argv, ibl_args *a)
                                        optarg);
             a->threads = (int)n;
             break;
+        case OPT_EXPOSURE:
+            if (!cli_parse_float(optarg, -64, 64, &f))
+                return cli_usage_error("ibl", "--exposure must be an EV100 in -64..64, not '%s'",
+                                       optarg);
+            a->exposure_ev100 = f;
+            a->has_exposure = true;
+            break;
+        case OPT_TONEMAP:
+            if (!lx_tonemap_parse(optarg, &a->tonemap))
+                return cli_usage_error("ibl", "--tonemap must be filmic, aces or clamp, not '%s'",
+                                       optarg);
+            tonemap_given = true;
+            break;
         case 'q':
             a->quiet = true;
+            cli_set_quiet(true);
             break;
         case 'v':
             cli_set_verbose(true);
@@ -332,6 +359,10 @@ static int parse_args(int argc, char **argv, ibl_args *a)
         a->mips = a->phong_count;
     if (a->half && a->format != LX_IMAGE_EXR && a->layout != LX_ENV_KTX)
         return cli_usage_error("ibl", "--half applies to --format exr and --layout ktx only");
+    bool eight = a->format == LX_IMAGE_PNG && a->layout != LX_ENV_KTX;
+    if (!eight && (a->has_exposure || tonemap_given))
+        return cli_usage_error("ibl", "--exposure and --tonemap apply to 8-bit outputs "
+                                      "(--format png)");
     return 0;
 }
 
@@ -379,6 +410,10 @@ static lx_env_write_desc write_desc(const ibl_args *a, bool mip_names)
 {
     lx_env_write_desc d = {.layout = a->layout,
                            .format = a->format,
+                           .exposure = a->has_exposure
+                                           ? lx_exposure_from_ev100((float)a->exposure_ev100)
+                                           : 0.0f,
+                           .tonemap = a->tonemap,
                            .half = a->half,
                            .mip_names = mip_names,
                            .threads = a->threads};
@@ -693,7 +728,10 @@ int cmd_ibl(int argc, char **argv)
         char name[32];
         lut_name(&a, name, sizeof name);
         cli_progress_init(&progress, "write", a.quiet);
+        /* the table is data, not a picture: no exposure, no curve, and in
+         * a PNG linear codes, not sRGB */
         lx_image_write_desc wd = {.format = a.format,
+                                  .linear = true,
                                   .half = a.half && a.format == LX_IMAGE_EXR,
                                   .threads = a.threads,
                                   .progress = cli_progress_update,

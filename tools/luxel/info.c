@@ -51,13 +51,27 @@ static void print_light(const lx_light *l)
     if (l->profile) {
         lx_ies_info ies;
         lx_ies_get_info(l->profile, &ies);
-        printf("  profile %s %s, %.4g lm x %.4g", ies.version, lx_ies_symmetry_name(ies.symmetry),
-               lx_ies_total_lumens(l->profile), l->profile_scale);
+        printf("  profile %s %s, %s lm, peak %s cd x %s", ies.version,
+               lx_ies_symmetry_name(ies.symmetry),
+               cli_num_digits(lx_ies_total_lumens(l->profile), 4),
+               cli_num_digits(lx_ies_peak_candela(l->profile), 4),
+               cli_num_digits(l->profile_scale, 4));
     }
     printf("  shadow %s", lx_shadow_mode_name(l->shadow));
     if (l->shadow == LX_SHADOW_SOFT)
         printf(" (%u samples)", lx_light_sample_count(l));
     printf("%s\n", l->dynamic ? "  dynamic" : "");
+}
+
+/* assimp's DefaultMaterial that no mesh uses. */
+static bool phantom_material(const lx_scene *s, uint32_t i)
+{
+    if (strcmp(s->materials[i].name, "DefaultMaterial") != 0)
+        return false;
+    for (uint32_t k = 0; k < s->mesh_count; k++)
+        if (s->meshes[k].material == i)
+            return false;
+    return true;
 }
 
 int cmd_info(int argc, char **argv)
@@ -117,9 +131,16 @@ int cmd_info(int argc, char **argv)
         printf("%s%s  material '%s'\n", any ? "" : " none", m->tangents ? "  tangents" : "",
                s->materials[m->material].name);
     }
-    printf("materials: %u\n", s->material_count);
+    /* assimp adds a DefaultMaterial to a file that has none: not listed
+     * when no mesh uses it */
+    uint32_t listed = 0;
+    for (uint32_t i = 0; i < s->material_count; i++)
+        listed += !phantom_material(s, i);
+    printf("materials: %u\n", listed);
     for (uint32_t i = 0; i < s->material_count; i++) {
         const lx_material *m = &s->materials[i];
+        if (phantom_material(s, i))
+            continue;
         printf("  %-24s base colour (%.3g, %.3g, %.3g)%s%s\n", m->name, m->base_color.x,
                m->base_color.y, m->base_color.z, m->base_color_map_path ? " + texture" : "",
                m->normal_map_path ? "  normal map" : "");

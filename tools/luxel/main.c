@@ -348,9 +348,35 @@ void cli_progress_finish(cli_progress *p)
 
 /* ---- logging and dispatch ----------------------------------------------- */
 
+static bool quiet, strict;
+
+void cli_set_quiet(bool q)
+{
+    quiet = q;
+}
+
+void cli_set_strict(bool s)
+{
+    strict = s;
+}
+
+bool cli_quiet(void)
+{
+    return quiet;
+}
+
+bool cli_strict(void)
+{
+    return strict;
+}
+
 static void print_log(void *user, lx_log_level level, const char *message)
 {
+    (void)user;
     if (level < (verbose ? LX_LOG_INFO : LX_LOG_WARN))
+        return;
+    /* --quiet silences warnings too, unless --strict makes them matter */
+    if (level == LX_LOG_WARN && quiet && !strict)
         return;
     fprintf(stderr, "luxel: %s%s\n", level == LX_LOG_WARN ? "warning: " : "", message);
 }
