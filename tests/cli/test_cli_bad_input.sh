@@ -192,8 +192,8 @@ f 1/1 3/3 4/4
 f 1/1 3/3 5/5
 EOF
 bad "OBJ with a zero-area triangle" 1 "sliver.obj|zero area|floor" bake "$IN/sliver.obj"
-bad_info "OBJ with a zero-area triangle" "sliver.obj|zero area|floor" "$IN/sliver.obj"
-run "$LUXEL" bake "$IN/sliver.obj" --resolution 32 --skip-degenerate -o "$WORK/out/sliver_ok"
+bad_info "OBJ with a zero-area triangle (--strict)" "sliver.obj|zero area|floor" "$IN/sliver.obj" --strict
+run "$LUXEL" bake "$IN/sliver.obj" --ambient 1,1,1 --resolution 32 --skip-degenerate -o "$WORK/out/sliver_ok"
 expect_rc 0 "--skip-degenerate bakes the zero-area OBJ"
 expect_stderr_has "--skip-degenerate: a warning naming the file, the mesh and the count" \
     "^luxel: warning: .*sliver\.obj.*'floor'.*1 zero-area"
@@ -204,7 +204,7 @@ write_gltf "$IN/sliver.gltf" sliver_mesh sliver_node \
     "0 0 0  0 0 1  1 0 1   0 0 0  0.5 0 0.5  1 0 1" \
     "0 0  0 1  1 1   0 0  0.5 0.5  1 1" || exit 1
 bad "glTF with a zero-area triangle" 1 "sliver.gltf|zero area|sliver_mesh" bake "$IN/sliver.gltf"
-run "$LUXEL" bake "$IN/sliver.gltf" --resolution 32 --skip-degenerate -o "$WORK/out/gsliver_ok"
+run "$LUXEL" bake "$IN/sliver.gltf" --ambient 1,1,1 --resolution 32 --skip-degenerate -o "$WORK/out/gsliver_ok"
 expect_rc 0 "--skip-degenerate bakes the zero-area glTF"
 expect_stderr_has "--skip-degenerate (glTF): a warning naming the mesh" \
     "^luxel: warning: .*sliver\.gltf.*sliver_mesh.*zero-area"
@@ -225,14 +225,14 @@ f 1/4 3/4 4/4
 EOF
 # the file's UVs kept (--unwrap never): a zero-UV-area triangle stops the bake
 bad "OBJ with a zero-UV-area triangle" 1 "flat_uv.obj|zero area|floor" \
-    bake "$IN/flat_uv.obj" --resolution 32 --unwrap never
+    bake "$IN/flat_uv.obj" --ambient 1,1,1 --resolution 32 --unwrap never
 # by default luxel makes the node's UVs instead, and says so once
-run "$LUXEL" bake "$IN/flat_uv.obj" --resolution 32 -o "$WORK/out/flat_auto"
+run "$LUXEL" bake "$IN/flat_uv.obj" --ambient 1,1,1 --resolution 32 -o "$WORK/out/flat_auto"
 expect_rc 0 "a zero-UV-area OBJ bakes on luxel's UVs"
 expect_stderr_has "a zero-UV-area OBJ: one warning says luxel makes the UVs" \
     "^luxel: warning: .*flat_uv\.obj: 1 of 1 nodes have no usable .*zero-area triangles 1.*luxel makes"
 check "a zero-UV-area OBJ: the atlas page is written" test -f "$WORK/out/flat_auto/lightmap-0.exr"
-run "$LUXEL" bake "$IN/flat_uv.obj" --resolution 32 --unwrap never --skip-degenerate \
+run "$LUXEL" bake "$IN/flat_uv.obj" --ambient 1,1,1 --resolution 32 --unwrap never --skip-degenerate \
     -o "$WORK/out/flat_ok"
 expect_rc 0 "--skip-degenerate bakes the zero-UV-area OBJ"
 expect_stderr_has "--skip-degenerate: a warning about the zero-UV-area triangle" \
@@ -243,7 +243,7 @@ write_gltf "$IN/flat_uv.gltf" flat_mesh flat_node \
     "0 0 0  0 0 1  1 0 1   0 0 0  1 0 1  1 0 0" \
     "0.125 0.125  0.125 0.875  0.875 0.875   0.5 0.5  0.5 0.5  0.5 0.5" || exit 1
 bad "glTF with a zero-UV-area triangle" 1 "flat_uv.gltf|zero area|flat_mesh" \
-    bake "$IN/flat_uv.gltf" --resolution 32 --unwrap never
+    bake "$IN/flat_uv.gltf" --ambient 1,1,1 --resolution 32 --unwrap never
 
 # ---- overlapping lightmap UVs: a warning, not an error -------------------------------
 
@@ -283,7 +283,7 @@ vt 0.875 0.875
 f 1/1 2/2 3/3
 f 1/1 3/2 4/3
 EOF
-run "$LUXEL" bake "$IN/overlap.obj" --resolution 30 --unwrap never -o "$WORK/out/overlap_obj"
+run "$LUXEL" bake "$IN/overlap.obj" --ambient 1,1,1 --resolution 30 --unwrap never -o "$WORK/out/overlap_obj"
 expect_rc 0 "overlapping UVs (OBJ) still bake"
 check "overlapping UVs (OBJ): no error line" test -z "$(grep '^luxel: error' "$ERR")"
 expect_stderr_has "overlapping UVs (OBJ): a warning with the count, $OVERLAP texels" \
@@ -296,7 +296,7 @@ check "overlapping UVs (OBJ): the manifest records $OVERLAP overlapping texels" 
 write_gltf "$IN/overlap.gltf" shared_mesh shared_node \
     "0 0 0  0 0 1  1 0 1   0 0 0  1 0 1  1 0 0" \
     "0.125 0.125  0.125 0.75  0.875 0.125   0.125 0.125  0.125 0.75  0.875 0.125" || exit 1
-run "$LUXEL" bake "$IN/overlap.gltf" --resolution 30 --unwrap never -o "$WORK/out/overlap_gltf"
+run "$LUXEL" bake "$IN/overlap.gltf" --ambient 1,1,1 --resolution 30 --unwrap never -o "$WORK/out/overlap_gltf"
 expect_rc 0 "overlapping UVs (glTF) still bake"
 check "overlapping UVs (glTF): the lightmap is written" \
     test -f "$WORK/out/overlap_gltf/shared_node.exr"
@@ -309,8 +309,8 @@ expect_stderr_has "overlapping UVs (glTF): the warning names the mesh 'shared_me
 
 printf 'o bare\nv 0 0 0\nv 1 0 0\nv 0 0 1\nf 1 2 3\n' >"$IN/no_uv.obj"
 bad "an OBJ without texture coordinates, --unwrap never" 1 "no_uv.obj" \
-    bake "$IN/no_uv.obj" --unwrap never
-run "$LUXEL" bake "$IN/no_uv.obj" -o "$WORK/out/no_uv_auto"
+    bake "$IN/no_uv.obj" --ambient 1,1,1 --unwrap never
+run "$LUXEL" bake "$IN/no_uv.obj" --ambient 1,1,1 -o "$WORK/out/no_uv_auto"
 expect_rc 0 "an OBJ without texture coordinates bakes on luxel's UVs"
 check "an OBJ without texture coordinates: its atlas page is written" \
     test -f "$WORK/out/no_uv_auto/lightmap-0.exr"

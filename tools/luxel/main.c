@@ -346,8 +346,16 @@ void cli_progress_finish(cli_progress *p)
 
 /* ---- logging and dispatch ----------------------------------------------- */
 
+static unsigned warnings; /* the log callback is never called concurrently */
+
+unsigned cli_warning_count(void)
+{
+    return warnings;
+}
+
 static void print_log(void *user, lx_log_level level, const char *message)
 {
+    warnings += level >= LX_LOG_WARN;
     if (level < (verbose ? LX_LOG_INFO : LX_LOG_WARN))
         return;
     fprintf(stderr, "luxel: %s%s\n", level == LX_LOG_WARN ? "warning: " : "", message);
