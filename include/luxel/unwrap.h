@@ -189,6 +189,10 @@ typedef struct lx_uv_health_desc {
     float max_overlap;   /* overlapped share of the covered texels above which
                             the set is not usable, 0 = 0.01 */
     int threads;         /* 0 = all cores */
+    lx_progress_fn progress; /* hears the texels' tiles (0 to 1), from one thread
+                                at a time; returning false stops the call with
+                                LX_ERR_CANCELLED */
+    void *progress_user;
 } lx_uv_health_desc;
 
 /* A copy of desc (or of zeros when NULL) with every default filled in. */
@@ -215,7 +219,9 @@ typedef struct lx_uv_health {
 
 /* UV set uv_set (0 or 1) of one mesh, in its own space, on a bitmap of
  * desc->resolution. desc may be NULL. LX_ERR_INVALID for a bad set or
- * options, LX_ERR_NOMEM. Deterministic for any thread count. */
+ * options, LX_ERR_NOMEM, LX_ERR_CANCELLED. Deterministic for any thread
+ * count; the time follows the covered texels (plus, per texel, the pairs
+ * of triangles that reach it). */
 lx_status lx_uv_health_mesh(const lx_mesh *mesh, int uv_set, const lx_uv_health_desc *desc,
                             lx_uv_health *out);
 /* The same for every mesh of scene node `node` together (they share the

@@ -14,6 +14,7 @@
 #include "core/internal.h"
 
 #include <math.h>
+#include <omp.h>
 #include <stdio.h>
 #include <stdlib.h>
 #include <string.h>
@@ -164,8 +165,8 @@ static bool u32s_push(u32s *a, uint32_t x)
 }
 
 /* Covered and overlapped texels of tris on a w x h grid. */
-static lx_status rasterize(const htri *tris, uint32_t count, int w, int h, int threads,
-                           uint64_t *covered, uint64_t *overlapped)
+static lx_status rasterize(const htri *tris, uint32_t count, int w, int h,
+                           const lx_uv_health_desc *d, uint64_t *covered, uint64_t *overlapped)
 {
     *covered = *overlapped = 0;
     int tx = (w + TILE - 1) / TILE, ty = (h + TILE - 1) / TILE;
@@ -180,9 +181,11 @@ static lx_status rasterize(const htri *tris, uint32_t count, int w, int h, int t
         return lx_fail(LX_ERR_NOMEM, "UV health: out of memory for %d x %d texels", w, h);
     }
     /* bin the triangles to the tiles their bounds reach, in triangle order */
+    double work = 0.0; /* texel tests to come */
     for (uint32_t t = 0; t < count; t++) {
         if (tris[t].x0 > tris[t].x1 || tris[t].y0 > tris[t].y1)
             continue;
+        work += (double)(tris[t].x1 - tris[t].x0 + 1) * (tris[t].y1 - tris[t].y0 + 1);
         for (int j = tris[t].y0 / TILE; j <= tris[t].y1 / TILE; j++)
             for (int i = tris[t].x0 / TILE; i <= tris[t].x1 / TILE; i++)
                 start[(size_t)j * tx + i + 1]++;
@@ -209,9 +212,11 @@ static lx_status rasterize(const htri *tris, uint32_t count, int w, int h, int t
     }
     free(fill);
 
-    int failed = 0;
-    long long tile_count = (long long)tiles;
-#pragma omp parallel num_threads(lx_thread_count(threads))
+    int failed = 0, cancelled = 0;
+    long long tile_count = (long long)tiles, done = 0;
+    /* below a few milliseconds of work, waking threads costs more than it
+     * saves (a scene of many small nodes calls this once a node) */
+#pragma omp parallel num_threads(lx_thread_count(d->threads)) if (work > 1048576.0)
     {
         /* per texel of the tile: the triangles covering it (CSR) */
         uint32_t first[TILE * TILE + 1];
@@ -219,7 +224,12 @@ static lx_status rasterize(const htri *tris, uint32_t count, int w, int h, int t
         u32s at = {0}; /* (texel, triangle) pairs in triangle order */
 #pragma omp for schedule(dynamic, 1)
         for (long long k = 0; k < tile_count; k++) {
-            if (failed)
+            int stop_a, stop_b;
+#pragma omp atomic read
+            stop_a = failed;
+#pragma omp atomic read
+            stop_b = cancelled;
+            if (stop_a || stop_b)
                 continue;
             int ox = (int)(k % tx) * TILE, oy = (int)(k / tx) * TILE;
             at.n = 0;
@@ -284,6 +294,15 @@ static lx_status rasterize(const htri *tris, uint32_t count, int w, int h, int t
             }
             tile_cov[k] = cov;
             tile_ovl[k] = ovl;
+            long long now;
+#pragma omp atomic capture
+            now = ++done;
+            /* one thread reports; the others never wait for it */
+            if (d->progress && omp_get_thread_num() == 0 &&
+                !d->progress(d->progress_user, (float)now / (float)tile_count)) {
+#pragma omp atomic write
+                cancelled = 1;
+            }
         }
         free(list.v);
         free(at.v);
@@ -296,6 +315,8 @@ static lx_status rasterize(const htri *tris, uint32_t count, int w, int h, int t
     free(start);
     free(tile_cov);
     free(tile_ovl);
+    if (cancelled)
+        return lx_fail(LX_ERR_CANCELLED, "UV health cancelled");
     return failed ? lx_fail(LX_ERR_NOMEM, "UV health: out of memory for %d x %d texels", w, h)
                   : LX_OK;
 }
@@ -466,7 +487,7 @@ static lx_status health_of(const hmesh *meshes, uint32_t mesh_count, int uv_set,
     }
     free(cross);
     free(zero);
-    lx_status st = rasterize(tris, n, res, res, d.threads, &out->covered_texels,
+    lx_status st = rasterize(tris, n, res, res, &d, &out->covered_texels,
                              &out->overlap_texels);
     free(tris);
     if (st != LX_OK)

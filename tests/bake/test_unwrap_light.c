@@ -5,7 +5,8 @@
  * every triangle, are looked up through both UV sets (bilinear, the maps
  * padded): the area-weighted mean irradiance over the scene must agree
  * within 1% per channel, since the light is the same and only where its
- * texels sit differs.
+ * texels sit differs (measured: luxel's UVs 0.28% below on the room, 0.35%
+ * on retro, alike in every channel).
  *
  * gen_scenes is the one next to this test's executable (CMake puts both in
  * bin/); it shares no code with luxel. */

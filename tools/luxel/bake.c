@@ -106,6 +106,10 @@ typedef enum unwrap_choice { UNWRAP_AUTO, UNWRAP_ALWAYS, UNWRAP_NEVER } unwrap_c
  * resolution). */
 #define CLI_ATLAS_RESOLUTION 1024
 
+/* The largest bitmap a node's own UVs are checked on (lx_uv_health): the
+ * overlapped share hardly changes with the size, the time grows with it. */
+#define CLI_HEALTH_SIZE 256
+
 typedef struct bake_args {
     const char *scene;
     const char *output;
@@ -578,11 +582,18 @@ static int plan_lightmaps(bake_args *a, lx_scene *scene, lx_unwrap **out, bool *
         cli_error("out of memory");
         return EXIT_FAILED;
     }
-    /* the file's UVs are judged at the size the node's lightmap would have */
-    lx_uv_health_desc hd = {.resolution = a->desc.resolution,
-                            .texel_density = a->desc.texel_density,
-                            .max_resolution = a->desc.max_resolution,
-                            .threads = a->desc.threads};
+    /* the file's UVs are judged at the size the node's lightmap would have,
+     * at most CLI_HEALTH_SIZE a side */
+    cli_progress progress;
+    cli_progress_init(&progress, "uv health", a->quiet);
+    lx_uv_health_desc hd = {
+        .resolution = a->desc.resolution < CLI_HEALTH_SIZE ? a->desc.resolution : CLI_HEALTH_SIZE,
+        .texel_density = a->desc.texel_density,
+        .max_resolution =
+            a->desc.max_resolution < CLI_HEALTH_SIZE ? a->desc.max_resolution : CLI_HEALTH_SIZE,
+        .threads = a->desc.threads,
+        .progress = cli_progress_update,
+        .progress_user = &progress};
     uint32_t count[LX_UV_OVERLAP + 1] = {0}, generate = 0, skipped = 0;
     for (uint32_t n = 0; n < nn; n++) {
         sets[n] = lx_bake_uv_set(scene, n, a->desc.uv_set);
@@ -593,10 +604,16 @@ static int plan_lightmaps(bake_args *a, lx_scene *scene, lx_unwrap **out, bool *
         }
         if (a->unwrap == UNWRAP_AUTO) {
             lx_uv_health h;
-            if (lx_uv_health_node(scene, n, sets[n], &hd, &h) != LX_OK) {
+            cli_progress_part(&progress, (int)n, (int)nn);
+            lx_status hs = lx_uv_health_node(scene, n, sets[n], &hd, &h);
+            if (hs != LX_OK) {
+                cli_progress_clear(&progress);
                 free(modes);
                 free(sets);
-                cli_error("%s: %s", a->scene, lx_last_error());
+                if (hs == LX_ERR_CANCELLED)
+                    cli_report_interrupt(false);
+                else
+                    cli_error("%s: %s", a->scene, lx_last_error());
                 return EXIT_FAILED;
             }
             why = h.problem;
@@ -619,6 +636,7 @@ static int plan_lightmaps(bake_args *a, lx_scene *scene, lx_unwrap **out, bool *
             modes[n] = LX_UNWRAP_KEEP;
         }
     }
+    cli_progress_finish(&progress);
     *atlas = a->atlas == 1 || (a->atlas < 0 && generate > 0);
     if (generate && a->unwrap == UNWRAP_AUTO) {
         char detail[200] = "";
@@ -652,7 +670,6 @@ static int plan_lightmaps(bake_args *a, lx_scene *scene, lx_unwrap **out, bool *
             ud.texel_density = a->desc.texel_density;
         else
             ud.resolution = *atlas && !a->has_resolution ? CLI_ATLAS_RESOLUTION : a->desc.resolution;
-        cli_progress progress;
         cli_progress_init(&progress, "unwrap", a->quiet);
         ud.progress = cli_progress_update;
         ud.progress_user = &progress;
