@@ -13,8 +13,10 @@
  *   in nits: irradiance * base colour / pi (LX_QUANTITY_RADIANCE). Lights
  *   using the classic model add in their own units.
  * ERRORS  lx_baker_create names the mesh and the problem (zero-area UV
- *   triangles, no lightmap fits in memory...). Overlapping UVs, meshes
- *   without UVs and UVs outside [0,1] are warnings through lx_log.
+ *   triangles, no lightmap fits in memory, no node covering a single
+ *   texel: LX_ERR_INVALID rather than black lightmaps). Overlapping UVs,
+ *   meshes without UVs, UVs outside [0,1] and a node that covers no texel
+ *   while others do are warnings through lx_log.
  * MEMORY  lx_baker_create copies what it needs from the scene (the scene
  *   may be destroyed afterwards). Info structs are borrowed until
  *   lx_baker_destroy.

@@ -7,6 +7,8 @@
  * are cut again, and every chart of every node is packed, rotated, into
  * atlas pages at a texel density, each chart owning `padding` rings of
  * texels so that bilinear filtering never mixes two charts.
+ * lx_uv_health_mesh / _node say whether UVs a file brings can serve as
+ * lightmap UVs (range, zero-area, flipped and overlapping triangles).
  *
  * CONVENTIONS  Texel density in texels per metre of world space: a node's
  *   scale counts, so an instance scaled 2x gets twice the texels across.
@@ -26,7 +28,8 @@
  *   UVs of zero area and are counted in stats.degenerate_triangles.
  * MEMORY  lx_unwrap_scene allocates the result; lx_unwrap_destroy frees it.
  *   The scene is only read and may be destroyed afterwards.
- * THREADING  lx_unwrap_scene and lx_unwrap_desc_defaults are thread-safe;
+ * THREADING  lx_unwrap_scene, the lx_uv_health_* functions and the
+ *   *_desc_defaults are thread-safe;
  *   each call runs OpenMP over meshes and charts, at most desc.threads
  *   threads, and gives the same result for any thread count.
  *
@@ -157,6 +160,77 @@ void lx_unwrap_destroy(lx_unwrap *unwrap);
  * untouched. LX_ERR_INVALID when the unwrap was made for another scene;
  * not thread-safe with other users of the scene (it changes it). */
 lx_status lx_unwrap_apply(lx_scene *scene, const lx_unwrap *unwrap);
+
+/* ---- UV health -------------------------------------------------------------
+ * Whether a UV set can serve as lightmap UVs, and why not. Coverage is the
+ * baker's: a triangle covers a texel it overlaps with a positive area; a
+ * covered texel is overlapped when two triangles both cover more than a
+ * thousandth of it (triangles that only share an edge never do). Zero-area
+ * UV triangles follow the baker's rule (|e1 x e2| <= 1e-7 (longest edge)^2)
+ * and are left out of the texels, as the baker skips them. Flipped
+ * triangles are those wound against their mesh's majority in UV space
+ * (counted, not a problem by themselves: a mirrored chart bakes fine). */
+typedef enum lx_uv_problem {
+    LX_UV_OK = 0,    /* usable */
+    LX_UV_MISSING,   /* a mesh lacks the set */
+    LX_UV_OUTSIDE,   /* a triangle reaches outside [0,1] (texels there are lost) */
+    LX_UV_ZERO_AREA, /* triangles of zero UV area (the baker refuses them) */
+    LX_UV_OVERLAP    /* more than max_overlap of the covered texels overlapped */
+} lx_uv_problem;
+
+typedef struct lx_uv_health_desc {
+    int resolution;      /* texels a side of the bitmap overlaps are counted on,
+                            0 = 256 (the baker's default resolution) */
+    float texel_density; /* > 0: lx_uv_health_node sizes the bitmap as the baker
+                            sizes the node's lightmap at this density (texels per
+                            metre: side^2 * uv_area = density^2 * world_area,
+                            rounded up to a multiple of 4, 4..max_resolution) */
+    int max_resolution;  /* cap of density sizes, 0 = 4096 */
+    float max_overlap;   /* overlapped share of the covered texels above which
+                            the set is not usable, 0 = 0.01 */
+    int threads;         /* 0 = all cores */
+    lx_progress_fn progress; /* hears the texels' tiles (0 to 1), from one thread
+                                at a time; returning false stops the call with
+                                LX_ERR_CANCELLED */
+    void *progress_user;
+} lx_uv_health_desc;
+
+/* A copy of desc (or of zeros when NULL) with every default filled in. */
+lx_uv_health_desc lx_uv_health_desc_defaults(const lx_uv_health_desc *desc);
+
+typedef struct lx_uv_health {
+    int uv_set;                   /* the set looked at (0 = TEXCOORD_0) */
+    bool present;                 /* every mesh has it (else nothing below is filled) */
+    lx_vec2 min, max;             /* range of the triangles' UVs */
+    uint32_t triangles;
+    uint32_t zero_area_triangles;
+    uint32_t flipped_triangles;   /* wound against their mesh's majority */
+    int resolution;               /* side of the bitmap the texels were counted on */
+    uint64_t covered_texels;      /* texels inside [0,1]^2 some triangle covers */
+    uint64_t overlap_texels;      /* covered texels two triangles overlap */
+    double overlap_share;         /* overlap_texels / covered_texels (0 if none) */
+    double world_area;            /* m^2: world space for a node, object space for a mesh */
+    double uv_area;               /* summed UV area of the triangles (unit square = 1) */
+    bool usable;                  /* problem == LX_UV_OK */
+    lx_uv_problem problem;        /* the first of missing, outside, zero area, overlap */
+    char reason[96];              /* "" when usable, else e.g. "overlaps on 12.5% of its
+                                     texels", "outside [0,1] (u 1..2, v 0..1)" */
+} lx_uv_health;
+
+/* UV set uv_set (0 or 1) of one mesh, in its own space, on a bitmap of
+ * desc->resolution. desc may be NULL. LX_ERR_INVALID for a bad set or
+ * options, LX_ERR_NOMEM, LX_ERR_CANCELLED. Deterministic for any thread
+ * count; the time follows the covered texels (plus, per texel, the pairs
+ * of triangles that reach it). */
+lx_status lx_uv_health_mesh(const lx_mesh *mesh, int uv_set, const lx_uv_health_desc *desc,
+                            lx_uv_health *out);
+/* The same for every mesh of scene node `node` together (they share the
+ * node's lightmap), areas in world space, the bitmap sized as the baker
+ * would (desc->texel_density) or desc->resolution. */
+lx_status lx_uv_health_node(const lx_scene *scene, uint32_t node, int uv_set,
+                            const lx_uv_health_desc *desc, lx_uv_health *out);
+/* "usable", "missing", "outside [0,1]", "zero-area triangles", "overlapping". */
+const char *lx_uv_problem_name(lx_uv_problem problem);
 
 #ifdef __cplusplus
 }

@@ -175,6 +175,55 @@ static lx_status build_pages(lx_baker *b, const lx_scene *scene, const lx_bake_d
     return st;
 }
 
+/* A lightmap with no covered texel bakes to a black file: when no node
+ * covers a texel the bake fails; a node that covers none while others do
+ * is a warning naming it. */
+static lx_status check_coverage(const lx_baker *b, const lx_scene *scene)
+{
+    uint8_t *hit = calloc(scene->node_count + 1, 1);
+    if (!hit)
+        return lx_fail(LX_ERR_NOMEM, "out of memory creating a baker");
+    uint64_t total = 0;
+    for (uint32_t m = 0; m < b->map_count; m++) {
+        const lx_lightmap *map = &b->maps[m];
+        total += map->info.used_texels;
+        for (uint32_t i = 0; i < map->info.used_texels; i++)
+            hit[map->texels[i].node] = 1;
+    }
+    uint32_t empty = 0, first = UINT32_MAX;
+    for (uint32_t n = 0; n < scene->node_count; n++)
+        if (b->node_map[n] != UINT32_MAX && !hit[n]) {
+            empty++;
+            first = first == UINT32_MAX ? n : first;
+        }
+    if (empty == 0) {
+        free(hit);
+        return LX_OK;
+    }
+    const lx_lightmap_info *info = &b->maps[b->node_map[first]].info;
+    if (total == 0) {
+        free(hit);
+        return lx_fail(LX_ERR_INVALID,
+                       "%s: node '%s'%s: its lightmap UVs (TEXCOORD_%d) cover no texel of the "
+                       "%dx%d lightmap (are they outside [0,1]?): it would be black",
+                       scene->path, scene->nodes[first].name,
+                       empty > 1 ? " and every other node" : "",
+                       info->uv_set == LX_UV_SET_MIXED ? 1 : info->uv_set, info->width,
+                       info->height);
+    }
+    for (uint32_t n = 0; n < scene->node_count; n++)
+        if (b->node_map[n] != UINT32_MAX && !hit[n]) {
+            const lx_lightmap *map = &b->maps[b->node_map[n]];
+            lx_log(LX_LOG_WARN,
+                   "%s: node '%s': its lightmap UVs cover no texel of lightmap '%s' "
+                   "(%dx%d; are they outside [0,1]?): the node stays black",
+                   scene->path, scene->nodes[n].name, map->name, map->info.width,
+                   map->info.height);
+        }
+    free(hit);
+    return LX_OK;
+}
+
 lx_status lx_baker_create(const lx_scene *scene, const lx_bake_desc *in, lx_baker **out)
 {
     *out = NULL;
@@ -238,6 +287,8 @@ lx_status lx_baker_create(const lx_scene *scene, const lx_bake_desc *in, lx_bake
         b->node_scale_offset[n][2] = b->node_scale_offset[n][3] = 0.0f;
     }
     st = desc.atlas ? build_pages(b, scene, &desc) : build_node_maps(b, scene, &desc);
+    if (st == LX_OK)
+        st = check_coverage(b, scene);
     if (st != LX_OK) {
         lx_baker_destroy(b);
         return st;

@@ -197,7 +197,7 @@ f 1/1 3/3 4/4
 f 1/1 3/3 5/5
 EOF
 # dropped by default, with one warning per load that counts them
-run "$LUXEL" bake "$IN/sliver.obj" --resolution 32 -o "$WORK/out/sliver_ok"
+run "$LUXEL" bake "$IN/sliver.obj" --ambient 1,1,1 --resolution 32 -o "$WORK/out/sliver_ok"
 expect_rc 0 "the zero-area OBJ bakes"
 expect_stderr_has "zero-area OBJ: a warning naming the file and the count" \
     "^luxel: warning: .*sliver\.obj: 1 zero-area triangles left out"
@@ -206,13 +206,13 @@ check "zero-area OBJ: the lightmap is written" test -f "$WORK/out/sliver_ok/floo
 run "$LUXEL" info "$IN/sliver.obj"
 expect_rc 0 "info: the zero-area OBJ loads"
 # --skip-degenerate is still accepted (it is the default)
-run "$LUXEL" bake "$IN/sliver.obj" --resolution 32 --skip-degenerate -o "$WORK/out/sliver_ok2"
+run "$LUXEL" bake "$IN/sliver.obj" --ambient 1,1,1 --resolution 32 --skip-degenerate -o "$WORK/out/sliver_ok2"
 expect_rc 0 "--skip-degenerate is accepted"
 
 write_gltf "$IN/sliver.gltf" sliver_mesh sliver_node \
     "0 0 0  0 0 1  1 0 1   0 0 0  0.5 0 0.5  1 0 1" \
     "0 0  0 1  1 1   0 0  0.5 0.5  1 1" || exit 1
-run "$LUXEL" bake "$IN/sliver.gltf" --resolution 32 -o "$WORK/out/gsliver_ok"
+run "$LUXEL" bake "$IN/sliver.gltf" --ambient 1,1,1 --resolution 32 -o "$WORK/out/gsliver_ok"
 expect_rc 0 "the zero-area glTF bakes"
 expect_stderr_has "zero-area glTF: a warning with the count" \
     "^luxel: warning: .*sliver\.gltf: 1 zero-area triangles left out"
@@ -232,13 +232,13 @@ f 1/1 2/2 3/3
 f 1/4 3/4 4/4
 EOF
 # by default luxel makes the node's UVs instead, and says so once
-run "$LUXEL" bake "$IN/flat_uv.obj" --resolution 32 -o "$WORK/out/flat_auto"
+run "$LUXEL" bake "$IN/flat_uv.obj" --ambient 1,1,1 --resolution 32 -o "$WORK/out/flat_auto"
 expect_rc 0 "a zero-UV-area OBJ bakes on luxel's UVs"
 expect_stderr_has "a zero-UV-area OBJ: one warning says luxel makes the UVs" \
     "^luxel: warning: .*flat_uv\.obj: 1 of 1 nodes have no usable .*zero-area triangles 1.*luxel makes"
 check "a zero-UV-area OBJ: the atlas page is written" test -f "$WORK/out/flat_auto/lightmap-0.exr"
 # the file's UVs kept (--unwrap never): the triangle is left out with a warning
-run "$LUXEL" bake "$IN/flat_uv.obj" --resolution 32 --unwrap never -o "$WORK/out/flat_ok"
+run "$LUXEL" bake "$IN/flat_uv.obj" --ambient 1,1,1 --resolution 32 --unwrap never -o "$WORK/out/flat_ok"
 expect_rc 0 "the zero-UV-area OBJ bakes on its own UVs"
 expect_stderr_has "a warning about the zero-UV-area triangle" \
     "^luxel: warning: .*flat_uv\.obj.*'floor'.*1 .*zero UV area"
@@ -282,7 +282,7 @@ vt 0.875 0.875
 f 1/1 2/2 3/3
 f 1/1 3/2 4/3
 EOF
-run "$LUXEL" bake "$IN/overlap.obj" --resolution 30 --unwrap never -o "$WORK/out/overlap_obj"
+run "$LUXEL" bake "$IN/overlap.obj" --ambient 1,1,1 --resolution 30 --unwrap never -o "$WORK/out/overlap_obj"
 expect_rc 0 "overlapping UVs (OBJ) still bake"
 check "overlapping UVs (OBJ): no error line" test -z "$(grep '^luxel: error' "$ERR")"
 expect_stderr_has "overlapping UVs (OBJ): a warning with the count, $OVERLAP texels" \
@@ -295,7 +295,7 @@ check "overlapping UVs (OBJ): the manifest records $OVERLAP overlapping texels" 
 write_gltf "$IN/overlap.gltf" shared_mesh shared_node \
     "0 0 0  0 0 1  1 0 1   0 0 0  1 0 1  1 0 0" \
     "0.125 0.125  0.125 0.75  0.875 0.125   0.125 0.125  0.125 0.75  0.875 0.125" || exit 1
-run "$LUXEL" bake "$IN/overlap.gltf" --resolution 30 --unwrap never -o "$WORK/out/overlap_gltf"
+run "$LUXEL" bake "$IN/overlap.gltf" --ambient 1,1,1 --resolution 30 --unwrap never -o "$WORK/out/overlap_gltf"
 expect_rc 0 "overlapping UVs (glTF) still bake"
 check "overlapping UVs (glTF): the lightmap is written" \
     test -f "$WORK/out/overlap_gltf/shared_node.exr"
@@ -308,8 +308,8 @@ expect_stderr_has "overlapping UVs (glTF): the warning names the mesh 'shared_me
 
 printf 'o bare\nv 0 0 0\nv 1 0 0\nv 0 0 1\nf 1 2 3\n' >"$IN/no_uv.obj"
 bad "an OBJ without texture coordinates, --unwrap never" 1 "no_uv.obj" \
-    bake "$IN/no_uv.obj" --unwrap never
-run "$LUXEL" bake "$IN/no_uv.obj" -o "$WORK/out/no_uv_auto"
+    bake "$IN/no_uv.obj" --ambient 1,1,1 --unwrap never
+run "$LUXEL" bake "$IN/no_uv.obj" --ambient 1,1,1 -o "$WORK/out/no_uv_auto"
 expect_rc 0 "an OBJ without texture coordinates bakes on luxel's UVs"
 check "an OBJ without texture coordinates: its atlas page is written" \
     test -f "$WORK/out/no_uv_auto/lightmap-0.exr"

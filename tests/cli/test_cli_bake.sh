@@ -101,7 +101,7 @@ check "paths with spaces: the manifest is written" test -f "$WORK/with space/out
 # Node names become file names: one that climbs out of the folder must not.
 mkdir -p "$WORK/escape"
 write_gltf "$WORK/escape/scene.gltf" quad "../../x" "0 0 0  0 0 1  1 0 1" "0 0  0 1  1 1" || exit 1
-run "$LUXEL" bake "$WORK/escape/scene.gltf" --resolution 16 -q -o "$WORK/escape/a/b"
+run "$LUXEL" bake "$WORK/escape/scene.gltf" --resolution 16 --ambient 1,1,1 -q -o "$WORK/escape/a/b"
 expect_rc 0 "a node named '../../x'"
 check "'../../x': three files, all inside the output folder" \
     test "$(ls -A "$WORK/escape/a/b" | wc -l)" -eq 3
@@ -430,11 +430,19 @@ expect_files "--no-atlas: a lightmap per node, the scene with UVs" "$WORK/noatla
 check "--no-atlas: the room's UVs are generated" \
     test "$(manifest_get "$WORK/noatlas/manifest.json" room uvs)" = generated
 
-# --uv-set 0 reads TEXCOORD_0
-run "$LUXEL" bake "$ROOM" --uv-set 0 -q -o "$WORK/uv0"
+# --uv-set 0 reads TEXCOORD_0 (kept with --unwrap never)
+run "$LUXEL" bake "$ROOM" --uv-set 0 --unwrap never -q -o "$WORK/uv0"
 expect_rc 0 "bake --uv-set 0"
 check "--uv-set 0: the manifest says TEXCOORD_0" \
     test "$(manifest_get "$WORK/uv0/manifest.json" room uv_set)" = TEXCOORD_0
+# the room's TEXCOORD_0 spans [0,1] on every face (gen_scenes.c): the faces
+# overlap, so --unwrap auto makes the lightmap UVs instead
+run "$LUXEL" bake "$ROOM" --uv-set 0 -o "$WORK/uv0_auto"
+expect_rc 0 "bake --uv-set 0, --unwrap auto"
+expect_stderr_has "--uv-set 0: the faces' shared [0,1] squares count as overlapping" \
+    "^luxel: warning: .*3 of 3 nodes have no usable .*overlapping 3.*luxel makes"
+check "--uv-set 0, --unwrap auto: the room's UVs are generated" \
+    test "$(manifest_get "$WORK/uv0_auto/manifest.json" room uvs)" = generated
 
 # usage errors name the option
 for args in "--unwrap sometimes" "--uv-set 2" "--atlas --no-atlas" "--atlas-size 3" \

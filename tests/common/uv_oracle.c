@@ -68,6 +68,68 @@ double lx_uv_texel_coverage(const double uv[3][2], int x, int y)
     return fabs(0.5 * area);
 }
 
+/* Keeps the part of polygon `in` on the inner side of the line through a
+ * and b, inner being the side where `inner` lies. */
+static int clip_side(const double (*in)[2], int n, const double *a, const double *b,
+                     const double *inner, double (*out)[2])
+{
+    double ex = b[0] - a[0], ey = b[1] - a[1];
+    double ref = ex * (inner[1] - a[1]) - ey * (inner[0] - a[0]);
+    int m = 0;
+    for (int i = 0; i < n; i++) {
+        const double *p = in[i], *q = in[(i + 1) % n];
+        double dp = (ex * (p[1] - a[1]) - ey * (p[0] - a[0])) * (ref > 0 ? 1 : -1);
+        double dq = (ex * (q[1] - a[1]) - ey * (q[0] - a[0])) * (ref > 0 ? 1 : -1);
+        if (dp >= 0) {
+            out[m][0] = p[0], out[m][1] = p[1];
+            m++;
+        }
+        if ((dp >= 0) != (dq >= 0)) {
+            double t = dp / (dp - dq);
+            out[m][0] = p[0] + t * (q[0] - p[0]);
+            out[m][1] = p[1] + t * (q[1] - p[1]);
+            m++;
+        }
+    }
+    return m;
+}
+
+static int clip_by_triangle(double (*poly)[2], int n, const double t[3][2])
+{
+    double tmp[16][2];
+    for (int e = 0; e < 3 && n > 0; e++) {
+        n = clip_side((const double(*)[2])poly, n, t[e], t[(e + 1) % 3], t[(e + 2) % 3], tmp);
+        memcpy(poly, tmp, sizeof(double) * 2 * (size_t)n);
+    }
+    return n;
+}
+
+uint64_t lx_uv_pair_overlaps(const double (*uv)[3][2], uint32_t n, int width, int height,
+                             double min_area, uint64_t *covered)
+{
+    uint64_t overlapped = 0;
+    *covered = 0;
+    for (int y = 0; y < height; y++)
+        for (int x = 0; x < width; x++) {
+            bool cov = false, both = false;
+            for (uint32_t i = 0; i < n; i++) {
+                cov = cov || lx_uv_overlaps_texel(uv[i], x, y);
+                for (uint32_t j = i + 1; j < n && !both; j++) {
+                    double poly[16][2] = {{x, y}, {x + 1, y}, {x + 1, y + 1}, {x, y + 1}};
+                    int m = clip_by_triangle(poly, 4, uv[i]);
+                    m = clip_by_triangle(poly, m, uv[j]);
+                    double area = 0.0;
+                    for (int k = 0; k < m; k++)
+                        area += poly[k][0] * poly[(k + 1) % m][1] - poly[(k + 1) % m][0] * poly[k][1];
+                    both = fabs(0.5 * area) > min_area;
+                }
+            }
+            *covered += cov;
+            overlapped += both;
+        }
+    return overlapped;
+}
+
 typedef struct corner_key {
     double u, v;
     uint32_t tri;

@@ -42,6 +42,14 @@ bool lx_uv_overlaps_texel(const double uv[3][2], int x, int y);
  * triangle clipped by the texel's four sides (Sutherland-Hodgman). */
 double lx_uv_texel_coverage(const double uv[3][2], int x, int y);
 
+/* Texels of a width x height grid (uv in texel units, n triangles, every
+ * one with a nonzero area) some triangle overlaps with a positive area
+ * (*covered), and those where two triangles share more than min_area
+ * texels of area (returned): every texel against every pair of
+ * triangles, the texel clipped by each triangle's three sides. */
+uint64_t lx_uv_pair_overlaps(const double (*uv)[3][2], uint32_t n, int width, int height,
+                             double min_area, uint64_t *covered);
+
 /* Generated meshes (indexed, with normals; no UVs): a torus of radii R, r
  * with about `triangles` triangles; a closed cylinder (radius, height) with
  * caps; a bumpy height field of side `size`. */

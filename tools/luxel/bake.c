@@ -21,6 +21,8 @@ static const char *bake_usage =
     "DIR/lightmap-<k>.<format>; a scene whose own UVs all serve keeps a\n"
     "lightmap per node, DIR/<node>.<format>. Each has a PNG preview, and\n"
     "DIR/manifest.json says where every node's lightmap is (docs/manifest.md).\n"
+    "Something must emit light: lights in the file or --lights, --sky or\n"
+    "--ambient; a bake without, or whose lightmaps cover no texel, fails.\n"
     "\n"
     "options:\n"
     "  -o, --output DIR        output folder (default ./lightmaps)\n"
@@ -60,8 +62,9 @@ static const char *bake_usage =
     "  --padding N             texels of dilation around charts, 0 for none\n"
     "                          (default %d); charts luxel packs own as many\n"
     "  --unwrap MODE           auto (default): make lightmap UVs for the nodes\n"
-    "                          whose UVs are missing, outside [0,1] or of zero\n"
-    "                          area; always; or never\n"
+    "                          whose UVs are missing, outside [0,1], have\n"
+    "                          zero-area triangles or overlap on more than 1%%\n"
+    "                          of their texels (see luxel info); always; or never\n"
     "  --uv-set S              the lightmap UV set: 0, 1 or auto (default: 1 when\n"
     "                          every mesh of a node has TEXCOORD_1, else 0)\n"
     "  --atlas, --no-atlas     share pages between nodes, or a lightmap per node\n"
@@ -72,6 +75,8 @@ static const char *bake_usage =
     "  --threads N             worker threads (default: all cores)\n"
     "  --skip-degenerate       accepted for old scripts: zero-area triangles are\n"
     "                          always left out with a warning\n"
+    "  --strict                fail on any warning (suspect units, tiny spot\n"
+    "                          cones, unusable UVs...) instead of baking\n"
     "  -v, --verbose           the time of each phase, and notes\n"
     "  -q, --quiet             no progress bar or summary\n"
     "  -h, --help              show this help\n";
@@ -102,7 +107,8 @@ enum {
     OPT_ATLAS_SIZE,
     OPT_RENDER,
     OPT_TONEMAP,
-    OPT_CLEAN
+    OPT_CLEAN,
+    OPT_STRICT
 };
 
 typedef enum unwrap_choice { UNWRAP_AUTO, UNWRAP_ALWAYS, UNWRAP_NEVER } unwrap_choice;
@@ -111,6 +117,10 @@ typedef enum unwrap_choice { UNWRAP_AUTO, UNWRAP_ALWAYS, UNWRAP_NEVER } unwrap_c
  * sizes it: the CLI's own choice (a lightmap per node keeps the library's
  * resolution). */
 #define CLI_ATLAS_RESOLUTION 1024
+
+/* The largest bitmap a node's own UVs are checked on (lx_uv_health): the
+ * overlapped share hardly changes with the size, the time grows with it. */
+#define CLI_HEALTH_SIZE 256
 
 typedef struct bake_args {
     const char *scene;
@@ -124,6 +134,7 @@ typedef struct bake_args {
     bool has_exposure;
     double exposure_ev100;
     bool quiet;
+    bool strict;          /* warnings fail the run */
     const char *sky;      /* --sky, else the lights JSON's */
     double sky_intensity; /* < 0: not given */
     int sky_shadows;      /* 1 on, 0 off, -1 not given */
@@ -183,6 +194,7 @@ static int parse_args(int argc, char **argv, bake_args *a)
         {"render", no_argument, NULL, OPT_RENDER},
         {"tonemap", required_argument, NULL, OPT_TONEMAP},
         {"clean", no_argument, NULL, OPT_CLEAN},
+        {"strict", no_argument, NULL, OPT_STRICT},
         {"quiet", no_argument, NULL, 'q'},
         {"verbose", no_argument, NULL, 'v'},
         {"help", no_argument, NULL, 'h'},
@@ -349,6 +361,11 @@ static int parse_args(int argc, char **argv, bake_args *a)
         case OPT_CLEAN:
             a->clean = true;
             break;
+        case OPT_STRICT:
+            a->strict = true;
+            a->desc.strict = true; /* zero-area triangles refused, in space and in UV */
+            cli_set_strict(true);
+            break;
         case 'q':
             a->quiet = true;
             cli_set_quiet(true);
@@ -469,30 +486,130 @@ static cJSON *node_entries(const lx_scene *scene, const lx_baker *baker, const l
     return list;
 }
 
-/* Why node n's lightmap UVs (set `set`) cannot serve, or NULL when they
- * can: a mesh lacks them, they reach outside [0,1] (texels there are
- * lost), or a triangle has no area in them. */
-static const char *uvs_problem(const lx_scene *scene, uint32_t n, int set)
+/* True when every mesh of node n has UV set `set`. */
+static bool has_uv_set(const lx_scene *scene, uint32_t n, int set)
 {
     const lx_node *node = &scene->nodes[n];
+    for (uint32_t k = 0; k < node->mesh_count; k++)
+        if (!scene->meshes[node->meshes[k]].uv[set])
+            return false;
+    return true;
+}
+
+/* World-space surface area of node n. */
+static double node_area(const lx_scene *scene, uint32_t n)
+{
+    const lx_node *node = &scene->nodes[n];
+    double area = 0.0;
     for (uint32_t k = 0; k < node->mesh_count; k++) {
         const lx_mesh *m = &scene->meshes[node->meshes[k]];
-        const lx_vec2 *uv = m->uv[set];
-        if (!uv)
-            return "missing";
-        for (uint32_t v = 0; v < m->vertex_count; v++)
-            if (uv[v].x < 0.0f || uv[v].x > 1.0f || uv[v].y < 0.0f || uv[v].y > 1.0f)
-                return "outside [0,1]";
         for (uint32_t t = 0; t < m->triangle_count; t++) {
             const uint32_t *i = &m->indices[3 * t];
-            lx_vec2 p = uv[i[0]], q = uv[i[1]], r = uv[i[2]];
-            double area = ((double)q.x - p.x) * ((double)r.y - p.y) -
-                          ((double)r.x - p.x) * ((double)q.y - p.y);
-            if (area == 0.0)
-                return "zero-area triangles";
+            lx_vec3 p = lx_mat4_point(&node->world, m->positions[i[0]]);
+            lx_vec3 q = lx_mat4_point(&node->world, m->positions[i[1]]);
+            lx_vec3 r = lx_mat4_point(&node->world, m->positions[i[2]]);
+            area += 0.5 * lx_length(lx_cross(lx_sub(q, p), lx_sub(r, p)));
         }
     }
-    return NULL;
+    return area;
+}
+
+/* Warnings for units that look wrong: a scene smaller than 5 cm or larger
+ * than 10 km, a node that gets fewer than 8x8 texels at --texel-density,
+ * a scene only a few texels across at the unwrapper's density. */
+static void check_scale(const bake_args *a, const lx_scene *scene, const lx_unwrap *unwrap)
+{
+    lx_vec3 lo, hi;
+    if (!lx_scene_bounds(scene, &lo, &hi))
+        return;
+    lx_vec3 e = lx_sub(hi, lo);
+    double size = fmax(e.x, fmax(e.y, e.z)), total = 0.0, smallest = INFINITY;
+    uint32_t small = 0, which = 0;
+    float density = a->desc.texel_density;
+    for (uint32_t n = 0; n < scene->node_count; n++) {
+        double area = node_area(scene, n);
+        total += area;
+        if (density > 0.0f && area > 0.0 && area * density * density < 64.0) {
+            small++;
+            if (area < smallest) {
+                smallest = area;
+                which = n;
+            }
+        }
+    }
+    bool warned = false;
+    if (size < 0.05 || size > 1e4) {
+        lx_log(LX_LOG_WARN,
+               "%s: the scene spans %.3g x %.3g x %.3g m, bounds (%.4g, %.4g, %.4g) .. (%.4g, "
+               "%.4g, %.4g): %s than %s; are its units metres? (--texel-density %.3g gives it "
+               "about a 1024x1024 page)",
+               a->scene, (double)e.x, (double)e.y, (double)e.z, (double)lo.x, (double)lo.y,
+               (double)lo.z, (double)hi.x, (double)hi.y, (double)hi.z,
+               size < 0.05 ? "smaller" : "larger", size < 0.05 ? "5 cm" : "10 km",
+               total > 0.0 ? 1024.0 / sqrt(total) : 1.0);
+        warned = true;
+    }
+    if (small) {
+        double side = sqrt(smallest) * density;
+        lx_log(LX_LOG_WARN,
+               "%s: at %g texels/m node '%s' gets about %.2g x %.2g texels (%u node%s under "
+               "8x8): are the scene's units metres? --texel-density %.3g would give it 8x8",
+               a->scene, (double)density, scene->nodes[which].name, side, side, small,
+               small == 1 ? "" : "s", 8.0 / sqrt(smallest));
+        warned = true;
+    }
+    if (!warned && unwrap && density <= 0.0f) {
+        double across = lx_length(e) * unwrap->texel_density;
+        if (across < 16.0)
+            lx_log(LX_LOG_WARN,
+                   "%s: the scene is %.3g m across: at %g texels/m it gets about %.0f "
+                   "texels across; are its units metres?",
+                   a->scene, (double)lx_length(e), (double)unwrap->texel_density, across);
+    }
+}
+
+/* Something must emit light, or every lightmap is black: returns the
+ * error's reason, or NULL when a light, the sky or an ambient does. */
+static const char *nothing_emits(const lx_scene *scene, const lx_scene_sky *sky)
+{
+    if (sky->environment)
+        return NULL;
+    if (scene->ambient.x > 0.0f || scene->ambient.y > 0.0f || scene->ambient.z > 0.0f)
+        return NULL;
+    for (uint32_t l = 0; l < scene->light_count; l++) {
+        const lx_light *li = &scene->lights[l];
+        bool colour = li->color.x > 0.0f || li->color.y > 0.0f || li->color.z > 0.0f;
+        bool ambient = li->ambient.x > 0.0f || li->ambient.y > 0.0f || li->ambient.z > 0.0f;
+        if ((li->intensity > 0.0f && colour) || ambient)
+            return NULL;
+    }
+    return scene->light_count ? "every light has zero intensity or colour, and there is no sky "
+                                "or ambient"
+                              : "the scene has no lights, no sky and no ambient (luxel reads no "
+                                "emissive materials)";
+}
+
+/* A spot cone under a degree is almost surely radians typed as degrees. */
+static void check_spots(const bake_args *a, const lx_scene *scene)
+{
+    for (uint32_t l = 0; l < scene->light_count; l++) {
+        const lx_light *li = &scene->lights[l];
+        if (li->type == LX_LIGHT_SPOT && li->outer_angle < LX_DEG2RAD(1.0f))
+            lx_log(LX_LOG_WARN,
+                   "%s: spot light '%s' has a cone of %.3g degrees from its axis: radians typed "
+                   "as degrees? (lights files give angles in degrees)",
+                   a->scene, li->name[0] ? li->name : "-", LX_RAD2DEG(li->outer_angle));
+    }
+}
+
+/* --strict: any warning so far fails the run before anything is written. */
+static bool strict_failed(const bake_args *a)
+{
+    unsigned w = cli_warning_count();
+    if (!a->strict || w == 0)
+        return false;
+    cli_error("%s: %u %s with --strict: nothing written", a->scene, w, cli_plural(w, "warning", "warnings"));
+    return true;
 }
 
 /* Decides which nodes keep their lightmap UVs and which get luxel's, and
@@ -510,38 +627,74 @@ static int plan_lightmaps(bake_args *a, lx_scene *scene, lx_unwrap **out, bool *
         cli_error("out of memory");
         return EXIT_FAILED;
     }
-    static const char *reasons[] = {"missing", "outside [0,1]", "zero-area triangles"};
-    uint32_t count[3] = {0, 0, 0}, generate = 0, skipped = 0;
+    /* the file's UVs are judged at the size the node's lightmap would have,
+     * at most CLI_HEALTH_SIZE a side */
+    cli_progress progress;
+    cli_progress_init(&progress, "uv health", a->quiet);
+    lx_uv_health_desc hd = {
+        .resolution = a->desc.resolution < CLI_HEALTH_SIZE ? a->desc.resolution : CLI_HEALTH_SIZE,
+        .texel_density = a->desc.texel_density,
+        .max_resolution =
+            a->desc.max_resolution < CLI_HEALTH_SIZE ? a->desc.max_resolution : CLI_HEALTH_SIZE,
+        .threads = a->desc.threads,
+        .progress = cli_progress_update,
+        .progress_user = &progress};
+    uint32_t count[LX_UV_OVERLAP + 1] = {0}, generate = 0, skipped = 0;
     for (uint32_t n = 0; n < nn; n++) {
         sets[n] = lx_bake_uv_set(scene, n, a->desc.uv_set);
-        const char *why = scene->nodes[n].mesh_count ? uvs_problem(scene, n, sets[n]) : NULL;
+        lx_uv_problem why = LX_UV_OK;
         if (scene->nodes[n].mesh_count == 0) {
             modes[n] = LX_UNWRAP_SKIP;
-        } else if (a->unwrap == UNWRAP_ALWAYS || (a->unwrap == UNWRAP_AUTO && why)) {
+            continue;
+        }
+        if (a->unwrap == UNWRAP_AUTO) {
+            lx_uv_health h;
+            cli_progress_part(&progress, (int)n, (int)nn);
+            lx_status hs = lx_uv_health_node(scene, n, sets[n], &hd, &h);
+            if (hs != LX_OK) {
+                cli_progress_clear(&progress);
+                free(modes);
+                free(sets);
+                if (hs == LX_ERR_CANCELLED)
+                    cli_report_interrupt(false);
+                else
+                    cli_error("%s: %s", a->scene, lx_last_error());
+                return EXIT_FAILED;
+            }
+            why = h.problem;
+            if (why != LX_UV_OK)
+                lx_log(LX_LOG_INFO, "%s: node '%s': TEXCOORD_%d %s", a->scene,
+                       scene->nodes[n].name, sets[n], h.reason);
+        } else if (!has_uv_set(scene, n, sets[n])) {
+            why = LX_UV_MISSING;
+        }
+        if (a->unwrap == UNWRAP_ALWAYS || why != LX_UV_OK) {
+            if (a->unwrap == UNWRAP_NEVER) {
+                modes[n] = LX_UNWRAP_SKIP; /* missing: no lightmap */
+                skipped++;
+                continue;
+            }
             modes[n] = LX_UNWRAP_GENERATE;
             generate++;
-            for (int r = 0; r < 3; r++)
-                count[r] += why && strcmp(why, reasons[r]) == 0;
-        } else if (why && strcmp(why, "missing") == 0) {
-            modes[n] = LX_UNWRAP_SKIP; /* --unwrap never: no lightmap */
-            skipped++;
+            count[why]++;
         } else {
             modes[n] = LX_UNWRAP_KEEP;
         }
     }
+    cli_progress_finish(&progress);
     *atlas = a->atlas == 1 || (a->atlas < 0 && generate > 0);
     if (generate && a->unwrap == UNWRAP_AUTO) {
-        char detail[160] = "";
-        for (int r = 0, first = 1; r < 3; r++)
+        char detail[200] = "";
+        for (int r = LX_UV_MISSING, first = 1; r <= LX_UV_OVERLAP; r++)
             if (count[r]) {
                 size_t len = strlen(detail);
                 snprintf(detail + len, sizeof detail - len, "%s%s %u", first ? "" : ", ",
-                         reasons[r], count[r]);
+                         lx_uv_problem_name((lx_uv_problem)r), count[r]);
                 first = 0;
             }
         lx_log(LX_LOG_WARN,
                "%s: %u of %u nodes have no usable TEXCOORD lightmap UVs (%s): luxel makes "
-               "theirs%s (--unwrap never keeps the file's)",
+               "theirs%s (--unwrap never keeps the file's; -v names the nodes)",
                a->scene, generate, nn, detail, *atlas ? " and packs every node into atlas pages" : "");
     }
     if (skipped)
@@ -562,7 +715,6 @@ static int plan_lightmaps(bake_args *a, lx_scene *scene, lx_unwrap **out, bool *
             ud.texel_density = a->desc.texel_density;
         else
             ud.resolution = *atlas && !a->has_resolution ? CLI_ATLAS_RESOLUTION : a->desc.resolution;
-        cli_progress progress;
         cli_progress_init(&progress, "unwrap", a->quiet);
         ud.progress = cli_progress_update;
         ud.progress_user = &progress;
@@ -588,16 +740,6 @@ static int plan_lightmaps(bake_args *a, lx_scene *scene, lx_unwrap **out, bool *
                    cli_num_digits(100.0 * u->stats.efficiency, 3),
                    cli_num_digits(u->stats.stretch_mean, 4),
                    cli_num_digits(u->stats.stretch_max, 4), cli_num((double)u->texel_density));
-            lx_vec3 lo, hi;
-            if (lx_scene_bounds(scene, &lo, &hi)) {
-                double across = lx_length(lx_sub(hi, lo)) * u->texel_density;
-                if (across < 16.0)
-                    lx_log(LX_LOG_WARN,
-                           "%s: the scene is %s m across: at %s texels/m it gets about %s "
-                           "texels across; are its units metres?",
-                           a->scene, cli_num_digits(lx_length(lx_sub(hi, lo)), 3),
-                           cli_num((double)u->texel_density), cli_num_digits(across, 2));
-            }
             a->desc.atlas = u;
         }
     }
@@ -737,6 +879,14 @@ int cmd_bake(int argc, char **argv)
         a.desc.sky = lx_sky_desc_defaults(&given);
     }
     cli_phase(sky.environment ? "lights and sky" : "lights");
+    const char *dark = nothing_emits(scene, &sky);
+    if (dark) {
+        cli_error("%s: nothing emits light: %s; give lights with --lights FILE.json, a sky with "
+                  "--sky ENV or an ambient with --ambient R,G,B",
+                  a.scene, dark);
+        goto done;
+    }
+    check_spots(&a, scene);
     /* lightmap UVs: the file's, or luxel's where those do not serve */
     int planned = plan_lightmaps(&a, scene, &unwrap, &atlas);
     if (planned != EXIT_OK) {
@@ -745,6 +895,9 @@ int cmd_bake(int argc, char **argv)
     }
     if (unwrap)
         cli_phase("unwrap");
+    check_scale(&a, scene, unwrap);
+    if (strict_failed(&a))
+        goto done;
 
     cli_progress progress;
     cli_progress_init(&progress, "texel maps", a.quiet);
@@ -853,6 +1006,8 @@ int cmd_bake(int argc, char **argv)
         cli_report_interrupt(false);
         goto done;
     }
+    if (strict_failed(&a))
+        goto done;
     /* Everything goes to the staging folder first and is moved into place
      * only when every file is written: a failure leaves the folder as it
      * was, old lightmaps included. */

@@ -168,6 +168,10 @@ void cli_phase(const char *name);
  * <seconds> s" (the clock is not reset). */
 void cli_phase_part(const char *name, double seconds);
 
+/* Warnings printed so far (library and CLI, through lx_log): --strict
+ * turns any into a failed run. */
+unsigned cli_warning_count(void);
+
 /* strdup and a/b joined, malloc'd; NULL when out of memory. */
 char *cli_strdup(const char *s);
 char *cli_path_join(const char *a, const char *b);

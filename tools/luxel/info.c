@@ -12,10 +12,18 @@ static const char *info_usage =
     "usage: luxel info SCENE [options]\n"
     "\n"
     "Lists the meshes (triangles, UV sets), materials, nodes, lights (type and\n"
-    "physical units), the sky and bounds of a glTF 2.0 or OBJ scene.\n"
+    "physical units), the sky and bounds of a glTF 2.0 or OBJ scene, and the\n"
+    "health of every mesh's UV sets as lightmap UVs: their range, the share of\n"
+    "covered texels two triangles overlap at --resolution, zero-area and\n"
+    "flipped triangles, and whether luxel bake would use them (--unwrap auto\n"
+    "makes new ones when not). Zero-area triangles in space are dropped with a\n"
+    "warning.\n"
     "\n"
     "options:\n"
     "  --lights FILE.json   apply a lights file first (docs/lights-json.md)\n"
+    "  --resolution N       texels a side overlaps are counted at (default %d)\n"
+    "  --threads N          worker threads (default: all cores)\n"
+    "  --strict             fail on zero-area triangles and on any warning\n"
     "  -h, --help           show this help\n";
 
 static void print_light(const lx_light *l)
@@ -74,12 +82,43 @@ static bool phantom_material(const lx_scene *s, uint32_t i)
     return true;
 }
 
+/* Every UV set of every mesh: range, overlap, zero-area and flipped
+ * triangles, usable or why not. */
+static bool print_uv_health(const lx_scene *s, const lx_uv_health_desc *hd)
+{
+    printf("UV health (overlaps at %dx%d texels):\n", hd->resolution, hd->resolution);
+    for (uint32_t i = 0; i < s->mesh_count; i++) {
+        const lx_mesh *m = &s->meshes[i];
+        for (int k = 0; k < LX_MAX_UV_SETS; k++) {
+            if (!m->uv[k])
+                continue;
+            lx_uv_health h;
+            if (lx_uv_health_mesh(m, k, hd, &h) != LX_OK) {
+                cli_error("%s: mesh '%s': %s", s->path, m->name, lx_last_error());
+                return false;
+            }
+            printf("  %-24s TEXCOORD_%d  u %.4g..%.4g  v %.4g..%.4g  overlap %.3g%%  "
+                   "zero-area %u  flipped %u  %s%s\n",
+                   m->name, k, (double)h.min.x, (double)h.max.x, (double)h.min.y,
+                   (double)h.max.y, 100.0 * h.overlap_share, h.zero_area_triangles,
+                   h.flipped_triangles, h.usable ? "usable" : "not usable: ", h.reason);
+        }
+    }
+    return true;
+}
+
 int cmd_info(int argc, char **argv)
 {
     static const struct option options[] = {{"lights", required_argument, NULL, 'l'},
+                                            {"resolution", required_argument, NULL, 'r'},
+                                            {"threads", required_argument, NULL, 't'},
+                                            {"strict", no_argument, NULL, 's'},
                                             {"help", no_argument, NULL, 'h'},
                                             {NULL, 0, NULL, 0}};
     const char *lights = NULL;
+    lx_uv_health_desc hd = lx_uv_health_desc_defaults(NULL);
+    bool strict = false;
+    long v;
     opterr = 0;
     optind = 1;
     int c;
@@ -88,8 +127,24 @@ int cmd_info(int argc, char **argv)
         case 'l':
             lights = optarg;
             break;
+        case 'r':
+            if (!cli_parse_int(optarg, 1, LX_UNWRAP_MAX_ATLAS_SIZE, &v))
+                return cli_usage_error("info", "--resolution must be an integer in 1..%d, not '%s'",
+                                       LX_UNWRAP_MAX_ATLAS_SIZE, optarg);
+            hd.resolution = (int)v;
+            break;
+        case 't':
+            if (!cli_parse_int(optarg, 1, 1024, &v))
+                return cli_usage_error("info", "--threads must be an integer in 1..1024, not '%s'",
+                                       optarg);
+            hd.threads = (int)v;
+            break;
+        case 's':
+            strict = true;
+            cli_set_strict(true);
+            break;
         case 'h':
-            fputs(info_usage, stdout);
+            printf(info_usage, lx_uv_health_desc_defaults(NULL).resolution);
             return EXIT_OK;
         case ':':
             return cli_usage_error("info", "option '%s' needs a value", argv[optind - 1]);
@@ -103,8 +158,9 @@ int cmd_info(int argc, char **argv)
         return cli_usage_error("info", "one scene at a time ('%s' is extra)", argv[optind + 1]);
     const char *path = argv[optind];
     lx_scene *s;
-    /* listing needs the textures' names, not their pixels */
-    lx_scene_load_desc ld = {.skip_textures = true};
+    /* listing needs the textures' names, not their pixels; zero-area
+     * triangles are dropped with a warning (--strict: refused) */
+    lx_scene_load_desc ld = {.skip_textures = true, .strict = strict};
     if (lx_scene_load(path, &ld, &s) != LX_OK) {
         cli_error("%s", lx_last_error());
         return EXIT_FAILED;
@@ -128,8 +184,12 @@ int cmd_info(int argc, char **argv)
                 printf(" TEXCOORD_%d", k);
                 any = true;
             }
-        printf("%s%s  material '%s'\n", any ? "" : " none", m->tangents ? "  tangents" : "",
+        printf("%s%s  material '%s'", any ? "" : " none", m->tangents ? "  tangents" : "",
                s->materials[m->material].name);
+        if (m->dropped_triangles)
+            printf("  (%u zero-area %s left out)", m->dropped_triangles,
+                   cli_plural(m->dropped_triangles, "triangle", "triangles"));
+        printf("\n");
     }
     /* assimp adds a DefaultMaterial to a file that has none: not listed
      * when no mesh uses it */
@@ -148,12 +208,24 @@ int cmd_info(int argc, char **argv)
     printf("nodes: %u\n", s->node_count);
     for (uint32_t i = 0; i < s->node_count; i++) {
         const lx_node *n = &s->nodes[i];
-        printf("  %-24s at (%.3g, %.3g, %.3g), %u mesh%s\n", n->name, n->world.m[12],
-               n->world.m[13], n->world.m[14], n->mesh_count, n->mesh_count == 1 ? "" : "es");
+        printf("  %-24s at (%s, %s, %s), %u %s\n", n->name, cli_num_digits(n->world.m[12], 3),
+               cli_num_digits(n->world.m[13], 3), cli_num_digits(n->world.m[14], 3),
+               n->mesh_count, cli_plural(n->mesh_count, "mesh", "meshes"));
+    }
+    if (!print_uv_health(s, &hd)) {
+        lx_scene_destroy(s);
+        return EXIT_FAILED;
     }
     printf("lights: %u\n", s->light_count);
-    for (uint32_t i = 0; i < s->light_count; i++)
-        print_light(&s->lights[i]);
+    for (uint32_t i = 0; i < s->light_count; i++) {
+        const lx_light *l = &s->lights[i];
+        print_light(l);
+        if (l->type == LX_LIGHT_SPOT && l->outer_angle < LX_DEG2RAD(1.0f))
+            lx_log(LX_LOG_WARN,
+                   "%s: spot light '%s' has a cone of %.3g degrees from its axis: radians "
+                   "typed as degrees? (lights files give angles in degrees)",
+                   path, l->name[0] ? l->name : "-", LX_RAD2DEG(l->outer_angle));
+    }
     if (s->ambient.x > 0 || s->ambient.y > 0 || s->ambient.z > 0)
         printf("ambient: (%.3g, %.3g, %.3g) lx\n", s->ambient.x, s->ambient.y, s->ambient.z);
     if (s->sky.environment) {
@@ -166,8 +238,15 @@ int cmd_info(int argc, char **argv)
     }
     lx_vec3 lo, hi;
     if (lx_scene_bounds(s, &lo, &hi))
-        printf("bounds: (%.4g, %.4g, %.4g) .. (%.4g, %.4g, %.4g) m, %llu triangles\n", lo.x, lo.y,
-               lo.z, hi.x, hi.y, hi.z, (unsigned long long)tris);
+        printf("bounds: (%s, %s, %s) .. (%s, %s, %s) m, %llu triangles\n",
+               cli_num_digits(lo.x, 4), cli_num_digits(lo.y, 4), cli_num_digits(lo.z, 4),
+               cli_num_digits(hi.x, 4), cli_num_digits(hi.y, 4), cli_num_digits(hi.z, 4),
+               (unsigned long long)tris);
     lx_scene_destroy(s);
+    unsigned w = cli_warning_count();
+    if (strict && w) {
+        cli_error("%s: %u warning%s with --strict", path, w, w == 1 ? "" : "s");
+        return EXIT_FAILED;
+    }
     return EXIT_OK;
 }

@@ -349,6 +349,12 @@ void cli_progress_finish(cli_progress *p)
 /* ---- logging and dispatch ----------------------------------------------- */
 
 static bool quiet, strict;
+static unsigned warnings; /* the log callback is never called concurrently */
+
+unsigned cli_warning_count(void)
+{
+    return warnings;
+}
 
 void cli_set_quiet(bool q)
 {
@@ -373,6 +379,7 @@ bool cli_strict(void)
 static void print_log(void *user, lx_log_level level, const char *message)
 {
     (void)user;
+    warnings += level >= LX_LOG_WARN;
     if (level < (verbose ? LX_LOG_INFO : LX_LOG_WARN))
         return;
     /* --quiet silences warnings too, unless --strict makes them matter */
