@@ -103,7 +103,15 @@ static pthread_mutex_t reader_lock = PTHREAD_MUTEX_INITIALIZER;
 
 #define POST_FLAGS                                                                                 \
     (aiProcess_Triangulate | aiProcess_SortByPType | aiProcess_FlipUVs |                           \
-     aiProcess_GenSmoothNormals | aiProcess_JoinIdenticalVertices)
+     aiProcess_GenSmoothNormals)
+
+/* Formats read face by face (OBJ...) get their vertices shared. glTF's are
+ * already indexed, and assimp's joining would merge vertices that differ
+ * only in TEXCOORD_1 (a lightmap set written by luxel unwrap). */
+static unsigned post_flags(bool gltf2)
+{
+    return POST_FLAGS | (gltf2 ? 0u : (unsigned)aiProcess_JoinIdenticalVertices);
+}
 
 /* An assimp scene and how assimp_lock is held for it (until
  * assimp_release). */
@@ -297,7 +305,7 @@ static struct aiPropertyStore *import_properties(void)
 /* The whole import in one call holding assimp_lock exclusively, with the
  * log watched for dropped faces when watch_log. */
 static lx_status import_exclusive(const char *path, const import_source *src, bool watch_log,
-                                  assimp_import *im)
+                                  bool gltf2, assimp_import *im)
 {
     struct aiFileIO io = io_for(src);
     struct aiPropertyStore *props = import_properties();
@@ -307,7 +315,8 @@ static lx_status import_exclusive(const char *path, const import_source *src, bo
     if (watch_log)
         aiAttachLogStream(&log);
     im->ai = aiImportFileExWithProperties(src->read_path,
-                                          POST_FLAGS | aiProcess_ValidateDataStructure, &io, props);
+                                          post_flags(gltf2) | aiProcess_ValidateDataStructure, &io,
+                                          props);
     if (watch_log)
         aiDetachLogStream(&log);
     char why[512];
@@ -324,11 +333,11 @@ static lx_status import_exclusive(const char *path, const import_source *src, bo
  * assimp_lock until assimp_release (also on failure, when im->ai is
  * NULL and the lock is already let go). */
 static lx_status assimp_import_file(const char *path, const import_source *src, bool watch_log,
-                                   assimp_import *im)
+                                   bool gltf2, assimp_import *im)
 {
     memset(im, 0, sizeof *im);
     if (watch_log)
-        return import_exclusive(path, src, true, im);
+        return import_exclusive(path, src, true, gltf2, im);
     struct aiFileIO io = io_for(src);
     struct aiPropertyStore *props = import_properties();
     pthread_rwlock_rdlock(&assimp_lock);
@@ -349,9 +358,9 @@ static lx_status assimp_import_file(const char *path, const import_source *src, 
         atomic_fetch_sub(&post_processing_reserved, need);
         aiReleaseImport(ai);
         pthread_rwlock_unlock(&assimp_lock);
-        return import_exclusive(path, src, false, im);
+        return import_exclusive(path, src, false, gltf2, im);
     }
-    im->ai = aiApplyPostProcessing(ai, POST_FLAGS);
+    im->ai = aiApplyPostProcessing(ai, post_flags(gltf2));
     atomic_fetch_sub(&post_processing_reserved, need);
     if (!im->ai) {
         pthread_rwlock_unlock(&assimp_lock);
@@ -1218,7 +1227,7 @@ static lx_status import_scene(const char *path, const import_source *src,
 {
     *need_log = false;
     assimp_import im;
-    lx_status st = assimp_import_file(path, src, watch_log, &im);
+    lx_status st = assimp_import_file(path, src, watch_log, gltf2, &im);
     if (st != LX_OK)
         return st;
     const struct aiScene *ai = im.ai;

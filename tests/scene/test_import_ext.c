@@ -832,6 +832,39 @@ static void test_collada_lights_warned(void **state)
     lx_scene_destroy(s);
 }
 
+/* Two triangles with the same positions, normals and TEXCOORD_0 along
+ * their shared edge but their own TEXCOORD_1 (two lightmap charts, as
+ * luxel unwrap writes them): the load keeps every corner's TEXCOORD_1. */
+static void test_lightmap_set_not_joined(void **state)
+{
+    (void)state;
+    const char *dir = lx_test_dir("test_import_ext_charts");
+    static const float pos[] = {0, 0, 0, 0, 0, 1, 1, 0, 0, 1, 0, 0, 0, 0, 1, 1, 0, 1};
+    static const float nrm[] = {0, 1, 0, 0, 1, 0, 0, 1, 0, 0, 1, 0, 0, 1, 0, 0, 1, 0};
+    static const float uv0[] = {0, 0, 0, 1, 1, 0, 1, 0, 0, 1, 1, 1};
+    static const float uv1[] = {0.125f, 0.125f, 0.125f, 0.375f, 0.375f, 0.125f,
+                                0.625f, 0.625f, 0.625f, 0.875f, 0.875f, 0.875f};
+    static const uint32_t idx[] = {0, 1, 2, 3, 4, 5};
+    lx_test_gltf *g = lx_test_gltf_new();
+    lx_test_primitive p = {.vertex_count = 6, .position = pos, .normal = nrm, .uv0 = uv0,
+                           .uv1 = uv1, .index_count = 6, .indices = idx, .material = -1};
+    lx_test_gltf_node(g, "n", lx_test_gltf_mesh(g, "charts", &p, 1), "");
+    char path[1024];
+    path_in(path, sizeof path, dir, "two_charts.gltf");
+    lx_test_gltf_write(g, path);
+    lx_test_gltf_free(g);
+    logbook book;
+    lx_scene *s = load_logged(path, NULL, &book);
+    const lx_mesh *m = &s->meshes[0];
+    assert_int_equal(m->triangle_count, 2);
+    assert_non_null(m->uv[1]);
+    for (uint32_t c = 0; c < 6; c++) {
+        lx_vec2 got = m->uv[1][m->indices[c]];
+        assert_true(fabsf(got.x - uv1[2 * c]) < 1e-6f && fabsf(got.y - uv1[2 * c + 1]) < 1e-6f);
+    }
+    lx_scene_destroy(s);
+}
+
 int main(void)
 {
     const struct CMUnitTest tests[] = {
@@ -841,6 +874,7 @@ int main(void)
         cmocka_unit_test(test_required_extensions),  cmocka_unit_test(test_emissive_strength),
         cmocka_unit_test(test_lfs_pointers),         cmocka_unit_test(test_backslash_obj),
         cmocka_unit_test(test_source_mapping),       cmocka_unit_test(test_collada_lights_warned),
+        cmocka_unit_test(test_lightmap_set_not_joined),
     };
     return cmocka_run_group_tests(tests, NULL, NULL);
 }

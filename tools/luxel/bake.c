@@ -1033,6 +1033,11 @@ int cmd_bake(int argc, char **argv)
     if (a.desc.texel_density > 0.0f || unwrap)
         cJSON_AddNumberToObject(manifest, "texel_density",
                                 unwrap ? unwrap->texel_density : a.desc.texel_density);
+    if (unwrap) { /* what luxel render needs to make the same UVs again */
+        cJSON_AddNumberToObject(manifest, "padding", a.desc.padding);
+        cJSON_AddNumberToObject(manifest, "atlas_size",
+                                a.atlas_size ? a.atlas_size : lx_unwrap_desc_defaults(NULL).atlas_size);
+    }
     cJSON *list = cJSON_AddArrayToObject(manifest, "pages");
     bool failed = false;
     double t_maps = 0.0, t_previews = 0.0;
