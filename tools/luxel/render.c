@@ -35,7 +35,7 @@ static const char *render_usage =
     "                          log-average luminance of what the camera sees\n"
     "                          made 0.18, Reinhard's key; 'bake' takes the\n"
     "                          bake's preview_ev100)\n"
-    "  --tonemap T             aces (default), filmic or clamp\n"
+    "  --tonemap T             filmic (default), aces or clamp\n"
     "  --filter F              lightmap lookups: bilinear (default) or bicubic\n"
     "  --samples N             rays per pixel, stratified (default %d)\n"
     "  --two-sided             draw back faces (default: culled, as glTF's\n"
@@ -45,9 +45,9 @@ static const char *render_usage =
     "  -q, --quiet             no progress bar or summary\n"
     "  -h, --help              show this help\n";
 
-/* The CLI's tone curve: Hill's ACES fit keeps highlights from clipping and
- * is what most engines show by default. */
-#define CLI_RENDER_TONEMAP LX_TONEMAP_ACES
+/* The CLI's tone curve: the bake previews' (Hable's filmic), so a view and
+ * its lightmaps' previews look alike; highlights roll off, not clip. */
+#define CLI_RENDER_TONEMAP LX_TONEMAP_FILMIC
 /* Face size the manifest's sky is loaded at for the background. */
 #define CLI_RENDER_SKY_SIZE 512
 
