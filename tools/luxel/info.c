@@ -97,10 +97,11 @@ static bool print_uv_health(const lx_scene *s, const lx_uv_health_desc *hd)
                 cli_error("%s: mesh '%s': %s", s->path, m->name, lx_last_error());
                 return false;
             }
-            printf("  %-24s TEXCOORD_%d  u %.4g..%.4g  v %.4g..%.4g  overlap %.3g%%  "
+            printf("  %-24s TEXCOORD_%d  u %s..%s  v %s..%s  overlap %s%%  "
                    "zero-area %u  flipped %u  %s%s\n",
-                   m->name, k, (double)h.min.x, (double)h.max.x, (double)h.min.y,
-                   (double)h.max.y, 100.0 * h.overlap_share, h.zero_area_triangles,
+                   m->name, k, cli_num_digits(h.min.x, 4), cli_num_digits(h.max.x, 4),
+                   cli_num_digits(h.min.y, 4), cli_num_digits(h.max.y, 4),
+                   cli_num_digits(100.0 * h.overlap_share, 3), h.zero_area_triangles,
                    h.flipped_triangles, h.usable ? "usable" : "not usable: ", h.reason);
         }
     }
