@@ -161,7 +161,17 @@ typedef struct io_file {
     FILE *fp;
     const uint8_t *bytes;
     size_t size, pos;
+    struct aiFile *file;
+    struct io_file *prev, *next; /* the import's open files */
 } io_file;
+
+/* One import's callbacks: the files assimp has open, so the ones it never
+ * closes (its glTF reader loses streams when it gives up on a short
+ * buffer) are closed after it returns. */
+typedef struct io_state {
+    const import_source *src;
+    io_file *open;
+} io_state;
 
 static size_t io_read(struct aiFile *f, char *buf, size_t size, size_t count)
 {
@@ -235,7 +245,8 @@ static FILE *open_slashed(const char *path)
 
 static struct aiFile *io_open(struct aiFileIO *io, const char *path, const char *mode)
 {
-    const import_source *src = (const import_source *)(void *)io->UserData;
+    io_state *state = (io_state *)(void *)io->UserData;
+    const import_source *src = state->src;
     if (!path || (mode && (strchr(mode, 'w') || strchr(mode, 'a'))))
         return NULL;
     io_file *h = calloc(1, sizeof *h);
@@ -267,25 +278,48 @@ static struct aiFile *io_open(struct aiFileIO *io, const char *path, const char 
     f->SeekProc = io_seek;
     f->FlushProc = io_flush;
     f->UserData = (aiUserData)(void *)h;
+    h->file = f;
+    h->next = state->open;
+    if (state->open)
+        state->open->prev = h;
+    state->open = h;
     return f;
 }
 
 static void io_close(struct aiFileIO *io, struct aiFile *f)
 {
-    (void)io;
     if (!f)
         return;
+    io_state *state = (io_state *)(void *)io->UserData;
     io_file *h = (io_file *)(void *)f->UserData;
-    if (h && h->fp)
-        fclose(h->fp);
+    if (h) {
+        if (h->prev)
+            h->prev->next = h->next;
+        else
+            state->open = h->next;
+        if (h->next)
+            h->next->prev = h->prev;
+        if (h->fp)
+            fclose(h->fp);
+    }
     free(h);
     free(f);
 }
 
-static struct aiFileIO io_for(const import_source *src)
+static struct aiFileIO io_for(io_state *state, const import_source *src)
 {
-    struct aiFileIO io = {io_open, io_close, (aiUserData)(void *)src};
+    state->src = src;
+    state->open = NULL;
+    struct aiFileIO io = {io_open, io_close, (aiUserData)(void *)state};
     return io;
+}
+
+/* The files assimp left open when its import returned. */
+static void io_close_leftovers(struct aiFileIO *io)
+{
+    io_state *state = (io_state *)(void *)io->UserData;
+    while (state->open)
+        io_close(io, state->open->file);
 }
 
 static lx_status import_failed(const char *path, const char *why)
@@ -307,7 +341,8 @@ static struct aiPropertyStore *import_properties(void)
 static lx_status import_exclusive(const char *path, const import_source *src, bool watch_log,
                                   bool gltf2, assimp_import *im)
 {
-    struct aiFileIO io = io_for(src);
+    io_state state;
+    struct aiFileIO io = io_for(&state, src);
     struct aiPropertyStore *props = import_properties();
     struct aiLogStream log = {on_assimp_log, (char *)(void *)&im->dropped};
     pthread_rwlock_wrlock(&assimp_lock);
@@ -317,6 +352,7 @@ static lx_status import_exclusive(const char *path, const import_source *src, bo
     im->ai = aiImportFileExWithProperties(src->read_path,
                                           post_flags(gltf2) | aiProcess_ValidateDataStructure, &io,
                                           props);
+    io_close_leftovers(&io);
     if (watch_log)
         aiDetachLogStream(&log);
     char why[512];
@@ -338,12 +374,14 @@ static lx_status assimp_import_file(const char *path, const import_source *src, 
     memset(im, 0, sizeof *im);
     if (watch_log)
         return import_exclusive(path, src, true, gltf2, im);
-    struct aiFileIO io = io_for(src);
+    io_state state;
+    struct aiFileIO io = io_for(&state, src);
     struct aiPropertyStore *props = import_properties();
     pthread_rwlock_rdlock(&assimp_lock);
     pthread_mutex_lock(&reader_lock);
     const struct aiScene *ai =
         aiImportFileExWithProperties(src->read_path, aiProcess_ValidateDataStructure, &io, props);
+    io_close_leftovers(&io);
     char why[512];
     snprintf(why, sizeof why, "%s", ai ? "" : aiGetErrorString());
     pthread_mutex_unlock(&reader_lock);
