@@ -118,14 +118,13 @@ static int b64_value(unsigned char c)
     return -1;
 }
 
-/* RFC 4648 base64 (also its URL alphabet); '=' padding optional. */
-static bool b64_decode(const char *s, size_t n, uint8_t **out, size_t *size)
+int lx_gltf_base64_decode(const char *s, size_t n, uint8_t **out, size_t *size)
 {
     while (n && (s[n - 1] == '=' || s[n - 1] == '\n' || s[n - 1] == '\r'))
         n--;
     uint8_t *d = malloc(n / 4 * 3 + 3);
     if (!d)
-        return false;
+        return -1;
     size_t k = 0;
     uint32_t acc = 0;
     int bits = 0;
@@ -133,7 +132,7 @@ static bool b64_decode(const char *s, size_t n, uint8_t **out, size_t *size)
         int v = b64_value((unsigned char)s[i]);
         if (v < 0) {
             free(d);
-            return false;
+            return 0;
         }
         acc = acc << 6 | (uint32_t)v;
         bits += 6;
@@ -144,7 +143,7 @@ static bool b64_decode(const char *s, size_t n, uint8_t **out, size_t *size)
     }
     *out = d;
     *size = k;
-    return true;
+    return 1;
 }
 
 static int hex_value(char c)
@@ -172,7 +171,7 @@ lx_status lx_gltf_uri_read(const lx_gltf_file *f, const char *uri, const char *w
         size_t head = (size_t)(comma - uri);
         if (head < 12 || strncmp(comma - 7, ";base64", 7) != 0)
             return lx_fail(LX_ERR_UNSUPPORTED, "%s: %s: data: URI is not base64", f->path, what);
-        if (!b64_decode(comma + 1, strlen(comma + 1), out, size))
+        if (lx_gltf_base64_decode(comma + 1, strlen(comma + 1), out, size) != 1)
             return lx_fail(LX_ERR_FORMAT, "%s: %s: data: URI holds malformed base64", f->path,
                            what);
         if (mime) {

@@ -100,4 +100,9 @@ lx_status lx_glb_write(const char *path, cJSON *root, lx_glb_bin *b);
 /* "image/png", "image/jpeg"... from the first bytes, NULL when unknown. */
 const char *lx_image_mime_sniff(const uint8_t *bytes, size_t size);
 
+/* RFC 4648 base64 (also its URL alphabet; '=' padding optional) of the n
+ * characters at s into *out (malloc) and *size: 1 when decoded, 0 when
+ * malformed, -1 when out of memory. */
+int lx_gltf_base64_decode(const char *s, size_t n, uint8_t **out, size_t *size);
+
 #endif

@@ -8,6 +8,7 @@
  * rewritten in memory as a GLB: the JSON (changed in place, so every index
  * the importer matches stays the same) and a binary chunk that holds the
  * file's own binary chunk followed by the decoded and converted data. */
+#include "gltf_data.h"
 #include "gltf_json.h"
 #include "core/internal.h"
 
@@ -153,43 +154,14 @@ typedef struct rewrite {
     size_t added;         /* views added after the file's view_count */
 } rewrite;
 
-static int base64_value(int c)
-{
-    if (c >= 'A' && c <= 'Z')
-        return c - 'A';
-    if (c >= 'a' && c <= 'z')
-        return c - 'a' + 26;
-    if (c >= '0' && c <= '9')
-        return c - '0' + 52;
-    if (c == '+' || c == '-')
-        return 62;
-    if (c == '/' || c == '_')
-        return 63;
-    return -1;
-}
-
 static lx_status decode_base64(const rewrite *r, size_t index, const char *text, source_buffer *b)
 {
-    size_t n = strlen(text);
-    b->data = malloc(n / 4 * 3 + 3);
-    if (!b->data)
+    int decoded = lx_gltf_base64_decode(text, strlen(text), &b->data, &b->size);
+    if (decoded < 0)
         return failf(r->file, LX_ERR_NOMEM, "out of memory decoding buffer %zu", index);
+    if (decoded == 0)
+        return failf(r->file, LX_ERR_FORMAT, "buffer %zu: the data URI is not base64", index);
     b->owned = true;
-    uint32_t acc = 0;
-    int bits = 0;
-    size_t o = 0;
-    for (const char *p = text; *p && *p != '='; p++) {
-        int v = base64_value((unsigned char)*p);
-        if (v < 0)
-            return failf(r->file, LX_ERR_FORMAT, "buffer %zu: the data URI is not base64", index);
-        acc = acc << 6 | (uint32_t)v;
-        bits += 6;
-        if (bits >= 8) {
-            bits -= 8;
-            b->data[o++] = (uint8_t)(acc >> bits);
-        }
-    }
-    b->size = o;
     return LX_OK;
 }
 
