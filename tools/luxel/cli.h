@@ -178,7 +178,7 @@ char *cli_path_join(const char *a, const char *b);
 
 /* ---- staged output (stage.c) ---------------------------------------------
  * The commands that write several files (bake, ibl) stage them in
- * OUTPUT/.luxel-XXXXXX and move them into OUTPUT together once all are
+ * OUTPUT/.luxel-<random> and move them into OUTPUT together once all are
  * written. cli_stage_begin runs before the long work, so a folder that
  * cannot be written is reported before anything is computed; a failed or
  * interrupted run leaves OUTPUT as it was (and removes it, and any parent,
@@ -194,7 +194,7 @@ char *cli_path_join(const char *a, const char *b);
  */
 typedef struct cli_stage {
     char *output; /* the final folder */
-    char *dir;    /* OUTPUT/.luxel-XXXXXX (mkdtemp) */
+    char *dir;    /* OUTPUT/.luxel-<random> (made by mkdtemp) */
     char **names; /* files staged in dir, in the order they were named */
     uint32_t count, capacity;
     char **made; /* folders this run created, deepest first */

@@ -1,5 +1,5 @@
 /* Staged output for the commands that write several files (bake, ibl):
- * every file goes to DIR/.luxel-XXXXXX first and is moved into DIR only
+ * every file goes to DIR/.luxel-<random> first and is moved into DIR only
  * when all of them are written, so a failure or an interrupt leaves DIR as
  * it was. Publishing keeps what it replaces until the last rename is done
  * and restores it if one fails. */
