@@ -1,6 +1,11 @@
-/* luxel/maps.h - texture-space tools: tangent frames.
+/* luxel/maps.h - texture-space tools: tangent frames, height fields and
+ * the maps made from them (normal, parallax, horizon, ambient occlusion).
  *
- * CONVENTIONS  UV origin at the top-left (glTF). Tangents are xyz + w
+ * CONVENTIONS  UV origin at the top-left (glTF). A height field is a
+ *   one-channel lx_image, row 0 at the top; a value v is a height of
+ *   strength * v texels. Image x runs along columns, y up the image (toward
+ *   row 0). Texels outside the image are addressed by an lx_wrap mode, at
+ *   any size (not only powers of two). docs/maps.md has the pictures. Tangents are xyz + w
  *   handedness with bitangent = cross(normal, tangent.xyz) * w, the glTF
  *   convention: the tangent follows +u and the bitangent points toward -v
  *   (up in the image), matching normal maps whose green channel is "up".
@@ -32,6 +37,79 @@
 #ifdef __cplusplus
 extern "C" {
 #endif
+
+/* ---- height fields ------------------------------------------------------ */
+
+/* How texel indices outside [0, n) are addressed. REPEAT tiles (i mod n);
+ * CLAMP repeats the edge texel; MIRROR reflects with the edge texel
+ * repeated (OpenGL's MIRRORED_REPEAT: -1 -> 0, n -> n - 1, period 2n). */
+typedef enum lx_wrap { LX_WRAP_REPEAT = 0, LX_WRAP_CLAMP, LX_WRAP_MIRROR } lx_wrap;
+
+/* i addressed into [0, n) by wrap, for any int i; n must be >= 1. */
+int lx_wrap_index(lx_wrap wrap, int i, int n);
+/* "repeat", "clamp" or "mirror"; NULL for another value. */
+const char *lx_wrap_name(lx_wrap wrap);
+/* The mode named name (as lx_wrap_name writes it); false when none. */
+bool lx_wrap_parse(const char *name, lx_wrap *out);
+
+/* Loads a height image into a one-channel lx_image (*out, freed with
+ * lx_image_free): 8- and 16-bit PNG (and TGA, JPEG) as code / 255 or
+ * code / 65535 with no sRGB decoding, grey or the first channel; float
+ * formats (EXR, PFM, HDR) as stored. Fails with the file named for an
+ * unreadable or zero-size image and for NaN or infinite heights. On
+ * failure *out is zeroed. */
+lx_status lx_height_load(const char *path, lx_image *out);
+
+/* The height scale every tool uses when a desc leaves strength at 0: a
+ * value v is a height of 24 v texels (the seed's example scale). */
+#define LX_DEFAULT_HEIGHT_STRENGTH 24.0f
+
+/* ---- horizon and ambient-occlusion maps ---------------------------------
+ * Lengyel's horizon maps (FGED vol. 2 sec. 7.8): for each texel, the
+ * largest tangent of the elevation toward higher texels within a radius,
+ * in `angles` bins around the texel; eight directions (every 45 degrees
+ * from +x, counter-clockwise as seen with y up the image) stored as the
+ * sine of the horizon elevation averaged over each direction's bins, in
+ * two RGBA layers. The ambient factor is the mean over the bins of the
+ * cosine of the elevation (or of its square with ao_cosine), raised to
+ * ao_power. */
+
+typedef struct lx_horizon_desc {
+    float strength;          /* texels of height per unit value; 0 = LX_DEFAULT_HEIGHT_STRENGTH */
+    int angles;              /* angular bins, a power of two >= 16; 0 = 32 */
+    int radius;              /* search radius in texels; 0 = 16 */
+    lx_wrap wrap;            /* addressing outside the image (REPEAT) */
+    float ao_power;          /* exponent of the ambient factor; 0 = 1 */
+    bool ao_cosine;          /* ambient factor = cosine-weighted visible fraction */
+    int threads;             /* 0 = all cores */
+    lx_progress_fn progress; /* may be NULL; returning false cancels */
+    void *progress_user;
+} lx_horizon_desc;
+
+/* A copy of desc (or of zeros when NULL) with every default filled in. */
+lx_horizon_desc lx_horizon_desc_defaults(const lx_horizon_desc *desc);
+
+/* Horizon layers (two 4-channel images the size of height: layer0 holds
+ * directions 0..3, layer1 4..7) and the ambient map (one channel); any of
+ * the three outputs may be NULL. Outputs are allocated here and freed with
+ * lx_image_free; on failure they are zeroed. */
+lx_status lx_horizon_map(const lx_image *height, const lx_horizon_desc *desc, lx_image *layer0,
+                         lx_image *layer1, lx_image *ao);
+
+/* The four signed channel weights for tangent-space direction dir (the
+ * seed's weight cube map evaluated exactly): positive weights apply to
+ * layer0, negative ones (negated) to layer1. */
+void lx_horizon_weights(lx_vec3 dir, float w[4]);
+
+/* The weight cube map the shading function samples in a shader: six faces
+ * of size x size RGBA texels (+x, -x, +y, -y, +z, -z, as in cube maps),
+ * stacked in one image size wide and 6 size high. */
+lx_status lx_horizon_weight_cube(int size, lx_image *out);
+
+/* Light factor in [0,1] of a texel with horizon layers h0, h1 (4 values
+ * each) for the unit tangent-space light direction l (ApplyHorizonMap):
+ * saturate((l.z - sin(horizon)) * hardness + 1); hardness 0 = 8. */
+float lx_horizon_light(const float h0[4], const float h1[4], lx_vec3 l, float hardness);
 
 /* Per-vertex tangents from positions, normals and uv[uv_set] (Lengyel's
  * method, FGED vol. 2 ch. 7: per-triangle tangent/bitangent summed over
