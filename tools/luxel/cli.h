@@ -19,6 +19,26 @@ int cmd_render(int argc, char **argv);
 /* bake --render: DIR/view.png of DIR's lightmaps on scene (default camera). */
 int cli_render_bake(const char *dir, const lx_scene *scene, int threads, bool quiet);
 int cmd_unwrap(int argc, char **argv);
+int cmd_horizonmap(int argc, char **argv);
+int cmd_aomap(int argc, char **argv);
+
+/* Options luxel horizonmap and aomap share (horizonmap.c). */
+typedef struct cli_horizon_opts {
+    const char *input, *output;
+    lx_horizon_desc desc;
+    int bits;
+    bool quiet;
+} cli_horizon_opts;
+/* Parses argv of `command` ("horizonmap" or "aomap", which alone takes
+ * --power and --cosine): 0 when fine, -1 for --help, else the usage
+ * error's exit status (message printed). */
+int cli_horizon_args(const char *command, int argc, char **argv, cli_horizon_opts *o);
+/* Loads o->input (error printed on failure) into *hf. */
+int cli_horizon_load(const cli_horizon_opts *o, lx_image *hf);
+/* lx_horizon_map of hf with a progress bar; EXIT_OK or EXIT_FAILED (error
+ * printed). */
+int cli_horizon_run(const cli_horizon_opts *o, const lx_image *hf, lx_image *l0, lx_image *l1,
+                    lx_image *ao);
 
 /* Writes scene as a .glb at path with u's generated UVs in TEXCOORD_1
  * (lx_scene_write_glb; unwrap.c). The scene is the one u was made from,
