@@ -72,12 +72,16 @@ lx_status lx_height_load(const char *path, lx_image *out);
  * sine of the horizon elevation averaged over each direction's bins, in
  * two RGBA layers. The ambient factor is the mean over the bins of the
  * cosine of the elevation (or of its square with ao_cosine), raised to
- * ao_power. */
+ * ao_power. Bin m is the direction 2 pi m / angles; a texel at distance r
+ * (0 < r < radius) counts for the bins within atan(sqrt(1/2) / r) of its
+ * azimuth; direction k averages the angles/8 + 1 bins within 22.5 degrees
+ * of k * 45 degrees, ends included. docs/maps.md has the details. */
 
 typedef struct lx_horizon_desc {
     float strength;          /* texels of height per unit value; 0 = LX_DEFAULT_HEIGHT_STRENGTH */
-    int angles;              /* angular bins, a power of two >= 16; 0 = 32 */
-    int radius;              /* search radius in texels; 0 = 16 */
+    int angles;              /* angular bins, a power of two in 16..1024; 0 = 32 */
+    int radius;              /* search radius in texels, 2..256 (texels nearer
+                                than it count); 0 = 16 */
     lx_wrap wrap;            /* addressing outside the image (REPEAT) */
     float ao_power;          /* exponent of the ambient factor; 0 = 1 */
     bool ao_cosine;          /* ambient factor = cosine-weighted visible fraction */
@@ -91,8 +95,11 @@ lx_horizon_desc lx_horizon_desc_defaults(const lx_horizon_desc *desc);
 
 /* Horizon layers (two 4-channel images the size of height: layer0 holds
  * directions 0..3, layer1 4..7) and the ambient map (one channel); any of
- * the three outputs may be NULL. Outputs are allocated here and freed with
- * lx_image_free; on failure they are zeroed. */
+ * the three outputs may be NULL. height must have one channel and finite
+ * values; a desc value out of its range fails with LX_ERR_INVALID naming
+ * it. The result is the same for any desc->threads. Outputs are allocated
+ * here and freed with lx_image_free; on failure (and when the progress
+ * callback cancels: LX_ERR_CANCELLED) they are zeroed. */
 lx_status lx_horizon_map(const lx_image *height, const lx_horizon_desc *desc, lx_image *layer0,
                          lx_image *layer1, lx_image *ao);
 
