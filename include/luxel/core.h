@@ -164,6 +164,11 @@ typedef struct lx_image_write_desc {
                                 sRGB transfer, for data such as lookup
                                 tables (default: sRGB encoded) */
     bool half;               /* EXR: 16-bit half floats instead of 32-bit */
+    int bits;                /* integer formats' bits per sample: 0 = 8;
+                                16 writes a 16-bit PNG (coded as the 8-bit
+                                one: tone curve, sRGB or linear, alpha
+                                linear; codes round(65535 v)). JPEG and TGA
+                                fail with 16; float formats ignore it */
     int threads;             /* encoding threads, 0 = all cores */
     lx_progress_fn progress; /* may be NULL; returning false cancels */
     void *progress_user;
