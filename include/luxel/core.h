@@ -160,7 +160,8 @@ typedef struct lx_image_write_desc {
     float exposure;          /* multiplier applied to values, 0 = 1 */
     lx_tonemap tonemap;      /* 8-bit formats: the curve after exposure
                                 (CLAMP by default); float formats ignore it */
-    bool linear;             /* 8-bit formats: codes round(255 v) without the
+    bool linear;             /* 8/16-bit formats: codes round(255 v) (or
+                                round(65535 v)) without the
                                 sRGB transfer, for data such as lookup
                                 tables (default: sRGB encoded) */
     bool half;               /* EXR: 16-bit half floats instead of 32-bit */
