@@ -160,10 +160,16 @@ typedef struct lx_image_write_desc {
     float exposure;          /* multiplier applied to values, 0 = 1 */
     lx_tonemap tonemap;      /* 8-bit formats: the curve after exposure
                                 (CLAMP by default); float formats ignore it */
-    bool linear;             /* 8-bit formats: codes round(255 v) without the
+    bool linear;             /* 8/16-bit formats: codes round(255 v) (or
+                                round(65535 v)) without the
                                 sRGB transfer, for data such as lookup
                                 tables (default: sRGB encoded) */
     bool half;               /* EXR: 16-bit half floats instead of 32-bit */
+    int bits;                /* integer formats' bits per sample: 0 = 8;
+                                16 writes a 16-bit PNG (coded as the 8-bit
+                                one: tone curve, sRGB or linear, alpha
+                                linear; codes round(65535 v)). JPEG and TGA
+                                fail with 16; float formats ignore it */
     int threads;             /* encoding threads, 0 = all cores */
     lx_progress_fn progress; /* may be NULL; returning false cancels */
     void *progress_user;

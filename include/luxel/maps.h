@@ -64,6 +64,113 @@ lx_status lx_height_load(const char *path, lx_image *out);
  * value v is a height of 24 v texels (the seed's example scale). */
 #define LX_DEFAULT_HEIGHT_STRENGTH 24.0f
 
+/* ---- normal maps -----------------------------------------------------------
+ * Normals from a height field (Lengyel, FGED vol. 2 sec. 7.5): with h in
+ * texels (strength * value), n is proportional to (-dh/dx, -dh/dy, 1), x
+ * along the columns and y up the image (dh/dy = row above less row below),
+ * as unit tangent-space vectors. Encoded for a texture as rgb = n/2 + 1/2.
+ * Texel (x, y) of every map made here belongs to height texel (x, y): the
+ * maps are the height's size, with no shift. */
+
+/* The slope estimate. CENTRAL is the seed's (h[x+1] - h[x-1]) / 2; SOBEL
+ * and SCHARR smooth across the derivative with weights 1-2-1 and 3-10-3
+ * and are normalised (by 8 and 32) so a linear ramp gets the same slope
+ * from all three. */
+typedef enum lx_normal_filter {
+    LX_NORMAL_CENTRAL = 0,
+    LX_NORMAL_SOBEL,
+    LX_NORMAL_SCHARR
+} lx_normal_filter;
+
+/* "central", "sobel" or "scharr"; NULL for another value. */
+const char *lx_normal_filter_name(lx_normal_filter filter);
+/* The filter named name; false when none. */
+bool lx_normal_filter_parse(const char *name, lx_normal_filter *out);
+
+typedef struct lx_normalmap_desc {
+    float strength;          /* texels of height per unit value; 0 = LX_DEFAULT_HEIGHT_STRENGTH */
+    lx_normal_filter filter; /* slope estimate (CENTRAL) */
+    lx_wrap wrap;            /* addressing outside the image (REPEAT) */
+    bool green_down;         /* y down the image (DirectX); default up (OpenGL, glTF) */
+    int threads;             /* 0 = all cores */
+    lx_progress_fn progress; /* may be NULL; returning false cancels */
+    void *progress_user;
+} lx_normalmap_desc;
+
+/* A copy of desc (or of zeros when NULL) with every default filled in. */
+lx_normalmap_desc lx_normalmap_desc_defaults(const lx_normalmap_desc *desc);
+
+/* Unit tangent-space normals of a one-channel height field: *out is
+ * allocated here (3 channels, height's size; free with lx_image_free) and
+ * zeroed on failure. The result does not depend on desc->threads.
+ * Fails (LX_ERR_INVALID) for a strength that is not finite and > 0 and
+ * for a height that is not one channel. */
+lx_status lx_normal_map(const lx_image *height, const lx_normalmap_desc *desc, lx_image *out);
+
+/* Unit normals (3 or more channels; only the first three are read) to
+ * texture values rgb = n/2 + 1/2 in [0,1], 3 channels, into *out
+ * (allocated here). Written as 8- or 16-bit PNG with linear codes
+ * (lx_image_write_desc.linear) each channel is round((n + 1)/2 * max). */
+lx_status lx_normal_encode(const lx_image *normals, lx_image *out);
+
+/* Texture values (3 or 4 channels; alpha ignored) to unit normals
+ * 2 rgb - 1 normalized, 3 channels, into *out (allocated here). Fails with
+ * LX_ERR_FORMAT naming name and the pixel for a value that is not a
+ * direction (zero length) or not finite, and for fewer than 3 channels. */
+lx_status lx_normal_decode(const lx_image *encoded, const char *name, lx_image *out);
+
+/* How a detail normal map perturbs a base one (Barre-Brisebois and Hill,
+ * "Blending in Detail", 2012). RNM (reoriented normal mapping) rotates
+ * the detail by the rotation taking +z to the base normal:
+ * t = b + (0,0,1), u = d * (-1,-1,1), r = t (t.u) / t.z - u. UDN:
+ * normalize(b.x + d.x, b.y + d.y, b.z). WHITEOUT: normalize(b.x + d.x,
+ * b.y + d.y, b.z d.z). */
+typedef enum lx_normal_blend_method {
+    LX_BLEND_RNM = 0,
+    LX_BLEND_UDN,
+    LX_BLEND_WHITEOUT
+} lx_normal_blend_method;
+
+/* "rnm", "udn" or "whiteout"; NULL for another value. */
+const char *lx_normal_blend_name(lx_normal_blend_method method);
+/* The method named name; false when none. */
+bool lx_normal_blend_parse(const char *name, lx_normal_blend_method *out);
+
+/* The blend of unit tangent-space normals base and detail, unit length.
+ * RNM of a base pointing straight down (z = -1, no rotation defined)
+ * returns detail; a UDN or Whiteout sum of zero length (opposite slopes
+ * on bases lying in the plane) is (0, 0, 1). */
+lx_vec3 lx_normal_blend(lx_normal_blend_method method, lx_vec3 base, lx_vec3 detail);
+
+/* Per texel blend of two unit-normal images of the same size (3 or more
+ * channels; the first three read) into *out (3 channels, allocated here).
+ * threads: 0 = all cores; the result does not depend on it. Fails with
+ * LX_ERR_INVALID when the sizes differ. */
+lx_status lx_normal_blend_image(lx_normal_blend_method method, const lx_image *base,
+                                const lx_image *detail, int threads, lx_image *out);
+
+/* ---- parallax maps ----------------------------------------------------------
+ * The seed's parallax map (FGED vol. 2 sec. 7.7): per texel n.z * v, v the
+ * height value as stored (in [0,1] for PNG heights) and n.z the z of the
+ * texel's normal (lx_normal_map with the same desc; its green_down is not
+ * used). A renderer offsets texture coordinates toward the viewer by
+ * scale * n.z * v, iterated (lx_parallax_offset). */
+
+/* One channel, height's size, into *out (allocated here; zeroed on
+ * failure). Fails as lx_normal_map does. */
+lx_status lx_parallax_map(const lx_image *height, const lx_normalmap_desc *desc, lx_image *out);
+
+/* The seed's ApplyParallaxOffset: `iterations` times (0 = 4, the seed's)
+ * uv += p(uv) * (view.x * scale[0], -view.y * scale[1]), p sampled
+ * bilinearly from channel 0 of parallax (texel centres at
+ * ((x + 0.5)/W, (y + 0.5)/H), texels outside addressed by wrap). uv has the
+ * top-left origin (v down), view is the unit tangent-space direction
+ * toward the viewer (x right, y up the image, z out): its y is negated
+ * for v. scale is the UV offset per unit of parallax value: for heights of
+ * S texels per unit value, (S / W, S / H) is the physical depth. */
+lx_vec2 lx_parallax_offset(const lx_image *parallax, lx_wrap wrap, lx_vec2 uv, lx_vec3 view,
+                           const float scale[2], int iterations);
+
 /* ---- horizon and ambient-occlusion maps ---------------------------------
  * Lengyel's horizon maps (FGED vol. 2 sec. 7.8): for each texel, the
  * largest tangent of the elevation toward higher texels within a radius,

@@ -435,6 +435,8 @@ lx_image_write_desc lx_image_write_desc_defaults(const lx_image_write_desc *desc
         d = *desc;
     if (d.exposure == 0.0f)
         d.exposure = 1.0f;
+    if (d.bits == 0)
+        d.bits = 8;
     return d;
 }
 
@@ -461,6 +463,11 @@ lx_status lx_image_write(const char *path, const lx_image *img, const lx_image_w
                        "%s: cannot tell the image format from the name (use .exr, .hdr, .pfm, "
                        ".png, .jpg or .tga)",
                        path);
+    if (d.bits != 8 && d.bits != 16)
+        return lx_fail(LX_ERR_INVALID, "%s: %d bits per sample: use 8 or 16", path, d.bits);
+    if (d.bits == 16 && (format == LX_IMAGE_JPG || format == LX_IMAGE_TGA))
+        return lx_fail(LX_ERR_UNSUPPORTED, "%s: %s has no 16-bit samples (write png)", path,
+                       lx_image_format_extension(format));
     float exposure = d.exposure;
     if (!isfinite(exposure) || exposure < 0.0f)
         return lx_fail(LX_ERR_INVALID, "%s: exposure %g must be a finite value >= 0", path,
@@ -486,6 +493,13 @@ lx_status lx_image_write(const char *path, const lx_image *img, const lx_image_w
     case LX_IMAGE_EXR:
         s = lx_img_write_exr(f.fp, path, img, exposure, d.half, d.threads, &progress);
         break;
+    case LX_IMAGE_PNG:
+        if (d.bits == 16) {
+            s = lx_img_write_png16(f.fp, path, img, exposure, d.tonemap, d.linear, d.threads,
+                                   &progress);
+            break;
+        }
+        /* fall through */
     default:
         s = lx_img_write_stb(f.fp, path, img, format, exposure, d.tonemap, d.linear, d.threads,
                                  &progress);

@@ -85,6 +85,14 @@ LX_IMG_HIDDEN unsigned char *lx_img_png_encode(const unsigned char *pixels, int 
                                                int channels, int threads, lx_img_progress *progress,
                                                int *out_len);
 
+/* A 16-bit PNG of img (1..4 channels): colour values exposed, put through
+ * tonemap and stored as round(65535 v) of their sRGB encoding (or of v
+ * itself with linear); alpha as round(65535 a). As lx_img_write_stb
+ * otherwise (progress, cancel, threads, checked input). */
+LX_IMG_HIDDEN lx_status lx_img_write_png16(FILE *fp, const char *path, const lx_image *img,
+                                           float exposure, lx_tonemap tonemap, bool linear,
+                                           int threads, lx_img_progress *progress);
+
 /* The bound below which stb's RGBE encoder keeps its exponent byte in
  * range (2^127). */
 #define LX_RGBE_LIMIT 0x1p127f
