@@ -74,6 +74,24 @@ check "step: the wall's top sees nothing higher" [ "$(printf '%s\n' "${vals[@]:1
 check "step: the foot of the wall is occluded" awk -v v="${vals[15]}" 'BEGIN { exit !(v < 0.9) }'
 run "$LUXEL" aomap "$IN/flat.pfm" -o "$WORK/flat-ao.png" -q
 check "aomap writes a PNG" [ "$(magic "$WORK/flat-ao.png" 8)" = 89504e470d0a1a0a ]
+# PNG bit depth: byte 25 of the file (IHDR's bit depth, after the 8-byte
+# signature, the chunk's length and type, width and height)
+depth() { head -c 25 "$1" | tail -c 1 | od -An -tu1 | tr -d ' '; }
+check "aomap: 8-bit PNG by default" [ "$(depth "$WORK/flat-ao.png")" = 8 ]
+run "$LUXEL" aomap "$IN/flat.pfm" -o "$WORK/flat-ao16.png" -q --bits 16
+expect_rc 0 "aomap --bits 16"
+check "aomap --bits 16: a 16-bit PNG" [ "$(depth "$WORK/flat-ao16.png")" = 16 ]
+# the 16-bit file is one luxel reads again
+run "$LUXEL" aomap "$WORK/flat-ao16.png" -o "$WORK/reread.pfm" -q
+check "a 16-bit PNG luxel wrote loads back as a height image" [ "$RC" -eq 0 ]
+run "$LUXEL" horizonmap "$IN/step.pfm" -o "$WORK/h16" -q --bits 16
+expect_rc 0 "horizonmap --bits 16"
+for f in horizon0.png horizon1.png; do
+    check "horizonmap --bits 16: $f is a 16-bit PNG" [ "$(depth "$WORK/h16/$f")" = 16 ]
+done
+run "$LUXEL" aomap "$IN/flat.pfm" -o "$WORK/bad5.png" --bits 12
+expect_rc 2 "--bits 12"
+expect_error "--bits 12" "--bits" "12"
 
 # ---- bad input -------------------------------------------------------------------
 run "$LUXEL" horizonmap "$IN/missing.png" -o "$WORK/bad1"

@@ -25,7 +25,7 @@ static const char *ao_usage =
     "  --radius R         search radius in texels, 2..256 (default 16)\n"
     "  --wrap MODE        texels outside the image: repeat, clamp or mirror\n"
     "                     (default repeat, for tiling textures)\n"
-    "  --bits 8|16        PNG bit depth (default 8; 16 is not available yet)\n"
+    "  --bits 8|16        PNG bit depth (default 8; .exr and .pfm are float)\n"
     "  --threads N        worker threads (default: all cores)\n"
     "  -q, --quiet        no progress bar, no summary\n"
     "  -v, --verbose      phase times\n"
@@ -55,6 +55,7 @@ int cmd_aomap(int argc, char **argv)
     cli_progress progress;
     cli_progress_init(&progress, "write", o.quiet);
     lx_image_write_desc wd = {.linear = true,
+                              .bits = format == LX_IMAGE_PNG ? o.bits : 0,
                               .threads = o.desc.threads,
                               .progress = cli_progress_update,
                               .progress_user = &progress};

@@ -35,7 +35,7 @@ static const char *horizon_usage =
     "  --radius R         search radius in texels, 2..256 (default 16)\n"
     "  --wrap MODE        texels outside the image: repeat, clamp or mirror\n"
     "                     (default repeat, for tiling textures)\n"
-    "  --bits 8|16        PNG bit depth (default 8; 16 is not available yet)\n"
+    "  --bits 8|16        PNG bit depth (default 8)\n"
     "  --threads N        worker threads (default: all cores)\n"
     "  -q, --quiet        no progress bar, no summary\n"
     "  -v, --verbose      phase times\n"
@@ -102,9 +102,6 @@ int cli_horizon_args(const char *command, int argc, char **argv, cli_horizon_opt
         case OPT_BITS:
             if (!cli_parse_int(optarg, 8, 16, &n) || (n != 8 && n != 16))
                 return cli_usage_error(command, "--bits must be 8 or 16, not '%s'", optarg);
-            if (n == 16)
-                return cli_usage_error(command, "--bits 16: 16-bit PNG output is not available "
-                                                "in this build yet");
             o->bits = (int)n;
             break;
         case OPT_POWER:
@@ -214,7 +211,7 @@ int cmd_horizonmap(int argc, char **argv)
         cli_error("%s", lx_last_error());
         goto done;
     }
-    lx_image_write_desc wd = {.linear = true, .threads = o.desc.threads};
+    lx_image_write_desc wd = {.linear = true, .bits = o.bits, .threads = o.desc.threads};
     for (int k = 0; k < 3; k++)
         if (!cli_stage_image(&st, names[k], &img[k], &wd))
             goto done;
