@@ -49,6 +49,7 @@ bench: all
 	$(BUILD)/bin/bench_ibl
 	$(BUILD)/bin/bench_unwrap
 	$(BUILD)/bin/bench_render
+	$(BUILD)/bin/bench_maps
 	$(BUILD)/bin/bench_horizon
 
 fuzz: all

@@ -288,6 +288,34 @@ static bool inflate_check(const unsigned char *d, size_t size, bool zlib_header)
     return ret == Z_STREAM_END;
 }
 
+/* The IHDR chunk's size, bit depth and colour type (PNG specification,
+ * table 11.1), named in the message where stb would only say "unknown
+ * image type". A file too short for IHDR is stb's to report. */
+static lx_status check_png_header(const unsigned char *d, size_t size, const char *name)
+{
+    if (size < 8 + 8 + 13 || memcmp(d + 12, "IHDR", 4) != 0)
+        return LX_OK;
+    uint32_t w = (uint32_t)d[16] << 24 | (uint32_t)d[17] << 16 | (uint32_t)d[18] << 8 | d[19];
+    uint32_t h = (uint32_t)d[20] << 24 | (uint32_t)d[21] << 16 | (uint32_t)d[22] << 8 | d[23];
+    int depth = d[24], type = d[25];
+    if (w == 0 || h == 0)
+        return lx_fail(LX_ERR_FORMAT, "%s: the image has no pixels (%ux%u)", name, w, h);
+    /* the depths each colour type allows, as bits 1, 2, 4, 8, 16 */
+    int allowed;
+    switch (type) {
+    case 0: allowed = 1 | 2 | 4 | 8 | 16; break;
+    case 3: allowed = 1 | 2 | 4 | 8; break;
+    case 2: case 4: case 6: allowed = 8 | 16; break;
+    default:
+        return lx_fail(LX_ERR_FORMAT, "%s: unknown PNG colour type %d", name, type);
+    }
+    bool power = depth == 1 || depth == 2 || depth == 4 || depth == 8 || depth == 16;
+    if (!power || !(allowed & depth))
+        return lx_fail(LX_ERR_UNSUPPORTED,
+                       "%s: unsupported bit depth %d for PNG colour type %d", name, depth, type);
+    return LX_OK;
+}
+
 /* Gathers the IDAT chunks (the one zlib stream stb inflates) and checks it.
  * A "CgBI" chunk (Apple's PNG variant) means a raw stream without the
  * 2-byte zlib header, as stb reads it. */
@@ -339,8 +367,11 @@ lx_status lx_img_load_stb(const unsigned char *data, size_t size, const char *na
     lx_status s = LX_OK;
     if (size >= 3 && data[0] == 0xff && data[1] == 0xd8 && data[2] == 0xff)
         s = check_jpeg(data, size, name);
-    else if (size >= 8 && memcmp(data, "\x89PNG\r\n\x1a\n", 8) == 0)
-        s = check_png_data(data, size, name);
+    else if (size >= 8 && memcmp(data, "\x89PNG\r\n\x1a\n", 8) == 0) {
+        s = check_png_header(data, size, name);
+        if (s == LX_OK)
+            s = check_png_data(data, size, name);
+    }
     else if (is_tga)
         s = check_tga_size(data, size, name);
     if (s != LX_OK)

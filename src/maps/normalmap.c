@@ -288,8 +288,8 @@ lx_status lx_normal_decode(const lx_image *encoded, const char *name, lx_image *
     if (!encoded || !encoded->data || encoded->width < 1 || encoded->height < 1)
         return lx_fail(LX_ERR_FORMAT, "%s: the image has no pixels", name);
     if (encoded->channels < 3)
-        return lx_fail(LX_ERR_FORMAT, "%s: %d channels; a normal map needs RGB or RGBA", name,
-                       encoded->channels);
+        return lx_fail(LX_ERR_FORMAT, "%s: %d channel%s; a normal map needs RGB or RGBA", name,
+                       encoded->channels, encoded->channels == 1 ? "" : "s");
     lx_status s = lx_image_alloc(out, encoded->width, encoded->height, 3);
     if (s != LX_OK)
         return s;

@@ -4,6 +4,7 @@
  * hooks. */
 #define _POSIX_C_SOURCE 200809L
 #include "cli.h"
+#include "maps_cli.h"
 
 #include <errno.h>
 #include <math.h>
@@ -31,6 +32,11 @@ static const char *main_usage =
     "                SH, prefiltered specular mips, DFG table; faces/cross/KTX\n"
     "  render SCENE  a camera view of a scene with its baked lightmaps (PNG)\n"
     "  unwrap SCENE  make lightmap UVs and write the scene with them (.glb)\n"
+    "  normalmap HEIGHT\n"
+    "                tangent-space normal map of a height image;\n"
+    "                --blend BASE DETAIL blends two normal maps\n"
+    "  parallaxmap HEIGHT\n"
+    "                the parallax map n.z h of a height image\n"
     "  horizonmap HEIGHT\n"
     "                horizon maps of a height image (bumps that shadow\n"
     "                themselves) and their weight cube\n"
@@ -415,6 +421,7 @@ int main(int argc, char **argv)
         int (*run)(int argc, char **argv);
     } commands[] = {{"bake", cmd_bake},     {"info", cmd_info},     {"ies", cmd_ies},
                     {"ibl", cmd_ibl},       {"render", cmd_render}, {"unwrap", cmd_unwrap},
+                    {"normalmap", cmd_normalmap}, {"parallaxmap", cmd_parallaxmap},
                     {"horizonmap", cmd_horizonmap}, {"aomap", cmd_aomap}};
     for (size_t i = 0; i < sizeof commands / sizeof commands[0]; i++)
         if (strcmp(cmd, commands[i].name) == 0) {
