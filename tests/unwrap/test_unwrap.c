@@ -182,7 +182,10 @@ static void cylinder_caps_are_planar_charts(void **state)
     lx_scene_destroy(scene);
 }
 
-/* A bumpy height field: one surface, cut where it stretches. */
+/* A bumpy height field: one surface, cut where it stretches. Its
+ * projection stretches little (L2 1.003), so it is kept, as xatlas keeps
+ * it: angles then err as a projection's do (xatlas's UVs of the 10k
+ * terrain measure 0.0376 rad by this oracle, luxel's 0.0376). */
 static void terrain_is_cut_where_it_stretches(void **state)
 {
     (void)state;
@@ -192,8 +195,10 @@ static void terrain_is_cut_where_it_stretches(void **state)
     free(ground.indices);
     lx_unwrap_desc d = desc_at(12.0f);
     lx_unwrap *u;
-    /* measured: mean angle error 0.0084 rad, area 3.8e-9, efficiency 0.82 */
-    check(scene, &d, (expect){0.025, 1.2e-8, 0.7}, &u);
+    /* measured: mean angle error 0.0375 rad, area 3.8e-9, efficiency 0.969
+     * (one chart, a 128 x 128 page) */
+    check(scene, &d, (expect){0.06, 1.2e-8, 0.9}, &u);
+    assert_int_equal(u->stats.charts, 1);
     assert_true(u->stats.stretch_max <= d.max_stretch);
     lx_unwrap_destroy(u);
     lx_scene_destroy(scene);
