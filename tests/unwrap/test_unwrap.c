@@ -137,11 +137,14 @@ static void box_faces_are_isometric(void **state)
     lx_test_mesh_free(&box);
     lx_unwrap_desc d = desc_at(20.0f);
     lx_unwrap *u;
-    /* measured: mean angle error 1.6e-8 rad (float UVs), worst 3.8e-8;
-     * area 7.6e-9; efficiency 0.63 */
-    lx_uv_report r = check(scene, &d, (expect){1e-7, 3e-8, 0.55}, &u);
+    /* measured on a 56 x 76 page: mean angle error 2.5e-8 rad, worst
+     * 1.0e-7; area 6.2e-8 (1.6e-8, 3.8e-8 and 7.6e-9 on an earlier
+     * layout). Both are the page UVs' float rounding, at most 2^-25 of the
+     * page side a coordinate: 4.5e-7 rad on a 10-texel edge and 9e-7 of
+     * this box's area at worst. Efficiency 0.63. */
+    lx_uv_report r = check(scene, &d, (expect){1e-7, 2e-7, 0.55}, &u);
     assert_int_equal(r.charts, 6);
-    assert_true(r.angle_max < 1e-7);
+    assert_true(r.angle_max < 3e-7);
     assert_int_equal(u->stats.recut_charts, 0);
     assert_true(u->stats.stretch_max == 1.0);
     lx_unwrap_destroy(u);
