@@ -1,5 +1,8 @@
 /* Flattening a chart. Planar charts are projected onto their plane
- * (isometric). Curved charts take least-squares conformal maps (Levy,
+ * (isometric). A curved chart keeps its projection when that serves
+ * (xatlas's rule: nothing turned over or crossing, L2 stretch at most 1.1,
+ * no triangle's above 1.25); otherwise it takes least-squares conformal
+ * maps (Levy,
  * Petitjean, Ray and Maillot, "Least Squares Conformal Maps for Automatic
  * Texture Atlas Generation", SIGGRAPH 2002): the piecewise-linear map whose
  * gradients come closest to the Cauchy-Riemann equations, in the least-

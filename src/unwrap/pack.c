@@ -2,8 +2,10 @@
  * rasterized into the texels its triangles overlap, grown by the padding
  * (the rings it owns), and placed, upright or turned a quarter, where its
  * grown footprint meets no other one: the first hole inside the page's
- * used extent, else the place that grows the extent least (xatlas's
- * measure: the square of the larger side plus the area). Charts go largest first. A node's charts
+ * used extent, else the place that grows the extent least (the square of
+ * the larger side plus k times the area; xatlas's measure is k = 1).
+ * Charts go largest first. The packing runs for k = 1, 4 and 1000 and
+ * keeps the attempt covering the largest share of its pages. A node's charts
  * share one page: nodes are dealt to pages by area, and a node whose chart does not fit moves, all
  * its charts with it, to the next page. Footprints are kept as runs of texels per row, so charts
  * interlock and small ones fill the holes of rings. */
