@@ -1,5 +1,8 @@
 /* Flattening a chart. Planar charts are projected onto their plane
- * (isometric). Curved charts take least-squares conformal maps (Levy,
+ * (isometric). A curved chart keeps its projection when that serves
+ * (xatlas's rule: nothing turned over or crossing, L2 stretch at most 1.1,
+ * no triangle's above 1.25); otherwise it takes least-squares conformal
+ * maps (Levy,
  * Petitjean, Ray and Maillot, "Least Squares Conformal Maps for Automatic
  * Texture Atlas Generation", SIGGRAPH 2002): the piecewise-linear map whose
  * gradients come closest to the Cauchy-Riemann equations, in the least-
@@ -314,9 +317,11 @@ static double signed_area(const double *uv, const uint32_t *tri)
  * triangles of (1/s1^2 + 1/s2^2) / 2, s1 and s2 the singular values of
  * the map from the surface to the plane (those of the inverse map, plane
  * to surface, are 1/s). 1 for an isometry once areas are equal. */
-static double l2_stretch(const uw_mesh *m, const uw_chart *c)
+static double l2_stretch(const uw_mesh *m, const uw_chart *c, double *worst)
 {
     double sum = 0.0, area = 0.0;
+    if (worst)
+        *worst = 0.0;
     for (uint32_t i = 0; i < c->triangle_count; i++) {
         const uint32_t *idx = &m->indices[3 * c->triangles[i]];
         const uint32_t *cv = &c->corners[3 * i];
@@ -337,6 +342,12 @@ static double l2_stretch(const uw_mesh *m, const uw_chart *c)
             st[k] = (d2[k] * s1 - d1[k] * s2) / det;
         }
         double a = dot3(ss, ss), cc = dot3(st, st);
+        if (worst) {
+            /* the larger singular value of [ss st]: the most a unit of uv
+             * stretches to on the surface */
+            double b = dot3(ss, st), half = 0.5 * (a + cc), dif = 0.5 * (a - cc);
+            *worst = fmax(*worst, sqrt(half + sqrt(dif * dif + b * b)));
+        }
         double w = m->area[c->triangles[i]];
         sum += w * 0.5 * (a + cc);
         area += w;
@@ -560,6 +571,45 @@ static bool fit_box(uw_chart *c)
 
 /* ---- flattening ---------------------------------------------------------- */
 
+#define ORTHO_STRETCH 1.1 /* xatlas's limits for keeping a projection */
+#define ORTHO_WORST 1.25
+
+/* Every triangle the right way up, then the uv scaled to the chart's
+ * surface area; false when a triangle is not. */
+static bool scale_to_area(uw_chart *c)
+{
+    double uv_area = 0.0;
+    for (uint32_t i = 0; i < c->triangle_count; i++) {
+        double a = signed_area(c->uv, &c->corners[3 * i]);
+        if (!(a > 0.0) || !isfinite(a))
+            return false;
+        uv_area += a;
+    }
+    double scale = sqrt(c->area / uv_area);
+    if (!isfinite(scale) || !(scale > 0.0))
+        return false;
+    for (uint32_t v = 0; v < 2 * c->vertex_count; v++)
+        c->uv[v] *= scale;
+    return true;
+}
+
+/* Whether c's projection (in c->uv) serves as its flattening: 1 (uv
+ * scaled, c->stretch set), 0, or -1 out of memory. */
+static int projection_serves(const uw_mesh *m, uw_chart *c, double max_stretch)
+{
+    if (!scale_to_area(c))
+        return 0;
+    double worst;
+    double stretch = l2_stretch(m, c, &worst);
+    if (!(stretch <= ORTHO_STRETCH && stretch <= max_stretch && worst <= ORTHO_WORST))
+        return 0;
+    int crosses = border_crosses(m, c);
+    if (crosses)
+        return crosses < 0 ? -1 : 0;
+    c->stretch = stretch;
+    return 1;
+}
+
 bool uw_flatten(const uw_mesh *m, uw_chart *c, double max_stretch, lx_status *status)
 {
     *status = LX_OK;
@@ -585,7 +635,17 @@ bool uw_flatten(const uw_mesh *m, uw_chart *c, double max_stretch, lx_status *st
     for (uint32_t i = 0; i < c->triangle_count && planar; i++)
         planar = dot3(m->normal[c->triangles[i]], normal) >= PLANAR_COS;
     project(m, c, normal, c->uv);
-    if (!planar) {
+    /* A curved chart keeps its projection when that serves (xatlas's
+     * rule): nothing turned over or crossing, L2 stretch at most
+     * ORTHO_STRETCH and no triangle stretched beyond ORTHO_WORST. It fills
+     * its box as the surface does and needs no solve. */
+    int ortho = planar ? 1 : projection_serves(m, c, max_stretch);
+    if (ortho < 0) {
+        *status = lx_fail(LX_ERR_NOMEM, "out of memory flattening charts");
+        return false;
+    }
+    if (!ortho) {
+        project(m, c, normal, c->uv);
         /* pins: two vertices far apart (farthest from the first vertex,
          * then farthest from that one), held where the projection puts
          * them; they fix the similarity the conformal map is free in */
@@ -623,29 +683,20 @@ bool uw_flatten(const uw_mesh *m, uw_chart *c, double max_stretch, lx_status *st
             return false;
         }
     }
-    /* every triangle the right way up, and the area kept */
-    double uv_area = 0.0;
-    for (uint32_t i = 0; i < c->triangle_count; i++) {
-        double a = signed_area(c->uv, &c->corners[3 * i]);
-        if (!(a > 0.0) || !isfinite(a))
+    if (planar || !ortho) {
+        if (!scale_to_area(c))
             return false;
-        uv_area += a;
+        c->stretch = planar ? 1.0 : l2_stretch(m, c, NULL);
+        if (!(c->stretch <= max_stretch))
+            return false;
+        int crosses = border_crosses(m, c);
+        if (crosses < 0) {
+            *status = lx_fail(LX_ERR_NOMEM, "out of memory flattening charts");
+            return false;
+        }
+        if (crosses)
+            return false;
     }
-    double scale = sqrt(c->area / uv_area);
-    if (!isfinite(scale) || !(scale > 0.0))
-        return false;
-    for (uint32_t v = 0; v < 2 * c->vertex_count; v++)
-        c->uv[v] *= scale;
-    c->stretch = planar ? 1.0 : l2_stretch(m, c);
-    if (!(c->stretch <= max_stretch))
-        return false;
-    int crosses = border_crosses(m, c);
-    if (crosses < 0) {
-        *status = lx_fail(LX_ERR_NOMEM, "out of memory flattening charts");
-        return false;
-    }
-    if (crosses)
-        return false;
     if (!fit_box(c)) {
         *status = lx_fail(LX_ERR_NOMEM, "out of memory flattening charts");
         return false;

@@ -2,8 +2,10 @@
  * rasterized into the texels its triangles overlap, grown by the padding
  * (the rings it owns), and placed, upright or turned a quarter, where its
  * grown footprint meets no other one: the first hole inside the page's
- * used extent, else the place that grows the extent least (xatlas's
- * measure: the square of the larger side plus the area). Charts go largest first. A node's charts
+ * used extent, else the place that grows the extent least (the square of
+ * the larger side plus k times the area; xatlas's measure is k = 1).
+ * Charts go largest first. The packing runs for k = 1, 4 and 1000 and
+ * keeps the attempt covering the largest share of its pages. A node's charts
  * share one page: nodes are dealt to pages by area, and a node whose chart does not fit moves, all
  * its charts with it, to the next page. Footprints are kept as runs of texels per row, so charts
  * interlock and small ones fill the holes of rings. */
@@ -207,6 +209,7 @@ typedef struct page {
     int *rightmost;     /* per row: its last taken texel, -1 when none */
     int cursor;         /* holes are sought from this row on (see find_place) */
     int cursor_class;   /* the size class the cursor belongs to */
+    double area_weight; /* of the extent's area in the growth measure */
     int *inner;         /* per row: its longest free run left of rightmost */
     int used_w, used_h; /* extent of the placed footprints */
     uint32_t *nodes;    /* nodes dealt to the page */
@@ -345,7 +348,7 @@ static void consider(const page *p, const shape *s, int o, int x, int y, placeme
     int w = p->used_w > x + s->fw ? p->used_w : x + s->fw;
     int h = p->used_h > y + s->fh ? p->used_h : y + s->fh;
     int side = w > h ? w : h;
-    double metric = (double)side * side + (double)w * h;
+    double metric = (double)side * side + p->area_weight * w * h;
     if (metric < best->metric)
         *best = (placement){x, y, o, metric};
 }
@@ -416,6 +419,7 @@ typedef struct packer {
     page *pages;
     uint32_t page_count;
     int pad, size;
+    double area_weight; /* the growth measure of this attempt */
 } packer;
 
 static page *add_page(packer *k)
@@ -430,6 +434,7 @@ static page *add_page(packer *k)
     p->words = (k->size + 63) / 64;
     p->bits = calloc((size_t)p->words * p->size, sizeof(uint64_t));
     p->cursor_class = INT32_MIN;
+    p->area_weight = k->area_weight;
     p->rightmost = malloc(sizeof(int) * p->size);
     p->inner = calloc((size_t)p->size, sizeof(int));
     if (!p->bits || !p->rightmost || !p->inner) {
@@ -515,6 +520,179 @@ static void page_extent(packer *k, page *p, uint32_t pi)
     }
 }
 
+/* One attempt: deals the nodes to fresh pages and places every item,
+ * largest first, with the growth measure k->area_weight. */
+static lx_status place_all(packer *k, uw_item *items, uint32_t item_count,
+                           const uw_pack_desc *desc, const double *node_area, uint32_t *too_big,
+                           float from, float to)
+{
+    lx_status st = LX_OK;
+    for (uint32_t i = 0; i < item_count; i++)
+        items[i].page = UW_NONE;
+    /* deal nodes to pages by area, largest node first */
+    uint32_t *nodes = malloc(sizeof(uint32_t) * (k->node_count ? k->node_count : 1));
+    if (!nodes) {
+        st = lx_fail(LX_ERR_NOMEM, "out of memory packing charts");
+        return st;
+    }
+    uint32_t nn = 0;
+    for (uint32_t n = 0; n < k->node_count; n++) {
+        k->node_page[n] = UW_NONE;
+        if (node_area[n] > 0.0)
+            nodes[nn++] = n;
+    }
+    for (uint32_t i = 1; i < nn; i++) /* insertion sort: node counts are small */
+        for (uint32_t j = i;
+             j > 0 && (node_area[nodes[j]] > node_area[nodes[j - 1]] ||
+                       (node_area[nodes[j]] == node_area[nodes[j - 1]] && nodes[j] < nodes[j - 1]));
+             j--) {
+            uint32_t t = nodes[j];
+            nodes[j] = nodes[j - 1];
+            nodes[j - 1] = t;
+        }
+    double capacity = FILL_ESTIMATE * (double)k->size * k->size;
+    for (uint32_t i = 0; i < nn; i++) {
+        uint32_t n = nodes[i], p = 0;
+        while (p < k->page_count && (desc->page_per_node || (k->pages[p].planned > 0.0 &&
+                                                            k->pages[p].planned + node_area[n] >
+                                                                capacity)))
+            p++;
+        if (p == k->page_count && !add_page(k)) {
+            free(nodes);
+            st = lx_fail(LX_ERR_NOMEM, "out of memory packing charts");
+            return st;
+        }
+        if (!page_add_node(&k->pages[p], n, node_area[n])) {
+            free(nodes);
+            st = lx_fail(LX_ERR_NOMEM, "out of memory packing charts");
+            return st;
+        }
+        k->node_page[n] = p;
+    }
+    free(nodes);
+    /* pack page by page; a node that does not fit moves on */
+    uint32_t placed = 0;
+    for (uint32_t pi = 0; pi < k->page_count; pi++) {
+        for (uint32_t oi = 0; oi < item_count; oi++) {
+            uint32_t i = k->order[oi];
+            uw_item *it = &items[i];
+            if (k->node_page[it->node] != pi || it->page != UW_NONE)
+                continue;
+            page *p = &k->pages[pi];
+            placement best;
+            if (find_place(p, k->shapes[i], item_count > MANY_CHARTS, &best)) {
+                it->page = pi;
+                it->x = best.x;
+                it->y = best.y;
+                it->dx = k->shapes[i][best.turned].dx;
+                it->dy = k->shapes[i][best.turned].dy;
+                it->turned = best.turned;
+                stamp(p, &k->shapes[i][best.turned], best.x, best.y, true);
+                const shape *s = &k->shapes[i][best.turned];
+                p->used_w = best.x + s->fw > p->used_w ? best.x + s->fw : p->used_w;
+                p->used_h = best.y + s->fh > p->used_h ? best.y + s->fh : p->used_h;
+                placed++;
+            } else {
+                /* the node moves to the next page with all its items */
+                uint32_t node = it->node;
+                bool alone = true;
+                for (uint32_t j = 0; j < p->node_count; j++)
+                    alone = alone && p->nodes[j] == node;
+                if (alone) {
+                    *too_big = node;
+                    st = lx_fail(LX_ERR_UNSUPPORTED, "node %u: its charts do not fit in one page",
+                                 node);
+                    return st;
+                }
+                for (uint32_t j = 0; j < item_count; j++)
+                    if (items[j].node == node && items[j].page == pi) {
+                        stamp(p, &k->shapes[j][items[j].turned], items[j].x, items[j].y, false);
+                        items[j].page = UW_NONE;
+                        placed--;
+                    }
+                page_extent(k, p, pi);
+                p->cursor = 0;
+                if (pi + 1 == k->page_count && !add_page(k)) {
+                    st = lx_fail(LX_ERR_NOMEM, "out of memory packing charts");
+                    return st;
+                }
+                p = &k->pages[pi];
+                if (!page_add_node(&k->pages[pi + 1], node, node_area[node])) {
+                    st = lx_fail(LX_ERR_NOMEM, "out of memory packing charts");
+                    return st;
+                }
+                k->node_page[node] = pi + 1;
+            }
+            if (desc->progress && (placed & 63) == 0) {
+                float f = from + (to - from) * (float)placed / (float)(item_count ? item_count : 1);
+                if (!desc->progress(desc->progress_user, f)) {
+                    st = lx_fail(LX_ERR_CANCELLED, "cancelled");
+                    return st;
+                }
+            }
+        }
+    }
+    return st;
+}
+
+/* The pages of an attempt: cropped sizes, items renumbered. */
+static lx_status crop_pages(packer *k, uw_item *items, uint32_t item_count,
+                            lx_unwrap_page **pages_out, uint32_t *page_count_out)
+{
+    lx_status st = LX_OK;
+    /* crop: the outer padding goes (nothing outside a page is sampled) */
+    lx_unwrap_page *out = calloc(k->page_count ? k->page_count : 1, sizeof *out);
+    if (!out) {
+        st = lx_fail(LX_ERR_NOMEM, "out of memory packing charts");
+        return st;
+    }
+    uint32_t used_pages = 0;
+    uint32_t *renumber = malloc(sizeof(uint32_t) * (k->page_count ? k->page_count : 1));
+    if (!renumber) {
+        free(out);
+        st = lx_fail(LX_ERR_NOMEM, "out of memory packing charts");
+        return st;
+    }
+    for (uint32_t pi = 0; pi < k->page_count; pi++) {
+        const page *p = &k->pages[pi];
+        renumber[pi] = UW_NONE;
+        if (p->used_w == 0)
+            continue;
+        int w = p->used_w - 2 * k->pad, h = p->used_h - 2 * k->pad;
+        w = w < 1 ? 1 : w;
+        h = h < 1 ? 1 : h;
+        out[used_pages].width = (w + 3) / 4 * 4;
+        out[used_pages].height = (h + 3) / 4 * 4;
+        renumber[pi] = used_pages++;
+    }
+    for (uint32_t i = 0; i < item_count; i++) {
+        uw_item *it = &items[i];
+        it->page = renumber[it->page];
+        out[it->page].covered_texels += it->covered;
+        out[it->page].chart_count++;
+        /* page texel of uv (0, 0): the footprint's corner, less the
+         * cropped outer padding, plus the item's own padding */
+        it->covered = k->shapes[i][it->turned].covered;
+    }
+    free(renumber);
+    *pages_out = out;
+    *page_count_out = used_pages;
+    return LX_OK;
+}
+
+static void pages_free(packer *k)
+{
+    for (uint32_t p = 0; p < k->page_count; p++) {
+        free(k->pages[p].bits);
+        free(k->pages[p].rightmost);
+        free(k->pages[p].inner);
+        free(k->pages[p].nodes);
+    }
+    free(k->pages);
+    k->pages = NULL;
+    k->page_count = 0;
+}
+
 lx_status uw_pack(uw_item *items, uint32_t item_count, const uw_pack_desc *desc,
                   lx_unwrap_page **pages_out, uint32_t *page_count_out, uint32_t *too_big)
 {
@@ -567,148 +745,66 @@ lx_status uw_pack(uw_item *items, uint32_t item_count, const uw_pack_desc *desc,
         k.order[i] = i;
     }
     sort_items(k.order, item_count, &k);
-    /* deal nodes to pages by area, largest node first */
-    uint32_t *nodes = malloc(sizeof(uint32_t) * (node_count ? node_count : 1));
-    if (!nodes) {
-        st = lx_fail(LX_ERR_NOMEM, "out of memory packing charts");
-        goto done;
-    }
-    uint32_t nn = 0;
-    for (uint32_t n = 0; n < node_count; n++) {
-        k.node_page[n] = UW_NONE;
-        if (node_area[n] > 0.0)
-            nodes[nn++] = n;
-    }
-    for (uint32_t i = 1; i < nn; i++) /* insertion sort: node counts are small */
-        for (uint32_t j = i;
-             j > 0 && (node_area[nodes[j]] > node_area[nodes[j - 1]] ||
-                       (node_area[nodes[j]] == node_area[nodes[j - 1]] && nodes[j] < nodes[j - 1]));
-             j--) {
-            uint32_t t = nodes[j];
-            nodes[j] = nodes[j - 1];
-            nodes[j - 1] = t;
-        }
-    double capacity = FILL_ESTIMATE * (double)k.size * k.size;
-    for (uint32_t i = 0; i < nn; i++) {
-        uint32_t n = nodes[i], p = 0;
-        while (p < k.page_count && (desc->page_per_node || (k.pages[p].planned > 0.0 &&
-                                                            k.pages[p].planned + node_area[n] >
-                                                                capacity)))
-            p++;
-        if (p == k.page_count && !add_page(&k)) {
-            free(nodes);
-            st = lx_fail(LX_ERR_NOMEM, "out of memory packing charts");
-            goto done;
-        }
-        if (!page_add_node(&k.pages[p], n, node_area[n])) {
-            free(nodes);
-            st = lx_fail(LX_ERR_NOMEM, "out of memory packing charts");
-            goto done;
-        }
-        k.node_page[n] = p;
-    }
-    free(nodes);
-    /* pack page by page; a node that does not fit moves on */
-    uint32_t placed = 0;
-    for (uint32_t pi = 0; pi < k.page_count; pi++) {
-        for (uint32_t oi = 0; oi < item_count; oi++) {
-            uint32_t i = k.order[oi];
-            uw_item *it = &items[i];
-            if (k.node_page[it->node] != pi || it->page != UW_NONE)
-                continue;
-            page *p = &k.pages[pi];
-            placement best;
-            if (find_place(p, k.shapes[i], item_count > MANY_CHARTS, &best)) {
-                it->page = pi;
-                it->x = best.x;
-                it->y = best.y;
-                it->dx = k.shapes[i][best.turned].dx;
-                it->dy = k.shapes[i][best.turned].dy;
-                it->turned = best.turned;
-                stamp(p, &k.shapes[i][best.turned], best.x, best.y, true);
-                const shape *s = &k.shapes[i][best.turned];
-                p->used_w = best.x + s->fw > p->used_w ? best.x + s->fw : p->used_w;
-                p->used_h = best.y + s->fh > p->used_h ? best.y + s->fh : p->used_h;
-                placed++;
-            } else {
-                /* the node moves to the next page with all its items */
-                uint32_t node = it->node;
-                bool alone = true;
-                for (uint32_t j = 0; j < p->node_count; j++)
-                    alone = alone && p->nodes[j] == node;
-                if (alone) {
-                    *too_big = node;
-                    st = lx_fail(LX_ERR_UNSUPPORTED, "node %u: its charts do not fit in one page",
-                                 node);
-                    goto done;
-                }
-                for (uint32_t j = 0; j < item_count; j++)
-                    if (items[j].node == node && items[j].page == pi) {
-                        stamp(p, &k.shapes[j][items[j].turned], items[j].x, items[j].y, false);
-                        items[j].page = UW_NONE;
-                        placed--;
-                    }
-                page_extent(&k, p, pi);
-                p->cursor = 0;
-                if (pi + 1 == k.page_count && !add_page(&k)) {
-                    st = lx_fail(LX_ERR_NOMEM, "out of memory packing charts");
-                    goto done;
-                }
-                p = &k.pages[pi];
-                if (!page_add_node(&k.pages[pi + 1], node, node_area[node])) {
-                    st = lx_fail(LX_ERR_NOMEM, "out of memory packing charts");
-                    goto done;
-                }
-                k.node_page[node] = pi + 1;
+    /* Attempts with growth measures from square-first to area-first; the
+     * one covering the largest share of its pages wins (ties: the
+     * earlier). Each is deterministic, so the result is too. */
+    static const double weights[] = {1.0, 4.0, 1000.0};
+    const int attempts = (int)(sizeof weights / sizeof weights[0]);
+    uw_item *best_items = NULL;
+    lx_unwrap_page *best_pages = NULL;
+    uint32_t best_count = 0;
+    double best_share = -1.0;
+    for (int a = 0; a < attempts && st == LX_OK; a++) {
+        pages_free(&k);
+        k.area_weight = weights[a];
+        float span = (desc->progress_to - desc->progress_from) / (float)attempts;
+        float from = desc->progress_from + span * (float)a;
+        st = place_all(&k, items, item_count, desc, node_area, too_big, from, from + span);
+        lx_unwrap_page *pages = NULL;
+        uint32_t count = 0;
+        if (st == LX_OK)
+            st = crop_pages(&k, items, item_count, &pages, &count);
+        if (st != LX_OK) {
+            /* a node too big for a page under one measure may fit under
+             * another; with nothing placed yet it is refused */
+            if (st == LX_ERR_UNSUPPORTED && best_pages && a + 1 < attempts) {
+                st = LX_OK;
+                *too_big = UW_NONE;
             }
-            if (desc->progress && (placed & 63) == 0) {
-                float f = desc->progress_from + (desc->progress_to - desc->progress_from) *
-                                                    (float)placed /
-                                                    (float)(item_count ? item_count : 1);
-                if (!desc->progress(desc->progress_user, f)) {
-                    st = lx_fail(LX_ERR_CANCELLED, "cancelled");
-                    goto done;
-                }
-            }
-        }
-    }
-    /* crop: the outer padding goes (nothing outside a page is sampled) */
-    lx_unwrap_page *out = calloc(k.page_count ? k.page_count : 1, sizeof *out);
-    if (!out) {
-        st = lx_fail(LX_ERR_NOMEM, "out of memory packing charts");
-        goto done;
-    }
-    uint32_t used_pages = 0;
-    uint32_t *renumber = malloc(sizeof(uint32_t) * (k.page_count ? k.page_count : 1));
-    if (!renumber) {
-        free(out);
-        st = lx_fail(LX_ERR_NOMEM, "out of memory packing charts");
-        goto done;
-    }
-    for (uint32_t pi = 0; pi < k.page_count; pi++) {
-        const page *p = &k.pages[pi];
-        renumber[pi] = UW_NONE;
-        if (p->used_w == 0)
             continue;
-        int w = p->used_w - 2 * k.pad, h = p->used_h - 2 * k.pad;
-        w = w < 1 ? 1 : w;
-        h = h < 1 ? 1 : h;
-        out[used_pages].width = (w + 3) / 4 * 4;
-        out[used_pages].height = (h + 3) / 4 * 4;
-        renumber[pi] = used_pages++;
+        }
+        double covered = 0.0, texels = 0.0;
+        for (uint32_t p = 0; p < count; p++) {
+            covered += pages[p].covered_texels;
+            texels += (double)pages[p].width * pages[p].height;
+        }
+        double share = texels > 0.0 ? covered / texels : 0.0;
+        if (share > best_share) {
+            if (!best_items)
+                best_items = malloc(sizeof *best_items * (item_count ? item_count : 1));
+            if (!best_items) {
+                free(pages);
+                st = lx_fail(LX_ERR_NOMEM, "out of memory packing charts");
+                break;
+            }
+            memcpy(best_items, items, sizeof *items * item_count);
+            free(best_pages);
+            best_pages = pages;
+            best_count = count;
+            best_share = share;
+        } else {
+            free(pages);
+        }
     }
-    for (uint32_t i = 0; i < item_count; i++) {
-        uw_item *it = &items[i];
-        it->page = renumber[it->page];
-        out[it->page].covered_texels += it->covered;
-        out[it->page].chart_count++;
-        /* page texel of uv (0, 0): the footprint's corner, less the
-         * cropped outer padding, plus the item's own padding */
-        it->covered = k.shapes[i][it->turned].covered;
+    if (st == LX_OK && best_pages) {
+        memcpy(items, best_items, sizeof *items * item_count);
+        *pages_out = best_pages;
+        *page_count_out = best_count;
+        *too_big = UW_NONE;
+    } else {
+        free(best_pages);
     }
-    free(renumber);
-    *pages_out = out;
-    *page_count_out = used_pages;
+    free(best_items);
 done:
     if (k.shapes)
         for (uint32_t i = 0; i < item_count; i++) {
@@ -719,12 +815,6 @@ done:
     free(k.order);
     free(k.node_page);
     free(node_area);
-    for (uint32_t p = 0; p < k.page_count; p++) {
-        free(k.pages[p].bits);
-        free(k.pages[p].rightmost);
-        free(k.pages[p].inner);
-        free(k.pages[p].nodes);
-    }
-    free(k.pages);
+    pages_free(&k);
     return st;
 }

@@ -137,11 +137,14 @@ static void box_faces_are_isometric(void **state)
     lx_test_mesh_free(&box);
     lx_unwrap_desc d = desc_at(20.0f);
     lx_unwrap *u;
-    /* measured: mean angle error 1.6e-8 rad (float UVs), worst 3.8e-8;
-     * area 7.6e-9; efficiency 0.63 */
-    lx_uv_report r = check(scene, &d, (expect){1e-7, 3e-8, 0.55}, &u);
+    /* measured on a 56 x 76 page: mean angle error 2.5e-8 rad, worst
+     * 1.0e-7; area 6.2e-8 (1.6e-8, 3.8e-8 and 7.6e-9 on an earlier
+     * layout). Both are the page UVs' float rounding, at most 2^-25 of the
+     * page side a coordinate: 4.5e-7 rad on a 10-texel edge and 9e-7 of
+     * this box's area at worst. Efficiency 0.725. */
+    lx_uv_report r = check(scene, &d, (expect){1e-7, 2e-7, 0.55}, &u);
     assert_int_equal(r.charts, 6);
-    assert_true(r.angle_max < 1e-7);
+    assert_true(r.angle_max < 3e-7);
     assert_int_equal(u->stats.recut_charts, 0);
     assert_true(u->stats.stretch_max == 1.0);
     lx_unwrap_destroy(u);
@@ -158,7 +161,7 @@ static void torus_is_conformal(void **state)
     free(torus.indices);
     lx_unwrap_desc d = desc_at(64.0f);
     lx_unwrap *u;
-    /* measured: mean angle error 0.0094 rad, area 8e-9, efficiency 0.59 */
+    /* measured: mean angle error 0.0094 rad, area 8e-9, efficiency 0.61 */
     check(scene, &d, (expect){0.03, 3e-8, 0.52}, &u);
     assert_true(u->stats.stretch_max <= d.max_stretch);
     assert_true(u->stats.stretch_mean >= 1.0);
@@ -176,13 +179,16 @@ static void cylinder_caps_are_planar_charts(void **state)
     free(cyl.indices);
     lx_unwrap_desc d = desc_at(40.0f);
     /* measured: mean angle error 2.8e-7 rad (a cylinder unrolls: LSCM is
-     * then isometric), area 2.4e-8, efficiency 0.76 */
+     * then isometric), area 2.4e-8, efficiency 0.83 */
     lx_uv_report r = check(scene, &d, (expect){1e-6, 1e-7, 0.65}, NULL);
     assert_true(r.charts >= 3);
     lx_scene_destroy(scene);
 }
 
-/* A bumpy height field: one surface, cut where it stretches. */
+/* A bumpy height field: one surface, cut where it stretches. Its
+ * projection stretches little (L2 1.003), so it is kept, as xatlas keeps
+ * it: angles then err as a projection's do (xatlas's UVs of the 10k
+ * terrain measure 0.0376 rad by this oracle, luxel's 0.0376). */
 static void terrain_is_cut_where_it_stretches(void **state)
 {
     (void)state;
@@ -192,8 +198,10 @@ static void terrain_is_cut_where_it_stretches(void **state)
     free(ground.indices);
     lx_unwrap_desc d = desc_at(12.0f);
     lx_unwrap *u;
-    /* measured: mean angle error 0.0084 rad, area 3.8e-9, efficiency 0.82 */
-    check(scene, &d, (expect){0.025, 1.2e-8, 0.7}, &u);
+    /* measured: mean angle error 0.0375 rad, area 3.8e-9, efficiency 0.969
+     * (one chart, a 128 x 128 page) */
+    check(scene, &d, (expect){0.06, 1.2e-8, 0.9}, &u);
+    assert_int_equal(u->stats.charts, 1);
     assert_true(u->stats.stretch_max <= d.max_stretch);
     lx_unwrap_destroy(u);
     lx_scene_destroy(scene);
@@ -216,7 +224,7 @@ static void instances_get_their_own_regions(void **state)
     assert_int_equal(lx_scene_add_node(scene, "large", &b, &index, 1, NULL), LX_OK);
     lx_unwrap_desc d = desc_at(30.0f);
     lx_unwrap *u;
-    /* measured: mean angle error 3e-7 rad, area 4.4e-8, efficiency 0.70 */
+    /* measured: mean angle error 3e-7 rad, area 4.4e-8, efficiency 0.74 */
     check(scene, &d, (expect){1e-6, 1.5e-7, 0.6}, &u);
     assert_int_equal(u->mesh_count, 2);
     assert_int_equal(u->nodes[0].page, u->nodes[1].page);
@@ -309,7 +317,7 @@ static void pages_of_their_own(void **state)
     d.resolution = 128;
     d.page_per_node = true;
     lx_unwrap *u;
-    /* measured: efficiency 0.54 (one torus a page) */
+    /* measured: efficiency 0.57 (one torus a page) */
     check(scene, &d, (expect){0.04, 1.2e-7, 0.48}, &u);
     assert_int_equal(u->page_count, 3);
     for (uint32_t n = 0; n < 3; n++)
@@ -337,7 +345,7 @@ static void resolution_fills_one_page(void **state)
     lx_unwrap_desc d = desc_at(0.0f);
     d.resolution = 256;
     lx_unwrap *u;
-    /* measured: mean angle error 0.014 rad, area 3.9e-8, efficiency 0.59 */
+    /* measured: mean angle error 0.014 rad, area 3.9e-8, efficiency 0.61 */
     check(scene, &d, (expect){0.04, 1.2e-7, 0.52}, &u);
     assert_int_equal(u->page_count, 1);
     assert_true(u->pages[0].width <= 256 && u->pages[0].height <= 256);
