@@ -225,6 +225,40 @@ lx_status lx_horizon_weight_cube(int size, lx_image *out);
  * saturate((l.z - sin(horizon)) * hardness + 1); hardness 0 = 8. */
 float lx_horizon_light(const float h0[4], const float h1[4], lx_vec3 l, float hardness);
 
+/* ---- tangent frames --------------------------------------------------------
+ * Tangents are xyz + w handedness (glTF TANGENT). MikkTSpace frames belong
+ * to triangle corners: one vertex may need several (at UV seams, mirrored
+ * halves, hard edges), so the corner functions write 3 * triangle_count
+ * entries, out[3 * t + k] for corner k of triangle t. */
+
+/* How tangents are computed. MIKKTSPACE (default): Mikkelsen's method,
+ * agreeing with the reference implementation glTF names for files without
+ * tangents. LENGYEL: per-vertex sums of triangle gradients (the seed). */
+typedef enum lx_tangent_method { LX_TANGENTS_MIKKTSPACE = 0, LX_TANGENTS_LENGYEL } lx_tangent_method;
+
+/* "mikktspace" or "lengyel"; NULL for another value. */
+const char *lx_tangent_method_name(lx_tangent_method method);
+/* The method named name; false when none. */
+bool lx_tangent_method_parse(const char *name, lx_tangent_method *out);
+
+/* MikkTSpace tangents per triangle corner from positions, normals and
+ * uv[uv_set] (Mikkelsen 2008, with the reference implementation's default
+ * settings: corners welded on equal position, normal and UV; groups split
+ * by handedness; angle-weighted; degenerate triangles take a neighbouring
+ * corner's frame). The handedness is for glTF's v-down UVs (the reference's
+ * sign negated). Every xyz is unit length and perpendicular to the corner's
+ * normal; where the reference would give a zero tangent (no UV gradient
+ * anywhere around a vertex) it is any unit vector perpendicular to the
+ * normal. out must hold 3 * mesh->triangle_count entries. Fails with
+ * LX_ERR_INVALID when the mesh has no normals or no such UV set. */
+lx_status lx_compute_tangents_mikktspace(const lx_mesh *mesh, int uv_set, lx_vec4 *out);
+
+/* Tangents per triangle corner by method: MIKKTSPACE as above, LENGYEL the
+ * per-vertex tangent of lx_compute_tangents at each corner. out must hold
+ * 3 * mesh->triangle_count entries. */
+lx_status lx_compute_corner_tangents(const lx_mesh *mesh, lx_tangent_method method, int uv_set,
+                                     lx_vec4 *out);
+
 /* Per-vertex tangents from positions, normals and uv[uv_set] (Lengyel's
  * method, FGED vol. 2 ch. 7: per-triangle tangent/bitangent summed over
  * vertices, Gram-Schmidt against the normal, handedness in w). Vertices

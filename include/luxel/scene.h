@@ -231,16 +231,31 @@ lx_status lx_gltf_lights_load_memory(lx_scene *scene, const void *bytes, size_t 
 
 /* ---- writing a scene with lightmap UVs (glTF binary) ---------------------- */
 
-/* The lightmap UVs of one mesh as one node places it: new vertices, each a
- * copy of mesh vertex vertex_source[v] with UV uv[v], and the mesh's
- * triangles over them in the same order (lx_unwrap_mesh in unwrap.h has
- * these fields). */
+/* A per-vertex attribute a writer adds (or replaces, when the primitive
+ * has one of that name): components floats per vertex. */
+typedef struct lx_vertex_attribute {
+    const char *name; /* glTF attribute name: "TANGENT", "TEXCOORD_2"... */
+    int components;   /* 1..4 (SCALAR, VEC2, VEC3, VEC4) */
+    const float *data; /* components * the entry's vertex_count, finite */
+} lx_vertex_attribute;
+
+/* node of an entry that applies to a mesh wherever it is placed: the
+ * mesh is changed in place instead of copied per node. */
+#define LX_SCENE_EVERY_NODE UINT32_MAX
+
+/* New vertices for one mesh as one node places it (or as every node does,
+ * node = LX_SCENE_EVERY_NODE): each a copy of mesh vertex vertex_source[v]
+ * (all its attributes), with the lightmap UV uv[v] when uv is not NULL
+ * and the extra attributes, and the mesh's triangles over them in the
+ * same order (lx_unwrap_mesh in unwrap.h has the first fields). */
 typedef struct lx_scene_uvs {
     uint32_t node, mesh; /* scene indices; the node places the mesh */
     uint32_t vertex_count;
     const uint32_t *vertex_source; /* vertex_count */
-    const lx_vec2 *uv;             /* vertex_count, top-left origin */
+    const lx_vec2 *uv;             /* vertex_count, top-left origin; NULL: no lightmap set */
     const uint32_t *indices;       /* 3 * the mesh's triangle_count */
+    const lx_vertex_attribute *attributes; /* attribute_count, per new vertex */
+    uint32_t attribute_count;
 } lx_scene_uvs;
 
 typedef struct lx_glb_write_desc {
@@ -262,11 +277,17 @@ lx_glb_write_desc lx_glb_write_desc_defaults(const lx_glb_write_desc *desc);
  * reads a texture through it, as the next free TEXCOORD_n. A primitive
  * without TEXCOORD_0 gets the UVs as TEXCOORD_0 too (sets are numbered
  * from 0). A mesh that several nodes place with new UVs is copied for
- * every node after the first. All buffers become the GLB's binary chunk
- * and images are embedded in it; the old accessors stay (unused).
+ * every node after the first. An entry's attributes are added to its
+ * primitive, replacing those of the same name (a TANGENT is left out, with
+ * a warning through lx_log, where the file's primitive has no NORMAL).
+ * All buffers become the GLB's binary chunk and images are embedded in it;
+ * accessors and bufferViews the rewrite left unused are dropped (unless
+ * the file uses an extension luxel does not know, which might refer to
+ * them).
  * Other scenes (OBJ, built ones) are written from luxel's data: one node
  * per scene node (its world matrix), one primitive per mesh with POSITION,
- * NORMAL, TANGENT, TEXCOORD_0 and the lightmap TEXCOORD_1, materials with
+ * NORMAL, TANGENT, TEXCOORD_0 and the lightmap TEXCOORD_1 (and the
+ * entries' attributes), materials with
  * their base colour factor and PNG/JPEG textures embedded.
  * Fails (nothing written) with LX_ERR_INVALID when an entry names a node
  * or mesh the scene does not pair, LX_ERR_UNSUPPORTED for compressed

@@ -6,6 +6,7 @@
 #include "core/internal.h"
 
 #include <stdlib.h>
+#include <string.h>
 
 lx_status lx_compute_tangents(const lx_mesh *mesh, int uv_set, lx_vec4 *out)
 {
@@ -47,6 +48,48 @@ lx_status lx_compute_tangents(const lx_mesh *mesh, int uv_set, lx_vec4 *out)
     }
     free(acc);
     return LX_OK;
+}
+
+const char *lx_tangent_method_name(lx_tangent_method method)
+{
+    switch (method) {
+    case LX_TANGENTS_MIKKTSPACE:
+        return "mikktspace";
+    case LX_TANGENTS_LENGYEL:
+        return "lengyel";
+    }
+    return NULL;
+}
+
+bool lx_tangent_method_parse(const char *name, lx_tangent_method *out)
+{
+    for (int m = LX_TANGENTS_MIKKTSPACE; name && m <= LX_TANGENTS_LENGYEL; m++)
+        if (strcmp(name, lx_tangent_method_name((lx_tangent_method)m)) == 0) {
+            *out = (lx_tangent_method)m;
+            return true;
+        }
+    return false;
+}
+
+lx_status lx_compute_corner_tangents(const lx_mesh *mesh, lx_tangent_method method, int uv_set,
+                                     lx_vec4 *out)
+{
+    if (method == LX_TANGENTS_MIKKTSPACE)
+        return lx_compute_tangents_mikktspace(mesh, uv_set, out);
+    if (method != LX_TANGENTS_LENGYEL)
+        return lx_fail(LX_ERR_INVALID, "lx_compute_corner_tangents: unknown method %d", method);
+    if (!mesh->normals)
+        return lx_fail(LX_ERR_INVALID, "mesh '%s': no normals for tangents",
+                       mesh->name ? mesh->name : "?");
+    lx_vec4 *per_vertex = malloc(sizeof(lx_vec4) * (mesh->vertex_count ? mesh->vertex_count : 1));
+    if (!per_vertex)
+        return lx_fail(LX_ERR_NOMEM, "mesh '%s': out of memory for tangents",
+                       mesh->name ? mesh->name : "?");
+    lx_status st = lx_compute_tangents(mesh, uv_set, per_vertex);
+    for (size_t k = 0; st == LX_OK && k < 3 * (size_t)mesh->triangle_count; k++)
+        out[k] = per_vertex[mesh->indices[k]];
+    free(per_vertex);
+    return st;
 }
 
 lx_vec3 lx_tangent_to_world(lx_vec3 m, lx_vec3 n, lx_vec4 t)

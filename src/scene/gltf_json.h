@@ -108,5 +108,9 @@ lx_status lx_gltf_check_lfs(const char *path, const cJSON *root);
  * bufferViews) and *glb receives the whole file as a GLB (malloc'd) for
  * assimp. Otherwise *glb is NULL and root unchanged. */
 lx_status lx_gltf_rewrite(const char *path, cJSON *root, uint8_t **glb, size_t *glb_size);
+/* Every accessor within its bufferView and every bufferView within its
+ * buffer, by the JSON's numbers (gltf_ranges.c); the error names the
+ * accessor or view and how many bytes it overruns. */
+lx_status lx_gltf_check_ranges(const char *path, const cJSON *root);
 
 #endif

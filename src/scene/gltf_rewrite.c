@@ -692,6 +692,9 @@ lx_status lx_gltf_rewrite(const char *path, cJSON *root, uint8_t **glb, size_t *
 {
     *glb = NULL;
     *glb_size = 0;
+    lx_status range = lx_gltf_check_ranges(path, root);
+    if (range != LX_OK)
+        return range;
     cJSON *views = cJSON_GetObjectItemCaseSensitive(root, "bufferViews");
     cJSON *accessors = cJSON_GetObjectItemCaseSensitive(root, "accessors");
     rewrite r = {.file = path, .root = root};

@@ -22,11 +22,15 @@ typedef struct job {
     const lx_scene_uvs *uvs;
 } job;
 
+#define EVERY_NODE SIZE_MAX /* a job for a mesh wherever it is placed */
+
 static int job_cmp(const void *a, const void *b)
 {
     const job *x = a, *y = b;
     if (x->node != y->node)
         return x->node < y->node ? -1 : 1;
+    if (x->mesh != y->mesh)
+        return x->mesh < y->mesh ? -1 : 1;
     return x->prim < y->prim ? -1 : x->prim > y->prim;
 }
 
@@ -113,16 +117,29 @@ static lx_status remap_accessor(wctx *c, size_t ai, const uint32_t *src_of, size
     return LX_OK;
 }
 
+/* True when name is skip or one of e's attributes (NULL: none). */
+static bool skipped(const char *name, const char *skip, const lx_scene_uvs *e)
+{
+    if (!name)
+        return false;
+    if (skip && strcmp(name, skip) == 0)
+        return true;
+    for (uint32_t k = 0; e && k < e->attribute_count; k++)
+        if (strcmp(e->attributes[k].name, name) == 0)
+            return true;
+    return false;
+}
+
 /* Every attribute of obj (a primitive's "attributes" or a morph target)
- * replaced by its copy per new vertex; skip names one left out. */
+ * replaced by its copy per new vertex; those skipped() are left out. */
 static lx_status remap_attributes(wctx *c, cJSON *obj, const uint32_t *src_of, size_t count,
-                                  const char *skip, const char *where)
+                                  const char *skip, const lx_scene_uvs *e, const char *where)
 {
     cJSON *next;
     for (cJSON *a = obj ? obj->child : NULL; a; a = next) {
         next = a->next;
-        if (skip && a->string && strcmp(a->string, skip) == 0) {
-            cJSON_DeleteItemFromObjectCaseSensitive(obj, skip);
+        if (skipped(a->string, skip, e)) {
+            cJSON_DeleteItemFromObjectCaseSensitive(obj, a->string);
             continue;
         }
         size_t ai = accessor_at(c->f, obj, a->string);
@@ -201,6 +218,46 @@ static lx_status primitive_corners(wctx *c, const cJSON *prim, size_t vertex_cou
 }
 
 #define DROPPED UINT32_MAX
+
+/* The entry's attributes over the new vertices (vertex v is entry vertex
+ * key_of[v]; DROPPED ones, corners of zero-area triangles, get zeros and,
+ * for TANGENT, a unit +x). */
+static lx_status add_attributes(wctx *c, cJSON *attrs, const lx_scene_uvs *e,
+                                const uint32_t *key_of, size_t nv, bool has_normal,
+                                const char *where)
+{
+    static const char *const types[] = {"", "SCALAR", "VEC2", "VEC3", "VEC4"};
+    for (uint32_t k = 0; k < e->attribute_count; k++) {
+        const lx_vertex_attribute *at = &e->attributes[k];
+        bool tangent = strcmp(at->name, "TANGENT") == 0;
+        if (tangent && !has_normal) {
+            lx_log(LX_LOG_WARN, "%s: %s has no NORMAL: TANGENT left out (glTF ignores it)",
+                   c->f->path, where);
+            continue;
+        }
+        size_t comps = (size_t)at->components;
+        float *d = calloc(nv ? nv * comps : 1, sizeof(float));
+        if (!d)
+            return lx_fail(LX_ERR_NOMEM, "%s: out of memory", c->out);
+        for (size_t v = 0; v < nv; v++) {
+            if (key_of[v] == DROPPED) {
+                if (tangent)
+                    d[v * comps] = d[v * comps + 3] = 1.0f;
+                continue;
+            }
+            memcpy(d + v * comps, at->data + (size_t)key_of[v] * comps, sizeof(float) * comps);
+        }
+        int view = lx_glb_add_view(c->f->root, &c->bin, d, sizeof(float) * comps * nv, 0,
+                                   LX_GL_ARRAY_BUFFER);
+        free(d);
+        int acc = lx_glb_add_accessor(c->f->root, view, LX_GL_FLOAT, nv, types[comps], false,
+                                      NULL, NULL);
+        if (acc < 0 || c->bin.failed)
+            return lx_fail(LX_ERR_NOMEM, "%s: out of memory", c->out);
+        cJSON_AddNumberToObject(attrs, at->name, acc);
+    }
+    return LX_OK;
+}
 
 static lx_status rebuild_primitive(wctx *c, cJSON *prim, const job *jb, const char *where)
 {
@@ -305,7 +362,7 @@ static lx_status rebuild_primitive(wctx *c, cJSON *prim, const job *jb, const ch
                 found = (uint32_t)nv++;
                 key_of[found] = key;
                 src_of[found] = gv;
-                uv[found] = key == DROPPED ? lx_v2(0.0f, 0.0f) : e->uv[key];
+                uv[found] = key == DROPPED || !e->uv ? lx_v2(0.0f, 0.0f) : e->uv[key];
                 next[found] = head[gv];
                 head[gv] = found;
             }
@@ -319,7 +376,9 @@ static lx_status rebuild_primitive(wctx *c, cJSON *prim, const job *jb, const ch
     if (lx_gltf_index(lx_gltf_get(prim, "material"), (size_t)cJSON_GetArraySize(mats), &mi))
         mat = cJSON_GetArrayItem(mats, (int)mi);
     char set[32] = "TEXCOORD_1";
-    if (lx_gltf_get(attrs, "TEXCOORD_1") && uses_set(mat, 1)) {
+    if (!e->uv)
+        set[0] = '\0'; /* no lightmap set */
+    else if (lx_gltf_get(attrs, "TEXCOORD_1") && uses_set(mat, 1)) {
         int n = 2;
         for (;; n++) {
             snprintf(set, sizeof set, "TEXCOORD_%d", n);
@@ -327,20 +386,27 @@ static lx_status rebuild_primitive(wctx *c, cJSON *prim, const job *jb, const ch
                 break;
         }
     }
-    st = remap_attributes(c, attrs, src_of, nv, set, where);
+    bool has_normal = lx_gltf_get(attrs, "NORMAL") != NULL;
+    st = remap_attributes(c, attrs, src_of, nv, set[0] ? set : NULL, e, where);
     cJSON *targets = cJSON_GetObjectItemCaseSensitive(prim, "targets");
     for (cJSON *tg = cJSON_IsArray(targets) ? targets->child : NULL; st == LX_OK && tg;
          tg = tg->next)
-        st = remap_attributes(c, tg, src_of, nv, NULL, where);
+        st = remap_attributes(c, tg, src_of, nv, NULL, NULL, where);
     if (st != LX_OK)
         goto done;
-    int view = lx_glb_add_view(c->f->root, &c->bin, uv, sizeof(lx_vec2) * nv, 0,
+    int view, acc;
+    if (e->uv) {
+        view = lx_glb_add_view(c->f->root, &c->bin, uv, sizeof(lx_vec2) * nv, 0,
                                LX_GL_ARRAY_BUFFER);
-    int acc = lx_glb_add_accessor(c->f->root, view, LX_GL_FLOAT, nv, "VEC2", false, NULL, NULL);
-    /* TEXCOORD_0 before the set: readers (assimp) want sets in order */
-    if (!lx_gltf_get(attrs, "TEXCOORD_0"))
-        cJSON_AddNumberToObject(attrs, "TEXCOORD_0", acc);
-    cJSON_AddNumberToObject(attrs, set, acc);
+        acc = lx_glb_add_accessor(c->f->root, view, LX_GL_FLOAT, nv, "VEC2", false, NULL, NULL);
+        /* TEXCOORD_0 before the set: readers (assimp) want sets in order */
+        if (!lx_gltf_get(attrs, "TEXCOORD_0"))
+            cJSON_AddNumberToObject(attrs, "TEXCOORD_0", acc);
+        cJSON_AddNumberToObject(attrs, set, acc);
+    }
+    st = add_attributes(c, attrs, e, key_of, nv, has_normal, where);
+    if (st != LX_OK)
+        goto done;
     /* indices: 16 bits when they fit below the restart value */
     bool small = nv < 65535;
     size_t isz = small ? 2 : 4;
@@ -440,8 +506,20 @@ static lx_status make_jobs(wctx *c, const lx_glb_write_desc *d, job *jobs)
     size_t nn = (size_t)cJSON_GetArraySize(nodes), nm = (size_t)cJSON_GetArraySize(meshes);
     for (uint32_t k = 0; k < d->uv_count; k++) {
         const lx_scene_uvs *e = &d->uvs[k];
-        const lx_node *n = &s->nodes[e->node];
         const lx_mesh *m = &s->meshes[e->mesh];
+        if (e->node == LX_SCENE_EVERY_NODE) {
+            if (m->source_mesh < 0 || m->source_primitive < 0 || (size_t)m->source_mesh >= nm ||
+                m->source_primitive >=
+                    cJSON_GetArraySize(lx_gltf_get(cJSON_GetArrayItem(meshes, m->source_mesh),
+                                                   "primitives")))
+                return lx_fail(LX_ERR_UNSUPPORTED,
+                               "%s: mesh '%s': luxel could not tell which primitive of the file "
+                               "it came from",
+                               c->f->path, m->name);
+            jobs[k] = (job){EVERY_NODE, (size_t)m->source_mesh, (size_t)m->source_primitive, e};
+            continue;
+        }
+        const lx_node *n = &s->nodes[e->node];
         if (n->source_node < 0 || m->source_mesh < 0 || m->source_primitive < 0 ||
             (size_t)n->source_node >= nn || (size_t)m->source_mesh >= nm)
             return lx_fail(LX_ERR_UNSUPPORTED,
@@ -459,7 +537,8 @@ static lx_status make_jobs(wctx *c, const lx_glb_write_desc *d, job *jobs)
     }
     qsort(jobs, d->uv_count, sizeof *jobs, job_cmp);
     for (uint32_t k = 1; k < d->uv_count; k++)
-        if (jobs[k].node == jobs[k - 1].node && jobs[k].prim == jobs[k - 1].prim)
+        if (jobs[k].node == jobs[k - 1].node && jobs[k].mesh == jobs[k - 1].mesh &&
+            jobs[k].prim == jobs[k - 1].prim)
             return lx_fail(LX_ERR_INVALID, "%s: two sets of UVs for node %zu, primitive %zu",
                            c->f->path, jobs[k].node, jobs[k].prim);
     return LX_OK;
@@ -476,6 +555,11 @@ static lx_status write_from_file(wctx *c, const lx_glb_write_desc *d)
                            "%s: compressed geometry (%s) cannot be written again", f->path,
                            compressed[i]);
     lx_status st = lx_gltf_file_buffers(f);
+    if (st != LX_OK)
+        return st;
+    bool *acc_before = NULL, *view_before = NULL;
+    size_t nacc_before = 0, nview_before = 0;
+    st = lx_gltf_used(f->root, &acc_before, &nacc_before, &view_before, &nview_before);
     if (st != LX_OK)
         return st;
     /* the old buffers, one after the other, become the start of the new one */
@@ -511,15 +595,18 @@ static lx_status write_from_file(wctx *c, const lx_glb_write_desc *d)
         if (lx_gltf_index(lx_gltf_get(n, "mesh"), nm, &gm))
             users[gm]++;
     for (uint32_t k = 0; k < d->uv_count; k++)
-        if (k == 0 || jobs[k].node != jobs[k - 1].node)
+        if (jobs[k].node != EVERY_NODE && (k == 0 || jobs[k].node != jobs[k - 1].node))
             job_users[jobs[k].mesh]++;
     for (uint32_t k = 0; k < d->uv_count && st == LX_OK;) {
         uint32_t end = k;
-        while (end < d->uv_count && jobs[end].node == jobs[k].node)
+        while (end < d->uv_count && jobs[end].node == jobs[k].node &&
+               (jobs[k].node != EVERY_NODE || jobs[end].mesh == jobs[k].mesh))
             end++;
         size_t mesh = jobs[k].mesh;
         cJSON *target;
-        if (!claimed[mesh] && users[mesh] == job_users[mesh]) {
+        if (jobs[k].node == EVERY_NODE) {
+            target = cJSON_GetArrayItem(meshes, (int)mesh); /* in place, for every node */
+        } else if (!claimed[mesh] && users[mesh] == job_users[mesh]) {
             claimed[mesh] = true; /* the first of the nodes that all get UVs */
             target = cJSON_GetArrayItem(meshes, (int)mesh);
         } else {
@@ -564,8 +651,12 @@ static lx_status write_from_file(wctx *c, const lx_glb_write_desc *d)
         if (base[b] + off)
             cJSON_AddNumberToObject(v, "byteOffset", (double)(base[b] + off));
     }
-    st = lx_glb_write(c->out, f->root, &c->bin);
+    st = lx_gltf_drop_unused(f->root, acc_before, nacc_before, view_before, nview_before);
+    if (st == LX_OK)
+        st = lx_glb_write(c->out, f->root, &c->bin);
 done:
+    free(acc_before);
+    free(view_before);
     cJSON_Delete(pristine);
     free(users);
     free(job_users);

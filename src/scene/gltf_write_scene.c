@@ -29,14 +29,29 @@ static lx_status check_uvs(const lx_scene *s, const char *path, const lx_glb_wri
         return lx_fail(LX_ERR_INVALID, "%s: %u UV entries given as NULL", path, d->uv_count);
     for (uint32_t k = 0; k < d->uv_count; k++) {
         const lx_scene_uvs *e = &d->uvs[k];
-        if (e->node >= s->node_count || e->mesh >= s->mesh_count)
+        if ((e->node >= s->node_count && e->node != LX_SCENE_EVERY_NODE) ||
+            e->mesh >= s->mesh_count)
             return lx_fail(LX_ERR_INVALID,
                            "%s: UV entry %u: node %u or mesh %u out of range (%u nodes, %u "
                            "meshes)",
                            path, k, e->node, e->mesh, s->node_count, s->mesh_count);
         const lx_mesh *m = &s->meshes[e->mesh];
-        if (e->vertex_count && (!e->vertex_source || !e->uv))
+        if (e->vertex_count && !e->vertex_source)
             return lx_fail(LX_ERR_INVALID, "%s: UV entry %u has no vertices", path, k);
+        if (e->attribute_count && !e->attributes)
+            return lx_fail(LX_ERR_INVALID, "%s: UV entry %u: %u attributes given as NULL", path,
+                           k, e->attribute_count);
+        for (uint32_t a = 0; a < e->attribute_count; a++) {
+            const lx_vertex_attribute *at = &e->attributes[a];
+            if (!at->name || !*at->name || at->components < 1 || at->components > 4 ||
+                (e->vertex_count && !at->data))
+                return lx_fail(LX_ERR_INVALID, "%s: UV entry %u: attribute %u is malformed", path,
+                               k, a);
+            for (size_t i = 0; i < (size_t)at->components * e->vertex_count; i++)
+                if (!isfinite(at->data[i]))
+                    return lx_fail(LX_ERR_INVALID, "%s: UV entry %u: %s of vertex %zu is not finite",
+                                   path, k, at->name, i / (size_t)at->components);
+        }
         if (m->triangle_count && !e->indices)
             return lx_fail(LX_ERR_INVALID, "%s: UV entry %u has no indices", path, k);
         for (uint32_t v = 0; v < e->vertex_count; v++) {
@@ -45,7 +60,7 @@ static lx_status check_uvs(const lx_scene *s, const char *path, const lx_glb_wri
                                "%s: UV entry %u: vertex %u copies vertex %u of mesh '%s' (count "
                                "%u)",
                                path, k, v, e->vertex_source[v], m->name, m->vertex_count);
-            if (!isfinite(e->uv[v].x) || !isfinite(e->uv[v].y))
+            if (e->uv && (!isfinite(e->uv[v].x) || !isfinite(e->uv[v].y)))
                 return lx_fail(LX_ERR_INVALID, "%s: UV entry %u: vertex %u: UV is not finite",
                                path, k, v);
         }
@@ -94,6 +109,15 @@ static int float_attribute(bctx *c, const float *data, int comps, const uint32_t
                                bounds && n ? lo : NULL, bounds && n ? hi : NULL);
 }
 
+/* True when entry e brings an attribute called name. */
+static bool replaced(const lx_scene_uvs *e, const char *name)
+{
+    for (uint32_t k = 0; e && k < e->attribute_count; k++)
+        if (strcmp(e->attributes[k].name, name) == 0)
+            return true;
+    return false;
+}
+
 static cJSON *primitive(bctx *c, const lx_mesh *m, const lx_scene_uvs *e)
 {
     size_t nv = e ? e->vertex_count : m->vertex_count;
@@ -107,16 +131,29 @@ static cJSON *primitive(bctx *c, const lx_mesh *m, const lx_scene_uvs *e)
     }
     cJSON_AddNumberToObject(a, "POSITION",
                             float_attribute(c, &m->positions[0].x, 3, src, nv, true));
-    if (m->normals)
+    if (m->normals && !replaced(e, "NORMAL"))
         cJSON_AddNumberToObject(a, "NORMAL",
                                 float_attribute(c, &m->normals[0].x, 3, src, nv, false));
-    if (m->tangents)
+    if (m->tangents && !replaced(e, "TANGENT"))
         cJSON_AddNumberToObject(a, "TANGENT",
                                 float_attribute(c, &m->tangents[0].x, 4, src, nv, false));
-    int uv0 = m->uv[0] ? float_attribute(c, &m->uv[0][0].x, 2, src, nv, false) : -1;
-    int uv1 = e ? float_attribute(c, &e->uv[0].x, 2, NULL, nv, false)
-              : m->uv[1] ? float_attribute(c, &m->uv[1][0].x, 2, NULL, nv, false)
-                         : -1;
+    int uv0 = m->uv[0] && !replaced(e, "TEXCOORD_0")
+                  ? float_attribute(c, &m->uv[0][0].x, 2, src, nv, false)
+                  : -1;
+    int uv1 = e && e->uv         ? float_attribute(c, &e->uv[0].x, 2, NULL, nv, false)
+              : replaced(e, "TEXCOORD_1") ? -1
+              : m->uv[1]         ? float_attribute(c, &m->uv[1][0].x, 2, src, nv, false)
+                                 : -1;
+    for (uint32_t k = 0; e && k < e->attribute_count; k++) {
+        const lx_vertex_attribute *at = &e->attributes[k];
+        if (strcmp(at->name, "TEXCOORD_0") == 0)
+            uv0 = float_attribute(c, at->data, at->components, NULL, nv, false);
+        else if (strcmp(at->name, "TEXCOORD_1") == 0)
+            uv1 = float_attribute(c, at->data, at->components, NULL, nv, false);
+        else
+            cJSON_AddNumberToObject(a, at->name,
+                                    float_attribute(c, at->data, at->components, NULL, nv, false));
+    }
     /* sets are numbered from 0: the lightmap set stands in for a missing 0 */
     if (uv0 >= 0 || uv1 >= 0)
         cJSON_AddNumberToObject(a, "TEXCOORD_0", uv0 >= 0 ? uv0 : uv1);
@@ -257,8 +294,14 @@ static lx_status write_built(const lx_scene *s, const char *path, const lx_glb_w
                 has = true;
                 cJSON_AddItemToArray(prims, primitive(&c, &s->meshes[d->uvs[k].mesh], &d->uvs[k]));
             }
-        for (uint32_t k = 0; !has && k < node->mesh_count; k++)
-            cJSON_AddItemToArray(prims, primitive(&c, &s->meshes[node->meshes[k]], NULL));
+        for (uint32_t k = 0; !has && k < node->mesh_count; k++) {
+            /* an entry for the mesh wherever it is placed, else as it is */
+            const lx_scene_uvs *every = NULL;
+            for (uint32_t q = 0; q < d->uv_count && !every; q++)
+                if (d->uvs[q].node == LX_SCENE_EVERY_NODE && d->uvs[q].mesh == node->meshes[k])
+                    every = &d->uvs[q];
+            cJSON_AddItemToArray(prims, primitive(&c, &s->meshes[node->meshes[k]], every));
+        }
         cJSON_AddItemToArray(meshes, mesh);
         cJSON *j = cJSON_CreateObject();
         cJSON_AddStringToObject(j, "name", node->name);

@@ -19,6 +19,7 @@ int cmd_render(int argc, char **argv);
 /* bake --render: DIR/view.png of DIR's lightmaps on scene (default camera). */
 int cli_render_bake(const char *dir, const lx_scene *scene, int threads, bool quiet);
 int cmd_unwrap(int argc, char **argv);
+int cmd_tangents(int argc, char **argv);
 int cmd_horizonmap(int argc, char **argv);
 int cmd_aomap(int argc, char **argv);
 
