@@ -19,6 +19,7 @@ int cmd_render(int argc, char **argv);
 /* bake --render: DIR/view.png of DIR's lightmaps on scene (default camera). */
 int cli_render_bake(const char *dir, const lx_scene *scene, int threads, bool quiet);
 int cmd_unwrap(int argc, char **argv);
+int cmd_light2d(int argc, char **argv);
 
 /* Writes scene as a .glb at path with u's generated UVs in TEXCOORD_1
  * (lx_scene_write_glb; unwrap.c). The scene is the one u was made from,

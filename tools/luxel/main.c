@@ -31,6 +31,7 @@ static const char *main_usage =
     "                SH, prefiltered specular mips, DFG table; faces/cross/KTX\n"
     "  render SCENE  a camera view of a scene with its baked lightmaps (PNG)\n"
     "  unwrap SCENE  make lightmap UVs and write the scene with them (.glb)\n"
+    "  light2d       shadowed 2D lights over a caster image (--casters, --lights)\n"
     "\n"
     "options:\n"
     "  -h, --help    show this help (luxel <command> --help for a command)\n"
@@ -410,7 +411,8 @@ int main(int argc, char **argv)
         const char *name;
         int (*run)(int argc, char **argv);
     } commands[] = {{"bake", cmd_bake},     {"info", cmd_info},     {"ies", cmd_ies},
-                    {"ibl", cmd_ibl},       {"render", cmd_render}, {"unwrap", cmd_unwrap}};
+                    {"ibl", cmd_ibl},       {"render", cmd_render}, {"unwrap", cmd_unwrap},
+                    {"light2d", cmd_light2d}};
     for (size_t i = 0; i < sizeof commands / sizeof commands[0]; i++)
         if (strcmp(cmd, commands[i].name) == 0) {
             lx_set_log_callback(print_log, NULL);
