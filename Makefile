@@ -49,6 +49,7 @@ bench: all
 	$(BUILD)/bin/bench_ibl
 	$(BUILD)/bin/bench_unwrap
 	$(BUILD)/bin/bench_render
+	$(BUILD)/bin/bench_light2d
 
 fuzz: all
 	@test -f $(BUILD_FUZZ)/CMakeCache.txt || CC=clang cmake -S . -B $(BUILD_FUZZ) -DCMAKE_BUILD_TYPE=Debug -DLX_FUZZ=ON

@@ -7,6 +7,17 @@
 
 #include <stdint.h>
 
+/* min and max without libm's NaN rules (a call each otherwise); the
+ * values here are never NaN */
+static inline float l2_min(float a, float b)
+{
+    return a < b ? a : b;
+}
+static inline float l2_max(float a, float b)
+{
+    return a > b ? a : b;
+}
+
 /* Boundary caster pixels are bucketed in square tiles of this many pixels,
  * so a light visits only the tiles under its reach. */
 #define L2_TILE 32
@@ -81,9 +92,13 @@ void l2_polar_free(l2_polar *pm);
  * d, for a caster pixel or not. */
 float l2_visibility(const l2_polar *pm, const lx_light2d_light *l, float dx, float dy, float d,
                     bool caster);
+/* Soft visibility at distance d on the ray at continuous bin c, u2 the
+ * squared slope of the pseudo-angle there (polar.c). */
+float l2_soft_visibility(const l2_polar *pm, float s, float c, float u2, float d);
 
 /* Adds the light's contribution to row y of acc (width*3 floats), filling
- * its cache row first when it is a static light being re-lit (shade.c). */
-void l2_shade_row(const lx_light2d *ctx, const l2_prep *p, int y, float *acc);
+ * its cache row first when it is a static light being re-lit; scratch
+ * holds 4*width floats (shade.c). */
+void l2_shade_row(const lx_light2d *ctx, const l2_prep *p, int y, float *acc, float *scratch);
 
 #endif

@@ -19,7 +19,7 @@
 
 #define L2_FAR 1e30f
 /* Filter taps beyond which a penumbra window is sampled, not summed. */
-#define L2_MAX_TAPS 64
+#define L2_MAX_TAPS 32
 
 /* Pseudo-angle in [0, 8] of the direction (dx, dy) (not both zero), see
  * l2_polar; *u gets the slope on its face (dp/dangle = 1 + u^2). */
@@ -64,16 +64,16 @@ static void square_bins(const l2_polar *pm, float ax, float bx, float ay, float 
                   pseudo_angle(bx, by, &u)};
     float lo = p[0], hi = p[0];
     for (int k = 1; k < 4; k++) {
-        lo = fminf(lo, p[k]);
-        hi = fmaxf(hi, p[k]);
+        lo = l2_min(lo, p[k]);
+        hi = l2_max(hi, p[k]);
     }
     if (hi - lo > 4.0f) { /* the square straddles p = 0 */
         lo = 8.0f;
         hi = 0.0f;
         for (int k = 0; k < 4; k++) {
             float q = p[k] < 4.0f ? p[k] + 8.0f : p[k];
-            lo = fminf(lo, q);
-            hi = fmaxf(hi, q);
+            lo = l2_min(lo, q);
+            hi = l2_max(hi, q);
         }
     }
     int n = pm->n;
@@ -177,7 +177,7 @@ lx_status l2_polar_build(const lx_light2d *ctx, l2_prep *p)
                                 occ[i] = dn;
                         }
                     } else {
-                        float fx = fmaxf(ax * ax, bx * bx), fy = fmaxf(ay * ay, by * by);
+                        float fx = l2_max(ax * ax, bx * bx), fy = l2_max(ay * ay, by * by);
                         float df = sqrtf(fx + fy);
                         for (int b = b0; b <= b1; b++) {
                             int i = b >= n ? b - n : b;
@@ -202,8 +202,8 @@ lx_status l2_polar_build(const lx_light2d *ctx, l2_prep *p)
             int h = 1 << (k - 1);
             for (int i = 0; i < n; i++) {
                 int j = i + h >= n ? i + h - n : i + h;
-                c[i] = fminf(a[i], a[j]);
-                d[i] = fmaxf(b[i], b[j]);
+                c[i] = l2_min(a[i], a[j]);
+                d[i] = l2_max(b[i], b[j]);
             }
         }
     }
@@ -217,13 +217,10 @@ static inline float range_query(const l2_polar *pm, const float *table, int lo, 
     int len = hi - lo + 1;
     int k = 31 - __builtin_clz((unsigned)len);
     const float *t = table + (size_t)k * n;
-    int a = lo % n;
-    if (a < 0)
-        a += n;
-    int b = (hi - (1 << k) + 1) % n;
-    if (b < 0)
-        b += n;
-    return max ? fmaxf(t[a], t[b]) : fminf(t[a], t[b]);
+    /* windows are under n rays and centred in [0, n]: one wrap at most */
+    int a = wrap(lo, n);
+    int b = wrap(hi - (1 << k) + 1, n);
+    return max ? l2_max(t[a], t[b]) : l2_min(t[a], t[b]);
 }
 
 /* Fraction of the window [c - k, c + k] (in bins) whose rays reach past d. */
@@ -239,8 +236,8 @@ static float filter(const l2_polar *pm, float c, float k, float d)
     if (b1 - b0 + 1 <= L2_MAX_TAPS) {
         float lit = 0.0f;
         for (int b = b0; b <= b1; b++) {
-            float w = fminf(hi, (float)(b + 1)) - fmaxf(lo, (float)b);
-            if (pm->occ[wrap(b % n, n)] >= d)
+            float w = l2_min(hi, (float)(b + 1)) - l2_max(lo, (float)b);
+            if (pm->occ[wrap(b, n)] >= d)
                 lit += w;
         }
         return lit / (hi - lo);
@@ -249,7 +246,7 @@ static float filter(const l2_polar *pm, float c, float k, float d)
     float step = (hi - lo) / L2_MAX_TAPS;
     for (int i = 0; i < L2_MAX_TAPS; i++) {
         int b = (int)floorf(lo + (i + 0.5f) * step);
-        if (pm->occ[wrap(b % n, n)] >= d)
+        if (pm->occ[wrap(b, n)] >= d)
             lit++;
     }
     return (float)lit / L2_MAX_TAPS;
@@ -258,20 +255,35 @@ static float filter(const l2_polar *pm, float c, float k, float d)
 /* Soft visibility at distance d on the ray at continuous bin c: the
  * nearest occluder o in a search window (the window an occluder at d/8
  * would need), then the filter over the half-angle softness (d - o) /
- * (d o), the angle a light of radius softness subtends behind o. */
-static float soft_visibility(const l2_polar *pm, float s, float c, float u2, float d)
+ * (d o), the angle a light of radius softness subtends behind o, with o
+ * the nearest occluder inside that window. */
+float l2_soft_visibility(const l2_polar *pm, float s, float c, float u2, float d)
 {
     float scale = (1.0f + u2) * pm->bins_per_p; /* bins per radian */
     float cap = 0.5f * (float)pm->n - 1.0f;
-    float ks = fminf(7.0f * s / d * scale, cap);
+    float ks = l2_min(7.0f * s / d * scale, cap);
     int b0 = (int)floorf(c - ks), b1 = (int)floorf(c + ks);
     float m = range_query(pm, pm->tmin, b0, b1, false);
     if (m >= d)
         return 1.0f;
-    float o = fmaxf(m, 0.5f);
-    float k = fminf(s * (d - o) / (d * o) * scale, cap);
+    /* the nearest occluder's window shrinks as farther occluders are
+     * found nearest inside it: iterate to (close to) the fixed point, where
+     * the window is that of the nearest occluder inside it */
+    float k = 0.0f;
+    for (int it = 0; it < 4; it++) {
+        float o = l2_max(m, 0.5f);
+        k = l2_min(s * (d - o) / (d * o) * scale, cap);
+        if (k < 0.5f)
+            break;
+        float m2 = range_query(pm, pm->tmin, (int)floorf(c - k), (int)floorf(c + k), false);
+        if (m2 >= d)
+            return 1.0f;
+        if (m2 == m)
+            break;
+        m = m2;
+    }
     if (k < 0.5f)
-        return pm->occ[wrap((int)floorf(c) % pm->n, pm->n)] >= d ? 1.0f : 0.0f;
+        return pm->occ[wrap((int)floorf(c), pm->n)] >= d ? 1.0f : 0.0f;
     return filter(pm, c, k, d);
 }
 
@@ -289,6 +301,6 @@ float l2_visibility(const l2_polar *pm, const lx_light2d_light *l, float dx, flo
         return (d < o || face) ? 1.0f : 0.0f;
     float de = d;
     if (face)
-        de = fmaxf(fminf(d, o - 0.5f), 0.5f);
-    return soft_visibility(pm, l->softness, c, u * u, de);
+        de = l2_max(l2_min(d, o - 0.5f), 0.5f);
+    return l2_soft_visibility(pm, l->softness, c, u * u, de);
 }

@@ -16,7 +16,7 @@
 #include <omp.h>
 #endif
 
-void l2_shade_row(const lx_light2d *ctx, const l2_prep *p, int y, float *acc)
+void l2_shade_row(const lx_light2d *ctx, const l2_prep *p, int y, float *acc, float *scratch)
 {
     const lx_light2d_light *l = &p->l;
     float dy = (float)y + 0.5f - l->y;
@@ -27,59 +27,96 @@ void l2_shade_row(const lx_light2d *ctx, const l2_prep *p, int y, float *acc)
     if (dy2 >= p->r2)
         return;
     float half = sqrtf(p->r2 - dy2);
-    int xa = (int)fmaxf((float)p->x0, floorf(l->x - half - 0.5f));
-    int xb = (int)fminf((float)p->x1, ceilf(l->x + half + 0.5f));
-    const uint8_t *caster = ctx->caster + (size_t)y * ctx->width;
-    const float *normals = ctx->normals ? ctx->normals + (size_t)y * ctx->width * 3 : NULL;
-    bool shadow = l->shadow;
-    float h = l->height, h2 = h * h;
-    for (int x = xa; x < xb; x++) {
-        float dx = (float)x + 0.5f - l->x;
+    int xa = (int)l2_max((float)p->x0, floorf(l->x - half - 0.5f));
+    int xb = (int)l2_min((float)p->x1, ceilf(l->x + half + 0.5f));
+    int n = xb - xa;
+    if (n <= 0)
+        return;
+    /* pass 1, branch-free so that it vectorizes: distance, falloff and the
+     * continuous polar bin of every pixel of the span */
+    float *fa = scratch, *da = scratch + ctx->width, *ca = scratch + 2 * ctx->width,
+          *ua = scratch + 3 * ctx->width;
+    float lx = l->x, r2 = p->r2, inv_r = p->inv_r, inv_r2 = p->inv_r2;
+    float bpp = p->polar.bins_per_p;
+    int kind = (int)l->falloff;
+    for (int i = 0; i < n; i++) {
+        float dx = (float)(xa + i) + 0.5f - lx;
         float d2 = dx * dx + dy2;
-        if (d2 >= p->r2)
-            continue;
-        float f;
         float d = sqrtf(d2);
-        if (l->falloff == LX_FALLOFF2D_SMOOTH) {
-            float q = 1.0f - d2 * p->inv_r2;
-            f = q * q;
-        } else if (l->falloff == LX_FALLOFF2D_LINEAR) {
-            f = 1.0f - d * p->inv_r;
-        } else {
-            f = 1.0f;
+        float q = 1.0f - d2 * inv_r2;
+        float f = kind == 0 ? q * q : (kind == 1 ? 1.0f - d * inv_r : 1.0f);
+        fa[i] = d2 < r2 ? f : 0.0f;
+        da[i] = d;
+        float ax = fabsf(dx), ay = fabsf(dy);
+        bool big = ax >= ay;
+        float m = big ? ax : ay;
+        float num = big ? dy : dx;
+        float t = num / l2_max(m, 1e-30f);
+        float pa = big ? (dx > 0.0f ? 1.0f + t : 5.0f - t) : (dy > 0.0f ? 3.0f - t : 7.0f + t);
+        ca[i] = pa * bpp;
+        ua[i] = t;
+    }
+    if (p->spot) {
+        float cx = p->dir_x, cy = p->dir_y, co = p->cos_outer, ci = p->cos_inner, k = p->inv_fade;
+        for (int i = 0; i < n; i++) {
+            float dx = (float)(xa + i) + 0.5f - lx;
+            float d = da[i];
+            float c = d > 0.0f ? (dx * cx + dy * cy) / d : 1.0f;
+            float t = l2_min(l2_max((c - co) * k, 0.0f), 1.0f);
+            float s = c >= ci ? 1.0f : (c <= co ? 0.0f : t * t * (3.0f - 2.0f * t));
+            fa[i] *= s;
         }
-        if (p->spot && d > 0.0f) {
-            float c = (dx * p->dir_x + dy * p->dir_y) / d;
-            if (c <= p->cos_outer)
+    }
+    if (ctx->normals) {
+        const float *nn = ctx->normals + ((size_t)y * ctx->width + xa) * 3;
+        float h = l->height, h2 = h * h;
+        for (int i = 0; i < n; i++) {
+            float dx = (float)(xa + i) + 0.5f - lx;
+            float ndl = -dx * nn[3 * i] - dy * nn[3 * i + 1] + h * nn[3 * i + 2];
+            float len = sqrtf(da[i] * da[i] + h2);
+            fa[i] *= ndl > 0.0f && len > 0.0f ? ndl / len : 0.0f;
+        }
+    }
+    /* pass 2: shadows from the polar map */
+    if (l->shadow) {
+        const uint8_t *caster = ctx->caster + (size_t)y * ctx->width + xa;
+        const l2_polar *pm = &p->polar;
+        int nb = pm->n;
+        bool soft = l->softness > 0.0f, face_ok = !l->self_shadow;
+        for (int i = 0; i < n; i++) {
+            if (fa[i] <= 0.0f)
                 continue;
-            if (c < p->cos_inner) {
-                float t = (c - p->cos_outer) * p->inv_fade;
-                f *= t * t * (3.0f - 2.0f * t);
+            float d = da[i];
+            if (d <= 0.0f)
+                continue;
+            int b = (int)ca[i];
+            if (b >= nb)
+                b -= nb;
+            float o = pm->occ[b];
+            bool face = face_ok && caster[i] && d <= pm->ex[b];
+            if (!soft) {
+                if (!(d < o || face))
+                    fa[i] = 0.0f;
+                continue;
             }
+            float de = face ? l2_max(l2_min(d, o - 0.5f), 0.5f) : d;
+            fa[i] *= l2_soft_visibility(pm, l->softness, ca[i], ua[i] * ua[i], de);
         }
-        if (normals) {
-            const float *nn = normals + 3 * x;
-            float ndl = -dx * nn[0] - dy * nn[1] + h * nn[2];
-            if (ndl <= 0.0f)
-                continue;
-            f *= ndl / sqrtf(d2 + h2);
+    }
+    float cr = p->rgb.x, cg = p->rgb.y, cb = p->rgb.z;
+    float *a = acc + 3 * xa;
+    if (cache) {
+        float *c = cache + 3 * (xa - p->x0);
+        for (int i = 0; i < n; i++) {
+            c[3 * i] = cr * fa[i];
+            c[3 * i + 1] = cg * fa[i];
+            c[3 * i + 2] = cb * fa[i];
         }
-        if (shadow && d > 0.0f) {
-            float v = l2_visibility(&p->polar, l, dx, dy, d, caster[x] != 0);
-            if (v <= 0.0f)
-                continue;
-            f *= v;
-        }
-        float r = p->rgb.x * f, g = p->rgb.y * f, b = p->rgb.z * f;
-        if (cache) {
-            float *c = cache + 3 * (x - p->x0);
-            c[0] = r;
-            c[1] = g;
-            c[2] = b;
-        }
-        acc[3 * x] += r;
-        acc[3 * x + 1] += g;
-        acc[3 * x + 2] += b;
+    }
+    for (int i = 0; i < n; i++) {
+        a[3 * i] += cr * fa[i];
+        a[3 * i + 1] += cg * fa[i];
+        a[3 * i + 2] += cb * fa[i];
     }
 }
 
@@ -133,7 +170,8 @@ lx_status lx_light2d_render(lx_light2d *ctx, lx_vec3 ambient, const lx_image *al
     }
     if (st != LX_OK)
         return st;
-    float *rows = malloc((size_t)threads * w * 3 * sizeof *rows);
+    /* per thread: an accumulated row and four rows of scratch */
+    float *rows = malloc((size_t)threads * w * 7 * sizeof *rows);
     if (!rows)
         return lx_fail(LX_ERR_NOMEM, "light2d: out of memory for %d rows", threads);
     int ach = albedo ? albedo->channels : 0;
@@ -143,7 +181,8 @@ lx_status lx_light2d_render(lx_light2d *ctx, lx_vec3 ambient, const lx_image *al
 #ifdef _OPENMP
         tid = omp_get_thread_num();
 #endif
-        float *acc = rows + (size_t)tid * w * 3;
+        float *acc = rows + (size_t)tid * w * 7;
+        float *scratch = acc + (size_t)w * 3;
 #pragma omp for schedule(dynamic, 4)
         for (int y = 0; y < hgt; y++) {
             for (int x = 0; x < w; x++) {
@@ -156,7 +195,7 @@ lx_status lx_light2d_render(lx_light2d *ctx, lx_vec3 ambient, const lx_image *al
                 if (y < p->y0 || y >= p->y1 || p->x1 <= p->x0)
                     continue;
                 if (p->relight)
-                    l2_shade_row(ctx, p, y, acc);
+                    l2_shade_row(ctx, p, y, acc, scratch);
                 else
                     add_cached(p, y, acc);
             }
