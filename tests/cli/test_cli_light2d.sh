@@ -65,7 +65,7 @@ bad_lights() { # NAME JSON NEEDLE...
     expect_error "$name" "$name.json" "$@"
     check "$name: no image" test ! -e "$WORK/$name.png"
 }
-bad_lights radius '{"lights": [{"position": [10, 10], "radius": 0}]}' "lights\[0\]" "radius 0 must be > 0"
+bad_lights radius '{"lights": [{"position": [10, 10], "radius": 0}]}' "lights[0]" "radius 0 must be > 0"
 bad_lights negradius '{"lights": [{"position": [10, 10], "radius": -5}]}' "radius -5"
 bad_lights arc '{"lights": [{"type": "spot", "position": [1, 1], "direction": [1, 0], "radius": 9, "arc": 0}]}' "arc 0 must be in (0, 360]"
 bad_lights arc2 '{"lights": [{"type": "spot", "position": [1, 1], "direction": [1, 0], "radius": 9, "arc": 361}]}' "arc 361"
