@@ -51,6 +51,7 @@ bench: all
 	$(BUILD)/bin/bench_render
 	$(BUILD)/bin/bench_maps
 	$(BUILD)/bin/bench_horizon
+	$(BUILD)/bin/bench_light2d
 
 fuzz: all
 	@test -f $(BUILD_FUZZ)/CMakeCache.txt || CC=clang cmake -S . -B $(BUILD_FUZZ) -DCMAKE_BUILD_TYPE=Debug -DLX_FUZZ=ON

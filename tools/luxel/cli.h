@@ -40,6 +40,7 @@ int cli_horizon_load(const cli_horizon_opts *o, lx_image *hf);
  * printed). */
 int cli_horizon_run(const cli_horizon_opts *o, const lx_image *hf, lx_image *l0, lx_image *l1,
                     lx_image *ao);
+int cmd_light2d(int argc, char **argv);
 
 /* Writes scene as a .glb at path with u's generated UVs in TEXCOORD_1
  * (lx_scene_write_glb; unwrap.c). The scene is the one u was made from,

@@ -43,6 +43,7 @@ static const char *main_usage =
     "  aomap HEIGHT  ambient-occlusion map of a height image\n"
     "  tangents SCENE\n"
     "                write the scene with MikkTSpace (or Lengyel) tangents (.glb)\n"
+    "  light2d       shadowed 2D lights over a caster image (--casters, --lights)\n"
     "\n"
     "options:\n"
     "  -h, --help    show this help (luxel <command> --help for a command)\n"
@@ -425,7 +426,7 @@ int main(int argc, char **argv)
                     {"ibl", cmd_ibl},       {"render", cmd_render}, {"unwrap", cmd_unwrap},
                     {"normalmap", cmd_normalmap}, {"parallaxmap", cmd_parallaxmap},
                     {"horizonmap", cmd_horizonmap}, {"aomap", cmd_aomap},
-                    {"tangents", cmd_tangents}};
+                    {"tangents", cmd_tangents}, {"light2d", cmd_light2d}};
     for (size_t i = 0; i < sizeof commands / sizeof commands[0]; i++)
         if (strcmp(cmd, commands[i].name) == 0) {
             lx_set_log_callback(print_log, NULL);

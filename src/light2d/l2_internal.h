@@ -1,0 +1,104 @@
+/* Private to src/light2d: the context of 2D shadowed lights, the per-light
+ * polar shadow maps (polar.c) and the shading of rows (shade.c). */
+#ifndef LX_LIGHT2D_INTERNAL_H
+#define LX_LIGHT2D_INTERNAL_H
+
+#include "luxel/light2d.h"
+
+#include <stdint.h>
+
+/* min and max without libm's NaN rules (a call each otherwise); the
+ * values here are never NaN */
+static inline float l2_min(float a, float b)
+{
+    return a < b ? a : b;
+}
+static inline float l2_max(float a, float b)
+{
+    return a > b ? a : b;
+}
+
+/* Boundary caster pixels are bucketed in square tiles of this many pixels,
+ * so a light visits only the tiles under its reach. */
+#define L2_TILE 32
+
+/* Which 4-neighbours of a boundary pixel are free (not casters, or outside
+ * the image). */
+enum { L2_FREE_LEFT = 1, L2_FREE_RIGHT = 2, L2_FREE_UP = 4, L2_FREE_DOWN = 8 };
+
+typedef struct l2_edge {
+    uint16_t x, y;
+    uint8_t free;
+} l2_edge;
+
+/* A light's polar shadow map: n rays over the pseudo-angle p in [0, 8)
+ * (the point where the ray meets the unit square around the light, walked
+ * counter-clockwise: p = 1 + dy/dx on the +x face, 3 - dx/dy on +y, 5 +
+ * dy/dx on -x, 7 - dx/dy on -y). occ[b]: distance to the nearest caster
+ * along ray b; ex[b]: where the first caster run of the ray ends. For soft
+ * lights, sparse tables of the minimum and maximum of occ over 2^l rays. */
+typedef struct l2_polar {
+    int n;
+    float bins_per_p; /* n / 8 */
+    float *occ, *ex;
+    float *tmin, *tmax; /* levels x n */
+    int levels;
+    int capacity; /* floats allocated per array (occ, ex: n; tables: levels*n) */
+    int table_capacity;
+} l2_polar;
+
+/* A light prepared for a frame. */
+typedef struct l2_prep {
+    lx_light2d_light l;
+    int x0, y0, x1, y1; /* pixels under its reach, clipped: [x0,x1) x [y0,y1) */
+    float r2, inv_r, inv_r2;
+    lx_vec3 rgb; /* colour x intensity */
+    bool spot;
+    float dir_x, dir_y, cos_outer, cos_inner, inv_fade;
+    bool relight; /* computed this frame (dynamic, or a cache to refill) */
+    float *cache; /* static lights: (x1-x0)*(y1-y0)*3 floats */
+    l2_polar polar;
+} l2_prep;
+
+struct lx_light2d {
+    int width, height;
+    int channels;
+    bool mask;
+    float threshold;
+    int threads;
+    int polar_resolution;
+    uint8_t *caster; /* width*height, 1 for casters */
+    int tiles_x, tiles_y;
+    uint32_t *tile_start; /* tiles_x*tiles_y + 1 offsets into edges */
+    l2_edge *edges;
+    float *normals; /* width*height*3 unit vectors in pixel space (x right,
+                       y down, z towards the viewer), or NULL */
+    l2_prep *preps;
+    int count, prep_capacity;
+    int relit;
+};
+
+/* Rebuilds the tile lists of boundary caster pixels (context.c). */
+lx_status l2_build_edges(lx_light2d *ctx);
+
+/* Rays for a light of this radius (or the context's fixed resolution). */
+int l2_ray_count(const lx_light2d *ctx, float radius);
+
+/* Fills p->polar for the light (allocating as needed). */
+lx_status l2_polar_build(const lx_light2d *ctx, l2_prep *p);
+void l2_polar_free(l2_polar *pm);
+
+/* Visibility in [0, 1] of the point at (dx, dy) from the light, distance
+ * d, for a caster pixel or not. */
+float l2_visibility(const l2_polar *pm, const lx_light2d_light *l, float dx, float dy, float d,
+                    bool caster);
+/* Soft visibility at distance d on the ray at continuous bin c, u2 the
+ * squared slope of the pseudo-angle there (polar.c). */
+float l2_soft_visibility(const l2_polar *pm, float s, float c, float u2, float d);
+
+/* Adds the light's contribution to row y of acc (width*3 floats), filling
+ * its cache row first when it is a static light being re-lit; scratch
+ * holds 4*width floats (shade.c). */
+void l2_shade_row(const lx_light2d *ctx, const l2_prep *p, int y, float *acc, float *scratch);
+
+#endif

@@ -1,0 +1,306 @@
+/* Polar shadow maps of 2D lights (seed 003, "2D lighting system tutorial
+ * part 4": the casters around a light unwrapped into a column per ray and
+ * each column reduced to its nearest occluder). On the CPU the unwrap and
+ * the reduction are one step: every boundary caster pixel under the light's
+ * reach is rasterised into the angular bins its square covers, keeping the
+ * nearest distance per bin (only boundary pixels can be the first caster a
+ * ray meets). A second pass keeps where the first caster run of each ray
+ * ends, so casters can be lit on their face. Soft shadows filter the map
+ * along the angle (percentage-closer filtering) over a window that grows
+ * with the distance behind the occluder, as a light of radius `softness`
+ * predicts; sparse tables of the window minimum and maximum skip the
+ * filter wherever the window is wholly lit or wholly shadowed. */
+#include "l2_internal.h"
+#include "core/internal.h"
+
+#include <math.h>
+#include <stdlib.h>
+#include <string.h>
+
+#define L2_FAR 1e30f
+/* Filter taps beyond which a penumbra window is sampled, not summed. */
+#define L2_MAX_TAPS 32
+
+/* Pseudo-angle in [0, 8] of the direction (dx, dy) (not both zero), see
+ * l2_polar; *u gets the slope on its face (dp/dangle = 1 + u^2). */
+static inline float pseudo_angle(float dx, float dy, float *u)
+{
+    float ax = fabsf(dx), ay = fabsf(dy);
+    if (ax >= ay) {
+        if (ax == 0.0f) {
+            *u = 0.0f;
+            return 0.0f;
+        }
+        float t = dy / ax;
+        *u = t;
+        return dx > 0.0f ? 1.0f + t : 5.0f - t;
+    }
+    float t = dx / ay;
+    *u = t;
+    return dy > 0.0f ? 3.0f - t : 7.0f + t;
+}
+
+static inline int wrap(int i, int n)
+{
+    return i < 0 ? i + n : (i >= n ? i - n : i);
+}
+
+void l2_polar_free(l2_polar *pm)
+{
+    free(pm->occ);
+    free(pm->ex);
+    free(pm->tmin);
+    free(pm->tmax);
+    memset(pm, 0, sizeof *pm);
+}
+
+/* The bins [b0, b1] (b1 may pass n: wrap) the square [ax,bx] x [ay,by]
+ * (relative to the light, not containing it) covers. */
+static void square_bins(const l2_polar *pm, float ax, float bx, float ay, float by, int *b0,
+                        int *b1)
+{
+    float u;
+    float p[4] = {pseudo_angle(ax, ay, &u), pseudo_angle(bx, ay, &u), pseudo_angle(ax, by, &u),
+                  pseudo_angle(bx, by, &u)};
+    float lo = p[0], hi = p[0];
+    for (int k = 1; k < 4; k++) {
+        lo = l2_min(lo, p[k]);
+        hi = l2_max(hi, p[k]);
+    }
+    if (hi - lo > 4.0f) { /* the square straddles p = 0 */
+        lo = 8.0f;
+        hi = 0.0f;
+        for (int k = 0; k < 4; k++) {
+            float q = p[k] < 4.0f ? p[k] + 8.0f : p[k];
+            lo = l2_min(lo, q);
+            hi = l2_max(hi, q);
+        }
+    }
+    int n = pm->n;
+    int a = (int)(lo * pm->bins_per_p), b = (int)(hi * pm->bins_per_p);
+    if (a >= n) {
+        a -= n;
+        b -= n;
+    }
+    if (b > a + n - 1)
+        b = a + n - 1;
+    *b0 = a;
+    *b1 = b;
+}
+
+static lx_status reserve(l2_polar *pm, int n, int levels)
+{
+    if (n > pm->capacity) {
+        float *occ = realloc(pm->occ, (size_t)n * sizeof *occ);
+        if (occ)
+            pm->occ = occ;
+        float *ex = realloc(pm->ex, (size_t)n * sizeof *ex);
+        if (ex)
+            pm->ex = ex;
+        if (!occ || !ex)
+            return lx_fail(LX_ERR_NOMEM, "light2d: out of memory for a polar map of %d rays", n);
+        pm->capacity = n;
+    }
+    size_t t = (size_t)n * levels;
+    if (t > (size_t)pm->table_capacity) {
+        float *a = realloc(pm->tmin, t * sizeof *a);
+        if (a)
+            pm->tmin = a;
+        float *b = realloc(pm->tmax, t * sizeof *b);
+        if (b)
+            pm->tmax = b;
+        if (!a || !b)
+            return lx_fail(LX_ERR_NOMEM, "light2d: out of memory for a polar map of %d rays", n);
+        pm->table_capacity = (int)t;
+    }
+    return LX_OK;
+}
+
+lx_status l2_polar_build(const lx_light2d *ctx, l2_prep *p)
+{
+    const lx_light2d_light *l = &p->l;
+    l2_polar *pm = &p->polar;
+    int n = l2_ray_count(ctx, l->radius);
+    bool soft = l->softness > 0.0f;
+    int levels = 0;
+    if (soft)
+        while ((1 << levels) <= n)
+            levels++;
+    lx_status st = reserve(pm, n, levels);
+    if (st != LX_OK)
+        return st;
+    pm->n = n;
+    pm->levels = levels;
+    pm->bins_per_p = (float)n / 8.0f;
+    float *occ = pm->occ, *ex = pm->ex;
+    for (int b = 0; b < n; b++) {
+        occ[b] = L2_FAR;
+        ex[b] = L2_FAR;
+    }
+    float lx = l->x, ly = l->y, r = l->radius, r2 = r * r;
+    int tx0 = (int)fmax(0.0, floor((l->x - r - 1.0) / L2_TILE));
+    int ty0 = (int)fmax(0.0, floor((l->y - r - 1.0) / L2_TILE));
+    int tx1 = (int)fmin(ctx->tiles_x - 1, floor((l->x + r + 1.0) / L2_TILE));
+    int ty1 = (int)fmin(ctx->tiles_y - 1, floor((l->y + r + 1.0) / L2_TILE));
+    bool face = !l->self_shadow;
+    for (int pass = 0; pass < (face ? 2 : 1); pass++)
+        for (int ty = ty0; ty <= ty1; ty++)
+            for (int tx = tx0; tx <= tx1; tx++) {
+                size_t t = (size_t)ty * ctx->tiles_x + tx;
+                for (uint32_t e = ctx->tile_start[t]; e < ctx->tile_start[t + 1]; e++) {
+                    const l2_edge *ed = &ctx->edges[e];
+                    float ax = (float)ed->x - lx, bx = ax + 1.0f;
+                    float ay = (float)ed->y - ly, by = ay + 1.0f;
+                    float nx = ax > 0.0f ? ax : (bx < 0.0f ? -bx : 0.0f);
+                    float ny = ay > 0.0f ? ay : (by < 0.0f ? -by : 0.0f);
+                    float dn2 = nx * nx + ny * ny;
+                    if (dn2 >= r2)
+                        continue;
+                    bool inside = nx == 0.0f && ny == 0.0f;
+                    if (pass == 1) {
+                        float cx = ax + 0.5f, cy = ay + 0.5f;
+                        bool exit = ((ed->free & L2_FREE_RIGHT) && cx > 0.0f) ||
+                                    ((ed->free & L2_FREE_LEFT) && cx < 0.0f) ||
+                                    ((ed->free & L2_FREE_DOWN) && cy > 0.0f) ||
+                                    ((ed->free & L2_FREE_UP) && cy < 0.0f) || inside;
+                        if (!exit)
+                            continue;
+                    }
+                    int b0 = 0, b1 = n - 1;
+                    if (!inside)
+                        square_bins(pm, ax, bx, ay, by, &b0, &b1);
+                    if (pass == 0) {
+                        float dn = sqrtf(dn2);
+                        for (int b = b0; b <= b1; b++) {
+                            int i = b >= n ? b - n : b;
+                            if (dn < occ[i])
+                                occ[i] = dn;
+                        }
+                    } else {
+                        float fx = l2_max(ax * ax, bx * bx), fy = l2_max(ay * ay, by * by);
+                        float df = sqrtf(fx + fy);
+                        for (int b = b0; b <= b1; b++) {
+                            int i = b >= n ? b - n : b;
+                            if (df >= occ[i] && df < ex[i])
+                                ex[i] = df;
+                        }
+                    }
+                }
+            }
+    /* a light inside a caster pixel that is not on a boundary */
+    int ix = (int)floorf(lx), iy = (int)floorf(ly);
+    if (ix >= 0 && iy >= 0 && ix < ctx->width && iy < ctx->height &&
+        ctx->caster[(size_t)iy * ctx->width + ix])
+        for (int b = 0; b < n; b++)
+            occ[b] = 0.0f;
+    if (soft) {
+        memcpy(pm->tmin, occ, (size_t)n * sizeof *occ);
+        memcpy(pm->tmax, occ, (size_t)n * sizeof *occ);
+        for (int k = 1; k < levels; k++) {
+            const float *a = pm->tmin + (size_t)(k - 1) * n, *b = pm->tmax + (size_t)(k - 1) * n;
+            float *c = pm->tmin + (size_t)k * n, *d = pm->tmax + (size_t)k * n;
+            int h = 1 << (k - 1);
+            for (int i = 0; i < n; i++) {
+                int j = i + h >= n ? i + h - n : i + h;
+                c[i] = l2_min(a[i], a[j]);
+                d[i] = l2_max(b[i], b[j]);
+            }
+        }
+    }
+    return LX_OK;
+}
+
+/* Minimum (or maximum) of occ over bins [lo, hi], hi - lo < n. */
+static inline float range_query(const l2_polar *pm, const float *table, int lo, int hi, bool max)
+{
+    int n = pm->n;
+    int len = hi - lo + 1;
+    int k = 31 - __builtin_clz((unsigned)len);
+    const float *t = table + (size_t)k * n;
+    /* windows are under n rays and centred in [0, n]: one wrap at most */
+    int a = wrap(lo, n);
+    int b = wrap(hi - (1 << k) + 1, n);
+    return max ? l2_max(t[a], t[b]) : l2_min(t[a], t[b]);
+}
+
+/* Fraction of the window [c - k, c + k] (in bins) whose rays reach past d. */
+static float filter(const l2_polar *pm, float c, float k, float d)
+{
+    int n = pm->n;
+    float lo = c - k, hi = c + k;
+    int b0 = (int)floorf(lo), b1 = (int)floorf(hi);
+    if (range_query(pm, pm->tmax, b0, b1, true) < d)
+        return 0.0f;
+    if (range_query(pm, pm->tmin, b0, b1, false) >= d)
+        return 1.0f;
+    if (b1 - b0 + 1 <= L2_MAX_TAPS) {
+        float lit = 0.0f;
+        for (int b = b0; b <= b1; b++) {
+            float w = l2_min(hi, (float)(b + 1)) - l2_max(lo, (float)b);
+            if (pm->occ[wrap(b, n)] >= d)
+                lit += w;
+        }
+        return lit / (hi - lo);
+    }
+    int lit = 0;
+    float step = (hi - lo) / L2_MAX_TAPS;
+    for (int i = 0; i < L2_MAX_TAPS; i++) {
+        int b = (int)floorf(lo + (i + 0.5f) * step);
+        if (pm->occ[wrap(b, n)] >= d)
+            lit++;
+    }
+    return (float)lit / L2_MAX_TAPS;
+}
+
+/* Soft visibility at distance d on the ray at continuous bin c: the
+ * nearest occluder o in a search window (the window an occluder at d/8
+ * would need), then the filter over the half-angle softness (d - o) /
+ * (d o), the angle a light of radius softness subtends behind o, with o
+ * the nearest occluder inside that window. */
+float l2_soft_visibility(const l2_polar *pm, float s, float c, float u2, float d)
+{
+    float scale = (1.0f + u2) * pm->bins_per_p; /* bins per radian */
+    float cap = 0.5f * (float)pm->n - 1.0f;
+    float ks = l2_min(7.0f * s / d * scale, cap);
+    int b0 = (int)floorf(c - ks), b1 = (int)floorf(c + ks);
+    float m = range_query(pm, pm->tmin, b0, b1, false);
+    if (m >= d)
+        return 1.0f;
+    /* the nearest occluder's window shrinks as farther occluders are
+     * found nearest inside it: iterate to (close to) the fixed point, where
+     * the window is that of the nearest occluder inside it */
+    float k = 0.0f;
+    for (int it = 0; it < 4; it++) {
+        float o = l2_max(m, 0.5f);
+        k = l2_min(s * (d - o) / (d * o) * scale, cap);
+        if (k < 0.5f)
+            break;
+        float m2 = range_query(pm, pm->tmin, (int)floorf(c - k), (int)floorf(c + k), false);
+        if (m2 >= d)
+            return 1.0f;
+        if (m2 == m)
+            break;
+        m = m2;
+    }
+    if (k < 0.5f)
+        return pm->occ[wrap((int)floorf(c), pm->n)] >= d ? 1.0f : 0.0f;
+    return filter(pm, c, k, d);
+}
+
+float l2_visibility(const l2_polar *pm, const lx_light2d_light *l, float dx, float dy, float d,
+                    bool caster)
+{
+    float u;
+    float c = pseudo_angle(dx, dy, &u) * pm->bins_per_p;
+    int b = (int)c;
+    if (b >= pm->n)
+        b -= pm->n;
+    float o = pm->occ[b];
+    bool face = caster && !l->self_shadow && d <= pm->ex[b];
+    if (l->softness <= 0.0f)
+        return (d < o || face) ? 1.0f : 0.0f;
+    float de = d;
+    if (face)
+        de = l2_max(l2_min(d, o - 0.5f), 0.5f);
+    return l2_soft_visibility(pm, l->softness, c, u * u, de);
+}

@@ -1,0 +1,224 @@
+/* 2D lights: shading a frame (seed 003, "2D lighting system", the light
+ * map pass): out = albedo x (ambient + sum of lights), each light touching
+ * only the pixels within its radius, with its falloff, spot cone, shadow
+ * visibility from its polar map (polar.c) and, over a normal map, N.L
+ * towards the light lifted to its height. Rows are independent and every
+ * row adds its lights in their order, so the bytes do not depend on the
+ * thread count; static lights keep their contribution in a cache and add
+ * the same floats again on later frames. */
+#include "l2_internal.h"
+#include "core/internal.h"
+
+#include <math.h>
+#include <stdlib.h>
+#include <string.h>
+#ifdef _OPENMP
+#include <omp.h>
+#endif
+
+void l2_shade_row(const lx_light2d *ctx, const l2_prep *p, int y, float *acc, float *scratch)
+{
+    const lx_light2d_light *l = &p->l;
+    float dy = (float)y + 0.5f - l->y;
+    float dy2 = dy * dy;
+    float *cache = p->cache ? p->cache + (size_t)(y - p->y0) * (p->x1 - p->x0) * 3 : NULL;
+    if (cache)
+        memset(cache, 0, (size_t)(p->x1 - p->x0) * 3 * sizeof *cache);
+    if (dy2 >= p->r2)
+        return;
+    float half = sqrtf(p->r2 - dy2);
+    int xa = (int)l2_max((float)p->x0, floorf(l->x - half - 0.5f));
+    int xb = (int)l2_min((float)p->x1, ceilf(l->x + half + 0.5f));
+    int n = xb - xa;
+    if (n <= 0)
+        return;
+    /* pass 1, branch-free so that it vectorizes: distance, falloff and the
+     * continuous polar bin of every pixel of the span */
+    float *fa = scratch, *da = scratch + ctx->width, *ca = scratch + 2 * ctx->width,
+          *ua = scratch + 3 * ctx->width;
+    float lx = l->x, r2 = p->r2, inv_r = p->inv_r, inv_r2 = p->inv_r2;
+    float bpp = p->polar.bins_per_p;
+    int kind = (int)l->falloff;
+    for (int i = 0; i < n; i++) {
+        float dx = (float)(xa + i) + 0.5f - lx;
+        float d2 = dx * dx + dy2;
+        float d = sqrtf(d2);
+        float q = 1.0f - d2 * inv_r2;
+        float f = kind == 0 ? q * q : (kind == 1 ? 1.0f - d * inv_r : 1.0f);
+        fa[i] = d2 < r2 ? f : 0.0f;
+        da[i] = d;
+        float ax = fabsf(dx), ay = fabsf(dy);
+        bool big = ax >= ay;
+        float m = big ? ax : ay;
+        float num = big ? dy : dx;
+        float t = num / l2_max(m, 1e-30f);
+        float pa = big ? (dx > 0.0f ? 1.0f + t : 5.0f - t) : (dy > 0.0f ? 3.0f - t : 7.0f + t);
+        ca[i] = pa * bpp;
+        ua[i] = t;
+    }
+    if (p->spot) {
+        float cx = p->dir_x, cy = p->dir_y, co = p->cos_outer, ci = p->cos_inner, k = p->inv_fade;
+        for (int i = 0; i < n; i++) {
+            float dx = (float)(xa + i) + 0.5f - lx;
+            float d = da[i];
+            float c = d > 0.0f ? (dx * cx + dy * cy) / d : 1.0f;
+            float t = l2_min(l2_max((c - co) * k, 0.0f), 1.0f);
+            float s = c >= ci ? 1.0f : (c <= co ? 0.0f : t * t * (3.0f - 2.0f * t));
+            fa[i] *= s;
+        }
+    }
+    if (ctx->normals) {
+        const float *nn = ctx->normals + ((size_t)y * ctx->width + xa) * 3;
+        float h = l->height, h2 = h * h;
+        for (int i = 0; i < n; i++) {
+            float dx = (float)(xa + i) + 0.5f - lx;
+            float ndl = -dx * nn[3 * i] - dy * nn[3 * i + 1] + h * nn[3 * i + 2];
+            float len = sqrtf(da[i] * da[i] + h2);
+            fa[i] *= ndl > 0.0f && len > 0.0f ? ndl / len : 0.0f;
+        }
+    }
+    /* pass 2: shadows from the polar map */
+    if (l->shadow) {
+        const uint8_t *caster = ctx->caster + (size_t)y * ctx->width + xa;
+        const l2_polar *pm = &p->polar;
+        int nb = pm->n;
+        bool soft = l->softness > 0.0f, face_ok = !l->self_shadow;
+        for (int i = 0; i < n; i++) {
+            if (fa[i] <= 0.0f)
+                continue;
+            float d = da[i];
+            if (d <= 0.0f)
+                continue;
+            int b = (int)ca[i];
+            if (b >= nb)
+                b -= nb;
+            float o = pm->occ[b];
+            bool face = face_ok && caster[i] && d <= pm->ex[b];
+            if (!soft) {
+                if (!(d < o || face))
+                    fa[i] = 0.0f;
+                continue;
+            }
+            float de = face ? l2_max(l2_min(d, o - 0.5f), 0.5f) : d;
+            fa[i] *= l2_soft_visibility(pm, l->softness, ca[i], ua[i] * ua[i], de);
+        }
+    }
+    float cr = p->rgb.x, cg = p->rgb.y, cb = p->rgb.z;
+    float *a = acc + 3 * xa;
+    if (cache) {
+        float *c = cache + 3 * (xa - p->x0);
+        for (int i = 0; i < n; i++) {
+            c[3 * i] = cr * fa[i];
+            c[3 * i + 1] = cg * fa[i];
+            c[3 * i + 2] = cb * fa[i];
+        }
+    }
+    for (int i = 0; i < n; i++) {
+        a[3 * i] += cr * fa[i];
+        a[3 * i + 1] += cg * fa[i];
+        a[3 * i + 2] += cb * fa[i];
+    }
+}
+
+/* Adds a cached light's row. */
+static void add_cached(const l2_prep *p, int y, float *acc)
+{
+    const float *c = p->cache + (size_t)(y - p->y0) * (p->x1 - p->x0) * 3;
+    float *a = acc + 3 * p->x0;
+    int n = (p->x1 - p->x0) * 3;
+    for (int i = 0; i < n; i++)
+        a[i] += c[i];
+}
+
+lx_status lx_light2d_render(lx_light2d *ctx, lx_vec3 ambient, const lx_image *albedo, float *out,
+                            float *light_map)
+{
+    int w = ctx->width, hgt = ctx->height;
+    if (albedo) {
+        if (albedo->width != w || albedo->height != hgt)
+            return lx_fail(LX_ERR_INVALID, "casters: %dx%d but albedo: %dx%d", w, hgt,
+                           albedo->width, albedo->height);
+        if (albedo->channels < 3)
+            return lx_fail(LX_ERR_INVALID, "albedo: %d channel%s, not RGB", albedo->channels,
+                           albedo->channels == 1 ? "" : "s");
+    }
+    if (!isfinite(ambient.x) || !isfinite(ambient.y) || !isfinite(ambient.z) ||
+        ambient.x < 0.0f || ambient.y < 0.0f || ambient.z < 0.0f)
+        return lx_fail(LX_ERR_INVALID, "ambient must be finite and >= 0");
+    int threads = lx_thread_count(ctx->threads);
+    /* polar maps of the lights computed this frame */
+    int count = ctx->count;
+    int relit = 0;
+    lx_status st = LX_OK;
+    for (int i = 0; i < count; i++) {
+        l2_prep *p = &ctx->preps[i];
+        if (p->l.dynamic || !p->cache)
+            p->relight = true;
+        if (p->relight)
+            relit++;
+    }
+#pragma omp parallel for schedule(dynamic, 1) num_threads(threads)
+    for (int i = 0; i < count; i++) {
+        l2_prep *p = &ctx->preps[i];
+        if (!p->relight || !p->l.shadow || p->x1 <= p->x0 || p->y1 <= p->y0)
+            continue;
+        lx_status s = l2_polar_build(ctx, p);
+        if (s != LX_OK) {
+#pragma omp critical(lx_light2d_status)
+            st = s;
+        }
+    }
+    if (st != LX_OK)
+        return st;
+    /* per thread: an accumulated row and four rows of scratch */
+    float *rows = malloc((size_t)threads * w * 7 * sizeof *rows);
+    if (!rows)
+        return lx_fail(LX_ERR_NOMEM, "light2d: out of memory for %d rows", threads);
+    int ach = albedo ? albedo->channels : 0;
+#pragma omp parallel num_threads(threads)
+    {
+        int tid = 0;
+#ifdef _OPENMP
+        tid = omp_get_thread_num();
+#endif
+        float *acc = rows + (size_t)tid * w * 7;
+        float *scratch = acc + (size_t)w * 3;
+#pragma omp for schedule(dynamic, 4)
+        for (int y = 0; y < hgt; y++) {
+            for (int x = 0; x < w; x++) {
+                acc[3 * x] = ambient.x;
+                acc[3 * x + 1] = ambient.y;
+                acc[3 * x + 2] = ambient.z;
+            }
+            for (int i = 0; i < count; i++) {
+                const l2_prep *p = &ctx->preps[i];
+                if (y < p->y0 || y >= p->y1 || p->x1 <= p->x0)
+                    continue;
+                if (p->relight)
+                    l2_shade_row(ctx, p, y, acc, scratch);
+                else
+                    add_cached(p, y, acc);
+            }
+            size_t row = (size_t)y * w * 3;
+            if (light_map)
+                memcpy(light_map + row, acc, (size_t)w * 3 * sizeof *acc);
+            if (out) {
+                float *o = out + row;
+                if (albedo) {
+                    const float *a = albedo->data + (size_t)y * w * ach;
+                    for (int x = 0; x < w; x++)
+                        for (int k = 0; k < 3; k++)
+                            o[3 * x + k] = a[ach * x + k] * acc[3 * x + k];
+                } else {
+                    memcpy(o, acc, (size_t)w * 3 * sizeof *acc);
+                }
+            }
+        }
+    }
+    free(rows);
+    for (int i = 0; i < count; i++)
+        if (ctx->preps[i].cache)
+            ctx->preps[i].relight = false;
+    ctx->relit = relit;
+    return LX_OK;
+}
