@@ -41,6 +41,9 @@ static const char *main_usage =
     "                horizon maps of a height image (bumps that shadow\n"
     "                themselves) and their weight cube\n"
     "  aomap HEIGHT  ambient-occlusion map of a height image\n"
+    "  shade --height H | --normal N\n"
+    "                material preview: a quad or sphere lit, with parallax\n"
+    "                and horizon shadows\n"
     "\n"
     "options:\n"
     "  -h, --help    show this help (luxel <command> --help for a command)\n"
@@ -422,7 +425,8 @@ int main(int argc, char **argv)
     } commands[] = {{"bake", cmd_bake},     {"info", cmd_info},     {"ies", cmd_ies},
                     {"ibl", cmd_ibl},       {"render", cmd_render}, {"unwrap", cmd_unwrap},
                     {"normalmap", cmd_normalmap}, {"parallaxmap", cmd_parallaxmap},
-                    {"horizonmap", cmd_horizonmap}, {"aomap", cmd_aomap}};
+                    {"horizonmap", cmd_horizonmap}, {"aomap", cmd_aomap},
+                    {"shade", cmd_shade}};
     for (size_t i = 0; i < sizeof commands / sizeof commands[0]; i++)
         if (strcmp(cmd, commands[i].name) == 0) {
             lx_set_log_callback(print_log, NULL);
