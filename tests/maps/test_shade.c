@@ -194,6 +194,38 @@ static void step_shadow(void **state)
     lx_image_free(&hf);
 }
 
+/* Normals given (y up, or y flipped with green_down) shade as the normals
+ * the heights give, bit for bit, with parallax and horizon off. */
+static void normals_input(void **state)
+{
+    (void)state;
+    lx_image hf = flat(16, 12, 0.0f), nm, a, b;
+    for (int i = 0; i < 16 * 12; i++)
+        hf.data[i] = (float)((i * 37 % 11) / 10.0);
+    lx_normalmap_desc nd = {.strength = 5.0f, .wrap = LX_WRAP_MIRROR};
+    assert_int_equal(lx_normal_map(&hf, &nd, &nm), LX_OK);
+    lx_shade_desc d = flat_desc(&hf, 29);
+    d.strength = 5.0f;
+    d.wrap = LX_WRAP_MIRROR;
+    d.no_parallax = d.no_horizon = true;
+    d.shape = LX_SHADE_SPHERE;
+    assert_int_equal(lx_shade(&d, &a), LX_OK);
+    d.height = NULL;
+    d.normals = &nm;
+    assert_int_equal(lx_shade(&d, &b), LX_OK);
+    assert_memory_equal(a.data, b.data, sizeof(float) * 29 * 29 * 3);
+    lx_image_free(&b);
+    for (int i = 0; i < 16 * 12; i++)
+        nm.data[i * 3 + 1] = -nm.data[i * 3 + 1];
+    d.green_down = true;
+    assert_int_equal(lx_shade(&d, &b), LX_OK);
+    assert_memory_equal(a.data, b.data, sizeof(float) * 29 * 29 * 3);
+    lx_image_free(&a);
+    lx_image_free(&b);
+    lx_image_free(&nm);
+    lx_image_free(&hf);
+}
+
 static void bad_inputs(void **state)
 {
     (void)state;
@@ -221,6 +253,7 @@ int main(void)
         cmocka_unit_test(flat_quad_and_sphere),
         cmocka_unit_test(flat_on_off),
         cmocka_unit_test(step_shadow),
+        cmocka_unit_test(normals_input),
         cmocka_unit_test(bad_inputs),
     };
     return cmocka_run_group_tests(tests, NULL, NULL);
