@@ -259,6 +259,69 @@ lx_status lx_compute_tangents_mikktspace(const lx_mesh *mesh, int uv_set, lx_vec
 lx_status lx_compute_corner_tangents(const lx_mesh *mesh, lx_tangent_method method, int uv_set,
                                      lx_vec4 *out);
 
+/* ---- material preview --------------------------------------------------
+ * A height or normal map (and a base colour) lit on a quad or a sphere by
+ * one directional light (seed 002: Lambert diffuse rho/pi and Blinn-Phong
+ * specular, ApplyParallaxOffset, ApplyHorizonMap). World axes: x right,
+ * y up, z toward the camera, a perspective camera on +z looking at the
+ * origin. The quad is the plane z = 0 filling the frame (texture tiled once
+ * across it; its tangent frame is the world's, so a tangent-space light is
+ * the world light); the sphere of radius sin(fov/2) D (D the camera
+ * distance) just fills the frame's height, u = 1/2 + longitude / 2 pi
+ * (longitude 0 facing the camera), v = 1/2 - latitude / pi, the tangent
+ * along +u and the bitangent toward the north pole. Per pixel:
+ *   L = base/pi (E sat(n.l) + ambient)
+ *     + specular E sat(n.h)^exponent [n.l > 0]   (h = normalize(l + v))
+ * the direct part times lx_horizon_light(l) with horizon shadows, and 0
+ * where the light is below the geometric surface. E = colour * illuminance. */
+
+typedef enum lx_shade_shape { LX_SHADE_QUAD = 0, LX_SHADE_SPHERE } lx_shade_shape;
+
+typedef struct lx_shade_desc {
+    const lx_image *height;  /* one channel; or NULL with normals */
+    const lx_image *normals; /* unit tangent-space normals (lx_normal_decode),
+                                used instead of heights when given */
+    const lx_image *base_color; /* linear RGB (3 or 4 channels); NULL = grey 0.8 */
+    float strength;          /* texels of height per unit value; 0 = LX_DEFAULT_HEIGHT_STRENGTH */
+    lx_wrap wrap;            /* addressing outside the textures (REPEAT) */
+    bool green_down;         /* normals have y down the image (DirectX) */
+    lx_shade_shape shape;    /* QUAD */
+    lx_vec3 light;           /* world direction toward the light; zero =
+                                lx_shade_light_dir(135, 35) */
+    float light_color[3];    /* all zero = white */
+    float illuminance;       /* E multiplier; 0 = pi (white Lambert face-on = 1) */
+    float ambient;           /* ambient illuminance (0) */
+    float fov;               /* vertical field of view in degrees; 0 = 40 */
+    float specular[3];       /* Blinn-Phong colour; all zero = 0.04 grey */
+    float exponent;          /* Blinn-Phong power; 0 = 64 */
+    bool no_specular;        /* no specular term */
+    bool no_parallax;        /* no parallax offset (off anyway without heights) */
+    float parallax_scale;    /* multiplier on the physical depth S/W; 0 = 1 */
+    bool no_horizon;         /* no horizon shadows (off anyway without heights) */
+    lx_horizon_desc horizon; /* the horizon map's settings (strength and
+                                wrap are taken from this desc) */
+    int out_width, out_height; /* output size in pixels; 0 = 512 */
+    int threads;             /* 0 = all cores */
+    lx_progress_fn progress; /* may be NULL; returning false cancels */
+    void *progress_user;
+} lx_shade_desc;
+
+/* A copy of desc (or of zeros when NULL) with every default filled in. */
+lx_shade_desc lx_shade_desc_defaults(const lx_shade_desc *desc);
+
+/* The unit world direction toward a light at azimuth az (degrees,
+ * counter-clockwise from +x in the quad's plane) and elevation el (degrees
+ * above that plane). */
+lx_vec3 lx_shade_light_dir(float az, float el);
+
+/* Renders the preview into *out (3 channels linear RGB, allocated here;
+ * zeroed on failure). The result does not depend on desc->threads. Fails
+ * (LX_ERR_INVALID) without a height or normals, for a height that is not
+ * one channel, normals with fewer than 3 channels, a base colour with
+ * fewer than 3, a light that is not finite or zero after defaults, and
+ * values out of range. */
+lx_status lx_shade(const lx_shade_desc *desc, lx_image *out);
+
 /* Per-vertex tangents from positions, normals and uv[uv_set] (Lengyel's
  * method, FGED vol. 2 ch. 7: per-triangle tangent/bitangent summed over
  * vertices, Gram-Schmidt against the normal, handedness in w). Vertices

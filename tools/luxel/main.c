@@ -41,6 +41,9 @@ static const char *main_usage =
     "                horizon maps of a height image (bumps that shadow\n"
     "                themselves) and their weight cube\n"
     "  aomap HEIGHT  ambient-occlusion map of a height image\n"
+    "  shade --height H | --normal N\n"
+    "                material preview: a quad or sphere lit, with parallax\n"
+    "                and horizon shadows\n"
     "  tangents SCENE\n"
     "                write the scene with MikkTSpace (or Lengyel) tangents (.glb)\n"
     "  light2d       shadowed 2D lights over a caster image (--casters, --lights)\n"
@@ -426,7 +429,8 @@ int main(int argc, char **argv)
                     {"ibl", cmd_ibl},       {"render", cmd_render}, {"unwrap", cmd_unwrap},
                     {"normalmap", cmd_normalmap}, {"parallaxmap", cmd_parallaxmap},
                     {"horizonmap", cmd_horizonmap}, {"aomap", cmd_aomap},
-                    {"tangents", cmd_tangents}, {"light2d", cmd_light2d}};
+                    {"tangents", cmd_tangents}, {"shade", cmd_shade},
+                    {"light2d", cmd_light2d}};
     for (size_t i = 0; i < sizeof commands / sizeof commands[0]; i++)
         if (strcmp(cmd, commands[i].name) == 0) {
             lx_set_log_callback(print_log, NULL);

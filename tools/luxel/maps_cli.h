@@ -8,6 +8,7 @@
 
 int cmd_normalmap(int argc, char **argv);
 int cmd_parallaxmap(int argc, char **argv);
+int cmd_shade(int argc, char **argv);
 
 /* One output image: -o OUT, --format png|exr|pfm (default from OUT's
  * extension), --bits 8|16 (PNG only; default 8). */
