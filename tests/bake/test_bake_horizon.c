@@ -70,6 +70,7 @@ typedef struct bake_setup {
     float elevation;  /* of the directional light from +x, degrees; < 0: none */
     lx_vec3 ambient;  /* scene ambient, lux */
     const char *json; /* lights JSON text (NULL: none), applied as dir/lights.json */
+    float sky;        /* radiance of a constant unshadowed sky, nits; 0: none */
 } bake_setup;
 
 /* Bakes a 4 m plane with material "bumpy" under the setup into *img. */
@@ -96,8 +97,16 @@ static void bake(const char *dir, const bake_setup *s, lx_image *img)
         assert_int_equal(lx_lights_json_apply_text(scene, s->json, strlen(s->json), name), LX_OK);
     }
     lx_bake_desc desc = {.resolution = s->size, .padding = LX_PADDING_NONE, .threads = 2};
+    lx_cubemap env = {0};
+    if (s->sky > 0.0f) {
+        assert_int_equal(lx_cubemap_alloc(&env, 8), LX_OK);
+        for (int i = 0; i < 6 * 8 * 8 * 3; i++)
+            env.data[i] = s->sky;
+        desc.sky.environment = &env;
+    }
     lx_baker *baker;
     assert_int_equal(lx_baker_create(scene, &desc, &baker), LX_OK);
+    lx_cubemap_free(&env);
     assert_int_equal(lx_baker_bake(baker), LX_OK);
     assert_int_equal(lx_baker_apply_alloc(baker, 0, img), LX_OK);
     lx_baker_destroy(baker);
@@ -109,7 +118,7 @@ static void flat_height_changes_no_byte(void **state)
     (void)state;
     const char *dir = lx_test_dir("bake-horizon-flat");
     write_height(dir, "flat.pfm", 16, flat);
-    bake_setup s = {16, 30.0f, {3.0f, 2.0f, 1.0f}, NULL};
+    bake_setup s = {16, 30.0f, {3.0f, 2.0f, 1.0f}, NULL, 0.5f};
     lx_image plain, flat_img;
     bake(dir, &s, &plain);
     s.json = "{\"materials\": {\"bumpy\": {\"height\": \"flat.pfm\", \"strength\": 8}}}";
@@ -127,7 +136,7 @@ static void step_shadows_where_the_closed_form_says(void **state)
     const int size = 16;
     const float H = 4.0f, e = 30.0f; /* wall height in texels, light elevation */
     write_height(dir, "step.pfm", size, step);
-    bake_setup s = {size, e, {0, 0, 0}, NULL};
+    bake_setup s = {size, e, {0, 0, 0}, NULL, 0.0f};
     lx_image plain, img;
     bake(dir, &s, &plain);
     s.json = "{\"materials\": {\"bumpy\": {\"height\": \"step.pfm\", \"strength\": 4, "
@@ -166,15 +175,22 @@ static void step_shadows_where_the_closed_form_says(void **state)
     lx_image_free(&img);
 }
 
-static void check_cone_ao(float k)
+/* The ambient A (sky 0) or a constant sky of radiance L (ambient 0) at the
+ * pit's bottom: A or pi L (the sky's irradiance on an open plane) times
+ * 1 / sqrt(k^2 + 1). */
+static void check_cone_ao(float k, bool sky)
 {
     char tag[64];
-    snprintf(tag, sizeof tag, "bake-horizon-cone-%g", k);
+    snprintf(tag, sizeof tag, "bake-horizon-cone-%g-%d", k, (int)sky);
     const char *dir = lx_test_dir(tag);
     const int size = 64;
     cone_k = k;
     write_height(dir, "cone.pfm", size, cone);
-    bake_setup s = {size, -1.0f, {100.0f, 100.0f, 100.0f}, NULL};
+    bake_setup s = {size, -1.0f, {100.0f, 100.0f, 100.0f}, NULL, 0.0f};
+    if (sky) {
+        s.ambient = lx_v3(0, 0, 0);
+        s.sky = 100.0f / LX_PI;
+    }
     s.json = "{\"materials\": {\"bumpy\": {\"height\": \"cone.pfm\", \"strength\": 1, "
              "\"horizon\": false}}}";
     lx_image img;
@@ -189,8 +205,10 @@ static void check_cone_ao(float k)
 static void cone_pit_ao_scales_ambient(void **state)
 {
     (void)state;
-    check_cone_ao(1.0f);
-    check_cone_ao(0.5f);
+    check_cone_ao(1.0f, false);
+    check_cone_ao(0.5f, false);
+    check_cone_ao(1.0f, true);
+    check_cone_ao(0.5f, true);
 }
 
 static void bad_input_is_named(void **state)
