@@ -116,6 +116,14 @@ typedef struct lx_material {
                        * KHR_materials_emissive_strength (OBJ's Ke); 0 = none.
                        * Read for writers and viewers; the baker does not
                        * treat surfaces as lights. */
+    /* The lights JSON's "materials" entry (docs/lights-json.md): a height
+     * texture the baker self-shadows (horizon) and occludes (ao) the
+     * material's texels with, read at uv[normal_uv_set] under
+     * normal_transform. NULL path = none. */
+    char *height_map_path; /* resolved against the JSON's folder; loaded by the baker */
+    float height_strength; /* texels of height per unit value; 0 = LX_DEFAULT_HEIGHT_STRENGTH */
+    bool height_horizon;   /* direct light times the horizon factor */
+    bool height_ao;        /* ambient and sky light times the AO map */
 } lx_material;
 
 typedef struct lx_node {

@@ -3,6 +3,7 @@
 #define LX_BAKE_INTERNAL_H
 
 #include "luxel/bake.h"
+#include "luxel/maps.h"
 #include "luxel/trace.h"
 
 /* Texels are stored in tiles of TILE x TILE for coherent rays; a tile is
@@ -18,6 +19,24 @@ typedef struct lx_texel {
     uint32_t triangle; /* in that mesh */
     uint32_t node;     /* scene node placing the mesh (a page holds several) */
 } lx_texel;
+
+/* A texel of a material with a height (horizon.c): its horizon layers and
+ * AO sampled at its material UV, and the world tangent frame of the
+ * surface under the height. flags 0: the texel bakes as without one. */
+#define LX_TEXEL_HORIZON 1u
+#define LX_TEXEL_AO 2u
+typedef struct lx_texel_horizon {
+    float h0[4], h1[4];
+    float ao; /* 1 without an AO map */
+    uint32_t flags;
+    lx_vec3 t, b, n;
+} lx_texel_horizon;
+
+/* A scene material's horizon layers and AO map (empty when not asked). */
+typedef struct lx_horizon_material {
+    lx_image layer0, layer1, ao;
+    bool horizon, use_ao, active;
+} lx_horizon_material;
 
 typedef struct lx_lightmap {
     lx_lightmap_info info;
@@ -36,6 +55,7 @@ typedef struct lx_lightmap {
     lx_vec3 *object_geometric_normal;
     lx_vec3 *albedo; /* per texel base colour (factor x texture); NULL unless
                         the bake is of radiance, the one use of it */
+    lx_texel_horizon *horizon; /* per texel; NULL when no texel's material has a height */
     uint8_t *mask;   /* width * height */
     float *baked;    /* width * height * 3 */
     float *realtime; /* width * height * 3; NULL (reads as zero) until the
@@ -65,6 +85,9 @@ struct lx_baker {
                               less its peak */
     float *sky_peak;       /* NULL, or the bright part per texel (RGB) */
     double *sky_peak_cdf;  /* cumulative luminance x solid angle of the peak */
+    /* during lx_baker_create only: each material's horizon layers and AO */
+    lx_horizon_material *horizon_materials;
+    uint32_t horizon_material_count;
 };
 
 /* Bytes a lightmap needs per texel at most: raster scratch, mask, baked and
@@ -103,7 +126,19 @@ typedef struct lx_texel_progress {
  * == 0 and a warning when no node of it has UVs to bake. */
 lx_status lx_texel_map_build(const lx_scene *scene, const lx_page_spec *page,
                              const lx_bake_desc *desc, lx_texel_progress progress,
-                             lx_lightmap *map);
+                             const lx_horizon_material *horizon, lx_lightmap *map);
+
+/* horizon.c: the horizon layers and AO of every material with a height
+ * (one per scene material; *out NULL when none has one), loaded and made
+ * once; the per-texel data of a map (b1, b2: the raster's barycentrics
+ * per pixel); a light's factor at a texel; whether a tile has any such
+ * texel. */
+lx_status lx_bake_horizon_load(const lx_scene *scene, int threads, lx_horizon_material **out);
+void lx_bake_horizon_free(lx_horizon_material *hm, uint32_t count);
+lx_status lx_bake_horizon_texels(const lx_scene *scene, const lx_horizon_material *hm,
+                                 lx_lightmap *map, const float *b1, const float *b2, int threads);
+float lx_texel_horizon_factor(const lx_texel_horizon *h, lx_vec3 to_light);
+bool lx_tile_has_horizon(const lx_lightmap *map, uint32_t first, uint32_t count);
 void lx_texel_map_free(lx_lightmap *map);
 /* Makes the object-space copies a move needs (a map built at the
  * identity has none); LX_ERR_NOMEM when they do not fit. */

@@ -90,7 +90,7 @@ static lx_status build_node_maps(lx_baker *b, const lx_scene *scene, const lx_ba
                                    TEXEL_MAPS_SHARE * (float)(n + 1) / (float)scene->node_count};
         lx_page_node pn = {n, (int)desc->uv_set - 1, {1.0f, 1.0f, 0.0f, 0.0f}};
         lx_page_spec page = {scene->nodes[n].name, 0, 0, &pn, 1};
-        st = lx_texel_map_build(scene, &page, desc, share, map);
+        st = lx_texel_map_build(scene, &page, desc, share, b->horizon_materials, map);
         if (st != LX_OK) {
             lx_texel_map_free(map);
             break;
@@ -153,7 +153,7 @@ static lx_status build_pages(lx_baker *b, const lx_scene *scene, const lx_bake_d
         lx_texel_progress share = {TEXEL_MAPS_SHARE * (float)p / (float)atlas->page_count,
                                    TEXEL_MAPS_SHARE * (float)(p + 1) / (float)atlas->page_count};
         lx_lightmap *map = &b->maps[b->map_count];
-        st = lx_texel_map_build(scene, &page, desc, share, map);
+        st = lx_texel_map_build(scene, &page, desc, share, b->horizon_materials, map);
         if (st != LX_OK) {
             lx_texel_map_free(map);
             break;
@@ -286,7 +286,14 @@ lx_status lx_baker_create(const lx_scene *scene, const lx_bake_desc *in, lx_bake
         b->node_scale_offset[n][0] = b->node_scale_offset[n][1] = 1.0f;
         b->node_scale_offset[n][2] = b->node_scale_offset[n][3] = 0.0f;
     }
-    st = desc.atlas ? build_pages(b, scene, &desc) : build_node_maps(b, scene, &desc);
+    /* heights named by the lights JSON: horizon layers and AO, made once */
+    b->horizon_material_count = scene->material_count;
+    st = lx_bake_horizon_load(scene, desc.threads, &b->horizon_materials);
+    if (st == LX_OK)
+        st = desc.atlas ? build_pages(b, scene, &desc) : build_node_maps(b, scene, &desc);
+    /* the texels keep what they need of them */
+    lx_bake_horizon_free(b->horizon_materials, b->horizon_material_count);
+    b->horizon_materials = NULL;
     if (st == LX_OK)
         st = check_coverage(b, scene);
     if (st != LX_OK) {

@@ -104,9 +104,15 @@ static void light_tile(const lx_baker *b, uint32_t map_index, const lx_lightmap 
         uint32_t i = first + k;
         lx_light_eval e;
         bool direct = lx_light_evaluate(light, map->world_position[i], map->world_normal[i], &e);
-        accum[k] = lx_add(accum[k], e.ambient);
+        /* a texel with a height (horizon.c): ambient times its AO, the
+         * direct term times its horizon factor (both 1 on a flat height,
+         * and a product by 1 changes no bit) */
+        const lx_texel_horizon *h = map->horizon && map->horizon[i].flags ? &map->horizon[i] : NULL;
+        accum[k] = lx_add(accum[k], h ? lx_scale(e.ambient, h->ao) : e.ambient);
         if (!direct)
             continue;
+        if (h)
+            e.illuminance = lx_scale(e.illuminance, lx_texel_horizon_factor(h, e.to_light));
         if (light->shadow == LX_SHADOW_NONE) {
             accum[k] = lx_add(accum[k], e.illuminance);
             continue;
@@ -484,8 +490,20 @@ lx_status lx_bake_lights(lx_baker *b, const uint32_t *lights, uint32_t light_cou
             tile_load(b, map, first, count, &t);
             for (uint32_t k = 0; k < TILE_TEXELS; k++)
                 t.acc[0][k] = ambient.x, t.acc[1][k] = ambient.y, t.acc[2][k] = ambient.z;
+            /* a tile with texels under a height takes the general path,
+             * which scales their terms (light_tile) */
+            bool horizon = lx_tile_has_horizon(map, first, count);
+            if (horizon)
+                for (int k = 0; k < TILE_TEXELS; k++) {
+                    const lx_texel_horizon *h =
+                        t.texel[k] >= 0 ? &map->horizon[first + (uint32_t)t.texel[k]] : NULL;
+                    if (h && h->flags) {
+                        lx_vec3 a = lx_scale(ambient, h->ao);
+                        t.acc[0][k] = a.x, t.acc[1][k] = a.y, t.acc[2][k] = a.z;
+                    }
+                }
             for (uint32_t l = 0; l < light_count; l++) {
-                if (is_fast[l]) {
+                if (is_fast[l] && !horizon) {
                     fast_light_tile(b, &fast[l], &t);
                     continue;
                 }
@@ -493,9 +511,22 @@ lx_status lx_bake_lights(lx_baker *b, const uint32_t *lights, uint32_t light_cou
                 light_tile(b, m, map, first, count, lights[l], accum);
                 vec3_to_acc(accum, &t);
             }
-            if (!to_realtime && b->has_sky) {
+            if (!to_realtime && b->has_sky && !horizon) {
                 acc_to_vec3(&t, accum);
                 lx_sky_tile(b, m, map, first, count, accum);
+                vec3_to_acc(accum, &t);
+            } else if (!to_realtime && b->has_sky) {
+                /* the sky alone, then added as lx_sky_tile adds it (times
+                 * the AO under a height) */
+                lx_vec3 sky[TILE_TEXELS];
+                for (uint32_t k = 0; k < count; k++)
+                    sky[k] = lx_v3(0.0f, 0.0f, 0.0f);
+                lx_sky_tile(b, m, map, first, count, sky);
+                acc_to_vec3(&t, accum);
+                for (uint32_t k = 0; k < count; k++) {
+                    const lx_texel_horizon *h = &map->horizon[first + k];
+                    accum[k] = lx_add(accum[k], h->flags ? lx_scale(sky[k], h->ao) : sky[k]);
+                }
                 vec3_to_acc(accum, &t);
             }
             /* every texel belongs to one tile: plain stores, no clearing */

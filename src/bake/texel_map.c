@@ -549,7 +549,8 @@ static uint32_t collect_slots(const lx_scene *scene, uint32_t node_index, const 
 }
 
 lx_status lx_texel_map_build(const lx_scene *scene, const lx_page_spec *page,
-                             const lx_bake_desc *desc, lx_texel_progress progress, lx_lightmap *map)
+                             const lx_bake_desc *desc, lx_texel_progress progress,
+                             const lx_horizon_material *horizon, lx_lightmap *map)
 {
     memset(map, 0, sizeof *map);
     map->info.node = page->node_count == 1 ? page->nodes[0].node : UINT32_MAX;
@@ -767,6 +768,8 @@ lx_status lx_texel_map_build(const lx_scene *scene, const lx_page_spec *page,
             }
     }
     map->info.used_texels = n;
+    if (st == LX_OK)
+        st = lx_bake_horizon_texels(scene, horizon, map, r.b1, r.b2, desc->threads);
     for (uint32_t s = 0; s < slot_count; s++)
         if (own_tangents[s])
             free(tangents[s]);
@@ -851,6 +854,7 @@ void lx_texel_map_free(lx_lightmap *map)
     free(map->texels);
     free(map->tile_start);
     free(map->world_position);
+    free(map->horizon);
     free(map->world_normal);
     free(map->world_geometric_normal);
     free(map->object_position);

@@ -703,7 +703,7 @@ static lx_status read_light(ctx *c, const cJSON *obj, const name_table *names,
 
 /* ---- the file ----------------------------------------------------------- */
 
-static const char *const root_keys[] = {"ambient", "lights", "sky"};
+static const char *const root_keys[] = {"ambient", "lights", "sky", "materials"};
 static const char *const sky_keys[] = {"environment", "intensity", "shadows", "samples"};
 
 /* "sky": {"environment": path relative to the file, "intensity",
@@ -752,6 +752,103 @@ static lx_status read_sky(ctx *c, const cJSON *obj, lx_scene_sky *sky)
     return LX_OK;
 }
 
+/* ---- materials: height textures for the baker's horizon and AO --------- */
+
+static const char *const material_keys[] = {"height", "strength", "horizon", "ao"};
+
+/* One material's settings from the file (path NULL: the file names none). */
+typedef struct pending_material {
+    char *path;
+    float strength;
+    bool horizon, ao;
+} pending_material;
+
+static lx_status read_material_entry(ctx *c, const cJSON *obj, pending_material *p)
+{
+    if (!cJSON_IsObject(obj))
+        return fail(c, LX_ERR_FORMAT, "must be an object with \"height\"");
+    lx_status st = check_keys(c, obj, material_keys, COUNT(material_keys));
+    if (st != LX_OK)
+        return st;
+    const cJSON *it = cJSON_GetObjectItemCaseSensitive(obj, "height");
+    const char *rel = NULL;
+    if (!it)
+        return fail(c, LX_ERR_FORMAT, "missing 'height' (a height image file)");
+    if ((st = get_string(c, it, "height", &rel)) != LX_OK)
+        return st;
+    if (!rel[0])
+        return fail(c, LX_ERR_FORMAT, "height is an empty path");
+    p->strength = 0.0f;
+    if ((it = cJSON_GetObjectItemCaseSensitive(obj, "strength"))) {
+        if ((st = get_float(c, it, "strength", &p->strength)) != LX_OK)
+            return st;
+        if (!(p->strength > 0.0f))
+            return fail(c, LX_ERR_INVALID, "strength %g must be above 0", p->strength);
+    }
+    static const char *const flags[] = {"horizon", "ao"};
+    bool *dst[] = {&p->horizon, &p->ao};
+    for (int k = 0; k < 2; k++) {
+        *dst[k] = true;
+        if ((it = cJSON_GetObjectItemCaseSensitive(obj, flags[k]))) {
+            if (!cJSON_IsBool(it))
+                return fail(c, LX_ERR_FORMAT, "%s must be true or false", flags[k]);
+            *dst[k] = cJSON_IsTrue(it);
+        }
+    }
+    p->path = relative_to_file(c, rel);
+    return p->path ? LX_OK : fail(c, LX_ERR_NOMEM, "out of memory");
+}
+
+/* "materials": {"<material name>": {"height", "strength", "horizon",
+ * "ao"}}, into pending (one per scene material, every material of the
+ * name given). A name no scene material has is an error. */
+static lx_status read_materials(ctx *c, const cJSON *obj, const lx_scene *scene,
+                                pending_material *pending)
+{
+    snprintf(c->where, sizeof c->where, "materials");
+    if (!cJSON_IsObject(obj))
+        return fail(c, LX_ERR_FORMAT, "must be an object of material names");
+    for (const cJSON *e = obj->child; e; e = e->next) {
+        const char *name = e->string ? e->string : "";
+        snprintf(c->where, sizeof c->where, "materials");
+        for (const cJSON *p = obj->child; p != e; p = p->next)
+            if (strcmp(p->string, name) == 0)
+                return fail(c, LX_ERR_FORMAT, "material '%.40s' appears twice", name);
+        bool found = false;
+        for (uint32_t m = 0; m < scene->material_count && !found; m++)
+            found = scene->materials[m].name && strcmp(scene->materials[m].name, name) == 0;
+        if (!found)
+            return fail(c, LX_ERR_INVALID, "unknown material '%.40s' (%s has none of that name)",
+                        name, scene->path ? scene->path : "the scene");
+        snprintf(c->where, sizeof c->where, "materials ('%.40s')", name);
+        pending_material p = {0};
+        lx_status st = read_material_entry(c, e, &p);
+        if (st != LX_OK) {
+            free(p.path);
+            return st;
+        }
+        for (uint32_t m = 0; m < scene->material_count; m++) {
+            if (!scene->materials[m].name || strcmp(scene->materials[m].name, name) != 0)
+                continue;
+            pending[m] = p;
+            pending[m].path = lx_strdup(p.path);
+            if (!pending[m].path) {
+                free(p.path);
+                return fail(c, LX_ERR_NOMEM, "out of memory");
+            }
+        }
+        free(p.path);
+    }
+    return LX_OK;
+}
+
+static void free_pending_materials(pending_material *p, uint32_t count)
+{
+    for (uint32_t m = 0; p && m < count; m++)
+        free(p[m].path);
+    free(p);
+}
+
 static lx_status apply_root(lx_scene *scene, const cJSON *root, const char *file)
 {
     ctx c = {.file = file, .where = ""};
@@ -781,6 +878,18 @@ static lx_status apply_root(lx_scene *scene, const cJSON *root, const char *file
         free(sky.environment);
         return st;
     }
+    const cJSON *mat_item = cJSON_GetObjectItemCaseSensitive(root, "materials");
+    pending_material *mats = NULL;
+    if (mat_item) {
+        mats = calloc(scene->material_count + 1, sizeof *mats);
+        st = mats ? read_materials(&c, mat_item, scene, mats)
+                  : fail(&c, LX_ERR_NOMEM, "out of memory");
+        if (st != LX_OK) {
+            free_pending_materials(mats, scene->material_count);
+            free(sky.environment);
+            return st;
+        }
+    }
     c.where[0] = '\0';
     lx_light *pending = malloc((count ? count : 1) * sizeof *pending);
     name_table names = {0};
@@ -788,6 +897,7 @@ static lx_status apply_root(lx_scene *scene, const cJSON *root, const char *file
         free(pending);
         table_free(&names);
         free(sky.environment);
+        free_pending_materials(mats, scene->material_count);
         return fail(&c, LX_ERR_NOMEM, "out of memory for %zu lights", count);
     }
     for (uint32_t i = 0; i < scene->light_count; i++)
@@ -818,6 +928,17 @@ static lx_status apply_root(lx_scene *scene, const cJSON *root, const char *file
             scene->sky = sky;
             sky.environment = NULL;
         }
+        for (uint32_t m = 0; mats && m < scene->material_count; m++) {
+            if (!mats[m].path)
+                continue;
+            lx_material *mat = &scene->materials[m];
+            free(mat->height_map_path);
+            mat->height_map_path = mats[m].path;
+            mat->height_strength = mats[m].strength;
+            mat->height_horizon = mats[m].horizon;
+            mat->height_ao = mats[m].ao;
+            mats[m].path = NULL;
+        }
         for (i = 0; i < count && st == LX_OK; i++)
             if ((st = lx_scene_add_light(scene, &pending[i])) != LX_OK) {
                 char where[160];
@@ -827,6 +948,7 @@ static lx_status apply_root(lx_scene *scene, const cJSON *root, const char *file
     }
     free(pending);
     free(sky.environment);
+    free_pending_materials(mats, scene->material_count);
     return st;
 }
 

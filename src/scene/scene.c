@@ -66,6 +66,7 @@ static void material_free(lx_material *m)
     free(m->name);
     free(m->normal_map_path);
     free(m->base_color_map_path);
+    free(m->height_map_path);
     lx_image_free(&m->normal_map);
     lx_image_free(&m->base_color_map);
 }
@@ -248,6 +249,7 @@ lx_status lx_scene_add_material(lx_scene *s, const lx_material *src, uint32_t *i
     m.name = lx_strdup(src->name && src->name[0] ? src->name : fallback);
     m.normal_map_path = src->normal_map_path ? lx_strdup(src->normal_map_path) : NULL;
     m.base_color_map_path = src->base_color_map_path ? lx_strdup(src->base_color_map_path) : NULL;
+    m.height_map_path = src->height_map_path ? lx_strdup(src->height_map_path) : NULL;
     memset(&m.normal_map, 0, sizeof m.normal_map);
     memset(&m.base_color_map, 0, sizeof m.base_color_map);
     const lx_image *maps[2] = {&src->normal_map, &src->base_color_map};

@@ -389,6 +389,15 @@ printf '{"lights": [{"type": "laser", "position": [0, 1, 0], "intensity": 5}]}\n
 bad "lights JSON: unknown light type" 1 "bad_type.json|type|laser" \
     bake "$ROOM" --lights "$IN/bad_type.json"
 
+printf '{"materials": {"stone": {"height": "h.png"}}}\n' >"$IN/unknown_material.json"
+bad "lights JSON: a material the scene does not have" 1 "unknown_material.json|stone" \
+    bake "$ROOM" --lights "$IN/unknown_material.json"
+
+printf '{"materials": {"red": {"height": "no_such_height.png", "strength": 4}}}\n' \
+    >"$IN/missing_height.json"
+bad "lights JSON: a material's height file is missing" 1 "no_such_height.png|red" \
+    bake "$ROOM" --lights "$IN/missing_height.json"
+
 printf '{"lights": [{"type": "point", "position": [0, 1], "intensity": 5}]}\n' >"$IN/short_vec.json"
 bad "lights JSON: position with 2 numbers" 1 "short_vec.json|position" \
     bake "$ROOM" --lights "$IN/short_vec.json"

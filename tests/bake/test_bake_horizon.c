@@ -1,0 +1,257 @@
+/* Horizon self-shadowing and AO in the baker (a height per material from
+ * the lights JSON's "materials"). Expected values are closed forms on a
+ * +Y plane whose material UV equals its lightmap UV, texel for texel with
+ * the height image (u along +x = image x, the tangent; v along +z):
+ * - a flat height has no horizon and AO 1: the bake is the same bytes as
+ *   without it;
+ * - a step of H texels lit from +x at elevation e: a low texel d texels
+ *   before the step sees it at atan(H / d) (less off the axis, down to
+ *   atan(H cos 22.5 / d) at the edge of direction 0's bins); with
+ *   tan e < H cos(22.5) / d well past the transition (sin of the horizon
+ *   above sin e + 1/8, the hardness 8) the light is gone, with
+ *   tan e > H / d the texel is as without the height, and on the plateau
+ *   (nothing higher toward the light) it is unchanged;
+ * - at the bottom of a cone pit of slope k every direction's horizon is
+ *   atan(k), so the AO is cos(atan k) = 1 / sqrt(k^2 + 1) and the ambient
+ *   there is scaled by it. */
+#include <setjmp.h>
+#include <stdarg.h>
+#include <stddef.h>
+#include <stdint.h>
+
+#include <cmocka.h>
+
+#include "helpers.h"
+
+#include <math.h>
+#include <stdio.h>
+#include <stdlib.h>
+#include <string.h>
+
+/* Writes a size x size float height to dir/name (PFM, values as given). */
+static void write_height(const char *dir, const char *name, int size,
+                         float (*fn)(int x, int y, int size))
+{
+    lx_image img;
+    assert_int_equal(lx_image_alloc(&img, size, size, 1), LX_OK);
+    for (int y = 0; y < size; y++)
+        for (int x = 0; x < size; x++)
+            img.data[y * size + x] = fn(x, y, size);
+    char path[1024];
+    snprintf(path, sizeof path, "%s/%s", dir, name);
+    assert_int_equal(lx_image_write(path, &img, NULL), LX_OK);
+    lx_image_free(&img);
+}
+
+static float flat(int x, int y, int size)
+{
+    (void)x, (void)y, (void)size;
+    return 0.5f;
+}
+
+/* 0 on the left half, 1 on the right: a step up at size/2 going +x (and
+ * down at the wrap) */
+static float step(int x, int y, int size)
+{
+    (void)y;
+    return x >= size / 2 ? 1.0f : 0.0f;
+}
+
+static float cone_k = 1.0f;
+/* a pit: k times the distance in texels from texel (size/2, size/2) */
+static float cone(int x, int y, int size)
+{
+    double dx = x - size / 2, dy = y - size / 2;
+    return (float)(cone_k * sqrt(dx * dx + dy * dy));
+}
+
+typedef struct bake_setup {
+    int size;         /* lightmap and height texels a side */
+    float elevation;  /* of the directional light from +x, degrees; < 0: none */
+    lx_vec3 ambient;  /* scene ambient, lux */
+    const char *json; /* lights JSON text (NULL: none), applied as dir/lights.json */
+    float sky;        /* radiance of a constant unshadowed sky, nits; 0: none */
+} bake_setup;
+
+/* Bakes a 4 m plane with material "bumpy" under the setup into *img. */
+static void bake(const char *dir, const bake_setup *s, lx_image *img)
+{
+    lx_scene *scene = lx_test_new_scene("horizon");
+    lx_material mat = {.name = "bumpy", .base_color = {1, 1, 1, 1}, .normal_scale = 1.0f};
+    assert_int_equal(lx_scene_add_material(scene, &mat, NULL), LX_OK);
+    lx_mesh plane = lx_test_plane("plane", 4.0f, 0.0f, 0.0f, 0.0f, 2);
+    lx_test_add(scene, &plane);
+    lx_test_mesh_free(&plane);
+    scene->ambient = s->ambient;
+    if (s->elevation >= 0.0f) {
+        lx_light sun = lx_light_defaults(LX_LIGHT_DIRECTIONAL);
+        double e = s->elevation * LX_PI / 180.0;
+        sun.direction = lx_v3((float)-cos(e), (float)-sin(e), 0.0f);
+        sun.intensity = 1000.0f;
+        sun.shadow = LX_SHADOW_HARD;
+        assert_int_equal(lx_scene_add_light(scene, &sun), LX_OK);
+    }
+    if (s->json) {
+        char name[1024];
+        snprintf(name, sizeof name, "%s/lights.json", dir);
+        assert_int_equal(lx_lights_json_apply_text(scene, s->json, strlen(s->json), name), LX_OK);
+    }
+    lx_bake_desc desc = {.resolution = s->size, .padding = LX_PADDING_NONE, .threads = 2};
+    lx_cubemap env = {0};
+    if (s->sky > 0.0f) {
+        assert_int_equal(lx_cubemap_alloc(&env, 8), LX_OK);
+        for (int i = 0; i < 6 * 8 * 8 * 3; i++)
+            env.data[i] = s->sky;
+        desc.sky.environment = &env;
+    }
+    lx_baker *baker;
+    assert_int_equal(lx_baker_create(scene, &desc, &baker), LX_OK);
+    lx_cubemap_free(&env);
+    assert_int_equal(lx_baker_bake(baker), LX_OK);
+    assert_int_equal(lx_baker_apply_alloc(baker, 0, img), LX_OK);
+    lx_baker_destroy(baker);
+    lx_scene_destroy(scene);
+}
+
+static void flat_height_changes_no_byte(void **state)
+{
+    (void)state;
+    const char *dir = lx_test_dir("bake-horizon-flat");
+    write_height(dir, "flat.pfm", 16, flat);
+    bake_setup s = {16, 30.0f, {3.0f, 2.0f, 1.0f}, NULL, 0.5f};
+    lx_image plain, flat_img;
+    bake(dir, &s, &plain);
+    s.json = "{\"materials\": {\"bumpy\": {\"height\": \"flat.pfm\", \"strength\": 8}}}";
+    bake(dir, &s, &flat_img);
+    size_t bytes = sizeof(float) * 3 * 16 * 16;
+    assert_memory_equal(plain.data, flat_img.data, bytes);
+    lx_image_free(&plain);
+    lx_image_free(&flat_img);
+}
+
+static void step_shadows_where_the_closed_form_says(void **state)
+{
+    (void)state;
+    const char *dir = lx_test_dir("bake-horizon-step");
+    const int size = 16;
+    const float H = 4.0f, e = 30.0f; /* wall height in texels, light elevation */
+    write_height(dir, "step.pfm", size, step);
+    bake_setup s = {size, e, {0, 0, 0}, NULL, 0.0f};
+    lx_image plain, img;
+    bake(dir, &s, &plain);
+    s.json = "{\"materials\": {\"bumpy\": {\"height\": \"step.pfm\", \"strength\": 4, "
+             "\"ao\": false}}}";
+    bake(dir, &s, &img);
+    double te = tan(e * LX_PI / 180.0), se = sin(e * LX_PI / 180.0);
+    double cos_edge = cos(22.5 * LX_PI / 180.0);
+    int dark = 0, same = 0;
+    for (int y = 0; y < size; y++)
+        for (int x = 0; x < size; x++) {
+            size_t p = (size_t)(y * size + x) * 3;
+            float got = img.data[p], want = plain.data[p];
+            /* unshadowed the plane gets 1000 sin(e) lux */
+            lx_test_assert_rel(want, 1000.0 * se, 1e-6);
+            if (x >= size / 2) {
+                assert_true(got == want); /* the plateau: nothing higher toward +x */
+                same++;
+                continue;
+            }
+            double d = size / 2 - x;
+            double low = sin(atan(H * cos_edge / (d + 0.5))); /* the lowest bin's horizon */
+            if (low > se + 1.0 / 8.0) {
+                assert_true(got == 0.0f);
+                dark++;
+            } else if (te > H / d) {
+                assert_true(got == want);
+                same++;
+            } else {
+                assert_true(got >= 0.0f && got <= want);
+            }
+        }
+    /* at least columns d = 1..3 dark; d = 7, 8 and the plateau unchanged */
+    assert_true(dark >= 3 * size);
+    assert_int_equal(same, (size / 2 + 2) * size);
+    lx_image_free(&plain);
+    lx_image_free(&img);
+}
+
+/* The ambient A (sky 0) or a constant sky of radiance L (ambient 0) at the
+ * pit's bottom: A or pi L (the sky's irradiance on an open plane) times
+ * 1 / sqrt(k^2 + 1). */
+static void check_cone_ao(float k, bool sky)
+{
+    char tag[64];
+    snprintf(tag, sizeof tag, "bake-horizon-cone-%g-%d", k, (int)sky);
+    const char *dir = lx_test_dir(tag);
+    const int size = 64;
+    cone_k = k;
+    write_height(dir, "cone.pfm", size, cone);
+    bake_setup s = {size, -1.0f, {100.0f, 100.0f, 100.0f}, NULL, 0.0f};
+    if (sky) {
+        s.ambient = lx_v3(0, 0, 0);
+        s.sky = 100.0f / LX_PI;
+    }
+    s.json = "{\"materials\": {\"bumpy\": {\"height\": \"cone.pfm\", \"strength\": 1, "
+             "\"horizon\": false}}}";
+    lx_image img;
+    bake(dir, &s, &img);
+    size_t p = (size_t)(size / 2 * size + size / 2) * 3;
+    double want = 100.0 / sqrt((double)k * k + 1.0);
+    for (int c = 0; c < 3; c++)
+        lx_test_assert_rel(img.data[p + c], want, 1e-5);
+    lx_image_free(&img);
+}
+
+static void cone_pit_ao_scales_ambient(void **state)
+{
+    (void)state;
+    check_cone_ao(1.0f, false);
+    check_cone_ao(0.5f, false);
+    check_cone_ao(1.0f, true);
+    check_cone_ao(0.5f, true);
+}
+
+static void bad_input_is_named(void **state)
+{
+    (void)state;
+    const char *dir = lx_test_dir("bake-horizon-bad");
+    char name[1024];
+    snprintf(name, sizeof name, "%s/lights.json", dir);
+    lx_scene *scene = lx_test_new_scene("horizon-bad");
+    lx_material mat = {.name = "bumpy", .base_color = {1, 1, 1, 1}, .normal_scale = 1.0f};
+    assert_int_equal(lx_scene_add_material(scene, &mat, NULL), LX_OK);
+    lx_mesh plane = lx_test_plane("plane", 4.0f, 0.0f, 0.0f, 0.0f, 2);
+    lx_test_add(scene, &plane);
+    lx_test_mesh_free(&plane);
+
+    const char *unknown = "{\"materials\": {\"stone\": {\"height\": \"h.png\"}}}";
+    assert_int_not_equal(lx_lights_json_apply_text(scene, unknown, strlen(unknown), name), LX_OK);
+    assert_non_null(strstr(lx_last_error(), "stone"));
+    assert_non_null(strstr(lx_last_error(), "lights.json"));
+    assert_null(scene->materials[0].height_map_path);
+
+    const char *key = "{\"materials\": {\"bumpy\": {\"height\": \"h.png\", \"bumps\": 2}}}";
+    assert_int_not_equal(lx_lights_json_apply_text(scene, key, strlen(key), name), LX_OK);
+    assert_non_null(strstr(lx_last_error(), "bumps"));
+
+    const char *missing = "{\"materials\": {\"bumpy\": {\"height\": \"no-such-height.png\"}}}";
+    assert_int_equal(lx_lights_json_apply_text(scene, missing, strlen(missing), name), LX_OK);
+    lx_bake_desc desc = {.resolution = 8, .threads = 2};
+    lx_baker *baker = NULL;
+    assert_int_not_equal(lx_baker_create(scene, &desc, &baker), LX_OK);
+    assert_null(baker);
+    assert_non_null(strstr(lx_last_error(), "no-such-height.png"));
+    lx_scene_destroy(scene);
+}
+
+int main(void)
+{
+    lx_test_watchdog(300);
+    const struct CMUnitTest tests[] = {
+        cmocka_unit_test(flat_height_changes_no_byte),
+        cmocka_unit_test(step_shadows_where_the_closed_form_says),
+        cmocka_unit_test(cone_pit_ao_scales_ambient),
+        cmocka_unit_test(bad_input_is_named),
+    };
+    return cmocka_run_group_tests(tests, NULL, NULL);
+}
