@@ -10,8 +10,32 @@
 #include <stdint.h>
 #include <stdlib.h>
 #include <string.h>
+#ifdef __linux__
+#include <sys/mman.h>
+#endif
 
 /* ---- allocation ----------------------------------------------------------- */
+
+/* Large images live in fresh pages (calloc maps them untouched), and the
+ * first write to each 4 KiB page faults: for a 2048^2 RGB image that is
+ * 12k faults, most of the cost of filling it. Asking for transparent huge
+ * pages over the 2 MiB-aligned interior makes that 24 faults. Advice only:
+ * where the kernel declines, nothing changes. */
+static void advise_huge_pages(void *data, size_t bytes)
+{
+#if defined(__linux__) && defined(MADV_HUGEPAGE)
+    const uintptr_t huge = (uintptr_t)2 << 20;
+    if (bytes < 4 * huge)
+        return;
+    uintptr_t begin = ((uintptr_t)data + huge - 1) & ~(huge - 1);
+    uintptr_t end = ((uintptr_t)data + bytes) & ~(huge - 1);
+    if (end > begin)
+        (void)madvise((void *)begin, end - begin, MADV_HUGEPAGE);
+#else
+    (void)data;
+    (void)bytes;
+#endif
+}
 
 lx_status lx_image_alloc(lx_image *img, int width, int height, int channels)
 {
@@ -34,6 +58,7 @@ lx_status lx_image_alloc(lx_image *img, int width, int height, int channels)
     float *data = calloc(count, sizeof(float));
     if (!data)
         return lx_fail(LX_ERR_NOMEM, "%s: cannot allocate %zu bytes", what, bytes);
+    advise_huge_pages(data, bytes);
     img->width = width;
     img->height = height;
     img->channels = channels;
