@@ -241,8 +241,8 @@ static void compare_with_oracle(lx_mesh *m)
             /* the reference's initial frame, for corners no group reached
              * (triangles without a UV gradient): luxel makes it
              * perpendicular to the normal */
-            lx_vec3 n = m->normals[m->indices[k]];
-            lx_vec3 p = lx_normalize(lx_sub(lx_v3(1, 0, 0), lx_scale(n, n.x)));
+            lx_vec3 nk = m->normals[m->indices[k]];
+            lx_vec3 p = lx_normalize(lx_sub(lx_v3(1, 0, 0), lx_scale(nk, nk.x)));
             want[k] = lx_v4(p.x, p.y, p.z, want[k].w);
             wl = 1;
             initial++;

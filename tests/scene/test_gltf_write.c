@@ -90,8 +90,12 @@ static void unwrap_and_write(const char *in_path, const char *out_path, lx_scene
     assert_non_null(uvs);
     for (uint32_t k = 0; k < (*unwrap)->mesh_count; k++) {
         const lx_unwrap_mesh *m = &(*unwrap)->meshes[k];
-        uvs[k] = (lx_scene_uvs){m->node, m->mesh, m->vertex_count, m->vertex_source, m->uv,
-                                m->indices};
+        uvs[k] = (lx_scene_uvs){.node = m->node,
+                                .mesh = m->mesh,
+                                .vertex_count = m->vertex_count,
+                                .vertex_source = m->vertex_source,
+                                .uv = m->uv,
+                                .indices = m->indices};
     }
     lx_glb_write_desc wd = {.uvs = uvs, .uv_count = (*unwrap)->mesh_count};
     lx_status st = lx_scene_write_glb(*scene, out_path, &wd);
@@ -622,7 +626,12 @@ static void test_bad_inputs(void **state)
     lx_unwrap *u;
     assert_int_equal(lx_unwrap_scene(s, NULL, &u), LX_OK);
     const lx_unwrap_mesh *m = &u->meshes[0];
-    lx_scene_uvs e = {m->node, m->mesh, m->vertex_count, m->vertex_source, m->uv, m->indices};
+    lx_scene_uvs e = {.node = m->node,
+                      .mesh = m->mesh,
+                      .vertex_count = m->vertex_count,
+                      .vertex_source = m->vertex_source,
+                      .uv = m->uv,
+                      .indices = m->indices};
     lx_glb_write_desc d = {.uvs = &e, .uv_count = 1};
     /* a node the scene does not have */
     e.node = 99;

@@ -63,6 +63,19 @@ void cli_error(const char *fmt, ...) __attribute__((format(printf, 1, 2)));
 int cli_usage_error(const char *command, const char *fmt, ...)
     __attribute__((format(printf, 2, 3)));
 
+/* ---- options every command shares (options.c) --------------------------
+ * getopt_long's code for --threads in every command's table (beyond any
+ * character), and the largest worker count a command accepts. */
+#define CLI_OPT_THREADS 0x1000
+#define CLI_MAX_THREADS 1024
+/* The end of every command's option switch: --threads N into *threads,
+ * -q into *quiet (and cli_set_quiet), -v (cli_set_verbose); getopt's ':'
+ * (a missing value) and anything else (an unknown option, or --threads
+ * or -q where threads or quiet is NULL) are usage errors. Returns 0 when
+ * handled, else EXIT_USAGE with the error printed. Call it from the
+ * switch's default case with getopt's optarg/optind state current. */
+int cli_common_option(const char *command, int c, char **argv, int *threads, bool *quiet);
+
 /* Strict number parsing: the whole string, finite, within [lo, hi]. */
 bool cli_parse_int(const char *s, long lo, long hi, long *out);
 bool cli_parse_float(const char *s, double lo, double hi, double *out);

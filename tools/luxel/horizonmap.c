@@ -2,7 +2,7 @@
  * seed's ConstructHorizonMap) and the weight cube map their shading
  * function samples; and the options it shares with luxel aomap. */
 #define _POSIX_C_SOURCE 200809L
-#include "cli.h"
+#include "maps_cli.h"
 
 #include <getopt.h>
 #include <stdio.h>
@@ -41,20 +41,19 @@ static const char *horizon_usage =
     "  -v, --verbose      phase times\n"
     "  -h, --help         show this help\n";
 
-enum { OPT_STRENGTH = 256, OPT_ANGLES, OPT_RADIUS, OPT_WRAP, OPT_BITS, OPT_POWER, OPT_COSINE,
-       OPT_THREADS };
+enum { OPT_ANGLES = MAPS_OPT_OWN, OPT_RADIUS, OPT_POWER, OPT_COSINE };
 
 int cli_horizon_args(const char *command, int argc, char **argv, cli_horizon_opts *o)
 {
     static const struct option options[] = {{"output", required_argument, NULL, 'o'},
-                                            {"strength", required_argument, NULL, OPT_STRENGTH},
+                                            {"strength", required_argument, NULL, MAPS_OPT_STRENGTH},
                                             {"angles", required_argument, NULL, OPT_ANGLES},
                                             {"radius", required_argument, NULL, OPT_RADIUS},
-                                            {"wrap", required_argument, NULL, OPT_WRAP},
-                                            {"bits", required_argument, NULL, OPT_BITS},
+                                            {"wrap", required_argument, NULL, MAPS_OPT_WRAP},
+                                            {"bits", required_argument, NULL, MAPS_OPT_BITS},
                                             {"power", required_argument, NULL, OPT_POWER},
                                             {"cosine", no_argument, NULL, OPT_COSINE},
-                                            {"threads", required_argument, NULL, OPT_THREADS},
+                                            {"threads", required_argument, NULL, CLI_OPT_THREADS},
                                             {"quiet", no_argument, NULL, 'q'},
                                             {"verbose", no_argument, NULL, 'v'},
                                             {"help", no_argument, NULL, 'h'},
@@ -63,6 +62,7 @@ int cli_horizon_args(const char *command, int argc, char **argv, cli_horizon_opt
     memset(o, 0, sizeof *o);
     o->desc = lx_horizon_desc_defaults(NULL);
     o->bits = 8;
+    maps_common m = {.output_is_folder = !ao};
     opterr = 0;
     optind = 1;
     int c;
@@ -70,17 +70,6 @@ int cli_horizon_args(const char *command, int argc, char **argv, cli_horizon_opt
     double f;
     while ((c = getopt_long(argc, argv, ":o:qvh", options, NULL)) != -1) {
         switch (c) {
-        case 'o':
-            if (!*optarg)
-                return cli_usage_error(command, "-o needs a %s name", ao ? "file" : "folder");
-            o->output = optarg;
-            break;
-        case OPT_STRENGTH:
-            if (!cli_parse_float(optarg, 1e-6, 1e6, &f))
-                return cli_usage_error(command, "--strength must be a number in 1e-6..1e6, not '%s'",
-                                       optarg);
-            o->desc.strength = (float)f;
-            break;
         case OPT_ANGLES:
             if (!cli_parse_int(optarg, 16, 1024, &n) || (n & (n - 1)) != 0)
                 return cli_usage_error(command,
@@ -93,16 +82,6 @@ int cli_horizon_args(const char *command, int argc, char **argv, cli_horizon_opt
                 return cli_usage_error(command, "--radius must be texels in 2..256, not '%s'",
                                        optarg);
             o->desc.radius = (int)n;
-            break;
-        case OPT_WRAP:
-            if (!lx_wrap_parse(optarg, &o->desc.wrap))
-                return cli_usage_error(command, "--wrap must be repeat, clamp or mirror, not '%s'",
-                                       optarg);
-            break;
-        case OPT_BITS:
-            if (!cli_parse_int(optarg, 8, 16, &n) || (n != 8 && n != 16))
-                return cli_usage_error(command, "--bits must be 8 or 16, not '%s'", optarg);
-            o->bits = (int)n;
             break;
         case OPT_POWER:
             if (!ao)
@@ -117,26 +96,25 @@ int cli_horizon_args(const char *command, int argc, char **argv, cli_horizon_opt
                 return cli_usage_error(command, "unknown option '--cosine'");
             o->desc.ao_cosine = true;
             break;
-        case OPT_THREADS:
-            if (!cli_parse_int(optarg, 1, 1024, &n))
-                return cli_usage_error(command, "--threads must be an integer in 1..1024, not '%s'",
-                                       optarg);
-            o->desc.threads = (int)n;
-            break;
-        case 'q':
-            o->quiet = true;
-            break;
-        case 'v':
-            cli_set_verbose(true);
-            break;
         case 'h':
             return -1;
-        case ':':
-            return cli_usage_error(command, "%s needs a value", argv[optind - 1]);
-        default:
-            return cli_usage_error(command, "unknown option '%s'", argv[optind - 1]);
+        default: {
+            int rc = maps_common_option(command, c, argv, &m);
+            if (rc != 0)
+                return rc;
+        }
         }
     }
+    o->output = m.out.path;
+    if (m.strength > 0.0f)
+        o->desc.strength = m.strength;
+    if (m.wrap_given)
+        o->desc.wrap = m.wrap;
+    if (m.out.bits)
+        o->bits = m.out.bits;
+    if (m.threads)
+        o->desc.threads = m.threads;
+    o->quiet = m.quiet;
     if (optind >= argc)
         return cli_usage_error(command, "no height image given");
     if (optind + 1 < argc)

@@ -86,7 +86,6 @@ enum {
     OPT_HALF,
     OPT_NO_SEAM_FIX,
     OPT_INTENSITY,
-    OPT_THREADS,
     OPT_EXPOSURE,
     OPT_TONEMAP
 };
@@ -186,7 +185,7 @@ static int parse_args(int argc, char **argv, ibl_args *a)
         {"half", no_argument, NULL, OPT_HALF},
         {"no-seam-fix", no_argument, NULL, OPT_NO_SEAM_FIX},
         {"intensity", required_argument, NULL, OPT_INTENSITY},
-        {"threads", required_argument, NULL, OPT_THREADS},
+        {"threads", required_argument, NULL, CLI_OPT_THREADS},
         {"exposure", required_argument, NULL, OPT_EXPOSURE},
         {"tonemap", required_argument, NULL, OPT_TONEMAP},
         {"quiet", no_argument, NULL, 'q'},
@@ -303,12 +302,6 @@ static int parse_args(int argc, char **argv, ibl_args *a)
                                        optarg);
             a->intensity = (float)f;
             break;
-        case OPT_THREADS:
-            if (!cli_parse_int(optarg, 1, 1024, &n))
-                return cli_usage_error("ibl", "--threads must be an integer in 1..1024, not '%s'",
-                                       optarg);
-            a->threads = (int)n;
-            break;
         case OPT_EXPOSURE:
             if (!cli_parse_float(optarg, -64, 64, &f))
                 return cli_usage_error("ibl", "--exposure must be an EV100 in -64..64, not '%s'",
@@ -322,20 +315,14 @@ static int parse_args(int argc, char **argv, ibl_args *a)
                                        optarg);
             tonemap_given = true;
             break;
-        case 'q':
-            a->quiet = true;
-            cli_set_quiet(true);
-            break;
-        case 'v':
-            cli_set_verbose(true);
-            break;
         case 'h':
             print_usage();
             return -1;
-        case ':':
-            return cli_usage_error("ibl", "option '%s' needs a value", argv[optind - 1]);
-        default:
-            return cli_usage_error("ibl", "unknown option '%s'", argv[optind - 1]);
+        default: {
+            int rc = cli_common_option("ibl", c, argv, &a->threads, &a->quiet);
+            if (rc != 0)
+                return rc;
+        }
         }
     }
     if (optind >= argc)

@@ -303,10 +303,11 @@ int cmd_ies(int argc, char **argv)
         case 'h':
             fputs(ies_usage, stdout);
             return EXIT_OK;
-        case ':':
-            return cli_usage_error("ies", "option '%s' needs a value", argv[optind - 1]);
-        default:
-            return cli_usage_error("ies", "unknown option '%s'", argv[optind - 1]);
+        default: {
+            int rc = cli_common_option("ies", c, argv, NULL, NULL);
+            if (rc != 0)
+                return rc;
+        }
         }
     }
     if (optind >= argc)

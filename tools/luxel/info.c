@@ -147,10 +147,11 @@ int cmd_info(int argc, char **argv)
         case 'h':
             printf(info_usage, lx_uv_health_desc_defaults(NULL).resolution);
             return EXIT_OK;
-        case ':':
-            return cli_usage_error("info", "option '%s' needs a value", argv[optind - 1]);
-        default:
-            return cli_usage_error("info", "unknown option '%s'", argv[optind - 1]);
+        default: {
+            int rc = cli_common_option("info", c, argv, NULL, NULL);
+            if (rc != 0)
+                return rc;
+        }
         }
     }
     if (optind >= argc)

@@ -5,6 +5,7 @@
 #define _POSIX_C_SOURCE 200809L
 #include "maps_cli.h"
 
+#include <getopt.h>
 #include <math.h>
 #include <stdio.h>
 #include <stdlib.h>
@@ -26,6 +27,59 @@ bool maps_parse_bits(const char *s, int *out)
         return true;
     }
     return false;
+}
+
+int maps_common_option(const char *command, int c, char **argv, maps_common *m)
+{
+    double f;
+    switch (c) {
+    case 'o':
+        if (!*optarg)
+            return cli_usage_error(command, "-o needs a %s name",
+                                   m->output_is_folder ? "folder" : "file");
+        m->out.path = optarg;
+        return 0;
+    case MAPS_OPT_STRENGTH:
+        if (!cli_parse_float(optarg, 1e-6, 1e6, &f))
+            return cli_usage_error(command, "--strength must be a number in 1e-6..1e6, not '%s'",
+                                   optarg);
+        m->strength = (float)f;
+        m->height_option = "--strength";
+        return 0;
+    case MAPS_OPT_FILTER:
+        if (!lx_normal_filter_parse(optarg, &m->filter))
+            return cli_usage_error(command, "--filter must be central, sobel or scharr, not '%s'",
+                                   optarg);
+        m->filter_given = true;
+        m->height_option = "--filter";
+        return 0;
+    case MAPS_OPT_WRAP:
+        if (!lx_wrap_parse(optarg, &m->wrap))
+            return cli_usage_error(command, "--wrap must be repeat, clamp or mirror, not '%s'",
+                                   optarg);
+        m->wrap_given = true;
+        m->height_option = "--wrap";
+        return 0;
+    case MAPS_OPT_GREEN:
+        if (strcmp(optarg, "up") == 0)
+            m->green_down = false;
+        else if (strcmp(optarg, "down") == 0)
+            m->green_down = true;
+        else
+            return cli_usage_error(command, "--green must be up or down, not '%s'", optarg);
+        return 0;
+    case MAPS_OPT_BITS:
+        if (!maps_parse_bits(optarg, &m->out.bits))
+            return cli_usage_error(command, "--bits must be 8 or 16, not '%s'", optarg);
+        return 0;
+    case MAPS_OPT_FORMAT:
+        if (!maps_parse_format(optarg, &m->out.format))
+            return cli_usage_error(command, "--format must be png, exr or pfm, not '%s'", optarg);
+        m->out.format_given = true;
+        return 0;
+    default:
+        return cli_common_option(command, c, argv, &m->threads, &m->quiet);
+    }
 }
 
 /* The file name part of a path ("" when it ends with '/'). */

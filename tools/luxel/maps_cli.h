@@ -19,6 +19,39 @@ typedef struct maps_output {
     bool format_given;
 } maps_output;
 
+/* getopt_long codes of the options the map commands share (a command's
+ * own codes start at MAPS_OPT_OWN; --threads is CLI_OPT_THREADS). */
+enum {
+    MAPS_OPT_STRENGTH = 256,
+    MAPS_OPT_FILTER,
+    MAPS_OPT_WRAP,
+    MAPS_OPT_GREEN,
+    MAPS_OPT_BITS,
+    MAPS_OPT_FORMAT,
+    MAPS_OPT_OWN
+};
+
+/* What the shared options set; each stays zero until its option is given
+ * (copy the given ones into the command's desc after parsing). */
+typedef struct maps_common {
+    bool output_is_folder;    /* set before parsing: -o names a folder */
+    maps_output out;          /* -o, --format, --bits */
+    float strength;           /* --strength; 0 = not given */
+    lx_normal_filter filter;  /* --filter */
+    lx_wrap wrap;             /* --wrap */
+    bool filter_given, wrap_given;
+    bool green_down;          /* --green down */
+    const char *height_option; /* the last of --strength, --filter, --wrap given */
+    int threads;              /* --threads; 0 = not given */
+    bool quiet;
+} maps_common;
+
+/* Handles option c of `command` when it is a shared one, or the common
+ * tail (cli_common_option): 0 when handled, else EXIT_USAGE with the
+ * error printed (a bad value, a missing value, an unknown option). Call
+ * it from the default case of the command's switch. */
+int maps_common_option(const char *command, int c, char **argv, maps_common *m);
+
 /* --format's value: png, exr or pfm. */
 bool maps_parse_format(const char *s, lx_image_format *out);
 /* --bits' value: 8 or 16. */

@@ -42,17 +42,7 @@ static const char *normalmap_usage =
     "  -q, --quiet          no progress bar or summary\n"
     "  -h, --help           show this help\n";
 
-enum {
-    OPT_STRENGTH = 256,
-    OPT_FILTER,
-    OPT_WRAP,
-    OPT_GREEN,
-    OPT_BITS,
-    OPT_FORMAT,
-    OPT_BLEND,
-    OPT_METHOD,
-    OPT_THREADS
-};
+enum { OPT_BLEND = MAPS_OPT_OWN, OPT_METHOD };
 
 typedef struct normalmap_args {
     const char *inputs[2];
@@ -60,8 +50,7 @@ typedef struct normalmap_args {
     maps_output out;
     lx_normalmap_desc desc;
     bool blend, quiet;
-    bool height_option; /* --strength, --filter or --wrap given */
-    const char *height_option_name;
+    const char *height_option; /* --strength, --filter or --wrap given */
     bool method_given;
     lx_normal_blend_method method;
 } normalmap_args;
@@ -69,75 +58,26 @@ typedef struct normalmap_args {
 static int parse_args(int argc, char **argv, normalmap_args *a)
 {
     static const struct option options[] = {{"output", required_argument, NULL, 'o'},
-                                            {"strength", required_argument, NULL, OPT_STRENGTH},
-                                            {"filter", required_argument, NULL, OPT_FILTER},
-                                            {"wrap", required_argument, NULL, OPT_WRAP},
-                                            {"green", required_argument, NULL, OPT_GREEN},
-                                            {"bits", required_argument, NULL, OPT_BITS},
-                                            {"format", required_argument, NULL, OPT_FORMAT},
+                                            {"strength", required_argument, NULL, MAPS_OPT_STRENGTH},
+                                            {"filter", required_argument, NULL, MAPS_OPT_FILTER},
+                                            {"wrap", required_argument, NULL, MAPS_OPT_WRAP},
+                                            {"green", required_argument, NULL, MAPS_OPT_GREEN},
+                                            {"bits", required_argument, NULL, MAPS_OPT_BITS},
+                                            {"format", required_argument, NULL, MAPS_OPT_FORMAT},
                                             {"blend", no_argument, NULL, OPT_BLEND},
                                             {"method", required_argument, NULL, OPT_METHOD},
-                                            {"threads", required_argument, NULL, OPT_THREADS},
+                                            {"threads", required_argument, NULL, CLI_OPT_THREADS},
                                             {"quiet", no_argument, NULL, 'q'},
                                             {"verbose", no_argument, NULL, 'v'},
                                             {"help", no_argument, NULL, 'h'},
                                             {NULL, 0, NULL, 0}};
     memset(a, 0, sizeof *a);
+    maps_common m = {0};
     opterr = 0;
     optind = 1;
     int c;
-    long n;
-    double f;
     while ((c = getopt_long(argc, argv, ":o:qvh", options, NULL)) != -1) {
         switch (c) {
-        case 'o':
-            if (!*optarg)
-                return cli_usage_error("normalmap", "-o needs a file name");
-            a->out.path = optarg;
-            break;
-        case OPT_STRENGTH:
-            if (!cli_parse_float(optarg, 1e-6, 1e6, &f))
-                return cli_usage_error("normalmap",
-                                       "--strength must be a number in 1e-6..1e6, not '%s'",
-                                       optarg);
-            a->desc.strength = (float)f;
-            a->height_option = true;
-            a->height_option_name = "--strength";
-            break;
-        case OPT_FILTER:
-            if (!lx_normal_filter_parse(optarg, &a->desc.filter))
-                return cli_usage_error("normalmap",
-                                       "--filter must be central, sobel or scharr, not '%s'",
-                                       optarg);
-            a->height_option = true;
-            a->height_option_name = "--filter";
-            break;
-        case OPT_WRAP:
-            if (!lx_wrap_parse(optarg, &a->desc.wrap))
-                return cli_usage_error("normalmap",
-                                       "--wrap must be repeat, clamp or mirror, not '%s'", optarg);
-            a->height_option = true;
-            a->height_option_name = "--wrap";
-            break;
-        case OPT_GREEN:
-            if (strcmp(optarg, "up") == 0)
-                a->desc.green_down = false;
-            else if (strcmp(optarg, "down") == 0)
-                a->desc.green_down = true;
-            else
-                return cli_usage_error("normalmap", "--green must be up or down, not '%s'",
-                                       optarg);
-            break;
-        case OPT_BITS:
-            if (!maps_parse_bits(optarg, &a->out.bits))
-                return cli_usage_error("normalmap", "--bits must be 8 or 16, not '%s'", optarg);
-            break;
-        case OPT_FORMAT:
-            if (!maps_parse_format(optarg, &a->out.format))
-                return cli_usage_error("normalmap", "--format must be png, exr or pfm, not '%s'",
-                                       optarg);
-            a->out.format_given = true;
-            break;
         case OPT_BLEND:
             a->blend = true;
             break;
@@ -147,30 +87,26 @@ static int parse_args(int argc, char **argv, normalmap_args *a)
                                        optarg);
             a->method_given = true;
             break;
-        case OPT_THREADS:
-            if (!cli_parse_int(optarg, 1, 1024, &n))
-                return cli_usage_error("normalmap",
-                                       "--threads must be an integer in 1..1024, not '%s'", optarg);
-            a->desc.threads = (int)n;
-            break;
-        case 'q':
-            a->quiet = true;
-            cli_set_quiet(true);
-            break;
-        case 'v':
-            cli_set_verbose(true);
-            break;
         case 'h': {
             lx_normalmap_desc d = lx_normalmap_desc_defaults(NULL);
             printf(normalmap_usage, (double)d.strength);
             return -1;
         }
-        case ':':
-            return cli_usage_error("normalmap", "option '%s' needs a value", argv[optind - 1]);
-        default:
-            return cli_usage_error("normalmap", "unknown option '%s'", argv[optind - 1]);
+        default: {
+            int rc = maps_common_option("normalmap", c, argv, &m);
+            if (rc != 0)
+                return rc;
+        }
         }
     }
+    a->out = m.out;
+    a->desc.strength = m.strength;
+    a->desc.filter = m.filter;
+    a->desc.wrap = m.wrap;
+    a->desc.green_down = m.green_down;
+    a->desc.threads = m.threads;
+    a->quiet = m.quiet;
+    a->height_option = m.height_option;
     int want = a->blend ? 2 : 1;
     a->input_count = argc - optind;
     if (a->input_count < want)
@@ -181,8 +117,7 @@ static int parse_args(int argc, char **argv, normalmap_args *a)
     for (int i = 0; i < want; i++)
         a->inputs[i] = argv[optind + i];
     if (a->blend && a->height_option)
-        return cli_usage_error("normalmap", "%s is for heights, not --blend",
-                               a->height_option_name);
+        return cli_usage_error("normalmap", "%s is for heights, not --blend", a->height_option);
     if (!a->blend && a->method_given)
         return cli_usage_error("normalmap", "--method is for --blend");
     return maps_output_resolve("normalmap", &a->out);

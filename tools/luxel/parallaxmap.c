@@ -31,8 +31,6 @@ static const char *parallaxmap_usage =
     "  -q, --quiet          no progress bar or summary\n"
     "  -h, --help           show this help\n";
 
-enum { OPT_STRENGTH = 256, OPT_FILTER, OPT_WRAP, OPT_BITS, OPT_FORMAT, OPT_THREADS };
-
 typedef struct parallax_args {
     const char *input;
     maps_output out;
@@ -43,81 +41,37 @@ typedef struct parallax_args {
 static int parse_args(int argc, char **argv, parallax_args *a)
 {
     static const struct option options[] = {{"output", required_argument, NULL, 'o'},
-                                            {"strength", required_argument, NULL, OPT_STRENGTH},
-                                            {"filter", required_argument, NULL, OPT_FILTER},
-                                            {"wrap", required_argument, NULL, OPT_WRAP},
-                                            {"bits", required_argument, NULL, OPT_BITS},
-                                            {"format", required_argument, NULL, OPT_FORMAT},
-                                            {"threads", required_argument, NULL, OPT_THREADS},
+                                            {"strength", required_argument, NULL, MAPS_OPT_STRENGTH},
+                                            {"filter", required_argument, NULL, MAPS_OPT_FILTER},
+                                            {"wrap", required_argument, NULL, MAPS_OPT_WRAP},
+                                            {"bits", required_argument, NULL, MAPS_OPT_BITS},
+                                            {"format", required_argument, NULL, MAPS_OPT_FORMAT},
+                                            {"threads", required_argument, NULL, CLI_OPT_THREADS},
                                             {"quiet", no_argument, NULL, 'q'},
                                             {"verbose", no_argument, NULL, 'v'},
                                             {"help", no_argument, NULL, 'h'},
                                             {NULL, 0, NULL, 0}};
     memset(a, 0, sizeof *a);
+    maps_common m = {0};
     opterr = 0;
     optind = 1;
     int c;
-    long n;
-    double f;
     while ((c = getopt_long(argc, argv, ":o:qvh", options, NULL)) != -1) {
-        switch (c) {
-        case 'o':
-            if (!*optarg)
-                return cli_usage_error("parallaxmap", "-o needs a file name");
-            a->out.path = optarg;
-            break;
-        case OPT_STRENGTH:
-            if (!cli_parse_float(optarg, 1e-6, 1e6, &f))
-                return cli_usage_error("parallaxmap",
-                                       "--strength must be a number in 1e-6..1e6, not '%s'",
-                                       optarg);
-            a->desc.strength = (float)f;
-            break;
-        case OPT_FILTER:
-            if (!lx_normal_filter_parse(optarg, &a->desc.filter))
-                return cli_usage_error("parallaxmap",
-                                       "--filter must be central, sobel or scharr, not '%s'",
-                                       optarg);
-            break;
-        case OPT_WRAP:
-            if (!lx_wrap_parse(optarg, &a->desc.wrap))
-                return cli_usage_error("parallaxmap",
-                                       "--wrap must be repeat, clamp or mirror, not '%s'", optarg);
-            break;
-        case OPT_BITS:
-            if (!maps_parse_bits(optarg, &a->out.bits))
-                return cli_usage_error("parallaxmap", "--bits must be 8 or 16, not '%s'", optarg);
-            break;
-        case OPT_FORMAT:
-            if (!maps_parse_format(optarg, &a->out.format))
-                return cli_usage_error("parallaxmap",
-                                       "--format must be png, exr or pfm, not '%s'", optarg);
-            a->out.format_given = true;
-            break;
-        case OPT_THREADS:
-            if (!cli_parse_int(optarg, 1, 1024, &n))
-                return cli_usage_error("parallaxmap",
-                                       "--threads must be an integer in 1..1024, not '%s'", optarg);
-            a->desc.threads = (int)n;
-            break;
-        case 'q':
-            a->quiet = true;
-            cli_set_quiet(true);
-            break;
-        case 'v':
-            cli_set_verbose(true);
-            break;
-        case 'h': {
+        if (c == 'h') {
             lx_normalmap_desc d = lx_normalmap_desc_defaults(NULL);
             printf(parallaxmap_usage, (double)d.strength);
             return -1;
         }
-        case ':':
-            return cli_usage_error("parallaxmap", "option '%s' needs a value", argv[optind - 1]);
-        default:
-            return cli_usage_error("parallaxmap", "unknown option '%s'", argv[optind - 1]);
-        }
+        int rc = maps_common_option("parallaxmap", c, argv, &m);
+        if (rc != 0)
+            return rc;
     }
+    a->out = m.out;
+    a->desc.strength = m.strength;
+    a->desc.filter = m.filter;
+    a->desc.wrap = m.wrap;
+    a->desc.threads = m.threads;
+    a->quiet = m.quiet;
     if (optind >= argc)
         return cli_usage_error("parallaxmap", "no height image given");
     if (optind + 1 < argc)

@@ -61,8 +61,7 @@ enum {
     OPT_TONEMAP,
     OPT_FILTER,
     OPT_SAMPLES,
-    OPT_TWO_SIDED,
-    OPT_THREADS
+    OPT_TWO_SIDED
 };
 
 typedef struct render_args {
@@ -138,7 +137,7 @@ static int parse_args(int argc, char **argv, render_args *a)
                                             {"filter", required_argument, NULL, OPT_FILTER},
                                             {"samples", required_argument, NULL, OPT_SAMPLES},
                                             {"two-sided", no_argument, NULL, OPT_TWO_SIDED},
-                                            {"threads", required_argument, NULL, OPT_THREADS},
+                                            {"threads", required_argument, NULL, CLI_OPT_THREADS},
                                             {"quiet", no_argument, NULL, 'q'},
                                             {"verbose", no_argument, NULL, 'v'},
                                             {"help", no_argument, NULL, 'h'},
@@ -230,28 +229,17 @@ static int parse_args(int argc, char **argv, render_args *a)
         case OPT_TWO_SIDED:
             a->desc.two_sided = true;
             break;
-        case OPT_THREADS:
-            if (!cli_parse_int(optarg, 1, 1024, &n))
-                return cli_usage_error("render",
-                                       "--threads must be an integer in 1..1024, not '%s'", optarg);
-            a->desc.threads = (int)n;
-            break;
-        case 'q':
-            a->quiet = true;
-            break;
-        case 'v':
-            cli_set_verbose(true);
-            break;
         case 'h': {
             lx_render_desc d = lx_render_desc_defaults(NULL);
             printf(render_usage, (double)LX_RENDER_DEFAULT_FOV_DEGREES, d.width, d.height,
                    d.samples);
             return -1;
         }
-        case ':':
-            return cli_usage_error("render", "option '%s' needs a value", argv[optind - 1]);
-        default:
-            return cli_usage_error("render", "unknown option '%s'", argv[optind - 1]);
+        default: {
+            int rc = cli_common_option("render", c, argv, &a->desc.threads, &a->quiet);
+            if (rc != 0)
+                return rc;
+        }
         }
     }
     if (optind >= argc)

@@ -46,22 +46,18 @@ static const char *shade_usage =
     "  -h, --help           show this help\n";
 
 enum {
-    OPT_HEIGHT = 256,
+    OPT_HEIGHT = MAPS_OPT_OWN,
     OPT_NORMAL,
     OPT_BASE,
     OPT_SHAPE,
     OPT_LIGHT,
-    OPT_STRENGTH,
     OPT_SIZE,
     OPT_EXPOSURE,
     OPT_TONEMAP,
     OPT_AMBIENT,
     OPT_NO_PARALLAX,
     OPT_NO_HORIZON,
-    OPT_NO_SPECULAR,
-    OPT_GREEN,
-    OPT_WRAP,
-    OPT_THREADS
+    OPT_NO_SPECULAR
 };
 
 typedef struct shade_args {
@@ -81,7 +77,7 @@ static int parse_args(int argc, char **argv, shade_args *a)
                                             {"output", required_argument, NULL, 'o'},
                                             {"shape", required_argument, NULL, OPT_SHAPE},
                                             {"light", required_argument, NULL, OPT_LIGHT},
-                                            {"strength", required_argument, NULL, OPT_STRENGTH},
+                                            {"strength", required_argument, NULL, MAPS_OPT_STRENGTH},
                                             {"size", required_argument, NULL, OPT_SIZE},
                                             {"exposure", required_argument, NULL, OPT_EXPOSURE},
                                             {"tonemap", required_argument, NULL, OPT_TONEMAP},
@@ -89,30 +85,25 @@ static int parse_args(int argc, char **argv, shade_args *a)
                                             {"no-parallax", no_argument, NULL, OPT_NO_PARALLAX},
                                             {"no-horizon", no_argument, NULL, OPT_NO_HORIZON},
                                             {"no-specular", no_argument, NULL, OPT_NO_SPECULAR},
-                                            {"green", required_argument, NULL, OPT_GREEN},
-                                            {"wrap", required_argument, NULL, OPT_WRAP},
-                                            {"threads", required_argument, NULL, OPT_THREADS},
+                                            {"green", required_argument, NULL, MAPS_OPT_GREEN},
+                                            {"wrap", required_argument, NULL, MAPS_OPT_WRAP},
+                                            {"threads", required_argument, NULL, CLI_OPT_THREADS},
                                             {"quiet", no_argument, NULL, 'q'},
                                             {"verbose", no_argument, NULL, 'v'},
                                             {"help", no_argument, NULL, 'h'},
                                             {NULL, 0, NULL, 0}};
     memset(a, 0, sizeof *a);
     a->tonemap = LX_TONEMAP_FILMIC;
+    maps_common m = {0};
     opterr = 0;
     optind = 1;
     int c;
-    long n;
     double f;
     while ((c = getopt_long(argc, argv, ":o:qvh", options, NULL)) != -1) {
         switch (c) {
         case OPT_HEIGHT: a->height = optarg; break;
         case OPT_NORMAL: a->normal = optarg; break;
         case OPT_BASE: a->base = optarg; break;
-        case 'o':
-            if (!*optarg)
-                return cli_usage_error("shade", "-o needs a file name");
-            a->out.path = optarg;
-            break;
         case OPT_SHAPE:
             if (strcmp(optarg, "quad") == 0)
                 a->desc.shape = LX_SHADE_QUAD;
@@ -132,12 +123,6 @@ static int parse_args(int argc, char **argv, shade_args *a)
             a->desc.light = lx_shade_light_dir((float)az, (float)el);
             break;
         }
-        case OPT_STRENGTH:
-            if (!cli_parse_float(optarg, 1e-6, 1e6, &f))
-                return cli_usage_error("shade", "--strength must be a number in 1e-6..1e6, not '%s'",
-                                       optarg);
-            a->desc.strength = (float)f;
-            break;
         case OPT_SIZE: {
             int w, h;
             char tail;
@@ -169,39 +154,22 @@ static int parse_args(int argc, char **argv, shade_args *a)
         case OPT_NO_PARALLAX: a->desc.no_parallax = true; break;
         case OPT_NO_HORIZON: a->desc.no_horizon = true; break;
         case OPT_NO_SPECULAR: a->desc.no_specular = true; break;
-        case OPT_GREEN:
-            if (strcmp(optarg, "up") == 0)
-                a->desc.green_down = false;
-            else if (strcmp(optarg, "down") == 0)
-                a->desc.green_down = true;
-            else
-                return cli_usage_error("shade", "--green must be up or down, not '%s'", optarg);
-            break;
-        case OPT_WRAP:
-            if (!lx_wrap_parse(optarg, &a->desc.wrap))
-                return cli_usage_error("shade", "--wrap must be repeat, clamp or mirror, not '%s'",
-                                       optarg);
-            break;
-        case OPT_THREADS:
-            if (!cli_parse_int(optarg, 1, 1024, &n))
-                return cli_usage_error("shade", "--threads must be an integer in 1..1024, not '%s'",
-                                       optarg);
-            a->desc.threads = (int)n;
-            break;
-        case 'q':
-            a->quiet = true;
-            cli_set_quiet(true);
-            break;
-        case 'v': cli_set_verbose(true); break;
         case 'h':
             printf(shade_usage, (double)LX_DEFAULT_HEIGHT_STRENGTH);
             return -1;
-        case ':':
-            return cli_usage_error("shade", "option '%s' needs a value", argv[optind - 1]);
-        default:
-            return cli_usage_error("shade", "unknown option '%s'", argv[optind - 1]);
+        default: {
+            int rc = maps_common_option("shade", c, argv, &m);
+            if (rc != 0)
+                return rc;
+        }
         }
     }
+    a->out = m.out;
+    a->desc.strength = m.strength;
+    a->desc.green_down = m.green_down;
+    a->desc.wrap = m.wrap;
+    a->desc.threads = m.threads;
+    a->quiet = m.quiet;
     if (optind < argc)
         return cli_usage_error("shade", "'%s' is extra", argv[optind]);
     if (!a->height == !a->normal)

@@ -70,16 +70,14 @@ static int parse_args(int argc, char **argv, tangents_args *a)
                                        LX_MAX_UV_SETS - 1, optarg);
             a->uv_set = (int)n;
             break;
-        case 'q':
-            a->quiet = true;
-            break;
         case 'h':
             fputs(tangents_usage, stdout);
             return -1;
-        case ':':
-            return cli_usage_error("tangents", "option '%s' needs a value", argv[optind - 1]);
-        default:
-            return cli_usage_error("tangents", "unknown option '%s'", argv[optind - 1]);
+        default: {
+            int rc = cli_common_option("tangents", c, argv, NULL, &a->quiet);
+            if (rc != 0)
+                return rc;
+        }
         }
     }
     if (optind >= argc)

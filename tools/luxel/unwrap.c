@@ -38,7 +38,6 @@ enum {
     OPT_PADDING,
     OPT_ATLAS_SIZE,
     OPT_STRICT,
-    OPT_THREADS,
 };
 
 typedef struct unwrap_args {
@@ -64,7 +63,7 @@ static int parse_args(int argc, char **argv, unwrap_args *a)
         {"padding", required_argument, NULL, OPT_PADDING},
         {"atlas-size", required_argument, NULL, OPT_ATLAS_SIZE},
         {"strict", no_argument, NULL, OPT_STRICT},
-        {"threads", required_argument, NULL, OPT_THREADS},
+        {"threads", required_argument, NULL, CLI_OPT_THREADS},
         {"quiet", no_argument, NULL, 'q'},
         {"verbose", no_argument, NULL, 'v'},
         {"help", no_argument, NULL, 'h'},
@@ -112,28 +111,17 @@ static int parse_args(int argc, char **argv, unwrap_args *a)
         case OPT_STRICT:
             a->strict = true;
             break;
-        case OPT_THREADS:
-            if (!cli_parse_int(optarg, 1, 4096, &n))
-                return cli_usage_error("unwrap", "--threads must be an integer in 1..4096, not '%s'",
-                                       optarg);
-            a->desc.threads = (int)n;
-            break;
-        case 'q':
-            a->quiet = true;
-            break;
-        case 'v':
-            cli_set_verbose(true);
-            break;
         case 'h': {
             lx_unwrap_desc d = lx_unwrap_desc_defaults(NULL);
             printf(unwrap_usage, d.resolution, LX_UNWRAP_MAX_PADDING,
                    LX_UNWRAP_PADDING_RECOMMENDED, d.atlas_size);
             return -1;
         }
-        case ':':
-            return cli_usage_error("unwrap", "option '%s' needs a value", argv[optind - 1]);
-        default:
-            return cli_usage_error("unwrap", "unknown option '%s'", argv[optind - 1]);
+        default: {
+            int rc = cli_common_option("unwrap", c, argv, &a->desc.threads, &a->quiet);
+            if (rc != 0)
+                return rc;
+        }
         }
     }
     if (optind >= argc)
@@ -160,8 +148,12 @@ lx_status cli_write_scene_with_uvs(const lx_scene *scene, const lx_unwrap *u, co
         return LX_ERR_NOMEM;
     for (uint32_t k = 0; k < u->mesh_count; k++) {
         const lx_unwrap_mesh *m = &u->meshes[k];
-        uvs[k] = (lx_scene_uvs){m->node, m->mesh, m->vertex_count, m->vertex_source, m->uv,
-                                m->indices};
+        uvs[k] = (lx_scene_uvs){.node = m->node,
+                                .mesh = m->mesh,
+                                .vertex_count = m->vertex_count,
+                                .vertex_source = m->vertex_source,
+                                .uv = m->uv,
+                                .indices = m->indices};
     }
     lx_glb_write_desc d = {.uvs = uvs, .uv_count = u->mesh_count};
     lx_status st = lx_scene_write_glb(scene, path, &d);
