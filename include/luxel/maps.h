@@ -160,14 +160,19 @@ lx_status lx_normal_blend_image(lx_normal_blend_method method, const lx_image *b
  * failure). Fails as lx_normal_map does. */
 lx_status lx_parallax_map(const lx_image *height, const lx_normalmap_desc *desc, lx_image *out);
 
+/* The seed's iteration count. */
+#define LX_PARALLAX_ITERATIONS 4
+
 /* The seed's ApplyParallaxOffset: `iterations` times (0 = 4, the seed's)
  * uv += p(uv) * (view.x * scale[0], -view.y * scale[1]), p sampled
  * bilinearly from channel 0 of parallax (texel centres at
  * ((x + 0.5)/W, (y + 0.5)/H), texels outside addressed by wrap). uv has the
  * top-left origin (v down), view is the unit tangent-space direction
  * toward the viewer (x right, y up the image, z out): its y is negated
- * for v. scale is the UV offset per unit of parallax value: for heights of
- * S texels per unit value, (S / W, S / H) is the physical depth. */
+ * for v. scale is the UV offset per unit of parallax value, per
+ * iteration: the moves add up, so on a smooth surface the offset is about
+ * `iterations` times one move. For the physical (offset-limited) depth
+ * of heights of S texels per unit value, scale = (S/W, S/H) / iterations. */
 lx_vec2 lx_parallax_offset(const lx_image *parallax, lx_wrap wrap, lx_vec2 uv, lx_vec3 view,
                            const float scale[2], int iterations);
 
@@ -296,7 +301,8 @@ typedef struct lx_shade_desc {
     float exponent;          /* Blinn-Phong power; 0 = 64 */
     bool no_specular;        /* no specular term */
     bool no_parallax;        /* no parallax offset (off anyway without heights) */
-    float parallax_scale;    /* multiplier on the physical depth S/W; 0 = 1 */
+    float parallax_scale;    /* multiplier on the physical depth: a scale of
+                                (S/W, S/H) / LX_PARALLAX_ITERATIONS; 0 = 1 */
     bool no_horizon;         /* no horizon shadows (off anyway without heights) */
     lx_horizon_desc horizon; /* the horizon map's settings (strength and
                                 wrap are taken from this desc) */

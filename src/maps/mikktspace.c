@@ -447,7 +447,7 @@ lx_status lx_compute_tangents_mikktspace(const lx_mesh *mesh, int uv_set, lx_vec
             return lx_fail(LX_ERR_INVALID, "mesh '%s': index %u out of range (count %u)", name,
                            mesh->indices[k], mesh->vertex_count);
     mctx c = {.m = mesh, .uv = mesh->uv[uv_set], .nt = mesh->triangle_count};
-    size_t nc = 3 * c.nt ? 3 * c.nt : 1;
+    size_t nc = c.nt > 0 ? 3 * (size_t)c.nt : 1;
     c.weld = malloc(sizeof(uint32_t) * nc);
     c.tri = malloc(sizeof(tri_info) * (c.nt ? c.nt : 1));
     c.group_vertex = malloc(sizeof(int32_t) * nc);

@@ -105,7 +105,7 @@ lx_vec2 lx_parallax_offset(const lx_image *parallax, lx_wrap wrap, lx_vec2 uv, l
         !isfinite(scale[0]) || !isfinite(scale[1]))
         return uv;
     if (iterations <= 0)
-        iterations = 4;
+        iterations = LX_PARALLAX_ITERATIONS;
     /* the offset direction in UV: tangent y runs up the image, v down */
     float pu = view.x * scale[0], pv = -view.y * scale[1];
     for (int i = 0; i < iterations; i++) {

@@ -264,8 +264,10 @@ lx_status lx_shade(const lx_shade_desc *desc, lx_image *out)
         job.dist = 1.0 / tan((double)d.fov * SH_PI / 360.0);
         job.radius = job.dist * sin((double)d.fov * SH_PI / 360.0);
         if (hf) {
-            job.pscale[0] = d.parallax_scale * d.strength / (float)hf->width;
-            job.pscale[1] = d.parallax_scale * d.strength / (float)hf->height;
+            /* each of the iterations moves about the whole offset again */
+            float depth = d.parallax_scale * d.strength / (float)LX_PARALLAX_ITERATIONS;
+            job.pscale[0] = depth / (float)hf->width;
+            job.pscale[1] = depth / (float)hf->height;
         }
         bool bad = false;
         s = lx_nm_run_rows(d.out_height, 1, d.threads, d.progress, d.progress_user, shade_rows,
