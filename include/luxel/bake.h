@@ -225,6 +225,40 @@ bool lx_baker_texel(const lx_baker *baker, uint32_t map, int x, int y, lx_texel_
  * is 0: every lightmap is black. */
 void lx_baker_meter_ev100(const lx_baker *baker, float *ev100, bool *lit);
 
+/* ---- ambient occlusion lightmaps --------------------------------------------
+ * The share of a texel's cosine-weighted hemisphere that is open within
+ * `distance` metres, as Bakery, Unity and Unreal bake it: 1 in the open, 0
+ * fully enclosed. Stratified cosine-weighted rays from the texel (seeded
+ * by map, texel and sample: the same bytes for any thread count); a ray
+ * that meets any surface, either face, within the distance is occluded,
+ * and so is a direction below the texel's geometric surface. Under a
+ * large parallel ceiling at height h < distance the exact value is
+ * (h / distance)^2. */
+#define LX_AO_DISTANCE_DEFAULT 1.0f /* metres, Unity's default */
+#define LX_AO_SAMPLES_DEFAULT 256u
+#define LX_MAX_AO_SAMPLES 65536u
+
+typedef struct lx_ao_desc {
+    float distance;          /* metres, > 0; 0 = LX_AO_DISTANCE_DEFAULT */
+    uint32_t samples;        /* rays per texel, 1..LX_MAX_AO_SAMPLES; 0 = default */
+    int threads;             /* 0 = the baker's desc.threads */
+    lx_progress_fn progress; /* may be NULL; returning false cancels */
+    void *progress_user;
+} lx_ao_desc;
+
+/* A copy of desc (or of zeros when NULL) with every default filled in. */
+lx_ao_desc lx_ao_desc_defaults(const lx_ao_desc *desc);
+
+/* The ambient occlusion of lightmap `map` into *out (one channel, the
+ * lightmap's size, allocated here; free with lx_image_free): AO at
+ * covered texels, padded like lx_baker_apply (the baker's desc.padding
+ * passes of lx_dilate), 0 elsewhere. Reads the scene as the baker holds it
+ * (nodes where they were last placed). Fails with LX_ERR_INVALID for a
+ * distance that is not finite and > 0 or samples out of range,
+ * LX_ERR_CANCELLED when the progress callback says so; *out is zeroed on
+ * failure. */
+lx_status lx_baker_ao(lx_baker *baker, uint32_t map, const lx_ao_desc *desc, lx_image *out);
+
 /* Threads and progress of lx_dilate. desc may be NULL (all cores, no
  * progress). */
 typedef struct lx_dilate_desc {
