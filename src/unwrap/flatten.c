@@ -62,11 +62,13 @@ static bool chart_vertices(const uw_mesh *m, uw_chart *c)
     for (size_t i = 0; i < nc; i++)
         if (n == 0 || ids[n - 1] != ids[i])
             ids[n++] = ids[i];
-    c->vertices = realloc(ids, sizeof(uint32_t) * n);
-    if (!c->vertices) {
+    /* never a zero size: realloc(p, 0) may free p and return NULL */
+    uint32_t *shrunk = realloc(ids, sizeof(uint32_t) * (n ? n : 1));
+    if (!shrunk) {
         free(ids);
         return false;
     }
+    c->vertices = shrunk;
     c->vertex_count = n;
     for (size_t i = 0; i < nc; i++)
         c->corners[i] = find_vertex(c->vertices, n, c->corners[i]);
