@@ -123,6 +123,12 @@ typedef struct lx_bake_desc {
     int padding;            /* texels of dilation around the charts, 0..64; 0 = none
                                (the one field whose zero is a value, not a default;
                                luxel bake uses LX_PADDING_RECOMMENDED) */
+    bool stitch_seams;      /* make texels across UV seams agree (lx_baker_apply,
+                               after the padding): where a surface crosses from
+                               one chart to another, bilinear lookups on both
+                               sides then read the same light, and no line shows.
+                               Off by default (texels near seams then hold their
+                               own texel's light exactly); luxel bake turns it on */
     int threads;            /* 0 = all cores */
     bool strict;            /* zero-UV-area triangles fail the bake instead of
                                being left out with one warning per mesh */

@@ -232,6 +232,26 @@ lx_status lx_uv_health_node(const lx_scene *scene, uint32_t node, int uv_set,
 /* "usable", "missing", "outside [0,1]", "zero-area triangles", "overlapping". */
 const char *lx_uv_problem_name(lx_uv_problem problem);
 
+/* ---- UV seams -----------------------------------------------------------------
+ * Edges where the surface continues but its UVs do not: two triangles
+ * share an edge by position (vertices welded where their positions are
+ * equal) but not its UVs in the set. Bilinear lookups on the two sides
+ * then read different texels for the same point of the surface, which
+ * shows as a line unless the texels are made to agree (the baker's seam
+ * stitching). a[k] and b[k] are the same point of the surface on side A
+ * (triangle_a) and side B (triangle_b). */
+typedef struct lx_uv_seam {
+    lx_vec2 a[2], b[2];
+    uint32_t triangle_a, triangle_b;
+} lx_uv_seam;
+
+/* The seams of one mesh's UV set, each edge once, in triangle order, into
+ * *out (malloc'd, free with free(); NULL when there are none) and *count.
+ * Only manifold edges count (two triangles, opposite directions);
+ * degenerate triangles are left out. LX_ERR_INVALID for a set the mesh
+ * lacks, LX_ERR_NOMEM. */
+lx_status lx_uv_seams(const lx_mesh *mesh, int uv_set, lx_uv_seam **out, uint32_t *count);
+
 #ifdef __cplusplus
 }
 #endif

@@ -38,6 +38,10 @@ typedef struct lx_horizon_material {
     bool horizon, use_ao, active;
 } lx_horizon_material;
 
+/* Seam stitching (stitch.c): the samples along a map's UV seams, made with
+ * its texel map when desc.stitch_seams asks. */
+typedef struct lx_seam_stitch lx_seam_stitch;
+
 typedef struct lx_lightmap {
     lx_lightmap_info info;
     char *name;
@@ -60,6 +64,7 @@ typedef struct lx_lightmap {
     float *baked;    /* width * height * 3 */
     float *realtime; /* width * height * 3; NULL (reads as zero) until the
                         first update with dynamic lights */
+    lx_seam_stitch *stitch; /* NULL: not asked, or no seams */
 } lx_lightmap;
 
 struct lx_baker {
@@ -163,6 +168,23 @@ void lx_sky_free(lx_baker *b);
 /* Adds the sky's irradiance to accum for count texels from first. */
 void lx_sky_tile(const lx_baker *b, uint32_t map_index, const lx_lightmap *map, uint32_t first,
                  uint32_t count, lx_vec3 *accum);
+
+/* A mesh of a page for stitch.c: its lightmap UV set and the scale and
+ * offset that take it into the page. */
+typedef struct lx_stitch_mesh {
+    const lx_mesh *mesh;
+    int uv_set;
+    double scale_offset[4];
+} lx_stitch_mesh;
+/* The seam samples of a width x height page holding meshes; *out NULL
+ * when there are no seams. what names the page in errors. */
+lx_status lx_seam_stitch_build(const lx_stitch_mesh *meshes, uint32_t count, int width,
+                               int height, const char *what, lx_seam_stitch **out);
+/* Stitches data (the page's pixels, `channels` floats each) in place. */
+lx_status lx_seam_stitch_apply(const lx_seam_stitch *s, float *data, int channels,
+                               const char *what);
+uint32_t lx_seam_stitch_samples(const lx_seam_stitch *s);
+void lx_seam_stitch_free(lx_seam_stitch *s);
 
 lx_status lx_bake_lights(lx_baker *baker, const uint32_t *lights, uint32_t light_count,
                          lx_vec3 ambient, bool to_realtime, float progress_base,

@@ -515,6 +515,9 @@ lx_status lx_baker_apply(const lx_baker *b, uint32_t map_index, lx_image *out)
     } else if (b->desc.progress && !b->desc.progress(b->desc.progress_user, 1.0f)) {
         st = lx_fail(LX_ERR_CANCELLED, "apply cancelled");
     }
+    /* after the padding: bilinear lookups at a seam read padding texels */
+    if (st == LX_OK && map->stitch)
+        st = lx_seam_stitch_apply(map->stitch, out->data, 3, map->name);
     if (st != LX_OK) {
         if (st != LX_ERR_CANCELLED) {
             char what[300];

@@ -548,6 +548,24 @@ static uint32_t collect_slots(const lx_scene *scene, uint32_t node_index, const 
     return n;
 }
 
+/* The page's seam samples (stitch.c), from its meshes' UV seams. */
+static lx_status build_stitch(const slot *slots, uint32_t slot_count, lx_lightmap *map,
+                              const char *what)
+{
+    lx_stitch_mesh *meshes = malloc(sizeof *meshes * (slot_count ? slot_count : 1));
+    if (!meshes)
+        return lx_fail(LX_ERR_NOMEM, "%s: out of memory", what);
+    for (uint32_t s = 0; s < slot_count; s++) {
+        meshes[s].mesh = slots[s].mesh;
+        meshes[s].uv_set = slots[s].uv == slots[s].mesh->uv[1] ? 1 : 0;
+        memcpy(meshes[s].scale_offset, slots[s].scale_offset, sizeof meshes[s].scale_offset);
+    }
+    lx_status st = lx_seam_stitch_build(meshes, slot_count, map->info.width, map->info.height,
+                                        what, &map->stitch);
+    free(meshes);
+    return st;
+}
+
 lx_status lx_texel_map_build(const lx_scene *scene, const lx_page_spec *page,
                              const lx_bake_desc *desc, lx_texel_progress progress,
                              const lx_horizon_material *horizon, lx_lightmap *map)
@@ -770,6 +788,8 @@ lx_status lx_texel_map_build(const lx_scene *scene, const lx_page_spec *page,
     map->info.used_texels = n;
     if (st == LX_OK)
         st = lx_bake_horizon_texels(scene, horizon, map, r.b1, r.b2, desc->threads);
+    if (st == LX_OK && desc->stitch_seams)
+        st = build_stitch(slots, slot_count, map, what);
     for (uint32_t s = 0; s < slot_count; s++)
         if (own_tangents[s])
             free(tangents[s]);
@@ -864,5 +884,6 @@ void lx_texel_map_free(lx_lightmap *map)
     free(map->mask);
     free(map->baked);
     free(map->realtime);
+    lx_seam_stitch_free(map->stitch);
     memset(map, 0, sizeof *map);
 }
