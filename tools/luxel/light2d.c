@@ -46,7 +46,6 @@ enum {
     OPT_MASK,
     OPT_THRESHOLD,
     OPT_LIGHT_MAP,
-    OPT_THREADS,
     OPT_FRAMES
 };
 
@@ -75,7 +74,7 @@ static int parse_args(int argc, char **argv, l2_args *a)
                                             {"mask", no_argument, NULL, OPT_MASK},
                                             {"threshold", required_argument, NULL, OPT_THRESHOLD},
                                             {"light-map", required_argument, NULL, OPT_LIGHT_MAP},
-                                            {"threads", required_argument, NULL, OPT_THREADS},
+                                            {"threads", required_argument, NULL, CLI_OPT_THREADS},
                                             {"frames", required_argument, NULL, OPT_FRAMES},
                                             {"quiet", no_argument, NULL, 'q'},
                                             {"help", no_argument, NULL, 'h'},
@@ -122,27 +121,20 @@ static int parse_args(int argc, char **argv, l2_args *a)
                 return cli_usage_error("light2d", "--threshold must be in [0, 1], not '%s'",
                                        optarg);
             break;
-        case OPT_THREADS:
-            if (!cli_parse_int(optarg, 1, 1024, &n))
-                return cli_usage_error("light2d", "--threads must be 1..1024, not '%s'", optarg);
-            a->threads = (int)n;
-            break;
         case OPT_FRAMES:
             if (!cli_parse_int(optarg, 1, 1000000, &n))
                 return cli_usage_error("light2d", "--frames must be 1..1000000, not '%s'",
                                        optarg);
             a->frames = n;
             break;
-        case 'q':
-            a->quiet = true;
-            break;
         case 'h':
             fputs(light2d_usage, stdout);
             return -1;
-        case ':':
-            return cli_usage_error("light2d", "%s needs a value", argv[optind - 1]);
-        default:
-            return cli_usage_error("light2d", "unknown option '%s'", argv[optind - 1]);
+        default: {
+            int rc = cli_common_option("light2d", c, argv, &a->threads, &a->quiet);
+            if (rc != 0)
+                return rc;
+        }
         }
     }
     if (optind < argc)
