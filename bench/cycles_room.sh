@@ -1,0 +1,28 @@
+#!/usr/bin/env bash
+# The demo room baked by luxel and by Blender Cycles (bench/cycles_room.py),
+# compared texel by texel, with both times. Needs Blender
+# (apt-get install blender); not part of make bench, which must run
+# without it.
+#
+#   bash bench/cycles_room.sh [BUILD] [BOUNCES] [SAMPLES] [RESOLUTION]
+set -euo pipefail
+build=${1:-build}
+bounces=${2:-2}
+samples=${3:-1024}
+res=${4:-128}
+here=$(cd "$(dirname "$0")" && pwd)
+work=$(mktemp -d)
+trap 'rm -rf "$work"' EXIT
+command -v blender > /dev/null || { echo "cycles_room: blender is not installed"; exit 1; }
+"$build/bin/gen_scenes" "$work/scenes" > /dev/null
+extra=()
+if "$build/bin/luxel" bake --help | grep -q -- --bounces; then
+    extra=(--bounces "$bounces" --gi-samples "$samples")
+fi
+start=$(date +%s.%N)
+"$build/bin/luxel" bake "$work/scenes/room.glb" --lights "$here/cycles_room.json" \
+    --resolution "$res" --padding 0 -o "$work/luxel" -q "${extra[@]}"
+end=$(date +%s.%N)
+echo "cycles_room: luxel baked in $(echo "$end - $start" | bc) s (${extra[*]:-direct light only})"
+blender -b --factory-startup -P "$here/cycles_room.py" -- "$work/scenes/room.glb" "$work/luxel" \
+    --bounces "$bounces" --samples "$samples" --resolution "$res" 2>&1 | grep '^cycles_room\|^  '
