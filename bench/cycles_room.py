@@ -16,7 +16,9 @@
 # N surfaces). Materials become Lambertian (Diffuse BSDF, roughness 0)
 # of the same base colour. Texels are compared inside the charts (the texel and its
 # four neighbours covered by Cycles' bake, which has no margin), per node:
-# the mean ratio luxel / Cycles and the RMS of the relative difference.
+# the mean ratio luxel / Cycles and the RMS difference relative to the mean
+# (both bakes' noise and Cycles' averaging over each texel's area, where
+# luxel takes its centre, are in it).
 import math
 import sys
 import time
@@ -134,11 +136,12 @@ for o in meshes:
             n += 1
             sum_c += ce
             sum_l += le
-            sum_sq += ((le - ce) / ce) ** 2
+            sum_sq += (le - ce) ** 2
     if n == 0:
         sys.exit("cycles_room: Cycles covered no texel of %s" % o.name)
     ratio = sum_l / sum_c
     worst_ratio = max(worst_ratio, abs(ratio - 1.0))
-    print("  %-10s %6d texels: luxel / Cycles %.4f (means %.4g / %.4g lx), RMS difference %.1f%%"
-          % (o.name, n, ratio, sum_l / n, sum_c / n, 100.0 * math.sqrt(sum_sq / n)))
+    print("  %-10s %6d texels: luxel / Cycles %.4f (means %.4g / %.4g lx), RMS difference %.1f%% "
+          "of the mean" % (o.name, n, ratio, sum_l / n, sum_c / n,
+                           100.0 * math.sqrt(sum_sq / n) / (sum_c / n)))
 print("cycles_room: worst mean difference %.2f%%" % (100.0 * worst_ratio))
