@@ -21,6 +21,7 @@
 typedef struct geometry_ref {
     uint32_t node;
     uint32_t mesh;
+    bool mirrored; /* the node's transform has a negative determinant */
 } geometry_ref;
 
 struct lx_tracer {
@@ -190,7 +191,7 @@ lx_status lx_tracer_create(const lx_scene *scene, const lx_tracer_desc *in, lx_t
             }
             rtcAttachGeometryByID(tr->scene, geom, g);
             tr->geometries[g] = geom;
-            tr->refs[g] = (geometry_ref){n, mi};
+            tr->refs[g] = (geometry_ref){n, mi, lx_mat4_det3(&node->world) < 0.0f};
             g++;
         }
     }
@@ -249,6 +250,7 @@ lx_status lx_tracer_set_node_transform(lx_tracer *tr, uint32_t node, const lx_ma
         place_vertices(verts, tr->mesh_positions[mi], tr->mesh_vertex_counts[mi], world);
         rtcUpdateGeometryBuffer(tr->geometries[i], RTC_BUFFER_TYPE_VERTEX, 0);
         rtcCommitGeometry(tr->geometries[i]);
+        tr->refs[i].mirrored = lx_mat4_det3(world) < 0.0f;
     }
     return LX_OK;
 }
@@ -372,6 +374,22 @@ bool lx_tracer_closest(const lx_tracer *tr, const lx_ray *ray, lx_hit *hit)
         hit->triangle = rh.hit.primID;
         hit->u = rh.hit.u;
         hit->v = rh.hit.v;
+        hit->normal = lx_v3(0.0f, 0.0f, 0.0f);
+        if (g < tr->geometry_count) {
+            /* from the world-space buffers Embree traced */
+            const float *vb = rtcGetGeometryBufferData(tr->geometries[g], RTC_BUFFER_TYPE_VERTEX, 0);
+            const unsigned *ib =
+                rtcGetGeometryBufferData(tr->geometries[g], RTC_BUFFER_TYPE_INDEX, 0);
+            const unsigned *t = ib + 3 * (size_t)rh.hit.primID;
+            lx_vec3 p0 = lx_v3(vb[3 * t[0]], vb[3 * t[0] + 1], vb[3 * t[0] + 2]);
+            lx_vec3 p1 = lx_v3(vb[3 * t[1]], vb[3 * t[1] + 1], vb[3 * t[1] + 2]);
+            lx_vec3 p2 = lx_v3(vb[3 * t[2]], vb[3 * t[2] + 1], vb[3 * t[2] + 2]);
+            lx_vec3 n = lx_cross(lx_sub(p1, p0), lx_sub(p2, p0));
+            float len = lx_length(n);
+            /* a mirroring transform turns the winding over (glTF) */
+            if (len > 0.0f)
+                hit->normal = lx_scale(n, (tr->refs[g].mirrored ? -1.0f : 1.0f) / len);
+        }
     }
     return true;
 }
