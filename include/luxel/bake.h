@@ -211,7 +211,8 @@ const uint8_t *lx_baker_mask(const lx_baker *baker, uint32_t map);
  * valid neighbours. The result is direct + E_1 + ... + E_bounces, in the
  * same units; emission itself is not in the lightmaps (the material
  * draws it). Dynamic lights get no indirect light. Memory while baking:
- * 37 bytes a texel, plus 12 per texel of an emissive material. */
+ * about 50 bytes a texel (albedo, validity, the sources and two
+ * irradiance buffers), plus 12 per texel of an emissive material. */
 lx_status lx_baker_bake(lx_baker *baker);
 
 /* Light access: index as in scene->lights. Changing a static light takes

@@ -123,25 +123,43 @@ typedef struct gi_run {
     float base, span;
 } gi_run;
 
-/* A gather ray from texel i of map: stratified cosine-weighted direction
- * k of cells (sx x sy) about the shading normal, jittered by key; false
- * when it points below the geometric surface (it counts as dark). */
-static bool gather_ray(const lx_baker *b, uint32_t map_index, const lx_lightmap *map, uint32_t i,
-                       uint32_t k, uint32_t sx, uint32_t sy, uint32_t key, lx_ray *ray)
+/* A texel's gather frame: the ray origin (lifted off the surface along
+ * the geometric normal, as lx_shadow_ray does), its normals and the
+ * tangents of the shading normal. */
+typedef struct gather_frame {
+    lx_vec3 origin, n, ng, t, bt;
+    uint32_t map, pixel;
+} gather_frame;
+
+static gather_frame frame_of(const lx_baker *b, uint32_t map_index, const lx_lightmap *map,
+                             uint32_t i)
 {
-    lx_vec3 p = map->world_position[i], n = map->world_normal[i];
-    lx_vec3 ng = map->world_geometric_normal[i];
-    uint32_t pixel = map->texels[i].pixel;
-    float u = ((float)(k % sx) + lx_random(map_index, pixel, k, key)) / (float)sx;
-    float v = ((float)(k / sx) + lx_random(map_index, pixel, k, key + 1)) / (float)sy;
+    gather_frame f;
+    lx_vec3 p = map->world_position[i];
+    f.n = map->world_normal[i];
+    f.ng = map->world_geometric_normal[i];
+    f.t = lx_perpendicular(f.n);
+    f.bt = lx_cross(f.n, f.t);
+    f.origin = lx_madd(p, f.ng, b->bias + 4e-6f * lx_max_abs_component(p));
+    f.map = map_index;
+    f.pixel = map->texels[i].pixel;
+    return f;
+}
+
+/* Gather ray k of a texel: stratified cosine-weighted direction in cell k
+ * of sx x sy about the shading normal, jittered by key; false when it
+ * points below the geometric surface (it counts as dark). */
+static bool gather_ray(const gather_frame *f, uint32_t k, uint32_t sx, uint32_t sy, uint32_t key,
+                       lx_ray *ray)
+{
+    float u = ((float)(k % sx) + lx_random(f->map, f->pixel, k, key)) / (float)sx;
+    float v = ((float)(k / sx) + lx_random(f->map, f->pixel, k, key + 1)) / (float)sy;
     float r = sqrtf(u), phi = 2.0f * LX_PI * v;
-    lx_vec3 t = lx_perpendicular(n), bt = lx_cross(n, t);
-    lx_vec3 d = lx_add(lx_add(lx_scale(t, r * cosf(phi)), lx_scale(bt, r * sinf(phi))),
-                       lx_scale(n, sqrtf(fmaxf(0.0f, 1.0f - u))));
-    if (!(lx_dot(d, ng) > 0.0f))
+    lx_vec3 d = lx_add(lx_add(lx_scale(f->t, r * cosf(phi)), lx_scale(f->bt, r * sinf(phi))),
+                       lx_scale(f->n, sqrtf(fmaxf(0.0f, 1.0f - u))));
+    if (!(lx_dot(d, f->ng) > 0.0f))
         return false;
-    float bias = b->bias + 4e-6f * lx_max_abs_component(p);
-    ray->origin = lx_madd(p, ng, bias);
+    ray->origin = f->origin;
     ray->dir = d;
     ray->tmin = 0.0f;
     ray->tmax = INFINITY;
@@ -238,10 +256,11 @@ static bool texel_inside(const gi_run *run, uint32_t map_index, uint32_t i)
     uint32_t sx, sy;
     strata(want, &sx, &sy);
     uint32_t cells = sx * sy, back = 0;
+    gather_frame f = frame_of(b, map_index, map, i);
     for (uint32_t k = 0; k < cells; k++) {
         lx_ray ray;
         lx_hit h;
-        if (!gather_ray(b, map_index, map, i, k, sx, sy, VALIDITY_KEY, &ray))
+        if (!gather_ray(&f, k, sx, sy, VALIDITY_KEY, &ray))
             continue;
         if (lx_tracer_closest(b->tracer, &ray, &h) && lx_dot(ray.dir, h.normal) > 0.0f)
             back++;
@@ -258,10 +277,11 @@ static lx_vec3 texel_gather(const gi_run *run, uint32_t map_index, uint32_t i, u
     strata(b->desc.gi_samples, &sx, &sy);
     uint32_t cells = sx * sy;
     double sum[3] = {0.0, 0.0, 0.0};
+    gather_frame f = frame_of(b, map_index, map, i);
     for (uint32_t k = 0; k < cells; k++) {
         lx_ray ray;
         lx_hit h;
-        if (!gather_ray(b, map_index, map, i, k, sx, sy, key, &ray))
+        if (!gather_ray(&f, k, sx, sy, key, &ray))
             continue;
         if (!lx_tracer_closest(b->tracer, &ray, &h) || !(lx_dot(ray.dir, h.normal) < 0.0f))
             continue; /* escaped (sky: direct light), or a back face */

@@ -482,7 +482,15 @@ static lx_vec3 sample_emission(const lx_material *mat, const lx_mesh *m, const u
                                float w0, float w1, float w2, float scale)
 {
     lx_vec3 e = lx_material_emission(mat, scale);
-    (void)m, (void)i, (void)w0, (void)w1, (void)w2;
+    const lx_vec2 *uv = m->uv[mat->emissive_uv_set];
+    if (mat->emissive_map.width > 0 && uv && (e.x > 0.0f || e.y > 0.0f || e.z > 0.0f)) {
+        float u = uv[i[0]].x * w0 + uv[i[1]].x * w1 + uv[i[2]].x * w2;
+        float v = uv[i[0]].y * w0 + uv[i[1]].y * w1 + uv[i[2]].y * w2;
+        lx_vec2 at = lx_uv_transform_apply(&mat->emissive_transform, lx_v2(u, v));
+        float c[4] = {1, 1, 1, 1};
+        lx_image_sample_bilinear(&mat->emissive_map, at.x, at.y, c);
+        e = lx_mul(e, lx_v3(c[0], c[1], c[2]));
+    }
     return e;
 }
 
