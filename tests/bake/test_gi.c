@@ -23,7 +23,9 @@
 #include <cmocka.h>
 
 #include "cube_reference.h"
+#include "gltf_writer.h"
 #include "helpers.h"
+#include "texture_oracle.h"
 
 #include <math.h>
 #include <stdio.h>
@@ -136,6 +138,62 @@ static void emissive_scale_scales_emitters(void **state)
     lx_scene_destroy(scene);
     assert_true(worst_error(b, 0, PI_D * 250.0) < 1e-5);
     lx_baker_destroy(b);
+}
+
+/* Emission = factor x texture: a constant 0.5 emissive texture on the
+ * furnace's walls halves its light. */
+static void emissive_texture_scales_emission(void **state)
+{
+    (void)state;
+    lx_scene *scene = furnace_scene(0.5f, 3.0f, 0.0f);
+    lx_material *mat = &scene->materials[0];
+    assert_int_equal(lx_image_alloc(&mat->emissive_map, 2, 2, 4), LX_OK);
+    for (int i = 0; i < 16; i++)
+        mat->emissive_map.data[i] = (i % 4) == 3 ? 1.0f : 0.5f;
+    lx_bake_desc d = {.resolution = 16, .bounces = 1, .gi_samples = 4};
+    lx_baker *b = bake(scene, &d);
+    lx_scene_destroy(scene);
+    double worst = worst_error(b, 0, PI_D * 3.0 * 0.5);
+    printf("emissive texture: worst relative error %.3g\n", worst);
+    assert_true(worst < 1e-5);
+    lx_baker_destroy(b);
+}
+
+/* The loader reads emissiveTexture, its texCoord and KHR_texture_transform,
+ * and emissiveFactor x emissiveStrength: the glTF spec's meaning of each. */
+static void loader_reads_the_emissive_texture(void **state)
+{
+    (void)state;
+    const char *dir = lx_test_dir("gi_emissive");
+    char png[1024], path[1024];
+    snprintf(png, sizeof png, "%s/glow.png", dir);
+    /* sRGB 188 is linear 0.5029 (IEC 61966-2-1: ((188/255 + 0.055) / 1.055)^2.4) */
+    uint8_t px[4 * 3];
+    for (int i = 0; i < 12; i++)
+        px[i] = 188;
+    lx_test_write_png(png, 2, 2, 3, px);
+    lx_test_quad q = {{0, 0, 0}, {1, 0, 0}, {0, 0, 1}, {{{0, 0}, {1, 0}, {0, 1}}, {{0, 0}, {1, 0}, {0, 1}}}};
+    snprintf(path, sizeof path, "%s/glow.gltf", dir);
+    const char *uri = "glow.png";
+    lx_test_write_quad_gltf(
+        path, &q,
+        "{\"emissiveFactor\":[1,0.5,0.25],\"emissiveTexture\":{\"index\":0,\"texCoord\":0,"
+        "\"extensions\":{\"KHR_texture_transform\":{\"offset\":[0.25,0.5],\"texCoord\":1}}},"
+        "\"extensions\":{\"KHR_materials_emissive_strength\":{\"emissiveStrength\":40}}}",
+        &uri, 1, NULL);
+    lx_scene *scene;
+    assert_int_equal(lx_scene_load(path, NULL, &scene), LX_OK);
+    const lx_material *m = &scene->materials[scene->meshes[0].material];
+    lx_test_assert_vec3(m->emissive, 40.0, 20.0, 10.0);
+    assert_int_equal(m->emissive_map.width, 2);
+    double linear = pow((188.0 / 255.0 + 0.055) / 1.055, 2.4);
+    assert_true(fabs(m->emissive_map.data[0] - linear) < 1e-4);
+    assert_int_equal(m->emissive_uv_set, 1);
+    assert_true(m->emissive_transform.enabled);
+    assert_true(fabs(m->emissive_transform.offset.x - 0.25f) < 1e-7f);
+    assert_true(fabs(m->emissive_transform.offset.y - 0.5f) < 1e-7f);
+    assert_non_null(m->emissive_map_path);
+    lx_scene_destroy(scene);
 }
 
 /* The bytes of every lightmap of a baker. */
@@ -457,6 +515,8 @@ int main(void)
         cmocka_unit_test(furnace_emitter_is_a_geometric_series),
         cmocka_unit_test(furnace_ambient_is_a_geometric_series),
         cmocka_unit_test(emissive_scale_scales_emitters),
+        cmocka_unit_test(emissive_texture_scales_emission),
+        cmocka_unit_test(loader_reads_the_emissive_texture),
         cmocka_unit_test(open_floor_under_sky_gets_no_indirect),
         cmocka_unit_test(facing_squares_match_the_form_factor),
         cmocka_unit_test(room_lit_from_outside_stays_black),
