@@ -374,22 +374,14 @@ bool lx_tracer_closest(const lx_tracer *tr, const lx_ray *ray, lx_hit *hit)
         hit->triangle = rh.hit.primID;
         hit->u = rh.hit.u;
         hit->v = rh.hit.v;
-        hit->normal = lx_v3(0.0f, 0.0f, 0.0f);
-        if (g < tr->geometry_count) {
-            /* from the world-space buffers Embree traced */
-            const float *vb = rtcGetGeometryBufferData(tr->geometries[g], RTC_BUFFER_TYPE_VERTEX, 0);
-            const unsigned *ib =
-                rtcGetGeometryBufferData(tr->geometries[g], RTC_BUFFER_TYPE_INDEX, 0);
-            const unsigned *t = ib + 3 * (size_t)rh.hit.primID;
-            lx_vec3 p0 = lx_v3(vb[3 * t[0]], vb[3 * t[0] + 1], vb[3 * t[0] + 2]);
-            lx_vec3 p1 = lx_v3(vb[3 * t[1]], vb[3 * t[1] + 1], vb[3 * t[1] + 2]);
-            lx_vec3 p2 = lx_v3(vb[3 * t[2]], vb[3 * t[2] + 1], vb[3 * t[2] + 2]);
-            lx_vec3 n = lx_cross(lx_sub(p1, p0), lx_sub(p2, p0));
-            float len = lx_length(n);
-            /* a mirroring transform turns the winding over (glTF) */
-            if (len > 0.0f)
-                hit->normal = lx_scale(n, (tr->refs[g].mirrored ? -1.0f : 1.0f) / len);
-        }
+        /* Embree's Ng: (p1 - p0) x (p2 - p0) in the world-space vertices
+         * it traced (counter-clockwise = front, its manual); a mirroring
+         * transform turns the winding over (glTF) */
+        lx_vec3 n = lx_v3(rh.hit.Ng_x, rh.hit.Ng_y, rh.hit.Ng_z);
+        float len = lx_length(n);
+        bool mirrored = g < tr->geometry_count && tr->refs[g].mirrored;
+        hit->normal = len > 0.0f ? lx_scale(n, (mirrored ? -1.0f : 1.0f) / len)
+                                 : lx_v3(0.0f, 0.0f, 0.0f);
     }
     return true;
 }
