@@ -112,10 +112,15 @@ typedef struct lx_material {
     int normal_uv_set;                    /* UV set the normal map uses */
     char *normal_map_path;                /* where it came from (for messages), or NULL */
     lx_uv_transform normal_transform;     /* KHR_texture_transform of the map */
-    lx_vec3 emissive; /* linear emitted colour: glTF emissiveFactor times
-                       * KHR_materials_emissive_strength (OBJ's Ke); 0 = none.
-                       * Read for writers and viewers; the baker does not
-                       * treat surfaces as lights. */
+    lx_vec3 emissive; /* linear emitted radiance in nits: glTF emissiveFactor
+                       * times KHR_materials_emissive_strength (OBJ's Ke);
+                       * 0 = none. The baker's bounces gather it
+                       * (lx_bake_desc.bounces, emissive_scale). */
+    lx_image emissive_map;              /* linear RGBA (sRGB-decoded), width 0 if none;
+                                           emission = emissive x its RGB */
+    int emissive_uv_set;                /* texCoord (or KHR_texture_transform's) */
+    char *emissive_map_path;            /* where it came from, or NULL */
+    lx_uv_transform emissive_transform; /* KHR_texture_transform of the map */
     /* The lights JSON's "materials" entry (docs/lights-json.md): a height
      * texture the baker self-shadows (horizon) and occludes (ao) the
      * material's texels with, read at uv[normal_uv_set] under

@@ -66,6 +66,10 @@ typedef struct lx_hit {
     uint32_t mesh;     /* scene mesh index */
     uint32_t triangle; /* triangle index in the mesh */
     float u, v;        /* barycentrics of vertices 1 and 2 */
+    lx_vec3 normal;    /* unit world geometric normal of the triangle, by its
+                          winding: (p1 - p0) x (p2 - p0), negated under a
+                          node transform that mirrors (as glTF); a ray with
+                          dot(dir, normal) > 0 hit its back face */
 } lx_hit;
 
 typedef struct lx_tracer_desc {

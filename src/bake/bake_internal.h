@@ -58,7 +58,10 @@ typedef struct lx_lightmap {
     lx_vec3 *object_normal;
     lx_vec3 *object_geometric_normal;
     lx_vec3 *albedo; /* per texel base colour (factor x texture); NULL unless
-                        the bake is of radiance, the one use of it */
+                        the bake is of radiance or has bounces */
+    lx_vec3 *emission; /* per texel emitted radiance (nits, emissive scale
+                          applied); NULL unless bounces > 0 and a material
+                          of the map emits */
     lx_texel_horizon *horizon; /* per texel; NULL when no texel's material has a height */
     uint8_t *mask;   /* width * height */
     float *baked;    /* width * height * 3 */
@@ -90,6 +93,16 @@ struct lx_baker {
                               less its peak */
     float *sky_peak;       /* NULL, or the bright part per texel (RGB) */
     double *sky_peak_cdf;  /* cumulative luminance x solid angle of the peak */
+    /* global illumination (gi.c), made when desc.bounces > 0: each node's
+     * lightmap UV set, and each mesh's UVs (both sets), triangles and
+     * emission, to find what a gather ray hit */
+    int8_t *node_uv_set;
+    uint32_t mesh_count;
+    lx_vec2 **mesh_uv[LX_MAX_UV_SETS];
+    uint32_t **mesh_indices;
+    uint32_t *mesh_triangles;
+    lx_vec3 *mesh_emission;
+    uint64_t gi_invalid_texels; /* found by the last bake */
     /* during lx_baker_create only: each material's horizon layers and AO */
     lx_horizon_material *horizon_materials;
     uint32_t horizon_material_count;
@@ -185,6 +198,14 @@ lx_status lx_seam_stitch_apply(const lx_seam_stitch *s, float *data, int channel
                                const char *what);
 uint32_t lx_seam_stitch_samples(const lx_seam_stitch *s);
 void lx_seam_stitch_free(lx_seam_stitch *s);
+/* gi.c: copies what finding a gather ray's hit needs (when desc.bounces
+ * > 0); frees it; adds desc.bounces of indirect light into the baked
+ * buffers, within [progress_base, progress_base + progress_span]. */
+lx_status lx_gi_prepare(lx_baker *b, const lx_scene *scene);
+void lx_gi_free(lx_baker *b);
+lx_status lx_bake_indirect(lx_baker *b, float progress_base, float progress_span);
+/* A material's emitted radiance in nits times scale, without texture. */
+lx_vec3 lx_material_emission(const lx_material *mat, float scale);
 
 lx_status lx_bake_lights(lx_baker *baker, const uint32_t *lights, uint32_t light_count,
                          lx_vec3 ambient, bool to_realtime, float progress_base,

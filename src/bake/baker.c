@@ -31,6 +31,10 @@ lx_bake_desc lx_bake_desc_defaults(const lx_bake_desc *desc)
     if (d.max_resolution == 0)
         d.max_resolution = 4096;
     d.sky = lx_sky_desc_defaults(&d.sky);
+    if (d.gi_samples == 0)
+        d.gi_samples = LX_GI_SAMPLES_DEFAULT;
+    if (d.emissive_scale == 0.0f)
+        d.emissive_scale = 1.0f;
     return d;
 }
 
@@ -50,6 +54,13 @@ static lx_status validate_desc(const lx_bake_desc *d)
         return lx_fail(LX_ERR_INVALID, "thread count %d is outside 0..1024", d->threads);
     if (!(d->shadow_bias >= 0.0f) || !isfinite(d->shadow_bias))
         return lx_fail(LX_ERR_INVALID, "shadow bias must be finite and >= 0");
+    if (d->bounces < 0 || d->bounces > LX_MAX_BOUNCES)
+        return lx_fail(LX_ERR_INVALID, "bounces %d is outside 0..%d", d->bounces, LX_MAX_BOUNCES);
+    if (d->gi_samples < 1 || d->gi_samples > LX_MAX_GI_SAMPLES)
+        return lx_fail(LX_ERR_INVALID, "gi samples %u is outside 1..%u", d->gi_samples,
+                       LX_MAX_GI_SAMPLES);
+    if (!(d->emissive_scale > 0.0f) || !isfinite(d->emissive_scale))
+        return lx_fail(LX_ERR_INVALID, "emissive scale must be a finite number > 0");
     if (d->quantity != LX_QUANTITY_IRRADIANCE && d->quantity != LX_QUANTITY_RADIANCE)
         return lx_fail(LX_ERR_INVALID, "unknown quantity %d", (int)d->quantity);
     if (d->uv_set != LX_UV_SET_AUTO && d->uv_set != LX_UV_SET_0 && d->uv_set != LX_UV_SET_1)
@@ -100,6 +111,8 @@ static lx_status build_node_maps(lx_baker *b, const lx_scene *scene, const lx_ba
             continue;
         }
         b->node_map[n] = b->map_count++;
+        if (b->node_uv_set)
+            b->node_uv_set[n] = (int8_t)lx_bake_uv_set(scene, n, desc->uv_set);
         /* building large texel maps takes long enough to report and stop */
         if (desc->progress && !desc->progress(desc->progress_user, share.to))
             st = lx_fail(LX_ERR_CANCELLED, "bake cancelled");
@@ -164,6 +177,11 @@ static lx_status build_pages(lx_baker *b, const lx_scene *scene, const lx_bake_d
         }
         for (uint32_t k = 0; k < count; k++) {
             b->node_map[nodes[k].node] = b->map_count;
+            if (b->node_uv_set)
+                b->node_uv_set[nodes[k].node] =
+                    (int8_t)(nodes[k].uv_set >= 0
+                                 ? nodes[k].uv_set
+                                 : lx_bake_uv_set(scene, nodes[k].node, LX_UV_SET_AUTO));
             memcpy(b->node_scale_offset[nodes[k].node], nodes[k].scale_offset,
                    sizeof nodes[k].scale_offset);
         }
@@ -286,6 +304,10 @@ lx_status lx_baker_create(const lx_scene *scene, const lx_bake_desc *in, lx_bake
         b->node_scale_offset[n][0] = b->node_scale_offset[n][1] = 1.0f;
         b->node_scale_offset[n][2] = b->node_scale_offset[n][3] = 0.0f;
     }
+    if (desc.bounces > 0 && (st = lx_gi_prepare(b, scene)) != LX_OK) {
+        lx_baker_destroy(b);
+        return st;
+    }
     /* heights named by the lights JSON: horizon layers and AO, made once */
     b->horizon_material_count = scene->material_count;
     st = lx_bake_horizon_load(scene, desc.threads, &b->horizon_materials);
@@ -320,6 +342,7 @@ void lx_baker_destroy(lx_baker *b)
         lx_texel_map_free(&b->maps[m]);
     lx_tracer_destroy(b->tracer);
     lx_sky_free(b);
+    lx_gi_free(b);
     free(b->maps);
     free(b->node_map);
     free(b->node_scale_offset);
@@ -423,7 +446,12 @@ lx_status lx_baker_bake(lx_baker *b)
     if (!idx)
         return lx_fail(LX_ERR_NOMEM, "out of memory");
     uint32_t n = select_lights(b, false, idx);
-    lx_status st = lx_bake_lights(b, idx, n, b->ambient, false, 0.0f, 1.0f);
+    /* progress: the direct pass, then the indirect one's gathers (a
+     * validity pass and a gather a bounce, each about as long) */
+    float direct = b->desc.bounces > 0 ? 1.0f / (float)(b->desc.bounces + 2) : 1.0f;
+    lx_status st = lx_bake_lights(b, idx, n, b->ambient, false, 0.0f, direct);
+    if (st == LX_OK && b->desc.bounces > 0)
+        st = lx_bake_indirect(b, direct, 1.0f - direct);
     if (st != LX_OK)
         clear_buffers(b, false);
     free(idx);

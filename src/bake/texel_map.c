@@ -476,6 +476,24 @@ static lx_vec3 sample_albedo(const lx_material *mat, const lx_mesh *m, const uin
     return a;
 }
 
+/* The emitted radiance at a point of a mesh: the material's emission
+ * (lx_material_emission) times its emissive texture there. */
+static lx_vec3 sample_emission(const lx_material *mat, const lx_mesh *m, const uint32_t *i,
+                               float w0, float w1, float w2, float scale)
+{
+    lx_vec3 e = lx_material_emission(mat, scale);
+    const lx_vec2 *uv = m->uv[mat->emissive_uv_set];
+    if (mat->emissive_map.width > 0 && uv && (e.x > 0.0f || e.y > 0.0f || e.z > 0.0f)) {
+        float u = uv[i[0]].x * w0 + uv[i[1]].x * w1 + uv[i[2]].x * w2;
+        float v = uv[i[0]].y * w0 + uv[i[1]].y * w1 + uv[i[2]].y * w2;
+        lx_vec2 at = lx_uv_transform_apply(&mat->emissive_transform, lx_v2(u, v));
+        float c[4] = {1, 1, 1, 1};
+        lx_image_sample_bilinear(&mat->emissive_map, at.x, at.y, c);
+        e = lx_mul(e, lx_v3(c[0], c[1], c[2]));
+    }
+    return e;
+}
+
 /* Texel n's world-space position and normals under world (nm: its normal
  * matrix), as lx_texel_map_transform computes them, and its object space
  * when the map keeps it. */
@@ -669,11 +687,20 @@ lx_status lx_texel_map_build(const lx_scene *scene, const lx_page_spec *page,
     map->world_position = malloc(sizeof(lx_vec3) * (used ? used : 1));
     map->world_normal = malloc(sizeof(lx_vec3) * (used ? used : 1));
     map->world_geometric_normal = malloc(sizeof(lx_vec3) * (used ? used : 1));
-    if (desc->quantity == LX_QUANTITY_RADIANCE)
+    bool want_albedo = desc->quantity == LX_QUANTITY_RADIANCE || desc->bounces > 0;
+    if (want_albedo)
         map->albedo = malloc(sizeof(lx_vec3) * (used ? used : 1));
+    /* emission per texel: for the gather, when a material here emits */
+    bool emits = false;
+    for (uint32_t s = 0; s < slot_count && desc->bounces > 0; s++) {
+        lx_vec3 e = lx_material_emission(material_of(scene, slots[s].mesh), desc->emissive_scale);
+        emits |= e.x > 0.0f || e.y > 0.0f || e.z > 0.0f;
+    }
+    if (emits)
+        map->emission = malloc(sizeof(lx_vec3) * (used ? used : 1));
     if (!map->texels || !map->tile_start || !map->mask || !map->world_position ||
-        !map->world_normal || !map->world_geometric_normal ||
-        (desc->quantity == LX_QUANTITY_RADIANCE && !map->albedo)) {
+        !map->world_normal || !map->world_geometric_normal || (want_albedo && !map->albedo) ||
+        (emits && !map->emission)) {
         st = lx_fail(LX_ERR_NOMEM, "%s: out of memory", what);
         goto done;
     }
@@ -780,6 +807,9 @@ lx_status lx_texel_map_build(const lx_scene *scene, const lx_page_spec *page,
                     sample_normal_map(mat, m, tangents[s], i, w0, w1, w2, &nrm);
                 if (map->albedo)
                     map->albedo[k] = sample_albedo(mat, m, i, w0, w1, w2);
+                if (map->emission)
+                    map->emission[k] =
+                        sample_emission(mat, m, i, w0, w1, w2, desc->emissive_scale);
                 place_texel(map, k++, &scene->nodes[slots[s].node].world, &nms[slot_node[s]],
                             position, nrm, geometric);
                 map->mask[p] = 1;
@@ -881,6 +911,7 @@ void lx_texel_map_free(lx_lightmap *map)
     free(map->object_normal);
     free(map->object_geometric_normal);
     free(map->albedo);
+    free(map->emission);
     free(map->mask);
     free(map->baked);
     free(map->realtime);

@@ -61,6 +61,10 @@ typedef struct lx_gltf_texture_ref {
 lx_status lx_gltf_material_textures(const char *file, const cJSON *material, size_t index,
                                     lx_gltf_texture_ref *base_color, lx_gltf_texture_ref *normal);
 
+/* The emissiveTexture of glTF material `index` (zeroed when none). */
+lx_status lx_gltf_material_emissive_texture(const char *file, const cJSON *material, size_t index,
+                                            lx_gltf_texture_ref *emissive);
+
 /* emissiveFactor times KHR_materials_emissive_strength of glTF material
  * `index` (zero when it states none). */
 lx_status lx_gltf_material_emissive(const char *file, const cJSON *material, size_t index,

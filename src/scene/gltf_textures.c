@@ -86,6 +86,18 @@ lx_status lx_gltf_material_textures(const char *file, const cJSON *m, size_t ind
     return read_ref(file, where, lx_gltf_get(m, "normalTexture"), normal);
 }
 
+lx_status lx_gltf_material_emissive_texture(const char *file, const cJSON *m, size_t index,
+                                            lx_gltf_texture_ref *emissive)
+{
+    memset(emissive, 0, sizeof *emissive);
+    if (!cJSON_IsObject(m))
+        return LX_OK;
+    char who[160], where[200];
+    lx_gltf_label(who, sizeof who, "material", index, m);
+    snprintf(where, sizeof where, "%s: emissiveTexture", who);
+    return read_ref(file, where, lx_gltf_get(m, "emissiveTexture"), emissive);
+}
+
 lx_status lx_gltf_material_emissive(const char *file, const cJSON *m, size_t index, lx_vec3 *out)
 {
     *out = lx_v3(0, 0, 0);

@@ -954,6 +954,43 @@ static lx_status import_materials(import_ctx *c)
             }
             m.base_color_uv_set = uv < LX_MAX_UV_SETS ? (int)uv : LX_MAX_UV_SETS;
         }
+        /* the emissive texture (its KHR_texture_transform when the
+         * material is matched to the file's) */
+        uv = 0;
+        if (aiGetMaterialTexture(am, aiTextureType_EMISSIVE, 0, &tex, NULL, &uv, NULL, NULL, NULL,
+                                 NULL) == aiReturn_SUCCESS) {
+            load_texture(c, &tex, false, "emissive", name_buf, &m.emissive_map,
+                         &m.emissive_map_path);
+            if (c->gltf && c->map && c->map->material_of[i] >= 0 &&
+                (size_t)c->map->material_of[i] < c->map->material_count) {
+                size_t j = (size_t)c->map->material_of[i];
+                lx_gltf_texture_ref ref;
+                st = lx_gltf_material_emissive_texture(c->path, c->map->materials[j], j, &ref);
+                if (st != LX_OK) {
+                    lx_image_free(&m.normal_map);
+                    lx_image_free(&m.base_color_map);
+                    lx_image_free(&m.emissive_map);
+                    free(m.normal_map_path);
+                    free(m.base_color_map_path);
+                    free(m.emissive_map_path);
+                    return st;
+                }
+                if (ref.present) {
+                    uv = ref.tex_coord;
+                    m.emissive_transform = ref.transform;
+                }
+            }
+            m.emissive_uv_set = uv < LX_MAX_UV_SETS ? (int)uv : LX_MAX_UV_SETS;
+            if (m.emissive_uv_set >= LX_MAX_UV_SETS) {
+                lx_log(LX_LOG_WARN,
+                       "%s: material '%s': emissive texture on UV set %u is not supported "
+                       "(0 and 1 are); ignored",
+                       c->path, name_buf, uv);
+                lx_image_free(&m.emissive_map);
+                m.emissive_uv_set = 0;
+                m.emissive_transform = (lx_uv_transform){0};
+            }
+        }
         if (m.normal_uv_set >= LX_MAX_UV_SETS || m.base_color_uv_set >= LX_MAX_UV_SETS) {
             lx_log(LX_LOG_WARN,
                    "%s: material '%s': textures on UV sets above 1 are not "
@@ -975,8 +1012,10 @@ static lx_status import_materials(import_ctx *c)
         st = lx_scene_add_material(c->scene, &m, NULL);
         lx_image_free(&m.normal_map);
         lx_image_free(&m.base_color_map);
+        lx_image_free(&m.emissive_map);
         free(m.normal_map_path);
         free(m.base_color_map_path);
+        free(m.emissive_map_path);
         if (st != LX_OK)
             return st;
     }

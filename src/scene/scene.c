@@ -69,6 +69,8 @@ static void material_free(lx_material *m)
     free(m->height_map_path);
     lx_image_free(&m->normal_map);
     lx_image_free(&m->base_color_map);
+    free(m->emissive_map_path);
+    lx_image_free(&m->emissive_map);
 }
 
 void lx_scene_destroy(lx_scene *s)
@@ -251,10 +253,12 @@ lx_status lx_scene_add_material(lx_scene *s, const lx_material *src, uint32_t *i
     m.base_color_map_path = src->base_color_map_path ? lx_strdup(src->base_color_map_path) : NULL;
     m.height_map_path = src->height_map_path ? lx_strdup(src->height_map_path) : NULL;
     memset(&m.normal_map, 0, sizeof m.normal_map);
+    m.emissive_map_path = src->emissive_map_path ? lx_strdup(src->emissive_map_path) : NULL;
     memset(&m.base_color_map, 0, sizeof m.base_color_map);
-    const lx_image *maps[2] = {&src->normal_map, &src->base_color_map};
-    lx_image *dst[2] = {&m.normal_map, &m.base_color_map};
-    for (int i = 0; i < 2; i++) {
+    memset(&m.emissive_map, 0, sizeof m.emissive_map);
+    const lx_image *maps[3] = {&src->normal_map, &src->base_color_map, &src->emissive_map};
+    lx_image *dst[3] = {&m.normal_map, &m.base_color_map, &m.emissive_map};
+    for (int i = 0; i < 3; i++) {
         if (maps[i]->width <= 0)
             continue;
         if (lx_image_alloc(dst[i], maps[i]->width, maps[i]->height, maps[i]->channels) != LX_OK) {

@@ -21,6 +21,7 @@
 typedef struct geometry_ref {
     uint32_t node;
     uint32_t mesh;
+    bool mirrored; /* the node's transform has a negative determinant */
 } geometry_ref;
 
 struct lx_tracer {
@@ -190,7 +191,7 @@ lx_status lx_tracer_create(const lx_scene *scene, const lx_tracer_desc *in, lx_t
             }
             rtcAttachGeometryByID(tr->scene, geom, g);
             tr->geometries[g] = geom;
-            tr->refs[g] = (geometry_ref){n, mi};
+            tr->refs[g] = (geometry_ref){n, mi, lx_mat4_det3(&node->world) < 0.0f};
             g++;
         }
     }
@@ -249,6 +250,7 @@ lx_status lx_tracer_set_node_transform(lx_tracer *tr, uint32_t node, const lx_ma
         place_vertices(verts, tr->mesh_positions[mi], tr->mesh_vertex_counts[mi], world);
         rtcUpdateGeometryBuffer(tr->geometries[i], RTC_BUFFER_TYPE_VERTEX, 0);
         rtcCommitGeometry(tr->geometries[i]);
+        tr->refs[i].mirrored = lx_mat4_det3(world) < 0.0f;
     }
     return LX_OK;
 }
@@ -372,6 +374,14 @@ bool lx_tracer_closest(const lx_tracer *tr, const lx_ray *ray, lx_hit *hit)
         hit->triangle = rh.hit.primID;
         hit->u = rh.hit.u;
         hit->v = rh.hit.v;
+        /* Embree's Ng: (p1 - p0) x (p2 - p0) in the world-space vertices
+         * it traced (counter-clockwise = front, its manual); a mirroring
+         * transform turns the winding over (glTF) */
+        lx_vec3 n = lx_v3(rh.hit.Ng_x, rh.hit.Ng_y, rh.hit.Ng_z);
+        float len = lx_length(n);
+        bool mirrored = g < tr->geometry_count && tr->refs[g].mirrored;
+        hit->normal = len > 0.0f ? lx_scale(n, (mirrored ? -1.0f : 1.0f) / len)
+                                 : lx_v3(0.0f, 0.0f, 0.0f);
     }
     return true;
 }

@@ -60,9 +60,10 @@ static lx_image reference; /* the library's bake */
  * goes to DIR/cli.log. Returns the exit status. */
 static int run_bake(const char *const *args)
 {
-    const char *argv[32] = {luxel,       "bake",         scene_path, "--lights",
-                            lights_path, "--resolution", "32",       "-q"};
-    int n = 8;
+    /* direct light only: the library bake it is compared with has no bounces */
+    const char *argv[32] = {luxel,       "bake",         scene_path, "--lights", lights_path,
+                            "--resolution", "32",       "-q",       "--bounces", "0"};
+    int n = 10;
     for (; *args && n < 31; args++)
         argv[n++] = *args;
     argv[n] = NULL;

@@ -359,6 +359,26 @@ static void test_move_node_and_commit(void **state)
     assert_true(lx_tracer_closest(tr, &down, &h));
     assert_int_equal(h.node, 0);
     assert_true(fabsf(h.t - 2.7f) <= T_TOL * 2.7); /* measured exact */
+    /* the outward box's top faces up: the ray meets its front */
+    assert_true(fabsf(h.normal.x) < 1e-6f && fabsf(h.normal.y - 1.0f) < 1e-6f &&
+                fabsf(h.normal.z) < 1e-6f);
+    /* from inside the box the top is a back face: the same normal */
+    lx_ray up = {lx_v3(-1.1f, 0.9f, 0.35f), 0.0f, lx_v3(0, 1, 0), INFINITY};
+    assert_true(lx_tracer_closest(tr, &up, &h));
+    assert_int_equal(h.node, 0);
+    assert_true(lx_dot(up.dir, h.normal) > 0.99f);
+    /* mirrored in x (a negative determinant): glTF turns the winding
+     * over, so the top still faces up */
+    lx_mat4 mirror = s->nodes[0].world;
+    for (int r = 0; r < 3; r++)
+        mirror.m[r] = -mirror.m[r]; /* column 0: x flipped */
+    assert_int_equal(lx_tracer_set_node_transform(tr, 0, &mirror), LX_OK);
+    assert_int_equal(lx_tracer_commit(tr), LX_OK);
+    assert_true(lx_tracer_closest(tr, &down, &h)); /* the box is centred on its node */
+    assert_int_equal(h.node, 0);
+    assert_true(h.normal.y > 0.99f);
+    assert_int_equal(lx_tracer_set_node_transform(tr, 0, &s->nodes[0].world), LX_OK);
+    assert_int_equal(lx_tracer_commit(tr), LX_OK);
 
     /* move the box: 2 m along +x and 0.5 m down, with a turn */
     lx_mat4 moved =

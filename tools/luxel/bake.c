@@ -53,6 +53,12 @@ static const char *bake_usage =
     "  --no-sky-shadows        unshadowed sky even when the lights file asks\n"
     "                          for shadows\n"
     "  --sky-samples N         rays per texel with sky shadows (default %u)\n"
+    "  --bounces N             indirect diffuse bounces, 0..%d; 0 bakes direct\n"
+    "                          light only (default %d)\n"
+    "  --gi-samples N          gather rays per texel per bounce (default %u)\n"
+    "  --emissive-scale X      multiplier on emissive materials' radiance (nits),\n"
+    "                          for files not authored in physical units\n"
+    "                          (default 1); emitters light through the bounces\n"
     "  --exposure EV100        exposure of the PNG preview (default: automatic)\n"
     "  --tonemap C             tone curve of the PNG preview: filmic (default),\n"
     "                          aces or clamp\n"
@@ -108,7 +114,10 @@ enum {
     OPT_RENDER,
     OPT_TONEMAP,
     OPT_CLEAN,
-    OPT_STRICT
+    OPT_STRICT,
+    OPT_BOUNCES,
+    OPT_GI_SAMPLES,
+    OPT_EMISSIVE_SCALE
 };
 
 typedef enum unwrap_choice { UNWRAP_AUTO, UNWRAP_ALWAYS, UNWRAP_NEVER } unwrap_choice;
@@ -195,6 +204,9 @@ static int parse_args(int argc, char **argv, bake_args *a)
         {"tonemap", required_argument, NULL, OPT_TONEMAP},
         {"clean", no_argument, NULL, OPT_CLEAN},
         {"strict", no_argument, NULL, OPT_STRICT},
+        {"bounces", required_argument, NULL, OPT_BOUNCES},
+        {"gi-samples", required_argument, NULL, OPT_GI_SAMPLES},
+        {"emissive-scale", required_argument, NULL, OPT_EMISSIVE_SCALE},
         {"quiet", no_argument, NULL, 'q'},
         {"verbose", no_argument, NULL, 'v'},
         {"help", no_argument, NULL, 'h'},
@@ -202,6 +214,7 @@ static int parse_args(int argc, char **argv, bake_args *a)
     memset(a, 0, sizeof *a);
     a->desc = lx_bake_desc_defaults(NULL);
     a->desc.padding = LX_PADDING_RECOMMENDED;
+    a->desc.bounces = LX_BOUNCES_RECOMMENDED;
     a->output = "lightmaps";
     a->format = LX_IMAGE_EXR;
     a->sky_intensity = -1.0;
@@ -361,6 +374,25 @@ static int parse_args(int argc, char **argv, bake_args *a)
         case OPT_CLEAN:
             a->clean = true;
             break;
+        case OPT_BOUNCES:
+            if (!cli_parse_int(optarg, 0, LX_MAX_BOUNCES, &n))
+                return cli_usage_error("bake", "--bounces must be an integer in 0..%d, not '%s'",
+                                       LX_MAX_BOUNCES, optarg);
+            a->desc.bounces = (int)n;
+            break;
+        case OPT_GI_SAMPLES:
+            if (!cli_parse_int(optarg, 1, (long)LX_MAX_GI_SAMPLES, &n))
+                return cli_usage_error("bake", "--gi-samples must be an integer in 1..%u, not '%s'",
+                                       LX_MAX_GI_SAMPLES, optarg);
+            a->desc.gi_samples = (uint32_t)n;
+            break;
+        case OPT_EMISSIVE_SCALE:
+            if (!cli_parse_float(optarg, 1e-30, 1e30, &f))
+                return cli_usage_error("bake",
+                                       "--emissive-scale must be a number above 0, not '%s'",
+                                       optarg);
+            a->desc.emissive_scale = (float)f;
+            break;
         case OPT_STRICT:
             a->strict = true;
             a->desc.strict = true; /* zero-area triangles refused, in space and in UV */
@@ -379,7 +411,8 @@ static int parse_args(int argc, char **argv, bake_args *a)
             lx_unwrap_desc u = lx_unwrap_desc_defaults(NULL);
             printf(bake_usage, d.resolution, CLI_ATLAS_RESOLUTION, d.max_resolution,
                    d.quantity == LX_QUANTITY_RADIANCE ? "radiance" : "irradiance",
-                   (double)d.sky.intensity, d.sky.samples, LX_PADDING_RECOMMENDED, u.atlas_size);
+                   (double)d.sky.intensity, d.sky.samples, LX_MAX_BOUNCES,
+                   LX_BOUNCES_RECOMMENDED, d.gi_samples, LX_PADDING_RECOMMENDED, u.atlas_size);
             return -1;
         }
         case ':':
@@ -570,10 +603,16 @@ static void check_scale(const bake_args *a, const lx_scene *scene, const lx_unwr
 
 /* Something must emit light, or every lightmap is black: returns the
  * error's reason, or NULL when a light, the sky or an ambient does. */
-static const char *nothing_emits(const lx_scene *scene, const lx_scene_sky *sky)
+static const char *nothing_emits(const lx_scene *scene, const lx_scene_sky *sky, int bounces)
 {
     if (sky->environment)
         return NULL;
+    /* emissive materials light through the bounces */
+    for (uint32_t m = 0; m < scene->material_count && bounces > 0; m++) {
+        lx_vec3 e = scene->materials[m].emissive;
+        if (e.x > 0.0f || e.y > 0.0f || e.z > 0.0f)
+            return NULL;
+    }
     if (scene->ambient.x > 0.0f || scene->ambient.y > 0.0f || scene->ambient.z > 0.0f)
         return NULL;
     for (uint32_t l = 0; l < scene->light_count; l++) {
@@ -585,8 +624,11 @@ static const char *nothing_emits(const lx_scene *scene, const lx_scene_sky *sky)
     }
     return scene->light_count ? "every light has zero intensity or colour, and there is no sky "
                                 "or ambient"
-                              : "the scene has no lights, no sky and no ambient (luxel reads no "
-                                "emissive materials)";
+                              : bounces > 0 ? "the scene has no lights, no sky, no ambient and "
+                                              "no emissive material"
+                                            : "the scene has no lights, no sky and no ambient "
+                                              "(emissive materials light through --bounces "
+                                              "only)";
 }
 
 /* A spot cone under a degree is almost surely radians typed as degrees. */
@@ -879,7 +921,7 @@ int cmd_bake(int argc, char **argv)
         a.desc.sky = lx_sky_desc_defaults(&given);
     }
     cli_phase(sky.environment ? "lights and sky" : "lights");
-    const char *dark = nothing_emits(scene, &sky);
+    const char *dark = nothing_emits(scene, &sky, a.desc.bounces);
     if (dark) {
         cli_error("%s: nothing emits light: %s; give lights with --lights FILE.json, a sky with "
                   "--sky ENV or an ambient with --ambient R,G,B",
@@ -1029,6 +1071,12 @@ int cmd_bake(int argc, char **argv)
         cJSON_AddBoolToObject(sk, "shadows", sky.shadows);
         if (sky.shadows)
             cJSON_AddNumberToObject(sk, "samples", a.desc.sky.samples);
+    }
+    if (a.desc.bounces > 0) {
+        cJSON *gi = cJSON_AddObjectToObject(manifest, "indirect");
+        cJSON_AddNumberToObject(gi, "bounces", a.desc.bounces);
+        cJSON_AddNumberToObject(gi, "gi_samples", a.desc.gi_samples);
+        cJSON_AddNumberToObject(gi, "emissive_scale", a.desc.emissive_scale);
     }
     if (a.desc.texel_density > 0.0f || unwrap)
         cJSON_AddNumberToObject(manifest, "texel_density",

@@ -1,0 +1,246 @@
+/* bench_gi - the indirect light of lx_baker_bake (lx_bake_desc.bounces)
+ * on the room demo scene (examples/gen_scenes.c) at --res texels a node,
+ * against its baseline measured in the same run: as many incoherent rays
+ * as the gathers cast (a validity pass of min(samples, 64) rays and
+ * `bounces` passes of --samples rays a texel, cosine-weighted about each
+ * texel's normal), straight through Embree's rtcIntersect1 on one flat BVH
+ * built here, over the same 8x8 tiles, OpenMP schedule and threads, with
+ * no lookups. The GI time is the bake with bounces less the same bake
+ * without; the ratio says what finding the hit's lightmap texels and
+ * summing costs on top of the rays. Best and median of --reps runs each.
+ *
+ * Usage: bench_gi [--threads N] [--reps N] [--res N] [--samples N]
+ *                 [--bounces N] [--scene FILE.glb] */
+#define _POSIX_C_SOURCE 200809L
+#define _DEFAULT_SOURCE
+#include "helpers.h"
+#include "core/internal.h"
+#include "scenes.h"
+
+#include <embree3/rtcore.h>
+#include <math.h>
+#include <omp.h>
+#include <stdio.h>
+#include <stdlib.h>
+#include <string.h>
+#include <unistd.h>
+
+static int cmp_double(const void *a, const void *b)
+{
+    double x = *(const double *)a, y = *(const double *)b;
+    return (x > y) - (x < y);
+}
+
+/* The room from gen_scenes into a fresh temporary folder. */
+static void make_room(char *path, size_t size)
+{
+    char exe[4096];
+    ssize_t n = readlink("/proc/self/exe", exe, sizeof exe - 1);
+    if (n <= 0)
+        lx_bench_die("readlink /proc/self/exe");
+    exe[n] = '\0';
+    char *slash = strrchr(exe, '/');
+    if (slash)
+        *slash = '\0';
+    char dir[] = "/tmp/bench_gi.XXXXXX";
+    if (!mkdtemp(dir))
+        lx_bench_die("mkdtemp");
+    char cmd[8400];
+    snprintf(cmd, sizeof cmd, "'%s/gen_scenes' '%s' >/dev/null", exe, dir);
+    if (system(cmd) != 0) {
+        fprintf(stderr, "bench_gi: %s failed\n", cmd);
+        exit(1);
+    }
+    snprintf(path, size, "%s/room.glb", dir);
+}
+
+/* Seconds of lx_baker_bake with `bounces`. */
+static double bake_time(lx_baker *b)
+{
+    double t0 = lx_bench_now();
+    if (lx_baker_bake(b) != LX_OK)
+        lx_bench_die("bake");
+    return lx_bench_now() - t0;
+}
+
+typedef struct texel {
+    lx_vec3 p, n, ng;
+    uint32_t pixel;
+} texel;
+
+/* The gathers' rays through rtcIntersect1: per texel `passes` rounds of
+ * rays (counts[pass] each), cosine-weighted about its normal, over tiles
+ * of texels; returns seconds and the rays cast in *rays. */
+static double raw_gathers(RTCScene flat, const texel *tx, const uint32_t *tile_start, int tiles,
+                          const uint32_t *counts, int passes, float bias, int threads,
+                          uint64_t *rays)
+{
+    uint64_t total = 0;
+    double t0 = lx_bench_now();
+    for (int pass = 0; pass < passes; pass++) {
+        uint32_t want = counts[pass];
+        uint32_t sx = (uint32_t)sqrtf((float)want), sy = (want + sx - 1) / sx;
+#pragma omp parallel for schedule(dynamic, 1) num_threads(threads) reduction(+ : total)
+        for (int t = 0; t < tiles; t++)
+            for (uint32_t i = tile_start[t]; i < tile_start[t + 1]; i++) {
+                lx_vec3 n = tx[i].n, tt = lx_perpendicular(n), bt = lx_cross(n, tt);
+                lx_vec3 o = lx_madd(tx[i].p, tx[i].ng, bias);
+                for (uint32_t k = 0; k < sx * sy; k++) {
+                    float u = ((float)(k % sx) + lx_random(0, tx[i].pixel, k, (uint32_t)pass)) / sx;
+                    float v = ((float)(k / sx) + lx_random(1, tx[i].pixel, k, (uint32_t)pass)) / sy;
+                    float r = sqrtf(u), phi = 2.0f * LX_PI * v;
+                    lx_vec3 d = lx_add(lx_add(lx_scale(tt, r * cosf(phi)), lx_scale(bt, r * sinf(phi))),
+                                       lx_scale(n, sqrtf(fmaxf(0.0f, 1.0f - u))));
+                    struct RTCIntersectContext ctx;
+                    rtcInitIntersectContext(&ctx);
+                    struct RTCRayHit rh = {0};
+                    rh.ray.org_x = o.x, rh.ray.org_y = o.y, rh.ray.org_z = o.z;
+                    rh.ray.dir_x = d.x, rh.ray.dir_y = d.y, rh.ray.dir_z = d.z;
+                    rh.ray.tnear = 0.0f, rh.ray.tfar = INFINITY, rh.ray.mask = 0xFFFFFFFFu;
+                    rh.hit.geomID = RTC_INVALID_GEOMETRY_ID;
+                    rtcIntersect1(flat, &ctx, &rh);
+                    total++;
+                }
+            }
+    }
+    *rays = total;
+    return lx_bench_now() - t0;
+}
+
+int main(int argc, char **argv)
+{
+    int threads = 0, reps = 3, res = 128, samples = 64, bounces = 2;
+    const char *scene_path = NULL;
+    for (int i = 1; i < argc; i++) {
+        if (!strcmp(argv[i], "--threads") && i + 1 < argc)
+            threads = atoi(argv[++i]);
+        else if (!strcmp(argv[i], "--reps") && i + 1 < argc)
+            reps = atoi(argv[++i]);
+        else if (!strcmp(argv[i], "--res") && i + 1 < argc)
+            res = atoi(argv[++i]);
+        else if (!strcmp(argv[i], "--samples") && i + 1 < argc)
+            samples = atoi(argv[++i]);
+        else if (!strcmp(argv[i], "--bounces") && i + 1 < argc)
+            bounces = atoi(argv[++i]);
+        else if (!strcmp(argv[i], "--scene") && i + 1 < argc)
+            scene_path = argv[++i];
+        else {
+            fprintf(stderr,
+                    "usage: %s [--threads N] [--reps N] [--res N] [--samples N] [--bounces N] "
+                    "[--scene FILE.glb]\n",
+                    argv[0]);
+            return 2;
+        }
+    }
+    if (reps < 1 || reps > 100 || res < 4 || res > 4096 || samples < 1 || samples > 4096 ||
+        bounces < 1 || bounces > 16) {
+        fprintf(stderr, "bench_gi: --reps 1..100, --res 4..4096, --samples 1..4096, --bounces "
+                        "1..16\n");
+        return 2;
+    }
+    threads = lx_thread_count(threads);
+    lx_bench_header("bench_gi", threads);
+    char room[4200];
+    if (!scene_path) {
+        make_room(room, sizeof room);
+        scene_path = room;
+    }
+    lx_scene *scene;
+    if (lx_scene_load(scene_path, NULL, &scene) != LX_OK)
+        lx_bench_die(scene_path);
+    if (scene_path == room) {
+        char cmd[8500], *slash = strrchr(room, '/');
+        *slash = '\0';
+        snprintf(cmd, sizeof cmd, "rm -rf '%s'", room);
+        if (system(cmd) != 0)
+            fprintf(stderr, "bench_gi: could not remove %s\n", room);
+        scene_path = "room (gen_scenes)";
+    }
+    lx_bake_desc d = lx_bake_desc_defaults(NULL);
+    d.resolution = res;
+    d.threads = threads;
+    lx_baker *direct, *gi;
+    if (lx_baker_create(scene, &d, &direct) != LX_OK)
+        lx_bench_die("baker");
+    d.bounces = bounces;
+    d.gi_samples = (uint32_t)samples;
+    if (lx_baker_create(scene, &d, &gi) != LX_OK)
+        lx_bench_die("baker");
+
+    /* the texels, tile by tile, as the baker orders them */
+    uint64_t used = 0;
+    for (uint32_t m = 0; m < lx_baker_lightmap_count(gi); m++)
+        used += lx_baker_lightmap_info(gi, m)->used_texels;
+    texel *tx = malloc(sizeof *tx * (used + 1));
+    int tiles_max = 0;
+    for (uint32_t m = 0; m < lx_baker_lightmap_count(gi); m++) {
+        const lx_lightmap_info *info = lx_baker_lightmap_info(gi, m);
+        tiles_max += ((info->width + 7) / 8) * ((info->height + 7) / 8);
+    }
+    uint32_t *tile_start = malloc(sizeof(uint32_t) * (size_t)(tiles_max + 1));
+    int tiles = 0;
+    uint32_t n = 0;
+    for (uint32_t m = 0; m < lx_baker_lightmap_count(gi); m++) {
+        const lx_lightmap_info *info = lx_baker_lightmap_info(gi, m);
+        for (int ty = 0; ty < info->height; ty += LX_BENCH_TILE)
+            for (int txx = 0; txx < info->width; txx += LX_BENCH_TILE) {
+                tile_start[tiles++] = n;
+                for (int y = ty; y < ty + LX_BENCH_TILE && y < info->height; y++)
+                    for (int x = txx; x < txx + LX_BENCH_TILE && x < info->width; x++) {
+                        lx_texel_sample s;
+                        if (!lx_baker_texel(gi, m, x, y, &s))
+                            continue;
+                        tx[n++] = (texel){s.position, s.normal, s.geometric_normal,
+                                          (uint32_t)(y * info->width + x)};
+                    }
+            }
+    }
+    tile_start[tiles] = n;
+    uint32_t counts[17];
+    counts[0] = samples < 64 ? (uint32_t)samples : 64u;
+    for (int k = 1; k <= bounces; k++)
+        counts[k] = (uint32_t)samples;
+    lx_vec3 lo, hi;
+    lx_scene_bounds(scene, &lo, &hi);
+    float bias = 1e-5f * lx_length(lx_sub(hi, lo));
+    RTCDevice dev = rtcNewDevice(NULL);
+    RTCScene flat = lx_bench_flat_scene(dev, scene);
+
+    double *tg = calloc((size_t)reps, sizeof *tg), *tr = calloc((size_t)reps, sizeof *tr);
+    uint64_t rays = 0;
+    /* warm up, then alternate so load changes hit both alike */
+    bake_time(direct);
+    bake_time(gi);
+    raw_gathers(flat, tx, tile_start, tiles, counts, bounces + 1, bias, threads, &rays);
+    for (int k = 0; k < reps; k++) {
+        double t_direct = bake_time(direct);
+        double t_gi = bake_time(gi);
+        tg[k] = t_gi - t_direct;
+        tr[k] = raw_gathers(flat, tx, tile_start, tiles, counts, bounces + 1, bias, threads,
+                            &rays);
+    }
+    qsort(tg, (size_t)reps, sizeof *tg, cmp_double);
+    qsort(tr, (size_t)reps, sizeof *tr, cmp_double);
+    char a[32], b[32];
+    printf("\nGI  %s, %dx%d a node, %u texels, %d bounces x %d rays a texel (+%u validity), %d "
+           "threads, %d runs\n",
+           scene_path, res, res, n, bounces, samples, counts[0], threads, reps);
+    printf("  %-38s %9s %9s %12s\n", "", "best", "median", "rays/s best");
+    printf("  %-38s %8.3fs %8.3fs %12s\n", "indirect light (bake - direct bake)", tg[0],
+           tg[reps / 2], lx_bench_si((double)rays / tg[0], a));
+    printf("  %-38s %8.3fs %8.3fs %12s\n", "raw rtcIntersect1, as many rays", tr[0], tr[reps / 2],
+           lx_bench_si((double)rays / tr[0], b));
+    printf("gi: %.2fx the time of raw incoherent rtcIntersect1 on as many rays (best; median "
+           "%.2fx)\n",
+           tg[0] / tr[0], tg[reps / 2] / tr[reps / 2]);
+    free(tg);
+    free(tr);
+    free(tx);
+    free(tile_start);
+    rtcReleaseScene(flat);
+    rtcReleaseDevice(dev);
+    lx_baker_destroy(direct);
+    lx_baker_destroy(gi);
+    lx_scene_destroy(scene);
+    return 0;
+}

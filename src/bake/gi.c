@@ -1,0 +1,516 @@
+/* Indirect diffuse light (global illumination) in the baker: a final
+ * gather per bounce over the lightmaps themselves, the "irradiance
+ * caching in lightmap space" production lightmappers use (Unity's and
+ * Bakery's progressive lightmappers, Frostbite's Flux, as described in
+ * Hillaire's and Seyb's talks; the method is Jensen's final gather, with
+ * the lightmap as the cache). Bounce k: every valid texel casts N
+ * stratified cosine-weighted rays (Malley's method, as sky.c); a ray that
+ * hits the front face of a lightmapped surface reads that surface's bounce
+ * k-1 exitant radiance, albedo / pi x E_{k-1} (plus its emission at the
+ * first gather), bilinearly over the valid texels of its lightmap; the
+ * texel's E_k = pi / N x sum (the cosine-weighted estimator of the
+ * irradiance integral). Escaping rays and back faces bring nothing.
+ * Validity (Unity's "backface tolerance"): a texel whose rays mostly hit
+ * back faces sits inside geometry; it is left out of the bounces and takes
+ * its valid neighbours' average at the end. Every texel's rays are seeded
+ * by (map, texel, sample, bounce), and each texel is written by one tile,
+ * so the bytes are the same for any thread count. */
+#include "bake_internal.h"
+#include "core/internal.h"
+
+#include <math.h>
+#include <omp.h>
+#include <stdlib.h>
+#include <string.h>
+
+/* lx_random dimensions apart from the lights' and the sky's */
+#define GI_KEY 0x6100u
+#define VALIDITY_KEY 0x6000u
+/* rays of the validity pass, at most */
+#define VALIDITY_RAYS 64u
+/* rings searched for a valid texel when none of the four bilinear ones is */
+#define LOOKUP_RINGS 3
+
+lx_vec3 lx_material_emission(const lx_material *mat, float scale)
+{
+    return lx_scale(mat->emissive, scale);
+}
+
+lx_status lx_gi_prepare(lx_baker *b, const lx_scene *scene)
+{
+    b->mesh_count = scene->mesh_count;
+    size_t m1 = scene->mesh_count + 1;
+    b->node_uv_set = calloc(scene->node_count + 1, 1);
+    for (int s = 0; s < LX_MAX_UV_SETS; s++)
+        b->mesh_uv[s] = calloc(m1, sizeof(lx_vec2 *));
+    b->mesh_indices = calloc(m1, sizeof(uint32_t *));
+    b->mesh_triangles = calloc(m1, sizeof(uint32_t));
+    b->mesh_emission = calloc(m1, sizeof(lx_vec3));
+    bool ok = b->node_uv_set && b->mesh_indices && b->mesh_triangles && b->mesh_emission;
+    for (int s = 0; s < LX_MAX_UV_SETS; s++)
+        ok &= b->mesh_uv[s] != NULL;
+    for (uint32_t m = 0; m < scene->mesh_count && ok; m++) {
+        const lx_mesh *mesh = &scene->meshes[m];
+        const lx_material *mat =
+            mesh->material < scene->material_count ? &scene->materials[mesh->material] : NULL;
+        if (mat)
+            b->mesh_emission[m] = lx_material_emission(mat, b->desc.emissive_scale);
+        bool any = false;
+        for (int s = 0; s < LX_MAX_UV_SETS && ok; s++) {
+            if (!mesh->uv[s])
+                continue;
+            any = true;
+            b->mesh_uv[s][m] = malloc(sizeof(lx_vec2) * (mesh->vertex_count + 1));
+            ok = b->mesh_uv[s][m] != NULL;
+            if (ok)
+                memcpy(b->mesh_uv[s][m], mesh->uv[s], sizeof(lx_vec2) * mesh->vertex_count);
+        }
+        if (!any || !ok)
+            continue;
+        b->mesh_indices[m] = malloc(sizeof(uint32_t) * 3 * ((size_t)mesh->triangle_count + 1));
+        ok = b->mesh_indices[m] != NULL;
+        if (ok)
+            memcpy(b->mesh_indices[m], mesh->indices,
+                   sizeof(uint32_t) * 3 * (size_t)mesh->triangle_count);
+        b->mesh_triangles[m] = mesh->triangle_count;
+    }
+    if (!ok)
+        return lx_fail(LX_ERR_NOMEM, "%s: out of memory for global illumination", scene->path);
+    return LX_OK;
+}
+
+void lx_gi_free(lx_baker *b)
+{
+    for (uint32_t m = 0; m < b->mesh_count; m++) {
+        for (int s = 0; s < LX_MAX_UV_SETS; s++)
+            if (b->mesh_uv[s])
+                free(b->mesh_uv[s][m]);
+        if (b->mesh_indices)
+            free(b->mesh_indices[m]);
+    }
+    for (int s = 0; s < LX_MAX_UV_SETS; s++) {
+        free(b->mesh_uv[s]);
+        b->mesh_uv[s] = NULL;
+    }
+    free(b->mesh_indices);
+    free(b->mesh_triangles);
+    free(b->mesh_emission);
+    free(b->node_uv_set);
+    b->mesh_indices = NULL;
+    b->mesh_triangles = NULL;
+    b->mesh_emission = NULL;
+    b->node_uv_set = NULL;
+}
+
+/* Per map during the indirect pass. */
+typedef struct gi_map {
+    uint8_t *valid;   /* width * height: covered and not inside geometry */
+    float *source;    /* width * height * 3: exitant radiance of the last bounce */
+    lx_vec3 *prev;    /* per texel: the last bounce's irradiance */
+    lx_vec3 *next;    /* per texel: this bounce's */
+    uint8_t *invalid; /* per texel, from the validity pass */
+} gi_map;
+
+typedef struct gi_run {
+    lx_baker *b;
+    gi_map *maps;
+    uint32_t *map_first_tile;
+    int tiles;
+    int threads;
+    bool first_gather; /* emission is picked up */
+    /* progress */
+    uint64_t total_work;
+    float base, span;
+} gi_run;
+
+/* A texel's gather frame: the ray origin (lifted off the surface along
+ * the geometric normal, as lx_shadow_ray does), its normals and the
+ * tangents of the shading normal. */
+typedef struct gather_frame {
+    lx_vec3 origin, n, ng, t, bt;
+    uint32_t map, pixel;
+} gather_frame;
+
+static gather_frame frame_of(const lx_baker *b, uint32_t map_index, const lx_lightmap *map,
+                             uint32_t i)
+{
+    gather_frame f;
+    lx_vec3 p = map->world_position[i];
+    f.n = map->world_normal[i];
+    f.ng = map->world_geometric_normal[i];
+    f.t = lx_perpendicular(f.n);
+    f.bt = lx_cross(f.n, f.t);
+    f.origin = lx_madd(p, f.ng, b->bias + 4e-6f * lx_max_abs_component(p));
+    f.map = map_index;
+    f.pixel = map->texels[i].pixel;
+    return f;
+}
+
+/* Gather ray k of a texel: stratified cosine-weighted direction in cell k
+ * of sx x sy about the shading normal, jittered by key; false when it
+ * points below the geometric surface (it counts as dark). */
+static bool gather_ray(const gather_frame *f, uint32_t k, uint32_t sx, uint32_t sy, uint32_t key,
+                       lx_ray *ray)
+{
+    float u = ((float)(k % sx) + lx_random(f->map, f->pixel, k, key)) / (float)sx;
+    float v = ((float)(k / sx) + lx_random(f->map, f->pixel, k, key + 1)) / (float)sy;
+    float r = sqrtf(u), phi = 2.0f * LX_PI * v;
+    lx_vec3 d = lx_add(lx_add(lx_scale(f->t, r * cosf(phi)), lx_scale(f->bt, r * sinf(phi))),
+                       lx_scale(f->n, sqrtf(fmaxf(0.0f, 1.0f - u))));
+    if (!(lx_dot(d, f->ng) > 0.0f))
+        return false;
+    ray->origin = f->origin;
+    ray->dir = d;
+    ray->tmin = 0.0f;
+    ray->tmax = INFINITY;
+    return true;
+}
+
+/* The exitant radiance a front-face hit sees: the hit surface's source
+ * texels, bilinear over the valid ones (or the valid texels of the nearest
+ * ring around the hit's texel); a surface without a lightmap emits its
+ * material's emission at the first gather and reflects nothing. */
+static lx_vec3 hit_radiance(const gi_run *run, const lx_hit *h)
+{
+    const lx_baker *b = run->b;
+    lx_vec3 none = lx_v3(0.0f, 0.0f, 0.0f);
+    if (h->mesh >= b->mesh_count || h->node >= b->node_count)
+        return none;
+    uint32_t mi = b->node_map[h->node];
+    int set = mi == UINT32_MAX ? 0 : b->node_uv_set[h->node];
+    const lx_vec2 *uv = mi == UINT32_MAX ? NULL : b->mesh_uv[set][h->mesh];
+    if (!uv || h->triangle >= b->mesh_triangles[h->mesh])
+        return run->first_gather ? b->mesh_emission[h->mesh] : none;
+    const uint32_t *tri = b->mesh_indices[h->mesh] + 3 * (size_t)h->triangle;
+    float w0 = 1.0f - h->u - h->v;
+    float s = uv[tri[0]].x * w0 + uv[tri[1]].x * h->u + uv[tri[2]].x * h->v;
+    float t = uv[tri[0]].y * w0 + uv[tri[1]].y * h->u + uv[tri[2]].y * h->v;
+    const float *so = b->node_scale_offset[h->node];
+    s = s * so[0] + so[2];
+    t = t * so[1] + so[3];
+    const lx_lightmap *map = &b->maps[mi];
+    const gi_map *g = &run->maps[mi];
+    int w = map->info.width, hgt = map->info.height;
+    float fx = s * (float)w - 0.5f, fy = t * (float)hgt - 0.5f;
+    if (!isfinite(fx) || !isfinite(fy))
+        return none;
+    fx = fminf(fmaxf(fx, -1.0f), (float)w);
+    fy = fminf(fmaxf(fy, -1.0f), (float)hgt);
+    int x0 = (int)floorf(fx), y0 = (int)floorf(fy);
+    float ax = fx - (float)x0, ay = fy - (float)y0;
+    float sum[3] = {0.0f, 0.0f, 0.0f}, wsum = 0.0f;
+    for (int dy = 0; dy < 2; dy++)
+        for (int dx = 0; dx < 2; dx++) {
+            int x = x0 + dx, y = y0 + dy;
+            if (x < 0 || y < 0 || x >= w || y >= hgt)
+                continue;
+            size_t p = (size_t)y * (size_t)w + (size_t)x;
+            if (!g->valid[p])
+                continue;
+            float wt = (dx ? ax : 1.0f - ax) * (dy ? ay : 1.0f - ay);
+            wsum += wt;
+            for (int c = 0; c < 3; c++)
+                sum[c] += wt * g->source[3 * p + c];
+        }
+    if (wsum > 0.0f)
+        return lx_v3(sum[0] / wsum, sum[1] / wsum, sum[2] / wsum);
+    /* none of the four: the valid texels of the nearest ring */
+    int cx = (int)floorf(fx + 0.5f), cy = (int)floorf(fy + 0.5f);
+    for (int r = 1; r <= LOOKUP_RINGS; r++) {
+        int n = 0;
+        for (int y = cy - r; y <= cy + r; y++)
+            for (int x = cx - r; x <= cx + r; x++) {
+                if (abs(x - cx) != r && abs(y - cy) != r)
+                    continue;
+                if (x < 0 || y < 0 || x >= w || y >= hgt)
+                    continue;
+                size_t p = (size_t)y * (size_t)w + (size_t)x;
+                if (!g->valid[p])
+                    continue;
+                for (int c = 0; c < 3; c++)
+                    sum[c] += g->source[3 * p + c];
+                n++;
+            }
+        if (n)
+            return lx_v3(sum[0] / (float)n, sum[1] / (float)n, sum[2] / (float)n);
+    }
+    return none;
+}
+
+/* Stratification of n samples: sx x sy cells with sx * sy >= n. */
+static void strata(uint32_t n, uint32_t *sx, uint32_t *sy)
+{
+    uint32_t x = (uint32_t)sqrtf((float)n);
+    x = x ? x : 1u;
+    *sx = x;
+    *sy = (n + x - 1) / x;
+}
+
+/* The validity pass for one texel: true when most of its rays hit back
+ * faces. */
+static bool texel_inside(const gi_run *run, uint32_t map_index, uint32_t i)
+{
+    const lx_baker *b = run->b;
+    const lx_lightmap *map = &b->maps[map_index];
+    uint32_t want = b->desc.gi_samples < VALIDITY_RAYS ? b->desc.gi_samples : VALIDITY_RAYS;
+    uint32_t sx, sy;
+    strata(want, &sx, &sy);
+    uint32_t cells = sx * sy, back = 0;
+    gather_frame f = frame_of(b, map_index, map, i);
+    for (uint32_t k = 0; k < cells; k++) {
+        lx_ray ray;
+        lx_hit h;
+        if (!gather_ray(&f, k, sx, sy, VALIDITY_KEY, &ray))
+            continue;
+        if (lx_tracer_closest(b->tracer, &ray, &h) && lx_dot(ray.dir, h.normal) > 0.0f)
+            back++;
+    }
+    return 2 * back > cells;
+}
+
+/* One gather for one texel: pi / N x the radiance its rays bring. */
+static lx_vec3 texel_gather(const gi_run *run, uint32_t map_index, uint32_t i, uint32_t key)
+{
+    const lx_baker *b = run->b;
+    const lx_lightmap *map = &b->maps[map_index];
+    uint32_t sx, sy;
+    strata(b->desc.gi_samples, &sx, &sy);
+    uint32_t cells = sx * sy;
+    double sum[3] = {0.0, 0.0, 0.0};
+    gather_frame f = frame_of(b, map_index, map, i);
+    for (uint32_t k = 0; k < cells; k++) {
+        lx_ray ray;
+        lx_hit h;
+        if (!gather_ray(&f, k, sx, sy, key, &ray))
+            continue;
+        if (!lx_tracer_closest(b->tracer, &ray, &h) || !(lx_dot(ray.dir, h.normal) < 0.0f))
+            continue; /* escaped (sky: direct light), or a back face */
+        lx_vec3 l = hit_radiance(run, &h);
+        sum[0] += l.x;
+        sum[1] += l.y;
+        sum[2] += l.z;
+    }
+    double scale = LX_PI / (double)cells;
+    return lx_v3((float)(sum[0] * scale), (float)(sum[1] * scale), (float)(sum[2] * scale));
+}
+
+/* One pass over every tile of every map: the validity pass (validity) or
+ * a gather into gi_map.next (keyed by key). false when cancelled. */
+static bool run_pass(gi_run *run, bool validity, uint32_t key, float from, float to)
+{
+    lx_baker *b = run->b;
+    bool report = b->desc.progress != NULL;
+    volatile int cancelled = 0;
+    uint64_t done_work = 0;
+#pragma omp parallel for schedule(dynamic, 1) num_threads(run->threads)
+    for (int global = 0; global < run->tiles; global++) {
+        if (cancelled)
+            continue;
+        uint32_t m = 0;
+        while (run->map_first_tile[m + 1] <= (uint32_t)global)
+            m++;
+        const lx_lightmap *map = &b->maps[m];
+        gi_map *g = &run->maps[m];
+        uint32_t tile = (uint32_t)global - run->map_first_tile[m];
+        uint32_t first = map->tile_start[tile], count = map->tile_start[tile + 1] - first;
+        for (uint32_t i = first; i < first + count; i++) {
+            if (validity) {
+                g->invalid[i] = texel_inside(run, m, i);
+            } else if (g->invalid[i]) {
+                g->next[i] = lx_v3(0.0f, 0.0f, 0.0f);
+            } else {
+                g->next[i] = texel_gather(run, m, i, key);
+            }
+        }
+        if (report) {
+            uint64_t done;
+#pragma omp atomic capture
+            done = done_work += count + 1;
+            if (omp_get_thread_num() == 0) {
+                double f = (double)done / (double)run->total_work;
+                if (!b->desc.progress(b->desc.progress_user,
+                                      run->base + run->span * (from + (to - from) * (float)f)))
+                    cancelled = 1;
+            }
+        }
+    }
+    return !cancelled;
+}
+
+/* Gives invalid texels the average of their valid (or already filled)
+ * 8-neighbours among the covered texels, ring by ring, each pass reading
+ * what the previous one left; texels no valid texel reaches keep their
+ * value. Sequential: invalid texels are few. */
+static lx_status fill_invalid(const lx_lightmap *map, const gi_map *g)
+{
+    int w = map->info.width, h = map->info.height;
+    uint32_t n = map->info.used_texels, open = 0;
+    uint32_t *todo = malloc(sizeof(uint32_t) * (n + 1));
+    float *vals = malloc(sizeof(float) * 3 * (n + 1));
+    uint8_t *filled = malloc((size_t)w * (size_t)h);
+    if (!todo || !vals || !filled) {
+        free(todo);
+        free(vals);
+        free(filled);
+        return lx_fail(LX_ERR_NOMEM, "lightmap '%s': out of memory", map->name);
+    }
+    memcpy(filled, g->valid, (size_t)w * (size_t)h);
+    for (uint32_t i = 0; i < n; i++)
+        if (g->invalid[i])
+            todo[open++] = map->texels[i].pixel;
+    while (open) {
+        uint32_t got = 0;
+        for (uint32_t k = 0; k < open; k++) {
+            uint32_t p = todo[k];
+            int x = (int)(p % (uint32_t)w), y = (int)(p / (uint32_t)w);
+            float s[3] = {0.0f, 0.0f, 0.0f};
+            int c = 0;
+            for (int dy = -1; dy <= 1; dy++)
+                for (int dx = -1; dx <= 1; dx++) {
+                    int xx = x + dx, yy = y + dy;
+                    if ((dx == 0 && dy == 0) || xx < 0 || yy < 0 || xx >= w || yy >= h)
+                        continue;
+                    size_t q = (size_t)yy * (size_t)w + (size_t)xx;
+                    if (filled[q] != 1)
+                        continue;
+                    for (int ch = 0; ch < 3; ch++)
+                        s[ch] += map->baked[3 * q + ch];
+                    c++;
+                }
+            if (c) {
+                for (int ch = 0; ch < 3; ch++)
+                    vals[3 * k + ch] = s[ch] / (float)c;
+                filled[p] = 2; /* this pass: not read until it ends */
+                got++;
+            }
+        }
+        if (!got)
+            break;
+        uint32_t left = 0;
+        for (uint32_t k = 0; k < open; k++) {
+            uint32_t p = todo[k];
+            if (filled[p] == 2) {
+                memcpy(map->baked + 3 * (size_t)p, vals + 3 * k, sizeof(float) * 3);
+                filled[p] = 1;
+            } else {
+                todo[left++] = p;
+            }
+        }
+        open = left;
+    }
+    free(todo);
+    free(vals);
+    free(filled);
+    return LX_OK;
+}
+
+lx_status lx_bake_indirect(lx_baker *b, float progress_base, float progress_span)
+{
+    uint32_t count = b->map_count;
+    gi_run run = {.b = b, .base = progress_base, .span = progress_span};
+    run.threads = lx_thread_count(b->desc.threads);
+    run.maps = calloc(count + 1, sizeof(gi_map));
+    run.map_first_tile = malloc(sizeof(uint32_t) * (count + 1));
+    lx_status st = LX_OK;
+    if (!run.maps || !run.map_first_tile)
+        st = lx_fail(LX_ERR_NOMEM, "out of memory for global illumination");
+    uint64_t bytes = 0;
+    for (uint32_t m = 0; m < count && st == LX_OK; m++) {
+        const lx_lightmap *map = &b->maps[m];
+        uint64_t pixels = (uint64_t)map->info.width * (uint64_t)map->info.height;
+        bytes += pixels * 13 + (uint64_t)map->info.used_texels * 25;
+    }
+    if (st == LX_OK)
+        st = lx_check_memory(bytes, "global illumination's buffers");
+    run.map_first_tile[0] = 0;
+    for (uint32_t m = 0; m < count && st == LX_OK; m++) {
+        const lx_lightmap *map = &b->maps[m];
+        gi_map *g = &run.maps[m];
+        size_t pixels = (size_t)map->info.width * (size_t)map->info.height;
+        size_t used = map->info.used_texels + 1;
+        g->valid = malloc(pixels);
+        g->source = malloc(sizeof(float) * 3 * pixels);
+        g->prev = malloc(sizeof(lx_vec3) * used);
+        g->next = malloc(sizeof(lx_vec3) * used);
+        g->invalid = malloc(used);
+        if (!g->valid || !g->source || !g->prev || !g->next || !g->invalid)
+            st = lx_fail(LX_ERR_NOMEM, "lightmap '%s': out of memory for global illumination",
+                         map->name);
+        run.map_first_tile[m + 1] = run.map_first_tile[m] + map->tile_count;
+        run.total_work += map->info.used_texels + map->tile_count;
+    }
+    run.tiles = st == LX_OK ? (int)run.map_first_tile[count] : 0;
+    float passes = (float)(b->desc.bounces + 1);
+    /* validity */
+    if (st == LX_OK && !run_pass(&run, true, 0, 0.0f, 1.0f / passes))
+        st = lx_fail(LX_ERR_CANCELLED, "bake cancelled");
+    b->gi_invalid_texels = 0;
+    for (uint32_t m = 0; m < count && st == LX_OK; m++) {
+        const lx_lightmap *map = &b->maps[m];
+        gi_map *g = &run.maps[m];
+        memcpy(g->valid, map->mask, (size_t)map->info.width * (size_t)map->info.height);
+        for (uint32_t i = 0; i < map->info.used_texels; i++) {
+            size_t p = map->texels[i].pixel;
+            if (g->invalid[i]) {
+                g->valid[p] = 0;
+                b->gi_invalid_texels++;
+            }
+            g->prev[i] = lx_v3(map->baked[3 * p], map->baked[3 * p + 1], map->baked[3 * p + 2]);
+        }
+    }
+    for (int k = 1; k <= b->desc.bounces && st == LX_OK; k++) {
+        /* the sources: albedo / pi x the last bounce (+ emission, first) */
+        run.first_gather = k == 1;
+        for (uint32_t m = 0; m < count; m++) {
+            const lx_lightmap *map = &b->maps[m];
+            gi_map *g = &run.maps[m];
+            memset(g->source, 0,
+                   sizeof(float) * 3 * (size_t)map->info.width * (size_t)map->info.height);
+            for (uint32_t i = 0; i < map->info.used_texels; i++) {
+                if (g->invalid[i])
+                    continue;
+                lx_vec3 l = lx_scale(lx_mul(map->albedo[i], g->prev[i]), 1.0f / LX_PI);
+                if (k == 1 && map->emission)
+                    l = lx_add(l, map->emission[i]);
+                float *dst = g->source + 3 * (size_t)map->texels[i].pixel;
+                dst[0] = l.x, dst[1] = l.y, dst[2] = l.z;
+            }
+        }
+        if (!run_pass(&run, false, GI_KEY + 2u * (uint32_t)k, (float)k / passes,
+                      (float)(k + 1) / passes)) {
+            st = lx_fail(LX_ERR_CANCELLED, "bake cancelled");
+            break;
+        }
+        for (uint32_t m = 0; m < count; m++) {
+            lx_lightmap *map = &b->maps[m];
+            gi_map *g = &run.maps[m];
+            for (uint32_t i = 0; i < map->info.used_texels; i++) {
+                float *px = map->baked + 3 * (size_t)map->texels[i].pixel;
+                px[0] += g->next[i].x;
+                px[1] += g->next[i].y;
+                px[2] += g->next[i].z;
+            }
+            lx_vec3 *swap = g->prev;
+            g->prev = g->next;
+            g->next = swap;
+        }
+    }
+    for (uint32_t m = 0; m < count && st == LX_OK; m++)
+        if (b->gi_invalid_texels)
+            st = fill_invalid(&b->maps[m], &run.maps[m]);
+    if (st == LX_OK && b->gi_invalid_texels)
+        lx_log(LX_LOG_INFO,
+               "global illumination: %llu texels sit inside geometry (their rays mostly hit back "
+               "faces); they take their valid neighbours' light",
+               (unsigned long long)b->gi_invalid_texels);
+    for (uint32_t m = 0; run.maps && m < count; m++) {
+        free(run.maps[m].valid);
+        free(run.maps[m].source);
+        free(run.maps[m].prev);
+        free(run.maps[m].next);
+        free(run.maps[m].invalid);
+    }
+    free(run.maps);
+    free(run.map_first_tile);
+    return st;
+}
