@@ -26,7 +26,7 @@
 /* samples per texel of seam length */
 #define STITCH_DENSITY 2.0
 #define STITCH_MAX_ITERATIONS 200
-#define STITCH_TOLERANCE 1e-10 /* squared residual relative to the start's */
+#define STITCH_TOLERANCE 1e-24 /* squared residual relative to the start's: to double precision */
 #define NO_VAR UINT32_MAX
 
 struct lx_seam_stitch {

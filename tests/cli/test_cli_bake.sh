@@ -277,9 +277,13 @@ expect_stdout_has "the partial override adds no light" '^lights: 2$'
 
 # ---- radiance ------------------------------------------------------------------
 
-run "$LUXEL" bake "$ROOM" --resolution 64 --format pfm -q -o "$WORK/irr"
+# (--no-stitch: seam stitching solves each file's seams from its own
+# values, exact only to the solver's precision, which dark texels beside
+# bright ones feel beyond this bound)
+run "$LUXEL" bake "$ROOM" --resolution 64 --format pfm -q --no-stitch -o "$WORK/irr"
 expect_rc 0 "--quantity irradiance (explicit default) as pfm"
-run "$LUXEL" bake "$ROOM" --resolution 64 --format pfm --quantity radiance -q -o "$WORK/rad"
+run "$LUXEL" bake "$ROOM" --resolution 64 --format pfm --quantity radiance -q --no-stitch \
+    -o "$WORK/rad"
 expect_rc 0 "--quantity radiance"
 check "manifest: quantity radiance" grep -Eq '"quantity":[[:space:]]*"radiance"' "$WORK/rad/manifest.json"
 check "manifest: radiance in nits" grep -Eq '"unit":[[:space:]]*"(nt|nits|cd/m2)"' "$WORK/rad/manifest.json"

@@ -59,6 +59,13 @@ static const char *bake_usage =
     "  --emissive-scale X      multiplier on emissive materials' radiance (nits),\n"
     "                          for files not authored in physical units\n"
     "                          (default 1); emitters light through the bounces\n"
+    "  --no-stitch             leave UV seams as baked (default: the texels on both\n"
+    "                          sides of a seam are solved to agree, so no line\n"
+    "                          shows where a surface crosses charts)\n"
+    "  --ao                    also an ambient-occlusion map per lightmap,\n"
+    "                          DIR/<name>_ao.png (grey, linear: 1 open, 0 closed)\n"
+    "  --ao-distance D         metres within which surfaces occlude (default %g)\n"
+    "  --ao-samples N          AO rays per texel (default %u)\n"
     "  --exposure EV100        exposure of the PNG preview (default: automatic)\n"
     "  --tonemap C             tone curve of the PNG preview: filmic (default),\n"
     "                          aces or clamp\n"
@@ -99,7 +106,6 @@ enum {
     OPT_AMBIENT,
     OPT_EXPOSURE,
     OPT_PADDING,
-    OPT_THREADS,
     OPT_SKIP_DEGENERATE,
     OPT_SKY,
     OPT_SKY_INTENSITY,
@@ -117,7 +123,11 @@ enum {
     OPT_STRICT,
     OPT_BOUNCES,
     OPT_GI_SAMPLES,
-    OPT_EMISSIVE_SCALE
+    OPT_EMISSIVE_SCALE,
+    OPT_NO_STITCH,
+    OPT_AO,
+    OPT_AO_DISTANCE,
+    OPT_AO_SAMPLES
 };
 
 typedef enum unwrap_choice { UNWRAP_AUTO, UNWRAP_ALWAYS, UNWRAP_NEVER } unwrap_choice;
@@ -155,6 +165,9 @@ typedef struct bake_args {
     bool render;    /* --render: DIR/view.png after the bake */
     lx_tonemap tonemap;
     bool clean;
+    bool ao;                /* --ao: DIR/<name>_ao.png per lightmap */
+    lx_ao_desc ao_desc;
+    const char *ao_option;  /* the last --ao-* given, for the error without --ao */
     lx_bake_desc desc;
 } bake_args;
 
@@ -188,7 +201,7 @@ static int parse_args(int argc, char **argv, bake_args *a)
         {"ambient", required_argument, NULL, OPT_AMBIENT},
         {"exposure", required_argument, NULL, OPT_EXPOSURE},
         {"padding", required_argument, NULL, OPT_PADDING},
-        {"threads", required_argument, NULL, OPT_THREADS},
+        {"threads", required_argument, NULL, CLI_OPT_THREADS},
         {"skip-degenerate", no_argument, NULL, OPT_SKIP_DEGENERATE},
         {"sky", required_argument, NULL, OPT_SKY},
         {"sky-intensity", required_argument, NULL, OPT_SKY_INTENSITY},
@@ -207,6 +220,10 @@ static int parse_args(int argc, char **argv, bake_args *a)
         {"bounces", required_argument, NULL, OPT_BOUNCES},
         {"gi-samples", required_argument, NULL, OPT_GI_SAMPLES},
         {"emissive-scale", required_argument, NULL, OPT_EMISSIVE_SCALE},
+        {"no-stitch", no_argument, NULL, OPT_NO_STITCH},
+        {"ao", no_argument, NULL, OPT_AO},
+        {"ao-distance", required_argument, NULL, OPT_AO_DISTANCE},
+        {"ao-samples", required_argument, NULL, OPT_AO_SAMPLES},
         {"quiet", no_argument, NULL, 'q'},
         {"verbose", no_argument, NULL, 'v'},
         {"help", no_argument, NULL, 'h'},
@@ -214,6 +231,7 @@ static int parse_args(int argc, char **argv, bake_args *a)
     memset(a, 0, sizeof *a);
     a->desc = lx_bake_desc_defaults(NULL);
     a->desc.padding = LX_PADDING_RECOMMENDED;
+    a->desc.stitch_seams = true;
     a->desc.bounces = LX_BOUNCES_RECOMMENDED;
     a->output = "lightmaps";
     a->format = LX_IMAGE_EXR;
@@ -300,12 +318,6 @@ static int parse_args(int argc, char **argv, bake_args *a)
                                        optarg);
             a->desc.padding = (int)n;
             break;
-        case OPT_THREADS:
-            if (!cli_parse_int(optarg, 1, 1024, &n))
-                return cli_usage_error("bake", "--threads must be an integer in 1..1024, not '%s'",
-                                       optarg);
-            a->desc.threads = (int)n;
-            break;
         case OPT_SKIP_DEGENERATE: /* the default now */
             break;
         case OPT_SKY:
@@ -380,6 +392,26 @@ static int parse_args(int argc, char **argv, bake_args *a)
                                        LX_MAX_BOUNCES, optarg);
             a->desc.bounces = (int)n;
             break;
+        case OPT_NO_STITCH:
+            a->desc.stitch_seams = false;
+            break;
+        case OPT_AO:
+            a->ao = true;
+            break;
+        case OPT_AO_DISTANCE:
+            if (!cli_parse_float(optarg, 1e-6, 1e6, &f))
+                return cli_usage_error("bake", "--ao-distance must be metres in 1e-6..1e6, not '%s'",
+                                       optarg);
+            a->ao_desc.distance = (float)f;
+            a->ao_option = "--ao-distance";
+            break;
+        case OPT_AO_SAMPLES:
+            if (!cli_parse_int(optarg, 1, (long)LX_MAX_AO_SAMPLES, &n))
+                return cli_usage_error("bake", "--ao-samples must be an integer in 1..%u, not '%s'",
+                                       LX_MAX_AO_SAMPLES, optarg);
+            a->ao_desc.samples = (uint32_t)n;
+            a->ao_option = "--ao-samples";
+            break;
         case OPT_GI_SAMPLES:
             if (!cli_parse_int(optarg, 1, (long)LX_MAX_GI_SAMPLES, &n))
                 return cli_usage_error("bake", "--gi-samples must be an integer in 1..%u, not '%s'",
@@ -398,13 +430,6 @@ static int parse_args(int argc, char **argv, bake_args *a)
             a->desc.strict = true; /* zero-area triangles refused, in space and in UV */
             cli_set_strict(true);
             break;
-        case 'q':
-            a->quiet = true;
-            cli_set_quiet(true);
-            break;
-        case 'v':
-            cli_set_verbose(true);
-            break;
         case 'h': {
             /* the defaults shown are the library's */
             lx_bake_desc d = lx_bake_desc_defaults(NULL);
@@ -412,13 +437,15 @@ static int parse_args(int argc, char **argv, bake_args *a)
             printf(bake_usage, d.resolution, CLI_ATLAS_RESOLUTION, d.max_resolution,
                    d.quantity == LX_QUANTITY_RADIANCE ? "radiance" : "irradiance",
                    (double)d.sky.intensity, d.sky.samples, LX_MAX_BOUNCES,
-                   LX_BOUNCES_RECOMMENDED, d.gi_samples, LX_PADDING_RECOMMENDED, u.atlas_size);
+                   LX_BOUNCES_RECOMMENDED, d.gi_samples, (double)LX_AO_DISTANCE_DEFAULT,
+                   LX_AO_SAMPLES_DEFAULT, LX_PADDING_RECOMMENDED, u.atlas_size);
             return -1;
         }
-        case ':':
-            return cli_usage_error("bake", "option '%s' needs a value", argv[optind - 1]);
-        default:
-            return cli_usage_error("bake", "unknown option '%s'", argv[optind - 1]);
+        default: {
+            int rc = cli_common_option("bake", c, argv, &a->desc.threads, &a->quiet);
+            if (rc != 0)
+                return rc;
+        }
         }
     }
     if (optind >= argc)
@@ -435,6 +462,8 @@ static int parse_args(int argc, char **argv, bake_args *a)
         return cli_usage_error("bake", "--atlas-size needs atlas pages, not --no-atlas");
     if (a->pre_expose && a->format == LX_IMAGE_PNG)
         return cli_usage_error("bake", "--pre-expose applies to float formats, not png");
+    if (a->ao_option && !a->ao)
+        return cli_usage_error("bake", "%s needs --ao", a->ao_option);
     return 0;
 }
 
@@ -474,12 +503,15 @@ static float preview_scale(const bake_args *a)
     return a->desc.quantity == LX_QUANTITY_RADIANCE ? 1.0f : 1.0f / LX_PI;
 }
 
-static cJSON *page_entry(const lx_lightmap_info *info, const char *file, const char *preview)
+static cJSON *page_entry(const lx_lightmap_info *info, const char *file, const char *preview,
+                         const char *ao)
 {
     cJSON *e = cJSON_CreateObject();
     cJSON_AddStringToObject(e, "file", file);
     if (preview)
         cJSON_AddStringToObject(e, "preview", preview);
+    if (ao)
+        cJSON_AddStringToObject(e, "ao", ao);
     cJSON_AddNumberToObject(e, "width", info->width);
     cJSON_AddNumberToObject(e, "height", info->height);
     cJSON_AddNumberToObject(e, "used_texels", info->used_texels);
@@ -826,7 +858,7 @@ static bool find_stale(const bake_args *a, char **stems, uint32_t maps, const ch
                        cli_stale *out)
 {
     uint32_t n = 0;
-    char **names = calloc(2 * (size_t)maps + 2, sizeof *names);
+    char **names = calloc(3 * (size_t)maps + 2, sizeof *names);
     bool ok = names != NULL;
     if (ok && uvs_name[0]) /* the scene with luxel's UVs, written again */
         ok = (names[n++] = cli_strdup(uvs_name)) != NULL;
@@ -836,6 +868,8 @@ static bool find_stale(const bake_args *a, char **stems, uint32_t maps, const ch
         ok = (names[n++] = cli_strdup(name)) != NULL;
         snprintf(name, sizeof name, "%s.png", stems[m]);
         ok = ok && (names[n++] = cli_strdup(name)) != NULL;
+        snprintf(name, sizeof name, "%s_ao.png", stems[m]);
+        ok = ok && (!a->ao || (names[n++] = cli_strdup(name)) != NULL);
     }
     if (!ok)
         cli_error("out of memory");
@@ -856,7 +890,7 @@ int cmd_bake(int argc, char **argv)
 
     lx_scene *scene = NULL;
     lx_baker *baker = NULL;
-    lx_image *images = NULL;
+    lx_image *images = NULL, *ao_images = NULL;
     char **stems = NULL;
     uint32_t maps = 0;
     cli_stage stage = {0};
@@ -963,8 +997,9 @@ int cmd_bake(int argc, char **argv)
     /* every output's name, checked before the bake: a folder in the way of
      * one fails now, not after minutes of work */
     images = calloc(maps, sizeof *images);
+    ao_images = calloc(maps, sizeof *ao_images);
     stems = calloc(maps, sizeof *stems);
-    if (!images || !stems) {
+    if (!images || !ao_images || !stems) {
         cli_error("out of memory");
         goto done;
     }
@@ -985,6 +1020,9 @@ int cmd_bake(int argc, char **argv)
             goto done;
         snprintf(name, sizeof name, "%s.png", stem);
         if (a.format != LX_IMAGE_PNG && !cli_stage_check(&stage, name))
+            goto done;
+        snprintf(name, sizeof name, "%s_ao.png", stem);
+        if (a.ao && !cli_stage_check(&stage, name))
             goto done;
     }
     if (!cli_stage_check(&stage, "manifest.json"))
@@ -1031,6 +1069,25 @@ int cmd_bake(int argc, char **argv)
                 cli_error("%s", lx_last_error());
             goto done;
         }
+    }
+    if (a.ao) {
+        cli_progress_init(&progress, "ambient occlusion", a.quiet);
+        lx_ao_desc ad = a.ao_desc;
+        ad.threads = a.desc.threads;
+        ad.progress = cli_progress_update;
+        ad.progress_user = &progress;
+        for (uint32_t m = 0; m < maps; m++) {
+            cli_progress_part(&progress, (int)m, (int)maps);
+            if ((st = lx_baker_ao(baker, m, &ad, &ao_images[m])) != LX_OK) {
+                cli_progress_finish(&progress);
+                if (st == LX_ERR_CANCELLED)
+                    cli_report_interrupt(false);
+                else
+                    cli_error("%s", lx_last_error());
+                goto done;
+            }
+        }
+        cli_progress_finish(&progress);
     }
     float metered;
     bool lit;
@@ -1081,6 +1138,11 @@ int cmd_bake(int argc, char **argv)
     if (a.desc.texel_density > 0.0f || unwrap)
         cJSON_AddNumberToObject(manifest, "texel_density",
                                 unwrap ? unwrap->texel_density : a.desc.texel_density);
+    if (a.ao) {
+        lx_ao_desc ad = lx_ao_desc_defaults(&a.ao_desc);
+        cJSON_AddNumberToObject(manifest, "ao_distance", ad.distance);
+    }
+    cJSON_AddBoolToObject(manifest, "seams_stitched", a.desc.stitch_seams);
     if (unwrap) { /* what luxel render needs to make the same UVs again */
         cJSON_AddNumberToObject(manifest, "padding", a.desc.padding);
         cJSON_AddNumberToObject(manifest, "atlas_size",
@@ -1129,7 +1191,16 @@ int cmd_bake(int argc, char **argv)
             failed = !cli_stage_image(&stage, preview, &images[m], &pd);
             t_previews += cli_now() - t;
         }
-        cJSON_AddItemToArray(list, page_entry(info, file, want_preview ? preview : NULL));
+        char ao_file[300];
+        snprintf(ao_file, sizeof ao_file, "%s_ao.png", stems[m]);
+        if (!failed && a.ao) {
+            /* linear codes: occlusion is a factor, not a colour */
+            lx_image_write_desc ad = {.format = LX_IMAGE_PNG, .linear = true,
+                                      .threads = a.desc.threads};
+            failed = !cli_stage_image(&stage, ao_file, &ao_images[m], &ad);
+        }
+        cJSON_AddItemToArray(list, page_entry(info, file, want_preview ? preview : NULL,
+                                              a.ao ? ao_file : NULL));
     }
     cJSON_AddItemToObject(manifest, "nodes", node_entries(scene, baker, unwrap, &a));
     int with_uvs = !failed && uvs_name[0] ? cli_stage_scene_with_uvs(&stage, uvs_name, scene, unwrap)
@@ -1190,6 +1261,10 @@ done:
     if (images)
         for (uint32_t m = 0; m < maps; m++)
             lx_image_free(&images[m]);
+    if (ao_images)
+        for (uint32_t m = 0; m < maps; m++)
+            lx_image_free(&ao_images[m]);
+    free(ao_images);
     if (stems)
         for (uint32_t m = 0; m < maps; m++)
             free(stems[m]);
