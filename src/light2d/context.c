@@ -51,6 +51,12 @@ lx_status lx_light2d_light_validate(const lx_light2d_light *l)
         return lx_fail(LX_ERR_INVALID, "color has a negative component");
     if (l->intensity < 0.0f)
         return lx_fail(LX_ERR_INVALID, "intensity %g is negative", l->intensity);
+    /* a bound far above any real light keeps every sum of lights finite
+     * (an infinite colour times a zero falloff would be NaN) */
+    float peak = l2_max(l->color.x, l2_max(l->color.y, l->color.z));
+    if ((double)peak * l->intensity > LX_LIGHT2D_MAX_LIGHT)
+        return lx_fail(LX_ERR_INVALID, "intensity %g x color %g is more than %g", l->intensity,
+                       peak, LX_LIGHT2D_MAX_LIGHT);
     if (l->softness < 0.0f)
         return lx_fail(LX_ERR_INVALID, "softness %g is negative", l->softness);
     if (l->height < 0.0f)

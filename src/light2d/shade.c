@@ -142,9 +142,10 @@ lx_status lx_light2d_render(lx_light2d *ctx, lx_vec3 ambient, const lx_image *al
             return lx_fail(LX_ERR_INVALID, "albedo: %d channel%s, not RGB", albedo->channels,
                            albedo->channels == 1 ? "" : "s");
     }
-    if (!isfinite(ambient.x) || !isfinite(ambient.y) || !isfinite(ambient.z) ||
-        ambient.x < 0.0f || ambient.y < 0.0f || ambient.z < 0.0f)
-        return lx_fail(LX_ERR_INVALID, "ambient must be finite and >= 0");
+    if (!(ambient.x >= 0.0f && ambient.x <= LX_LIGHT2D_MAX_LIGHT) ||
+        !(ambient.y >= 0.0f && ambient.y <= LX_LIGHT2D_MAX_LIGHT) ||
+        !(ambient.z >= 0.0f && ambient.z <= LX_LIGHT2D_MAX_LIGHT))
+        return lx_fail(LX_ERR_INVALID, "ambient must be in [0, %g]", LX_LIGHT2D_MAX_LIGHT);
     int threads = lx_thread_count(ctx->threads);
     /* polar maps of the lights computed this frame */
     int count = ctx->count;
