@@ -49,6 +49,9 @@ void l2_polar_free(l2_polar *pm)
 {
     free(pm->occ);
     free(pm->ex);
+    free(pm->lit);
+    free(pm->qocc);
+    free(pm->gap);
     free(pm->tmin);
     free(pm->tmax);
     memset(pm, 0, sizeof *pm);
@@ -88,8 +91,16 @@ static void square_bins(const l2_polar *pm, float ax, float bx, float ay, float 
     *b1 = b;
 }
 
-static lx_status reserve(l2_polar *pm, int n, int levels)
+static lx_status reserve(l2_polar *pm, int n, int levels, int depth_levels)
 {
+    size_t g = (size_t)n * depth_levels;
+    if (g > (size_t)pm->gap_capacity) {
+        uint16_t *a = realloc(pm->gap, g * sizeof *a);
+        if (!a)
+            return lx_fail(LX_ERR_NOMEM, "light2d: out of memory for a polar map of %d rays", n);
+        pm->gap = a;
+        pm->gap_capacity = (int)g;
+    }
     if (n > pm->capacity) {
         float *occ = realloc(pm->occ, (size_t)n * sizeof *occ);
         if (occ)
@@ -97,7 +108,13 @@ static lx_status reserve(l2_polar *pm, int n, int levels)
         float *ex = realloc(pm->ex, (size_t)n * sizeof *ex);
         if (ex)
             pm->ex = ex;
-        if (!occ || !ex)
+        float *lit = realloc(pm->lit, (size_t)n * sizeof *lit);
+        if (lit)
+            pm->lit = lit;
+        float *qocc = realloc(pm->qocc, (size_t)n * sizeof *qocc);
+        if (qocc)
+            pm->qocc = qocc;
+        if (!occ || !ex || !lit || !qocc)
             return lx_fail(LX_ERR_NOMEM, "light2d: out of memory for a polar map of %d rays", n);
         pm->capacity = n;
     }
@@ -116,6 +133,83 @@ static lx_status reserve(l2_polar *pm, int n, int levels)
     return LX_OK;
 }
 
+/* The penumbra wedges' reach (l2_polar.lit). The occluder of ray j, at
+ * inverse distance q_j = 1/occ[j], casts a penumbra over the points at
+ * inverse distance q whose window s (q_j - q) x scale (in bins, scale the
+ * bins per radian at the point) reaches ray j: with g the whole bins
+ * between rays b and j, a point of ray b can be in it only when q < q_j -
+ * g / (s x scale). scale is at most n/4 (where the pseudo-angle's slope is
+ * 1), so lit[b] = max_j (q_j - g / (s n/4)) bounds every wedge reaching ray
+ * b: a distance transform with a linear cone, one pass each way around the
+ * circle (twice round, so that wedges wrap). */
+static void penumbra_reach(l2_polar *pm, float s)
+{
+    int n = pm->n;
+    const float *occ = pm->occ;
+    float *lit = pm->lit;
+    float step = 1.0f / (s * 0.25f * (float)n);
+    for (int i = 0; i < n; i++)
+        lit[i] = occ[i] >= L2_FAR ? 0.0f : 1.0f / l2_max(occ[i], 1e-6f);
+    /* g: the best wedge arriving from the bins before i, its gap counted */
+    float g = 0.0f;
+    for (int lap = 0; lap < 2; lap++)
+        for (int i = 0; i < n; i++) {
+            float q = occ[i] >= L2_FAR ? 0.0f : 1.0f / l2_max(occ[i], 1e-6f);
+            if (lap)
+                lit[i] = l2_max(lit[i], g);
+            g = l2_max(q, g - step);
+        }
+    g = 0.0f;
+    for (int lap = 0; lap < 2; lap++)
+        for (int i = n - 1; i >= 0; i--) {
+            float q = occ[i] >= L2_FAR ? 0.0f : 1.0f / l2_max(occ[i], 1e-6f);
+            if (lap)
+                lit[i] = l2_max(lit[i], g);
+            g = l2_max(q, g - step);
+        }
+}
+
+/* gap[lv]: per ray, the whole bins between it and the nearest ray whose
+ * occluder is at the level's distance or beyond (a 1D distance transform
+ * around the circle: twice round each way). */
+static void open_gaps(l2_polar *pm, int lv)
+{
+    int n = pm->n;
+    /* the level's distance, as l2_depth_level counts: 2^(lv/2) exactly
+     * for even lv, the float just at or above 2^(lv/2) sqrt(2) for odd */
+    union {
+        uint32_t u;
+        float f;
+    } t = {(uint32_t)((lv >> 1) + 127) << 23 | ((lv & 1) ? 0x3504f3u : 0u)};
+    float thr = t.f * L2_DEPTH0;
+    const float *occ = pm->occ;
+    uint16_t *g = pm->gap + (size_t)lv * n;
+    const int none = 1 << 30;
+    int run = none; /* bins since the last open ray */
+    for (int lap = 0; lap < 2; lap++)
+        for (int i = 0; i < n; i++) {
+            if (occ[i] >= thr)
+                run = 0;
+            else if (run < none)
+                run++;
+            if (lap)
+                g[i] = (uint16_t)(run == 0 ? 0 : (run - 1 < 65535 ? run - 1 : 65535));
+        }
+    run = none;
+    for (int lap = 0; lap < 2; lap++)
+        for (int i = n - 1; i >= 0; i--) {
+            if (occ[i] >= thr)
+                run = 0;
+            else if (run < none)
+                run++;
+            if (lap) {
+                int v = run == 0 ? 0 : (run - 1 < 65535 ? run - 1 : 65535);
+                if (v < g[i])
+                    g[i] = (uint16_t)v;
+            }
+        }
+}
+
 lx_status l2_polar_build(const lx_light2d *ctx, l2_prep *p)
 {
     const lx_light2d_light *l = &p->l;
@@ -126,11 +220,14 @@ lx_status l2_polar_build(const lx_light2d *ctx, l2_prep *p)
     if (soft)
         while ((1 << levels) <= n)
             levels++;
-    lx_status st = reserve(pm, n, levels);
+    /* depth levels up to the farthest shaded distance, the radius */
+    int depth_levels = soft ? l2_depth_level(l->radius + 2.0f, 1 << 10) + 1 : 0;
+    lx_status st = reserve(pm, n, levels, depth_levels);
     if (st != LX_OK)
         return st;
     pm->n = n;
     pm->levels = levels;
+    pm->depth_levels = depth_levels;
     pm->bins_per_p = (float)n / 8.0f;
     float *occ = pm->occ, *ex = pm->ex;
     for (int b = 0; b < n; b++) {
@@ -194,6 +291,11 @@ lx_status l2_polar_build(const lx_light2d *ctx, l2_prep *p)
         for (int b = 0; b < n; b++)
             occ[b] = 0.0f;
     if (soft) {
+        penumbra_reach(pm, l->softness);
+        for (int i = 0; i < n; i++)
+            pm->qocc[i] = 1.0f / l2_max(occ[i], 0.5f);
+        for (int lv = 0; lv < depth_levels; lv++)
+            open_gaps(pm, lv);
         memcpy(pm->tmin, occ, (size_t)n * sizeof *occ);
         memcpy(pm->tmax, occ, (size_t)n * sizeof *occ);
         for (int k = 1; k < levels; k++) {
@@ -224,7 +326,7 @@ static inline float range_query(const l2_polar *pm, const float *table, int lo, 
 }
 
 /* Fraction of the window [c - k, c + k] (in bins) whose rays reach past d. */
-static float filter(const l2_polar *pm, float c, float k, float d)
+float l2_filter(const l2_polar *pm, float c, float k, float d)
 {
     int n = pm->n;
     float lo = c - k, hi = c + k;
@@ -284,23 +386,5 @@ float l2_soft_visibility(const l2_polar *pm, float s, float c, float u2, float d
     }
     if (k < 0.5f)
         return pm->occ[wrap((int)floorf(c), pm->n)] >= d ? 1.0f : 0.0f;
-    return filter(pm, c, k, d);
-}
-
-float l2_visibility(const l2_polar *pm, const lx_light2d_light *l, float dx, float dy, float d,
-                    bool caster)
-{
-    float u;
-    float c = pseudo_angle(dx, dy, &u) * pm->bins_per_p;
-    int b = (int)c;
-    if (b >= pm->n)
-        b -= pm->n;
-    float o = pm->occ[b];
-    bool face = caster && !l->self_shadow && d <= pm->ex[b];
-    if (l->softness <= 0.0f)
-        return (d < o || face) ? 1.0f : 0.0f;
-    float de = d;
-    if (face)
-        de = l2_max(l2_min(d, o - 0.5f), 0.5f);
-    return l2_soft_visibility(pm, l->softness, c, u * u, de);
+    return l2_filter(pm, c, k, d);
 }

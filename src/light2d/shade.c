@@ -74,7 +74,8 @@ void l2_shade_row(const lx_light2d *ctx, const l2_prep *p, int y, float *acc, fl
             float dx = (float)(xa + i) + 0.5f - lx;
             float ndl = -dx * nn[3 * i] - dy * nn[3 * i + 1] + h * nn[3 * i + 2];
             float len = sqrtf(da[i] * da[i] + h2);
-            fa[i] *= ndl > 0.0f && len > 0.0f ? ndl / len : 0.0f;
+            float v = ndl / l2_max(len, 1e-30f);
+            fa[i] *= ndl > 0.0f ? v : 0.0f;
         }
     }
     /* pass 2: shadows from the polar map */
@@ -83,6 +84,8 @@ void l2_shade_row(const lx_light2d *ctx, const l2_prep *p, int y, float *acc, fl
         const l2_polar *pm = &p->polar;
         int nb = pm->n;
         bool soft = l->softness > 0.0f, face_ok = !l->self_shadow;
+        float kcap = 0.5f * (float)nb - 1.0f;
+        int dtop = pm->depth_levels - 1;
         for (int i = 0; i < n; i++) {
             if (fa[i] <= 0.0f)
                 continue;
@@ -100,7 +103,23 @@ void l2_shade_row(const lx_light2d *ctx, const l2_prep *p, int y, float *acc, fl
                 continue;
             }
             float de = face ? l2_max(l2_min(d, o - 0.5f), 0.5f) : d;
-            fa[i] *= l2_soft_visibility(pm, l->softness, ca[i], ua[i] * ua[i], de);
+            if (de * pm->lit[b] < 1.0f)
+                continue; /* in no occluder's penumbra */
+            float u2 = ua[i] * ua[i];
+            if (face || d < o) {
+                fa[i] *= l2_soft_visibility(pm, l->softness, ca[i], u2, de);
+                continue;
+            }
+            /* in the hard shadow of its ray's occluder o: the penumbra of
+             * o, fully shadowed when the window holds no open ray */
+            float k = l->softness * (pm->qocc[b] - 1.0f / d) * (1.0f + u2) * bpp;
+            k = l2_min(k, kcap);
+            if (k < 0.5f || (d >= L2_DEPTH0 &&
+                             k <= (float)pm->gap[(size_t)l2_depth_level(d, dtop) * nb + b])) {
+                fa[i] = 0.0f;
+                continue;
+            }
+            fa[i] *= l2_filter(pm, ca[i], k, d);
         }
     }
     float cr = p->rgb.x, cg = p->rgb.y, cb = p->rgb.z;
