@@ -184,6 +184,11 @@ lx_status l2_build_edges(lx_light2d *ctx)
             edges[fill[t]++] = (l2_edge){(uint16_t)x, (uint16_t)y, f};
         }
     free(fill);
+    memset(ctx->block_caster, 0, (size_t)ctx->blocks_x * ctx->blocks_y);
+    for (int y = 0; y < ctx->height; y++)
+        for (int x = 0; x < ctx->width; x++)
+            if (ctx->caster[(size_t)y * ctx->width + x])
+                ctx->block_caster[(size_t)(y / L2_BLOCK) * ctx->blocks_x + x / L2_BLOCK] = 1;
     free(ctx->tile_start);
     free(ctx->edges);
     ctx->tile_start = count;
@@ -223,8 +228,13 @@ lx_status lx_light2d_create(const lx_image *casters, const lx_light2d_desc *desc
     ctx->polar_resolution = d.polar_resolution > 0 ? (d.polar_resolution + 7) & ~7 : 0;
     ctx->tiles_x = (ctx->width + L2_TILE - 1) / L2_TILE;
     ctx->tiles_y = (ctx->height + L2_TILE - 1) / L2_TILE;
+    ctx->blocks_x = (ctx->width + L2_BLOCK - 1) / L2_BLOCK;
+    ctx->blocks_y = (ctx->height + L2_BLOCK - 1) / L2_BLOCK;
     ctx->caster = malloc((size_t)ctx->width * ctx->height);
-    if (!ctx->caster) {
+    ctx->block_caster = malloc((size_t)ctx->blocks_x * ctx->blocks_y);
+    if (!ctx->caster || !ctx->block_caster) {
+        free(ctx->caster);
+        free(ctx->block_caster);
         free(ctx);
         return lx_fail(LX_ERR_NOMEM, "light2d: out of memory for a %dx%d caster mask",
                        casters->width, casters->height);
@@ -255,6 +265,7 @@ void lx_light2d_destroy(lx_light2d *ctx)
     }
     free(ctx->preps);
     free(ctx->caster);
+    free(ctx->block_caster);
     free(ctx->tile_start);
     free(ctx->edges);
     free(ctx->normals);

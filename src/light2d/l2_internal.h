@@ -22,6 +22,10 @@ static inline float l2_max(float a, float b)
  * so a light visits only the tiles under its reach. */
 #define L2_TILE 32
 
+/* Frames are shaded in bands of this many rows, and each light first
+ * drops the blocks of L2_BLOCK x L2_BLOCK pixels it leaves wholly dark. */
+#define L2_BLOCK 8
+
 /* Which 4-neighbours of a boundary pixel are free (not casters, or outside
  * the image). */
 enum { L2_FREE_LEFT = 1, L2_FREE_RIGHT = 2, L2_FREE_UP = 4, L2_FREE_DOWN = 8 };
@@ -102,6 +106,8 @@ struct lx_light2d {
     int tiles_x, tiles_y;
     uint32_t *tile_start; /* tiles_x*tiles_y + 1 offsets into edges */
     l2_edge *edges;
+    int blocks_x, blocks_y;
+    uint8_t *block_caster; /* blocks_x*blocks_y: 1 when the block holds a caster */
     float *normals; /* width*height*3 unit vectors in pixel space (x right,
                        y down, z towards the viewer), or NULL */
     l2_prep *preps;
@@ -131,9 +137,10 @@ float l2_soft_visibility(const l2_polar *pm, float s, float c, float u2, float d
  * scale the bins per radian there. */
 float l2_filter(const l2_polar *pm, float c, float k, float d);
 
-/* Adds the light's contribution to row y of acc (width*3 floats), filling
- * its cache row first when it is a static light being re-lit; scratch
- * holds 4*width floats (shade.c). */
-void l2_shade_row(const lx_light2d *ctx, const l2_prep *p, int y, float *acc, float *scratch);
+/* Whether the light leaves every pixel of the block [x0, x1) x [y0, y1)
+ * dark (exactly what shading them would give: out of reach, or in a hard
+ * shadow whose penumbra window holds no open ray); has_caster: the block
+ * holds a caster pixel (polar.c). */
+bool l2_block_dark(const l2_prep *p, int x0, int y0, int x1, int y1, bool has_caster);
 
 #endif

@@ -217,9 +217,8 @@ lx_status l2_polar_build(const lx_light2d *ctx, l2_prep *p)
     int n = l2_ray_count(ctx, l->radius);
     bool soft = l->softness > 0.0f;
     int levels = 0;
-    if (soft)
-        while ((1 << levels) <= n)
-            levels++;
+    while ((1 << levels) <= n)
+        levels++;
     /* depth levels up to the farthest shaded distance, the radius */
     int depth_levels = soft ? l2_depth_level(l->radius + 2.0f, 1 << 10) + 1 : 0;
     lx_status st = reserve(pm, n, levels, depth_levels);
@@ -296,17 +295,17 @@ lx_status l2_polar_build(const lx_light2d *ctx, l2_prep *p)
             pm->qocc[i] = 1.0f / l2_max(occ[i], 0.5f);
         for (int lv = 0; lv < depth_levels; lv++)
             open_gaps(pm, lv);
-        memcpy(pm->tmin, occ, (size_t)n * sizeof *occ);
-        memcpy(pm->tmax, occ, (size_t)n * sizeof *occ);
-        for (int k = 1; k < levels; k++) {
-            const float *a = pm->tmin + (size_t)(k - 1) * n, *b = pm->tmax + (size_t)(k - 1) * n;
-            float *c = pm->tmin + (size_t)k * n, *d = pm->tmax + (size_t)k * n;
-            int h = 1 << (k - 1);
-            for (int i = 0; i < n; i++) {
-                int j = i + h >= n ? i + h - n : i + h;
-                c[i] = l2_min(a[i], a[j]);
-                d[i] = l2_max(b[i], b[j]);
-            }
+    }
+    memcpy(pm->tmin, occ, (size_t)n * sizeof *occ);
+    memcpy(pm->tmax, occ, (size_t)n * sizeof *occ);
+    for (int k = 1; k < levels; k++) {
+        const float *a = pm->tmin + (size_t)(k - 1) * n, *b = pm->tmax + (size_t)(k - 1) * n;
+        float *c = pm->tmin + (size_t)k * n, *d = pm->tmax + (size_t)k * n;
+        int h = 1 << (k - 1);
+        for (int i = 0; i < n; i++) {
+            int j = i + h >= n ? i + h - n : i + h;
+            c[i] = l2_min(a[i], a[j]);
+            d[i] = l2_max(b[i], b[j]);
         }
     }
     return LX_OK;
@@ -387,4 +386,67 @@ float l2_soft_visibility(const l2_polar *pm, float s, float c, float u2, float d
     if (k < 0.5f)
         return pm->occ[wrap((int)floorf(c), pm->n)] >= d ? 1.0f : 0.0f;
     return l2_filter(pm, c, k, d);
+}
+
+bool l2_block_dark(const l2_prep *p, int x0, int y0, int x1, int y1, bool has_caster)
+{
+    const lx_light2d_light *l = &p->l;
+    const l2_polar *pm = &p->polar;
+    int n = pm->n;
+    /* the pixel centres, relative to the light, as shade.c computes them */
+    float ax = (float)x0 + 0.5f - l->x, bx = (float)(x1 - 1) + 0.5f - l->x;
+    float ay = (float)y0 + 0.5f - l->y, by = (float)(y1 - 1) + 0.5f - l->y;
+    float nx = ax > 0.0f ? ax : (bx < 0.0f ? bx : 0.0f);
+    float ny = ay > 0.0f ? ay : (by < 0.0f ? by : 0.0f);
+    /* squares and sums round monotonically: no pixel is nearer */
+    float dmin2 = nx * nx + ny * ny;
+    if (dmin2 >= p->r2)
+        return true; /* out of reach: no falloff */
+    if (!l->shadow || (has_caster && !l->self_shadow) || dmin2 < 4.0f)
+        return false;
+    float fx = l2_max(ax * ax, bx * bx), fy = l2_max(ay * ay, by * by);
+    float dmin = sqrtf(dmin2), dmax = sqrtf(fx + fy);
+    /* the rays of the pixels, one more each side for rounding */
+    int b0, b1;
+    square_bins(pm, ax, bx, ay, by, &b0, &b1);
+    b0--;
+    b1++;
+    if (b1 - b0 + 1 >= n)
+        return false;
+    /* every ray blocked before the nearest pixel (with a margin for the
+     * rounding of d x 1/occ) */
+    float before = dmin * (1.0f - 1e-5f);
+    if (range_query(pm, pm->tmax, b0, b1, true) >= before)
+        return false;
+    if (l->softness <= 0.0f)
+        return true;
+    /* and, as shade.c tests each pixel, no open ray in the penumbra window
+     * of its ray's occluder: k = s (1/max(o, 0.5) - 1/d) (1 + u^2) n/8 is
+     * at most its value at dmax and the largest u^2 of the block (at a
+     * corner, or 1 across a face's edge), and the rays open at d are open
+     * at the level of dmin */
+    if (dmin < L2_DEPTH0)
+        return false;
+    float u, u2max = 0.0f, plo = 8.0f, phi = 0.0f;
+    float cx[4] = {ax, bx, ax, bx}, cy[4] = {ay, ay, by, by};
+    for (int c = 0; c < 4; c++) {
+        float pa = pseudo_angle(cx[c], cy[c], &u);
+        u2max = l2_max(u2max, u * u);
+        plo = l2_min(plo, pa);
+        phi = l2_max(phi, pa);
+    }
+    /* a face's edge (|u| = 1) at p = 0, 2, 4, 6 between the corners */
+    if (phi - plo > 4.0f || (int)(plo * 0.5f) != (int)(phi * 0.5f))
+        u2max = 1.0f;
+    float sc = 1.0f + u2max * (1.0f + 1e-5f), inv = 1.0f / dmax;
+    float kcap = 0.5f * (float)n - 1.0f;
+    const uint16_t *g = pm->gap + (size_t)l2_depth_level(dmin, pm->depth_levels - 1) * n;
+    for (int b = b0; b <= b1; b++) {
+        int i = wrap(b, n);
+        float k = l->softness * (pm->qocc[i] - inv) * sc * pm->bins_per_p;
+        k = l2_min(k, kcap);
+        if (k >= 0.5f && k > (float)g[i])
+            return false;
+    }
+    return true;
 }
