@@ -45,6 +45,8 @@ typedef struct l2_polar {
     int n;
     float bins_per_p; /* n / 8 */
     float *occ, *ex;
+    float *occx; /* occ three times over: occx[n + b] = occ[b mod n] for b
+                    in [-n, 2n), so that windows need no wrapping */
     /* soft lights: the reach of the occluders' penumbra wedges, as an
      * inverse distance per ray: a pixel on ray b at distance d with
      * d * lit[b] < 1 lies in no occluder's penumbra (fully lit) */
@@ -64,6 +66,13 @@ typedef struct l2_polar {
     int capacity; /* floats allocated per array (occ, ex: n; tables: levels*n) */
     int table_capacity;
 } l2_polar;
+
+/* floor(x) for |x| < 2^31, inline (floorf is a call without SSE4.1). */
+static inline int l2_floor(float x)
+{
+    int i = (int)x;
+    return i - (x < (float)i);
+}
 
 /* The first distance of the depth levels of l2_polar.gap. */
 #define L2_DEPTH0 1.0f

@@ -50,6 +50,7 @@ void l2_polar_free(l2_polar *pm)
     free(pm->occ);
     free(pm->ex);
     free(pm->lit);
+    free(pm->occx);
     free(pm->qocc);
     free(pm->gap);
     free(pm->tmin);
@@ -114,7 +115,10 @@ static lx_status reserve(l2_polar *pm, int n, int levels, int depth_levels)
         float *qocc = realloc(pm->qocc, (size_t)n * sizeof *qocc);
         if (qocc)
             pm->qocc = qocc;
-        if (!occ || !ex || !lit || !qocc)
+        float *occx = realloc(pm->occx, (size_t)n * 3 * sizeof *occx);
+        if (occx)
+            pm->occx = occx;
+        if (!occ || !ex || !lit || !qocc || !occx)
             return lx_fail(LX_ERR_NOMEM, "light2d: out of memory for a polar map of %d rays", n);
         pm->capacity = n;
     }
@@ -296,6 +300,8 @@ lx_status l2_polar_build(const lx_light2d *ctx, l2_prep *p)
         for (int lv = 0; lv < depth_levels; lv++)
             open_gaps(pm, lv);
     }
+    for (int rep = 0; rep < 3; rep++)
+        memcpy(pm->occx + (size_t)rep * n, occ, (size_t)n * sizeof *occ);
     memcpy(pm->tmin, occ, (size_t)n * sizeof *occ);
     memcpy(pm->tmax, occ, (size_t)n * sizeof *occ);
     for (int k = 1; k < levels; k++) {
@@ -329,27 +335,26 @@ float l2_filter(const l2_polar *pm, float c, float k, float d)
 {
     int n = pm->n;
     float lo = c - k, hi = c + k;
-    int b0 = (int)floorf(lo), b1 = (int)floorf(hi);
+    int b0 = l2_floor(lo), b1 = l2_floor(hi);
     if (range_query(pm, pm->tmax, b0, b1, true) < d)
         return 0.0f;
     if (range_query(pm, pm->tmin, b0, b1, false) >= d)
         return 1.0f;
+    const float *occ = pm->occx + n; /* b in [-n, 2n) */
     if (b1 - b0 + 1 <= L2_MAX_TAPS) {
         float lit = 0.0f;
         for (int b = b0; b <= b1; b++) {
             float w = l2_min(hi, (float)(b + 1)) - l2_max(lo, (float)b);
-            if (pm->occ[wrap(b, n)] >= d)
-                lit += w;
+            lit += occ[b] >= d ? w : 0.0f;
         }
         return lit / (hi - lo);
     }
+    /* taps at the centres of L2_MAX_TAPS equal parts */
     int lit = 0;
     float step = (hi - lo) / L2_MAX_TAPS;
-    for (int i = 0; i < L2_MAX_TAPS; i++) {
-        int b = (int)floorf(lo + (i + 0.5f) * step);
-        if (pm->occ[wrap(b, n)] >= d)
-            lit++;
-    }
+    float base = lo + 0.5f * step;
+    for (int i = 0; i < L2_MAX_TAPS; i++)
+        lit += occ[l2_floor(base + (float)i * step)] >= d;
     return (float)lit / L2_MAX_TAPS;
 }
 
@@ -363,7 +368,7 @@ float l2_soft_visibility(const l2_polar *pm, float s, float c, float u2, float d
     float scale = (1.0f + u2) * pm->bins_per_p; /* bins per radian */
     float cap = 0.5f * (float)pm->n - 1.0f;
     float ks = l2_min(7.0f * s / d * scale, cap);
-    int b0 = (int)floorf(c - ks), b1 = (int)floorf(c + ks);
+    int b0 = l2_floor(c - ks), b1 = l2_floor(c + ks);
     float m = range_query(pm, pm->tmin, b0, b1, false);
     if (m >= d)
         return 1.0f;
@@ -376,7 +381,7 @@ float l2_soft_visibility(const l2_polar *pm, float s, float c, float u2, float d
         k = l2_min(s * (d - o) / (d * o) * scale, cap);
         if (k < 0.5f)
             break;
-        float m2 = range_query(pm, pm->tmin, (int)floorf(c - k), (int)floorf(c + k), false);
+        float m2 = range_query(pm, pm->tmin, l2_floor(c - k), l2_floor(c + k), false);
         if (m2 >= d)
             return 1.0f;
         if (m2 == m)
@@ -384,7 +389,7 @@ float l2_soft_visibility(const l2_polar *pm, float s, float c, float u2, float d
         m = m2;
     }
     if (k < 0.5f)
-        return pm->occ[wrap((int)floorf(c), pm->n)] >= d ? 1.0f : 0.0f;
+        return pm->occx[pm->n + l2_floor(c)] >= d ? 1.0f : 0.0f;
     return l2_filter(pm, c, k, d);
 }
 
