@@ -331,6 +331,7 @@ static inline float range_query(const l2_polar *pm, const float *table, int lo, 
 }
 
 /* Fraction of the window [c - k, c + k] (in bins) whose rays reach past d. */
+L2_CLONES
 float l2_filter(const l2_polar *pm, float c, float k, float d)
 {
     int n = pm->n;

@@ -20,16 +20,6 @@
  * (the row's width*3 floats), and to its cache row when it is a static
  * light being re-lit (the caller cleared that row); scratch holds 4*width
  * floats. */
-/* With GCC on x86-64 Linux, an AVX2 clone of the per-pixel passes is picked
- * at load time where the CPU has it: 8 pixels a vector instead of 4. The
- * operations are the same IEEE ones (no contraction), so are the bytes. */
-#if defined(__GNUC__) && !defined(__clang__) && defined(__x86_64__) && defined(__linux__) && \
-    !defined(L2_NO_CLONES)
-#define L2_CLONES __attribute__((target_clones("avx2", "default")))
-#else
-#define L2_CLONES
-#endif
-
 L2_CLONES
 static void shade_span(const lx_light2d *ctx, const l2_prep *p, int y, int xs, int xe,
                        float *acc, float *scratch)
