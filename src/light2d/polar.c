@@ -351,11 +351,13 @@ float l2_filter(const l2_polar *pm, float c, float k, float d)
         return lit / (hi - lo);
     }
     /* taps at the centres of L2_MAX_TAPS equal parts */
+    /* from the start of occx (lo + n > 0: c >= 0, k < n/2), where
+     * truncation floors */
     int lit = 0;
     float step = (hi - lo) / L2_MAX_TAPS;
-    float base = lo + 0.5f * step;
+    float base = lo + 0.5f * step + (float)n;
     for (int i = 0; i < L2_MAX_TAPS; i++)
-        lit += occ[l2_floor(base + (float)i * step)] >= d;
+        lit += pm->occx[(int)(base + (float)i * step)] >= d;
     return (float)lit / L2_MAX_TAPS;
 }
 
