@@ -61,9 +61,13 @@ fuzz: all
 	$(BUILD)/bin/gen_scenes $(BUILD_FUZZ)/seeds
 	@mkdir -p $(BUILD_FUZZ)/corpus/fuzz_scene
 	@(printf '\000'; cat $(BUILD_FUZZ)/seeds/room.glb) > $(BUILD_FUZZ)/corpus/fuzz_scene/room
+	@# fuzz/corpus/<name>/ holds text seeds and fuzz/<name>.dict a dictionary
+	@# for fuzz_<name>, when they exist
 	@for f in $(BUILD_FUZZ)/bin/fuzz_*; do \
-		corpus=$(BUILD_FUZZ)/corpus/$$(basename $$f); mkdir -p $$corpus; \
-		echo "== $$f"; $$f -max_total_time=$(FUZZ_SECONDS) $$corpus || exit 1; done
+		name=$$(basename $$f); corpus=$(BUILD_FUZZ)/corpus/$$name; mkdir -p $$corpus; \
+		seeds=; test -d fuzz/corpus/$${name#fuzz_} && seeds=fuzz/corpus/$${name#fuzz_}; \
+		dict=; test -f fuzz/$${name#fuzz_}.dict && dict=-dict=fuzz/$${name#fuzz_}.dict; \
+		echo "== $$f"; $$f -max_total_time=$(FUZZ_SECONDS) $$dict $$corpus $$seeds || exit 1; done
 
 clean:
 	rm -rf $(BUILD) $(BUILD_ASAN) $(BUILD_FUZZ)

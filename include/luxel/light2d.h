@@ -52,6 +52,10 @@ typedef enum lx_light2d_falloff {
     LX_FALLOFF2D_NONE
 } lx_light2d_falloff;
 
+/* The largest colour x intensity of a light and the largest ambient: far
+ * above any real light, they keep every sum of lights finite. */
+#define LX_LIGHT2D_MAX_LIGHT 1e30
+
 /* Spot edge fade when none is given: the last 5 degrees of the arc. */
 #define LX_LIGHT2D_DEFAULT_EDGE 5.0f
 
@@ -83,7 +87,8 @@ typedef struct lx_light2d_light {
 lx_light2d_light lx_light2d_light_defaults(lx_light2d_type type);
 
 /* LX_OK or LX_ERR_INVALID naming the field ("radius 0 must be > 0", "arc
- * 400 must be in (0, 360]", "direction is zero", non-finite values). */
+ * 400 must be in (0, 360]", "direction is zero", non-finite values, colour
+ * x intensity above LX_LIGHT2D_MAX_LIGHT). */
 lx_status lx_light2d_light_validate(const lx_light2d_light *light);
 
 typedef struct lx_light2d_desc {
@@ -123,7 +128,8 @@ lx_status lx_light2d_update_casters(lx_light2d *ctx, const lx_image *casters, in
  * cached lighting; moved or changed lights are re-lit. */
 lx_status lx_light2d_set_lights(lx_light2d *ctx, const lx_light2d_light *lights, int count);
 
-/* Renders a frame. out (may be NULL) gets width*height*3 floats,
+/* Renders a frame; ambient components must be in [0,
+ * LX_LIGHT2D_MAX_LIGHT]. out (may be NULL) gets width*height*3 floats,
  * albedo x (ambient + sum of lights), albedo from `albedo` (the casters'
  * size, RGB or RGBA, linear; NULL = white). light_map (may be NULL) gets
  * width*height*3 floats of ambient + sum of lights. */

@@ -51,6 +51,12 @@ lx_status lx_light2d_light_validate(const lx_light2d_light *l)
         return lx_fail(LX_ERR_INVALID, "color has a negative component");
     if (l->intensity < 0.0f)
         return lx_fail(LX_ERR_INVALID, "intensity %g is negative", l->intensity);
+    /* a bound far above any real light keeps every sum of lights finite
+     * (an infinite colour times a zero falloff would be NaN) */
+    float peak = l2_max(l->color.x, l2_max(l->color.y, l->color.z));
+    if ((double)peak * l->intensity > LX_LIGHT2D_MAX_LIGHT)
+        return lx_fail(LX_ERR_INVALID, "intensity %g x color %g is more than %g", l->intensity,
+                       peak, LX_LIGHT2D_MAX_LIGHT);
     if (l->softness < 0.0f)
         return lx_fail(LX_ERR_INVALID, "softness %g is negative", l->softness);
     if (l->height < 0.0f)
@@ -178,6 +184,11 @@ lx_status l2_build_edges(lx_light2d *ctx)
             edges[fill[t]++] = (l2_edge){(uint16_t)x, (uint16_t)y, f};
         }
     free(fill);
+    memset(ctx->block_caster, 0, (size_t)ctx->blocks_x * ctx->blocks_y);
+    for (int y = 0; y < ctx->height; y++)
+        for (int x = 0; x < ctx->width; x++)
+            if (ctx->caster[(size_t)y * ctx->width + x])
+                ctx->block_caster[(size_t)(y / L2_BLOCK) * ctx->blocks_x + x / L2_BLOCK] = 1;
     free(ctx->tile_start);
     free(ctx->edges);
     ctx->tile_start = count;
@@ -217,8 +228,13 @@ lx_status lx_light2d_create(const lx_image *casters, const lx_light2d_desc *desc
     ctx->polar_resolution = d.polar_resolution > 0 ? (d.polar_resolution + 7) & ~7 : 0;
     ctx->tiles_x = (ctx->width + L2_TILE - 1) / L2_TILE;
     ctx->tiles_y = (ctx->height + L2_TILE - 1) / L2_TILE;
+    ctx->blocks_x = (ctx->width + L2_BLOCK - 1) / L2_BLOCK;
+    ctx->blocks_y = (ctx->height + L2_BLOCK - 1) / L2_BLOCK;
     ctx->caster = malloc((size_t)ctx->width * ctx->height);
-    if (!ctx->caster) {
+    ctx->block_caster = malloc((size_t)ctx->blocks_x * ctx->blocks_y);
+    if (!ctx->caster || !ctx->block_caster) {
+        free(ctx->caster);
+        free(ctx->block_caster);
         free(ctx);
         return lx_fail(LX_ERR_NOMEM, "light2d: out of memory for a %dx%d caster mask",
                        casters->width, casters->height);
@@ -249,6 +265,7 @@ void lx_light2d_destroy(lx_light2d *ctx)
     }
     free(ctx->preps);
     free(ctx->caster);
+    free(ctx->block_caster);
     free(ctx->tile_start);
     free(ctx->edges);
     free(ctx->normals);

@@ -22,6 +22,10 @@ static inline float l2_max(float a, float b)
  * so a light visits only the tiles under its reach. */
 #define L2_TILE 32
 
+/* Frames are shaded in bands of this many rows, and each light first
+ * drops the blocks of L2_BLOCK x L2_BLOCK pixels it leaves wholly dark. */
+#define L2_BLOCK 8
+
 /* Which 4-neighbours of a boundary pixel are free (not casters, or outside
  * the image). */
 enum { L2_FREE_LEFT = 1, L2_FREE_RIGHT = 2, L2_FREE_UP = 4, L2_FREE_DOWN = 8 };
@@ -41,11 +45,62 @@ typedef struct l2_polar {
     int n;
     float bins_per_p; /* n / 8 */
     float *occ, *ex;
+    float *occx; /* occ three times over: occx[n + b] = occ[b mod n] for b
+                    in [-n, 2n), so that windows need no wrapping */
+    /* soft lights: the reach of the occluders' penumbra wedges, as an
+     * inverse distance per ray: a pixel on ray b at distance d with
+     * d * lit[b] < 1 lies in no occluder's penumbra (fully lit) */
+    float *lit;
+    /* soft lights: 1 / max(occ, 0.5) per ray, and per depth level l (the
+     * distances from L2_DEPTH0 x 2^(l/2) on) the whole bins between each
+     * ray and the nearest ray whose occluder lies at that distance or
+     * beyond (65535 when none): a point of ray b in hard shadow at a
+     * distance of level l whose penumbra window is at most gap[l][b] bins
+     * wide on each side sees no open ray (fully shadowed) */
+    float *qocc;
+    uint16_t *gap; /* depth_levels x n */
+    int depth_levels;
+    int gap_capacity;
     float *tmin, *tmax; /* levels x n */
     int levels;
     int capacity; /* floats allocated per array (occ, ex: n; tables: levels*n) */
     int table_capacity;
 } l2_polar;
+
+/* With GCC on x86-64 Linux, AVX2 clones of the per-pixel passes and of the
+ * penumbra filter are picked at load time where the CPU has it: 8 lanes a
+ * vector instead of 4. The operations are the same IEEE ones in the same
+ * order (no contraction, sums in order), so are the bytes. */
+#if defined(__GNUC__) && !defined(__clang__) && defined(__x86_64__) && defined(__linux__) && \
+    !defined(L2_NO_CLONES)
+#define L2_CLONES __attribute__((target_clones("avx2", "default")))
+#else
+#define L2_CLONES
+#endif
+
+/* floor(x) for |x| < 2^31, inline (floorf is a call without SSE4.1). */
+static inline int l2_floor(float x)
+{
+    int i = (int)x;
+    return i - (x < (float)i);
+}
+
+/* The first distance of the depth levels of l2_polar.gap. */
+#define L2_DEPTH0 1.0f
+
+/* The depth level of a distance d >= L2_DEPTH0: floor(2 log2(d / L2_DEPTH0))
+ * from the float's bits (exact: no libm rounding), at most top. */
+static inline int l2_depth_level(float d, int top)
+{
+    union {
+        float f;
+        uint32_t u;
+    } v = {d / L2_DEPTH0};
+    int e = (int)(v.u >> 23) - 127;
+    /* the mantissa against sqrt(2) = 1.0110101000001001111001...b */
+    int l = 2 * e + ((v.u & 0x7fffff) >= 0x3504f3u ? 1 : 0);
+    return l < top ? l : top;
+}
 
 /* A light prepared for a frame. */
 typedef struct l2_prep {
@@ -71,6 +126,8 @@ struct lx_light2d {
     int tiles_x, tiles_y;
     uint32_t *tile_start; /* tiles_x*tiles_y + 1 offsets into edges */
     l2_edge *edges;
+    int blocks_x, blocks_y;
+    uint8_t *block_caster; /* blocks_x*blocks_y: 1 when the block holds a caster */
     float *normals; /* width*height*3 unit vectors in pixel space (x right,
                        y down, z towards the viewer), or NULL */
     l2_prep *preps;
@@ -88,17 +145,22 @@ int l2_ray_count(const lx_light2d *ctx, float radius);
 lx_status l2_polar_build(const lx_light2d *ctx, l2_prep *p);
 void l2_polar_free(l2_polar *pm);
 
-/* Visibility in [0, 1] of the point at (dx, dy) from the light, distance
- * d, for a caster pixel or not. */
-float l2_visibility(const l2_polar *pm, const lx_light2d_light *l, float dx, float dy, float d,
-                    bool caster);
 /* Soft visibility at distance d on the ray at continuous bin c, u2 the
- * squared slope of the pseudo-angle there (polar.c). */
+ * squared slope of the pseudo-angle there, for a point its own ray reaches
+ * (d before the ray's occluder, or on a lit face): the penumbra of the
+ * nearest occluder whose window holds it (polar.c). */
 float l2_soft_visibility(const l2_polar *pm, float s, float c, float u2, float d);
+/* Fraction of the window [c - k, c + k] (in bins, 0.5 <= k < n/2) whose
+ * rays reach past d: the percentage-closer filter (polar.c). For a point
+ * in its ray's hard shadow (ray b, occluder o), the window is that
+ * occluder's penumbra, k = min(s (1/max(o, 0.5) - 1/d) x scale, n/2 - 1),
+ * scale the bins per radian there. */
+float l2_filter(const l2_polar *pm, float c, float k, float d);
 
-/* Adds the light's contribution to row y of acc (width*3 floats), filling
- * its cache row first when it is a static light being re-lit; scratch
- * holds 4*width floats (shade.c). */
-void l2_shade_row(const lx_light2d *ctx, const l2_prep *p, int y, float *acc, float *scratch);
+/* Whether the light leaves every pixel of the block [x0, x1) x [y0, y1)
+ * dark (exactly what shading them would give: out of reach, or in a hard
+ * shadow whose penumbra window holds no open ray); has_caster: the block
+ * holds a caster pixel (polar.c). */
+bool l2_block_dark(const l2_prep *p, int x0, int y0, int x1, int y1, bool has_caster);
 
 #endif

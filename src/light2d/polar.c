@@ -49,6 +49,10 @@ void l2_polar_free(l2_polar *pm)
 {
     free(pm->occ);
     free(pm->ex);
+    free(pm->lit);
+    free(pm->occx);
+    free(pm->qocc);
+    free(pm->gap);
     free(pm->tmin);
     free(pm->tmax);
     memset(pm, 0, sizeof *pm);
@@ -88,8 +92,16 @@ static void square_bins(const l2_polar *pm, float ax, float bx, float ay, float 
     *b1 = b;
 }
 
-static lx_status reserve(l2_polar *pm, int n, int levels)
+static lx_status reserve(l2_polar *pm, int n, int levels, int depth_levels)
 {
+    size_t g = (size_t)n * depth_levels;
+    if (g > (size_t)pm->gap_capacity) {
+        uint16_t *a = realloc(pm->gap, g * sizeof *a);
+        if (!a)
+            return lx_fail(LX_ERR_NOMEM, "light2d: out of memory for a polar map of %d rays", n);
+        pm->gap = a;
+        pm->gap_capacity = (int)g;
+    }
     if (n > pm->capacity) {
         float *occ = realloc(pm->occ, (size_t)n * sizeof *occ);
         if (occ)
@@ -97,7 +109,16 @@ static lx_status reserve(l2_polar *pm, int n, int levels)
         float *ex = realloc(pm->ex, (size_t)n * sizeof *ex);
         if (ex)
             pm->ex = ex;
-        if (!occ || !ex)
+        float *lit = realloc(pm->lit, (size_t)n * sizeof *lit);
+        if (lit)
+            pm->lit = lit;
+        float *qocc = realloc(pm->qocc, (size_t)n * sizeof *qocc);
+        if (qocc)
+            pm->qocc = qocc;
+        float *occx = realloc(pm->occx, (size_t)n * 3 * sizeof *occx);
+        if (occx)
+            pm->occx = occx;
+        if (!occ || !ex || !lit || !qocc || !occx)
             return lx_fail(LX_ERR_NOMEM, "light2d: out of memory for a polar map of %d rays", n);
         pm->capacity = n;
     }
@@ -116,6 +137,83 @@ static lx_status reserve(l2_polar *pm, int n, int levels)
     return LX_OK;
 }
 
+/* The penumbra wedges' reach (l2_polar.lit). The occluder of ray j, at
+ * inverse distance q_j = 1/occ[j], casts a penumbra over the points at
+ * inverse distance q whose window s (q_j - q) x scale (in bins, scale the
+ * bins per radian at the point) reaches ray j: with g the whole bins
+ * between rays b and j, a point of ray b can be in it only when q < q_j -
+ * g / (s x scale). scale is at most n/4 (where the pseudo-angle's slope is
+ * 1), so lit[b] = max_j (q_j - g / (s n/4)) bounds every wedge reaching ray
+ * b: a distance transform with a linear cone, one pass each way around the
+ * circle (twice round, so that wedges wrap). */
+static void penumbra_reach(l2_polar *pm, float s)
+{
+    int n = pm->n;
+    const float *occ = pm->occ;
+    float *lit = pm->lit;
+    float step = 1.0f / (s * 0.25f * (float)n);
+    for (int i = 0; i < n; i++)
+        lit[i] = occ[i] >= L2_FAR ? 0.0f : 1.0f / l2_max(occ[i], 1e-6f);
+    /* g: the best wedge arriving from the bins before i, its gap counted */
+    float g = 0.0f;
+    for (int lap = 0; lap < 2; lap++)
+        for (int i = 0; i < n; i++) {
+            float q = occ[i] >= L2_FAR ? 0.0f : 1.0f / l2_max(occ[i], 1e-6f);
+            if (lap)
+                lit[i] = l2_max(lit[i], g);
+            g = l2_max(q, g - step);
+        }
+    g = 0.0f;
+    for (int lap = 0; lap < 2; lap++)
+        for (int i = n - 1; i >= 0; i--) {
+            float q = occ[i] >= L2_FAR ? 0.0f : 1.0f / l2_max(occ[i], 1e-6f);
+            if (lap)
+                lit[i] = l2_max(lit[i], g);
+            g = l2_max(q, g - step);
+        }
+}
+
+/* gap[lv]: per ray, the whole bins between it and the nearest ray whose
+ * occluder is at the level's distance or beyond (a 1D distance transform
+ * around the circle: twice round each way). */
+static void open_gaps(l2_polar *pm, int lv)
+{
+    int n = pm->n;
+    /* the level's distance, as l2_depth_level counts: 2^(lv/2) exactly
+     * for even lv, the float just at or above 2^(lv/2) sqrt(2) for odd */
+    union {
+        uint32_t u;
+        float f;
+    } t = {(uint32_t)((lv >> 1) + 127) << 23 | ((lv & 1) ? 0x3504f3u : 0u)};
+    float thr = t.f * L2_DEPTH0;
+    const float *occ = pm->occ;
+    uint16_t *g = pm->gap + (size_t)lv * n;
+    const int none = 1 << 30;
+    int run = none; /* bins since the last open ray */
+    for (int lap = 0; lap < 2; lap++)
+        for (int i = 0; i < n; i++) {
+            if (occ[i] >= thr)
+                run = 0;
+            else if (run < none)
+                run++;
+            if (lap)
+                g[i] = (uint16_t)(run == 0 ? 0 : (run - 1 < 65535 ? run - 1 : 65535));
+        }
+    run = none;
+    for (int lap = 0; lap < 2; lap++)
+        for (int i = n - 1; i >= 0; i--) {
+            if (occ[i] >= thr)
+                run = 0;
+            else if (run < none)
+                run++;
+            if (lap) {
+                int v = run == 0 ? 0 : (run - 1 < 65535 ? run - 1 : 65535);
+                if (v < g[i])
+                    g[i] = (uint16_t)v;
+            }
+        }
+}
+
 lx_status l2_polar_build(const lx_light2d *ctx, l2_prep *p)
 {
     const lx_light2d_light *l = &p->l;
@@ -123,14 +221,16 @@ lx_status l2_polar_build(const lx_light2d *ctx, l2_prep *p)
     int n = l2_ray_count(ctx, l->radius);
     bool soft = l->softness > 0.0f;
     int levels = 0;
-    if (soft)
-        while ((1 << levels) <= n)
-            levels++;
-    lx_status st = reserve(pm, n, levels);
+    while ((1 << levels) <= n)
+        levels++;
+    /* depth levels up to the farthest shaded distance, the radius */
+    int depth_levels = soft ? l2_depth_level(l->radius + 2.0f, 1 << 10) + 1 : 0;
+    lx_status st = reserve(pm, n, levels, depth_levels);
     if (st != LX_OK)
         return st;
     pm->n = n;
     pm->levels = levels;
+    pm->depth_levels = depth_levels;
     pm->bins_per_p = (float)n / 8.0f;
     float *occ = pm->occ, *ex = pm->ex;
     for (int b = 0; b < n; b++) {
@@ -194,17 +294,24 @@ lx_status l2_polar_build(const lx_light2d *ctx, l2_prep *p)
         for (int b = 0; b < n; b++)
             occ[b] = 0.0f;
     if (soft) {
-        memcpy(pm->tmin, occ, (size_t)n * sizeof *occ);
-        memcpy(pm->tmax, occ, (size_t)n * sizeof *occ);
-        for (int k = 1; k < levels; k++) {
-            const float *a = pm->tmin + (size_t)(k - 1) * n, *b = pm->tmax + (size_t)(k - 1) * n;
-            float *c = pm->tmin + (size_t)k * n, *d = pm->tmax + (size_t)k * n;
-            int h = 1 << (k - 1);
-            for (int i = 0; i < n; i++) {
-                int j = i + h >= n ? i + h - n : i + h;
-                c[i] = l2_min(a[i], a[j]);
-                d[i] = l2_max(b[i], b[j]);
-            }
+        penumbra_reach(pm, l->softness);
+        for (int i = 0; i < n; i++)
+            pm->qocc[i] = 1.0f / l2_max(occ[i], 0.5f);
+        for (int lv = 0; lv < depth_levels; lv++)
+            open_gaps(pm, lv);
+    }
+    for (int rep = 0; rep < 3; rep++)
+        memcpy(pm->occx + (size_t)rep * n, occ, (size_t)n * sizeof *occ);
+    memcpy(pm->tmin, occ, (size_t)n * sizeof *occ);
+    memcpy(pm->tmax, occ, (size_t)n * sizeof *occ);
+    for (int k = 1; k < levels; k++) {
+        const float *a = pm->tmin + (size_t)(k - 1) * n, *b = pm->tmax + (size_t)(k - 1) * n;
+        float *c = pm->tmin + (size_t)k * n, *d = pm->tmax + (size_t)k * n;
+        int h = 1 << (k - 1);
+        for (int i = 0; i < n; i++) {
+            int j = i + h >= n ? i + h - n : i + h;
+            c[i] = l2_min(a[i], a[j]);
+            d[i] = l2_max(b[i], b[j]);
         }
     }
     return LX_OK;
@@ -224,31 +331,33 @@ static inline float range_query(const l2_polar *pm, const float *table, int lo, 
 }
 
 /* Fraction of the window [c - k, c + k] (in bins) whose rays reach past d. */
-static float filter(const l2_polar *pm, float c, float k, float d)
+L2_CLONES
+float l2_filter(const l2_polar *pm, float c, float k, float d)
 {
     int n = pm->n;
     float lo = c - k, hi = c + k;
-    int b0 = (int)floorf(lo), b1 = (int)floorf(hi);
+    int b0 = l2_floor(lo), b1 = l2_floor(hi);
     if (range_query(pm, pm->tmax, b0, b1, true) < d)
         return 0.0f;
     if (range_query(pm, pm->tmin, b0, b1, false) >= d)
         return 1.0f;
+    const float *occ = pm->occx + n; /* b in [-n, 2n) */
     if (b1 - b0 + 1 <= L2_MAX_TAPS) {
         float lit = 0.0f;
         for (int b = b0; b <= b1; b++) {
             float w = l2_min(hi, (float)(b + 1)) - l2_max(lo, (float)b);
-            if (pm->occ[wrap(b, n)] >= d)
-                lit += w;
+            lit += occ[b] >= d ? w : 0.0f;
         }
         return lit / (hi - lo);
     }
+    /* taps at the centres of L2_MAX_TAPS equal parts */
+    /* from the start of occx (lo + n > 0: c >= 0, k < n/2), where
+     * truncation floors */
     int lit = 0;
     float step = (hi - lo) / L2_MAX_TAPS;
-    for (int i = 0; i < L2_MAX_TAPS; i++) {
-        int b = (int)floorf(lo + (i + 0.5f) * step);
-        if (pm->occ[wrap(b, n)] >= d)
-            lit++;
-    }
+    float base = lo + 0.5f * step + (float)n;
+    for (int i = 0; i < L2_MAX_TAPS; i++)
+        lit += pm->occx[(int)(base + (float)i * step)] >= d;
     return (float)lit / L2_MAX_TAPS;
 }
 
@@ -262,7 +371,7 @@ float l2_soft_visibility(const l2_polar *pm, float s, float c, float u2, float d
     float scale = (1.0f + u2) * pm->bins_per_p; /* bins per radian */
     float cap = 0.5f * (float)pm->n - 1.0f;
     float ks = l2_min(7.0f * s / d * scale, cap);
-    int b0 = (int)floorf(c - ks), b1 = (int)floorf(c + ks);
+    int b0 = l2_floor(c - ks), b1 = l2_floor(c + ks);
     float m = range_query(pm, pm->tmin, b0, b1, false);
     if (m >= d)
         return 1.0f;
@@ -275,7 +384,7 @@ float l2_soft_visibility(const l2_polar *pm, float s, float c, float u2, float d
         k = l2_min(s * (d - o) / (d * o) * scale, cap);
         if (k < 0.5f)
             break;
-        float m2 = range_query(pm, pm->tmin, (int)floorf(c - k), (int)floorf(c + k), false);
+        float m2 = range_query(pm, pm->tmin, l2_floor(c - k), l2_floor(c + k), false);
         if (m2 >= d)
             return 1.0f;
         if (m2 == m)
@@ -283,24 +392,69 @@ float l2_soft_visibility(const l2_polar *pm, float s, float c, float u2, float d
         m = m2;
     }
     if (k < 0.5f)
-        return pm->occ[wrap((int)floorf(c), pm->n)] >= d ? 1.0f : 0.0f;
-    return filter(pm, c, k, d);
+        return pm->occx[pm->n + l2_floor(c)] >= d ? 1.0f : 0.0f;
+    return l2_filter(pm, c, k, d);
 }
 
-float l2_visibility(const l2_polar *pm, const lx_light2d_light *l, float dx, float dy, float d,
-                    bool caster)
+bool l2_block_dark(const l2_prep *p, int x0, int y0, int x1, int y1, bool has_caster)
 {
-    float u;
-    float c = pseudo_angle(dx, dy, &u) * pm->bins_per_p;
-    int b = (int)c;
-    if (b >= pm->n)
-        b -= pm->n;
-    float o = pm->occ[b];
-    bool face = caster && !l->self_shadow && d <= pm->ex[b];
+    const lx_light2d_light *l = &p->l;
+    const l2_polar *pm = &p->polar;
+    int n = pm->n;
+    /* the pixel centres, relative to the light, as shade.c computes them */
+    float ax = (float)x0 + 0.5f - l->x, bx = (float)(x1 - 1) + 0.5f - l->x;
+    float ay = (float)y0 + 0.5f - l->y, by = (float)(y1 - 1) + 0.5f - l->y;
+    float nx = ax > 0.0f ? ax : (bx < 0.0f ? bx : 0.0f);
+    float ny = ay > 0.0f ? ay : (by < 0.0f ? by : 0.0f);
+    /* squares and sums round monotonically: no pixel is nearer */
+    float dmin2 = nx * nx + ny * ny;
+    if (dmin2 >= p->r2)
+        return true; /* out of reach: no falloff */
+    if (!l->shadow || (has_caster && !l->self_shadow) || dmin2 < 4.0f)
+        return false;
+    float fx = l2_max(ax * ax, bx * bx), fy = l2_max(ay * ay, by * by);
+    float dmin = sqrtf(dmin2), dmax = sqrtf(fx + fy);
+    /* the rays of the pixels, one more each side for rounding */
+    int b0, b1;
+    square_bins(pm, ax, bx, ay, by, &b0, &b1);
+    b0--;
+    b1++;
+    if (b1 - b0 + 1 >= n)
+        return false;
+    /* every ray blocked before the nearest pixel (with a margin for the
+     * rounding of d x 1/occ) */
+    float before = dmin * (1.0f - 1e-5f);
+    if (range_query(pm, pm->tmax, b0, b1, true) >= before)
+        return false;
     if (l->softness <= 0.0f)
-        return (d < o || face) ? 1.0f : 0.0f;
-    float de = d;
-    if (face)
-        de = l2_max(l2_min(d, o - 0.5f), 0.5f);
-    return l2_soft_visibility(pm, l->softness, c, u * u, de);
+        return true;
+    /* and, as shade.c tests each pixel, no open ray in the penumbra window
+     * of its ray's occluder: k = s (1/max(o, 0.5) - 1/d) (1 + u^2) n/8 is
+     * at most its value at dmax and the largest u^2 of the block (at a
+     * corner, or 1 across a face's edge), and the rays open at d are open
+     * at the level of dmin */
+    if (dmin < L2_DEPTH0)
+        return false;
+    float u, u2max = 0.0f, plo = 8.0f, phi = 0.0f;
+    float cx[4] = {ax, bx, ax, bx}, cy[4] = {ay, ay, by, by};
+    for (int c = 0; c < 4; c++) {
+        float pa = pseudo_angle(cx[c], cy[c], &u);
+        u2max = l2_max(u2max, u * u);
+        plo = l2_min(plo, pa);
+        phi = l2_max(phi, pa);
+    }
+    /* a face's edge (|u| = 1) at p = 0, 2, 4, 6 between the corners */
+    if (phi - plo > 4.0f || (int)(plo * 0.5f) != (int)(phi * 0.5f))
+        u2max = 1.0f;
+    float sc = 1.0f + u2max * (1.0f + 1e-5f), inv = 1.0f / dmax;
+    float kcap = 0.5f * (float)n - 1.0f;
+    const uint16_t *g = pm->gap + (size_t)l2_depth_level(dmin, pm->depth_levels - 1) * n;
+    for (int b = b0; b <= b1; b++) {
+        int i = wrap(b, n);
+        float k = l->softness * (pm->qocc[i] - inv) * sc * pm->bins_per_p;
+        k = l2_min(k, kcap);
+        if (k >= 0.5f && k > (float)g[i])
+            return false;
+    }
+    return true;
 }

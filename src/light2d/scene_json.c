@@ -266,6 +266,11 @@ lx_status lx_light2d_scene_parse(const char *name, const char *text, size_t size
                 st = jfail(&c, LX_ERR_INVALID, "ambient has a negative component");
                 goto done;
             }
+            if (v[0] > LX_LIGHT2D_MAX_LIGHT || v[1] > LX_LIGHT2D_MAX_LIGHT ||
+                v[2] > LX_LIGHT2D_MAX_LIGHT) {
+                st = jfail(&c, LX_ERR_INVALID, "ambient is more than %g", LX_LIGHT2D_MAX_LIGHT);
+                goto done;
+            }
             out->ambient = lx_v3(v[0], v[1], v[2]);
         } else if (strcmp(it->string, "lights") == 0) {
             if (!cJSON_IsArray(it)) {

@@ -16,19 +16,23 @@
 #include <omp.h>
 #endif
 
-void l2_shade_row(const lx_light2d *ctx, const l2_prep *p, int y, float *acc, float *scratch)
+/* Adds the light's contribution to the pixels [xs, xe) of row y into acc
+ * (the row's width*3 floats), and to its cache row when it is a static
+ * light being re-lit (the caller cleared that row); scratch holds 4*width
+ * floats. */
+L2_CLONES
+static void shade_span(const lx_light2d *ctx, const l2_prep *p, int y, int xs, int xe,
+                       float *acc, float *scratch)
 {
     const lx_light2d_light *l = &p->l;
     float dy = (float)y + 0.5f - l->y;
     float dy2 = dy * dy;
     float *cache = p->cache ? p->cache + (size_t)(y - p->y0) * (p->x1 - p->x0) * 3 : NULL;
-    if (cache)
-        memset(cache, 0, (size_t)(p->x1 - p->x0) * 3 * sizeof *cache);
     if (dy2 >= p->r2)
         return;
     float half = sqrtf(p->r2 - dy2);
-    int xa = (int)l2_max((float)p->x0, floorf(l->x - half - 0.5f));
-    int xb = (int)l2_min((float)p->x1, ceilf(l->x + half + 0.5f));
+    int xa = (int)l2_max((float)xs, floorf(l->x - half - 0.5f));
+    int xb = (int)l2_min((float)xe, ceilf(l->x + half + 0.5f));
     int n = xb - xa;
     if (n <= 0)
         return;
@@ -74,7 +78,8 @@ void l2_shade_row(const lx_light2d *ctx, const l2_prep *p, int y, float *acc, fl
             float dx = (float)(xa + i) + 0.5f - lx;
             float ndl = -dx * nn[3 * i] - dy * nn[3 * i + 1] + h * nn[3 * i + 2];
             float len = sqrtf(da[i] * da[i] + h2);
-            fa[i] *= ndl > 0.0f && len > 0.0f ? ndl / len : 0.0f;
+            float v = ndl / l2_max(len, 1e-30f);
+            fa[i] *= ndl > 0.0f ? v : 0.0f;
         }
     }
     /* pass 2: shadows from the polar map */
@@ -83,6 +88,8 @@ void l2_shade_row(const lx_light2d *ctx, const l2_prep *p, int y, float *acc, fl
         const l2_polar *pm = &p->polar;
         int nb = pm->n;
         bool soft = l->softness > 0.0f, face_ok = !l->self_shadow;
+        float kcap = 0.5f * (float)nb - 1.0f;
+        int dtop = pm->depth_levels - 1;
         for (int i = 0; i < n; i++) {
             if (fa[i] <= 0.0f)
                 continue;
@@ -100,7 +107,23 @@ void l2_shade_row(const lx_light2d *ctx, const l2_prep *p, int y, float *acc, fl
                 continue;
             }
             float de = face ? l2_max(l2_min(d, o - 0.5f), 0.5f) : d;
-            fa[i] *= l2_soft_visibility(pm, l->softness, ca[i], ua[i] * ua[i], de);
+            if (de * pm->lit[b] < 1.0f)
+                continue; /* in no occluder's penumbra */
+            float u2 = ua[i] * ua[i];
+            if (face || d < o) {
+                fa[i] *= l2_soft_visibility(pm, l->softness, ca[i], u2, de);
+                continue;
+            }
+            /* in the hard shadow of its ray's occluder o: the penumbra of
+             * o, fully shadowed when the window holds no open ray */
+            float k = l->softness * (pm->qocc[b] - 1.0f / d) * (1.0f + u2) * bpp;
+            k = l2_min(k, kcap);
+            if (k < 0.5f || (d >= L2_DEPTH0 &&
+                             k <= (float)pm->gap[(size_t)l2_depth_level(d, dtop) * nb + b])) {
+                fa[i] = 0.0f;
+                continue;
+            }
+            fa[i] *= l2_filter(pm, ca[i], k, d);
         }
     }
     float cr = p->rgb.x, cg = p->rgb.y, cb = p->rgb.z;
@@ -130,6 +153,50 @@ static void add_cached(const l2_prep *p, int y, float *acc)
         a[i] += c[i];
 }
 
+/* Adds light p to the rows [y0, y1) of a band (acc: the band's rows,
+ * width*3 floats each, from row y0): the blocks the light leaves dark are
+ * skipped, the rest shaded in runs of neighbouring blocks. runs holds
+ * 2*(blocks_x+1) ints. */
+static void shade_band(const lx_light2d *ctx, const l2_prep *p, int y0, int y1, float *acc,
+                       float *scratch, int *runs)
+{
+    int w = ctx->width;
+    int ya = y0 > p->y0 ? y0 : p->y0, yb = y1 < p->y1 ? y1 : p->y1;
+    if (ya >= yb || p->x1 <= p->x0)
+        return;
+    if (!p->relight) {
+        for (int y = ya; y < yb; y++)
+            add_cached(p, y, acc + (size_t)(y - y0) * w * 3);
+        return;
+    }
+    if (p->cache)
+        for (int y = ya; y < yb; y++)
+            memset(p->cache + (size_t)(y - p->y0) * (p->x1 - p->x0) * 3, 0,
+                   (size_t)(p->x1 - p->x0) * 3 * sizeof(float));
+    /* the band's blocks under the light, merged into runs of lit ones */
+    int by = y0 / L2_BLOCK, count = 0;
+    int bx0 = p->x0 / L2_BLOCK, bx1 = (p->x1 - 1) / L2_BLOCK;
+    for (int bx = bx0; bx <= bx1; bx++) {
+        int xs = bx * L2_BLOCK, xe = xs + L2_BLOCK < w ? xs + L2_BLOCK : w;
+        xs = xs > p->x0 ? xs : p->x0;
+        xe = xe < p->x1 ? xe : p->x1;
+        bool caster = ctx->block_caster[(size_t)by * ctx->blocks_x + bx] != 0;
+        if (l2_block_dark(p, xs, ya, xe, yb, caster))
+            continue;
+        if (count > 0 && runs[2 * count - 1] == xs)
+            runs[2 * count - 1] = xe;
+        else {
+            runs[2 * count] = xs;
+            runs[2 * count + 1] = xe;
+            count++;
+        }
+    }
+    for (int y = ya; y < yb; y++)
+        for (int r = 0; r < count; r++)
+            shade_span(ctx, p, y, runs[2 * r], runs[2 * r + 1], acc + (size_t)(y - y0) * w * 3,
+                       scratch);
+}
+
 lx_status lx_light2d_render(lx_light2d *ctx, lx_vec3 ambient, const lx_image *albedo, float *out,
                             float *light_map)
 {
@@ -142,9 +209,10 @@ lx_status lx_light2d_render(lx_light2d *ctx, lx_vec3 ambient, const lx_image *al
             return lx_fail(LX_ERR_INVALID, "albedo: %d channel%s, not RGB", albedo->channels,
                            albedo->channels == 1 ? "" : "s");
     }
-    if (!isfinite(ambient.x) || !isfinite(ambient.y) || !isfinite(ambient.z) ||
-        ambient.x < 0.0f || ambient.y < 0.0f || ambient.z < 0.0f)
-        return lx_fail(LX_ERR_INVALID, "ambient must be finite and >= 0");
+    if (!(ambient.x >= 0.0f && ambient.x <= LX_LIGHT2D_MAX_LIGHT) ||
+        !(ambient.y >= 0.0f && ambient.y <= LX_LIGHT2D_MAX_LIGHT) ||
+        !(ambient.z >= 0.0f && ambient.z <= LX_LIGHT2D_MAX_LIGHT))
+        return lx_fail(LX_ERR_INVALID, "ambient must be in [0, %g]", LX_LIGHT2D_MAX_LIGHT);
     int threads = lx_thread_count(ctx->threads);
     /* polar maps of the lights computed this frame */
     int count = ctx->count;
@@ -170,47 +238,49 @@ lx_status lx_light2d_render(lx_light2d *ctx, lx_vec3 ambient, const lx_image *al
     }
     if (st != LX_OK)
         return st;
-    /* per thread: an accumulated row and four rows of scratch */
-    float *rows = malloc((size_t)threads * w * 7 * sizeof *rows);
+    /* per thread: a band of accumulated rows, four rows of scratch and the
+     * runs of a band */
+    size_t band = (size_t)L2_BLOCK * w * 3, per = band + (size_t)w * 4;
+    size_t nruns = 2 * ((size_t)ctx->blocks_x + 1);
+    float *rows = malloc((size_t)threads * (per * sizeof(float) + nruns * sizeof(int)));
     if (!rows)
-        return lx_fail(LX_ERR_NOMEM, "light2d: out of memory for %d rows", threads);
+        return lx_fail(LX_ERR_NOMEM, "light2d: out of memory for %d bands", threads);
+    int *all_runs = (int *)(rows + (size_t)threads * per);
     int ach = albedo ? albedo->channels : 0;
+    int bands = (hgt + L2_BLOCK - 1) / L2_BLOCK;
 #pragma omp parallel num_threads(threads)
     {
         int tid = 0;
 #ifdef _OPENMP
         tid = omp_get_thread_num();
 #endif
-        float *acc = rows + (size_t)tid * w * 7;
-        float *scratch = acc + (size_t)w * 3;
-#pragma omp for schedule(dynamic, 4)
-        for (int y = 0; y < hgt; y++) {
-            for (int x = 0; x < w; x++) {
+        float *acc = rows + (size_t)tid * per;
+        float *scratch = acc + band;
+        int *runs = all_runs + (size_t)tid * nruns;
+#pragma omp for schedule(dynamic, 1)
+        for (int bi = 0; bi < bands; bi++) {
+            int y0 = bi * L2_BLOCK, y1 = y0 + L2_BLOCK < hgt ? y0 + L2_BLOCK : hgt;
+            size_t len = (size_t)(y1 - y0) * w;
+            for (size_t x = 0; x < len; x++) {
                 acc[3 * x] = ambient.x;
                 acc[3 * x + 1] = ambient.y;
                 acc[3 * x + 2] = ambient.z;
             }
-            for (int i = 0; i < count; i++) {
-                const l2_prep *p = &ctx->preps[i];
-                if (y < p->y0 || y >= p->y1 || p->x1 <= p->x0)
-                    continue;
-                if (p->relight)
-                    l2_shade_row(ctx, p, y, acc, scratch);
-                else
-                    add_cached(p, y, acc);
-            }
-            size_t row = (size_t)y * w * 3;
+            /* every pixel adds its lights in their order */
+            for (int i = 0; i < count; i++)
+                shade_band(ctx, &ctx->preps[i], y0, y1, acc, scratch, runs);
+            size_t row = (size_t)y0 * w * 3;
             if (light_map)
-                memcpy(light_map + row, acc, (size_t)w * 3 * sizeof *acc);
+                memcpy(light_map + row, acc, len * 3 * sizeof *acc);
             if (out) {
                 float *o = out + row;
                 if (albedo) {
-                    const float *a = albedo->data + (size_t)y * w * ach;
-                    for (int x = 0; x < w; x++)
+                    const float *a = albedo->data + (size_t)y0 * w * ach;
+                    for (size_t x = 0; x < len; x++)
                         for (int k = 0; k < 3; k++)
                             o[3 * x + k] = a[ach * x + k] * acc[3 * x + k];
                 } else {
-                    memcpy(o, acc, (size_t)w * 3 * sizeof *acc);
+                    memcpy(o, acc, len * 3 * sizeof *acc);
                 }
             }
         }

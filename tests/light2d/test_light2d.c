@@ -499,6 +499,12 @@ static void test_json(void **state)
     expect_json_error("{\"ambient\": [1, 2], \"lights\": []}", "ambient must be an array of 3");
     expect_json_error("{\"lights\": [{\"radius\": 5}]}", "position is missing");
     expect_json_error("{\"light\": []}", "unknown key 'light'");
+    /* colour x intensity would overflow a sum of lights (found by
+     * fuzz_light2d_json: infinite light, NaN where the falloff is 0) */
+    expect_json_error("{\"lights\": [{\"position\": [1, 2], \"radius\": 5, \"color\": [1e38, "
+                      "1, 1], \"intensity\": 1e38}]}",
+                      "lights[0]: intensity 1e+38 x color 1e+38 is more than 1e+30");
+    expect_json_error("{\"ambient\": [3e38, 0, 0], \"lights\": []}", "ambient is more than");
 }
 
 static void test_bad_input(void **state)
