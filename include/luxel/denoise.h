@@ -32,7 +32,7 @@
  *   field out of range, or a valid texel whose colour, position, normal,
  *   albedo, size or variance is NaN, infinite (or a zero normal, a
  *   negative size or variance); the message names the texel. LX_ERR_NOMEM
- *   when the scratch (52 bytes a texel) does not fit, LX_ERR_CANCELLED
+ *   when the scratch (64 bytes a texel) does not fit, LX_ERR_CANCELLED
  *   when the progress callback says stop. On any failure out is left as
  *   it was.
  * MEMORY  The guides are borrowed for the call. lx_baker_denoise_guides

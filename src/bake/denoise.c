@@ -44,6 +44,7 @@
 #include "core/internal.h"
 #include "luxel/denoise.h"
 
+#include <float.h>
 #include <math.h>
 #include <omp.h>
 #include <stdatomic.h>
@@ -60,9 +61,8 @@
 #define VARIANCE_LIMIT 1e36f
 /* the luminance weight's denominator never reaches 0 (SVGF's epsilon) */
 #define SD_EPSILON 1e-10f
-/* scratch bytes a texel: normal, size, surface label, two passes' RGB +
- * variance */
-#define BYTES_PER_TEXEL (12 + 4 + 4 + 2 * 16)
+/* scratch bytes a texel: its guide record, two passes' RGB + variance */
+#define BYTES_PER_TEXEL (32 + 2 * 16)
 
 static const float H[5] = {1.0f / 16.0f, 1.0f / 4.0f, 3.0f / 8.0f, 1.0f / 4.0f, 1.0f / 16.0f};
 static const float G[3] = {0.25f, 0.5f, 0.25f};
@@ -110,18 +110,24 @@ bool lx_denoise_mode_parse(const char *name, lx_denoise_mode *out)
     return false;
 }
 
+/* What a tap reads of a texel's guides, in one place (32 bytes). */
+typedef struct guide {
+    lx_vec3 p; /* world position */
+    float s;   /* while the guides are built: the texel's world size t;
+                  for the passes 1 / t^2 (FLT_MAX for t = 0) */
+    lx_vec3 n; /* unit normal */
+    uint32_t surface; /* label (first texel) of its surface, NO_SURFACE when invalid */
+} guide;
+
 typedef struct filter {
     int w, h, threads;
     const uint8_t *valid;
-    const lx_vec3 *pos;
     const lx_vec3 *albedo; /* NULL: no albedo weight */
     const uint32_t *chart; /* NULL: one chart */
-    lx_vec3 *n;            /* unit normals */
-    float *size;           /* world size of each texel, metres */
-    uint32_t *surface;     /* label (first texel) of each valid texel's surface */
-    float *a, *b;          /* RGB + luminance variance a texel: a pass reads one,
-                              writes the other */
-    float cos_cut, sigma_n, sigma_p, r_cut, sigma_l, inv_sa2;
+    guide *g;
+    float *a, *b; /* RGB + luminance variance a texel: a pass reads one,
+                     writes the other */
+    float cos_cut, sigma_n, sigma_p, r_cut, r_cut2, sigma_l, inv_sa2;
     bool use_luminance;
     /* progress: rows done of the current stage, reported by thread 0 */
     lx_progress_fn progress;
@@ -136,9 +142,34 @@ static inline float lum(const float *c)
     return 0.2126f * c[0] + 0.7152f * c[1] + 0.0722f * c[2];
 }
 
-static inline float dist(lx_vec3 a, lx_vec3 b)
+/* e^-x for x >= 0, to 5e-6 relative (the weights need far less), inline
+ * and branch-light where libm's expf is a call: 2^-k by the exponent bits,
+ * e^-r for r = f ln 2 in [0, 0.7) by its Taylor series to r^7 (error below
+ * r^8 / 8! = 1.3e-6). The same float operations on every machine. */
+static inline float exp_neg(float x)
 {
-    return lx_length(lx_sub(a, b));
+    if (!(x < 86.0f))
+        return 0.0f;
+    float y = x * 1.44269504f; /* in [0, 124.1) */
+    int k = (int)y;            /* floor for y >= 0 */
+    float r = (y - (float)k) * 0.693147181f;
+    float e =
+        1.0f -
+        r * (1.0f -
+             r * (0.5f -
+                  r * (1.0f / 6.0f -
+                       r * (1.0f / 24.0f -
+                            r * (1.0f / 120.0f - r * (1.0f / 720.0f - r * (1.0f / 5040.0f)))))));
+    uint32_t bits = (uint32_t)(127 - k) << 23;
+    float scale;
+    memcpy(&scale, &bits, sizeof scale);
+    return e * scale;
+}
+
+static inline float dist2(lx_vec3 a, lx_vec3 b)
+{
+    lx_vec3 d = lx_sub(a, b);
+    return lx_dot(d, d);
 }
 
 /* Counts a finished row; thread 0 reports the stage's share (at most
@@ -173,20 +204,30 @@ static inline bool alike(const filter *f, size_t p, size_t q, float *nd)
 {
     if (f->chart && f->chart[p] != f->chart[q])
         return false;
-    *nd = lx_dot(f->n[p], f->n[q]);
+    *nd = lx_dot(f->g[p].n, f->g[q].n);
     return *nd >= f->cos_cut;
 }
 
 /* ---- guides: normals, sizes, surfaces -------------------------------------- */
 
-static void unit_normals(filter *f, const lx_vec3 *normal)
+/* Positions, unit normals and the caller's sizes (0 when none) of the
+ * valid texels; zeros elsewhere. */
+static void init_guides(filter *f, const lx_denoise_guides *in)
 {
     int w = f->w, h = f->h;
-#pragma omp parallel for schedule(dynamic, 16) num_threads(f->threads)
+#pragma omp parallel for schedule(static) num_threads(f->threads)
     for (int y = 0; y < h; y++) {
         for (int x = 0; x < w; x++) {
             size_t p = (size_t)y * w + x;
-            f->n[p] = f->valid[p] ? lx_normalize(normal[p]) : lx_v3(0.0f, 0.0f, 0.0f);
+            guide *g = &f->g[p];
+            if (!f->valid[p]) {
+                *g = (guide){.surface = NO_SURFACE};
+                continue;
+            }
+            g->p = in->position[p];
+            g->n = lx_normalize(in->normal[p]);
+            g->s = in->texel_size ? in->texel_size[p] : 0.0f;
+            g->surface = (uint32_t)p;
         }
     }
 }
@@ -198,7 +239,6 @@ static void measure_sizes(filter *f)
     for (int y = 0; y < h; y++) {
         for (int x = 0; x < w; x++) {
             size_t p = (size_t)y * w + x;
-            f->size[p] = 0.0f;
             if (!f->valid[p])
                 continue;
             float cand[8], dmin = INFINITY;
@@ -212,7 +252,8 @@ static void measure_sizes(filter *f)
                     float nd;
                     if (!f->valid[q] || !alike(f, p, q, &nd))
                         continue;
-                    float d = dist(f->pos[p], f->pos[q]) * (dx && dy ? 0.70710678f : 1.0f);
+                    float d =
+                        sqrtf(dist2(f->g[p].p, f->g[q].p)) * (dx && dy ? 0.70710678f : 1.0f);
                     if (d > 0.0f) {
                         cand[k++] = d;
                         dmin = d < dmin ? d : dmin;
@@ -222,37 +263,36 @@ static void measure_sizes(filter *f)
             for (int i = 0; i < k; i++)
                 if (cand[i] <= 2.0f * dmin && cand[i] > t)
                     t = cand[i];
-            f->size[p] = t;
+            f->g[p].s = t;
         }
     }
 }
 
-static uint32_t find(uint32_t *parent, uint32_t a)
+/* Union-find over the surface labels (a texel's label is its parent). */
+static uint32_t find(guide *g, uint32_t a)
 {
-    while (parent[a] != a) {
-        parent[a] = parent[parent[a]];
-        a = parent[a];
+    while (g[a].surface != a) {
+        g[a].surface = g[g[a].surface].surface;
+        a = g[a].surface;
     }
     return a;
 }
 
 /* Joins the surfaces of a and b; the root is always the smaller index, so
  * a surface's label is its first texel in raster order. */
-static void unite(uint32_t *parent, uint32_t a, uint32_t b)
+static void unite(guide *g, uint32_t a, uint32_t b)
 {
-    uint32_t ra = find(parent, a), rb = find(parent, b);
+    uint32_t ra = find(g, a), rb = find(g, b);
     if (ra < rb)
-        parent[rb] = ra;
+        g[rb].surface = ra;
     else if (rb < ra)
-        parent[ra] = rb;
+        g[ra].surface = rb;
 }
 
 static void build_surfaces(filter *f)
 {
     int w = f->w, h = f->h;
-    uint32_t *s = f->surface;
-    for (size_t p = 0; p < (size_t)w * h; p++)
-        s[p] = f->valid[p] ? (uint32_t)p : NO_SURFACE;
+    guide *g = f->g;
     /* each pair once: right, down-left, down, down-right */
     static const int DX[4] = {1, -1, 0, 1}, DY[4] = {0, 1, 1, 1};
     for (int y = 0; y < h; y++)
@@ -268,15 +308,17 @@ static void build_surfaces(filter *f)
                 float nd;
                 if (!f->valid[q] || !alike(f, p, q, &nd))
                     continue;
-                float t = f->size[p] < f->size[q] ? f->size[p] : f->size[q];
-                float len = DX[k] && DY[k] ? 1.41421356f : 1.0f;
-                if (dist(f->pos[p], f->pos[q]) <= f->r_cut * len * t)
-                    unite(s, (uint32_t)p, (uint32_t)q);
+                float t = g[p].s < g[q].s ? g[p].s : g[q].s;
+                float len2 = DX[k] && DY[k] ? 2.0f : 1.0f;
+                if (dist2(g[p].p, g[q].p) <= f->r_cut2 * len2 * t * t)
+                    unite(g, (uint32_t)p, (uint32_t)q);
             }
         }
     for (size_t p = 0; p < (size_t)w * h; p++)
-        if (s[p] != NO_SURFACE)
-            s[p] = find(s, (uint32_t)p);
+        if (g[p].surface != NO_SURFACE) {
+            g[p].surface = find(g, (uint32_t)p);
+            g[p].s = g[p].s > 0.0f ? 1.0f / (g[p].s * g[p].s) : FLT_MAX;
+        }
 }
 
 /* Sample variance of the luminance over the 5x5 texels of p's surface
@@ -291,7 +333,7 @@ static void estimate_variance(filter *f)
             continue;
         for (int x = 0; x < w; x++) {
             size_t p = (size_t)y * w + x;
-            uint32_t s = f->surface[p];
+            uint32_t s = f->g[p].surface;
             if (s == NO_SURFACE)
                 continue;
             double m1 = 0.0, m2 = 0.0;
@@ -303,7 +345,7 @@ static void estimate_variance(filter *f)
                         continue;
                     size_t q = (size_t)qy * w + qx;
                     float nd;
-                    if (f->surface[q] != s || !alike(f, p, q, &nd))
+                    if (f->g[q].surface != s || !alike(f, p, q, &nd))
                         continue;
                     double l = lum(a + 4 * q);
                     m1 += l;
@@ -323,11 +365,18 @@ static void estimate_variance(filter *f)
 
 /* ---- the a-trous passes ------------------------------------------------------ */
 
+/* The tap offsets' squared lengths in texels, 1 / (i^2 + j^2) (0 unused). */
+static const float INV_LEN2[5][5] = {
+    {1.0f / 8, 1.0f / 5, 1.0f / 4, 1.0f / 5, 1.0f / 8}, {1.0f / 5, 1.0f / 2, 1.0f, 1.0f / 2, 1.0f / 5},
+    {1.0f / 4, 1.0f, 0.0f, 1.0f, 1.0f / 4},             {1.0f / 5, 1.0f / 2, 1.0f, 1.0f / 2, 1.0f / 5},
+    {1.0f / 8, 1.0f / 5, 1.0f / 4, 1.0f / 5, 1.0f / 8}};
+
 static void filter_texel(const filter *f, const float *src, float *dst, int x, int y, int step)
 {
     int w = f->w, h = f->h;
     size_t p = (size_t)y * w + x;
-    uint32_t s = f->surface[p];
+    const guide *gp = &f->g[p];
+    uint32_t s = gp->surface;
     const float *cp = src + 4 * p;
     /* p's variance smoothed over its 3x3 neighbours on its surface */
     float vs = 0.0f, gs = 0.0f;
@@ -337,7 +386,7 @@ static void filter_texel(const filter *f, const float *src, float *dst, int x, i
             if (qx < 0 || qy < 0 || qx >= w || qy >= h)
                 continue;
             size_t q = (size_t)qy * w + qx;
-            if (f->surface[q] != s)
+            if (f->g[q].surface != s)
                 continue;
             float g = G[dx + 1] * G[dy + 1];
             vs += g * src[4 * q + 3];
@@ -346,8 +395,7 @@ static void filter_texel(const filter *f, const float *src, float *dst, int x, i
     vs /= gs;
     float inv_sd = 1.0f / (f->sigma_l * sqrtf(vs) + SD_EPSILON);
     float lp = lum(cp);
-    lx_vec3 np = f->n[p], xp = f->pos[p];
-    float tp = f->size[p];
+    float inv_step2 = 1.0f / (float)(step * step);
     float wsum = H[2] * H[2];
     float acc[3] = {0.0f, 0.0f, 0.0f};
     float vacc = wsum * wsum * cp[3];
@@ -360,26 +408,21 @@ static void filter_texel(const filter *f, const float *src, float *dst, int x, i
             if ((i == 0 && j == 0) || qx < 0 || qx >= w)
                 continue;
             size_t q = (size_t)qy * w + qx;
-            if (f->surface[q] != s)
+            const guide *gq = &f->g[q];
+            if (gq->surface != s)
                 continue;
-            float nd = lx_dot(np, f->n[q]);
+            float nd = lx_dot(gp->n, gq->n);
             if (nd < f->cos_cut)
                 continue;
-            float t = tp < f->size[q] ? tp : f->size[q];
-            float d = dist(xp, f->pos[q]);
-            float e = t * (float)step * sqrtf((float)(i * i + j * j));
-            float r;
-            if (e > 0.0f)
-                r = d / e;
-            else if (d == 0.0f)
-                r = 0.0f;
-            else
-                continue;
-            if (r > f->r_cut)
+            /* r^2: the squared distance over the squared offset in metres
+             * at the smaller texel size (the larger 1 / t^2) */
+            float inv_t2 = gp->s > gq->s ? gp->s : gq->s;
+            float r2 = dist2(gp->p, gq->p) * (INV_LEN2[j + 2][i + 2] * inv_step2) * inv_t2;
+            if (!(r2 <= f->r_cut2))
                 continue;
             float ex = f->sigma_n * (1.0f - nd);
-            if (r > 1.0f) {
-                float u = (r - 1.0f) / f->sigma_p;
+            if (r2 > 1.0f) {
+                float u = (sqrtf(r2) - 1.0f) / f->sigma_p;
                 ex += u * u;
             }
             const float *cq = src + 4 * q;
@@ -389,7 +432,7 @@ static void filter_texel(const filter *f, const float *src, float *dst, int x, i
                 lx_vec3 da = lx_sub(f->albedo[p], f->albedo[q]);
                 ex += lx_dot(da, da) * f->inv_sa2;
             }
-            float wq = H[i + 2] * H[j + 2] * expf(-ex);
+            float wq = H[i + 2] * H[j + 2] * exp_neg(ex);
             acc[0] += wq * (cq[0] - cp[0]);
             acc[1] += wq * (cq[1] - cp[1]);
             acc[2] += wq * (cq[2] - cp[2]);
@@ -412,7 +455,7 @@ static void atrous_pass(filter *f, const float *src, float *dst, int step)
         if (stopped(f))
             continue;
         for (int x = 0; x < w; x++)
-            if (f->surface[(size_t)y * w + x] != NO_SURFACE)
+            if (f->g[(size_t)y * w + x].surface != NO_SURFACE)
                 filter_texel(f, src, dst, x, y, step);
         row_done(f);
     }
@@ -558,13 +601,13 @@ static lx_status run(lx_denoise_mode mode, const lx_denoise_guides *g, const flo
                 .h = h,
                 .threads = threads,
                 .valid = g->valid,
-                .pos = g->position,
                 .albedo = g->albedo,
                 .chart = g->chart,
                 .cos_cut = cosf(d.normal_cutoff * (LX_PI / 180.0f)),
                 .sigma_n = d.normal_sigma,
                 .sigma_p = d.position_sigma,
                 .r_cut = 1.0f + 3.0f * d.position_sigma,
+                .r_cut2 = (1.0f + 3.0f * d.position_sigma) * (1.0f + 3.0f * d.position_sigma),
                 .sigma_l = d.luminance_sigma,
                 .inv_sa2 = 1.0f / (d.albedo_sigma * d.albedo_sigma),
                 .use_luminance = !d.ignore_luminance,
@@ -572,22 +615,18 @@ static lx_status run(lx_denoise_mode mode, const lx_denoise_guides *g, const flo
                 .user = d.progress_user};
     atomic_init(&f.rows, 0);
     atomic_init(&f.stop, false);
-    f.n = malloc(n * sizeof(lx_vec3));
-    f.size = malloc(n * sizeof(float));
-    f.surface = malloc(n * sizeof(uint32_t));
+    f.g = malloc(n * sizeof(guide));
     f.a = malloc(n * 4 * sizeof(float));
     f.b = malloc(n * 4 * sizeof(float));
-    if (!f.n || !f.size || !f.surface || !f.a || !f.b) {
+    if (!f.g || !f.a || !f.b) {
         st = lx_fail(LX_ERR_NOMEM, "%s: out of memory for the scratch", what);
         goto done;
     }
     /* progress: the guides and the variance count as one pass */
     float units = (float)d.iterations + 1.0f;
 
-    unit_normals(&f, g->normal);
-    if (g->texel_size)
-        memcpy(f.size, g->texel_size, n * sizeof(float));
-    else
+    init_guides(&f, g);
+    if (!g->texel_size)
         measure_sizes(&f);
     build_surfaces(&f);
 
@@ -636,9 +675,7 @@ static lx_status run(lx_denoise_mode mode, const lx_denoise_guides *g, const flo
         }
 
 done:
-    free(f.n);
-    free(f.size);
-    free(f.surface);
+    free(f.g);
     free(f.a);
     free(f.b);
     return st;
