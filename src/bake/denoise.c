@@ -142,24 +142,22 @@ static inline float lum(const float *c)
     return 0.2126f * c[0] + 0.7152f * c[1] + 0.0722f * c[2];
 }
 
-/* e^-x for x >= 0, to 5e-6 relative (the weights need far less), inline
- * and branch-light where libm's expf is a call: 2^-k by the exponent bits,
- * e^-r for r = f ln 2 in [0, 0.7) by its Taylor series to r^7 (error below
- * r^8 / 8! = 1.3e-6). The same float operations on every machine. */
+/* e^-x for x >= 0, to 6e-6 relative (the weights need far less), inline
+ * where libm's expf is a call: x log2 e = k + f with k the nearest
+ * integer, 2^-k by the exponent bits, e^-r for r = f ln 2 in [-0.35,
+ * 0.35] by its Taylor series to r^5 (error below r^6 / 6! = 2.4e-6),
+ * evaluated as Estrin's scheme so the chain of dependent operations stays
+ * short. The same float operations on every machine. */
 static inline float exp_neg(float x)
 {
     if (!(x < 86.0f))
         return 0.0f;
     float y = x * 1.44269504f; /* in [0, 124.1) */
-    int k = (int)y;            /* floor for y >= 0 */
+    int k = (int)(y + 0.5f);   /* nearest for y >= 0 */
     float r = (y - (float)k) * 0.693147181f;
-    float e =
-        1.0f -
-        r * (1.0f -
-             r * (0.5f -
-                  r * (1.0f / 6.0f -
-                       r * (1.0f / 24.0f -
-                            r * (1.0f / 120.0f - r * (1.0f / 720.0f - r * (1.0f / 5040.0f)))))));
+    float r2 = r * r;
+    float e = (1.0f - r) + r2 * (0.5f - r * (1.0f / 6.0f)) +
+              (r2 * r2) * (1.0f / 24.0f - r * (1.0f / 120.0f));
     uint32_t bits = (uint32_t)(127 - k) << 23;
     float scale;
     memcpy(&scale, &bits, sizeof scale);
