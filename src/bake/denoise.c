@@ -42,6 +42,7 @@
  * values in a fixed order; rows are shared among threads, so results are
  * bit-identical for any thread count. */
 #include "core/internal.h"
+#include "denoise_internal.h"
 #include "luxel/denoise.h"
 
 #include <float.h>
@@ -54,18 +55,14 @@
 
 #define MAX_ITERATIONS 12
 #define MAX_SIDE 65536
-#define NO_SURFACE UINT32_MAX
+#define NO_SURFACE LX_DN_NO_SURFACE
 /* colours, positions and sizes beyond this are refused: their squares
  * (variances, distances) must stay finite in float */
 #define VALUE_LIMIT 1e18f
 #define VARIANCE_LIMIT 1e36f
-/* the luminance weight's denominator never reaches 0 (SVGF's epsilon) */
-#define SD_EPSILON 1e-10f
-/* scratch bytes a texel: its guide record, two passes' RGB + variance */
-#define BYTES_PER_TEXEL (32 + 2 * 16)
-
-static const float H[5] = {1.0f / 16.0f, 1.0f / 4.0f, 3.0f / 8.0f, 1.0f / 4.0f, 1.0f / 16.0f};
-static const float G[3] = {0.25f, 0.5f, 0.25f};
+/* scratch bytes a texel at the peak: the guide record (32), the guides
+ * as planes (32) and the signal (16) while the planes are made */
+#define BYTES_PER_TEXEL (32 + 32 + 16)
 
 lx_denoise_desc lx_denoise_desc_defaults(const lx_denoise_desc *desc)
 {
@@ -125,8 +122,7 @@ typedef struct filter {
     const lx_vec3 *albedo; /* NULL: no albedo weight */
     const uint32_t *chart; /* NULL: one chart */
     guide *g;
-    float *a, *b; /* RGB + luminance variance a texel: a pass reads one,
-                     writes the other */
+    float *a; /* RGB + luminance variance a texel, until the passes' planes */
     float cos_cut, sigma_n, sigma_p, r_cut, r_cut2, sigma_l, inv_sa2;
     bool use_luminance;
     /* progress: rows done of the current stage, reported by thread 0 */
@@ -140,28 +136,6 @@ typedef struct filter {
 static inline float lum(const float *c)
 {
     return 0.2126f * c[0] + 0.7152f * c[1] + 0.0722f * c[2];
-}
-
-/* e^-x for x >= 0, to 6e-6 relative (the weights need far less), inline
- * where libm's expf is a call: x log2 e = k + f with k the nearest
- * integer, 2^-k by the exponent bits, e^-r for r = f ln 2 in [-0.35,
- * 0.35] by its Taylor series to r^5 (error below r^6 / 6! = 2.4e-6),
- * evaluated as Estrin's scheme so the chain of dependent operations stays
- * short. The same float operations on every machine. */
-static inline float exp_neg(float x)
-{
-    if (!(x < 86.0f))
-        return 0.0f;
-    float y = x * 1.44269504f; /* in [0, 124.1) */
-    int k = (int)(y + 0.5f);   /* nearest for y >= 0 */
-    float r = (y - (float)k) * 0.693147181f;
-    float r2 = r * r;
-    float e = (1.0f - r) + r2 * (0.5f - r * (1.0f / 6.0f)) +
-              (r2 * r2) * (1.0f / 24.0f - r * (1.0f / 120.0f));
-    uint32_t bits = (uint32_t)(127 - k) << 23;
-    float scale;
-    memcpy(&scale, &bits, sizeof scale);
-    return e * scale;
 }
 
 static inline float dist2(lx_vec3 a, lx_vec3 b)
@@ -363,99 +337,72 @@ static void estimate_variance(filter *f)
 
 /* ---- the a-trous passes ------------------------------------------------------ */
 
-/* The tap offsets' squared lengths in texels, 1 / (i^2 + j^2) (0 unused). */
-static const float INV_LEN2[5][5] = {
-    {1.0f / 8, 1.0f / 5, 1.0f / 4, 1.0f / 5, 1.0f / 8}, {1.0f / 5, 1.0f / 2, 1.0f, 1.0f / 2, 1.0f / 5},
-    {1.0f / 4, 1.0f, 0.0f, 1.0f, 1.0f / 4},             {1.0f / 5, 1.0f / 2, 1.0f, 1.0f / 2, 1.0f / 5},
-    {1.0f / 8, 1.0f / 5, 1.0f / 4, 1.0f / 5, 1.0f / 8}};
-
-static void filter_texel(const filter *f, const float *src, float *dst, int x, int y, int step)
+/* The passes' planes: the guides as lx_dn_guides (the AoS records are
+ * freed), the signal as planes (invalid texels zero in both). */
+static bool to_planes(filter *f, lx_dn_guides *dg, lx_dn_planes *src, lx_dn_planes *dst,
+                      float **lum)
 {
-    int w = f->w, h = f->h;
-    size_t p = (size_t)y * w + x;
-    const guide *gp = &f->g[p];
-    uint32_t s = gp->surface;
-    const float *cp = src + 4 * p;
-    /* p's variance smoothed over its 3x3 neighbours on its surface */
-    float vs = 0.0f, gs = 0.0f;
-    for (int dy = -1; dy <= 1; dy++)
-        for (int dx = -1; dx <= 1; dx++) {
-            int qx = x + dx, qy = y + dy;
-            if (qx < 0 || qy < 0 || qx >= w || qy >= h)
-                continue;
-            size_t q = (size_t)qy * w + qx;
-            if (f->g[q].surface != s)
-                continue;
-            float g = G[dx + 1] * G[dy + 1];
-            vs += g * src[4 * q + 3];
-            gs += g;
-        }
-    vs /= gs;
-    float inv_sd = 1.0f / (f->sigma_l * sqrtf(vs) + SD_EPSILON);
-    float lp = lum(cp);
-    float inv_step2 = 1.0f / (float)(step * step);
-    float wsum = H[2] * H[2];
-    float acc[3] = {0.0f, 0.0f, 0.0f};
-    float vacc = wsum * wsum * cp[3];
-    for (int j = -2; j <= 2; j++) {
-        int qy = y + j * step;
-        if (qy < 0 || qy >= h)
-            continue;
-        for (int i = -2; i <= 2; i++) {
-            int qx = x + i * step;
-            if ((i == 0 && j == 0) || qx < 0 || qx >= w)
-                continue;
-            size_t q = (size_t)qy * w + qx;
-            const guide *gq = &f->g[q];
-            if (gq->surface != s)
-                continue;
-            float nd = lx_dot(gp->n, gq->n);
-            if (nd < f->cos_cut)
-                continue;
-            /* r^2: the squared distance over the squared offset in metres
-             * at the smaller texel size (the larger 1 / t^2) */
-            float inv_t2 = gp->s > gq->s ? gp->s : gq->s;
-            float r2 = dist2(gp->p, gq->p) * (INV_LEN2[j + 2][i + 2] * inv_step2) * inv_t2;
-            if (!(r2 <= f->r_cut2))
-                continue;
-            float ex = f->sigma_n * (1.0f - nd);
-            if (r2 > 1.0f) {
-                float u = (sqrtf(r2) - 1.0f) / f->sigma_p;
-                ex += u * u;
-            }
-            const float *cq = src + 4 * q;
-            if (f->use_luminance)
-                ex += fabsf(lp - lum(cq)) * inv_sd;
-            if (f->albedo) {
-                lx_vec3 da = lx_sub(f->albedo[p], f->albedo[q]);
-                ex += lx_dot(da, da) * f->inv_sa2;
-            }
-            float wq = H[i + 2] * H[j + 2] * exp_neg(ex);
-            acc[0] += wq * (cq[0] - cp[0]);
-            acc[1] += wq * (cq[1] - cp[1]);
-            acc[2] += wq * (cq[2] - cp[2]);
-            wsum += wq;
-            vacc += wq * wq * cq[3];
-        }
+    size_t n = (size_t)f->w * f->h;
+    float *gp = malloc(n * 7 * sizeof(float));
+    uint32_t *surface = malloc(n * sizeof(uint32_t));
+    if (!gp || !surface) {
+        free(gp);
+        free(surface);
+        return false;
     }
-    float *o = dst + 4 * p;
-    o[0] = cp[0] + acc[0] / wsum;
-    o[1] = cp[1] + acc[1] / wsum;
-    o[2] = cp[2] + acc[2] / wsum;
-    o[3] = vacc / (wsum * wsum);
+    dg->px = gp, dg->py = gp + n, dg->pz = gp + 2 * n;
+    dg->nx = gp + 3 * n, dg->ny = gp + 4 * n, dg->nz = gp + 5 * n;
+    dg->inv_t2 = gp + 6 * n;
+    dg->surface = surface;
+#pragma omp parallel for schedule(static) num_threads(f->threads)
+    for (int y = 0; y < f->h; y++)
+        for (size_t p = (size_t)y * f->w; p < (size_t)(y + 1) * f->w; p++) {
+            const guide *g = &f->g[p];
+            dg->px[p] = g->p.x, dg->py[p] = g->p.y, dg->pz[p] = g->p.z;
+            dg->nx[p] = g->n.x, dg->ny[p] = g->n.y, dg->nz[p] = g->n.z;
+            dg->inv_t2[p] = g->s;
+            dg->surface[p] = g->surface;
+        }
+    free(f->g);
+    f->g = NULL;
+    float *sp = malloc(n * 4 * sizeof(float));
+    if (!sp)
+        return false;
+    src->r = sp, src->g = sp + n, src->b = sp + 2 * n, src->v = sp + 3 * n;
+#pragma omp parallel for schedule(static) num_threads(f->threads)
+    for (int y = 0; y < f->h; y++)
+        for (size_t p = (size_t)y * f->w; p < (size_t)(y + 1) * f->w; p++) {
+            src->r[p] = f->a[4 * p], src->g[p] = f->a[4 * p + 1];
+            src->b[p] = f->a[4 * p + 2], src->v[p] = f->a[4 * p + 3];
+        }
+    free(f->a);
+    f->a = NULL;
+    float *dp = calloc(n * 5, sizeof(float)); /* dst's planes and the luminance */
+    if (!dp)
+        return false;
+    dst->r = dp, dst->g = dp + n, dst->b = dp + 2 * n, dst->v = dp + 3 * n;
+    *lum = dp + 4 * n;
+    return true;
 }
 
-static void atrous_pass(filter *f, const float *src, float *dst, int step)
+static void atrous_pass(filter *f, const lx_dn_guides *dg, const lx_dn_planes *src,
+                        const lx_dn_planes *dst, float *lum, float *scratch, int step)
 {
     int w = f->w, h = f->h;
-#pragma omp parallel for schedule(dynamic, 4) num_threads(f->threads)
-    for (int y = 0; y < h; y++) {
-        if (stopped(f))
-            continue;
-        for (int x = 0; x < w; x++)
-            if (f->g[(size_t)y * w + x].surface != NO_SURFACE)
-                filter_texel(f, src, dst, x, y, step);
-        row_done(f);
+#pragma omp parallel num_threads(f->threads)
+    {
+#pragma omp for schedule(static)
+        for (int y = 0; y < h; y++)
+            for (size_t p = (size_t)y * w; p < (size_t)(y + 1) * w; p++)
+                lum[p] = 0.2126f * src->r[p] + 0.7152f * src->g[p] + 0.0722f * src->b[p];
+        float *mine = scratch + LX_DN_ROW_SCRATCH(w) * (size_t)omp_get_thread_num();
+#pragma omp for schedule(dynamic, 4)
+        for (int y = 0; y < h; y++) {
+            if (stopped(f))
+                continue;
+            lx_dn_atrous_row(dg, src, lum, dst, y, step, mine);
+            row_done(f);
+        }
     }
 }
 
@@ -613,10 +560,22 @@ static lx_status run(lx_denoise_mode mode, const lx_denoise_guides *g, const flo
                 .user = d.progress_user};
     atomic_init(&f.rows, 0);
     atomic_init(&f.stop, false);
+    lx_dn_guides dg = {.w = w,
+                       .h = h,
+                       .albedo = g->albedo,
+                       .cos_cut = f.cos_cut,
+                       .sigma_n = f.sigma_n,
+                       .sigma_p = f.sigma_p,
+                       .r_cut2 = f.r_cut2,
+                       .sigma_l = f.sigma_l,
+                       .inv_sa2 = f.inv_sa2,
+                       .use_luminance = f.use_luminance};
+    lx_dn_planes pa = {0}, pb = {0};
+    float *lum = NULL, *scratch = NULL;
     f.g = malloc(n * sizeof(guide));
     f.a = malloc(n * 4 * sizeof(float));
-    f.b = malloc(n * 4 * sizeof(float));
-    if (!f.g || !f.a || !f.b) {
+    scratch = malloc(LX_DN_ROW_SCRATCH(w) * (size_t)threads * sizeof(float));
+    if (!f.g || !f.a || !scratch) {
         st = lx_fail(LX_ERR_NOMEM, "%s: out of memory for the scratch", what);
         goto done;
     }
@@ -646,11 +605,15 @@ static lx_status run(lx_denoise_mode mode, const lx_denoise_guides *g, const flo
     if (!g->variance)
         estimate_variance(&f);
 
-    float *src = f.a, *dst = f.b;
+    if (!stopped(&f) && !to_planes(&f, &dg, &pa, &pb, &lum)) {
+        st = lx_fail(LX_ERR_NOMEM, "%s: out of memory for the scratch", what);
+        goto done;
+    }
+    lx_dn_planes *src = &pa, *dst = &pb;
     for (int it = 0; it < d.iterations && !stopped(&f); it++) {
         stage_begin(&f, (float)(it + 1) / units, 1.0f / units);
-        atrous_pass(&f, src, dst, 1 << it);
-        float *t = src;
+        atrous_pass(&f, &dg, src, dst, lum, scratch, 1 << it);
+        lx_dn_planes *t = src;
         src = dst;
         dst = t;
     }
@@ -666,7 +629,7 @@ static lx_status run(lx_denoise_mode mode, const lx_denoise_guides *g, const flo
                 passthrough(direct, indirect, out, p);
                 continue;
             }
-            const float *r = src + 4 * p;
+            float r[3] = {src->r[p], src->g[p], src->b[p]};
             for (int c = 0; c < 3; c++)
                 out[3 * p + c] =
                     mode == LX_DENOISE_INDIRECT && direct ? direct[3 * p + c] + r[c] : r[c];
@@ -675,7 +638,11 @@ static lx_status run(lx_denoise_mode mode, const lx_denoise_guides *g, const flo
 done:
     free(f.g);
     free(f.a);
-    free(f.b);
+    free(dg.px); /* the planes' blocks start at their first plane */
+    free(dg.surface);
+    free(pa.r);
+    free(pb.r);
+    free(scratch);
     return st;
 }
 
