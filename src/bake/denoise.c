@@ -40,7 +40,9 @@
  *
  * Every value a pass writes is a fixed sum over the previous pass's
  * values in a fixed order; rows are shared among threads, so results are
- * bit-identical for any thread count. */
+ * bit-identical for any thread count. This file checks the input, builds
+ * the guides (sizes, surfaces, variance) and runs the passes;
+ * denoise_atrous.c computes a pass's rows. */
 #include "core/internal.h"
 #include "denoise_internal.h"
 #include "luxel/denoise.h"
