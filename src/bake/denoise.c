@@ -269,7 +269,9 @@ static void build_surfaces(filter *f)
     guide *g = f->g;
     /* each pair once: right, down-left, down, down-right */
     static const int DX[4] = {1, -1, 0, 1}, DY[4] = {0, 1, 1, 1};
-    for (int y = 0; y < h; y++)
+    for (int y = 0; y < h; y++) {
+        if (stopped(f))
+            return;
         for (int x = 0; x < w; x++) {
             size_t p = (size_t)y * w + x;
             if (!f->valid[p])
@@ -288,6 +290,8 @@ static void build_surfaces(filter *f)
                     unite(g, (uint32_t)p, (uint32_t)q);
             }
         }
+        row_done(f); /* on the calling thread: thread 0 */
+    }
     for (size_t p = 0; p < (size_t)w * h; p++)
         if (g[p].surface != NO_SURFACE) {
             g[p].surface = find(g, (uint32_t)p);
@@ -587,6 +591,9 @@ static lx_status run(lx_denoise_mode mode, const lx_denoise_guides *g, const flo
     init_guides(&f, g);
     if (!g->texel_size)
         measure_sizes(&f);
+    /* progress: the surfaces are the first half of the first unit (they
+     * run on one thread), the variance the second */
+    stage_begin(&f, 0.0f, 0.5f / units);
     build_surfaces(&f);
 
     /* the signal: RGB and its variance */
@@ -603,8 +610,8 @@ static lx_status run(lx_denoise_mode mode, const lx_denoise_guides *g, const flo
                        (mode == LX_DENOISE_ALL && direct ? direct[3 * p + c] : 0.0f);
             a[3] = g->variance ? g->variance[p] : 0.0f;
         }
-    stage_begin(&f, 0.0f, 1.0f / units);
-    if (!g->variance)
+    stage_begin(&f, 0.5f / units, 0.5f / units);
+    if (!g->variance && !stopped(&f))
         estimate_variance(&f);
 
     if (!stopped(&f) && !to_planes(&f, &dg, &pa, &pb, &lum)) {

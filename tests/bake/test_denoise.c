@@ -534,6 +534,14 @@ static bool stop_at_half(void *user, float fraction)
     return fraction < 0.5f;
 }
 
+static bool stop_at_once(void *user, float fraction)
+{
+    (void)fraction;
+    int *calls = user;
+    (*calls)++;
+    return false;
+}
+
 /* Bad inputs fail with a message naming the problem (and the texel) and
  * leave out as it was; so does cancelling. */
 static void test_bad_input_and_cancel(void **state)
@@ -593,6 +601,13 @@ static void test_bad_input_and_cancel(void **state)
     lx_denoise_desc d = {.progress = stop_at_half, .progress_user = &calls};
     assert_int_equal(lx_denoise(&g, m.rgb, out, &d), LX_ERR_CANCELLED);
     assert_true(calls > 0);
+    for (size_t i = 0; i < 3 * n; i++)
+        assert_true(out[i] == -7.0f);
+    /* stopped at the first report (the surfaces, before any pass) */
+    calls = 0;
+    d.progress = stop_at_once;
+    assert_int_equal(lx_denoise(&g, m.rgb, out, &d), LX_ERR_CANCELLED);
+    assert_int_equal(calls, 1);
     for (size_t i = 0; i < 3 * n; i++)
         assert_true(out[i] == -7.0f);
     free(out);
