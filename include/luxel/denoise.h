@@ -32,7 +32,7 @@
  *   field out of range, or a valid texel whose colour, position, normal,
  *   albedo, size or variance is NaN, infinite (or a zero normal, a
  *   negative size or variance); the message names the texel. LX_ERR_NOMEM
- *   when the scratch (64 bytes a texel) does not fit, LX_ERR_CANCELLED
+ *   when the scratch (80 bytes a texel) does not fit, LX_ERR_CANCELLED
  *   when the progress callback says stop. On any failure out is left as
  *   it was.
  * MEMORY  The guides are borrowed for the call. lx_baker_denoise_guides
@@ -99,9 +99,9 @@ typedef struct lx_denoise_guides {
     const uint32_t *chart;   /* chart id, NULL = one chart; texels of different
                                 ids are never mixed */
     const float *texel_size; /* world size of a texel in metres, NULL = measured
-                                from the positions (the smallest distance to a
-                                neighbour on the same surface, or the largest of
-                                those within twice that: anisotropic charts) */
+                                from the positions: the largest distance to an
+                                8-neighbour of its chart and facing (diagonals
+                                / sqrt 2) within twice the smallest one */
     const float *variance;   /* variance of the filtered signal's luminance
                                 (a Monte Carlo estimate: sample variance /
                                 samples), NULL = estimated from the 5x5
