@@ -53,6 +53,7 @@ bench: all
 	$(BUILD)/bin/bench_horizon
 	$(BUILD)/bin/bench_light2d
 	$(BUILD)/bin/bench_gi
+	$(BUILD)/bin/bench_denoise
 
 fuzz: all
 	@test -f $(BUILD_FUZZ)/CMakeCache.txt || CC=clang cmake -S . -B $(BUILD_FUZZ) -DCMAKE_BUILD_TYPE=Debug -DLX_FUZZ=ON

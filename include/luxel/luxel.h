@@ -13,6 +13,7 @@
 #include "luxel/trace.h"
 #include "luxel/maps.h"
 #include "luxel/bake.h"
+#include "luxel/denoise.h"
 #include "luxel/ibl.h"
 #include "luxel/unwrap.h"
 #include "luxel/render.h"
