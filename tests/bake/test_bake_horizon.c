@@ -411,6 +411,53 @@ static void heights_from_normals_bad_input(void **state)
     lx_scene_destroy(scene);
 }
 
+static char g_warning[512];
+static int g_warnings;
+static void keep_warning(void *user, lx_log_level level, const char *message)
+{
+    (void)user;
+    if (level == LX_LOG_WARN && strstr(message, "UV set")) {
+        g_warnings++;
+        snprintf(g_warning, sizeof g_warning, "%s", message);
+    }
+}
+
+/* A height material read at a UV set its mesh lacks: one warning line
+ * naming the mesh, the set and the material; the bake is as without it. */
+static void missing_uv_set_warns(void **state)
+{
+    (void)state;
+    const char *dir = lx_test_dir("bake-horizon-uvset");
+    char name[1024];
+    snprintf(name, sizeof name, "%s/lights.json", dir);
+    write_height(dir, "step.pfm", 16, step);
+    lx_scene *scene = lx_test_new_scene("horizon-uvset");
+    lx_material mat = {.name = "bumpy", .base_color = {1, 1, 1, 1}, .normal_scale = 1.0f,
+                       .normal_uv_set = 1};
+    assert_int_equal(lx_scene_add_material(scene, &mat, NULL), LX_OK);
+    lx_mesh plane = lx_test_plane("plane", 4.0f, 0.0f, 0.0f, 0.0f, 2);
+    free(plane.uv[1]); /* the lightmap's UVs only */
+    plane.uv[1] = NULL;
+    lx_test_add(scene, &plane);
+    lx_test_mesh_free(&plane);
+    assert_null(scene->meshes[0].uv[1]);
+    const char *json = "{\"materials\": {\"bumpy\": {\"height\": \"step.pfm\"}}}";
+    assert_int_equal(lx_lights_json_apply_text(scene, json, strlen(json), name), LX_OK);
+    g_warnings = 0;
+    lx_set_log_callback(keep_warning, NULL);
+    lx_bake_desc desc = {.resolution = 8, .threads = 2};
+    lx_baker *baker = NULL;
+    lx_status st = lx_baker_create(scene, &desc, &baker);
+    lx_set_log_callback(NULL, NULL);
+    assert_int_equal(st, LX_OK);
+    assert_int_equal(g_warnings, 1);
+    assert_non_null(strstr(g_warning, "'plane'"));
+    assert_non_null(strstr(g_warning, "UV set 1"));
+    assert_non_null(strstr(g_warning, "'bumpy'"));
+    lx_baker_destroy(baker);
+    lx_scene_destroy(scene);
+}
+
 int main(void)
 {
     lx_test_watchdog(300);
@@ -421,6 +468,7 @@ int main(void)
         cmocka_unit_test(bad_input_is_named),
         cmocka_unit_test(heights_from_normals_bake_like_the_heights),
         cmocka_unit_test(heights_from_normals_bad_input),
+        cmocka_unit_test(missing_uv_set_warns),
     };
     return cmocka_run_group_tests(tests, NULL, NULL);
 }
