@@ -33,9 +33,9 @@
 #include <string.h>
 
 #define HN_PI 3.14159265358979323846
-/* Columns gathered and transformed together (cache lines of a column
- * block are used whole). */
-#define HN_BLOCK 8
+/* Columns gathered and transformed together: a block's part of a row
+ * spans whole cache lines and the gather touches each page once a block. */
+#define HN_BLOCK 32
 /* A normal's z below this counts as this: slopes at most 16. */
 #define HN_MIN_Z (1.0 / 16.0)
 
@@ -177,22 +177,32 @@ static void divergence(hn_job *j, const float *gx, const float *gy)
 
 /* Divides each transformed value by the eigenvalue of -L (the constant
  * mode, eigenvalue 0, set to 0). */
-static void solve_spectrum(hn_job *j)
+static lx_status solve_spectrum(hn_job *j)
 {
     int w = j->w, h = j->h, per = j->periodic ? 2 : 1;
     double ax = j->periodic ? HN_PI / w : HN_PI / (2.0 * w);
     double ay = j->periodic ? HN_PI / h : HN_PI / (2.0 * h);
+    /* 4 sin^2 along each axis, once */
+    double *ex = malloc(sizeof(double) * ((size_t)w + (size_t)h));
+    if (!ex)
+        return lx_fail(LX_ERR_NOMEM, "heights from normals: out of memory");
+    double *ey = ex + w;
+    for (int k = 0; k < w; k++)
+        ex[k] = 4.0 * sin(ax * k) * sin(ax * k);
+    for (int l = 0; l < h; l++)
+        ey[l] = 4.0 * sin(ay * l) * sin(ay * l);
 #pragma omp parallel for schedule(static) num_threads(lx_thread_count(j->threads))
     for (int l = 0; l < h; l++) {
-        double sy = sin(ay * l);
+        double *row = j->v + (size_t)l * (size_t)w * (size_t)per;
         for (int k = 0; k < w; k++) {
-            double sx = sin(ax * k);
-            double lambda = 4.0 * (sx * sx + sy * sy);
-            size_t i = ((size_t)l * (size_t)w + (size_t)k) * (size_t)per;
+            double lambda = ex[k] + ey[l];
+            double f = lambda > 0.0 ? 1.0 / lambda : 0.0;
             for (int c = 0; c < per; c++)
-                j->v[i + c] = lambda > 0.0 ? j->v[i + c] / lambda : 0.0;
+                row[(size_t)k * per + c] *= f;
         }
     }
+    free(ex);
+    return LX_OK;
 }
 
 static bool report(const lx_height_from_normals_desc *d, float f)
@@ -258,8 +268,8 @@ lx_status lx_height_from_normals(const lx_image *normals, const lx_height_from_n
             break;
         }
         st = pass(&j, steps[s].rows, steps[s].inverse);
-        if (s == 1)
-            solve_spectrum(&j);
+        if (s == 1 && st == LX_OK)
+            st = solve_spectrum(&j);
         f += 0.2f;
     }
     if (st != LX_OK)
