@@ -64,6 +64,10 @@ static lx_status pass(hn_job *j, bool along_rows, bool inverse)
 {
     const lx_fft_plan *p = along_rows ? &j->row : &j->col;
     int len = p->n, lines = along_rows ? j->h : j->w;
+    /* real data: the spectrum's columns k and W - k are conjugate, so
+     * columns 0..W/2 are all the solve needs (real_rows fills the rest) */
+    if (!along_rows && j->periodic)
+        lines = j->w / 2 + 1;
     int per = j->periodic ? 2 : 1; /* doubles per value */
     int block = along_rows ? 1 : HN_BLOCK;
     int tasks = (lines + block - 1) / block;
@@ -103,6 +107,69 @@ static lx_status pass(hn_job *j, bool along_rows, bool inverse)
                     for (int y = 0; y < len; y++)
                         for (int k = 0; k < per; k++)
                             j->v[(size_t)y * rowlen + x + k] = line[(size_t)y * per + k];
+                }
+            }
+        }
+        free(scratch);
+    }
+    return nomem ? lx_fail(LX_ERR_NOMEM, "heights from normals: out of memory") : LX_OK;
+}
+
+/* The periodic case's row transforms of real data, two rows in one complex
+ * transform (rows 2q and 2q + 1, the same pairs for any thread count).
+ * Forward: z = a + i b, Z = F(z), A_k = (Z_k + conj Z_-k) / 2,
+ * B_k = (Z_k - conj Z_-k) / 2i. Inverse: rows whose spectra are only valid
+ * for k <= W/2 (conjugate above), z = A + i B, F^-1(z) = a + i b, the real
+ * results in the real parts. */
+static lx_status real_rows(hn_job *j, bool inverse)
+{
+    const lx_fft_plan *p = &j->row;
+    int w = j->w, pairs = (j->h + 1) / 2;
+    size_t rowlen = 2 * (size_t)w;
+    volatile int nomem = 0;
+#pragma omp parallel num_threads(lx_thread_count(j->threads))
+    {
+        double *scratch = malloc(sizeof(double) * (lx_fft_scratch(p) + rowlen));
+        if (!scratch)
+            nomem = 1;
+#pragma omp for schedule(dynamic, 4)
+        for (int q = 0; q < pairs; q++) {
+            if (!scratch)
+                continue;
+            double *z = scratch + lx_fft_scratch(p);
+            double *a = j->v + (size_t)(2 * q) * rowlen;
+            double *b = 2 * q + 1 < j->h ? a + rowlen : NULL; /* none: the last of odd H */
+            if (!inverse) {
+                for (int k = 0; k < w; k++) {
+                    z[2 * k] = a[2 * k];
+                    z[2 * k + 1] = b ? b[2 * k] : 0.0;
+                }
+                lx_fft(p, z, false, scratch);
+                for (int k = 0; k < w; k++) {
+                    int m = k ? w - k : 0;
+                    double zr = z[2 * k], zi = z[2 * k + 1], mr = z[2 * m], mi = z[2 * m + 1];
+                    a[2 * k] = 0.5 * (zr + mr);
+                    a[2 * k + 1] = 0.5 * (zi - mi);
+                    if (b) {
+                        b[2 * k] = 0.5 * (zi + mi);
+                        b[2 * k + 1] = -0.5 * (zr - mr);
+                    }
+                }
+            } else {
+                for (int k = 0; k < w; k++) {
+                    /* above W/2 the conjugate of W - k */
+                    int m = k <= w / 2 ? k : w - k;
+                    double sg = k <= w / 2 ? 1.0 : -1.0;
+                    double ar = a[2 * m], ai = sg * a[2 * m + 1];
+                    double br = b ? b[2 * m] : 0.0, bi = b ? sg * b[2 * m + 1] : 0.0;
+                    z[2 * k] = ar - bi;
+                    z[2 * k + 1] = ai + br;
+                }
+                lx_fft(p, z, true, scratch);
+                for (int k = 0; k < w; k++) {
+                    a[2 * k] = z[2 * k];
+                    if (b)
+                        b[2 * k] = z[2 * k + 1];
                 }
             }
         }
@@ -267,7 +334,8 @@ lx_status lx_height_from_normals(const lx_image *normals, const lx_height_from_n
             st = lx_fail(LX_ERR_CANCELLED, "heights from normals cancelled");
             break;
         }
-        st = pass(&j, steps[s].rows, steps[s].inverse);
+        st = steps[s].rows && j.periodic ? real_rows(&j, steps[s].inverse)
+                                         : pass(&j, steps[s].rows, steps[s].inverse);
         if (s == 1 && st == LX_OK)
             st = solve_spectrum(&j);
         f += 0.2f;
