@@ -12,7 +12,11 @@
  *     then Sobel and Scharr;
  *  2. lx_parallax_map (one channel out);
  *  3. lx_normal_encode and the 16-bit PNG of the encoded map
- *     (lx_image_write, for scale: deflate dominates).
+ *     (lx_image_write, for scale: deflate dominates);
+ *  4. lx_height_from_normals of the central normal map: repeat (complex
+ *     transforms), clamp (cosine transforms), and repeat at the prime size
+ *     N - 9 when that is prime (2039: Bluestein's transforms), against the
+ *     baseline and the normal map that made them.
  *
  * Usage: bench_maps [--threads N] [--size N] (default 2 threads, 2048)
  * The last line is a one-line summary.
@@ -116,6 +120,25 @@ static void run_encode(void *p)
         lx_bench_die("lx_normal_encode");
 }
 
+static lx_wrap g_wrap;
+
+static void run_heights(void *p)
+{
+    job *j = p;
+    lx_image_free(&j->out);
+    lx_height_from_normals_desc d = {.wrap = g_wrap, .threads = g_threads};
+    if (lx_height_from_normals(&j->height, &d, &j->out) != LX_OK)
+        lx_bench_die("lx_height_from_normals");
+}
+
+static bool is_prime(int n)
+{
+    for (int k = 2; k * k <= n; k++)
+        if (n % k == 0)
+            return false;
+    return n > 1;
+}
+
 static void run_png16(void *p)
 {
     job *j = p;
@@ -196,6 +219,34 @@ int main(int argc, char **argv)
     printf("  %-40s %8.2f ms  %6.2fx baseline  (%d runs)\n", "16-bit PNG write of the map",
            1e3 * t_png, t_png / t_base, runs);
     lx_image_free(&encoded);
+
+    /* heights integrated back from the normals */
+    j.height = normals;
+    double t_heights[2];
+    for (int w = 0; w < 2; w++) {
+        g_wrap = w == 0 ? LX_WRAP_REPEAT : LX_WRAP_CLAMP;
+        t_heights[w] = best_of(run_heights, &j, 3, 1.0, &runs);
+        char what[64];
+        snprintf(what, sizeof what, "lx_height_from_normals (%s)", lx_wrap_name(g_wrap));
+        printf("  %-40s %8.2f ms  %6.2fx baseline  %5.1fx normal map  (%d runs)\n", what,
+               1e3 * t_heights[w], t_heights[w] / t_base, t_heights[w] / t_filter[0], runs);
+    }
+    if (is_prime(N - 9)) {
+        lx_image odd;
+        if (lx_image_alloc(&odd, N - 9, N - 9, 3) != LX_OK)
+            lx_bench_die("lx_image_alloc");
+        for (int y = 0; y < N - 9; y++)
+            memcpy(odd.data + (size_t)y * (N - 9) * 3, normals.data + (size_t)y * N * 3,
+                   sizeof(float) * 3 * (size_t)(N - 9));
+        j.height = odd;
+        g_wrap = LX_WRAP_REPEAT;
+        double t_odd = best_of(run_heights, &j, 3, 1.0, &runs);
+        char what[64];
+        snprintf(what, sizeof what, "  the same at %dx%d (prime)", N - 9, N - 9);
+        printf("  %-40s %8.2f ms  %6.2fx baseline  %5.1fx normal map  (%d runs)\n", what,
+               1e3 * t_odd, t_odd / t_base, t_odd / t_filter[0], runs);
+        lx_image_free(&odd);
+    }
     lx_image_free(&normals);
     j.height = keep;
 

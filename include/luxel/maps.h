@@ -119,6 +119,42 @@ lx_status lx_normal_encode(const lx_image *normals, lx_image *out);
  * direction (zero length) or not finite, and for fewer than 3 channels. */
 lx_status lx_normal_decode(const lx_image *encoded, const char *name, lx_image *out);
 
+/* ---- heights from normal maps -----------------------------------------------
+ * The inverse of lx_normal_map: heights whose slopes best fit a normal
+ * map's, g = (-n.x / n.z, -n.y / n.z) texels of height per texel (x along
+ * the columns, y up the image; normals with z below 1/16 count as
+ * z = 1/16). Least squares over every step between neighbouring texels
+ * (the step's height change against the mean of its two texels' slopes),
+ * solved exactly (the Poisson equation, by fast Fourier or cosine
+ * transforms at any size). Heights are defined up to a constant: the
+ * lowest is 0. docs/maps.md has the details and the accuracy. */
+
+typedef struct lx_height_from_normals_desc {
+    lx_wrap wrap;            /* REPEAT (default): the map tiles, steps wrap
+                                around the edges; CLAMP and MIRROR: no steps
+                                across the edges (Neumann boundaries) */
+    bool green_down;         /* y down the image (DirectX); default up (OpenGL, glTF) */
+    int threads;             /* 0 = all cores */
+    lx_progress_fn progress; /* may be NULL; returning false cancels */
+    void *progress_user;
+} lx_height_from_normals_desc;
+
+/* A copy of desc (or of zeros when NULL) with every default filled in. */
+lx_height_from_normals_desc
+lx_height_from_normals_desc_defaults(const lx_height_from_normals_desc *desc);
+
+/* Heights in texels (strength 1: lx_normal_map with strength 1 and the
+ * same wrap gives back the normals, up to the fit's error) of unit
+ * tangent-space normals (lx_normal_decode; 3 or more channels, the first
+ * three read; any non-zero length is normalized) into *out (one channel,
+ * the normals' size, allocated here; zeroed on failure). The lowest height
+ * is 0. The result does not depend on desc->threads. Fails with
+ * LX_ERR_INVALID naming the texel of a normal that is not finite or has
+ * zero length, LX_ERR_NOMEM (saying how much) when the work does not fit:
+ * 28 bytes a texel with REPEAT, 20 otherwise, and LX_ERR_CANCELLED. */
+lx_status lx_height_from_normals(const lx_image *normals, const lx_height_from_normals_desc *desc,
+                                 lx_image *out);
+
 /* How a detail normal map perturbs a base one (Barre-Brisebois and Hill,
  * "Blending in Detail", 2012). RNM (reoriented normal mapping) rotates
  * the detail by the rotation taking +z to the base normal:

@@ -126,7 +126,15 @@ typedef struct lx_material {
      * material's texels with, read at uv[normal_uv_set] under
      * normal_transform. NULL path = none. */
     char *height_map_path; /* resolved against the JSON's folder; loaded by the baker */
-    float height_strength; /* texels of height per unit value; 0 = LX_DEFAULT_HEIGHT_STRENGTH */
+    float height_strength; /* texels of height per unit value; 0 = LX_DEFAULT_HEIGHT_STRENGTH
+                            * (heights from normals: a multiplier, 0 = 1) */
+    /* Or heights integrated from a normal map (lx_height_from_normals, wrap
+     * repeat) when height_from_normals: the image at height_normal_path, or
+     * this material's normal_map (its heights times normal_scale) when that
+     * is NULL. height_map_path is then NULL. */
+    bool height_from_normals;
+    char *height_normal_path; /* resolved against the JSON's folder, or NULL */
+    bool height_green_down;   /* that normal map's y points down the image (DirectX) */
     bool height_horizon;   /* direct light times the horizon factor */
     bool height_ao;        /* ambient and sky light times the AO map */
 } lx_material;

@@ -147,11 +147,17 @@ lx_status lx_texel_map_build(const lx_scene *scene, const lx_page_spec *page,
                              const lx_horizon_material *horizon, lx_lightmap *map);
 
 /* horizon.c: the horizon layers and AO of every material with a height
- * (one per scene material; *out NULL when none has one), loaded and made
- * once; the per-texel data of a map (b1, b2: the raster's barycentrics
+ * (one per scene material; *out NULL when none has one), loaded (or
+ * integrated from a normal map) and made once, reporting to desc->progress
+ * within share and stopping with LX_ERR_CANCELLED when it says so; a
+ * warning for each mesh of such a material without its UV set; the per-texel data of a map (b1, b2: the raster's barycentrics
  * per pixel); a light's factor at a texel; whether a tile has any such
  * texel. */
-lx_status lx_bake_horizon_load(const lx_scene *scene, int threads, lx_horizon_material **out);
+lx_status lx_bake_horizon_load(const lx_scene *scene, const lx_bake_desc *desc,
+                               lx_texel_progress share, lx_horizon_material **out);
+/* Whether a mesh of node has a material with horizon maps (its texels
+ * then take an lx_texel_horizon each). */
+bool lx_bake_node_has_horizon(const lx_scene *scene, const lx_horizon_material *hm, uint32_t node);
 void lx_bake_horizon_free(lx_horizon_material *hm, uint32_t count);
 lx_status lx_bake_horizon_texels(const lx_scene *scene, const lx_horizon_material *hm,
                                  lx_lightmap *map, const float *b1, const float *b2, int threads);

@@ -68,8 +68,25 @@ static lx_status validate_desc(const lx_bake_desc *d)
     return LX_OK;
 }
 
-/* lx_baker_create's progress: the texel maps, then the BVH build. */
+/* lx_baker_create's progress: the materials' horizon maps (when any
+ * material has a height: up to HORIZON_SHARE), the texel maps (up to
+ * TEXEL_MAPS_SHARE), then the BVH build. */
 #define TEXEL_MAPS_SHARE 0.9f
+#define HORIZON_SHARE 0.3f
+
+/* Where the texel maps' progress starts. */
+static float maps_from(const lx_baker *b)
+{
+    return b->horizon_materials ? HORIZON_SHARE : 0.0f;
+}
+
+/* Bytes a w x h lightmap takes per texel, with the texel's horizon record
+ * when a material on it has a height. */
+static uint64_t map_bytes(int w, int h, bool horizon)
+{
+    return (uint64_t)w * (uint64_t)h *
+           (LX_BYTES_PER_TEXEL + (horizon ? sizeof(lx_texel_horizon) : 0));
+}
 
 static bool bvh_progress(void *user, float fraction)
 {
@@ -87,7 +104,7 @@ static lx_status build_node_maps(lx_baker *b, const lx_scene *scene, const lx_ba
     for (uint32_t n = 0; n < scene->node_count; n++) {
         int w, h;
         lx_texel_map_size(scene, n, desc, &w, &h);
-        bytes += (uint64_t)w * (uint64_t)h * LX_BYTES_PER_TEXEL;
+        bytes += map_bytes(w, h, lx_bake_node_has_horizon(scene, b->horizon_materials, n));
         largest = w > largest ? w : largest;
         with_uvs += w > 0;
     }
@@ -97,8 +114,9 @@ static lx_status build_node_maps(lx_baker *b, const lx_scene *scene, const lx_ba
     lx_status st = lx_check_memory(bytes, what);
     for (uint32_t n = 0; n < scene->node_count && st == LX_OK; n++) {
         lx_lightmap *map = &b->maps[b->map_count];
-        lx_texel_progress share = {TEXEL_MAPS_SHARE * (float)n / (float)scene->node_count,
-                                   TEXEL_MAPS_SHARE * (float)(n + 1) / (float)scene->node_count};
+        float from = maps_from(b), span = TEXEL_MAPS_SHARE - from;
+        lx_texel_progress share = {from + span * (float)n / (float)scene->node_count,
+                                   from + span * (float)(n + 1) / (float)scene->node_count};
         lx_page_node pn = {n, (int)desc->uv_set - 1, {1.0f, 1.0f, 0.0f, 0.0f}};
         lx_page_spec page = {scene->nodes[n].name, 0, 0, &pn, 1};
         st = lx_texel_map_build(scene, &page, desc, share, b->horizon_materials, map);
@@ -134,13 +152,20 @@ static lx_status build_pages(lx_baker *b, const lx_scene *scene, const lx_bake_d
             pg->height > LX_MAX_LIGHTMAP_SIZE)
             return lx_fail(LX_ERR_INVALID, "%s: atlas page %u is %dx%d (1..%d a side)", scene->path,
                            p, pg->width, pg->height, LX_MAX_LIGHTMAP_SIZE);
-        bytes += (uint64_t)pg->width * (uint64_t)pg->height * LX_BYTES_PER_TEXEL;
     }
     for (uint32_t n = 0; n < scene->node_count; n++) {
         const lx_unwrap_node *un = &atlas->nodes[n];
         if (un->page != UINT32_MAX && un->page >= atlas->page_count)
             return lx_fail(LX_ERR_INVALID, "%s: node '%s': atlas page %u out of range (count %u)",
                            scene->path, scene->nodes[n].name, un->page, atlas->page_count);
+    }
+    for (uint32_t p = 0; p < atlas->page_count; p++) {
+        /* a page takes horizon records when a node on it has a height */
+        bool horizon = false;
+        for (uint32_t n = 0; n < scene->node_count && !horizon; n++)
+            horizon = atlas->nodes[n].page == p &&
+                      lx_bake_node_has_horizon(scene, b->horizon_materials, n);
+        bytes += map_bytes(atlas->pages[p].width, atlas->pages[p].height, horizon);
     }
     char what[400];
     snprintf(what, sizeof what, "%s: baking %u atlas pages", scene->path, atlas->page_count);
@@ -163,8 +188,9 @@ static lx_status build_pages(lx_baker *b, const lx_scene *scene, const lx_bake_d
         char name[32];
         snprintf(name, sizeof name, "lightmap-%u", p);
         lx_page_spec page = {name, atlas->pages[p].width, atlas->pages[p].height, nodes, count};
-        lx_texel_progress share = {TEXEL_MAPS_SHARE * (float)p / (float)atlas->page_count,
-                                   TEXEL_MAPS_SHARE * (float)(p + 1) / (float)atlas->page_count};
+        float from = maps_from(b), span = TEXEL_MAPS_SHARE - from;
+        lx_texel_progress share = {from + span * (float)p / (float)atlas->page_count,
+                                   from + span * (float)(p + 1) / (float)atlas->page_count};
         lx_lightmap *map = &b->maps[b->map_count];
         st = lx_texel_map_build(scene, &page, desc, share, b->horizon_materials, map);
         if (st != LX_OK) {
@@ -310,7 +336,8 @@ lx_status lx_baker_create(const lx_scene *scene, const lx_bake_desc *in, lx_bake
     }
     /* heights named by the lights JSON: horizon layers and AO, made once */
     b->horizon_material_count = scene->material_count;
-    st = lx_bake_horizon_load(scene, desc.threads, &b->horizon_materials);
+    st = lx_bake_horizon_load(scene, &desc, (lx_texel_progress){0.0f, HORIZON_SHARE},
+                              &b->horizon_materials);
     if (st == LX_OK)
         st = desc.atlas ? build_pages(b, scene, &desc) : build_node_maps(b, scene, &desc);
     /* the texels keep what they need of them */

@@ -1,7 +1,8 @@
 /* Horizon self-shadowing and ambient occlusion of texels from a height
  * texture per material (Lengyel, FGED vol. 2 sec. 7.8: the horizon map and
  * its shading function ApplyHorizonMap, and the ambient factor): each
- * material the lights JSON gives a height gets its horizon layers and AO
+ * material the lights JSON gives a height (or a normal map to integrate
+ * heights from, lx_height_from_normals) gets its horizon layers and AO
  * map made once (lx_horizon_map, wrap repeat); each of its texels keeps the
  * layers and AO sampled bilinearly at its material UV and its tangent
  * frame, and direct.c scales a light's direct term by lx_horizon_light of
@@ -23,33 +24,104 @@ void lx_bake_horizon_free(lx_horizon_material *hm, uint32_t count)
     free(hm);
 }
 
-lx_status lx_bake_horizon_load(const lx_scene *scene, int threads, lx_horizon_material **out)
+static bool has_height(const lx_material *mat)
+{
+    return (mat->height_map_path || mat->height_from_normals) &&
+           (mat->height_horizon || mat->height_ao);
+}
+
+/* Progress of one material's steps within the bake's share for them. */
+typedef struct horizon_progress {
+    const lx_bake_desc *desc;
+    float from, to;
+} horizon_progress;
+
+static bool material_progress(void *user, float f)
+{
+    const horizon_progress *p = user;
+    return p->desc->progress(p->desc->progress_user, p->from + (p->to - p->from) * f);
+}
+
+/* The heights of mat integrated from its normal map (the named file, or
+ * its own normal texture), in texels times *strength_out's factor. */
+static lx_status heights_from_normals(const lx_material *mat, const lx_bake_desc *desc,
+                                      horizon_progress *hp, lx_image *height, float *scale)
+{
+    lx_image normals;
+    lx_status st;
+    *scale = mat->height_strength > 0.0f ? mat->height_strength : 1.0f;
+    if (mat->height_normal_path) {
+        lx_image img;
+        lx_image_load_desc ld = {.raw_8bit = true};
+        st = lx_image_load(mat->height_normal_path, &ld, &img);
+        if (st == LX_OK) {
+            st = lx_normal_decode(&img, mat->height_normal_path, &normals);
+            lx_image_free(&img);
+        }
+    } else {
+        /* the glTF normal texture, whose slopes normal_scale multiplies */
+        const char *name = mat->normal_map_path ? mat->normal_map_path : "normal texture";
+        st = lx_normal_decode(&mat->normal_map, name, &normals);
+        *scale *= mat->normal_scale > 0.0f ? mat->normal_scale : 1.0f;
+    }
+    if (st != LX_OK)
+        return st;
+    lx_height_from_normals_desc d = {.wrap = LX_WRAP_REPEAT,
+                                     .green_down = mat->height_green_down,
+                                     .threads = desc->threads,
+                                     .progress = desc->progress ? material_progress : NULL,
+                                     .progress_user = hp};
+    st = lx_height_from_normals(&normals, &d, height);
+    lx_image_free(&normals);
+    return st;
+}
+
+lx_status lx_bake_horizon_load(const lx_scene *scene, const lx_bake_desc *desc,
+                               lx_texel_progress share, lx_horizon_material **out)
 {
     *out = NULL;
-    bool any = false;
+    uint32_t count = 0;
     for (uint32_t m = 0; m < scene->material_count; m++)
-        any |= scene->materials[m].height_map_path != NULL &&
-               (scene->materials[m].height_horizon || scene->materials[m].height_ao);
-    if (!any)
+        count += has_height(&scene->materials[m]);
+    if (!count)
         return LX_OK;
     lx_horizon_material *hm = calloc(scene->material_count, sizeof *hm);
     if (!hm)
         return lx_fail(LX_ERR_NOMEM, "%s: out of memory for height maps", scene->path);
     lx_status st = LX_OK;
+    uint32_t done = 0;
     for (uint32_t m = 0; m < scene->material_count && st == LX_OK; m++) {
         const lx_material *mat = &scene->materials[m];
-        if (!mat->height_map_path || !(mat->height_horizon || mat->height_ao))
+        if (!has_height(mat))
             continue;
+        /* this material's part of the share: integrating (when from a
+         * normal map) and the horizon map, half each */
+        float from = share.from + (share.to - share.from) * (float)done / (float)count;
+        float to = share.from + (share.to - share.from) * (float)(done + 1) / (float)count;
+        float mid = mat->height_from_normals ? 0.5f * (from + to) : from;
+        horizon_progress hp = {desc, from, mid};
         lx_image height;
-        st = lx_height_load(mat->height_map_path, &height);
+        float strength = mat->height_strength;
+        if (mat->height_from_normals)
+            st = heights_from_normals(mat, desc, &hp, &height, &strength);
+        else
+            st = lx_height_load(mat->height_map_path, &height);
         if (st == LX_OK) {
-            lx_horizon_desc d = {.strength = mat->height_strength,
+            hp.from = mid;
+            hp.to = to;
+            lx_horizon_desc d = {.strength = strength,
                                  .wrap = LX_WRAP_REPEAT,
-                                 .threads = threads};
+                                 .threads = desc->threads,
+                                 .progress = desc->progress ? material_progress : NULL,
+                                 .progress_user = &hp};
             st = lx_horizon_map(&height, &d, mat->height_horizon ? &hm[m].layer0 : NULL,
                                 mat->height_horizon ? &hm[m].layer1 : NULL,
                                 mat->height_ao ? &hm[m].ao : NULL);
             lx_image_free(&height);
+        }
+        if (st == LX_ERR_CANCELLED) {
+            lx_fail(LX_ERR_CANCELLED, "bake cancelled");
+            break;
         }
         if (st != LX_OK) {
             char where[300];
@@ -61,6 +133,22 @@ lx_status lx_bake_horizon_load(const lx_scene *scene, int threads, lx_horizon_ma
         hm[m].horizon = mat->height_horizon;
         hm[m].use_ao = mat->height_ao;
         hm[m].active = true;
+        done++;
+    }
+    /* a mesh of such a material without the UV set its height is read at
+     * bakes without it: say so once per mesh */
+    for (uint32_t i = 0; i < scene->mesh_count && st == LX_OK; i++) {
+        const lx_mesh *mesh = &scene->meshes[i];
+        if (mesh->material >= scene->material_count || !hm[mesh->material].active)
+            continue;
+        const lx_material *mat = &scene->materials[mesh->material];
+        if (mat->normal_uv_set < 0 || mat->normal_uv_set >= LX_MAX_UV_SETS ||
+            !mesh->uv[mat->normal_uv_set])
+            lx_log(LX_LOG_WARN,
+                   "%s: mesh '%s' has no UV set %d for material '%s''s height: no horizon "
+                   "shadows or AO on it",
+                   scene->path, mesh->name ? mesh->name : "", mat->normal_uv_set,
+                   mat->name ? mat->name : "");
     }
     if (st != LX_OK) {
         lx_bake_horizon_free(hm, scene->material_count);
@@ -68,6 +156,19 @@ lx_status lx_bake_horizon_load(const lx_scene *scene, int threads, lx_horizon_ma
     }
     *out = hm;
     return LX_OK;
+}
+
+bool lx_bake_node_has_horizon(const lx_scene *scene, const lx_horizon_material *hm, uint32_t node)
+{
+    if (!hm)
+        return false;
+    const lx_node *n = &scene->nodes[node];
+    for (uint32_t k = 0; k < n->mesh_count; k++) {
+        const lx_mesh *m = &scene->meshes[n->meshes[k]];
+        if (m->material < scene->material_count && hm[m->material].active)
+            return true;
+    }
+    return false;
 }
 
 /* The material a texel's mesh uses, when it has horizon maps and the mesh

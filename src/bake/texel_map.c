@@ -627,7 +627,12 @@ lx_status lx_texel_map_build(const lx_scene *scene, const lx_page_spec *page,
     uint64_t pixels = (uint64_t)w * (uint64_t)h;
     char what[400];
     snprintf(what, sizeof what, "%s: lightmap '%s' (%dx%d)", scene->path, page->name, w, h);
-    lx_status st = lx_check_memory(pixels * LX_BYTES_PER_TEXEL, what);
+    /* with a horizon record a texel when a node here has a height */
+    bool horizon_texels = false;
+    for (uint32_t k = 0; k < page->node_count && !horizon_texels; k++)
+        horizon_texels = lx_bake_node_has_horizon(scene, horizon, page->nodes[k].node);
+    lx_status st = lx_check_memory(
+        pixels * (LX_BYTES_PER_TEXEL + (horizon_texels ? sizeof(lx_texel_horizon) : 0)), what);
     if (st != LX_OK) {
         free(slots);
         return st;

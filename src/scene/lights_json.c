@@ -5,10 +5,8 @@
  * is a sphere, as in Filament). Parsed with cJSON; every key, type, length and
  * value is checked, and nothing changes in the scene unless the whole file
  * is valid. */
-#include "luxel/scene.h"
-#include "core/internal.h"
-
-#include "json_text.h"
+#include "json_fields.h"
+#include "lights_json_internal.h"
 
 #include <cjson/cJSON.h>
 #include <stdio.h>
@@ -16,15 +14,6 @@
 #include <string.h>
 
 #define LX_LIGHTS_JSON_MAX ((size_t)64 << 20)
-
-typedef struct ctx {
-    const char *file;          /* name used in messages */
-    char where[128];           /* "lights[2] ('key')" or "" at the root */
-    lx_ies_profile **profiles; /* loaded by this file: the scene adopts them */
-    uint32_t profile_count;
-} ctx;
-
-#define fail(c, st, ...) lx_json_fail(st, (c)->file, (c)->where, __VA_ARGS__)
 
 /* ---- parsing the text -------------------------------------------------- */
 
@@ -36,122 +25,6 @@ static lx_status parse_json(const char *file, const char *text, size_t size, cJS
         return lx_fail(LX_ERR_FORMAT,
                        "%s: %zu bytes is more than the 64 MiB a lights file may have", file, size);
     return lx_json_parse_text(file, text, size, root);
-}
-
-/* ---- typed fields ------------------------------------------------------ */
-
-static lx_status get_float(const ctx *c, const cJSON *item, const char *field, float *out)
-{
-    if (!cJSON_IsNumber(item))
-        return fail(c, LX_ERR_FORMAT, "%s must be a number", field);
-    double v = item->valuedouble;
-    if (!isfinite(v) || !isfinite((float)v))
-        return fail(c, LX_ERR_FORMAT, "%s is not a finite number", field);
-    *out = (float)v;
-    return LX_OK;
-}
-
-static lx_status get_non_negative(const ctx *c, const cJSON *item, const char *field, float *out)
-{
-    lx_status st = get_float(c, item, field, out);
-    if (st == LX_OK && *out < 0.0f)
-        return fail(c, LX_ERR_INVALID, "%s %g is negative", field, *out);
-    return st;
-}
-
-static lx_status get_vec3(const ctx *c, const cJSON *item, const char *field, lx_vec3 *out)
-{
-    if (!cJSON_IsArray(item))
-        return fail(c, LX_ERR_FORMAT, "%s must be an array of 3 numbers", field);
-    int n = cJSON_GetArraySize(item);
-    if (n != 3)
-        return fail(c, LX_ERR_FORMAT, "%s must be an array of 3 numbers, not %d", field, n);
-    float v[3];
-    int i = 0;
-    for (const cJSON *e = item->child; e; e = e->next, i++) {
-        char name[48];
-        snprintf(name, sizeof name, "%s[%d]", field, i);
-        lx_status st = get_float(c, e, name, &v[i]);
-        if (st != LX_OK)
-            return st;
-    }
-    *out = lx_v3(v[0], v[1], v[2]);
-    return LX_OK;
-}
-
-/* A direction-like vector of any non-zero length, normalized; *raw keeps
- * the values as given (for messages). */
-static lx_status get_unit_vec3(const ctx *c, const cJSON *item, const char *field, lx_vec3 *out,
-                               lx_vec3 *raw)
-{
-    lx_vec3 d;
-    lx_status st = get_vec3(c, item, field, &d);
-    if (st != LX_OK)
-        return st;
-    /* The length in float can overflow even for finite components. */
-    double len = sqrt((double)d.x * d.x + (double)d.y * d.y + (double)d.z * d.z);
-    if (!(len > 1e-20))
-        return fail(c, LX_ERR_INVALID, "%s [%g, %g, %g] has zero length", field, d.x, d.y, d.z);
-    *out = lx_v3((float)(d.x / len), (float)(d.y / len), (float)(d.z / len));
-    if (raw)
-        *raw = d;
-    return LX_OK;
-}
-
-static lx_status get_color(const ctx *c, const cJSON *item, const char *field, lx_vec3 *out)
-{
-    lx_status st = get_vec3(c, item, field, out);
-    if (st == LX_OK && (out->x < 0.0f || out->y < 0.0f || out->z < 0.0f))
-        return fail(c, LX_ERR_INVALID, "%s [%g, %g, %g] has a negative component", field, out->x,
-                    out->y, out->z);
-    return st;
-}
-
-static lx_status get_string(const ctx *c, const cJSON *item, const char *field, const char **out)
-{
-    if (!cJSON_IsString(item) || !item->valuestring)
-        return fail(c, LX_ERR_FORMAT, "%s must be a string", field);
-    *out = item->valuestring;
-    return LX_OK;
-}
-
-/* Maps a string to one of the names; fails listing the accepted ones. */
-static lx_status get_enum(const ctx *c, const cJSON *item, const char *field,
-                          const char *const *names, int count, int *out)
-{
-    const char *s = NULL;
-    lx_status st = get_string(c, item, field, &s);
-    if (st != LX_OK)
-        return st;
-    for (int i = 0; i < count; i++)
-        if (strcmp(s, names[i]) == 0) {
-            *out = i;
-            return LX_OK;
-        }
-    char list[128] = "";
-    for (int i = 0; i < count; i++) {
-        strncat(list, i ? ", " : "", sizeof list - strlen(list) - 1);
-        strncat(list, names[i], sizeof list - strlen(list) - 1);
-    }
-    return fail(c, LX_ERR_FORMAT, "unknown %s '%.40s' (expected %s)", field, s, list);
-}
-
-/* Every key of obj must be in allowed, once. An object has at most as many
- * keys as allowed before this fails, so the duplicate scan stays short. */
-static lx_status check_keys(const ctx *c, const cJSON *obj, const char *const *allowed, int count)
-{
-    for (const cJSON *e = obj->child; e; e = e->next) {
-        const char *key = e->string ? e->string : "";
-        bool known = false;
-        for (int i = 0; i < count && !known; i++)
-            known = strcmp(key, allowed[i]) == 0;
-        if (!known)
-            return fail(c, LX_ERR_FORMAT, "unknown key '%.40s'", key);
-        for (const cJSON *p = obj->child; p != e; p = p->next)
-            if (strcmp(p->string, key) == 0)
-                return fail(c, LX_ERR_FORMAT, "key '%s' appears twice", key);
-    }
-    return LX_OK;
 }
 
 /* ---- lights by name: the file's own lights, then the scene's ----------- */
@@ -233,11 +106,9 @@ static const char *const shadow_names[] = {"hard", "none", "blur", "soft"};
 static const char *const model_names[] = {"physical", "classic"};
 static const char *const conversion_names[] = {"pi", "cone"};
 
-#define COUNT(a) ((int)(sizeof(a) / sizeof((a)[0])))
-
 /* Repeats the light module's "light 'key': problem" message as "file:
  * lights[i] ('key'): problem": where already names the light. */
-static lx_status restate(const ctx *c, lx_status st, const lx_light *l)
+static lx_status restate(const lx_jf_ctx *c, lx_status st, const lx_light *l)
 {
     char label[LX_LIGHT_NAME_MAX + 24], msg[512];
     if (l->name[0])
@@ -247,7 +118,7 @@ static lx_status restate(const ctx *c, lx_status st, const lx_light *l)
     const char *text = lx_last_error();
     size_t n = strlen(label);
     snprintf(msg, sizeof msg, "%s", strncmp(text, label, n) == 0 ? text + n : text);
-    return fail(c, st, "%s", msg);
+    return lx_jf_fail(c, st, "%s", msg);
 }
 
 /* ---- area lights ---------------------------------------------------------- */
@@ -323,50 +194,50 @@ static lx_vec3 default_up(lx_vec3 direction)
 /* The keys of area lights: radius (a point light given one becomes a
  * sphere), width, height, up, samples. new_shape: the light is new or
  * its type changed in this entry, so a rect gets the default up. */
-static lx_status read_area(const ctx *c, const cJSON *obj, bool new_shape, lx_light *l)
+static lx_status read_area(const lx_jf_ctx *c, const cJSON *obj, bool new_shape, lx_light *l)
 {
     lx_status st;
     const cJSON *it;
     if ((it = cJSON_GetObjectItemCaseSensitive(obj, "radius"))) {
         float r;
-        if ((st = get_non_negative(c, it, "radius", &r)) != LX_OK)
+        if ((st = lx_jf_non_negative(c, it, "radius", &r)) != LX_OK)
             return st;
         if (l->type == LX_LIGHT_POINT && r > 0.0f) {
             change_type(l, LX_LIGHT_SPHERE); /* a point light is a sphere of radius 0 */
             new_shape = true;
         }
         if (l->type != LX_LIGHT_POINT && !has_radius(l->type))
-            return fail(c, LX_ERR_INVALID,
-                        "radius is for sphere, disk, tube and point lights, not a %s light",
-                        lx_light_type_name(l->type));
+            return lx_jf_fail(c, LX_ERR_INVALID,
+                              "radius is for sphere, disk, tube and point lights, not a %s light",
+                              lx_light_type_name(l->type));
         if (has_radius(l->type) && l->type != LX_LIGHT_TUBE && !(r > 0.0f))
-            return fail(c, LX_ERR_INVALID, "radius %g must be above 0 for a %s light", r,
-                        lx_light_type_name(l->type));
+            return lx_jf_fail(c, LX_ERR_INVALID, "radius %g must be above 0 for a %s light", r,
+                              lx_light_type_name(l->type));
         if (has_radius(l->type))
             l->radius = r;
     }
     if ((it = cJSON_GetObjectItemCaseSensitive(obj, "length"))) {
         if (l->type != LX_LIGHT_TUBE)
-            return fail(c, LX_ERR_INVALID, "length is for tube lights, not a %s light",
-                        lx_light_type_name(l->type));
-        if ((st = get_non_negative(c, it, "length", &l->length)) != LX_OK)
+            return lx_jf_fail(c, LX_ERR_INVALID, "length is for tube lights, not a %s light",
+                              lx_light_type_name(l->type));
+        if ((st = lx_jf_non_negative(c, it, "length", &l->length)) != LX_OK)
             return st;
     }
     if (l->type == LX_LIGHT_TUBE && !(l->radius > 0.0f) && !(l->length > 0.0f))
-        return fail(c, LX_ERR_INVALID,
-                    "a tube with radius 0 (a linear light) needs a length above 0");
+        return lx_jf_fail(c, LX_ERR_INVALID,
+                          "a tube with radius 0 (a linear light) needs a length above 0");
     static const char *const sizes[] = {"width", "height"};
     for (int i = 0; i < 2; i++) {
         if (!(it = cJSON_GetObjectItemCaseSensitive(obj, sizes[i])))
             continue;
         if (l->type != LX_LIGHT_RECT)
-            return fail(c, LX_ERR_INVALID, "%s is for rect lights, not a %s light", sizes[i],
-                        lx_light_type_name(l->type));
+            return lx_jf_fail(c, LX_ERR_INVALID, "%s is for rect lights, not a %s light", sizes[i],
+                              lx_light_type_name(l->type));
         float v;
-        if ((st = get_float(c, it, sizes[i], &v)) != LX_OK)
+        if ((st = lx_jf_float(c, it, sizes[i], &v)) != LX_OK)
             return st;
         if (!(v > 0.0f))
-            return fail(c, LX_ERR_INVALID, "%s %g must be above 0", sizes[i], v);
+            return lx_jf_fail(c, LX_ERR_INVALID, "%s %g must be above 0", sizes[i], v);
         *(i == 0 ? &l->width : &l->height) = v;
     }
     if ((it = cJSON_GetObjectItemCaseSensitive(obj, "up"))) {
@@ -374,15 +245,17 @@ static lx_status read_area(const ctx *c, const cJSON *obj, bool new_shape, lx_li
         bool profiled = cJSON_GetObjectItemCaseSensitive(obj, "ies") || l->profile;
         if (l->type != LX_LIGHT_RECT &&
             !(profiled && (l->type == LX_LIGHT_POINT || l->type == LX_LIGHT_SPOT)))
-            return fail(c, LX_ERR_INVALID,
-                        "up is for rect lights and lights with an ies profile, not a %s light",
-                        lx_light_type_name(l->type));
+            return lx_jf_fail(
+                c, LX_ERR_INVALID,
+                "up is for rect lights and lights with an ies profile, not a %s light",
+                lx_light_type_name(l->type));
         lx_vec3 up, raw;
-        if ((st = get_unit_vec3(c, it, "up", &up, &raw)) != LX_OK)
+        if ((st = lx_jf_unit_vec3(c, it, "up", &up, &raw)) != LX_OK)
             return st;
         if (parallel(up, l->direction))
-            return fail(c, LX_ERR_INVALID, "up [%g, %g, %g] is parallel to direction [%g, %g, %g]",
-                        raw.x, raw.y, raw.z, l->direction.x, l->direction.y, l->direction.z);
+            return lx_jf_fail(c, LX_ERR_INVALID,
+                              "up [%g, %g, %g] is parallel to direction [%g, %g, %g]", raw.x, raw.y,
+                              raw.z, l->direction.x, l->direction.y, l->direction.z);
         l->up = up;
     } else if (l->type == LX_LIGHT_RECT && (new_shape || parallel(l->up, l->direction))) {
         /* An override that turns the rect toward its old up picks the
@@ -391,16 +264,18 @@ static lx_status read_area(const ctx *c, const cJSON *obj, bool new_shape, lx_li
     }
     if ((it = cJSON_GetObjectItemCaseSensitive(obj, "samples"))) {
         if (!is_area_type(l->type))
-            return fail(c, LX_ERR_INVALID,
-                        "samples is for area lights (sphere, disk, rect, tube), not a %s light",
-                        lx_light_type_name(l->type));
+            return lx_jf_fail(
+                c, LX_ERR_INVALID,
+                "samples is for area lights (sphere, disk, rect, tube), not a %s light",
+                lx_light_type_name(l->type));
         if (!cJSON_IsNumber(it))
-            return fail(c, LX_ERR_FORMAT, "samples must be a whole number");
+            return lx_jf_fail(c, LX_ERR_FORMAT, "samples must be a whole number");
         double v = it->valuedouble;
         if (!isfinite(v) || v != floor(v))
-            return fail(c, LX_ERR_FORMAT, "samples %g is not a whole number", v);
+            return lx_jf_fail(c, LX_ERR_FORMAT, "samples %g is not a whole number", v);
         if (v < 1.0 || v > (double)LX_MAX_LIGHT_SAMPLES)
-            return fail(c, LX_ERR_INVALID, "samples %g is outside 1..%u", v, LX_MAX_LIGHT_SAMPLES);
+            return lx_jf_fail(c, LX_ERR_INVALID, "samples %g is outside 1..%u", v,
+                              LX_MAX_LIGHT_SAMPLES);
         l->samples = (uint32_t)v;
     }
     return LX_OK;
@@ -410,7 +285,7 @@ static lx_status read_area(const ctx *c, const cJSON *obj, bool new_shape, lx_li
  * (nt) and linear (cd/m) without a new "intensity": the same candela along
  * the axis (a tube: across it), through the area the light shows there
  * (lx_area_light_projected_area) or along a linear tube's length. */
-static lx_status carry_intensity(const ctx *c, const lx_light *before, lx_light *l)
+static lx_status carry_intensity(const lx_jf_ctx *c, const lx_light *before, lx_light *l)
 {
     intensity_kind from = kind_of(before), to = kind_of(l);
     if (from == to || from == KIND_LUX || to == KIND_LUX)
@@ -421,7 +296,8 @@ static lx_status carry_intensity(const ctx *c, const lx_light *before, lx_light 
     else if (from == KIND_CANDELA_PER_METRE)
         cd *= before->length;
     if (!((float)cd <= 3.4028234663852886e38f))
-        return fail(c, LX_ERR_INVALID, "intensity %g overflows as candela", before->intensity);
+        return lx_jf_fail(c, LX_ERR_INVALID, "intensity %g overflows as candela",
+                          before->intensity);
     if (to == KIND_CANDELA) {
         l->intensity = (float)cd;
         return LX_OK;
@@ -431,23 +307,12 @@ static lx_status carry_intensity(const ctx *c, const lx_light *before, lx_light 
     return st == LX_OK ? LX_OK : restate(c, st, l);
 }
 
-/* Fills out from obj; a light named like one in names (earlier in the file
- * or already in the scene) starts from that light. */
-/* A path the file gives, relative to the file's folder (malloc'd). */
-static char *relative_to_file(const ctx *c, const char *rel)
-{
-    char *dir = lx_path_dirname(c->file);
-    char *path = dir ? lx_path_join(dir, rel) : NULL;
-    free(dir);
-    return path;
-}
-
 /* "ies" (a path relative to this file), "masked" and "multiplier":
  * Filament's photometric lights. A masked profile keeps its shape and takes
  * the light's intensity as its average (lumens / 4 pi); an unmasked one
  * keeps its own candela times the multiplier (a multiplier on a masked
  * profile is an error, not ignored). Runs after the intensity is known. */
-static lx_status read_profile(ctx *c, const cJSON *obj, lx_light *l)
+static lx_status read_profile(lx_jf_ctx *c, const cJSON *obj, lx_light *l)
 {
     lx_status st;
     const cJSON *ies = cJSON_GetObjectItemCaseSensitive(obj, "ies");
@@ -455,20 +320,21 @@ static lx_status read_profile(ctx *c, const cJSON *obj, lx_light *l)
     const cJSON *mult_item = cJSON_GetObjectItemCaseSensitive(obj, "multiplier");
     if (!ies) {
         if ((masked_item || mult_item) && !l->profile)
-            return fail(c, LX_ERR_FORMAT, "'masked' and 'multiplier' need an 'ies' profile");
+            return lx_jf_fail(c, LX_ERR_FORMAT, "'masked' and 'multiplier' need an 'ies' profile");
         if (!masked_item && !mult_item)
             return LX_OK;
     }
     if (l->type != LX_LIGHT_POINT && l->type != LX_LIGHT_SPOT)
-        return fail(c, LX_ERR_INVALID, "ies profiles go on point and spot lights, not a %s light",
-                    lx_light_type_name(l->type));
+        return lx_jf_fail(c, LX_ERR_INVALID,
+                          "ies profiles go on point and spot lights, not a %s light",
+                          lx_light_type_name(l->type));
     if (ies) {
         const char *rel = NULL;
-        if ((st = get_string(c, ies, "ies", &rel)) != LX_OK)
+        if ((st = lx_jf_string(c, ies, "ies", &rel)) != LX_OK)
             return st;
-        char *path = relative_to_file(c, rel);
+        char *path = lx_jf_relative_path(c, rel);
         if (!path)
-            return fail(c, LX_ERR_NOMEM, "out of memory");
+            return lx_jf_fail(c, LX_ERR_NOMEM, "out of memory");
         lx_ies_profile *profile = NULL;
         st = lx_ies_load(path, &profile);
         free(path);
@@ -482,7 +348,7 @@ static lx_status read_profile(ctx *c, const cJSON *obj, lx_light *l)
             realloc(c->profiles, sizeof(lx_ies_profile *) * (c->profile_count + 1));
         if (!list) {
             lx_ies_free(profile);
-            return fail(c, LX_ERR_NOMEM, "out of memory");
+            return lx_jf_fail(c, LX_ERR_NOMEM, "out of memory");
         }
         c->profiles = list;
         c->profiles[c->profile_count++] = profile;
@@ -491,44 +357,49 @@ static lx_status read_profile(ctx *c, const cJSON *obj, lx_light *l)
     bool masked = false;
     if (masked_item) {
         if (!cJSON_IsBool(masked_item))
-            return fail(c, LX_ERR_FORMAT, "masked must be true or false");
+            return lx_jf_fail(c, LX_ERR_FORMAT, "masked must be true or false");
         masked = cJSON_IsTrue(masked_item);
     }
     if (masked && mult_item)
-        return fail(c, LX_ERR_FORMAT,
-                    "'multiplier' scales an unmasked profile; a masked one takes its scale from "
-                    "'intensity'");
+        return lx_jf_fail(
+            c, LX_ERR_FORMAT,
+            "'multiplier' scales an unmasked profile; a masked one takes its scale from "
+            "'intensity'");
     if (masked) {
         double lumens = lx_ies_total_lumens(l->profile);
         if (!(lumens > 0.0))
-            return fail(c, LX_ERR_INVALID, "a masked ies profile needs some light (it has 0 lm)");
+            return lx_jf_fail(c, LX_ERR_INVALID,
+                              "a masked ies profile needs some light (it has 0 lm)");
         l->profile_scale = (float)(l->intensity / (lumens / (4.0 * 3.14159265358979323846)));
     } else {
         float multiplier = 1.0f;
-        if (mult_item && (st = get_non_negative(c, mult_item, "multiplier", &multiplier)) != LX_OK)
+        if (mult_item &&
+            (st = lx_jf_non_negative(c, mult_item, "multiplier", &multiplier)) != LX_OK)
             return st;
         l->profile_scale = multiplier;
     }
     return LX_OK;
 }
 
-static lx_status read_light(ctx *c, const cJSON *obj, const name_table *names,
+/* Fills out from obj; a light named like one in names (earlier in the file
+ * or already in the scene) starts from that light. */
+static lx_status read_light(lx_jf_ctx *c, const cJSON *obj, const name_table *names,
                             const lx_light *pending, const lx_scene *scene, lx_light *out)
 {
     lx_status st;
     const cJSON *name_item = cJSON_GetObjectItemCaseSensitive(obj, "name");
     const char *name = "";
     if (name_item) {
-        if ((st = get_string(c, name_item, "name", &name)) != LX_OK)
+        if ((st = lx_jf_string(c, name_item, "name", &name)) != LX_OK)
             return st;
         if (strlen(name) >= LX_LIGHT_NAME_MAX)
-            return fail(c, LX_ERR_INVALID, "name '%.20s...' is longer than %d bytes", name,
-                        LX_LIGHT_NAME_MAX - 1);
+            return lx_jf_fail(c, LX_ERR_INVALID, "name '%.20s...' is longer than %d bytes", name,
+                              LX_LIGHT_NAME_MAX - 1);
         size_t len = strlen(c->where);
         snprintf(c->where + len, sizeof c->where - len, " ('%s')", name);
     }
     const cJSON *type_item = cJSON_GetObjectItemCaseSensitive(obj, "type");
-    if ((st = check_keys(c, obj, light_keys, COUNT(light_keys))) != LX_OK)
+    if ((st = lx_jf_check_keys(c, obj, light_keys, LX_JF_COUNT(light_keys))) != LX_OK)
         return st;
 
     /* An override by name starts from the existing light: only the keys
@@ -536,8 +407,8 @@ static lx_status read_light(ctx *c, const cJSON *obj, const name_table *names,
     int32_t found = 0;
     bool is_override = name[0] && table_get(names, name, &found);
     int type = 0;
-    if (type_item &&
-        (st = get_enum(c, type_item, "type", type_names, COUNT(type_names), &type)) != LX_OK)
+    if (type_item && (st = lx_jf_enum(c, type_item, "type", type_names, LX_JF_COUNT(type_names),
+                                      &type)) != LX_OK)
         return st;
     lx_light l;
     bool new_shape = !is_override; /* a rect then gets the default up */
@@ -545,8 +416,9 @@ static lx_status read_light(ctx *c, const cJSON *obj, const name_table *names,
         l = found >= 0 ? pending[found] : scene->lights[-(found + 1)];
     } else {
         if (!type_item)
-            return fail(c, LX_ERR_FORMAT,
-                        "missing 'type' (point, spot, directional, sphere, disk, rect or tube)");
+            return lx_jf_fail(
+                c, LX_ERR_FORMAT,
+                "missing 'type' (point, spot, directional, sphere, disk, rect or tube)");
         l = lx_light_defaults((lx_light_type)type);
         memcpy(l.name, name, strlen(name) + 1);
     }
@@ -563,81 +435,84 @@ static lx_status read_light(ctx *c, const cJSON *obj, const name_table *names,
 
     const cJSON *it;
     if ((it = cJSON_GetObjectItemCaseSensitive(obj, "position"))) {
-        if ((st = get_vec3(c, it, "position", &l.position)) != LX_OK)
+        if ((st = lx_jf_vec3(c, it, "position", &l.position)) != LX_OK)
             return st;
     } else if (!is_override && l.type != LX_LIGHT_DIRECTIONAL) {
-        return fail(c, LX_ERR_FORMAT, "missing 'position' for a %s light",
-                    lx_light_type_name(l.type));
+        return lx_jf_fail(c, LX_ERR_FORMAT, "missing 'position' for a %s light",
+                          lx_light_type_name(l.type));
     }
     if ((it = cJSON_GetObjectItemCaseSensitive(obj, "direction"))) {
-        if ((st = get_unit_vec3(c, it, "direction", &l.direction, NULL)) != LX_OK)
+        if ((st = lx_jf_unit_vec3(c, it, "direction", &l.direction, NULL)) != LX_OK)
             return st;
     } else if (!is_override && l.type != LX_LIGHT_POINT && l.type != LX_LIGHT_SPHERE) {
-        return fail(c, LX_ERR_FORMAT, "missing 'direction' for a %s light",
-                    lx_light_type_name(l.type));
+        return lx_jf_fail(c, LX_ERR_FORMAT, "missing 'direction' for a %s light",
+                          lx_light_type_name(l.type));
     }
     /* one way to give the colour: linear RGB, sRGB-encoded, or kelvin */
     const cJSON *color_items[3] = {cJSON_GetObjectItemCaseSensitive(obj, "color"),
                                    cJSON_GetObjectItemCaseSensitive(obj, "srgb"),
                                    cJSON_GetObjectItemCaseSensitive(obj, "temperature")};
     if (!!color_items[0] + !!color_items[1] + !!color_items[2] > 1)
-        return fail(c, LX_ERR_FORMAT, "give one of 'color', 'srgb' and 'temperature', not several");
-    if (color_items[0] && (st = get_color(c, color_items[0], "color", &l.color)) != LX_OK)
+        return lx_jf_fail(c, LX_ERR_FORMAT,
+                          "give one of 'color', 'srgb' and 'temperature', not several");
+    if (color_items[0] && (st = lx_jf_color(c, color_items[0], "color", &l.color)) != LX_OK)
         return st;
     if (color_items[1]) {
         lx_vec3 srgb;
-        if ((st = get_color(c, color_items[1], "srgb", &srgb)) != LX_OK)
+        if ((st = lx_jf_color(c, color_items[1], "srgb", &srgb)) != LX_OK)
             return st;
         if (srgb.x > 1.0f || srgb.y > 1.0f || srgb.z > 1.0f)
-            return fail(c, LX_ERR_INVALID, "srgb [%g, %g, %g] has a component above 1", srgb.x,
-                        srgb.y, srgb.z);
+            return lx_jf_fail(c, LX_ERR_INVALID, "srgb [%g, %g, %g] has a component above 1",
+                              srgb.x, srgb.y, srgb.z);
         l.color = lx_srgb_color_to_linear(srgb);
     }
     if (color_items[2]) {
         float kelvin;
-        if ((st = get_float(c, color_items[2], "temperature", &kelvin)) != LX_OK)
+        if ((st = lx_jf_float(c, color_items[2], "temperature", &kelvin)) != LX_OK)
             return st;
         if (lx_temperature_to_rgb(kelvin, &l.color) != LX_OK)
-            return fail(c, LX_ERR_INVALID, "temperature %g K is outside %g..%g K", (double)kelvin,
-                        (double)LX_MIN_TEMPERATURE, (double)LX_MAX_TEMPERATURE);
+            return lx_jf_fail(c, LX_ERR_INVALID, "temperature %g K is outside %g..%g K",
+                              (double)kelvin, (double)LX_MIN_TEMPERATURE,
+                              (double)LX_MAX_TEMPERATURE);
     }
     if ((it = cJSON_GetObjectItemCaseSensitive(obj, "ambient")) &&
-        (st = get_color(c, it, "ambient", &l.ambient)) != LX_OK)
+        (st = lx_jf_color(c, it, "ambient", &l.ambient)) != LX_OK)
         return st;
     if ((it = cJSON_GetObjectItemCaseSensitive(obj, "range")) &&
-        (st = get_non_negative(c, it, "range", &l.range)) != LX_OK)
+        (st = lx_jf_non_negative(c, it, "range", &l.range)) != LX_OK)
         return st;
     float deg;
     if ((it = cJSON_GetObjectItemCaseSensitive(obj, "inner_angle"))) {
-        if ((st = get_non_negative(c, it, "inner_angle", &deg)) != LX_OK)
+        if ((st = lx_jf_non_negative(c, it, "inner_angle", &deg)) != LX_OK)
             return st;
         l.inner_angle = LX_DEG2RAD(deg);
     }
     if ((it = cJSON_GetObjectItemCaseSensitive(obj, "outer_angle"))) {
-        if ((st = get_non_negative(c, it, "outer_angle", &deg)) != LX_OK)
+        if ((st = lx_jf_non_negative(c, it, "outer_angle", &deg)) != LX_OK)
             return st;
         l.outer_angle = LX_DEG2RAD(deg);
     }
     int e = 0;
     if ((it = cJSON_GetObjectItemCaseSensitive(obj, "shadow"))) {
-        if ((st = get_enum(c, it, "shadow", shadow_names, COUNT(shadow_names), &e)) != LX_OK)
+        if ((st = lx_jf_enum(c, it, "shadow", shadow_names, LX_JF_COUNT(shadow_names), &e)) !=
+            LX_OK)
             return st;
         l.shadow = (lx_shadow_mode)e;
     }
     if ((it = cJSON_GetObjectItemCaseSensitive(obj, "model"))) {
-        if ((st = get_enum(c, it, "model", model_names, COUNT(model_names), &e)) != LX_OK)
+        if ((st = lx_jf_enum(c, it, "model", model_names, LX_JF_COUNT(model_names), &e)) != LX_OK)
             return st;
         l.model = (lx_falloff_model)e;
     }
     if ((it = cJSON_GetObjectItemCaseSensitive(obj, "blur_power")) &&
-        (st = get_non_negative(c, it, "blur_power", &l.blur_power)) != LX_OK)
+        (st = lx_jf_non_negative(c, it, "blur_power", &l.blur_power)) != LX_OK)
         return st;
     if ((it = cJSON_GetObjectItemCaseSensitive(obj, "blur_multiplier")) &&
-        (st = get_non_negative(c, it, "blur_multiplier", &l.blur_multiplier)) != LX_OK)
+        (st = lx_jf_non_negative(c, it, "blur_multiplier", &l.blur_multiplier)) != LX_OK)
         return st;
     if ((it = cJSON_GetObjectItemCaseSensitive(obj, "dynamic"))) {
         if (!cJSON_IsBool(it))
-            return fail(c, LX_ERR_FORMAT, "dynamic must be true or false");
+            return lx_jf_fail(c, LX_ERR_FORMAT, "dynamic must be true or false");
         l.dynamic = cJSON_IsTrue(it);
     }
 
@@ -647,17 +522,17 @@ static lx_status read_light(ctx *c, const cJSON *obj, const name_table *names,
         return st;
     bool area = is_area_type(l.type);
     if (l.shadow == LX_SHADOW_SOFT && !area)
-        return fail(c, LX_ERR_INVALID,
-                    "shadow 'soft' needs an area light (sphere, disk, rect, tube, or a point "
-                    "light with a radius), not a %s light",
-                    lx_light_type_name(l.type));
+        return lx_jf_fail(c, LX_ERR_INVALID,
+                          "shadow 'soft' needs an area light (sphere, disk, rect, tube, or a point "
+                          "light with a radius), not a %s light",
+                          lx_light_type_name(l.type));
 
     /* Units last: lumens over a spot's cone need the final outer angle, an
      * area light's lumens or candela its final size. */
     lx_spot_conversion conv = LX_SPOT_POWER_PI;
     if ((it = cJSON_GetObjectItemCaseSensitive(obj, "spot_conversion"))) {
-        if ((st = get_enum(c, it, "spot_conversion", conversion_names, COUNT(conversion_names),
-                           &e)) != LX_OK)
+        if ((st = lx_jf_enum(c, it, "spot_conversion", conversion_names,
+                             LX_JF_COUNT(conversion_names), &e)) != LX_OK)
             return st;
         conv = (lx_spot_conversion)e;
     }
@@ -665,30 +540,31 @@ static lx_status read_light(ctx *c, const cJSON *obj, const name_table *names,
     const cJSON *unit_item = cJSON_GetObjectItemCaseSensitive(obj, "unit");
     if (unit_item) {
         const char *s = NULL;
-        if ((st = get_string(c, unit_item, "unit", &s)) != LX_OK)
+        if ((st = lx_jf_string(c, unit_item, "unit", &s)) != LX_OK)
             return st;
         unit = lx_light_unit_from_string(s);
         if (unit == LX_UNIT_DEFAULT)
-            return fail(c, LX_ERR_FORMAT, "unknown unit '%.40s' (expected cd, lm, W, lx or nt)", s);
+            return lx_jf_fail(c, LX_ERR_FORMAT,
+                              "unknown unit '%.40s' (expected cd, lm, W, lx or nt)", s);
     }
     if ((it = cJSON_GetObjectItemCaseSensitive(obj, "intensity"))) {
         float value;
-        if ((st = get_non_negative(c, it, "intensity", &value)) != LX_OK)
+        if ((st = lx_jf_non_negative(c, it, "intensity", &value)) != LX_OK)
             return st;
         if ((unit == LX_UNIT_LUX || (unit == LX_UNIT_NIT && !area)) &&
             l.type != LX_LIGHT_DIRECTIONAL)
-            return fail(c, LX_ERR_INVALID, "unit: %s lights take %s, not %s",
-                        lx_light_type_name(l.type), area ? "nt, cd, lm or W" : "cd, lm or W",
-                        lx_light_unit_symbol(unit));
+            return lx_jf_fail(c, LX_ERR_INVALID, "unit: %s lights take %s, not %s",
+                              lx_light_type_name(l.type), area ? "nt, cd, lm or W" : "cd, lm or W",
+                              lx_light_unit_symbol(unit));
         if (unit != LX_UNIT_DEFAULT && unit != LX_UNIT_LUX && l.type == LX_LIGHT_DIRECTIONAL)
-            return fail(c, LX_ERR_INVALID, "unit: directional lights take lux, not %s",
-                        lx_light_unit_symbol(unit));
+            return lx_jf_fail(c, LX_ERR_INVALID, "unit: directional lights take lux, not %s",
+                              lx_light_unit_symbol(unit));
         if (unit == LX_UNIT_DEFAULT)
             unit = native_unit(written_type);
         if ((st = lx_light_intensity_to_native(&l, value, unit, conv, &l.intensity)) != LX_OK)
             return restate(c, st, &l);
     } else if (unit_item) {
-        return fail(c, LX_ERR_FORMAT, "'unit' is given without 'intensity'");
+        return lx_jf_fail(c, LX_ERR_FORMAT, "'unit' is given without 'intensity'");
     } else if ((st = carry_intensity(c, &before, &l)) != LX_OK) {
         return st;
     }
@@ -709,168 +585,72 @@ static const char *const sky_keys[] = {"environment", "intensity", "shadows", "s
 /* "sky": {"environment": path relative to the file, "intensity",
  * "shadows", "samples"}; the environment is named here, loaded by whoever
  * bakes. */
-static lx_status read_sky(ctx *c, const cJSON *obj, lx_scene_sky *sky)
+static lx_status read_sky(lx_jf_ctx *c, const cJSON *obj, lx_scene_sky *sky)
 {
     snprintf(c->where, sizeof c->where, "sky");
     if (!cJSON_IsObject(obj))
-        return fail(c, LX_ERR_FORMAT, "must be an object with \"environment\"");
-    lx_status st = check_keys(c, obj, sky_keys, COUNT(sky_keys));
+        return lx_jf_fail(c, LX_ERR_FORMAT, "must be an object with \"environment\"");
+    lx_status st = lx_jf_check_keys(c, obj, sky_keys, LX_JF_COUNT(sky_keys));
     if (st != LX_OK)
         return st;
     const cJSON *it = cJSON_GetObjectItemCaseSensitive(obj, "environment");
     const char *rel = NULL;
     if (!it)
-        return fail(c, LX_ERR_FORMAT, "missing 'environment' (an image file)");
-    if ((st = get_string(c, it, "environment", &rel)) != LX_OK)
+        return lx_jf_fail(c, LX_ERR_FORMAT, "missing 'environment' (an image file)");
+    if ((st = lx_jf_string(c, it, "environment", &rel)) != LX_OK)
         return st;
     if (!rel[0])
-        return fail(c, LX_ERR_FORMAT, "environment is an empty path");
+        return lx_jf_fail(c, LX_ERR_FORMAT, "environment is an empty path");
     sky->intensity = 1.0f;
     if ((it = cJSON_GetObjectItemCaseSensitive(obj, "intensity"))) {
-        if ((st = get_non_negative(c, it, "intensity", &sky->intensity)) != LX_OK)
+        if ((st = lx_jf_non_negative(c, it, "intensity", &sky->intensity)) != LX_OK)
             return st;
         if (!(sky->intensity > 0.0f))
-            return fail(c, LX_ERR_INVALID,
-                        "intensity must be above 0 (leave \"sky\" out for none)");
+            return lx_jf_fail(c, LX_ERR_INVALID,
+                              "intensity must be above 0 (leave \"sky\" out for none)");
     }
     if ((it = cJSON_GetObjectItemCaseSensitive(obj, "shadows"))) {
         if (!cJSON_IsBool(it))
-            return fail(c, LX_ERR_FORMAT, "shadows must be true or false");
+            return lx_jf_fail(c, LX_ERR_FORMAT, "shadows must be true or false");
         sky->shadows = cJSON_IsTrue(it);
     }
     if ((it = cJSON_GetObjectItemCaseSensitive(obj, "samples"))) {
         double v = cJSON_IsNumber(it) ? it->valuedouble : NAN;
         if (!isfinite(v) || v != floor(v))
-            return fail(c, LX_ERR_FORMAT, "samples must be a whole number");
+            return lx_jf_fail(c, LX_ERR_FORMAT, "samples must be a whole number");
         if (v < 1.0 || v > (double)LX_MAX_SKY_SAMPLES)
-            return fail(c, LX_ERR_INVALID, "samples %g is outside 1..%u", v, LX_MAX_SKY_SAMPLES);
+            return lx_jf_fail(c, LX_ERR_INVALID, "samples %g is outside 1..%u", v,
+                              LX_MAX_SKY_SAMPLES);
         sky->samples = (uint32_t)v;
     }
-    sky->environment = relative_to_file(c, rel);
+    sky->environment = lx_jf_relative_path(c, rel);
     if (!sky->environment)
-        return fail(c, LX_ERR_NOMEM, "out of memory");
+        return lx_jf_fail(c, LX_ERR_NOMEM, "out of memory");
     return LX_OK;
-}
-
-/* ---- materials: height textures for the baker's horizon and AO --------- */
-
-static const char *const material_keys[] = {"height", "strength", "horizon", "ao"};
-
-/* One material's settings from the file (path NULL: the file names none). */
-typedef struct pending_material {
-    char *path;
-    float strength;
-    bool horizon, ao;
-} pending_material;
-
-static lx_status read_material_entry(ctx *c, const cJSON *obj, pending_material *p)
-{
-    if (!cJSON_IsObject(obj))
-        return fail(c, LX_ERR_FORMAT, "must be an object with \"height\"");
-    lx_status st = check_keys(c, obj, material_keys, COUNT(material_keys));
-    if (st != LX_OK)
-        return st;
-    const cJSON *it = cJSON_GetObjectItemCaseSensitive(obj, "height");
-    const char *rel = NULL;
-    if (!it)
-        return fail(c, LX_ERR_FORMAT, "missing 'height' (a height image file)");
-    if ((st = get_string(c, it, "height", &rel)) != LX_OK)
-        return st;
-    if (!rel[0])
-        return fail(c, LX_ERR_FORMAT, "height is an empty path");
-    p->strength = 0.0f;
-    if ((it = cJSON_GetObjectItemCaseSensitive(obj, "strength"))) {
-        if ((st = get_float(c, it, "strength", &p->strength)) != LX_OK)
-            return st;
-        if (!(p->strength > 0.0f))
-            return fail(c, LX_ERR_INVALID, "strength %g must be above 0", p->strength);
-    }
-    static const char *const flags[] = {"horizon", "ao"};
-    bool *dst[] = {&p->horizon, &p->ao};
-    for (int k = 0; k < 2; k++) {
-        *dst[k] = true;
-        if ((it = cJSON_GetObjectItemCaseSensitive(obj, flags[k]))) {
-            if (!cJSON_IsBool(it))
-                return fail(c, LX_ERR_FORMAT, "%s must be true or false", flags[k]);
-            *dst[k] = cJSON_IsTrue(it);
-        }
-    }
-    p->path = relative_to_file(c, rel);
-    return p->path ? LX_OK : fail(c, LX_ERR_NOMEM, "out of memory");
-}
-
-/* "materials": {"<material name>": {"height", "strength", "horizon",
- * "ao"}}, into pending (one per scene material, every material of the
- * name given). A name no scene material has is an error. */
-static lx_status read_materials(ctx *c, const cJSON *obj, const lx_scene *scene,
-                                pending_material *pending)
-{
-    snprintf(c->where, sizeof c->where, "materials");
-    if (!cJSON_IsObject(obj))
-        return fail(c, LX_ERR_FORMAT, "must be an object of material names");
-    for (const cJSON *e = obj->child; e; e = e->next) {
-        const char *name = e->string ? e->string : "";
-        snprintf(c->where, sizeof c->where, "materials");
-        for (const cJSON *p = obj->child; p != e; p = p->next)
-            if (strcmp(p->string, name) == 0)
-                return fail(c, LX_ERR_FORMAT, "material '%.40s' appears twice", name);
-        bool found = false;
-        for (uint32_t m = 0; m < scene->material_count && !found; m++)
-            found = scene->materials[m].name && strcmp(scene->materials[m].name, name) == 0;
-        if (!found)
-            return fail(c, LX_ERR_INVALID, "unknown material '%.40s' (%s has none of that name)",
-                        name, scene->path ? scene->path : "the scene");
-        snprintf(c->where, sizeof c->where, "materials ('%.40s')", name);
-        pending_material p = {0};
-        lx_status st = read_material_entry(c, e, &p);
-        if (st != LX_OK) {
-            free(p.path);
-            return st;
-        }
-        for (uint32_t m = 0; m < scene->material_count; m++) {
-            if (!scene->materials[m].name || strcmp(scene->materials[m].name, name) != 0)
-                continue;
-            pending[m] = p;
-            pending[m].path = lx_strdup(p.path);
-            if (!pending[m].path) {
-                free(p.path);
-                return fail(c, LX_ERR_NOMEM, "out of memory");
-            }
-        }
-        free(p.path);
-    }
-    return LX_OK;
-}
-
-static void free_pending_materials(pending_material *p, uint32_t count)
-{
-    for (uint32_t m = 0; p && m < count; m++)
-        free(p[m].path);
-    free(p);
 }
 
 static lx_status apply_root(lx_scene *scene, const cJSON *root, const char *file)
 {
-    ctx c = {.file = file, .where = ""};
+    lx_jf_ctx c = {.file = file, .where = ""};
     if (!cJSON_IsObject(root))
-        return fail(&c, LX_ERR_FORMAT, "the top level must be an object with \"lights\"");
-    lx_status st = check_keys(&c, root, root_keys, COUNT(root_keys));
+        return lx_jf_fail(&c, LX_ERR_FORMAT, "the top level must be an object with \"lights\"");
+    lx_status st = lx_jf_check_keys(&c, root, root_keys, LX_JF_COUNT(root_keys));
     if (st != LX_OK)
         return st;
     const cJSON *amb = cJSON_GetObjectItemCaseSensitive(root, "ambient");
     lx_vec3 ambient = scene->ambient;
-    if (amb && (st = get_color(&c, amb, "ambient", &ambient)) != LX_OK)
+    if (amb && (st = lx_jf_color(&c, amb, "ambient", &ambient)) != LX_OK)
         return st;
     const cJSON *list = cJSON_GetObjectItemCaseSensitive(root, "lights");
     size_t count = 0;
     if (list) {
         if (!cJSON_IsArray(list))
-            return fail(&c, LX_ERR_FORMAT, "lights must be an array of objects");
+            return lx_jf_fail(&c, LX_ERR_FORMAT, "lights must be an array of objects");
         for (const cJSON *e = list->child; e; e = e->next)
             count++;
     }
     if (count > INT32_MAX / 4)
-        return fail(&c, LX_ERR_INVALID, "%zu lights are too many", count);
+        return lx_jf_fail(&c, LX_ERR_INVALID, "%zu lights are too many", count);
     /* the sky last before the lights: from here on every exit frees it */
     const cJSON *sky_item = cJSON_GetObjectItemCaseSensitive(root, "sky");
     lx_scene_sky sky = {0};
@@ -879,16 +659,10 @@ static lx_status apply_root(lx_scene *scene, const cJSON *root, const char *file
         return st;
     }
     const cJSON *mat_item = cJSON_GetObjectItemCaseSensitive(root, "materials");
-    pending_material *mats = NULL;
-    if (mat_item) {
-        mats = calloc(scene->material_count + 1, sizeof *mats);
-        st = mats ? read_materials(&c, mat_item, scene, mats)
-                  : fail(&c, LX_ERR_NOMEM, "out of memory");
-        if (st != LX_OK) {
-            free_pending_materials(mats, scene->material_count);
-            free(sky.environment);
-            return st;
-        }
+    lx_lj_materials *mats = NULL;
+    if (mat_item && (st = lx_lj_materials_read(&c, mat_item, scene, &mats)) != LX_OK) {
+        free(sky.environment);
+        return st;
     }
     c.where[0] = '\0';
     lx_light *pending = malloc((count ? count : 1) * sizeof *pending);
@@ -897,8 +671,8 @@ static lx_status apply_root(lx_scene *scene, const cJSON *root, const char *file
         free(pending);
         table_free(&names);
         free(sky.environment);
-        free_pending_materials(mats, scene->material_count);
-        return fail(&c, LX_ERR_NOMEM, "out of memory for %zu lights", count);
+        lx_lj_materials_free(mats);
+        return lx_jf_fail(&c, LX_ERR_NOMEM, "out of memory for %zu lights", count);
     }
     for (uint32_t i = 0; i < scene->light_count; i++)
         if (scene->lights[i].name[0])
@@ -908,7 +682,7 @@ static lx_status apply_root(lx_scene *scene, const cJSON *root, const char *file
     for (const cJSON *e = list ? list->child : NULL; e && st == LX_OK; e = e->next, i++) {
         snprintf(c.where, sizeof c.where, "lights[%zu]", i);
         if (!cJSON_IsObject(e))
-            st = fail(&c, LX_ERR_FORMAT, "must be an object");
+            st = lx_jf_fail(&c, LX_ERR_FORMAT, "must be an object");
         else
             st = read_light(&c, e, &names, pending, scene, &pending[i]);
         if (st == LX_OK && pending[i].name[0])
@@ -928,17 +702,7 @@ static lx_status apply_root(lx_scene *scene, const cJSON *root, const char *file
             scene->sky = sky;
             sky.environment = NULL;
         }
-        for (uint32_t m = 0; mats && m < scene->material_count; m++) {
-            if (!mats[m].path)
-                continue;
-            lx_material *mat = &scene->materials[m];
-            free(mat->height_map_path);
-            mat->height_map_path = mats[m].path;
-            mat->height_strength = mats[m].strength;
-            mat->height_horizon = mats[m].horizon;
-            mat->height_ao = mats[m].ao;
-            mats[m].path = NULL;
-        }
+        lx_lj_materials_apply(mats, scene);
         for (i = 0; i < count && st == LX_OK; i++)
             if ((st = lx_scene_add_light(scene, &pending[i])) != LX_OK) {
                 char where[160];
@@ -948,7 +712,7 @@ static lx_status apply_root(lx_scene *scene, const cJSON *root, const char *file
     }
     free(pending);
     free(sky.environment);
-    free_pending_materials(mats, scene->material_count);
+    lx_lj_materials_free(mats);
     return st;
 }
 

@@ -67,6 +67,7 @@ static void material_free(lx_material *m)
     free(m->normal_map_path);
     free(m->base_color_map_path);
     free(m->height_map_path);
+    free(m->height_normal_path);
     lx_image_free(&m->normal_map);
     lx_image_free(&m->base_color_map);
     free(m->emissive_map_path);
@@ -252,6 +253,7 @@ lx_status lx_scene_add_material(lx_scene *s, const lx_material *src, uint32_t *i
     m.normal_map_path = src->normal_map_path ? lx_strdup(src->normal_map_path) : NULL;
     m.base_color_map_path = src->base_color_map_path ? lx_strdup(src->base_color_map_path) : NULL;
     m.height_map_path = src->height_map_path ? lx_strdup(src->height_map_path) : NULL;
+    m.height_normal_path = src->height_normal_path ? lx_strdup(src->height_normal_path) : NULL;
     memset(&m.normal_map, 0, sizeof m.normal_map);
     m.emissive_map_path = src->emissive_map_path ? lx_strdup(src->emissive_map_path) : NULL;
     memset(&m.base_color_map, 0, sizeof m.base_color_map);

@@ -35,6 +35,8 @@ static const char *main_usage =
     "  normalmap HEIGHT\n"
     "                tangent-space normal map of a height image;\n"
     "                --blend BASE DETAIL blends two normal maps\n"
+    "  heightmap NORMALS\n"
+    "                heights integrated from a normal map (its inverse)\n"
     "  parallaxmap HEIGHT\n"
     "                the parallax map n.z h of a height image\n"
     "  horizonmap HEIGHT\n"
@@ -427,7 +429,8 @@ int main(int argc, char **argv)
         int (*run)(int argc, char **argv);
     } commands[] = {{"bake", cmd_bake},     {"info", cmd_info},     {"ies", cmd_ies},
                     {"ibl", cmd_ibl},       {"render", cmd_render}, {"unwrap", cmd_unwrap},
-                    {"normalmap", cmd_normalmap}, {"parallaxmap", cmd_parallaxmap},
+                    {"normalmap", cmd_normalmap}, {"heightmap", cmd_heightmap},
+                    {"parallaxmap", cmd_parallaxmap},
                     {"horizonmap", cmd_horizonmap}, {"aomap", cmd_aomap},
                     {"tangents", cmd_tangents}, {"shade", cmd_shade},
                     {"light2d", cmd_light2d}};

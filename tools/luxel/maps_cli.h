@@ -7,6 +7,7 @@
 #include "cli.h"
 
 int cmd_normalmap(int argc, char **argv);
+int cmd_heightmap(int argc, char **argv);
 int cmd_parallaxmap(int argc, char **argv);
 int cmd_shade(int argc, char **argv);
 
