@@ -111,6 +111,13 @@ int lx_bake_uv_set(const lx_scene *scene, uint32_t node, lx_uv_choice choice);
 #define LX_GI_SAMPLES_DEFAULT 128u
 #define LX_MAX_GI_SAMPLES 65536u
 
+/* What a bake's denoising filters (`luxel bake --denoise off|indirect|all`). */
+typedef enum lx_denoise_mode {
+    LX_DENOISE_OFF = 0,  /* nothing: out = direct + indirect */
+    LX_DENOISE_INDIRECT, /* the indirect part, direct added back: out = direct + F(indirect) */
+    LX_DENOISE_ALL       /* the sum: out = F(direct + indirect) */
+} lx_denoise_mode;
+
 typedef struct lx_sky_desc {
     const lx_cubemap *environment; /* NULL = no sky; read by lx_baker_create only */
     float intensity;               /* multiplier, 0 = 1 */
@@ -156,6 +163,11 @@ typedef struct lx_bake_desc {
                               LX_MAX_GI_SAMPLES, 0 = LX_GI_SAMPLES_DEFAULT */
     float emissive_scale;  /* multiplies the emissive materials' radiance
                               (nits) when bounces > 0; 0 = 1 */
+    lx_denoise_mode denoise; /* edge-aware denoising of the baked buffers at the
+                              end of lx_baker_bake (denoise.h): OFF (the
+                              library's default), INDIRECT (the bounces' part
+                              only; nothing without bounces) or ALL; luxel bake
+                              uses INDIRECT */
     lx_progress_fn progress;
     void *progress_user;
 } lx_bake_desc;

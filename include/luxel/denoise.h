@@ -76,12 +76,7 @@
 extern "C" {
 #endif
 
-/* What a bake's denoising filters (`luxel bake --denoise off|indirect|all`). */
-typedef enum lx_denoise_mode {
-    LX_DENOISE_OFF = 0,  /* nothing: out = direct + indirect */
-    LX_DENOISE_INDIRECT, /* the indirect part, direct added back: out = direct + F(indirect) */
-    LX_DENOISE_ALL       /* the sum: out = F(direct + indirect) */
-} lx_denoise_mode;
+/* lx_denoise_mode (what a bake's denoising filters) is in bake.h. */
 
 /* "off", "indirect" or "all"; NULL for another value. */
 const char *lx_denoise_mode_name(lx_denoise_mode mode);

@@ -213,6 +213,13 @@ lx_status lx_bake_indirect(lx_baker *b, float progress_base, float progress_span
 /* A material's emitted radiance in nits times scale, without texture. */
 lx_vec3 lx_material_emission(const lx_material *mat, float scale);
 
+/* bake_denoise.c: a copy of every map's baked buffer before the bounces
+ * when desc.denoise is INDIRECT with bounces (else NULL, *st LX_OK);
+ * its release; the denoising of every map within the given progress. */
+float **lx_bake_denoise_keep(const lx_baker *b, lx_status *st);
+void lx_bake_denoise_free(const lx_baker *b, float **direct);
+lx_status lx_bake_denoise(lx_baker *b, float **direct, float progress_base, float progress_span);
+
 lx_status lx_bake_lights(lx_baker *baker, const uint32_t *lights, uint32_t light_count,
                          lx_vec3 ambient, bool to_realtime, float progress_base,
                          float progress_span);

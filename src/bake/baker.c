@@ -56,6 +56,8 @@ static lx_status validate_desc(const lx_bake_desc *d)
         return lx_fail(LX_ERR_INVALID, "shadow bias must be finite and >= 0");
     if (d->bounces < 0 || d->bounces > LX_MAX_BOUNCES)
         return lx_fail(LX_ERR_INVALID, "bounces %d is outside 0..%d", d->bounces, LX_MAX_BOUNCES);
+    if ((unsigned)d->denoise > (unsigned)LX_DENOISE_ALL)
+        return lx_fail(LX_ERR_INVALID, "unknown denoise mode %d", (int)d->denoise);
     if (d->gi_samples < 1 || d->gi_samples > LX_MAX_GI_SAMPLES)
         return lx_fail(LX_ERR_INVALID, "gi samples %u is outside 1..%u", d->gi_samples,
                        LX_MAX_GI_SAMPLES);
@@ -475,10 +477,19 @@ lx_status lx_baker_bake(lx_baker *b)
     uint32_t n = select_lights(b, false, idx);
     /* progress: the direct pass, then the indirect one's gathers (a
      * validity pass and a gather a bounce, each about as long) */
-    float direct = b->desc.bounces > 0 ? 1.0f / (float)(b->desc.bounces + 2) : 1.0f;
+    bool denoise = b->desc.denoise == LX_DENOISE_ALL ||
+                   (b->desc.denoise == LX_DENOISE_INDIRECT && b->desc.bounces > 0);
+    float end = denoise ? 0.9f : 1.0f; /* the last tenth denoises */
+    float direct = b->desc.bounces > 0 ? end / (float)(b->desc.bounces + 2) : end;
+    float **kept = NULL;
     lx_status st = lx_bake_lights(b, idx, n, b->ambient, false, 0.0f, direct);
+    if (st == LX_OK)
+        kept = lx_bake_denoise_keep(b, &st);
     if (st == LX_OK && b->desc.bounces > 0)
-        st = lx_bake_indirect(b, direct, 1.0f - direct);
+        st = lx_bake_indirect(b, direct, end - direct);
+    if (st == LX_OK && denoise)
+        st = lx_bake_denoise(b, kept, end, 1.0f - end);
+    lx_bake_denoise_free(b, kept);
     if (st != LX_OK)
         clear_buffers(b, false);
     free(idx);

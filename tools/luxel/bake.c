@@ -59,6 +59,9 @@ static const char *bake_usage =
     "  --emissive-scale X      multiplier on emissive materials' radiance (nits),\n"
     "                          for files not authored in physical units\n"
     "                          (default 1); emitters light through the bounces\n"
+    "  --denoise M             indirect (default): the bounces' light filtered by\n"
+    "                          an edge-aware denoiser (docs/denoise.md); all: the\n"
+    "                          whole lightmap (area-light and sky noise too); off\n"
     "  --no-stitch             leave UV seams as baked (default: the texels on both\n"
     "                          sides of a seam are solved to agree, so no line\n"
     "                          shows where a surface crosses charts)\n"
@@ -125,6 +128,7 @@ enum {
     OPT_GI_SAMPLES,
     OPT_EMISSIVE_SCALE,
     OPT_NO_STITCH,
+    OPT_DENOISE,
     OPT_AO,
     OPT_AO_DISTANCE,
     OPT_AO_SAMPLES
@@ -221,6 +225,7 @@ static int parse_args(int argc, char **argv, bake_args *a)
         {"gi-samples", required_argument, NULL, OPT_GI_SAMPLES},
         {"emissive-scale", required_argument, NULL, OPT_EMISSIVE_SCALE},
         {"no-stitch", no_argument, NULL, OPT_NO_STITCH},
+        {"denoise", required_argument, NULL, OPT_DENOISE},
         {"ao", no_argument, NULL, OPT_AO},
         {"ao-distance", required_argument, NULL, OPT_AO_DISTANCE},
         {"ao-samples", required_argument, NULL, OPT_AO_SAMPLES},
@@ -232,6 +237,7 @@ static int parse_args(int argc, char **argv, bake_args *a)
     a->desc = lx_bake_desc_defaults(NULL);
     a->desc.padding = LX_PADDING_RECOMMENDED;
     a->desc.stitch_seams = true;
+    a->desc.denoise = LX_DENOISE_INDIRECT;
     a->desc.bounces = LX_BOUNCES_RECOMMENDED;
     a->output = "lightmaps";
     a->format = LX_IMAGE_EXR;
@@ -391,6 +397,11 @@ static int parse_args(int argc, char **argv, bake_args *a)
                 return cli_usage_error("bake", "--bounces must be an integer in 0..%d, not '%s'",
                                        LX_MAX_BOUNCES, optarg);
             a->desc.bounces = (int)n;
+            break;
+        case OPT_DENOISE:
+            if (!lx_denoise_mode_parse(optarg, &a->desc.denoise))
+                return cli_usage_error("bake", "--denoise must be off, indirect or all, not '%s'",
+                                       optarg);
             break;
         case OPT_NO_STITCH:
             a->desc.stitch_seams = false;
@@ -1143,6 +1154,7 @@ int cmd_bake(int argc, char **argv)
         cJSON_AddNumberToObject(manifest, "ao_distance", ad.distance);
     }
     cJSON_AddBoolToObject(manifest, "seams_stitched", a.desc.stitch_seams);
+    cJSON_AddStringToObject(manifest, "denoise", lx_denoise_mode_name(a.desc.denoise));
     if (unwrap) { /* what luxel render needs to make the same UVs again */
         cJSON_AddNumberToObject(manifest, "padding", a.desc.padding);
         cJSON_AddNumberToObject(manifest, "atlas_size",
