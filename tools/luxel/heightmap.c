@@ -38,8 +38,6 @@ static const char *heightmap_usage =
     "  -q, --quiet          no progress bar or summary\n"
     "  -h, --help           show this help\n";
 
-enum { OPT_WRAP = 256, OPT_GREEN, OPT_BITS, OPT_FORMAT, OPT_THREADS };
-
 typedef struct heightmap_args {
     const char *input;
     maps_output out;
@@ -50,73 +48,34 @@ typedef struct heightmap_args {
 static int parse_args(int argc, char **argv, heightmap_args *a)
 {
     static const struct option options[] = {{"output", required_argument, NULL, 'o'},
-                                            {"wrap", required_argument, NULL, OPT_WRAP},
-                                            {"green", required_argument, NULL, OPT_GREEN},
-                                            {"bits", required_argument, NULL, OPT_BITS},
-                                            {"format", required_argument, NULL, OPT_FORMAT},
-                                            {"threads", required_argument, NULL, OPT_THREADS},
+                                            {"wrap", required_argument, NULL, MAPS_OPT_WRAP},
+                                            {"green", required_argument, NULL, MAPS_OPT_GREEN},
+                                            {"bits", required_argument, NULL, MAPS_OPT_BITS},
+                                            {"format", required_argument, NULL, MAPS_OPT_FORMAT},
+                                            {"threads", required_argument, NULL, CLI_OPT_THREADS},
                                             {"quiet", no_argument, NULL, 'q'},
                                             {"verbose", no_argument, NULL, 'v'},
                                             {"help", no_argument, NULL, 'h'},
                                             {NULL, 0, NULL, 0}};
     memset(a, 0, sizeof *a);
+    maps_common m = {0};
     opterr = 0;
     optind = 1;
     int c;
-    long n;
     while ((c = getopt_long(argc, argv, ":o:qvh", options, NULL)) != -1) {
-        switch (c) {
-        case 'o':
-            if (!*optarg)
-                return cli_usage_error("heightmap", "-o needs a file name");
-            a->out.path = optarg;
-            break;
-        case OPT_WRAP:
-            if (!lx_wrap_parse(optarg, &a->desc.wrap))
-                return cli_usage_error("heightmap",
-                                       "--wrap must be repeat, clamp or mirror, not '%s'", optarg);
-            break;
-        case OPT_GREEN:
-            if (strcmp(optarg, "up") == 0)
-                a->desc.green_down = false;
-            else if (strcmp(optarg, "down") == 0)
-                a->desc.green_down = true;
-            else
-                return cli_usage_error("heightmap", "--green must be up or down, not '%s'",
-                                       optarg);
-            break;
-        case OPT_BITS:
-            if (!maps_parse_bits(optarg, &a->out.bits))
-                return cli_usage_error("heightmap", "--bits must be 8 or 16, not '%s'", optarg);
-            break;
-        case OPT_FORMAT:
-            if (!maps_parse_format(optarg, &a->out.format))
-                return cli_usage_error("heightmap", "--format must be png, exr or pfm, not '%s'",
-                                       optarg);
-            a->out.format_given = true;
-            break;
-        case OPT_THREADS:
-            if (!cli_parse_int(optarg, 1, 1024, &n))
-                return cli_usage_error("heightmap",
-                                       "--threads must be an integer in 1..1024, not '%s'", optarg);
-            a->desc.threads = (int)n;
-            break;
-        case 'q':
-            a->quiet = true;
-            cli_set_quiet(true);
-            break;
-        case 'v':
-            cli_set_verbose(true);
-            break;
-        case 'h':
+        if (c == 'h') {
             fputs(heightmap_usage, stdout);
             return -1;
-        case ':':
-            return cli_usage_error("heightmap", "option '%s' needs a value", argv[optind - 1]);
-        default:
-            return cli_usage_error("heightmap", "unknown option '%s'", argv[optind - 1]);
         }
+        int rc = maps_common_option("heightmap", c, argv, &m);
+        if (rc != 0)
+            return rc;
     }
+    a->out = m.out;
+    a->desc.wrap = m.wrap;
+    a->desc.green_down = m.green_down;
+    a->desc.threads = m.threads;
+    a->quiet = m.quiet;
     if (argc - optind < 1)
         return cli_usage_error("heightmap", "no normal map given");
     if (argc - optind > 1)
