@@ -16,6 +16,7 @@
 #include "helpers.h"
 #include "core/internal.h"
 #include "scenes.h"
+#include "bench_cli.h"
 
 #include <embree3/rtcore.h>
 #include <math.h>
@@ -25,34 +26,6 @@
 #include <string.h>
 #include <unistd.h>
 
-static int cmp_double(const void *a, const void *b)
-{
-    double x = *(const double *)a, y = *(const double *)b;
-    return (x > y) - (x < y);
-}
-
-/* The room from gen_scenes into a fresh temporary folder. */
-static void make_room(char *path, size_t size)
-{
-    char exe[4096];
-    ssize_t n = readlink("/proc/self/exe", exe, sizeof exe - 1);
-    if (n <= 0)
-        lx_bench_die("readlink /proc/self/exe");
-    exe[n] = '\0';
-    char *slash = strrchr(exe, '/');
-    if (slash)
-        *slash = '\0';
-    char dir[] = "/tmp/bench_gi.XXXXXX";
-    if (!mkdtemp(dir))
-        lx_bench_die("mkdtemp");
-    char cmd[8400];
-    snprintf(cmd, sizeof cmd, "'%s/gen_scenes' '%s' >/dev/null", exe, dir);
-    if (system(cmd) != 0) {
-        fprintf(stderr, "bench_gi: %s failed\n", cmd);
-        exit(1);
-    }
-    snprintf(path, size, "%s/room.glb", dir);
-}
 
 /* Seconds of lx_baker_bake with `bounces`. */
 static double bake_time(lx_baker *b)
@@ -142,7 +115,7 @@ int main(int argc, char **argv)
     lx_bench_header("bench_gi", threads);
     char room[4200];
     if (!scene_path) {
-        make_room(room, sizeof room);
+        lx_bench_make_room("bench_gi", room, sizeof room);
         scene_path = room;
     }
     lx_scene *scene;
@@ -219,8 +192,8 @@ int main(int argc, char **argv)
         tr[k] = raw_gathers(flat, tx, tile_start, tiles, counts, bounces + 1, bias, threads,
                             &rays);
     }
-    qsort(tg, (size_t)reps, sizeof *tg, cmp_double);
-    qsort(tr, (size_t)reps, sizeof *tr, cmp_double);
+    qsort(tg, (size_t)reps, sizeof *tg, lx_bench_cmp_double);
+    qsort(tr, (size_t)reps, sizeof *tr, lx_bench_cmp_double);
     char a[32], b[32];
     printf("\nGI  %s, %dx%d a node, %u texels, %d bounces x %d rays a texel (+%u validity), %d "
            "threads, %d runs\n",

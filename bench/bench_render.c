@@ -17,6 +17,7 @@
 #include "helpers.h"
 #include "core/internal.h"
 #include "scenes.h"
+#include "bench_cli.h"
 
 #include <embree3/rtcore.h>
 #include <math.h>
@@ -30,34 +31,6 @@
 #define H 720
 #define TILE 16
 
-static int cmp_double(const void *a, const void *b)
-{
-    double x = *(const double *)a, y = *(const double *)b;
-    return (x > y) - (x < y);
-}
-
-/* The room from gen_scenes into a fresh temporary folder. */
-static void make_room(char *path, size_t size)
-{
-    char exe[4096];
-    ssize_t n = readlink("/proc/self/exe", exe, sizeof exe - 1);
-    if (n <= 0)
-        lx_bench_die("readlink /proc/self/exe");
-    exe[n] = '\0';
-    char *slash = strrchr(exe, '/');
-    if (slash)
-        *slash = '\0';
-    char dir[] = "/tmp/bench_render.XXXXXX";
-    if (!mkdtemp(dir))
-        lx_bench_die("mkdtemp");
-    char cmd[8400];
-    snprintf(cmd, sizeof cmd, "'%s/gen_scenes' '%s' >/dev/null", exe, dir);
-    if (system(cmd) != 0) {
-        fprintf(stderr, "bench_render: %s failed\n", cmd);
-        exit(1);
-    }
-    snprintf(path, size, "%s/room.glb", dir);
-}
 
 /* The bake's lightmaps as lx_lightmaps, without files. */
 static void bake(const lx_scene *scene, int threads, lx_lightmaps *lm)
@@ -166,7 +139,7 @@ int main(int argc, char **argv)
     lx_bench_header("bench_render", threads);
     char room[4200];
     if (!scene_path) {
-        make_room(room, sizeof room);
+        lx_bench_make_room("bench_render", room, sizeof room);
         scene_path = room;
     }
     lx_scene *scene;
@@ -223,9 +196,9 @@ int main(int argc, char **argv)
         lx_image_free(&img);
         tw[k] = raw_frame(flat, &d.camera, samples, threads, &hits);
     }
-    qsort(tr, (size_t)reps, sizeof *tr, cmp_double);
-    qsort(tw, (size_t)reps, sizeof *tw, cmp_double);
-    qsort(t2, (size_t)reps, sizeof *t2, cmp_double);
+    qsort(tr, (size_t)reps, sizeof *tr, lx_bench_cmp_double);
+    qsort(tw, (size_t)reps, sizeof *tw, lx_bench_cmp_double);
+    qsort(t2, (size_t)reps, sizeof *t2, lx_bench_cmp_double);
     double rays = (double)W * H * samples;
     char a[32], b[32];
     printf("\nRENDER  %s, %dx%d, %d samples a pixel, %u triangles' scene, %d threads, %d frames\n",

@@ -30,6 +30,27 @@ void lx_bench_sibling(const char *name, char *out, size_t size)
     snprintf(out, size, "%s/%s", self, name);
 }
 
+void lx_bench_make_room(const char *program, char *path, size_t size)
+{
+    char gen[4096], dir[256], cmd[8400];
+    lx_bench_sibling("gen_scenes", gen, sizeof gen);
+    snprintf(dir, sizeof dir, "/tmp/%s.XXXXXX", program);
+    if (!mkdtemp(dir))
+        lx_bench_die("mkdtemp");
+    snprintf(cmd, sizeof cmd, "'%s' '%s' >/dev/null", gen, dir);
+    if (system(cmd) != 0) {
+        fprintf(stderr, "%s: %s failed\n", program, cmd);
+        exit(1);
+    }
+    snprintf(path, size, "%s/room.glb", dir);
+}
+
+int lx_bench_cmp_double(const void *a, const void *b)
+{
+    double x = *(const double *)a, y = *(const double *)b;
+    return (x > y) - (x < y);
+}
+
 double lx_bench_run_child(char *const argv[], const char *log)
 {
     fflush(stdout);

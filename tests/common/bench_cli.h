@@ -11,6 +11,13 @@
 /* The path of program `name` in this program's folder (build/bin). */
 void lx_bench_sibling(const char *name, char *out, size_t size);
 
+/* gen_scenes' room.glb, made in a fresh folder /tmp/<program>.XXXXXX;
+ * its path into path. */
+void lx_bench_make_room(const char *program, char *path, size_t size);
+
+/* qsort's comparison of doubles, ascending. */
+int lx_bench_cmp_double(const void *a, const void *b);
+
 /* Runs argv (argv[0] a path) as a child process with its stderr in file
  * log; returns its wall time from fork to exit, ending the bench when it
  * fails. */
