@@ -10,7 +10,9 @@
  * Each channel is solved on its own, in a fixed order, so the bytes do
  * not depend on the thread count. The samples are made once with the
  * texel map; solving runs where lx_baker_apply has padded the map, so the
- * padding texels the lookups also read take part. */
+ * padding texels the lookups also read take part. A texel the solution
+ * takes below zero (a dark texel beside a bright seam) is set to zero:
+ * light cannot be negative, and luxel render refuses negative texels. */
 #include "bake_internal.h"
 #include "core/internal.h"
 #include "luxel/unwrap.h"
@@ -235,8 +237,12 @@ lx_status lx_seam_stitch_apply(const lx_seam_stitch *s, float *data, int channel
             for (uint32_t v = 0; v < n; v++)
                 p[v] = res[v] + beta * p[v];
         }
+        /* light is never negative: where a dark texel beside a bright
+         * one would overshoot below zero, it keeps zero (the nearest
+         * value a lightmap can hold; the least squares has no bound) */
         for (uint32_t v = 0; v < n; v++)
-            data[(size_t)s->var_pixel[v] * (size_t)channels + (size_t)c] = (float)x[v];
+            data[(size_t)s->var_pixel[v] * (size_t)channels + (size_t)c] =
+                (float)(x[v] > 0.0 ? x[v] : 0.0);
     }
     free(x), free(x0), free(res), free(p), free(ap), free(rows);
     return LX_OK;

@@ -9,7 +9,7 @@
 set -u
 . "$(dirname "${BASH_SOURCE[0]}")/common.sh" "$@"
 
-GEN2D=$(dirname "$LUXEL")/gen_light2d
+GEN2D=$(dirname "$LUXEL_REAL")/gen_light2d
 if [ ! -x "$GEN2D" ]; then
     skip "gen_light2d is not built next to luxel"
     finish

@@ -19,7 +19,7 @@ no_match() { ! grep -Eq -- "$1" "$2"; }
 HERE=$(abspath "$(dirname "${BASH_SOURCE[0]}")")
 VALIDATE_JS=$HERE/../common/gltf_validate.js
 TRIS_JS=$HERE/glb_triangles.js
-ORACLES=$(dirname "$(dirname "$LUXEL")")/oracles
+ORACLES=$(dirname "$(dirname "$LUXEL_REAL")")/oracles
 
 # a quad strip whose UVs are mirrored at x = 0 (one vertex row shared by
 # both halves: its corners need two frames), with normals and UVs

@@ -18,7 +18,7 @@ IN=$WORK/in
 OUTD=$WORK/out
 mkdir -p "$IN" "$OUTD"
 VALIDATE_JS=$(abspath "$(dirname "${BASH_SOURCE[0]}")")/../common/gltf_validate.js
-ORACLES=$(dirname "$(dirname "$LUXEL")")/oracles
+ORACLES=$(dirname "$(dirname "$LUXEL_REAL")")/oracles
 
 # a cube and a floor quad as OBJ (two objects, one material)
 cat >"$IN/cube.obj" <<'EOF'
