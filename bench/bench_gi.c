@@ -113,22 +113,7 @@ int main(int argc, char **argv)
     }
     threads = lx_thread_count(threads);
     lx_bench_header("bench_gi", threads);
-    char room[4200];
-    if (!scene_path) {
-        lx_bench_make_room("bench_gi", room, sizeof room);
-        scene_path = room;
-    }
-    lx_scene *scene;
-    if (lx_scene_load(scene_path, NULL, &scene) != LX_OK)
-        lx_bench_die(scene_path);
-    if (scene_path == room) {
-        char cmd[8500], *slash = strrchr(room, '/');
-        *slash = '\0';
-        snprintf(cmd, sizeof cmd, "rm -rf '%s'", room);
-        if (system(cmd) != 0)
-            fprintf(stderr, "bench_gi: could not remove %s\n", room);
-        scene_path = "room (gen_scenes)";
-    }
+    lx_scene *scene = lx_bench_load_room("bench_gi", &scene_path);
     lx_bake_desc d = lx_bake_desc_defaults(NULL);
     d.resolution = res;
     d.threads = threads;

@@ -137,23 +137,7 @@ int main(int argc, char **argv)
     }
     threads = lx_thread_count(threads);
     lx_bench_header("bench_render", threads);
-    char room[4200];
-    if (!scene_path) {
-        lx_bench_make_room("bench_render", room, sizeof room);
-        scene_path = room;
-    }
-    lx_scene *scene;
-    if (lx_scene_load(scene_path, NULL, &scene) != LX_OK)
-        lx_bench_die(scene_path);
-    if (scene_path == room) {
-        /* the generated files are no longer needed */
-        char cmd[8500], *slash = strrchr(room, '/');
-        *slash = '\0';
-        snprintf(cmd, sizeof cmd, "rm -rf '%s'", room);
-        if (system(cmd) != 0)
-            fprintf(stderr, "bench_render: could not remove %s\n", room);
-        scene_path = "room (gen_scenes)";
-    }
+    lx_scene *scene = lx_bench_load_room("bench_render", &scene_path);
     uint32_t triangles = 0;
     for (uint32_t n = 0; n < scene->node_count; n++)
         for (uint32_t k = 0; k < scene->nodes[n].mesh_count; k++)

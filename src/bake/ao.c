@@ -38,19 +38,15 @@ static float texel_ao(const lx_baker *b, uint32_t map_index, const lx_lightmap *
     lx_vec3 ng = map->world_geometric_normal[texel];
     lx_vec3 t = lx_perpendicular(n), bt = lx_cross(n, t);
     uint32_t pixel = map->texels[texel].pixel;
-    uint32_t sx = (uint32_t)sqrtf((float)d->samples);
-    sx = sx ? sx : 1u;
-    uint32_t sy = (d->samples + sx - 1) / sx, cells = sx * sy;
+    uint32_t sx, sy;
+    lx_cosine_strata(d->samples, &sx, &sy);
+    uint32_t cells = sx * sy;
     enum { BATCH = 64 };
     lx_ray rays[BATCH];
     uint8_t occluded[BATCH];
     uint32_t open = 0, m = 0;
     for (uint32_t k = 0; k < cells; k++) {
-        float u = ((float)(k % sx) + lx_random(map_index, pixel, k, AO_KEY)) / (float)sx;
-        float v = ((float)(k / sx) + lx_random(map_index, pixel, k, AO_KEY + 1)) / (float)sy;
-        float r = sqrtf(u), phi = 2.0f * LX_PI * v;
-        lx_vec3 dir = lx_add(lx_add(lx_scale(t, r * cosf(phi)), lx_scale(bt, r * sinf(phi))),
-                             lx_scale(n, sqrtf(fmaxf(0.0f, 1.0f - u))));
+        lx_vec3 dir = lx_cosine_direction(t, bt, n, map_index, pixel, k, sx, sy, AO_KEY);
         if (!(lx_dot(dir, ng) > 0.0f))
             continue; /* into the surface itself */
         lx_light_eval e = {.to_light = dir, .distance = d->distance};

@@ -180,6 +180,15 @@ void lx_texel_map_transform(lx_lightmap *map, uint32_t node, const lx_mat4 *worl
  * light (direct.c). */
 lx_ray lx_shadow_ray(const lx_baker *b, lx_vec3 p, lx_vec3 ng, const lx_light_eval *e);
 
+/* Stratified cosine-weighted directions (Malley's method), shared by the
+ * sky's, the gathers' and AO's rays (sky.c): n rays as sx x sy cells
+ * (sx = floor(sqrt n), at least 1), and ray k's direction about the unit
+ * frame (t, bt, n), jittered by lx_random(map, pixel, k, key) and
+ * (..., key + 1), so any thread count gives the same rays. */
+void lx_cosine_strata(uint32_t count, uint32_t *sx, uint32_t *sy);
+lx_vec3 lx_cosine_direction(lx_vec3 t, lx_vec3 bt, lx_vec3 n, uint32_t map, uint32_t pixel,
+                            uint32_t k, uint32_t sx, uint32_t sy, uint32_t key);
+
 /* Takes what the baker needs of a sky (SH, the lookup for rays); nothing
  * when sky->environment is NULL (sky.c). */
 lx_status lx_sky_prepare(lx_baker *b, const lx_sky_desc *sky);

@@ -152,11 +152,7 @@ static gather_frame frame_of(const lx_baker *b, uint32_t map_index, const lx_lig
 static bool gather_ray(const gather_frame *f, uint32_t k, uint32_t sx, uint32_t sy, uint32_t key,
                        lx_ray *ray)
 {
-    float u = ((float)(k % sx) + lx_random(f->map, f->pixel, k, key)) / (float)sx;
-    float v = ((float)(k / sx) + lx_random(f->map, f->pixel, k, key + 1)) / (float)sy;
-    float r = sqrtf(u), phi = 2.0f * LX_PI * v;
-    lx_vec3 d = lx_add(lx_add(lx_scale(f->t, r * cosf(phi)), lx_scale(f->bt, r * sinf(phi))),
-                       lx_scale(f->n, sqrtf(fmaxf(0.0f, 1.0f - u))));
+    lx_vec3 d = lx_cosine_direction(f->t, f->bt, f->n, f->map, f->pixel, k, sx, sy, key);
     if (!(lx_dot(d, f->ng) > 0.0f))
         return false;
     ray->origin = f->origin;
@@ -238,14 +234,6 @@ static lx_vec3 hit_radiance(const gi_run *run, const lx_hit *h)
 }
 
 /* Stratification of n samples: sx x sy cells with sx * sy >= n. */
-static void strata(uint32_t n, uint32_t *sx, uint32_t *sy)
-{
-    uint32_t x = (uint32_t)sqrtf((float)n);
-    x = x ? x : 1u;
-    *sx = x;
-    *sy = (n + x - 1) / x;
-}
-
 /* The validity pass for one texel: true when most of its rays hit back
  * faces. */
 static bool texel_inside(const gi_run *run, uint32_t map_index, uint32_t i)
@@ -254,7 +242,7 @@ static bool texel_inside(const gi_run *run, uint32_t map_index, uint32_t i)
     const lx_lightmap *map = &b->maps[map_index];
     uint32_t want = b->desc.gi_samples < VALIDITY_RAYS ? b->desc.gi_samples : VALIDITY_RAYS;
     uint32_t sx, sy;
-    strata(want, &sx, &sy);
+    lx_cosine_strata(want, &sx, &sy);
     uint32_t cells = sx * sy, back = 0;
     gather_frame f = frame_of(b, map_index, map, i);
     for (uint32_t k = 0; k < cells; k++) {
@@ -274,7 +262,7 @@ static lx_vec3 texel_gather(const gi_run *run, uint32_t map_index, uint32_t i, u
     const lx_baker *b = run->b;
     const lx_lightmap *map = &b->maps[map_index];
     uint32_t sx, sy;
-    strata(b->desc.gi_samples, &sx, &sy);
+    lx_cosine_strata(b->desc.gi_samples, &sx, &sy);
     uint32_t cells = sx * sy;
     double sum[3] = {0.0, 0.0, 0.0};
     gather_frame f = frame_of(b, map_index, map, i);

@@ -229,6 +229,24 @@ static float shifted(float v, float offset)
     return r < 1.0f ? r : 0.99999994f;
 }
 
+void lx_cosine_strata(uint32_t count, uint32_t *sx, uint32_t *sy)
+{
+    uint32_t x = (uint32_t)sqrtf((float)count);
+    x = x ? x : 1u;
+    *sx = x;
+    *sy = (count + x - 1) / x;
+}
+
+lx_vec3 lx_cosine_direction(lx_vec3 t, lx_vec3 bt, lx_vec3 n, uint32_t map, uint32_t pixel,
+                            uint32_t k, uint32_t sx, uint32_t sy, uint32_t key)
+{
+    float u = ((float)(k % sx) + lx_random(map, pixel, k, key)) / (float)sx;
+    float v = ((float)(k / sx) + lx_random(map, pixel, k, key + 1)) / (float)sy;
+    float r = sqrtf(u), phi = 2.0f * LX_PI * v;
+    return lx_add(lx_add(lx_scale(t, r * cosf(phi)), lx_scale(bt, r * sinf(phi))),
+                  lx_scale(n, sqrtf(fmaxf(0.0f, 1.0f - u))));
+}
+
 /* Casts m rays (directions in rays[], weights per channel in w[]) and adds
  * the weights of those that escape to sum. */
 static void cast(const lx_baker *b, lx_ray *rays, const lx_vec3 *w, uint32_t m, double sum[3])
@@ -263,18 +281,13 @@ static lx_vec3 sky_visible(const lx_baker *b, uint32_t map_index, const lx_light
     lx_vec3 result = lx_v3(0.0f, 0.0f, 0.0f);
 
     /* base: stratified cosine-weighted directions, pi / N sum base(w) */
-    uint32_t want = b->sky_samples;
-    uint32_t sx = (uint32_t)sqrtf((float)want);
-    sx = sx ? sx : 1u;
-    uint32_t sy = (want + sx - 1) / sx, cells = sx * sy;
+    uint32_t want = b->sky_samples, sx, sy;
+    lx_cosine_strata(want, &sx, &sy);
+    uint32_t cells = sx * sy;
     double sum[3] = {0.0, 0.0, 0.0};
     uint32_t m = 0;
     for (uint32_t k = 0; k < cells; k++) {
-        float u = ((float)(k % sx) + lx_random(map_index, pixel, k, key)) / (float)sx;
-        float v = ((float)(k / sx) + lx_random(map_index, pixel, k, key + 1)) / (float)sy;
-        float r = sqrtf(u), phi = 2.0f * LX_PI * v;
-        lx_vec3 d = lx_add(lx_add(lx_scale(t, r * cosf(phi)), lx_scale(bt, r * sinf(phi))),
-                           lx_scale(nrm, sqrtf(fmaxf(0.0f, 1.0f - u))));
+        lx_vec3 d = lx_cosine_direction(t, bt, nrm, map_index, pixel, k, sx, sy, key);
         if (!(lx_dot(d, ng) > 0.0f))
             continue;
         const float *l = lookup->data + 3 * texel_index(n, d);

@@ -30,19 +30,33 @@ void lx_bench_sibling(const char *name, char *out, size_t size)
     snprintf(out, size, "%s/%s", self, name);
 }
 
-void lx_bench_make_room(const char *program, char *path, size_t size)
+lx_scene *lx_bench_load_room(const char *program, const char **path)
 {
-    char gen[4096], dir[256], cmd[8400];
-    lx_bench_sibling("gen_scenes", gen, sizeof gen);
-    snprintf(dir, sizeof dir, "/tmp/%s.XXXXXX", program);
-    if (!mkdtemp(dir))
-        lx_bench_die("mkdtemp");
-    snprintf(cmd, sizeof cmd, "'%s' '%s' >/dev/null", gen, dir);
-    if (system(cmd) != 0) {
-        fprintf(stderr, "%s: %s failed\n", program, cmd);
-        exit(1);
+    char room[4200] = "", dir[256], cmd[8500];
+    if (!*path) {
+        char gen[4096];
+        lx_bench_sibling("gen_scenes", gen, sizeof gen);
+        snprintf(dir, sizeof dir, "/tmp/%s.XXXXXX", program);
+        if (!mkdtemp(dir))
+            lx_bench_die("mkdtemp");
+        snprintf(cmd, sizeof cmd, "'%s' '%s' >/dev/null", gen, dir);
+        if (system(cmd) != 0) {
+            fprintf(stderr, "%s: %s failed\n", program, cmd);
+            exit(1);
+        }
+        snprintf(room, sizeof room, "%s/room.glb", dir);
     }
-    snprintf(path, size, "%s/room.glb", dir);
+    lx_scene *scene;
+    if (lx_scene_load(room[0] ? room : *path, NULL, &scene) != LX_OK)
+        lx_bench_die(room[0] ? room : *path);
+    if (room[0]) {
+        /* the generated files are no longer needed */
+        snprintf(cmd, sizeof cmd, "rm -rf '%s'", dir);
+        if (system(cmd) != 0)
+            fprintf(stderr, "%s: could not remove %s\n", program, dir);
+        *path = "room (gen_scenes)";
+    }
+    return scene;
 }
 
 int lx_bench_cmp_double(const void *a, const void *b)

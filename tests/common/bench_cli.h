@@ -11,9 +11,10 @@
 /* The path of program `name` in this program's folder (build/bin). */
 void lx_bench_sibling(const char *name, char *out, size_t size);
 
-/* gen_scenes' room.glb, made in a fresh folder /tmp/<program>.XXXXXX;
- * its path into path. */
-void lx_bench_make_room(const char *program, char *path, size_t size);
+/* The scene at *path, or when *path is NULL gen_scenes' room.glb, made in
+ * a fresh folder /tmp/<program>.XXXXXX that is removed once loaded (*path
+ * then names it "room (gen_scenes)"). Ends the bench when it fails. */
+lx_scene *lx_bench_load_room(const char *program, const char **path);
 
 /* qsort's comparison of doubles, ascending. */
 int lx_bench_cmp_double(const void *a, const void *b);
