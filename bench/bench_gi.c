@@ -9,8 +9,17 @@
  * without; the ratio says what finding the hit's lightmap texels and
  * summing costs on top of the rays. Best and median of --reps runs each.
  *
+ * Then the noise, at --noise-res texels a node: the bake at
+ * --noise-samples S gather rays a texel raw (--denoise off) and denoised
+ * (indirect, the CLI's default), and a raw bake at the sample count that
+ * takes as long as the denoised one (equal time), each against a
+ * reference of 64 S rays a texel: RMS error over every covered texel and
+ * channel, relative to the reference's mean; times are the best of --reps. The reference's own noise
+ * (about 1/8 of the raw S bake's) is in every figure.
+ *
  * Usage: bench_gi [--threads N] [--reps N] [--res N] [--samples N]
- *                 [--bounces N] [--scene FILE.glb] */
+ *                 [--bounces N] [--scene FILE.glb] [--noise-res N]
+ *                 [--noise-samples S] [--skip-noise] */
 #define _POSIX_C_SOURCE 200809L
 #define _DEFAULT_SOURCE
 #include "helpers.h"
@@ -34,6 +43,108 @@ static double bake_time(lx_baker *b)
     if (lx_baker_bake(b) != LX_OK)
         lx_bench_die("bake");
     return lx_bench_now() - t0;
+}
+
+/* Every covered texel's RGB of every lightmap of a bake with desc, in
+ * map order; *seconds the best time of `reps` bakes. */
+static float *baked_texels(const lx_scene *scene, const lx_bake_desc *desc, int reps,
+                           size_t *count, double *seconds)
+{
+    lx_baker *b;
+    if (lx_baker_create(scene, desc, &b) != LX_OK)
+        lx_bench_die("baker");
+    *seconds = bake_time(b);
+    for (int k = 1; k < reps; k++) {
+        double t = bake_time(b);
+        if (t < *seconds)
+            *seconds = t;
+    }
+    size_t n = 0, cap = 0;
+    float *out = NULL;
+    for (uint32_t m = 0; m < lx_baker_lightmap_count(b); m++) {
+        lx_image img;
+        if (lx_baker_apply_alloc(b, m, &img) != LX_OK)
+            lx_bench_die("apply");
+        const uint8_t *mask = lx_baker_mask(b, m);
+        size_t pixels = (size_t)img.width * (size_t)img.height;
+        if (n + pixels > cap) {
+            cap = (n + pixels) * 2;
+            out = realloc(out, sizeof(float) * 3 * cap);
+            if (!out)
+                lx_bench_die("memory");
+        }
+        for (size_t i = 0; i < pixels; i++) {
+            if (!mask[i])
+                continue;
+            for (size_t c = 0; c < 3; c++)
+                out[3 * n + c] = img.data[i * (size_t)img.channels + c];
+            n++;
+        }
+        lx_image_free(&img);
+    }
+    lx_baker_destroy(b);
+    *count = n;
+    return out;
+}
+
+/* RMS of (x - ref) over n texels' channels, relative to ref's mean. */
+static double relative_rms(const float *x, const float *ref, size_t n)
+{
+    double se = 0.0, sum = 0.0;
+    for (size_t i = 0; i < 3 * n; i++) {
+        double e = (double)x[i] - (double)ref[i];
+        se += e * e;
+        sum += ref[i];
+    }
+    return sum > 0.0 ? sqrt(se / (double)(3 * n)) / (sum / (double)(3 * n)) : 0.0;
+}
+
+/* The noise section (see the top). */
+static void noise_at_equal_time(const lx_scene *scene, const char *scene_path, int res,
+                                int samples, int bounces, int threads, int reps)
+{
+    lx_bake_desc d = lx_bake_desc_defaults(NULL);
+    d.resolution = res;
+    d.threads = threads;
+    size_t n_ref, n;
+    double t_direct, t_ref, t_raw, t_den, t_eq;
+    float *direct = baked_texels(scene, &d, reps, &n, &t_direct);
+    free(direct);
+    d.bounces = bounces;
+    d.gi_samples = (uint32_t)samples * 64u;
+    float *ref = baked_texels(scene, &d, 1, &n_ref, &t_ref);
+    d.gi_samples = (uint32_t)samples;
+    float *raw = baked_texels(scene, &d, reps, &n, &t_raw);
+    d.denoise = LX_DENOISE_INDIRECT;
+    float *den = baked_texels(scene, &d, reps, &n, &t_den);
+    /* the GI's time grows with its rays: the raw count that takes as long
+     * as the denoised bake */
+    double gi_raw = t_raw - t_direct, gi_den = t_den - t_direct;
+    int equal = (int)lround((double)samples * gi_den / (gi_raw > 1e-6 ? gi_raw : 1e-6));
+    if (equal < samples)
+        equal = samples;
+    d.denoise = LX_DENOISE_OFF;
+    d.gi_samples = (uint32_t)equal;
+    float *eq = baked_texels(scene, &d, reps, &n, &t_eq);
+    if (n != n_ref)
+        lx_bench_die("texel counts differ");
+    double e_raw = relative_rms(raw, ref, n), e_den = relative_rms(den, ref, n),
+           e_eq = relative_rms(eq, ref, n);
+    printf("\nnoise  %s, %dx%d a node, %zu texels, %d bounces, against %d rays a texel (%.1f s)\n",
+           scene_path, res, res, n, bounces, samples * 64, t_ref);
+    printf("  %-44s %9s %14s\n", "", "time", "RMS error");
+    printf("  %-44s %8.3fs %13.2f%%\n", "raw, gi-samples S", t_raw, 100.0 * e_raw);
+    printf("  %-44s %8.3fs %13.2f%%\n", "denoised (--denoise indirect), S", t_den, 100.0 * e_den);
+    printf("  raw at equal time, %-25d %8.3fs %13.2f%%\n", equal, t_eq, 100.0 * e_eq);
+    printf("noise: at %d rays a texel the denoiser cuts the RMS error against a 64x reference "
+           "%.1fx (%.2f%% -> %.2f%%); %.1fx against the raw bake of equal time (%d rays); "
+           "a raw bake would need about %.0f rays (1/sqrt law) to match\n",
+           samples, e_raw / e_den, 100.0 * e_raw, 100.0 * e_den, e_eq / e_den, equal,
+           (double)samples * (e_raw / e_den) * (e_raw / e_den));
+    free(ref);
+    free(raw);
+    free(den);
+    free(eq);
 }
 
 typedef struct texel {
@@ -82,7 +193,9 @@ static double raw_gathers(RTCScene flat, const texel *tx, const uint32_t *tile_s
 
 int main(int argc, char **argv)
 {
-    int threads = 0, reps = 3, res = 128, samples = 64, bounces = 2;
+    int threads = 0, reps = 3, res = 256, samples = 256, bounces = 2;
+    int noise_res = 128, noise_samples = 16;
+    bool skip_noise = false;
     const char *scene_path = NULL;
     for (int i = 1; i < argc; i++) {
         if (!strcmp(argv[i], "--threads") && i + 1 < argc)
@@ -97,18 +210,25 @@ int main(int argc, char **argv)
             bounces = atoi(argv[++i]);
         else if (!strcmp(argv[i], "--scene") && i + 1 < argc)
             scene_path = argv[++i];
+        else if (!strcmp(argv[i], "--noise-res") && i + 1 < argc)
+            noise_res = atoi(argv[++i]);
+        else if (!strcmp(argv[i], "--noise-samples") && i + 1 < argc)
+            noise_samples = atoi(argv[++i]);
+        else if (!strcmp(argv[i], "--skip-noise"))
+            skip_noise = true;
         else {
             fprintf(stderr,
                     "usage: %s [--threads N] [--reps N] [--res N] [--samples N] [--bounces N] "
-                    "[--scene FILE.glb]\n",
+                    "[--scene FILE.glb] [--noise-res N] [--noise-samples S] [--skip-noise]\n",
                     argv[0]);
             return 2;
         }
     }
     if (reps < 1 || reps > 100 || res < 4 || res > 4096 || samples < 1 || samples > 4096 ||
-        bounces < 1 || bounces > 16) {
+        bounces < 1 || bounces > 16 || noise_res < 4 || noise_res > 4096 || noise_samples < 1 ||
+        noise_samples > 1024) {
         fprintf(stderr, "bench_gi: --reps 1..100, --res 4..4096, --samples 1..4096, --bounces "
-                        "1..16\n");
+                        "1..16, --noise-res 4..4096, --noise-samples 1..1024\n");
         return 2;
     }
     threads = lx_thread_count(threads);
@@ -191,6 +311,8 @@ int main(int argc, char **argv)
     printf("gi: %.2fx the time of raw incoherent rtcIntersect1 on as many rays (best; median "
            "%.2fx)\n",
            tg[0] / tr[0], tg[reps / 2] / tr[reps / 2]);
+    if (!skip_noise)
+        noise_at_equal_time(scene, scene_path, noise_res, noise_samples, bounces, threads, reps);
     free(tg);
     free(tr);
     free(tx);
