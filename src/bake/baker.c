@@ -482,7 +482,11 @@ lx_status lx_baker_bake(lx_baker *b)
     float end = denoise ? 0.9f : 1.0f; /* the last tenth denoises */
     float direct = b->desc.bounces > 0 ? end / (float)(b->desc.bounces + 2) : end;
     float **kept = NULL;
-    lx_status st = lx_bake_lights(b, idx, n, b->ambient, false, 0.0f, direct);
+    /* emitters (with bounces): direct light, sampled after the lights */
+    float lights_end = b->emitter_count && b->desc.bounces > 0 ? 0.5f * direct : direct;
+    lx_status st = lx_bake_lights(b, idx, n, b->ambient, false, 0.0f, lights_end);
+    if (st == LX_OK && b->desc.bounces > 0)
+        st = lx_bake_emitters(b, lights_end, direct - lights_end);
     if (st == LX_OK)
         kept = lx_bake_denoise_keep(b, &st);
     if (st == LX_OK && b->desc.bounces > 0)
