@@ -43,7 +43,7 @@
 /* the control variate sums every triangle at every texel up to this many */
 #define EXACT_TRIANGLES 64u
 /* shadow rays per texel at most (desc.gi_samples when fewer) */
-#define NEE_SAMPLES_MAX 64u
+#define NEE_SAMPLES_MAX 256u
 
 typedef struct emitter_tri {
     lx_vec3 p0, e1, e2; /* a vertex and the edges to the other two */
@@ -223,6 +223,26 @@ static bool in_front(const lx_baker *b, const emitter_tri *t, lx_vec3 p)
     return lx_dot(t->n, lx_sub(p, t->p0)) > b->bias;
 }
 
+/* The shadow ray from texel point p (geometric normal ng) to emitter
+ * point x (front normal ne), d = x - p: both ends moved off their
+ * surfaces by the scale-aware bias (lx_shadow_ray's at p; at x along the
+ * emitter's normal), so the ray neither starts behind the texel's surface
+ * nor reaches the emitter itself, at any angle. */
+static lx_ray shadow_ray(const lx_baker *b, lx_vec3 p, lx_vec3 ng, lx_vec3 x, lx_vec3 ne, lx_vec3 d)
+{
+    lx_vec3 side = lx_dot(ng, d) >= 0.0f ? ng : lx_neg(ng);
+    lx_vec3 o = lx_madd(p, side, b->bias + 4e-6f * lx_max_abs_component(p));
+    lx_vec3 end = lx_madd(x, ne, b->bias + 4e-6f * lx_max_abs_component(x));
+    lx_vec3 dir = lx_sub(end, o);
+    float len = lx_length(dir);
+    lx_ray r;
+    r.origin = o;
+    r.dir = len > 0.0f ? lx_scale(dir, 1.0f / len) : lx_v3(0.0f, 1.0f, 0.0f);
+    r.tmin = 0.0f;
+    r.tmax = len;
+    return r;
+}
+
 /* The emitters' irradiance at texel i of map. */
 static lx_vec3 texel_emitters(const lx_baker *b, const emitter_set *set, uint32_t map_index,
                               const lx_lightmap *map, uint32_t i)
@@ -293,8 +313,7 @@ static lx_vec3 texel_emitters(const lx_baker *b, const emitter_set *set, uint32_
             on[m] = lx_v3((float)((le.x - base.x) * g), (float)((le.y - base.y) * g),
                           (float)((le.z - base.z) * g));
             off[m] = lx_v3((float)(-base.x * g), (float)(-base.y * g), (float)(-base.z * g));
-            lx_light_eval e = {.to_light = lx_scale(d, 1.0f / dist), .distance = dist};
-            rays[m] = lx_shadow_ray(b, p, ng, &e);
+            rays[m] = shadow_ray(b, p, ng, x, t->n, d);
             m++;
         }
         if (m == 0)
