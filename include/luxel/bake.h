@@ -274,10 +274,11 @@ lx_status lx_baker_set_node_transform(lx_baker *baker, uint32_t node, const lx_m
  * albedo / pi x the dynamic direct light at the cached hits (bilinear over
  * valid texels) and adds pi / N x their sum - no rays. The bounce is that
  * of lx_baker_bake with bounces = 1 for the same light, with N samples'
- * noise. Cost: 12 x N + 1 bytes per texel and 13 per lightmap pixel while
- * the baker lives (205 + 13 per texel at N = 16); per update about N
- * bilinear reads per texel (bench_realtime: docs/realtime.md). Bit-identical
- * for any thread count. */
+ * noise (N rounded up to whole strata, sx x sy). Cost: 12 x N + 1 bytes
+ * per texel and 13 per lightmap pixel while the baker lives (193 and 13
+ * at N = 16); per update about N bilinear reads per texel
+ * (bench_realtime; docs/ARCHITECTURE.md, "The dynamic lights' bounce").
+ * Bit-identical for any thread count. */
 lx_status lx_baker_update(lx_baker *baker);
 
 /* baked + real-time for one lightmap, in the desc's quantity, padded by
