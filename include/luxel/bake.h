@@ -110,6 +110,10 @@ int lx_bake_uv_set(const lx_scene *scene, uint32_t node, lx_uv_choice choice);
 #define LX_MAX_BOUNCES 64
 #define LX_GI_SAMPLES_DEFAULT 128u
 #define LX_MAX_GI_SAMPLES 65536u
+/* The dynamic lights' one bounce (lx_baker_update): the gather rays per
+ * texel a real-time user should start from, and the most taken. */
+#define LX_DYNAMIC_BOUNCE_SAMPLES_RECOMMENDED 16u
+#define LX_MAX_DYNAMIC_BOUNCE_SAMPLES 1024u
 
 /* What a bake's denoising filters (`luxel bake --denoise off|indirect|all`). */
 typedef enum lx_denoise_mode {
@@ -168,6 +172,13 @@ typedef struct lx_bake_desc {
                               library's default), INDIRECT (the bounces' part
                               only; nothing without bounces) or ALL; luxel bake
                               uses INDIRECT */
+    uint32_t dynamic_bounce_samples; /* the dynamic lights' one bounce in
+                              lx_baker_update: cached gather rays per texel,
+                              0..LX_MAX_DYNAMIC_BOUNCE_SAMPLES; 0 = none (the
+                              library's default, like bounces' zero a value:
+                              the update then stays direct light only, as
+                              before); LX_DYNAMIC_BOUNCE_SAMPLES_RECOMMENDED
+                              (16) for real time. Independent of bounces. */
     lx_progress_fn progress;
     void *progress_user;
 } lx_bake_desc;
@@ -218,17 +229,25 @@ const uint8_t *lx_baker_mask(const lx_baker *baker, uint32_t map);
  * (seeded by map, texel and sample: bit-identical for any thread count);
  * a ray that hits the front of a lightmapped surface brings that
  * surface's bounce k-1 exitant radiance, base colour / pi x irradiance,
- * read bilinearly over the valid texels of its lightmap (plus, at the
- * first gather, its emission: emissiveFactor x emissiveTexture x
- * KHR_materials_emissive_strength x desc.emissive_scale, nits); E_k = pi /
- * N x sum. A ray that escapes brings nothing (the sky it sees is direct
+ * read bilinearly over the valid texels of its lightmap; E_k = pi / N x
+ * sum. A ray that escapes brings nothing (the sky it sees is direct
  * light, already baked), a back face nothing. Surfaces without a
- * lightmap (no UVs) reflect nothing and emit their material's factor.
+ * lightmap (no UVs) reflect nothing.
+ * EMITTERS  An emissive surface (emissiveFactor x emissiveTexture x
+ * KHR_materials_emissive_strength x desc.emissive_scale, nits, from its
+ * front face) is direct light when bounces > 0: its triangles are
+ * importance-sampled (luminance x area) with shadow rays,
+ * min(gi_samples, 64) a texel, and their exact unshadowed irradiance
+ * (Lambert's polygon formula) is the control variate while the scene has
+ * at most 64 emissive triangles, so only penumbrae are noisy; the
+ * gathers do not count emission again. With N bounces emitted light is
+ * then reflected up to N times, as the lights' is (emitters.c).
  * A texel whose rays mostly hit back faces is inside geometry: it is
  * invalid, takes no part in the bounces, and gets the average of its
  * valid neighbours. The result is direct + E_1 + ... + E_bounces, in the
  * same units; emission itself is not in the lightmaps (the material
- * draws it). Dynamic lights get no indirect light. Memory while baking:
+ * draws it). Dynamic lights get one bounce in lx_baker_update when
+ * desc.dynamic_bounce_samples > 0 (see there). Memory while baking:
  * about 50 bytes a texel (albedo, validity, the sources and two
  * irradiance buffers), plus 12 per texel of an emissive material. */
 lx_status lx_baker_bake(lx_baker *baker);
@@ -246,7 +265,20 @@ lx_status lx_baker_set_light(lx_baker *baker, uint32_t light, const lx_light *va
 lx_status lx_baker_set_node_transform(lx_baker *baker, uint32_t node, const lx_mat4 *world);
 
 /* Re-evaluates the dynamic lights into the real-time buffers. Reports to
- * desc.progress like lx_baker_bake (leave it NULL for per-frame use). */
+ * desc.progress like lx_baker_bake (leave it NULL for per-frame use).
+ * With desc.dynamic_bounce_samples = N > 0 the dynamic lights also get one
+ * diffuse bounce through the lightmaps: the first update that needs it
+ * (and the first after lx_baker_set_node_transform) traces and caches N
+ * stratified cosine-weighted gather rays per texel and the texels'
+ * validity, as lx_baker_bake's bounces do; every update then reads
+ * albedo / pi x the dynamic direct light at the cached hits (bilinear over
+ * valid texels) and adds pi / N x their sum - no rays. The bounce is that
+ * of lx_baker_bake with bounces = 1 for the same light, with N samples'
+ * noise (N rounded up to whole strata, sx x sy). Cost: 12 x N + 1 bytes
+ * per texel and 13 per lightmap pixel while the baker lives (193 and 13
+ * at N = 16); per update about N bilinear reads per texel
+ * (bench_realtime; docs/ARCHITECTURE.md, "The dynamic lights' bounce").
+ * Bit-identical for any thread count. */
 lx_status lx_baker_update(lx_baker *baker);
 
 /* baked + real-time for one lightmap, in the desc's quantity, padded by

@@ -42,6 +42,15 @@ typedef struct lx_horizon_material {
  * its texel map when desc.stitch_seams asks. */
 typedef struct lx_seam_stitch lx_seam_stitch;
 
+/* An emissive mesh as placed by a node (emitters.c). */
+typedef struct lx_emitter_instance {
+    uint32_t node, mesh;
+} lx_emitter_instance;
+
+/* The dynamic lights' bounce (dyn_bounce.c): each texel's cached gather
+ * hits and the per-update buffers. */
+typedef struct lx_dyn_bounce lx_dyn_bounce;
+
 typedef struct lx_lightmap {
     lx_lightmap_info info;
     char *name;
@@ -102,7 +111,18 @@ struct lx_baker {
     uint32_t **mesh_indices;
     uint32_t *mesh_triangles;
     lx_vec3 *mesh_emission;
+    /* emitters (emitters.c): each emissive mesh's object-space positions
+     * (NULL for the others), whether a texture modulates its emission, and
+     * every node's emissive meshes */
+    lx_vec3 **mesh_positions;
+    uint8_t *mesh_emission_textured;
+    lx_emitter_instance *emitters;
+    uint32_t emitter_count;
     uint64_t gi_invalid_texels; /* found by the last bake */
+    /* the dynamic lights' bounce (dyn_bounce.c); NULL until the first
+     * update that needs it */
+    lx_dyn_bounce *dyn;
+    bool dyn_stale; /* a node moved: the cached hits are rebuilt */
     /* during lx_baker_create only: each material's horizon layers and AO */
     lx_horizon_material *horizon_materials;
     uint32_t horizon_material_count;
@@ -219,6 +239,46 @@ void lx_seam_stitch_free(lx_seam_stitch *s);
 lx_status lx_gi_prepare(lx_baker *b, const lx_scene *scene);
 void lx_gi_free(lx_baker *b);
 lx_status lx_bake_indirect(lx_baker *b, float progress_base, float progress_span);
+/* A texel's gather frame (gi.c): the ray origin (lifted off the surface
+ * along the geometric normal, as lx_shadow_ray does), its normals and the
+ * tangents of the shading normal. */
+typedef struct lx_gather_frame {
+    lx_vec3 origin, n, ng, t, bt;
+    uint32_t map, pixel;
+} lx_gather_frame;
+lx_gather_frame lx_gather_frame_of(const lx_baker *b, uint32_t map_index, const lx_lightmap *map,
+                                   uint32_t i);
+/* Gather ray k of a frame: stratified cosine-weighted direction in cell k
+ * of sx x sy about the shading normal, jittered by key; false when it
+ * points below the geometric surface (it counts as dark). */
+bool lx_gather_ray(const lx_gather_frame *f, uint32_t k, uint32_t sx, uint32_t sy, uint32_t key,
+                   lx_ray *ray);
+/* Where a point (barycentrics u, v of a triangle of mesh under node) lands
+ * in its lightmap: the map and continuous texel coordinates (texel centres
+ * at integers, clamped to [-1, w] x [-1, h]); false when the surface has
+ * no lightmap. */
+bool lx_gi_hit_texel(const lx_baker *b, uint32_t node, uint32_t mesh, uint32_t triangle, float u,
+                     float v, uint32_t *map_index, float *fx, float *fy);
+/* data (3 floats a pixel) at (fx, fy) of map: bilinear over the texels
+ * `valid` (per pixel) marks, else the average of the valid texels of the
+ * nearest ring (up to 3); zero when none. */
+lx_vec3 lx_gi_lookup(const lx_lightmap *map, const uint8_t *valid, const float *data, float fx,
+                     float fy);
+/* The validity test: true when most of texel i's rays hit back faces. */
+bool lx_gi_texel_inside(const lx_baker *b, uint32_t map_index, uint32_t i);
+/* Gives the invalid texels (per texel flags) of buf (3 floats a pixel) the
+ * average of their valid (per pixel flags) or already filled neighbours,
+ * ring by ring. */
+lx_status lx_gi_fill_invalid(const lx_lightmap *map, const uint8_t *valid, const uint8_t *invalid,
+                             float *buf);
+/* emitters.c: next-event estimation of the emissive triangles' light
+ * (direct light, when desc.bounces > 0 and an emitter exists), added into
+ * the baked buffers within [progress_base, progress_base + progress_span]. */
+lx_status lx_bake_emitters(lx_baker *b, float progress_base, float progress_span);
+/* dyn_bounce.c: one bounce of the real-time buffers' light (the dynamic
+ * lights' direct light) added into them; its cache's release. */
+lx_status lx_dyn_bounce_update(lx_baker *b);
+void lx_dyn_bounce_free(lx_baker *b);
 /* A material's emitted radiance in nits times scale, without texture. */
 lx_vec3 lx_material_emission(const lx_material *mat, float scale);
 

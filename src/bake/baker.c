@@ -63,6 +63,9 @@ static lx_status validate_desc(const lx_bake_desc *d)
                        LX_MAX_GI_SAMPLES);
     if (!(d->emissive_scale > 0.0f) || !isfinite(d->emissive_scale))
         return lx_fail(LX_ERR_INVALID, "emissive scale must be a finite number > 0");
+    if (d->dynamic_bounce_samples > LX_MAX_DYNAMIC_BOUNCE_SAMPLES)
+        return lx_fail(LX_ERR_INVALID, "dynamic bounce samples %u is outside 0..%u",
+                       d->dynamic_bounce_samples, LX_MAX_DYNAMIC_BOUNCE_SAMPLES);
     if (d->quantity != LX_QUANTITY_IRRADIANCE && d->quantity != LX_QUANTITY_RADIANCE)
         return lx_fail(LX_ERR_INVALID, "unknown quantity %d", (int)d->quantity);
     if (d->uv_set != LX_UV_SET_AUTO && d->uv_set != LX_UV_SET_0 && d->uv_set != LX_UV_SET_1)
@@ -332,7 +335,8 @@ lx_status lx_baker_create(const lx_scene *scene, const lx_bake_desc *in, lx_bake
         b->node_scale_offset[n][0] = b->node_scale_offset[n][1] = 1.0f;
         b->node_scale_offset[n][2] = b->node_scale_offset[n][3] = 0.0f;
     }
-    if (desc.bounces > 0 && (st = lx_gi_prepare(b, scene)) != LX_OK) {
+    if ((desc.bounces > 0 || desc.dynamic_bounce_samples > 0) &&
+        (st = lx_gi_prepare(b, scene)) != LX_OK) {
         lx_baker_destroy(b);
         return st;
     }
@@ -371,6 +375,7 @@ void lx_baker_destroy(lx_baker *b)
         lx_texel_map_free(&b->maps[m]);
     lx_tracer_destroy(b->tracer);
     lx_sky_free(b);
+    lx_dyn_bounce_free(b);
     lx_gi_free(b);
     free(b->maps);
     free(b->node_map);
@@ -443,6 +448,7 @@ lx_status lx_baker_set_node_transform(lx_baker *b, uint32_t node, const lx_mat4 
         return st;
     b->node_world[node] = *world;
     b->tracer_dirty = true;
+    b->dyn_stale = true; /* the dynamic bounce's cached hits */
     if (b->node_map[node] != UINT32_MAX)
         lx_texel_map_transform(&b->maps[b->node_map[node]], node, world);
     return LX_OK;
@@ -482,7 +488,11 @@ lx_status lx_baker_bake(lx_baker *b)
     float end = denoise ? 0.9f : 1.0f; /* the last tenth denoises */
     float direct = b->desc.bounces > 0 ? end / (float)(b->desc.bounces + 2) : end;
     float **kept = NULL;
-    lx_status st = lx_bake_lights(b, idx, n, b->ambient, false, 0.0f, direct);
+    /* emitters (with bounces): direct light, sampled after the lights */
+    float lights_end = b->emitter_count && b->desc.bounces > 0 ? 0.5f * direct : direct;
+    lx_status st = lx_bake_lights(b, idx, n, b->ambient, false, 0.0f, lights_end);
+    if (st == LX_OK && b->desc.bounces > 0)
+        st = lx_bake_emitters(b, lights_end, direct - lights_end);
     if (st == LX_OK)
         kept = lx_bake_denoise_keep(b, &st);
     if (st == LX_OK && b->desc.bounces > 0)
@@ -520,8 +530,16 @@ lx_status lx_baker_update(lx_baker *b)
                 st = lx_fail(LX_ERR_NOMEM, "lightmap '%s': out of memory for the real-time buffer",
                              map->name);
         }
+        bool bounce = b->desc.dynamic_bounce_samples > 0;
         if (st == LX_OK)
-            st = lx_bake_lights(b, idx, n, lx_v3(0, 0, 0), true, 0.0f, 1.0f);
+            st = lx_bake_lights(b, idx, n, lx_v3(0, 0, 0), true, 0.0f, bounce ? 0.5f : 1.0f);
+        if (st == LX_OK && bounce) {
+            st = lx_dyn_bounce_update(b);
+            if (st == LX_OK && b->desc.progress && !b->desc.progress(b->desc.progress_user, 1.0f))
+                st = lx_fail(LX_ERR_CANCELLED, "bake cancelled");
+        }
+        if (st != LX_OK)
+            clear_buffers(b, true);
     }
     if (idx != idx_buf)
         free(idx);

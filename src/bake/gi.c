@@ -46,7 +46,10 @@ lx_status lx_gi_prepare(lx_baker *b, const lx_scene *scene)
     b->mesh_indices = calloc(m1, sizeof(uint32_t *));
     b->mesh_triangles = calloc(m1, sizeof(uint32_t));
     b->mesh_emission = calloc(m1, sizeof(lx_vec3));
-    bool ok = b->node_uv_set && b->mesh_indices && b->mesh_triangles && b->mesh_emission;
+    b->mesh_positions = calloc(m1, sizeof(lx_vec3 *));
+    b->mesh_emission_textured = calloc(m1, 1);
+    bool ok = b->node_uv_set && b->mesh_indices && b->mesh_triangles && b->mesh_emission &&
+              b->mesh_positions && b->mesh_emission_textured;
     for (int s = 0; s < LX_MAX_UV_SETS; s++)
         ok &= b->mesh_uv[s] != NULL;
     for (uint32_t m = 0; m < scene->mesh_count && ok; m++) {
@@ -55,7 +58,18 @@ lx_status lx_gi_prepare(lx_baker *b, const lx_scene *scene)
             mesh->material < scene->material_count ? &scene->materials[mesh->material] : NULL;
         if (mat)
             b->mesh_emission[m] = lx_material_emission(mat, b->desc.emissive_scale);
-        bool any = false;
+        lx_vec3 em = b->mesh_emission[m];
+        bool emits = (em.x > 0.0f || em.y > 0.0f || em.z > 0.0f) && mesh->triangle_count > 0;
+        if (emits) {
+            /* an emitter (emitters.c): its triangles in object space */
+            b->mesh_emission_textured[m] = mat->emissive_map.width > 0;
+            b->mesh_positions[m] = malloc(sizeof(lx_vec3) * (mesh->vertex_count + 1));
+            ok = b->mesh_positions[m] != NULL;
+            if (ok)
+                memcpy(b->mesh_positions[m], mesh->positions,
+                       sizeof(lx_vec3) * mesh->vertex_count);
+        }
+        bool any = emits;
         for (int s = 0; s < LX_MAX_UV_SETS && ok; s++) {
             if (!mesh->uv[s])
                 continue;
@@ -74,6 +88,25 @@ lx_status lx_gi_prepare(lx_baker *b, const lx_scene *scene)
                    sizeof(uint32_t) * 3 * (size_t)mesh->triangle_count);
         b->mesh_triangles[m] = mesh->triangle_count;
     }
+    /* the emitters' instances: every node's emissive meshes */
+    uint32_t count = 0;
+    for (int pass = 0; pass < 2 && ok; pass++) {
+        count = 0;
+        for (uint32_t n = 0; n < scene->node_count; n++)
+            for (uint32_t k = 0; k < scene->nodes[n].mesh_count; k++) {
+                uint32_t mi = scene->nodes[n].meshes[k];
+                if (mi >= scene->mesh_count || !b->mesh_positions[mi])
+                    continue;
+                if (pass)
+                    b->emitters[count] = (lx_emitter_instance){n, mi};
+                count++;
+            }
+        if (!pass && count) {
+            b->emitters = malloc(sizeof(lx_emitter_instance) * count);
+            ok = b->emitters != NULL;
+        }
+    }
+    b->emitter_count = ok ? count : 0;
     if (!ok)
         return lx_fail(LX_ERR_NOMEM, "%s: out of memory for global illumination", scene->path);
     return LX_OK;
@@ -87,7 +120,16 @@ void lx_gi_free(lx_baker *b)
                 free(b->mesh_uv[s][m]);
         if (b->mesh_indices)
             free(b->mesh_indices[m]);
+        if (b->mesh_positions)
+            free(b->mesh_positions[m]);
     }
+    free(b->mesh_positions);
+    free(b->mesh_emission_textured);
+    free(b->emitters);
+    b->mesh_positions = NULL;
+    b->mesh_emission_textured = NULL;
+    b->emitters = NULL;
+    b->emitter_count = 0;
     for (int s = 0; s < LX_MAX_UV_SETS; s++) {
         free(b->mesh_uv[s]);
         b->mesh_uv[s] = NULL;
@@ -117,24 +159,15 @@ typedef struct gi_run {
     uint32_t *map_first_tile;
     int tiles;
     int threads;
-    bool first_gather; /* emission is picked up */
     /* progress */
     uint64_t total_work;
     float base, span;
 } gi_run;
 
-/* A texel's gather frame: the ray origin (lifted off the surface along
- * the geometric normal, as lx_shadow_ray does), its normals and the
- * tangents of the shading normal. */
-typedef struct gather_frame {
-    lx_vec3 origin, n, ng, t, bt;
-    uint32_t map, pixel;
-} gather_frame;
-
-static gather_frame frame_of(const lx_baker *b, uint32_t map_index, const lx_lightmap *map,
-                             uint32_t i)
+lx_gather_frame lx_gather_frame_of(const lx_baker *b, uint32_t map_index, const lx_lightmap *map,
+                                   uint32_t i)
 {
-    gather_frame f;
+    lx_gather_frame f;
     lx_vec3 p = map->world_position[i];
     f.n = map->world_normal[i];
     f.ng = map->world_geometric_normal[i];
@@ -146,11 +179,8 @@ static gather_frame frame_of(const lx_baker *b, uint32_t map_index, const lx_lig
     return f;
 }
 
-/* Gather ray k of a texel: stratified cosine-weighted direction in cell k
- * of sx x sy about the shading normal, jittered by key; false when it
- * points below the geometric surface (it counts as dark). */
-static bool gather_ray(const gather_frame *f, uint32_t k, uint32_t sx, uint32_t sy, uint32_t key,
-                       lx_ray *ray)
+bool lx_gather_ray(const lx_gather_frame *f, uint32_t k, uint32_t sx, uint32_t sy, uint32_t key,
+                   lx_ray *ray)
 {
     lx_vec3 d = lx_cosine_direction(f->t, f->bt, f->n, f->map, f->pixel, k, sx, sy, key);
     if (!(lx_dot(d, f->ng) > 0.0f))
@@ -162,36 +192,38 @@ static bool gather_ray(const gather_frame *f, uint32_t k, uint32_t sx, uint32_t 
     return true;
 }
 
-/* The exitant radiance a front-face hit sees: the hit surface's source
- * texels, bilinear over the valid ones (or the valid texels of the nearest
- * ring around the hit's texel); a surface without a lightmap emits its
- * material's emission at the first gather and reflects nothing. */
-static lx_vec3 hit_radiance(const gi_run *run, const lx_hit *h)
+bool lx_gi_hit_texel(const lx_baker *b, uint32_t node, uint32_t mesh, uint32_t triangle, float u,
+                     float v, uint32_t *map_index, float *fx_out, float *fy_out)
 {
-    const lx_baker *b = run->b;
-    lx_vec3 none = lx_v3(0.0f, 0.0f, 0.0f);
-    if (h->mesh >= b->mesh_count || h->node >= b->node_count)
-        return none;
-    uint32_t mi = b->node_map[h->node];
-    int set = mi == UINT32_MAX ? 0 : b->node_uv_set[h->node];
-    const lx_vec2 *uv = mi == UINT32_MAX ? NULL : b->mesh_uv[set][h->mesh];
-    if (!uv || h->triangle >= b->mesh_triangles[h->mesh])
-        return run->first_gather ? b->mesh_emission[h->mesh] : none;
-    const uint32_t *tri = b->mesh_indices[h->mesh] + 3 * (size_t)h->triangle;
-    float w0 = 1.0f - h->u - h->v;
-    float s = uv[tri[0]].x * w0 + uv[tri[1]].x * h->u + uv[tri[2]].x * h->v;
-    float t = uv[tri[0]].y * w0 + uv[tri[1]].y * h->u + uv[tri[2]].y * h->v;
-    const float *so = b->node_scale_offset[h->node];
+    if (mesh >= b->mesh_count || node >= b->node_count)
+        return false;
+    uint32_t mi = b->node_map[node];
+    int set = mi == UINT32_MAX ? 0 : b->node_uv_set[node];
+    const lx_vec2 *uv = mi == UINT32_MAX ? NULL : b->mesh_uv[set][mesh];
+    if (!uv || triangle >= b->mesh_triangles[mesh])
+        return false;
+    const uint32_t *tri = b->mesh_indices[mesh] + 3 * (size_t)triangle;
+    float w0 = 1.0f - u - v;
+    float s = uv[tri[0]].x * w0 + uv[tri[1]].x * u + uv[tri[2]].x * v;
+    float t = uv[tri[0]].y * w0 + uv[tri[1]].y * u + uv[tri[2]].y * v;
+    const float *so = b->node_scale_offset[node];
     s = s * so[0] + so[2];
     t = t * so[1] + so[3];
     const lx_lightmap *map = &b->maps[mi];
-    const gi_map *g = &run->maps[mi];
     int w = map->info.width, hgt = map->info.height;
     float fx = s * (float)w - 0.5f, fy = t * (float)hgt - 0.5f;
     if (!isfinite(fx) || !isfinite(fy))
-        return none;
-    fx = fminf(fmaxf(fx, -1.0f), (float)w);
-    fy = fminf(fmaxf(fy, -1.0f), (float)hgt);
+        return false;
+    *map_index = mi;
+    *fx_out = fminf(fmaxf(fx, -1.0f), (float)w);
+    *fy_out = fminf(fmaxf(fy, -1.0f), (float)hgt);
+    return true;
+}
+
+lx_vec3 lx_gi_lookup(const lx_lightmap *map, const uint8_t *valid, const float *data, float fx,
+                     float fy)
+{
+    int w = map->info.width, hgt = map->info.height;
     int x0 = (int)floorf(fx), y0 = (int)floorf(fy);
     float ax = fx - (float)x0, ay = fy - (float)y0;
     float sum[3] = {0.0f, 0.0f, 0.0f}, wsum = 0.0f;
@@ -201,12 +233,12 @@ static lx_vec3 hit_radiance(const gi_run *run, const lx_hit *h)
             if (x < 0 || y < 0 || x >= w || y >= hgt)
                 continue;
             size_t p = (size_t)y * (size_t)w + (size_t)x;
-            if (!g->valid[p])
+            if (!valid[p])
                 continue;
             float wt = (dx ? ax : 1.0f - ax) * (dy ? ay : 1.0f - ay);
             wsum += wt;
             for (int c = 0; c < 3; c++)
-                sum[c] += wt * g->source[3 * p + c];
+                sum[c] += wt * data[3 * p + c];
         }
     if (wsum > 0.0f)
         return lx_v3(sum[0] / wsum, sum[1] / wsum, sum[2] / wsum);
@@ -221,34 +253,43 @@ static lx_vec3 hit_radiance(const gi_run *run, const lx_hit *h)
                 if (x < 0 || y < 0 || x >= w || y >= hgt)
                     continue;
                 size_t p = (size_t)y * (size_t)w + (size_t)x;
-                if (!g->valid[p])
+                if (!valid[p])
                     continue;
                 for (int c = 0; c < 3; c++)
-                    sum[c] += g->source[3 * p + c];
+                    sum[c] += data[3 * p + c];
                 n++;
             }
         if (n)
             return lx_v3(sum[0] / (float)n, sum[1] / (float)n, sum[2] / (float)n);
     }
-    return none;
+    return lx_v3(0.0f, 0.0f, 0.0f);
 }
 
-/* Stratification of n samples: sx x sy cells with sx * sy >= n. */
-/* The validity pass for one texel: true when most of its rays hit back
- * faces. */
-static bool texel_inside(const gi_run *run, uint32_t map_index, uint32_t i)
+/* The exitant radiance a front-face hit sees: the hit surface's source
+ * texels (lx_gi_lookup over the valid ones); a surface without a lightmap
+ * reflects nothing. Emission is not picked up: emitters are direct light,
+ * sampled by emitters.c. */
+static lx_vec3 hit_radiance(const gi_run *run, const lx_hit *h)
 {
-    const lx_baker *b = run->b;
+    uint32_t mi;
+    float fx, fy;
+    if (!lx_gi_hit_texel(run->b, h->node, h->mesh, h->triangle, h->u, h->v, &mi, &fx, &fy))
+        return lx_v3(0.0f, 0.0f, 0.0f);
+    return lx_gi_lookup(&run->b->maps[mi], run->maps[mi].valid, run->maps[mi].source, fx, fy);
+}
+
+bool lx_gi_texel_inside(const lx_baker *b, uint32_t map_index, uint32_t i)
+{
     const lx_lightmap *map = &b->maps[map_index];
     uint32_t want = b->desc.gi_samples < VALIDITY_RAYS ? b->desc.gi_samples : VALIDITY_RAYS;
     uint32_t sx, sy;
     lx_cosine_strata(want, &sx, &sy);
     uint32_t cells = sx * sy, back = 0;
-    gather_frame f = frame_of(b, map_index, map, i);
+    lx_gather_frame f = lx_gather_frame_of(b, map_index, map, i);
     for (uint32_t k = 0; k < cells; k++) {
         lx_ray ray;
         lx_hit h;
-        if (!gather_ray(&f, k, sx, sy, VALIDITY_KEY, &ray))
+        if (!lx_gather_ray(&f, k, sx, sy, VALIDITY_KEY, &ray))
             continue;
         if (lx_tracer_closest(b->tracer, &ray, &h) && lx_dot(ray.dir, h.normal) > 0.0f)
             back++;
@@ -265,11 +306,11 @@ static lx_vec3 texel_gather(const gi_run *run, uint32_t map_index, uint32_t i, u
     lx_cosine_strata(b->desc.gi_samples, &sx, &sy);
     uint32_t cells = sx * sy;
     double sum[3] = {0.0, 0.0, 0.0};
-    gather_frame f = frame_of(b, map_index, map, i);
+    lx_gather_frame f = lx_gather_frame_of(b, map_index, map, i);
     for (uint32_t k = 0; k < cells; k++) {
         lx_ray ray;
         lx_hit h;
-        if (!gather_ray(&f, k, sx, sy, key, &ray))
+        if (!lx_gather_ray(&f, k, sx, sy, key, &ray))
             continue;
         if (!lx_tracer_closest(b->tracer, &ray, &h) || !(lx_dot(ray.dir, h.normal) < 0.0f))
             continue; /* escaped (sky: direct light), or a back face */
@@ -303,7 +344,7 @@ static bool run_pass(gi_run *run, bool validity, uint32_t key, float from, float
         uint32_t first = map->tile_start[tile], count = map->tile_start[tile + 1] - first;
         for (uint32_t i = first; i < first + count; i++) {
             if (validity) {
-                g->invalid[i] = texel_inside(run, m, i);
+                g->invalid[i] = lx_gi_texel_inside(b, m, i);
             } else if (g->invalid[i]) {
                 g->next[i] = lx_v3(0.0f, 0.0f, 0.0f);
             } else {
@@ -329,7 +370,8 @@ static bool run_pass(gi_run *run, bool validity, uint32_t key, float from, float
  * 8-neighbours among the covered texels, ring by ring, each pass reading
  * what the previous one left; texels no valid texel reaches keep their
  * value. Sequential: invalid texels are few. */
-static lx_status fill_invalid(const lx_lightmap *map, const gi_map *g)
+lx_status lx_gi_fill_invalid(const lx_lightmap *map, const uint8_t *valid, const uint8_t *invalid,
+                             float *buf)
 {
     int w = map->info.width, h = map->info.height;
     uint32_t n = map->info.used_texels, open = 0;
@@ -342,9 +384,9 @@ static lx_status fill_invalid(const lx_lightmap *map, const gi_map *g)
         free(filled);
         return lx_fail(LX_ERR_NOMEM, "lightmap '%s': out of memory", map->name);
     }
-    memcpy(filled, g->valid, (size_t)w * (size_t)h);
+    memcpy(filled, valid, (size_t)w * (size_t)h);
     for (uint32_t i = 0; i < n; i++)
-        if (g->invalid[i])
+        if (invalid[i])
             todo[open++] = map->texels[i].pixel;
     while (open) {
         uint32_t got = 0;
@@ -362,7 +404,7 @@ static lx_status fill_invalid(const lx_lightmap *map, const gi_map *g)
                     if (filled[q] != 1)
                         continue;
                     for (int ch = 0; ch < 3; ch++)
-                        s[ch] += map->baked[3 * q + ch];
+                        s[ch] += buf[3 * q + ch];
                     c++;
                 }
             if (c) {
@@ -378,7 +420,7 @@ static lx_status fill_invalid(const lx_lightmap *map, const gi_map *g)
         for (uint32_t k = 0; k < open; k++) {
             uint32_t p = todo[k];
             if (filled[p] == 2) {
-                memcpy(map->baked + 3 * (size_t)p, vals + 3 * k, sizeof(float) * 3);
+                memcpy(buf + 3 * (size_t)p, vals + 3 * k, sizeof(float) * 3);
                 filled[p] = 1;
             } else {
                 todo[left++] = p;
@@ -447,8 +489,8 @@ lx_status lx_bake_indirect(lx_baker *b, float progress_base, float progress_span
         }
     }
     for (int k = 1; k <= b->desc.bounces && st == LX_OK; k++) {
-        /* the sources: albedo / pi x the last bounce (+ emission, first) */
-        run.first_gather = k == 1;
+        /* the sources: albedo / pi x the last bounce (emission is direct
+         * light, emitters.c: already in the first) */
         for (uint32_t m = 0; m < count; m++) {
             const lx_lightmap *map = &b->maps[m];
             gi_map *g = &run.maps[m];
@@ -458,8 +500,6 @@ lx_status lx_bake_indirect(lx_baker *b, float progress_base, float progress_span
                 if (g->invalid[i])
                     continue;
                 lx_vec3 l = lx_scale(lx_mul(map->albedo[i], g->prev[i]), 1.0f / LX_PI);
-                if (k == 1 && map->emission)
-                    l = lx_add(l, map->emission[i]);
                 float *dst = g->source + 3 * (size_t)map->texels[i].pixel;
                 dst[0] = l.x, dst[1] = l.y, dst[2] = l.z;
             }
@@ -485,7 +525,8 @@ lx_status lx_bake_indirect(lx_baker *b, float progress_base, float progress_span
     }
     for (uint32_t m = 0; m < count && st == LX_OK; m++)
         if (b->gi_invalid_texels)
-            st = fill_invalid(&b->maps[m], &run.maps[m]);
+            st = lx_gi_fill_invalid(&b->maps[m], run.maps[m].valid, run.maps[m].invalid,
+                                    b->maps[m].baked);
     if (st == LX_OK && b->gi_invalid_texels)
         lx_log(LX_LOG_INFO,
                "global illumination: %llu texels sit inside geometry (their rays mostly hit back "

@@ -692,7 +692,8 @@ lx_status lx_texel_map_build(const lx_scene *scene, const lx_page_spec *page,
     map->world_position = malloc(sizeof(lx_vec3) * (used ? used : 1));
     map->world_normal = malloc(sizeof(lx_vec3) * (used ? used : 1));
     map->world_geometric_normal = malloc(sizeof(lx_vec3) * (used ? used : 1));
-    bool want_albedo = desc->quantity == LX_QUANTITY_RADIANCE || desc->bounces > 0;
+    bool want_albedo = desc->quantity == LX_QUANTITY_RADIANCE || desc->bounces > 0 ||
+                       desc->dynamic_bounce_samples > 0;
     if (want_albedo)
         map->albedo = malloc(sizeof(lx_vec3) * (used ? used : 1));
     /* emission per texel: for the gather, when a material here emits */

@@ -1,0 +1,398 @@
+/* Emissive surfaces as direct light: next-event estimation of the emissive
+ * triangles (Shirley, Wang and Zimmerman, "Monte Carlo Techniques for
+ * Direct Lighting Calculations", ACM TOG 1996; Pharr, Jakob and Humphreys,
+ * Physically Based Rendering, 3rd ed., 14.2: light sampling), with the
+ * exact unshadowed irradiance of each triangle (Lambert's polygon formula,
+ * Arvo, "Analytic Methods for Simulated Light Transport", 1995) as a
+ * control variate when the emitters are few.
+ *
+ * The emitters are every node's emissive triangles, picked with
+ * probability emission luminance (the material's factor) x area (a CDF
+ * over them); a point on the picked triangle is uniform in area. A texel
+ * casts S stratified samples (the unit square in sx x sy cells, jittered
+ * by (map, texel, sample), so any thread count gives the same bytes): the
+ * first coordinate picks the triangle through the CDF and, rescaled within
+ * the triangle's share, places the point with the second. Each sample
+ * brings L_e(x) V cos(theta) cos(theta') / d^2 / pdf(x), V from a shadow
+ * ray (lx_shadow_ray), theta at the texel's shading normal, theta' at the
+ * emitter's front face (an emitter emits from its front only, as the
+ * gathers see it).
+ *
+ * With at most EXACT_TRIANGLES emissive triangles, the estimator is
+ *     E = sum_j L_j F_j + 1/S sum_k (L_e(x_k) V_k - L_j(k)) G_k / pdf_k,
+ * F_j the triangle's exact point-to-polygon transfer (the triangle clipped
+ * to the texel's hemisphere), L_j its emission at its centroid: unbiased
+ * (the correction's expectation is the shadowed part less the exact
+ * unshadowed sum), and exact wherever every sample is visible and the
+ * emission uniform - only penumbrae are noisy. Beyond that count, the
+ * plain estimator (1/S sum L_e V G / pdf). A result below zero (a
+ * correction larger than the exact sum, noise) is clamped to zero.
+ *
+ * The gathers (gi.c) no longer pick up emission: each emitter's light is
+ * counted here once. */
+#include "bake_internal.h"
+#include "core/internal.h"
+
+#include <math.h>
+#include <omp.h>
+#include <stdlib.h>
+#include <string.h>
+
+/* lx_random dimensions apart from the lights', the sky's and GI's */
+#define NEE_KEY 0x6400u
+/* the control variate sums every triangle at every texel up to this many */
+#define EXACT_TRIANGLES 64u
+/* shadow rays per texel at most (desc.gi_samples when fewer) */
+#define NEE_SAMPLES_MAX 256u
+
+typedef struct emitter_tri {
+    lx_vec3 p0, e1, e2; /* a vertex and the edges to the other two */
+    lx_vec3 n;          /* unit front normal */
+    float area;
+    lx_vec3 le; /* emission at the centroid */
+    uint32_t node, mesh, triangle;
+    bool textured;
+} emitter_tri;
+
+typedef struct emitter_set {
+    emitter_tri *tri;
+    uint32_t count;
+    double *cdf; /* cumulative pick weights; cdf[count - 1] = total */
+    double total;
+    bool exact;
+    float **emission; /* per map: emitted radiance per pixel, or NULL */
+} emitter_set;
+
+static float max3(lx_vec3 v)
+{
+    return fmaxf(v.x, fmaxf(v.y, v.z));
+}
+
+/* The emission at barycentrics (u, v) of an emitter triangle: the
+ * material's without a texture; with one, its lightmap's texels there
+ * (a textured emitter without a lightmap: the factor). */
+static lx_vec3 emission_at(const lx_baker *b, const emitter_set *set, const emitter_tri *t, float u,
+                           float v)
+{
+    if (!t->textured)
+        return b->mesh_emission[t->mesh];
+    uint32_t mi;
+    float fx, fy;
+    if (!lx_gi_hit_texel(b, t->node, t->mesh, t->triangle, u, v, &mi, &fx, &fy) ||
+        !set->emission[mi])
+        return b->mesh_emission[t->mesh];
+    return lx_gi_lookup(&b->maps[mi], b->maps[mi].mask, set->emission[mi], fx, fy);
+}
+
+static void emitter_set_free(const lx_baker *b, emitter_set *set)
+{
+    for (uint32_t m = 0; set->emission && m < b->map_count; m++)
+        free(set->emission[m]);
+    free(set->emission);
+    free(set->tri);
+    free(set->cdf);
+}
+
+static lx_status emitter_set_build(const lx_baker *b, emitter_set *set)
+{
+    memset(set, 0, sizeof *set);
+    uint64_t n = 0;
+    for (uint32_t e = 0; e < b->emitter_count; e++)
+        n += b->mesh_triangles[b->emitters[e].mesh];
+    if (n > UINT32_MAX / 2)
+        return lx_fail(LX_ERR_INVALID, "%llu emissive triangles are too many",
+                       (unsigned long long)n);
+    lx_status st = lx_check_memory(n * (sizeof(emitter_tri) + sizeof(double)), "the emitters");
+    if (st != LX_OK)
+        return st;
+    set->tri = malloc(sizeof(emitter_tri) * (n + 1));
+    set->cdf = malloc(sizeof(double) * (n + 1));
+    set->emission = calloc(b->map_count + 1, sizeof(float *));
+    if (!set->tri || !set->cdf || !set->emission) {
+        emitter_set_free(b, set);
+        return lx_fail(LX_ERR_NOMEM, "out of memory for the emitters");
+    }
+    /* the emitting maps' emission per pixel, for textured emitters */
+    for (uint32_t m = 0; m < b->map_count; m++) {
+        const lx_lightmap *map = &b->maps[m];
+        if (!map->emission)
+            continue;
+        size_t pixels = (size_t)map->info.width * (size_t)map->info.height;
+        if (!(set->emission[m] = calloc(pixels * 3, sizeof(float)))) {
+            emitter_set_free(b, set);
+            return lx_fail(LX_ERR_NOMEM, "lightmap '%s': out of memory for its emission",
+                           map->name);
+        }
+        for (uint32_t i = 0; i < map->info.used_texels; i++) {
+            float *px = set->emission[m] + 3 * (size_t)map->texels[i].pixel;
+            px[0] = map->emission[i].x, px[1] = map->emission[i].y, px[2] = map->emission[i].z;
+        }
+    }
+    double total = 0.0;
+    uint32_t count = 0;
+    for (uint32_t e = 0; e < b->emitter_count; e++) {
+        uint32_t node = b->emitters[e].node, mesh = b->emitters[e].mesh;
+        const lx_mat4 *w = &b->node_world[node];
+        float flip = lx_mat4_det3(w) < 0.0f ? -1.0f : 1.0f;
+        lx_vec3 le = b->mesh_emission[mesh];
+        float rgb[3] = {le.x, le.y, le.z};
+        double lum = lx_luminance(rgb);
+        const lx_vec3 *pos = b->mesh_positions[mesh];
+        for (uint32_t t = 0; t < b->mesh_triangles[mesh]; t++) {
+            const uint32_t *idx = b->mesh_indices[mesh] + 3 * (size_t)t;
+            emitter_tri *tr = &set->tri[count];
+            lx_vec3 a = lx_mat4_point(w, pos[idx[0]]), bb = lx_mat4_point(w, pos[idx[1]]),
+                    c = lx_mat4_point(w, pos[idx[2]]);
+            tr->p0 = a;
+            tr->e1 = lx_sub(bb, a);
+            tr->e2 = lx_sub(c, a);
+            lx_vec3 cr = lx_cross(tr->e1, tr->e2);
+            float len = lx_length(cr);
+            tr->area = 0.5f * len;
+            if (!(tr->area > 0.0f) || !isfinite(tr->area) || !(lum > 0.0))
+                continue; /* emits nothing */
+            tr->n = lx_scale(cr, flip / len);
+            tr->node = node, tr->mesh = mesh, tr->triangle = t;
+            tr->textured = b->mesh_emission_textured[mesh] != 0;
+            tr->le = emission_at(b, set, tr, 1.0f / 3.0f, 1.0f / 3.0f);
+            total += lum * (double)tr->area;
+            set->cdf[count] = total;
+            count++;
+        }
+    }
+    set->count = count;
+    set->total = total;
+    set->exact = count <= EXACT_TRIANGLES;
+    return LX_OK;
+}
+
+/* Lambert's formula: the irradiance at p (unit normal n) from a convex
+ * polygon of unit radiance, 1/2 |sum_i gamma_i n . c_i| (gamma_i the angle
+ * the edge subtends, c_i the unit normal of the plane through p and the
+ * edge). The polygon lies in the hemisphere of n. */
+static double polygon_transfer(const double (*v)[3], int count, const double p[3],
+                               const double n[3])
+{
+    double sum = 0.0;
+    for (int i = 0; i < count; i++) {
+        const double *q0 = v[i], *q1 = v[(i + 1) % count];
+        double a[3] = {q0[0] - p[0], q0[1] - p[1], q0[2] - p[2]};
+        double b[3] = {q1[0] - p[0], q1[1] - p[1], q1[2] - p[2]};
+        double c[3] = {a[1] * b[2] - a[2] * b[1], a[2] * b[0] - a[0] * b[2],
+                       a[0] * b[1] - a[1] * b[0]};
+        double cl = sqrt(c[0] * c[0] + c[1] * c[1] + c[2] * c[2]);
+        double dot = a[0] * b[0] + a[1] * b[1] + a[2] * b[2];
+        if (!(cl > 0.0))
+            continue;
+        double gamma = atan2(cl, dot);
+        sum += gamma * (n[0] * c[0] + n[1] * c[1] + n[2] * c[2]) / cl;
+    }
+    return 0.5 * fabs(sum);
+}
+
+/* The exact unshadowed transfer of a triangle to a point: the triangle
+ * clipped to the point's hemisphere (Sutherland-Hodgman, one plane). */
+static double triangle_transfer(const emitter_tri *t, lx_vec3 p, lx_vec3 n)
+{
+    double in[3][3], out[4][3], pd[3] = {p.x, p.y, p.z}, nd[3] = {n.x, n.y, n.z};
+    lx_vec3 q[3] = {t->p0, lx_add(t->p0, t->e1), lx_add(t->p0, t->e2)};
+    double h[3];
+    for (int i = 0; i < 3; i++) {
+        in[i][0] = q[i].x, in[i][1] = q[i].y, in[i][2] = q[i].z;
+        h[i] = (in[i][0] - pd[0]) * nd[0] + (in[i][1] - pd[1]) * nd[1] + (in[i][2] - pd[2]) * nd[2];
+    }
+    int m = 0;
+    for (int i = 0; i < 3; i++) {
+        int j = (i + 1) % 3;
+        if (h[i] >= 0.0)
+            memcpy(out[m++], in[i], sizeof in[i]);
+        if ((h[i] >= 0.0) != (h[j] >= 0.0)) {
+            double s = h[i] / (h[i] - h[j]);
+            for (int c = 0; c < 3; c++)
+                out[m][c] = in[i][c] + s * (in[j][c] - in[i][c]);
+            m++;
+        }
+    }
+    return m >= 3 ? polygon_transfer((const double(*)[3])out, m, pd, nd) : 0.0;
+}
+
+/* Whether p is in front of an emitter triangle (further than the bias:
+ * a texel on the emitter's own plane gets nothing from it). */
+static bool in_front(const lx_baker *b, const emitter_tri *t, lx_vec3 p)
+{
+    return lx_dot(t->n, lx_sub(p, t->p0)) > b->bias;
+}
+
+/* The shadow ray from texel point p (geometric normal ng) to emitter
+ * point x (front normal ne), d = x - p: both ends moved off their
+ * surfaces by the scale-aware bias (lx_shadow_ray's at p; at x along the
+ * emitter's normal), so the ray neither starts behind the texel's surface
+ * nor reaches the emitter itself, at any angle. */
+static lx_ray shadow_ray(const lx_baker *b, lx_vec3 p, lx_vec3 ng, lx_vec3 x, lx_vec3 ne, lx_vec3 d)
+{
+    lx_vec3 side = lx_dot(ng, d) >= 0.0f ? ng : lx_neg(ng);
+    lx_vec3 o = lx_madd(p, side, b->bias + 4e-6f * lx_max_abs_component(p));
+    lx_vec3 end = lx_madd(x, ne, b->bias + 4e-6f * lx_max_abs_component(x));
+    lx_vec3 dir = lx_sub(end, o);
+    float len = lx_length(dir);
+    lx_ray r;
+    r.origin = o;
+    r.dir = len > 0.0f ? lx_scale(dir, 1.0f / len) : lx_v3(0.0f, 1.0f, 0.0f);
+    r.tmin = 0.0f;
+    r.tmax = len;
+    return r;
+}
+
+/* The emitters' irradiance at texel i of map. */
+static lx_vec3 texel_emitters(const lx_baker *b, const emitter_set *set, uint32_t map_index,
+                              const lx_lightmap *map, uint32_t i)
+{
+    lx_vec3 p = map->world_position[i], n = map->world_normal[i];
+    lx_vec3 ng = map->world_geometric_normal[i];
+    uint32_t pixel = map->texels[i].pixel;
+    double sum[3] = {0.0, 0.0, 0.0}, exact[3] = {0.0, 0.0, 0.0};
+    if (set->exact)
+        for (uint32_t j = 0; j < set->count; j++) {
+            const emitter_tri *t = &set->tri[j];
+            if (!in_front(b, t, p))
+                continue;
+            double f = triangle_transfer(t, p, n);
+            exact[0] += f * t->le.x, exact[1] += f * t->le.y, exact[2] += f * t->le.z;
+        }
+    uint32_t want = b->desc.gi_samples < NEE_SAMPLES_MAX ? b->desc.gi_samples : NEE_SAMPLES_MAX;
+    uint32_t sx, sy;
+    lx_cosine_strata(want, &sx, &sy);
+    uint32_t cells = sx * sy;
+    enum { BATCH = 64 };
+    lx_ray rays[BATCH];
+    lx_vec3 on[BATCH], off[BATCH]; /* what a visible and a blocked sample add */
+    uint8_t occluded[BATCH];
+    uint32_t k = 0;
+    while (k < cells) {
+        uint32_t m = 0;
+        for (; m < BATCH && k < cells; k++) {
+            float u = ((float)(k % sx) + lx_random(map_index, pixel, k, NEE_KEY)) / (float)sx;
+            float v = ((float)(k / sx) + lx_random(map_index, pixel, k, NEE_KEY + 1)) / (float)sy;
+            /* the triangle: the first cdf entry above u x total */
+            double target = (double)u * set->total;
+            uint32_t lo = 0, hi = set->count - 1;
+            while (lo < hi) {
+                uint32_t mid = (lo + hi) / 2;
+                if (set->cdf[mid] > target)
+                    hi = mid;
+                else
+                    lo = mid + 1;
+            }
+            const emitter_tri *t = &set->tri[lo];
+            double before = lo ? set->cdf[lo - 1] : 0.0, share = set->cdf[lo] - before;
+            if (!in_front(b, t, p) || !(share > 0.0))
+                continue;
+            float ur = (float)((target - before) / share);
+            ur = fminf(fmaxf(ur, 0.0f), 1.0f);
+            float su = sqrtf(ur), bu = su * (1.0f - v), bv = su * v;
+            lx_vec3 x = lx_add(t->p0, lx_add(lx_scale(t->e1, bu), lx_scale(t->e2, bv)));
+            lx_vec3 d = lx_sub(x, p);
+            float d2 = lx_dot(d, d);
+            if (!(d2 > 0.0f))
+                continue;
+            float dist = sqrtf(d2);
+            float cos_r = lx_dot(n, d) / dist, cos_e = -lx_dot(t->n, d) / dist;
+            if (!(cos_r > 0.0f) || !(cos_e > 0.0f))
+                continue;
+            /* G / pdf, pdf = share / total / area */
+            double g = (double)cos_r * (double)cos_e / (double)d2 * set->total / share *
+                       (double)t->area;
+            if (!isfinite(g))
+                continue;
+            lx_vec3 le = t->textured ? emission_at(b, set, t, bu, bv) : t->le;
+            if (set->exact && t->textured &&
+                max3(lx_v3(fabsf(le.x - t->le.x), fabsf(le.y - t->le.y), fabsf(le.z - t->le.z))) <=
+                    1e-5f * max3(t->le))
+                le = t->le; /* the same emission read twice: no float noise */
+            lx_vec3 base = set->exact ? t->le : lx_v3(0.0f, 0.0f, 0.0f);
+            on[m] = lx_v3((float)((le.x - base.x) * g), (float)((le.y - base.y) * g),
+                          (float)((le.z - base.z) * g));
+            off[m] = lx_v3((float)(-base.x * g), (float)(-base.y * g), (float)(-base.z * g));
+            rays[m] = shadow_ray(b, p, ng, x, t->n, d);
+            m++;
+        }
+        if (m == 0)
+            continue;
+        lx_tracer_occluded_batch(b->tracer, rays, m, true, occluded);
+        for (uint32_t j = 0; j < m; j++) {
+            lx_vec3 c = occluded[j] ? off[j] : on[j];
+            sum[0] += c.x, sum[1] += c.y, sum[2] += c.z;
+        }
+    }
+    double inv = 1.0 / (double)cells;
+    return lx_v3((float)fmax(exact[0] + sum[0] * inv, 0.0), (float)fmax(exact[1] + sum[1] * inv, 0.0),
+                 (float)fmax(exact[2] + sum[2] * inv, 0.0));
+}
+
+lx_status lx_bake_emitters(lx_baker *b, float progress_base, float progress_span)
+{
+    if (b->emitter_count == 0)
+        return LX_OK;
+    if (b->tracer_dirty) {
+        lx_status st = lx_tracer_commit(b->tracer);
+        if (st != LX_OK)
+            return st;
+        b->tracer_dirty = false;
+    }
+    emitter_set set;
+    lx_status st = emitter_set_build(b, &set);
+    if (st != LX_OK)
+        return st;
+    if (set.count == 0) {
+        emitter_set_free(b, &set);
+        return LX_OK;
+    }
+    uint32_t *map_first_tile = malloc(sizeof(uint32_t) * (b->map_count + 1));
+    if (!map_first_tile) {
+        emitter_set_free(b, &set);
+        return lx_fail(LX_ERR_NOMEM, "out of memory");
+    }
+    uint64_t total_work = 0;
+    map_first_tile[0] = 0;
+    for (uint32_t m = 0; m < b->map_count; m++) {
+        map_first_tile[m + 1] = map_first_tile[m] + b->maps[m].tile_count;
+        total_work += b->maps[m].info.used_texels + b->maps[m].tile_count;
+    }
+    int tiles = (int)map_first_tile[b->map_count];
+    int threads = lx_thread_count(b->desc.threads);
+    bool report = b->desc.progress != NULL;
+    volatile int cancelled = 0;
+    uint64_t done_work = 0;
+#pragma omp parallel for schedule(dynamic, 1) num_threads(threads)
+    for (int global = 0; global < tiles; global++) {
+        if (cancelled)
+            continue;
+        uint32_t m = 0;
+        while (map_first_tile[m + 1] <= (uint32_t)global)
+            m++;
+        lx_lightmap *map = &b->maps[m];
+        uint32_t tile = (uint32_t)global - map_first_tile[m];
+        uint32_t first = map->tile_start[tile], count = map->tile_start[tile + 1] - first;
+        for (uint32_t i = first; i < first + count; i++) {
+            lx_vec3 e = texel_emitters(b, &set, m, map, i);
+            float *px = map->baked + 3 * (size_t)map->texels[i].pixel;
+            px[0] += e.x, px[1] += e.y, px[2] += e.z;
+        }
+        if (report) {
+            uint64_t done;
+#pragma omp atomic capture
+            done = done_work += count + 1;
+            if (omp_get_thread_num() == 0) {
+                double f = (double)done / (double)total_work;
+                if (!b->desc.progress(b->desc.progress_user,
+                                      progress_base + progress_span * (float)f))
+                    cancelled = 1;
+            }
+        }
+    }
+    free(map_first_tile);
+    emitter_set_free(b, &set);
+    if (cancelled)
+        return lx_fail(LX_ERR_CANCELLED, "bake cancelled");
+    return LX_OK;
+}
