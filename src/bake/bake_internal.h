@@ -189,6 +189,23 @@ void lx_cosine_strata(uint32_t count, uint32_t *sx, uint32_t *sy);
 lx_vec3 lx_cosine_direction(lx_vec3 t, lx_vec3 bt, lx_vec3 n, uint32_t map, uint32_t pixel,
                             uint32_t k, uint32_t sx, uint32_t sy, uint32_t key);
 
+/* Stratified directions uniform over the unit sphere (sky.c, the
+ * light probes' rays): cell k of sx x sy (lx_cosine_strata) in (u, v),
+ * mapped by z = 1 - 2u, phi = 2 pi v, jittered by lx_random(seed, index,
+ * k, key) and (..., key + 1). */
+lx_vec3 lx_sphere_direction(uint32_t seed, uint32_t index, uint32_t k, uint32_t sx, uint32_t sy,
+                            uint32_t key);
+/* The sky radiance an escaping ray in direction d brings (nits): with sky
+ * shadows the filtered environment less its bright peak, else nothing
+ * (the unshadowed sky is its SH). */
+lx_vec3 lx_sky_radiance(const lx_baker *b, lx_vec3 d);
+/* The sky's bright peak (when it has one) seen from p, projected onto
+ * lx_sh9_basis and added to acc (radiance SH): count rays toward peak
+ * texels chosen by importance, as the texels' sky rays, each that escapes
+ * adding total x chroma x Y(d) / count; seeded by (seed, index, k, key..
+ * key + 3). */
+void lx_sky_peak_sh(const lx_baker *b, lx_vec3 p, uint32_t seed, uint32_t index, uint32_t count,
+                    uint32_t key, double acc[9][3]);
 /* Takes what the baker needs of a sky (SH, the lookup for rays); nothing
  * when sky->environment is NULL (sky.c). */
 lx_status lx_sky_prepare(lx_baker *b, const lx_sky_desc *sky);
@@ -219,6 +236,26 @@ void lx_seam_stitch_free(lx_seam_stitch *s);
 lx_status lx_gi_prepare(lx_baker *b, const lx_scene *scene);
 void lx_gi_free(lx_baker *b);
 lx_status lx_bake_indirect(lx_baker *b, float progress_base, float progress_span);
+/* The exitant radiance of every lightmap's surface, what a ray that hits
+ * it sees: per pixel a validity byte and RGB radiance (nits). */
+typedef struct lx_radiance_source {
+    const uint8_t *valid; /* width * height: 1 where source may be read */
+    const float *source;  /* width * height * 3 */
+} lx_radiance_source;
+/* The exitant radiance a front-face hit h sees (gi.c): the hit surface's
+ * source texels (sources[map], one per baker map), bilinear over the valid
+ * ones (or the valid texels of the nearest ring around the hit's texel);
+ * a surface without a lightmap reflects nothing and emits its material's
+ * emission when `emission` is set. Needs lx_gi_prepare's mesh data. Used
+ * by the gathers (gi.c) and the light probes (probes.c). */
+lx_vec3 lx_hit_radiance(const lx_baker *b, const lx_radiance_source *sources, bool emission,
+                        const lx_hit *h);
+/* Whether a baker made with desc keeps what lx_hit_radiance reads: each
+ * texel's albedo and emission and the meshes' UVs (bounces, or probes). */
+static inline bool lx_bake_keeps_surfaces(const lx_bake_desc *desc)
+{
+    return desc->bounces > 0 || desc->probes;
+}
 /* A material's emitted radiance in nits times scale, without texture. */
 lx_vec3 lx_material_emission(const lx_material *mat, float scale);
 

@@ -114,6 +114,7 @@ typedef struct gi_map {
 typedef struct gi_run {
     lx_baker *b;
     gi_map *maps;
+    lx_radiance_source *sources; /* each map's valid and source, for lx_hit_radiance */
     uint32_t *map_first_tile;
     int tiles;
     int threads;
@@ -162,13 +163,9 @@ static bool gather_ray(const gather_frame *f, uint32_t k, uint32_t sx, uint32_t 
     return true;
 }
 
-/* The exitant radiance a front-face hit sees: the hit surface's source
- * texels, bilinear over the valid ones (or the valid texels of the nearest
- * ring around the hit's texel); a surface without a lightmap emits its
- * material's emission at the first gather and reflects nothing. */
-static lx_vec3 hit_radiance(const gi_run *run, const lx_hit *h)
+lx_vec3 lx_hit_radiance(const lx_baker *b, const lx_radiance_source *sources, bool emission,
+                        const lx_hit *h)
 {
-    const lx_baker *b = run->b;
     lx_vec3 none = lx_v3(0.0f, 0.0f, 0.0f);
     if (h->mesh >= b->mesh_count || h->node >= b->node_count)
         return none;
@@ -176,7 +173,7 @@ static lx_vec3 hit_radiance(const gi_run *run, const lx_hit *h)
     int set = mi == UINT32_MAX ? 0 : b->node_uv_set[h->node];
     const lx_vec2 *uv = mi == UINT32_MAX ? NULL : b->mesh_uv[set][h->mesh];
     if (!uv || h->triangle >= b->mesh_triangles[h->mesh])
-        return run->first_gather ? b->mesh_emission[h->mesh] : none;
+        return emission ? b->mesh_emission[h->mesh] : none;
     const uint32_t *tri = b->mesh_indices[h->mesh] + 3 * (size_t)h->triangle;
     float w0 = 1.0f - h->u - h->v;
     float s = uv[tri[0]].x * w0 + uv[tri[1]].x * h->u + uv[tri[2]].x * h->v;
@@ -185,7 +182,7 @@ static lx_vec3 hit_radiance(const gi_run *run, const lx_hit *h)
     s = s * so[0] + so[2];
     t = t * so[1] + so[3];
     const lx_lightmap *map = &b->maps[mi];
-    const gi_map *g = &run->maps[mi];
+    const lx_radiance_source *g = &sources[mi];
     int w = map->info.width, hgt = map->info.height;
     float fx = s * (float)w - 0.5f, fy = t * (float)hgt - 0.5f;
     if (!isfinite(fx) || !isfinite(fy))
@@ -273,7 +270,7 @@ static lx_vec3 texel_gather(const gi_run *run, uint32_t map_index, uint32_t i, u
             continue;
         if (!lx_tracer_closest(b->tracer, &ray, &h) || !(lx_dot(ray.dir, h.normal) < 0.0f))
             continue; /* escaped (sky: direct light), or a back face */
-        lx_vec3 l = hit_radiance(run, &h);
+        lx_vec3 l = lx_hit_radiance(b, run->sources, run->first_gather, &h);
         sum[0] += l.x;
         sum[1] += l.y;
         sum[2] += l.z;
@@ -398,9 +395,10 @@ lx_status lx_bake_indirect(lx_baker *b, float progress_base, float progress_span
     gi_run run = {.b = b, .base = progress_base, .span = progress_span};
     run.threads = lx_thread_count(b->desc.threads);
     run.maps = calloc(count + 1, sizeof(gi_map));
+    run.sources = calloc(count + 1, sizeof(lx_radiance_source));
     run.map_first_tile = malloc(sizeof(uint32_t) * (count + 1));
     lx_status st = LX_OK;
-    if (!run.maps || !run.map_first_tile)
+    if (!run.maps || !run.sources || !run.map_first_tile)
         st = lx_fail(LX_ERR_NOMEM, "out of memory for global illumination");
     uint64_t bytes = 0;
     for (uint32_t m = 0; m < count && st == LX_OK; m++) {
@@ -424,6 +422,8 @@ lx_status lx_bake_indirect(lx_baker *b, float progress_base, float progress_span
         if (!g->valid || !g->source || !g->prev || !g->next || !g->invalid)
             st = lx_fail(LX_ERR_NOMEM, "lightmap '%s': out of memory for global illumination",
                          map->name);
+        run.sources[m].valid = g->valid;
+        run.sources[m].source = g->source;
         run.map_first_tile[m + 1] = run.map_first_tile[m] + map->tile_count;
         run.total_work += map->info.used_texels + map->tile_count;
     }
@@ -499,6 +499,7 @@ lx_status lx_bake_indirect(lx_baker *b, float progress_base, float progress_span
         free(run.maps[m].invalid);
     }
     free(run.maps);
+    free(run.sources);
     free(run.map_first_tile);
     return st;
 }

@@ -361,3 +361,55 @@ void lx_sky_tile(const lx_baker *b, uint32_t map_index, const lx_lightmap *map, 
         accum[k] = lx_add(accum[k], e);
     }
 }
+
+lx_vec3 lx_sphere_direction(uint32_t seed, uint32_t index, uint32_t k, uint32_t sx, uint32_t sy,
+                            uint32_t key)
+{
+    /* the equal-area map of the unit square onto the sphere (Archimedes'
+     * hat-box theorem: z uniform in [-1, 1], phi uniform) */
+    float u = ((float)(k % sx) + lx_random(seed, index, k, key)) / (float)sx;
+    float v = ((float)(k / sx) + lx_random(seed, index, k, key + 1)) / (float)sy;
+    float z = 1.0f - 2.0f * u, r = sqrtf(fmaxf(0.0f, 1.0f - z * z)), phi = 2.0f * LX_PI * v;
+    return lx_v3(r * cosf(phi), r * sinf(phi), z);
+}
+
+lx_vec3 lx_sky_radiance(const lx_baker *b, lx_vec3 d)
+{
+    if (!b->has_sky || !b->sky_shadows)
+        return lx_v3(0.0f, 0.0f, 0.0f);
+    const float *l = b->sky_lookup.data + 3 * texel_index(b->sky_lookup.size, d);
+    return lx_v3(l[0], l[1], l[2]);
+}
+
+void lx_sky_peak_sh(const lx_baker *b, lx_vec3 p, uint32_t seed, uint32_t index, uint32_t count,
+                    uint32_t key, double acc[9][3])
+{
+    if (!b->has_sky || !b->sky_shadows || !b->sky_peak || count == 0)
+        return;
+    int n = b->sky_lookup.size;
+    size_t texels = (size_t)6 * n * n;
+    double total = b->sky_peak_cdf[texels];
+    float ox = lx_random(seed, index, 0, key + 2), oy = lx_random(seed, index, 0, key + 3);
+    double scale = total / (double)count;
+    for (uint32_t k = 0; k < count; k++) {
+        double u = ((double)k + lx_random(seed, index, k, key)) / (double)count;
+        size_t i = pick_texel(b->sky_peak_cdf, texels, u);
+        int face, x, y;
+        texel_of(n, i, &face, &x, &y);
+        float s = ((float)x + shifted(radical_inverse(k, 2), ox)) / (float)n;
+        float tt = ((float)y + shifted(radical_inverse(k, 3), oy)) / (float)n;
+        lx_vec3 d = lx_cube_direction(face, s, tt);
+        lx_ray ray = {.origin = p, .dir = d, .tmin = 0.0f, .tmax = INFINITY};
+        if (lx_tracer_occluded(b->tracer, &ray))
+            continue;
+        /* the texel's radiance over its pdf (luminance x solid angle /
+         * total, per solid angle): total x chroma */
+        const float *l = b->sky_peak + 3 * i;
+        double w = scale / lx_luminance(l);
+        float y9[9];
+        lx_sh9_basis(d, y9);
+        for (int j = 0; j < 9; j++)
+            for (int c = 0; c < 3; c++)
+                acc[j][c] += w * (double)l[c] * (double)y9[j];
+    }
+}
