@@ -189,12 +189,16 @@ void lx_cosine_strata(uint32_t count, uint32_t *sx, uint32_t *sy);
 lx_vec3 lx_cosine_direction(lx_vec3 t, lx_vec3 bt, lx_vec3 n, uint32_t map, uint32_t pixel,
                             uint32_t k, uint32_t sx, uint32_t sy, uint32_t key);
 
-/* Stratified directions uniform over the unit sphere (sky.c, the
- * light probes' rays): cell k of sx x sy (lx_cosine_strata) in (u, v),
- * mapped by z = 1 - 2u, phi = 2 pi v, jittered by lx_random(seed, index,
- * k, key) and (..., key + 1). */
-lx_vec3 lx_sphere_direction(uint32_t seed, uint32_t index, uint32_t k, uint32_t sx, uint32_t sy,
-                            uint32_t key);
+/* Directions over the whole sphere for the light probes' rays (sky.c):
+ * sx x sy of them (lx_cosine_strata's split), sx equal-area rings of sy
+ * equally spaced azimuths, the rings' heights set so that the set
+ * integrates every spherical harmonic of order <= 2 exactly (its mean of
+ * z^2 is 1/3, odd moments and azimuthal terms vanish: a constant
+ * environment projects onto L00 alone, to rounding), turned by a uniformly
+ * random rotation m per probe (lx_sphere_rotation: lx_random(seed, index,
+ * 0, key..key + 2)), so each direction is uniform on the sphere. */
+void lx_sphere_rotation(uint32_t seed, uint32_t index, uint32_t key, float m[9]);
+lx_vec3 lx_sphere_direction(const float m[9], uint32_t k, uint32_t sx, uint32_t sy);
 /* The sky radiance an escaping ray in direction d brings (nits): with sky
  * shadows the filtered environment less its bright peak, else nothing
  * (the unshadowed sky is its SH). */

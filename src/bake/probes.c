@@ -1,7 +1,8 @@
 /* Light probes (lx_baker_probes): the incident radiance at a point
  * projected onto order-2 real spherical harmonics by Monte Carlo
- * integration, L_lm = 4 pi / N sum L(w_k) Y_lm(w_k) over N stratified
- * directions uniform on the sphere (the equal-area cylindrical map; P.-P.
+ * integration, L_lm = 4 pi / N sum L(w_k) Y_lm(w_k) over N directions,
+ * equal-area rings that integrate order-2 harmonics exactly, randomly
+ * rotated per probe (lx_sphere_direction; P.-P.
  * Sloan, "Stupid Spherical Harmonics (SH) Tricks", GDC 2008, for the
  * projection, and Ramamoorthi & Hanrahan 2001 for the irradiance engines
  * evaluate from it). A ray that hits a surface reads its exitant radiance
@@ -206,8 +207,10 @@ static void probe_one(const probe_run *run, uint32_t index, lx_vec3 p, lx_probe 
     double sum[9][3];
     memset(sum, 0, sizeof sum);
     memset(out, 0, sizeof *out);
+    float rot[9];
+    lx_sphere_rotation(PROBE_SEED, index, PROBE_KEY, rot);
     for (uint32_t k = 0; k < cells; k++) {
-        lx_vec3 d = lx_sphere_direction(PROBE_SEED, index, k, run->sx, run->sy, PROBE_KEY);
+        lx_vec3 d = lx_sphere_direction(rot, k, run->sx, run->sy);
         lx_ray ray = {.origin = p, .dir = d, .tmin = 0.0f, .tmax = INFINITY};
         lx_hit h;
         lx_vec3 l;

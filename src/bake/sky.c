@@ -362,15 +362,38 @@ void lx_sky_tile(const lx_baker *b, uint32_t map_index, const lx_lightmap *map, 
     }
 }
 
-lx_vec3 lx_sphere_direction(uint32_t seed, uint32_t index, uint32_t k, uint32_t sx, uint32_t sy,
-                            uint32_t key)
+void lx_sphere_rotation(uint32_t seed, uint32_t index, uint32_t key, float m[9])
 {
-    /* the equal-area map of the unit square onto the sphere (Archimedes'
-     * hat-box theorem: z uniform in [-1, 1], phi uniform) */
-    float u = ((float)(k % sx) + lx_random(seed, index, k, key)) / (float)sx;
-    float v = ((float)(k / sx) + lx_random(seed, index, k, key + 1)) / (float)sy;
-    float z = 1.0f - 2.0f * u, r = sqrtf(fmaxf(0.0f, 1.0f - z * z)), phi = 2.0f * LX_PI * v;
-    return lx_v3(r * cosf(phi), r * sinf(phi), z);
+    /* a uniformly random unit quaternion (Shoemake, "Uniform random
+     * rotations", Graphics Gems III) */
+    double u1 = lx_random(seed, index, 0, key), u2 = lx_random(seed, index, 0, key + 1);
+    double u3 = lx_random(seed, index, 0, key + 2);
+    double a = sqrt(1.0 - u1), b = sqrt(u1), t2 = 2.0 * LX_PI * u2, t3 = 2.0 * LX_PI * u3;
+    double w = a * sin(t2), x = a * cos(t2), y = b * sin(t3), z = b * cos(t3);
+    double r[9] = {1 - 2 * (y * y + z * z), 2 * (x * y - w * z),     2 * (x * z + w * y),
+                   2 * (x * y + w * z),     1 - 2 * (x * x + z * z), 2 * (y * z - w * x),
+                   2 * (x * z - w * y),     2 * (y * z + w * x),     1 - 2 * (x * x + y * y)};
+    for (int i = 0; i < 9; i++)
+        m[i] = (float)r[i];
+}
+
+lx_vec3 lx_sphere_direction(const float m[9], uint32_t k, uint32_t sx, uint32_t sy)
+{
+    /* ring i = k % sx of sx equal-area bands (z uniform: Archimedes'
+     * hat-box theorem), at its middle height scaled so that the rings'
+     * mean z^2 is 1/3, the sphere's (the middles' is (1 - 1/sx^2) / 3);
+     * sy azimuths equally spaced around it, each ring turned by a golden
+     * fraction of a step */
+    uint32_t i = k % sx, j = k / sx;
+    double scale = sx > 1 ? 1.0 / sqrt(1.0 - 1.0 / ((double)sx * (double)sx)) : 0.0;
+    double z = (1.0 - (2.0 * i + 1.0) / (double)sx) * scale;
+    double turn = fmod((double)i * 0.6180339887498949, 1.0);
+    double phi = 2.0 * LX_PI * (((double)j + turn) / (double)sy);
+    double r = sqrt(fmax(0.0, 1.0 - z * z));
+    double d[3] = {r * cos(phi), r * sin(phi), z};
+    return lx_v3((float)(m[0] * d[0] + m[1] * d[1] + m[2] * d[2]),
+                 (float)(m[3] * d[0] + m[4] * d[1] + m[5] * d[2]),
+                 (float)(m[6] * d[0] + m[7] * d[1] + m[8] * d[2]));
 }
 
 lx_vec3 lx_sky_radiance(const lx_baker *b, lx_vec3 d)
