@@ -335,8 +335,11 @@ lx_status lx_baker_ao(lx_baker *baker, uint32_t map, const lx_ao_desc *desc, lx_
  *   constant environment of radiance L has L_00 = 2 sqrt(pi) L and
  *   E = pi L for every normal.
  * WHAT A PROBE HOLDS  Everything the probe sees, as the bake left it:
- *   - desc.samples stratified rays uniform over the sphere (seeded by the
- *     probe's index and sample: the same bytes for any thread count); a ray
+ *   - desc.samples rays over the sphere: equal-area rings of equally
+ *     spaced directions that integrate every order-2 harmonic exactly (a
+ *     constant environment gives L_00 alone, to rounding), turned by a
+ *     random rotation per probe (seeded by the probe's index: the same
+ *     bytes for any thread count, each ray uniform on the sphere); a ray
  *     that hits the front of a lightmapped surface brings its exitant
  *     radiance, albedo / pi x the baked irradiance (direct + every bounce,
  *     denoised as baked) + its emission, read as the gathers of the bake
@@ -350,9 +353,10 @@ lx_status lx_baker_ao(lx_baker *baker, uint32_t map, const lx_ao_desc *desc, lx_
  *     light model's, range and cone included) times Y_lm toward it, times
  *     its visibility by one shadow ray (every shadow mode but NONE is hard
  *     at a probe); an area light by points on its surface (its soft-shadow
- *     samples, at least 64), each bringing luminance x cos / d^2 x its area
- *     share when not blocked; classic-model lights by the same delta with
- *     their formula's N.L taken as 1;
+ *     samples, at least LX_PROBE_AREA_SAMPLES_MIN), each bringing
+ *     luminance x cos / d^2 x its area share when not blocked;
+ *     classic-model lights by the same delta with their formula's N.L
+ *     taken as 1;
  *   - the scene's and the lights' ambient (lux, for any normal): a
  *     constant radiance ambient / pi.
  *   Dynamic lights are not in the probes (engines light dynamic objects
@@ -362,12 +366,13 @@ lx_status lx_baker_ao(lx_baker *baker, uint32_t map, const lx_ao_desc *desc, lx_
  *   zero. */
 #define LX_PROBE_SAMPLES_DEFAULT 256u
 #define LX_MAX_PROBE_SAMPLES 65536u
-#define LX_PROBE_AREA_SAMPLES_MIN 64u
+#define LX_PROBE_AREA_SAMPLES_MIN 256u
 
 typedef struct lx_probe_desc {
     uint32_t samples;        /* rays per probe, 1..LX_MAX_PROBE_SAMPLES; 0 =
-                                LX_PROBE_SAMPLES_DEFAULT (rounded up to a
-                                whole grid of strata: sx x sy, sx = floor(sqrt)) */
+                                LX_PROBE_SAMPLES_DEFAULT; rounded up to
+                                sx rings of sy, sx = floor(sqrt(samples)),
+                                sy = ceil(samples / sx) */
     int threads;             /* 0 = the baker's desc.threads */
     lx_progress_fn progress; /* may be NULL; returning false cancels */
     void *progress_user;

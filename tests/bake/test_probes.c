@@ -304,6 +304,109 @@ static void ambient_is_a_constant_radiance(void **state)
     lx_baker_destroy(b);
 }
 
+/* A 1 x 1 m rect light of luminance 1000 nt, 1 m above the probe facing
+ * it: L_lm = integral over the rect of L Y_lm(w) cos / r^2 dA, here by a
+ * 400 x 400 midpoint rule. */
+static void rect_light_against_its_integral(void **state)
+{
+    (void)state;
+    lx_scene *scene = empty_scene();
+    lx_light l = lx_light_defaults(LX_LIGHT_RECT);
+    l.position = lx_v3(0.0f, 1.0f, 0.0f);
+    l.direction = lx_v3(0.0f, -1.0f, 0.0f);
+    l.up = lx_v3(0.0f, 0.0f, 1.0f);
+    l.width = l.height = 1.0f;
+    l.intensity = 1000.0f;
+    assert_int_equal(lx_scene_add_light(scene, &l), LX_OK);
+    lx_bake_desc d = {.resolution = 4};
+    lx_baker *b = bake(scene, &d);
+    lx_scene_destroy(scene);
+    lx_vec3 at = lx_v3(0.0f, 0.0f, 0.0f);
+    lx_probe p;
+    assert_int_equal(lx_baker_probes(b, &at, 1, NULL, &p), LX_OK);
+    enum { M = 400 };
+    double want[9] = {0};
+    for (int i = 0; i < M; i++)
+        for (int k = 0; k < M; k++) {
+            double x = -0.5 + (i + 0.5) / M, z = -0.5 + (k + 0.5) / M, r2 = x * x + 1.0 + z * z;
+            double r = sqrt(r2), yb[9];
+            basis(x / r, 1.0 / r, z / r, yb);
+            double w = 1000.0 * (1.0 / r) / r2 / ((double)M * M); /* L cos dA / r^2 */
+            for (int j = 0; j < 9; j++)
+                want[j] += w * yb[j];
+        }
+    double worst = 0.0;
+    for (int j = 0; j < 9; j++)
+        worst = fmax(worst, fabs(p.sh.c[j][1] - want[j]) / want[0]);
+    double e = irradiance(&p.sh, 1, 0.0, 1.0, 0.0), ew = 0.0;
+    double yb0[9];
+    basis(0.0, 1.0, 0.0, yb0);
+    static const double a[9] = {PI_D,     2 * PI_D / 3, 2 * PI_D / 3, 2 * PI_D / 3, PI_D / 4,
+                                PI_D / 4, PI_D / 4,     PI_D / 4,     PI_D / 4};
+    for (int j = 0; j < 9; j++)
+        ew += a[j] * want[j] * yb0[j];
+    printf("rect light: L00 %.6g (want %.6g), worst coefficient error %.3g of L00, E up %.6g "
+           "(want %.6g)\n",
+           p.sh.c[0][1], want[0], worst, e, ew);
+    /* LX_PROBE_AREA_SAMPLES_MIN (256) jittered points on the light:
+     * measured 4.4e-3 of L00 (64 gave 3.5e-2, 1024 1.3e-3: sampling
+     * noise, no bias) */
+    assert_true(worst < 1.5e-2);
+    lx_baker_destroy(b);
+}
+
+/* A sky of 1 nt with a 5000 nt sun 3 degrees across: with sky shadows the
+ * sun is sampled toward it, the rest by the rays; against the cube's own
+ * projection (every texel's radiance x Y at its centre x its exact solid
+ * angle, cube_reference.h). */
+static const double sun_dir[3] = {0.3487, 0.8717, 0.3440};
+static void sun_env(double x, double y, double z, float out[3])
+{
+    double c = x * sun_dir[0] + y * sun_dir[1] + z * sun_dir[2];
+    float v = c > cos(3.0 * PI_D / 180.0) ? 5000.0f : 1.0f;
+    out[0] = out[1] = out[2] = v;
+}
+
+static void sun_against_the_cube_projection(void **state)
+{
+    (void)state;
+    const int size = 64;
+    lx_cubemap env = lx_test_make_env(size, sun_env);
+    double want[9] = {0};
+    for (int f = 0; f < 6; f++)
+        for (int y = 0; y < size; y++)
+            for (int x = 0; x < size; x++) {
+                double dir[3], yb[9];
+                lx_test_texel_dir(f, size, x, y, dir);
+                basis(dir[0], dir[1], dir[2], yb);
+                double w = *lx_test_cube_texel(&env, f, x, y) *
+                           lx_test_texel_solid_angle(size, x, y);
+                for (int j = 0; j < 9; j++)
+                    want[j] += w * yb[j];
+            }
+    lx_scene *scene = empty_scene();
+    lx_bake_desc d = {.resolution = 4};
+    d.sky.environment = &env;
+    d.sky.shadows = true;
+    lx_baker *b = bake(scene, &d);
+    lx_scene_destroy(scene);
+    lx_vec3 at[4] = {lx_v3(0, 0, 0), lx_v3(1, 2, 3), lx_v3(-2, 0.5f, 1), lx_v3(0.1f, -1, -3)};
+    lx_probe p[4];
+    assert_int_equal(lx_baker_probes(b, at, 4, NULL, p), LX_OK);
+    double worst = 0.0;
+    for (int i = 0; i < 4; i++)
+        for (int j = 0; j < 9; j++)
+            worst = fmax(worst, fabs(p[i].sh.c[j][0] - want[j]) / want[0]);
+    printf("sun: L00 %.6g (want %.6g), worst coefficient error %.3g of L00\n", p[0].sh.c[0][0],
+           want[0], worst);
+    /* the sun's share exact in L00, its position within its texels
+     * sampled; the rest's hole where the sun was cut out found by a ray
+     * now and then: measured 1.6e-3 of L00 */
+    assert_true(worst < 5e-3);
+    lx_baker_destroy(b);
+    lx_cubemap_free(&env);
+}
+
 static void grid_is_cell_centres(void **state)
 {
     (void)state;
@@ -416,6 +519,8 @@ int main(void)
         cmocka_unit_test(point_light_is_a_projected_delta),
         cmocka_unit_test(blocked_point_light_adds_nothing),
         cmocka_unit_test(ambient_is_a_constant_radiance),
+        cmocka_unit_test(rect_light_against_its_integral),
+        cmocka_unit_test(sun_against_the_cube_projection),
         cmocka_unit_test(grid_is_cell_centres),
         cmocka_unit_test(threads_give_the_same_bytes),
         cmocka_unit_test(bad_arguments_fail),
