@@ -393,7 +393,8 @@ typedef struct lx_probe {
  * LX_ERR_INVALID for a point that is not finite or samples out of range,
  * LX_ERR_CANCELLED when the progress callback says so (out is then
  * zeroed). Reads the scene as the baker holds it (nodes where they were
- * last placed). Bit-identical for any thread count. */
+ * last placed). Bit-identical for any thread count. Memory while it
+ * runs: 12 bytes a lightmap pixel (the surfaces' exitant radiance). */
 lx_status lx_baker_probes(lx_baker *baker, const lx_vec3 *points, uint32_t count,
                           const lx_probe_desc *desc, lx_probe *out);
 

@@ -53,6 +53,33 @@ run "$BIN" probes "$ROOM" "${SMALL[@]}" --grid 2,2,2 --threads 2 -o "$WORK/t2.js
 expect_rc 0 "--threads 2"
 check "the same bytes with 1 and 2 threads" cmp -s "$WORK/t1.json" "$WORK/t2.json"
 
+# ---- help, and Ctrl-C ------------------------------------------------------------
+run "$BIN" probes --help
+expect_rc 0 "luxel probes --help"
+expect_stdout_has "probes --help: usage" '^usage: luxel probes SCENE'
+for opt in --grid --points --samples --threads --lights --sky --bounces; do
+    expect_stdout_has "probes --help names $opt" -- "$opt"
+done
+run "$BIN" --help
+expect_stdout_has "luxel --help lists probes" '^  probes SCENE'
+
+# stopped by the test hook while the probes are computed, then SIGINT
+: >"$ERR"
+LUXEL_TEST_PAUSE=probes "$BIN" probes "$ROOM" "${SMALL[@]}" -o "$WORK/int/p.json" \
+    >"$OUT" 2>"$ERR" </dev/null &
+pid=$!
+for ((i = 0; i < 6000; i++)); do
+    grep -qs '^luxel: test: paused at probes' "$ERR" && break
+    kill -0 "$pid" 2>/dev/null || break
+    sleep 0.01
+done
+kill -INT "$pid"
+wait "$pid"
+RC=$?
+expect_rc 130 "SIGINT while computing probes"
+expect_error "SIGINT while computing probes" "interrupted"
+expect_no_output "SIGINT while computing probes" "$WORK/int"
+
 # ---- bad input -------------------------------------------------------------------
 printf '{"points": [[0, 1, 0],]}' >"$WORK/comma.json"
 printf '{"points": [[0, 1]]}' >"$WORK/short.json"
