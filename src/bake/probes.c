@@ -298,8 +298,7 @@ lx_status lx_baker_probes(lx_baker *b, const lx_vec3 *points, uint32_t count,
         return lx_fail(LX_ERR_INVALID, "light probes: thread count %d is outside 0..1024",
                        d.threads);
     if (count > LX_MAX_PROBES)
-        return lx_fail(LX_ERR_INVALID, "light probes: %u probes, at most %u", count,
-                       LX_MAX_PROBES);
+        return lx_fail(LX_ERR_INVALID, "light probes: %u probes, at most %u", count, LX_MAX_PROBES);
     for (uint32_t i = 0; i < count; i++)
         if (!lx_vec3_finite(points[i]))
             return lx_fail(LX_ERR_INVALID, "light probes: point %u is not finite", i);

@@ -55,9 +55,8 @@ static double irradiance(const lx_sh9 *sh, int c, double x, double y, double z)
 {
     double yb[9];
     basis(x, y, z, yb);
-    static const double a[9] = {PI_D,        2.0 * PI_D / 3, 2.0 * PI_D / 3,
-                                2.0 * PI_D / 3, PI_D / 4,     PI_D / 4,
-                                PI_D / 4,    PI_D / 4,       PI_D / 4};
+    static const double a[9] = {PI_D,     2.0 * PI_D / 3, 2.0 * PI_D / 3, 2.0 * PI_D / 3, PI_D / 4,
+                                PI_D / 4, PI_D / 4,       PI_D / 4,       PI_D / 4};
     double e = 0.0;
     for (int j = 0; j < 9; j++)
         e += a[j] * sh->c[j][c] * yb[j];
@@ -188,8 +187,8 @@ static void furnace_is_a_geometric_series(void **state)
             double e0 = fabs(p[i].sh.c[0][0] - 2.0 * sqrt(PI_D) * want) / (2.0 * sqrt(PI_D) * want);
             double ee = 0.0;
             for (int s = -1; s <= 1; s += 2)
-                ee = fmax(ee, fabs(irradiance(&p[i].sh, 1, 0.0, s, 0.0) - PI_D * want) /
-                                  (PI_D * want));
+                ee = fmax(ee,
+                          fabs(irradiance(&p[i].sh, 1, 0.0, s, 0.0) - PI_D * want) / (PI_D * want));
             printf("furnace, %d bounces, probe %d: radiance %.6g, L00 error %.3g, E error %.3g\n",
                    n, i, want, e0, ee);
             /* every ray hits a wall of the same radiance: rounding only
@@ -379,8 +378,8 @@ static void sun_against_the_cube_projection(void **state)
                 double dir[3], yb[9];
                 lx_test_texel_dir(f, size, x, y, dir);
                 basis(dir[0], dir[1], dir[2], yb);
-                double w = *lx_test_cube_texel(&env, f, x, y) *
-                           lx_test_texel_solid_angle(size, x, y);
+                double w =
+                    *lx_test_cube_texel(&env, f, x, y) * lx_test_texel_solid_angle(size, x, y);
                 for (int j = 0; j < 9; j++)
                     want[j] += w * yb[j];
             }
@@ -419,8 +418,7 @@ static void grid_is_cell_centres(void **state)
                 lx_test_assert_vec3(p, -1.0 + (i + 0.5), 0.0 + (j + 0.5), 2.0 + (k + 0.5));
             }
     assert_int_equal(lx_probe_grid(lx_v3(0, 0, 0), lx_v3(1, 1, 1), 0, 1, 1, pts), LX_ERR_INVALID);
-    assert_int_equal(lx_probe_grid(lx_v3(0, 0, 0), lx_v3(-1, 1, 1), 1, 1, 1, pts),
-                     LX_ERR_INVALID);
+    assert_int_equal(lx_probe_grid(lx_v3(0, 0, 0), lx_v3(-1, 1, 1), 1, 1, 1, pts), LX_ERR_INVALID);
     assert_int_equal(lx_probe_grid(lx_v3(0, 0, 0), lx_v3(1, 1, 1), 1025, 1, 1, pts),
                      LX_ERR_INVALID);
 }

@@ -36,7 +36,6 @@ static bool parse_ambient(const char *s, lx_vec3 *out)
     return true;
 }
 
-
 static bool has_uv_set(const lx_scene *scene, uint32_t n, int set)
 {
     const lx_node *node = &scene->nodes[n];
@@ -141,11 +140,11 @@ static const char *nothing_emits(const lx_scene *scene, const lx_scene_sky *sky,
     }
     return scene->light_count ? "every light has zero intensity or colour, and there is no sky "
                                 "or ambient"
-                              : bounces > 0 ? "the scene has no lights, no sky, no ambient and "
-                                              "no emissive material"
-                                            : "the scene has no lights, no sky and no ambient "
-                                              "(emissive materials light through --bounces "
-                                              "only)";
+           : bounces > 0      ? "the scene has no lights, no sky, no ambient and "
+                                "no emissive material"
+                              : "the scene has no lights, no sky and no ambient "
+                                "(emissive materials light through --bounces "
+                                "only)";
 }
 
 /* A spot cone under a degree is almost surely radians typed as degrees. */
@@ -167,7 +166,8 @@ bool cli_bake_strict_failed(const bake_args *a)
     unsigned w = cli_warning_count();
     if (!a->strict || w == 0)
         return false;
-    cli_error("%s: %u %s with --strict: nothing written", a->scene, w, cli_plural(w, "warning", "warnings"));
+    cli_error("%s: %u %s with --strict: nothing written", a->scene, w,
+              cli_plural(w, "warning", "warnings"));
     return true;
 }
 
@@ -222,8 +222,8 @@ static int plan_lightmaps(bake_args *a, lx_scene *scene, lx_unwrap **out, bool *
             }
             why = h.problem;
             if (why != LX_UV_OK)
-                lx_log(LX_LOG_INFO, "%s: node '%s': TEXCOORD_%d %s", a->scene,
-                       scene->nodes[n].name, sets[n], h.reason);
+                lx_log(LX_LOG_INFO, "%s: node '%s': TEXCOORD_%d %s", a->scene, scene->nodes[n].name,
+                       sets[n], h.reason);
         } else if (!has_uv_set(scene, n, sets[n])) {
             why = LX_UV_MISSING;
         }
@@ -254,7 +254,8 @@ static int plan_lightmaps(bake_args *a, lx_scene *scene, lx_unwrap **out, bool *
         lx_log(LX_LOG_WARN,
                "%s: %u of %u nodes have no usable TEXCOORD lightmap UVs (%s): luxel makes "
                "theirs%s (--unwrap never keeps the file's; -v names the nodes)",
-               a->scene, generate, nn, detail, *atlas ? " and packs every node into atlas pages" : "");
+               a->scene, generate, nn, detail,
+               *atlas ? " and packs every node into atlas pages" : "");
     }
     if (skipped)
         lx_log(LX_LOG_WARN,
@@ -273,7 +274,8 @@ static int plan_lightmaps(bake_args *a, lx_scene *scene, lx_unwrap **out, bool *
         if (a->desc.texel_density > 0.0f)
             ud.texel_density = a->desc.texel_density;
         else
-            ud.resolution = *atlas && !a->has_resolution ? CLI_ATLAS_RESOLUTION : a->desc.resolution;
+            ud.resolution =
+                *atlas && !a->has_resolution ? CLI_ATLAS_RESOLUTION : a->desc.resolution;
         cli_progress_init(&progress, "unwrap", a->quiet);
         ud.progress = cli_progress_update;
         ud.progress_user = &progress;
@@ -307,136 +309,134 @@ static int plan_lightmaps(bake_args *a, lx_scene *scene, lx_unwrap **out, bool *
     return status;
 }
 
-
 int cli_bake_option(bake_args *a, int c, const char *optarg)
 {
     long n;
     double f;
     switch (c) {
-        case OPT_RESOLUTION:
-            if (!cli_parse_int(optarg, 1, LX_MAX_LIGHTMAP_SIZE, &n))
-                return cli_usage_error(a->command, "--resolution must be an integer in 1..%d, not '%s'",
-                                       LX_MAX_LIGHTMAP_SIZE, optarg);
-            a->desc.resolution = (int)n;
-            a->has_resolution = true;
-            break;
-        case OPT_TEXEL_DENSITY:
-            if (!cli_parse_float(optarg, 1e-6, 1e6, &f))
-                return cli_usage_error(a->command,
-                                       "--texel-density must be a positive number of "
-                                       "texels per metre, not '%s'",
-                                       optarg);
-            a->desc.texel_density = (float)f;
-            break;
-        case OPT_MAX_RESOLUTION:
-            if (!cli_parse_int(optarg, 4, LX_MAX_LIGHTMAP_SIZE, &n))
-                return cli_usage_error(a->command, "--max-resolution must be an integer in 4..%d",
-                                       LX_MAX_LIGHTMAP_SIZE);
-            a->desc.max_resolution = (int)n;
-            break;
-        case OPT_LIGHTS:
-            a->lights = optarg;
-            break;
-        case OPT_AMBIENT:
-            if (!parse_ambient(optarg, &a->ambient))
-                return cli_usage_error(a->command,
-                                       "--ambient must be lux as L or R,G,B (or const:L, "
-                                       "const:R,G,B) with finite values >= 0, not '%s'",
-                                       optarg);
-            a->has_ambient = true;
-            break;
-        case OPT_PADDING:
-            if (!cli_parse_int(optarg, 0, 64, &n))
-                return cli_usage_error(a->command, "--padding must be an integer in 0..64, not '%s'",
-                                       optarg);
-            a->desc.padding = (int)n;
-            break;
-        case OPT_SKIP_DEGENERATE: /* the default now */
-            break;
-        case OPT_SKY:
-            a->sky = optarg;
-            break;
-        case OPT_SKY_INTENSITY:
-            if (!cli_parse_float(optarg, 1e-30, 1e30, &f))
-                return cli_usage_error(a->command, "--sky-intensity must be a number above 0, not '%s'",
-                                       optarg);
-            a->sky_intensity = f;
-            break;
-        case OPT_SKY_SHADOWS:
-        case OPT_NO_SKY_SHADOWS:
-            if (a->sky_shadows >= 0 && a->sky_shadows != (c == OPT_SKY_SHADOWS))
-                return cli_usage_error(a->command, "--sky-shadows and --no-sky-shadows contradict");
-            a->sky_shadows = c == OPT_SKY_SHADOWS;
-            break;
-        case OPT_SKY_SAMPLES:
-            if (!cli_parse_int(optarg, 1, (long)LX_MAX_SKY_SAMPLES, &n))
-                return cli_usage_error(a->command,
-                                       "--sky-samples must be an integer in 1..%u, not '%s'",
-                                       LX_MAX_SKY_SAMPLES, optarg);
-            a->sky_samples = n;
-            break;
-        case OPT_UNWRAP:
-            if (strcmp(optarg, "auto") == 0)
-                a->unwrap = UNWRAP_AUTO;
-            else if (strcmp(optarg, "always") == 0)
-                a->unwrap = UNWRAP_ALWAYS;
-            else if (strcmp(optarg, "never") == 0)
-                a->unwrap = UNWRAP_NEVER;
-            else
-                return cli_usage_error(a->command, "--unwrap must be auto, always or never, not '%s'",
-                                       optarg);
-            break;
-        case OPT_UV_SET:
-            if (strcmp(optarg, "auto") == 0)
-                a->desc.uv_set = LX_UV_SET_AUTO;
-            else if (strcmp(optarg, "0") == 0)
-                a->desc.uv_set = LX_UV_SET_0;
-            else if (strcmp(optarg, "1") == 0)
-                a->desc.uv_set = LX_UV_SET_1;
-            else
-                return cli_usage_error(a->command, "--uv-set must be 0, 1 or auto, not '%s'", optarg);
-            break;
-        case OPT_ATLAS:
-        case OPT_NO_ATLAS:
-            if (a->atlas >= 0 && a->atlas != (c == OPT_ATLAS))
-                return cli_usage_error(a->command, "--atlas and --no-atlas contradict");
-            a->atlas = c == OPT_ATLAS;
-            break;
-        case OPT_ATLAS_SIZE:
-            if (!cli_parse_int(optarg, 4, LX_UNWRAP_MAX_ATLAS_SIZE, &n))
-                return cli_usage_error(a->command, "--atlas-size must be an integer in 4..%d, not '%s'",
-                                       LX_UNWRAP_MAX_ATLAS_SIZE, optarg);
-            a->atlas_size = (int)n;
-            break;
-        case OPT_BOUNCES:
-            if (!cli_parse_int(optarg, 0, LX_MAX_BOUNCES, &n))
-                return cli_usage_error(a->command, "--bounces must be an integer in 0..%d, not '%s'",
-                                       LX_MAX_BOUNCES, optarg);
-            a->desc.bounces = (int)n;
-            break;
-        case OPT_DENOISE:
-            if (!lx_denoise_mode_parse(optarg, &a->desc.denoise))
-                return cli_usage_error(a->command, "--denoise must be off, indirect or all, not '%s'",
-                                       optarg);
-            break;
-        case OPT_GI_SAMPLES:
-            if (!cli_parse_int(optarg, 1, (long)LX_MAX_GI_SAMPLES, &n))
-                return cli_usage_error(a->command, "--gi-samples must be an integer in 1..%u, not '%s'",
-                                       LX_MAX_GI_SAMPLES, optarg);
-            a->desc.gi_samples = (uint32_t)n;
-            break;
-        case OPT_EMISSIVE_SCALE:
-            if (!cli_parse_float(optarg, 1e-30, 1e30, &f))
-                return cli_usage_error(a->command,
-                                       "--emissive-scale must be a number above 0, not '%s'",
-                                       optarg);
-            a->desc.emissive_scale = (float)f;
-            break;
-        case OPT_STRICT:
-            a->strict = true;
-            a->desc.strict = true; /* zero-area triangles refused, in space and in UV */
-            cli_set_strict(true);
-            break;
+    case OPT_RESOLUTION:
+        if (!cli_parse_int(optarg, 1, LX_MAX_LIGHTMAP_SIZE, &n))
+            return cli_usage_error(a->command, "--resolution must be an integer in 1..%d, not '%s'",
+                                   LX_MAX_LIGHTMAP_SIZE, optarg);
+        a->desc.resolution = (int)n;
+        a->has_resolution = true;
+        break;
+    case OPT_TEXEL_DENSITY:
+        if (!cli_parse_float(optarg, 1e-6, 1e6, &f))
+            return cli_usage_error(a->command,
+                                   "--texel-density must be a positive number of "
+                                   "texels per metre, not '%s'",
+                                   optarg);
+        a->desc.texel_density = (float)f;
+        break;
+    case OPT_MAX_RESOLUTION:
+        if (!cli_parse_int(optarg, 4, LX_MAX_LIGHTMAP_SIZE, &n))
+            return cli_usage_error(a->command, "--max-resolution must be an integer in 4..%d",
+                                   LX_MAX_LIGHTMAP_SIZE);
+        a->desc.max_resolution = (int)n;
+        break;
+    case OPT_LIGHTS:
+        a->lights = optarg;
+        break;
+    case OPT_AMBIENT:
+        if (!parse_ambient(optarg, &a->ambient))
+            return cli_usage_error(a->command,
+                                   "--ambient must be lux as L or R,G,B (or const:L, "
+                                   "const:R,G,B) with finite values >= 0, not '%s'",
+                                   optarg);
+        a->has_ambient = true;
+        break;
+    case OPT_PADDING:
+        if (!cli_parse_int(optarg, 0, 64, &n))
+            return cli_usage_error(a->command, "--padding must be an integer in 0..64, not '%s'",
+                                   optarg);
+        a->desc.padding = (int)n;
+        break;
+    case OPT_SKIP_DEGENERATE: /* the default now */
+        break;
+    case OPT_SKY:
+        a->sky = optarg;
+        break;
+    case OPT_SKY_INTENSITY:
+        if (!cli_parse_float(optarg, 1e-30, 1e30, &f))
+            return cli_usage_error(a->command, "--sky-intensity must be a number above 0, not '%s'",
+                                   optarg);
+        a->sky_intensity = f;
+        break;
+    case OPT_SKY_SHADOWS:
+    case OPT_NO_SKY_SHADOWS:
+        if (a->sky_shadows >= 0 && a->sky_shadows != (c == OPT_SKY_SHADOWS))
+            return cli_usage_error(a->command, "--sky-shadows and --no-sky-shadows contradict");
+        a->sky_shadows = c == OPT_SKY_SHADOWS;
+        break;
+    case OPT_SKY_SAMPLES:
+        if (!cli_parse_int(optarg, 1, (long)LX_MAX_SKY_SAMPLES, &n))
+            return cli_usage_error(a->command,
+                                   "--sky-samples must be an integer in 1..%u, not '%s'",
+                                   LX_MAX_SKY_SAMPLES, optarg);
+        a->sky_samples = n;
+        break;
+    case OPT_UNWRAP:
+        if (strcmp(optarg, "auto") == 0)
+            a->unwrap = UNWRAP_AUTO;
+        else if (strcmp(optarg, "always") == 0)
+            a->unwrap = UNWRAP_ALWAYS;
+        else if (strcmp(optarg, "never") == 0)
+            a->unwrap = UNWRAP_NEVER;
+        else
+            return cli_usage_error(a->command, "--unwrap must be auto, always or never, not '%s'",
+                                   optarg);
+        break;
+    case OPT_UV_SET:
+        if (strcmp(optarg, "auto") == 0)
+            a->desc.uv_set = LX_UV_SET_AUTO;
+        else if (strcmp(optarg, "0") == 0)
+            a->desc.uv_set = LX_UV_SET_0;
+        else if (strcmp(optarg, "1") == 0)
+            a->desc.uv_set = LX_UV_SET_1;
+        else
+            return cli_usage_error(a->command, "--uv-set must be 0, 1 or auto, not '%s'", optarg);
+        break;
+    case OPT_ATLAS:
+    case OPT_NO_ATLAS:
+        if (a->atlas >= 0 && a->atlas != (c == OPT_ATLAS))
+            return cli_usage_error(a->command, "--atlas and --no-atlas contradict");
+        a->atlas = c == OPT_ATLAS;
+        break;
+    case OPT_ATLAS_SIZE:
+        if (!cli_parse_int(optarg, 4, LX_UNWRAP_MAX_ATLAS_SIZE, &n))
+            return cli_usage_error(a->command, "--atlas-size must be an integer in 4..%d, not '%s'",
+                                   LX_UNWRAP_MAX_ATLAS_SIZE, optarg);
+        a->atlas_size = (int)n;
+        break;
+    case OPT_BOUNCES:
+        if (!cli_parse_int(optarg, 0, LX_MAX_BOUNCES, &n))
+            return cli_usage_error(a->command, "--bounces must be an integer in 0..%d, not '%s'",
+                                   LX_MAX_BOUNCES, optarg);
+        a->desc.bounces = (int)n;
+        break;
+    case OPT_DENOISE:
+        if (!lx_denoise_mode_parse(optarg, &a->desc.denoise))
+            return cli_usage_error(a->command, "--denoise must be off, indirect or all, not '%s'",
+                                   optarg);
+        break;
+    case OPT_GI_SAMPLES:
+        if (!cli_parse_int(optarg, 1, (long)LX_MAX_GI_SAMPLES, &n))
+            return cli_usage_error(a->command, "--gi-samples must be an integer in 1..%u, not '%s'",
+                                   LX_MAX_GI_SAMPLES, optarg);
+        a->desc.gi_samples = (uint32_t)n;
+        break;
+    case OPT_EMISSIVE_SCALE:
+        if (!cli_parse_float(optarg, 1e-30, 1e30, &f))
+            return cli_usage_error(a->command,
+                                   "--emissive-scale must be a number above 0, not '%s'", optarg);
+        a->desc.emissive_scale = (float)f;
+        break;
+    case OPT_STRICT:
+        a->strict = true;
+        a->desc.strict = true; /* zero-area triangles refused, in space and in UV */
+        cli_set_strict(true);
+        break;
     default:
         return CLI_BAKE_NOT_MINE;
     }
@@ -453,8 +453,8 @@ int cli_bake_check_args(const bake_args *a)
     return 0;
 }
 
-int cli_bake_prepare(bake_args *a, cli_progress *progress, lx_scene **scene_out,
-                     lx_scene_sky *sky, lx_unwrap **unwrap, bool *atlas, lx_baker **baker)
+int cli_bake_prepare(bake_args *a, cli_progress *progress, lx_scene **scene_out, lx_scene_sky *sky,
+                     lx_unwrap **unwrap, bool *atlas, lx_baker **baker)
 {
     memset(sky, 0, sizeof *sky);
     lx_cubemap sky_env = {0};
@@ -486,8 +486,9 @@ int cli_bake_prepare(bake_args *a, cli_progress *progress, lx_scene **scene_out,
     if (a->sky)
         sky->environment = (char *)a->sky;
     if (!sky->environment && (a->sky_shadows >= 0 || a->sky_intensity >= 0.0 || a->sky_samples)) {
-        status = cli_usage_error(a->command, "--sky-intensity, --sky-shadows, --no-sky-shadows and "
-                                         "--sky-samples need --sky ENV (or a \"sky\" in --lights)");
+        status =
+            cli_usage_error(a->command, "--sky-intensity, --sky-shadows, --no-sky-shadows and "
+                                        "--sky-samples need --sky ENV (or a \"sky\" in --lights)");
         goto done;
     }
     if (sky->environment) {
@@ -497,8 +498,9 @@ int cli_bake_prepare(bake_args *a, cli_progress *progress, lx_scene **scene_out,
             sky->shadows = a->sky_shadows;
         if (a->sky_samples && !sky->shadows) {
             /* rays are only cast with shadows: the count would do nothing */
-            status = cli_usage_error(a->command, "--sky-samples needs sky shadows (--sky-shadows, or "
-                                             "\"shadows\": true in the lights file)");
+            status =
+                cli_usage_error(a->command, "--sky-samples needs sky shadows (--sky-shadows, or "
+                                            "\"shadows\": true in the lights file)");
             goto done;
         }
         if (a->sky_samples)

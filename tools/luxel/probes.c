@@ -52,9 +52,9 @@ enum { OPT_GRID = BAKE_OPT_OWN, OPT_POINTS, OPT_SAMPLES };
 typedef struct probes_args {
     bake_args bake;
     const char *output;
-    int grid[3];         /* 0: not given */
-    const char *points;  /* --points FILE */
-    uint32_t samples;    /* 0: the library's default */
+    int grid[3];        /* 0: not given */
+    const char *points; /* --points FILE */
+    uint32_t samples;   /* 0: the library's default */
 } probes_args;
 
 /* "NX,NY,NZ", each 1..LX_MAX_PROBE_GRID, at most LX_MAX_PROBES in all. */
@@ -171,8 +171,8 @@ static int read_points(const char *path, lx_vec3 **out, uint32_t *count)
         return EXIT_USAGE;
     }
     int status = EXIT_USAGE;
-    const cJSON *list = cJSON_IsObject(root) ? cJSON_GetObjectItemCaseSensitive(root, "points")
-                                             : NULL;
+    const cJSON *list =
+        cJSON_IsObject(root) ? cJSON_GetObjectItemCaseSensitive(root, "points") : NULL;
     int n = cJSON_IsArray(list) ? cJSON_GetArraySize(list) : -1;
     if (n < 0) {
         cli_error("%s: expected an object with an array \"points\": [[x, y, z], ...]", path);
@@ -202,8 +202,8 @@ static int read_points(const char *path, lx_vec3 **out, uint32_t *count)
                 v[k++] = (float)x->valuedouble;
             }
             if (!ok || k != 3) {
-                cli_error("%s: points[%d]: expected [x, y, z], three finite numbers (metres)",
-                          path, i);
+                cli_error("%s: points[%d]: expected [x, y, z], three finite numbers (metres)", path,
+                          i);
                 break;
             }
             (*out)[i++] = lx_v3(v[0], v[1], v[2]);
@@ -277,8 +277,8 @@ static char *probes_json(const probes_args *a, const lx_bake_desc *desc, uint32_
         cJSON_AddBoolToObject(p, "valid", probes[i].valid);
         cJSON *sh = cJSON_AddArrayToObject(p, "sh");
         for (int j = 0; j < 9; j++)
-            cJSON_AddItemToArray(sh, triple(probes[i].sh.c[j][0], probes[i].sh.c[j][1],
-                                            probes[i].sh.c[j][2]));
+            cJSON_AddItemToArray(
+                sh, triple(probes[i].sh.c[j][0], probes[i].sh.c[j][1], probes[i].sh.c[j][2]));
         cJSON_AddItemToArray(list, p);
     }
     char *text = cJSON_Print(root);
@@ -370,8 +370,10 @@ int cmd_probes(int argc, char **argv)
     }
     if (cli_bake_strict_failed(&a.bake))
         goto done;
-    char *text = probes_json(&a, &a.bake.desc, lx_probe_desc_defaults(&(lx_probe_desc){.samples = a.samples}).samples,
-                             points, probes, count, a.points ? NULL : &lo, a.points ? NULL : &hi);
+    lx_probe_desc given = {.samples = a.samples};
+    uint32_t samples = lx_probe_desc_defaults(&given).samples;
+    char *text = probes_json(&a, &a.bake.desc, samples, points, probes, count,
+                             a.points ? NULL : &lo, a.points ? NULL : &hi);
     if (!text) {
         cli_error("out of memory");
         goto done;
