@@ -408,7 +408,8 @@ lx_status lx_bake_indirect(lx_baker *b, float progress_base, float progress_span
     }
     if (st == LX_OK)
         st = lx_check_memory(bytes, "global illumination's buffers");
-    run.map_first_tile[0] = 0;
+    if (run.map_first_tile)
+        run.map_first_tile[0] = 0;
     for (uint32_t m = 0; m < count && st == LX_OK; m++) {
         const lx_lightmap *map = &b->maps[m];
         gi_map *g = &run.maps[m];

@@ -302,6 +302,8 @@ lx_status lx_baker_probes(lx_baker *b, const lx_vec3 *points, uint32_t count,
     for (uint32_t i = 0; i < count; i++)
         if (!lx_vec3_finite(points[i]))
             return lx_fail(LX_ERR_INVALID, "light probes: point %u is not finite", i);
+    if (count == 0)
+        return LX_OK;
     if (b->tracer_dirty) {
         lx_status st = lx_tracer_commit(b->tracer);
         if (st != LX_OK)
