@@ -19,7 +19,8 @@ configure: deps
 
 # Generate the example scenes and sky, bake the room and the courtyard by
 # night and by day (sky light), each with a view of the lit scene
-# (view.png, bake --render), and filter the sky for image-based lighting.
+# (view.png, bake --render), filter the sky for image-based lighting, and
+# place light probes in the room.
 demo: all
 	$(BUILD)/bin/gen_scenes examples/scenes
 	$(BUILD)/bin/luxel bake examples/scenes/room.glb -o lightmaps/room --render
@@ -28,7 +29,8 @@ demo: all
 	$(BUILD)/bin/luxel bake examples/scenes/retro.glb --texel-density 8 \
 		--lights examples/retro-day.json -o lightmaps/retro-day --render
 	$(BUILD)/bin/luxel ibl examples/scenes/sky.pfm -o ibl/sky
-	@echo "demo: lightmaps, PNG previews, manifest.json and view.png are in lightmaps/room/, lightmaps/retro/ and lightmaps/retro-day/; the sky's irradiance, SH, specular mips and DFG table in ibl/sky/"
+	$(BUILD)/bin/luxel probes examples/scenes/room.glb --grid 4,3,4 -o probes/room.json
+	@echo "demo: lightmaps, PNG previews, manifest.json and view.png are in lightmaps/room/, lightmaps/retro/ and lightmaps/retro-day/; the sky's irradiance, SH, specular mips and DFG table in ibl/sky/; the room's light probes in probes/room.json"
 
 check: all
 	@bash scripts/install-test-oracles.sh $(BUILD)

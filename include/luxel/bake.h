@@ -179,6 +179,10 @@ typedef struct lx_bake_desc {
                               the update then stays direct light only, as
                               before); LX_DYNAMIC_BOUNCE_SAMPLES_RECOMMENDED
                               (16) for real time. Independent of bounces. */
+    bool probes;           /* keep what lx_baker_probes reads of the surfaces
+                              (each texel's albedo and emission, the meshes'
+                              UVs: 12-24 bytes a texel), kept anyway with
+                              bounces > 0 */
     lx_progress_fn progress;
     void *progress_user;
 } lx_bake_desc;
@@ -346,6 +350,95 @@ lx_ao_desc lx_ao_desc_defaults(const lx_ao_desc *desc);
  * LX_ERR_CANCELLED when the progress callback says so; *out is zeroed on
  * failure. */
 lx_status lx_baker_ao(lx_baker *baker, uint32_t map, const lx_ao_desc *desc, lx_image *out);
+
+/* ---- light probes ------------------------------------------------------------
+ * Irradiance probes for dynamic objects, as engines place them (Unity's
+ * light probes, Godot's LightmapGI probes): at each point, the incident
+ * radiance over the whole sphere projected onto order-2 (L2) real
+ * spherical harmonics, 9 RGB coefficients in ibl.h's lx_sh9 (the basis and
+ * order of lx_sh9_basis, luxel's axes, +Y up).
+ *
+ * CONVENTION  The coefficients are RADIANCE coefficients (nits), L_lm =
+ *   integral of L(w) Y_lm(w) dw, NOT convolved with the cosine lobe. An
+ *   engine gets the irradiance (lux) at unit normal n by Ramamoorthi and
+ *   Hanrahan's equation 13 (lx_sh_irradiance):
+ *     E(n) = sum_lm A_l L_lm Y_lm(n),  A_0 = pi, A_1 = 2 pi / 3, A_2 = pi / 4
+ *   and a diffuse surface of albedo a shows a / pi x E(n) (nits). A
+ *   constant environment of radiance L has L_00 = 2 sqrt(pi) L and
+ *   E = pi L for every normal.
+ * WHAT A PROBE HOLDS  Everything the probe sees, as the bake left it:
+ *   - desc.samples rays over the sphere: equal-area rings of equally
+ *     spaced directions that integrate every order-2 harmonic exactly (a
+ *     constant environment gives L_00 alone, to rounding), turned by a
+ *     random rotation per probe (seeded by the probe's index: the same
+ *     bytes for any thread count, each ray uniform on the sphere); a ray
+ *     that hits the front of a lightmapped surface brings its exitant
+ *     radiance, albedo / pi x the baked irradiance (direct + every bounce,
+ *     denoised as baked) + its emission, read as the gathers of the bake
+ *     read it; a surface without a lightmap brings its material's emission;
+ *   - a ray that escapes brings the sky it sees (with sky shadows; the
+ *     sky's bright part, a sun, by rays toward it chosen by importance);
+ *     an unshadowed sky is added whole from its SH, as the bake adds it to
+ *     every texel;
+ *   - the static lights seen from the probe: a point, spot or directional
+ *     light is a delta, its illuminance at normal incidence E (lux, the
+ *     light model's, range and cone included) times Y_lm toward it, times
+ *     its visibility by one shadow ray (every shadow mode but NONE is hard
+ *     at a probe); an area light by points on its surface (its soft-shadow
+ *     samples, at least LX_PROBE_AREA_SAMPLES_MIN), each bringing
+ *     luminance x cos / d^2 x its area share when not blocked;
+ *     classic-model lights by the same delta with their formula's N.L
+ *     taken as 1;
+ *   - the scene's and the lights' ambient (lux, for any normal): a
+ *     constant radiance ambient / pi.
+ *   Dynamic lights are not in the probes (engines light dynamic objects
+ *   with them directly).
+ * VALIDITY  A probe whose rays mostly hit back faces sits inside geometry
+ *   (the test of the bake's texel validity): valid = false, coefficients
+ *   zero. */
+#define LX_PROBE_SAMPLES_DEFAULT 256u
+#define LX_MAX_PROBE_SAMPLES 65536u
+#define LX_PROBE_AREA_SAMPLES_MIN 256u
+
+typedef struct lx_probe_desc {
+    uint32_t samples;        /* rays per probe, 1..LX_MAX_PROBE_SAMPLES; 0 =
+                                LX_PROBE_SAMPLES_DEFAULT; rounded up to
+                                sx rings of sy, sx = floor(sqrt(samples)),
+                                sy = ceil(samples / sx) */
+    int threads;             /* 0 = the baker's desc.threads */
+    lx_progress_fn progress; /* may be NULL; returning false cancels */
+    void *progress_user;
+} lx_probe_desc;
+
+/* A copy of desc (or of zeros when NULL) with every default filled in. */
+lx_probe_desc lx_probe_desc_defaults(const lx_probe_desc *desc);
+
+typedef struct lx_probe {
+    lx_sh9 sh;              /* radiance SH (nits), zero when not valid */
+    bool valid;             /* false: inside geometry */
+    float back_face_share;  /* the share of its rays that hit back faces */
+} lx_probe;
+
+/* The light probes at count points (world, metres) into out[count], after
+ * lx_baker_bake (before it, surfaces are black). The baker must keep its
+ * surfaces (desc.probes or bounces > 0), else LX_ERR_INVALID. Fails with
+ * LX_ERR_INVALID for a point that is not finite or samples out of range,
+ * LX_ERR_CANCELLED when the progress callback says so (out is then
+ * zeroed). Reads the scene as the baker holds it (nodes where they were
+ * last placed). Bit-identical for any thread count. Memory while it
+ * runs: 12 bytes a lightmap pixel (the surfaces' exitant radiance). */
+lx_status lx_baker_probes(lx_baker *baker, const lx_vec3 *points, uint32_t count,
+                          const lx_probe_desc *desc, lx_probe *out);
+
+/* The nx * ny * nz probe positions of a grid over the box [lo, hi]: the
+ * centres of its cells, lo + (i + 0.5) / nx (hi - lo) along x (so no probe
+ * sits on the box's faces, where a room's walls are), x fastest, then y,
+ * then z: out[(k * ny + j) * nx + i]. Each count 1..LX_MAX_PROBE_GRID and
+ * at most LX_MAX_PROBES probes in all, lo <= hi finite, else
+ * LX_ERR_INVALID. out must hold nx * ny * nz points. */
+#define LX_MAX_PROBE_GRID 1024
+#define LX_MAX_PROBES (1u << 24)
+lx_status lx_probe_grid(lx_vec3 lo, lx_vec3 hi, int nx, int ny, int nz, lx_vec3 *out);
 
 /* Threads and progress of lx_dilate. desc may be NULL (all cores, no
  * progress). */

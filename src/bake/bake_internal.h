@@ -209,6 +209,27 @@ void lx_cosine_strata(uint32_t count, uint32_t *sx, uint32_t *sy);
 lx_vec3 lx_cosine_direction(lx_vec3 t, lx_vec3 bt, lx_vec3 n, uint32_t map, uint32_t pixel,
                             uint32_t k, uint32_t sx, uint32_t sy, uint32_t key);
 
+/* Directions over the whole sphere for the light probes' rays (sky.c):
+ * sx x sy of them (lx_cosine_strata's split), sx equal-area rings of sy
+ * equally spaced azimuths, the rings' heights set so that the set
+ * integrates every spherical harmonic of order <= 2 exactly (its mean of
+ * z^2 is 1/3, odd moments and azimuthal terms vanish: a constant
+ * environment projects onto L00 alone, to rounding), turned by a uniformly
+ * random rotation m per probe (lx_sphere_rotation: lx_random(seed, index,
+ * 0, key..key + 2)), so each direction is uniform on the sphere. */
+void lx_sphere_rotation(uint32_t seed, uint32_t index, uint32_t key, float m[9]);
+lx_vec3 lx_sphere_direction(const float m[9], uint32_t k, uint32_t sx, uint32_t sy);
+/* The sky radiance an escaping ray in direction d brings (nits): with sky
+ * shadows the filtered environment less its bright peak, else nothing
+ * (the unshadowed sky is its SH). */
+lx_vec3 lx_sky_radiance(const lx_baker *b, lx_vec3 d);
+/* The sky's bright peak (when it has one) seen from p, projected onto
+ * lx_sh9_basis and added to acc (radiance SH): count rays toward peak
+ * texels chosen by importance, as the texels' sky rays, each that escapes
+ * adding total x chroma x Y(d) / count; seeded by (seed, index, k, key..
+ * key + 3). */
+void lx_sky_peak_sh(const lx_baker *b, lx_vec3 p, uint32_t seed, uint32_t index, uint32_t count,
+                    uint32_t key, double acc[9][3]);
 /* Takes what the baker needs of a sky (SH, the lookup for rays); nothing
  * when sky->environment is NULL (sky.c). */
 lx_status lx_sky_prepare(lx_baker *b, const lx_sky_desc *sky);
@@ -279,6 +300,27 @@ lx_status lx_bake_emitters(lx_baker *b, float progress_base, float progress_span
  * lights' direct light) added into them; its cache's release. */
 lx_status lx_dyn_bounce_update(lx_baker *b);
 void lx_dyn_bounce_free(lx_baker *b);
+/* The exitant radiance of every lightmap's surface, what a ray that hits
+ * it sees: per pixel a validity byte and RGB radiance (nits). */
+typedef struct lx_radiance_source {
+    const uint8_t *valid; /* width * height: 1 where source may be read */
+    const float *source;  /* width * height * 3 */
+} lx_radiance_source;
+/* The exitant radiance a front-face hit h sees (gi.c): the hit surface's
+ * source texels (sources[map], one per baker map), bilinear over the valid
+ * ones (or the valid texels of the nearest ring around the hit's texel);
+ * a surface without a lightmap reflects nothing and emits its material's
+ * emission when `emission` is set. Needs lx_gi_prepare's mesh data. Used
+ * by the gathers (gi.c) and the light probes (probes.c). */
+lx_vec3 lx_hit_radiance(const lx_baker *b, const lx_radiance_source *sources, bool emission,
+                        const lx_hit *h);
+/* Whether a baker made with desc keeps what lx_hit_radiance reads: each
+ * texel's albedo and emission and the meshes' UVs (bounces, the dynamic
+ * lights' bounce, or probes). */
+static inline bool lx_bake_keeps_surfaces(const lx_bake_desc *desc)
+{
+    return desc->bounces > 0 || desc->dynamic_bounce_samples > 0 || desc->probes;
+}
 /* A material's emitted radiance in nits times scale, without texture. */
 lx_vec3 lx_material_emission(const lx_material *mat, float scale);
 

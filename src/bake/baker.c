@@ -335,8 +335,7 @@ lx_status lx_baker_create(const lx_scene *scene, const lx_bake_desc *in, lx_bake
         b->node_scale_offset[n][0] = b->node_scale_offset[n][1] = 1.0f;
         b->node_scale_offset[n][2] = b->node_scale_offset[n][3] = 0.0f;
     }
-    if ((desc.bounces > 0 || desc.dynamic_bounce_samples > 0) &&
-        (st = lx_gi_prepare(b, scene)) != LX_OK) {
+    if (lx_bake_keeps_surfaces(&desc) && (st = lx_gi_prepare(b, scene)) != LX_OK) {
         lx_baker_destroy(b);
         return st;
     }

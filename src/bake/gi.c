@@ -156,6 +156,7 @@ typedef struct gi_map {
 typedef struct gi_run {
     lx_baker *b;
     gi_map *maps;
+    lx_radiance_source *sources; /* each map's valid and source, for lx_hit_radiance */
     uint32_t *map_first_tile;
     int tiles;
     int threads;
@@ -265,17 +266,15 @@ lx_vec3 lx_gi_lookup(const lx_lightmap *map, const uint8_t *valid, const float *
     return lx_v3(0.0f, 0.0f, 0.0f);
 }
 
-/* The exitant radiance a front-face hit sees: the hit surface's source
- * texels (lx_gi_lookup over the valid ones); a surface without a lightmap
- * reflects nothing. Emission is not picked up: emitters are direct light,
- * sampled by emitters.c. */
-static lx_vec3 hit_radiance(const gi_run *run, const lx_hit *h)
+lx_vec3 lx_hit_radiance(const lx_baker *b, const lx_radiance_source *sources, bool emission,
+                        const lx_hit *h)
 {
     uint32_t mi;
     float fx, fy;
-    if (!lx_gi_hit_texel(run->b, h->node, h->mesh, h->triangle, h->u, h->v, &mi, &fx, &fy))
-        return lx_v3(0.0f, 0.0f, 0.0f);
-    return lx_gi_lookup(&run->b->maps[mi], run->maps[mi].valid, run->maps[mi].source, fx, fy);
+    if (!lx_gi_hit_texel(b, h->node, h->mesh, h->triangle, h->u, h->v, &mi, &fx, &fy))
+        return emission && h->mesh < b->mesh_count ? b->mesh_emission[h->mesh]
+                                                   : lx_v3(0.0f, 0.0f, 0.0f);
+    return lx_gi_lookup(&b->maps[mi], sources[mi].valid, sources[mi].source, fx, fy);
 }
 
 bool lx_gi_texel_inside(const lx_baker *b, uint32_t map_index, uint32_t i)
@@ -314,7 +313,8 @@ static lx_vec3 texel_gather(const gi_run *run, uint32_t map_index, uint32_t i, u
             continue;
         if (!lx_tracer_closest(b->tracer, &ray, &h) || !(lx_dot(ray.dir, h.normal) < 0.0f))
             continue; /* escaped (sky: direct light), or a back face */
-        lx_vec3 l = hit_radiance(run, &h);
+        /* emission is direct light (emitters.c), not picked up here */
+        lx_vec3 l = lx_hit_radiance(b, run->sources, false, &h);
         sum[0] += l.x;
         sum[1] += l.y;
         sum[2] += l.z;
@@ -440,9 +440,10 @@ lx_status lx_bake_indirect(lx_baker *b, float progress_base, float progress_span
     gi_run run = {.b = b, .base = progress_base, .span = progress_span};
     run.threads = lx_thread_count(b->desc.threads);
     run.maps = calloc(count + 1, sizeof(gi_map));
+    run.sources = calloc(count + 1, sizeof(lx_radiance_source));
     run.map_first_tile = malloc(sizeof(uint32_t) * (count + 1));
     lx_status st = LX_OK;
-    if (!run.maps || !run.map_first_tile)
+    if (!run.maps || !run.sources || !run.map_first_tile)
         st = lx_fail(LX_ERR_NOMEM, "out of memory for global illumination");
     uint64_t bytes = 0;
     for (uint32_t m = 0; m < count && st == LX_OK; m++) {
@@ -452,7 +453,8 @@ lx_status lx_bake_indirect(lx_baker *b, float progress_base, float progress_span
     }
     if (st == LX_OK)
         st = lx_check_memory(bytes, "global illumination's buffers");
-    run.map_first_tile[0] = 0;
+    if (run.map_first_tile)
+        run.map_first_tile[0] = 0;
     for (uint32_t m = 0; m < count && st == LX_OK; m++) {
         const lx_lightmap *map = &b->maps[m];
         gi_map *g = &run.maps[m];
@@ -466,6 +468,8 @@ lx_status lx_bake_indirect(lx_baker *b, float progress_base, float progress_span
         if (!g->valid || !g->source || !g->prev || !g->next || !g->invalid)
             st = lx_fail(LX_ERR_NOMEM, "lightmap '%s': out of memory for global illumination",
                          map->name);
+        run.sources[m].valid = g->valid;
+        run.sources[m].source = g->source;
         run.map_first_tile[m + 1] = run.map_first_tile[m] + map->tile_count;
         run.total_work += map->info.used_texels + map->tile_count;
     }
@@ -540,6 +544,7 @@ lx_status lx_bake_indirect(lx_baker *b, float progress_base, float progress_span
         free(run.maps[m].invalid);
     }
     free(run.maps);
+    free(run.sources);
     free(run.map_first_tile);
     return st;
 }

@@ -361,3 +361,78 @@ void lx_sky_tile(const lx_baker *b, uint32_t map_index, const lx_lightmap *map, 
         accum[k] = lx_add(accum[k], e);
     }
 }
+
+void lx_sphere_rotation(uint32_t seed, uint32_t index, uint32_t key, float m[9])
+{
+    /* a uniformly random unit quaternion (Shoemake, "Uniform random
+     * rotations", Graphics Gems III) */
+    double u1 = lx_random(seed, index, 0, key), u2 = lx_random(seed, index, 0, key + 1);
+    double u3 = lx_random(seed, index, 0, key + 2);
+    double a = sqrt(1.0 - u1), b = sqrt(u1), t2 = 2.0 * LX_PI * u2, t3 = 2.0 * LX_PI * u3;
+    double w = a * sin(t2), x = a * cos(t2), y = b * sin(t3), z = b * cos(t3);
+    double r[9] = {1 - 2 * (y * y + z * z), 2 * (x * y - w * z),     2 * (x * z + w * y),
+                   2 * (x * y + w * z),     1 - 2 * (x * x + z * z), 2 * (y * z - w * x),
+                   2 * (x * z - w * y),     2 * (y * z + w * x),     1 - 2 * (x * x + y * y)};
+    for (int i = 0; i < 9; i++)
+        m[i] = (float)r[i];
+}
+
+lx_vec3 lx_sphere_direction(const float m[9], uint32_t k, uint32_t sx, uint32_t sy)
+{
+    /* ring i = k % sx of sx equal-area bands (z uniform: Archimedes'
+     * hat-box theorem), at its middle height scaled so that the rings'
+     * mean z^2 is 1/3, the sphere's (the middles' is (1 - 1/sx^2) / 3);
+     * sy azimuths equally spaced around it, each ring turned by a golden
+     * fraction of a step */
+    uint32_t i = k % sx, j = k / sx;
+    double scale = sx > 1 ? 1.0 / sqrt(1.0 - 1.0 / ((double)sx * (double)sx)) : 0.0;
+    double z = (1.0 - (2.0 * i + 1.0) / (double)sx) * scale;
+    double turn = fmod((double)i * 0.6180339887498949, 1.0);
+    double phi = 2.0 * LX_PI * (((double)j + turn) / (double)sy);
+    double r = sqrt(fmax(0.0, 1.0 - z * z));
+    double d[3] = {r * cos(phi), r * sin(phi), z};
+    return lx_v3((float)(m[0] * d[0] + m[1] * d[1] + m[2] * d[2]),
+                 (float)(m[3] * d[0] + m[4] * d[1] + m[5] * d[2]),
+                 (float)(m[6] * d[0] + m[7] * d[1] + m[8] * d[2]));
+}
+
+lx_vec3 lx_sky_radiance(const lx_baker *b, lx_vec3 d)
+{
+    if (!b->has_sky || !b->sky_shadows)
+        return lx_v3(0.0f, 0.0f, 0.0f);
+    const float *l = b->sky_lookup.data + 3 * texel_index(b->sky_lookup.size, d);
+    return lx_v3(l[0], l[1], l[2]);
+}
+
+void lx_sky_peak_sh(const lx_baker *b, lx_vec3 p, uint32_t seed, uint32_t index, uint32_t count,
+                    uint32_t key, double acc[9][3])
+{
+    if (!b->has_sky || !b->sky_shadows || !b->sky_peak || count == 0)
+        return;
+    int n = b->sky_lookup.size;
+    size_t texels = (size_t)6 * n * n;
+    double total = b->sky_peak_cdf[texels];
+    float ox = lx_random(seed, index, 0, key + 2), oy = lx_random(seed, index, 0, key + 3);
+    double scale = total / (double)count;
+    for (uint32_t k = 0; k < count; k++) {
+        double u = ((double)k + lx_random(seed, index, k, key)) / (double)count;
+        size_t i = pick_texel(b->sky_peak_cdf, texels, u);
+        int face, x, y;
+        texel_of(n, i, &face, &x, &y);
+        float s = ((float)x + shifted(radical_inverse(k, 2), ox)) / (float)n;
+        float tt = ((float)y + shifted(radical_inverse(k, 3), oy)) / (float)n;
+        lx_vec3 d = lx_cube_direction(face, s, tt);
+        lx_ray ray = {.origin = p, .dir = d, .tmin = 0.0f, .tmax = INFINITY};
+        if (lx_tracer_occluded(b->tracer, &ray))
+            continue;
+        /* the texel's radiance over its pdf (luminance x solid angle /
+         * total, per solid angle): total x chroma */
+        const float *l = b->sky_peak + 3 * i;
+        double w = scale / lx_luminance(l);
+        float y9[9];
+        lx_sh9_basis(d, y9);
+        for (int j = 0; j < 9; j++)
+            for (int c = 0; c < 3; c++)
+                acc[j][c] += w * (double)l[c] * (double)y9[j];
+    }
+}

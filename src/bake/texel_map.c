@@ -692,13 +692,12 @@ lx_status lx_texel_map_build(const lx_scene *scene, const lx_page_spec *page,
     map->world_position = malloc(sizeof(lx_vec3) * (used ? used : 1));
     map->world_normal = malloc(sizeof(lx_vec3) * (used ? used : 1));
     map->world_geometric_normal = malloc(sizeof(lx_vec3) * (used ? used : 1));
-    bool want_albedo = desc->quantity == LX_QUANTITY_RADIANCE || desc->bounces > 0 ||
-                       desc->dynamic_bounce_samples > 0;
+    bool want_albedo = desc->quantity == LX_QUANTITY_RADIANCE || lx_bake_keeps_surfaces(desc);
     if (want_albedo)
         map->albedo = malloc(sizeof(lx_vec3) * (used ? used : 1));
     /* emission per texel: for the gather, when a material here emits */
     bool emits = false;
-    for (uint32_t s = 0; s < slot_count && desc->bounces > 0; s++) {
+    for (uint32_t s = 0; s < slot_count && lx_bake_keeps_surfaces(desc); s++) {
         lx_vec3 e = lx_material_emission(material_of(scene, slots[s].mesh), desc->emissive_scale);
         emits |= e.x > 0.0f || e.y > 0.0f || e.z > 0.0f;
     }

@@ -22,6 +22,7 @@ int cmd_unwrap(int argc, char **argv);
 int cmd_tangents(int argc, char **argv);
 int cmd_horizonmap(int argc, char **argv);
 int cmd_aomap(int argc, char **argv);
+int cmd_probes(int argc, char **argv);
 
 /* Options luxel horizonmap and aomap share (horizonmap.c). */
 typedef struct cli_horizon_opts {
@@ -268,6 +269,9 @@ bool cli_json_trailing_comma(const char *text, size_t size, size_t error_at, siz
  * in err (a trailing comma named as such) on failure. */
 cJSON *cli_json_parse(const char *name, const char *text, size_t size, char *err,
                              size_t err_size);
+/* A whole file (at most 64 MiB) into a malloc'd buffer; NULL with errno
+ * set when it cannot be read (or is larger). */
+char *cli_read_text(const char *path, size_t *size);
 
 /* Files of an earlier bake in the output folder that this bake does not
  * write: the names its DIR/manifest.json lists (pages' files and previews,

@@ -26,6 +26,8 @@ static const char *main_usage =
     "\n"
     "commands:\n"
     "  bake SCENE    bake lightmaps for a glTF 2.0 (.gltf/.glb) or OBJ scene\n"
+    "  probes SCENE  L2 spherical-harmonic light probes (direct + indirect) on a\n"
+    "                grid over the scene or at given points (JSON)\n"
     "  info SCENE    list a scene's meshes, materials, lights and bounds\n"
     "  ies FILE      show an IES photometric file: header, lumens, beam; --plot\n"
     "  ibl ENV       image-based lighting from an environment map: irradiance,\n"
@@ -433,7 +435,7 @@ int main(int argc, char **argv)
                     {"parallaxmap", cmd_parallaxmap},
                     {"horizonmap", cmd_horizonmap}, {"aomap", cmd_aomap},
                     {"tangents", cmd_tangents}, {"shade", cmd_shade},
-                    {"light2d", cmd_light2d}};
+                    {"light2d", cmd_light2d}, {"probes", cmd_probes}};
     for (size_t i = 0; i < sizeof commands / sizeof commands[0]; i++)
         if (strcmp(cmd, commands[i].name) == 0) {
             lx_set_log_callback(print_log, NULL);

@@ -137,6 +137,11 @@ static char *dir_name(const char *path)
     return d;
 }
 
+const char *maps_output_name(const maps_output *o)
+{
+    return base_name(o->path);
+}
+
 bool maps_output_begin(const maps_output *o, cli_stage *st)
 {
     memset(st, 0, sizeof *st);

@@ -67,6 +67,8 @@ int maps_output_resolve(const char *command, maps_output *o);
 /* Stages OUT's folder (created when missing) and checks OUT can be
  * replaced, before the work; false with the error printed. */
 bool maps_output_begin(const maps_output *o, cli_stage *st);
+/* OUT's file name (past its last '/'), the name it is staged under. */
+const char *maps_output_name(const maps_output *o);
 
 /* Writes img as OUT (linear codes in PNG: data, not colour) through the
  * stage and moves it into place; false with the error printed (nothing

@@ -135,7 +135,7 @@ static bool same_scene(const char *a, const char *b)
     return realpath(a, ra) && realpath(b, rb) && strcmp(ra, rb) == 0;
 }
 
-static char *read_text(const char *path, size_t *size)
+char *cli_read_text(const char *path, size_t *size)
 {
     FILE *fp = fopen(path, "rb");
     if (!fp)
@@ -145,7 +145,7 @@ static char *read_text(const char *path, size_t *size)
     for (;;) {
         if (n + 4096 > cap) {
             cap = cap ? cap * 2 : 8192;
-            if (cap > ((size_t)64 << 20)) /* a manifest is small */
+            if (cap > ((size_t)64 << 20)) /* manifests and points files are small */
                 break;
             char *b = realloc(buf, cap);
             if (!b)
@@ -182,7 +182,7 @@ bool cli_stale_find(const char *dir, const char *scene, const char *const *outpu
         return true; /* no earlier bake here */
     }
     size_t size = 0;
-    char *text = read_text(path, &size);
+    char *text = cli_read_text(path, &size);
     if (!text) {
         lx_log(LX_LOG_WARN,
                "%s: cannot read the earlier bake's manifest (%s): stale files "
