@@ -6,6 +6,64 @@
 #include "luxel/maps.h"
 #include "luxel/trace.h"
 
+/* ---- directional data (directional.c) ----------------------------------
+ * Per texel, the order-1 spherical harmonics of the incoming radiance
+ * (nits), world space, luxel's SH basis (ibl.h): 4 RGB coefficients, L00,
+ * L1-1 (y), L10 (z), L11 (x), 12 floats. */
+#define LX_SH_FLOATS 12
+#define LX_SH_Y0 0.282095f
+#define LX_SH_Y1 0.488603f
+
+typedef struct lx_sh4 {
+    float c[LX_SH_FLOATS];
+} lx_sh4;
+
+/* Radiance e (a delta: e is the illuminance on a surface facing it) from
+ * unit direction d. */
+static inline void lx_sh4_add_delta(lx_sh4 *s, lx_vec3 e, lx_vec3 d)
+{
+    float y[4] = {LX_SH_Y0, LX_SH_Y1 * d.y, LX_SH_Y1 * d.z, LX_SH_Y1 * d.x};
+    for (int k = 0; k < 4; k++) {
+        s->c[3 * k] += e.x * y[k];
+        s->c[3 * k + 1] += e.y * y[k];
+        s->c[3 * k + 2] += e.z * y[k];
+    }
+}
+
+/* An irradiance a that is the same for every normal (the ambient terms):
+ * a uniform radiance a / pi over the sphere, L00 = 4 Y00 a. */
+static inline void lx_sh4_add_uniform(lx_sh4 *s, lx_vec3 a)
+{
+    s->c[0] += 4.0f * LX_SH_Y0 * a.x;
+    s->c[1] += 4.0f * LX_SH_Y0 * a.y;
+    s->c[2] += 4.0f * LX_SH_Y0 * a.z;
+}
+
+/* A contribution e (irradiance at the texel's normal n, lux) of light
+ * arriving from unit direction d: a delta of e / (n . d). */
+static inline void lx_sh4_add_lit(lx_sh4 *s, lx_vec3 e, lx_vec3 n, lx_vec3 d)
+{
+    float c = lx_dot(n, d);
+    c = c > 1e-3f ? c : 1e-3f;
+    lx_sh4_add_delta(s, lx_scale(e, 1.0f / c), d);
+}
+
+static inline void lx_sh4_scale(lx_sh4 *s, float k)
+{
+    for (int i = 0; i < LX_SH_FLOATS; i++)
+        s->c[i] *= k;
+}
+
+/* The weight of a cosine-distributed gather ray whose direction makes
+ * cos_theta with the texel's normal, for the estimate of int L Y dw (see
+ * directional.c): pi / cos, and 2 pi / LX_SH_HORIZON within
+ * LX_SH_HORIZON of the horizon. */
+#define LX_SH_HORIZON 0.1f
+static inline float lx_sh_ray_weight(float cos_theta)
+{
+    return cos_theta >= LX_SH_HORIZON ? LX_PI / cos_theta : 2.0f * LX_PI / LX_SH_HORIZON;
+}
+
 /* Texels are stored in tiles of TILE x TILE for coherent rays; a tile is
  * also the unit of parallel work, so results do not depend on threads. */
 #define LX_TILE 8
@@ -67,6 +125,9 @@ typedef struct lx_lightmap {
     float *baked;    /* width * height * 3 */
     float *realtime; /* width * height * 3; NULL (reads as zero) until the
                         first update with dynamic lights */
+    float *sh;       /* width * height * LX_SH_FLOATS: the baked light's L1
+                        spherical harmonics (directional.c); NULL unless
+                        desc.directional */
     lx_seam_stitch *stitch; /* NULL: not asked, or no seams */
 } lx_lightmap;
 
@@ -193,9 +254,10 @@ lx_vec3 lx_cosine_direction(lx_vec3 t, lx_vec3 bt, lx_vec3 n, uint32_t map, uint
  * when sky->environment is NULL (sky.c). */
 lx_status lx_sky_prepare(lx_baker *b, const lx_sky_desc *sky);
 void lx_sky_free(lx_baker *b);
-/* Adds the sky's irradiance to accum for count texels from first. */
+/* Adds the sky's irradiance to accum for count texels from first, and
+ * its directional data to sh (NULL: none). */
 void lx_sky_tile(const lx_baker *b, uint32_t map_index, const lx_lightmap *map, uint32_t first,
-                 uint32_t count, lx_vec3 *accum);
+                 uint32_t count, lx_vec3 *accum, lx_sh4 *sh);
 
 /* A mesh of a page for stitch.c: its lightmap UV set and the scale and
  * offset that take it into the page. */
