@@ -54,14 +54,31 @@ static inline void lx_sh4_scale(lx_sh4 *s, float k)
         s->c[i] *= k;
 }
 
-/* The weight of a cosine-distributed gather ray whose direction makes
- * cos_theta with the texel's normal, for the estimate of int L Y dw (see
- * directional.c): pi / cos, and 2 pi / LX_SH_HORIZON within
- * LX_SH_HORIZON of the horizon. */
-#define LX_SH_HORIZON 0.1f
-static inline float lx_sh_ray_weight(float cos_theta)
+/* What gather ray k (of sx x sy cells, lx_cosine_direction about the
+ * unit normal n) in unit direction d adds, times its radiance / N, to the
+ * estimate of int L Y dw over the hemisphere (directional.c): *w0 for
+ * L00 / Y00 and *v for L1 / Y1. Not 1 / pdf = pi / c (c = d . n), whose
+ * variance has no bound toward the horizon, but per elevation stratum
+ * (u = 1 - c^2 in [i / sx, (i + 1) / sx)) the means over it: L00 the mean
+ * of pi / c, L1 along n pi (the cosine estimator), L1 across n the mean of
+ * pi s / c over the mean of s (s = sqrt(u), the sine). Bounded, exact for
+ * a constant sky, unbiased for radiance that does not change with
+ * elevation within a stratum. */
+static inline void lx_sh_ray_weight(uint32_t k, uint32_t sx, lx_vec3 d, lx_vec3 n, float *w0,
+                                    lx_vec3 *v)
 {
-    return cos_theta >= LX_SH_HORIZON ? LX_PI / cos_theta : 2.0f * LX_PI / LX_SH_HORIZON;
+    uint32_t i = k % sx;
+    double a = (double)i / sx, b = (double)(i + 1) / sx;
+    if (b > 1.0)
+        b = 1.0;
+    double ca = sqrt(1.0 - a), cb = sqrt(1.0 - b), sa = sqrt(a), sb = sqrt(b);
+    *w0 = (float)(2.0 * LX_PI * sx * (ca - cb));
+    /* int sqrt(u / (1 - u)) du = asin(sqrt u) - sqrt(u (1 - u)) */
+    double fa = asin(sa) - sa * ca, fb = asin(sb) - sb * cb;
+    double mean_s = 2.0 / 3.0 * (sb * sb * sb - sa * sa * sa) * sx;
+    double wt = mean_s > 0.0 ? LX_PI * (fb - fa) * sx / mean_s : 0.0;
+    float c = lx_dot(d, n);
+    *v = lx_add(lx_scale(n, LX_PI), lx_scale(lx_sub(d, lx_scale(n, c)), (float)wt));
 }
 
 /* Texels are stored in tiles of TILE x TILE for coherent rays; a tile is

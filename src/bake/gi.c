@@ -284,9 +284,10 @@ static lx_vec3 texel_gather(const gi_run *run, uint32_t map_index, uint32_t i, u
         sum[2] += l.z;
         if (sh) {
             lx_vec3 d = ray.dir;
-            double wt = lx_sh_ray_weight(lx_dot(d, f.n));
-            double y[4] = {LX_SH_Y0 * wt, LX_SH_Y1 * d.y * wt, LX_SH_Y1 * d.z * wt,
-                           LX_SH_Y1 * d.x * wt};
+            float w0;
+            lx_vec3 v;
+            lx_sh_ray_weight(k, sx, d, f.n, &w0, &v);
+            double y[4] = {LX_SH_Y0 * w0, LX_SH_Y1 * v.y, LX_SH_Y1 * v.z, LX_SH_Y1 * v.x};
             for (int c = 0; c < 4; c++) {
                 shs[3 * c] += l.x * y[c];
                 shs[3 * c + 1] += l.y * y[c];

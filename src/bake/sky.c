@@ -248,10 +248,10 @@ lx_vec3 lx_cosine_direction(lx_vec3 t, lx_vec3 bt, lx_vec3 n, uint32_t map, uint
 }
 
 /* Casts m rays (directions in rays[], weights per channel in w[]) and adds
- * the weights of those that escape to sum; with shs, also w x shw x the
- * SH basis at the ray's direction to shs (4 x RGB). */
+ * the weights of those that escape to sum; with shs, also w x (Y00 shw,
+ * Y1 shv) to shs (4 x RGB). */
 static void cast(const lx_baker *b, lx_ray *rays, const lx_vec3 *w, uint32_t m, double sum[3],
-                 const float *shw, double *shs)
+                 const float *shw, const lx_vec3 *shv, double *shs)
 {
     uint8_t occluded[64];
     lx_tracer_occluded_batch(b->tracer, rays, m, false, occluded);
@@ -262,10 +262,10 @@ static void cast(const lx_baker *b, lx_ray *rays, const lx_vec3 *w, uint32_t m, 
             sum[2] += w[j].z;
             if (!shs)
                 continue;
-            lx_vec3 d = rays[j].dir;
-            double y[4] = {LX_SH_Y0, LX_SH_Y1 * d.y, LX_SH_Y1 * d.z, LX_SH_Y1 * d.x};
+            lx_vec3 v = shv[j];
+            double y[4] = {LX_SH_Y0 * shw[j], LX_SH_Y1 * v.y, LX_SH_Y1 * v.z, LX_SH_Y1 * v.x};
             for (int k = 0; k < 4; k++) {
-                double f = y[k] * shw[j];
+                double f = y[k];
                 shs[3 * k] += w[j].x * f;
                 shs[3 * k + 1] += w[j].y * f;
                 shs[3 * k + 2] += w[j].z * f;
@@ -291,6 +291,7 @@ static lx_vec3 sky_visible(const lx_baker *b, uint32_t map_index, const lx_light
     lx_ray rays[BATCH];
     lx_vec3 w[BATCH];
     float shw[BATCH];
+    lx_vec3 shv[BATCH];
     double shs_base[LX_SH_FLOATS] = {0}, shs_peak[LX_SH_FLOATS] = {0};
     lx_vec3 result = lx_v3(0.0f, 0.0f, 0.0f);
 
@@ -309,15 +310,17 @@ static lx_vec3 sky_visible(const lx_baker *b, uint32_t map_index, const lx_light
         rays[m] = lx_shadow_ray(b, p, ng, &e);
         /* the SH estimate's weight over pi (the irradiance's), see
          * directional.c */
-        shw[m] = lx_sh_ray_weight(lx_dot(d, nrm)) / LX_PI;
+        lx_sh_ray_weight(k, sx, d, nrm, &shw[m], &shv[m]);
+        shw[m] /= LX_PI;
+        shv[m] = lx_scale(shv[m], 1.0f / LX_PI);
         w[m++] = lx_v3(l[0], l[1], l[2]);
         if (m == BATCH) {
-            cast(b, rays, w, m, sum, shw, sh ? shs_base : NULL);
+            cast(b, rays, w, m, sum, shw, shv, sh ? shs_base : NULL);
             m = 0;
         }
     }
     if (m)
-        cast(b, rays, w, m, sum, shw, sh ? shs_base : NULL);
+        cast(b, rays, w, m, sum, shw, shv, sh ? shs_base : NULL);
     double scale = LX_PI / (double)cells;
     if (sh)
         for (int c = 0; c < LX_SH_FLOATS; c++)
@@ -355,14 +358,15 @@ static lx_vec3 sky_visible(const lx_baker *b, uint32_t map_index, const lx_light
         lx_light_eval e = {.to_light = d, .distance = INFINITY};
         rays[m] = lx_shadow_ray(b, p, ng, &e);
         shw[m] = 1.0f / cos_n;
+        shv[m] = lx_scale(d, shw[m]);
         w[m++] = lx_v3(l[0] * chroma, l[1] * chroma, l[2] * chroma);
         if (m == BATCH) {
-            cast(b, rays, w, m, sum, shw, sh ? shs_peak : NULL);
+            cast(b, rays, w, m, sum, shw, shv, sh ? shs_peak : NULL);
             m = 0;
         }
     }
     if (m)
-        cast(b, rays, w, m, sum, shw, sh ? shs_peak : NULL);
+        cast(b, rays, w, m, sum, shw, shv, sh ? shs_peak : NULL);
     scale = total / (double)peaks;
     if (sh)
         for (int c = 0; c < LX_SH_FLOATS; c++)
