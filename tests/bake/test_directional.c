@@ -48,6 +48,7 @@ typedef struct baked {
 /* A 1 m floor (8x8 texels) lit by what the caller put in desc and scene. */
 static void bake_floor(lx_scene *scene, lx_bake_desc desc, baked *out)
 {
+    uint32_t node = scene->node_count;
     lx_mesh floor = lx_test_plane("floor", 1.0f, 0.0f, 0.0f, 0.0f, 1);
     lx_test_add(scene, &floor);
     lx_test_mesh_free(&floor);
@@ -56,7 +57,7 @@ static void bake_floor(lx_scene *scene, lx_bake_desc desc, baked *out)
         desc.directional = LX_DIRECTIONAL_SH;
     assert_int_equal(lx_baker_create(scene, &desc, &out->baker), LX_OK);
     assert_int_equal(lx_baker_bake(out->baker), LX_OK);
-    uint32_t m = lx_test_map_of(out->baker, 0);
+    uint32_t m = lx_test_map_of(out->baker, node);
     assert_int_equal(lx_baker_apply_alloc(out->baker, m, &out->irradiance), LX_OK);
     assert_int_equal(lx_baker_sh(out->baker, m, out->sh), LX_OK);
     assert_int_equal(lx_baker_dominant(out->baker, m, &out->dominant), LX_OK);
@@ -310,6 +311,55 @@ static void test_threads(void **state)
     baked_free(&two);
 }
 
+/* Denoising keeps the directions: under a sun alone every texel's
+ * radiance is a delta from l (L1 = sqrt 3 L00 l) or nothing; the filter
+ * gives the four coefficient planes the same weights, so every filtered
+ * texel still has direction l, directionality 1, while the block's shadow
+ * edge is smoothed (some L00 changes). */
+static void test_denoise_keeps_direction(void **state)
+{
+    (void)state;
+    baked plain, filtered;
+    for (int k = 0; k < 2; k++) {
+        lx_scene *scene = lx_test_new_scene("shadow");
+        lx_mesh box =
+            lx_test_box("block", lx_v3(-0.1f, 0.05f, -0.1f), lx_v3(0.1f, 0.3f, 0.1f), false);
+        lx_test_add(scene, &box);
+        lx_test_mesh_free(&box);
+        lx_light sun = lx_light_defaults(LX_LIGHT_DIRECTIONAL);
+        sun.direction = lx_normalize(lx_v3(-0.6f, -1.0f, 0.3f));
+        sun.intensity = 800.0f;
+        sun.shadow = LX_SHADOW_HARD;
+        assert_int_equal(lx_scene_add_light(scene, &sun), LX_OK);
+        lx_bake_desc d = {.padding = LX_PADDING_NONE,
+                          .denoise = k ? LX_DENOISE_ALL : LX_DENOISE_OFF};
+        bake_floor(scene, d, k ? &filtered : &plain);
+        lx_scene_destroy(scene);
+    }
+    lx_vec3 l = lx_normalize(lx_v3(0.6f, 1.0f, -0.3f));
+    int changed = 0, lit = 0;
+    for (size_t p = 0; p < 64; p++) {
+        const float *c0 = filtered.sh[0].data + 3 * p;
+        changed += c0[0] != plain.sh[0].data[3 * p];
+        if (!(c0[0] > 0.0f))
+            continue;
+        lit++;
+        const float *d = filtered.dominant.data + 4 * p;
+        assert_true(fabs(2.0 * d[0] - 1.0 - l.x) <= 1e-5);
+        assert_true(fabs(2.0 * d[1] - 1.0 - l.y) <= 1e-5);
+        assert_true(fabs(2.0 * d[2] - 1.0 - l.z) <= 1e-5);
+    }
+    int irr_changed = 0;
+    for (size_t p = 0; p < 64; p++)
+        irr_changed += filtered.irradiance.data[3 * p] != plain.irradiance.data[3 * p];
+    printf("irradiance changed at %d\n", irr_changed);
+    printf("denoised: %d texels changed, %d lit texels all with the sun's direction\n", changed,
+           lit);
+    assert_true(changed > 0 && lit > 0);
+    baked_free(&plain);
+    baked_free(&filtered);
+}
+
 static void test_refused(void **state)
 {
     (void)state;
@@ -342,7 +392,8 @@ int main(void)
         cmocka_unit_test(test_directional_light), cmocka_unit_test(test_ambient),
         cmocka_unit_test(test_sky_unshadowed),    cmocka_unit_test(test_sky_shadowed),
         cmocka_unit_test(test_sky_linear),
-        cmocka_unit_test(test_threads),           cmocka_unit_test(test_refused),
+        cmocka_unit_test(test_threads),
+        cmocka_unit_test(test_denoise_keeps_direction),           cmocka_unit_test(test_refused),
     };
     return cmocka_run_group_tests(tests, NULL, NULL);
 }
