@@ -244,7 +244,9 @@ const uint8_t *lx_baker_mask(const lx_baker *baker, uint32_t map);
  * same units; emission itself is not in the lightmaps (the material
  * draws it). Dynamic lights get no indirect light. Memory while baking:
  * about 50 bytes a texel (albedo, validity, the sources and two
- * irradiance buffers), plus 12 per texel of an emissive material. */
+ * irradiance buffers), plus 12 per texel of an emissive material; with
+ * desc.directional 48 more a texel, kept (the SH), and 48 during the
+ * bounces. */
 lx_status lx_baker_bake(lx_baker *baker);
 
 /* Light access: index as in scene->lights. Changing a static light takes

@@ -481,6 +481,15 @@ lx_status lx_baker_bake(lx_baker *b)
     uint32_t n = select_lights(b, false, idx);
     /* the directional data: made by the first bake that asks (48 bytes a
      * texel), every texel written by the direct pass */
+    uint64_t sh_bytes = 0;
+    for (uint32_t m = 0; m < b->map_count && b->desc.directional; m++)
+        if (!b->maps[m].sh)
+            sh_bytes += (uint64_t)b->maps[m].info.width * (uint64_t)b->maps[m].info.height *
+                        LX_SH_FLOATS * sizeof(float);
+    if (sh_bytes && lx_check_memory(sh_bytes, "the directional lightmaps") != LX_OK) {
+        free(idx);
+        return LX_ERR_NOMEM;
+    }
     for (uint32_t m = 0; m < b->map_count && b->desc.directional; m++) {
         lx_lightmap *map = &b->maps[m];
         size_t count = (size_t)map->info.width * map->info.height * LX_SH_FLOATS;
