@@ -40,12 +40,26 @@ static inline void lx_sh4_add_uniform(lx_sh4 *s, lx_vec3 a)
 }
 
 /* A contribution e (irradiance at the texel's normal n, lux) of light
- * arriving from unit direction d: a delta of e / (n . d). */
-static inline void lx_sh4_add_lit(lx_sh4 *s, lx_vec3 e, lx_vec3 n, lx_vec3 d)
+ * arriving from unit direction d: a delta of e / (n . d), n . d taken as
+ * at least `floor` (a point-like light is only lit above the horizon,
+ * floor 1e-3; an area light's centre may sit below it while part of the
+ * light is above, floor 0.1 keeps its delta within 10 e). */
+static inline void lx_sh4_add_lit_floor(lx_sh4 *s, lx_vec3 e, lx_vec3 n, lx_vec3 d, float floor)
 {
     float c = lx_dot(n, d);
-    c = c > 1e-3f ? c : 1e-3f;
-    lx_sh4_add_delta(s, lx_scale(e, 1.0f / c), d);
+    c = c > floor ? c : floor;
+    float k = 1.0f / c;
+    float y[4] = {LX_SH_Y0, LX_SH_Y1 * d.y, LX_SH_Y1 * d.z, LX_SH_Y1 * d.x};
+    for (int i = 0; i < 4; i++) {
+        s->c[3 * i] += e.x * k * y[i];
+        s->c[3 * i + 1] += e.y * k * y[i];
+        s->c[3 * i + 2] += e.z * k * y[i];
+    }
+}
+
+static inline void lx_sh4_add_lit(lx_sh4 *s, lx_vec3 e, lx_vec3 n, lx_vec3 d)
+{
+    lx_sh4_add_lit_floor(s, e, n, d, 1e-3f);
 }
 
 static inline void lx_sh4_scale(lx_sh4 *s, float k)

@@ -93,12 +93,13 @@ static float soft_visibility(const lx_baker *b, uint32_t map_index, const lx_lig
 }
 
 /* sh (NULL: no directional data) gets what accum gets, with its
- * direction (lx_sh4_add_lit). */
+ * direction (lx_sh4_add_lit_floor). */
 static void light_tile(const lx_baker *b, uint32_t map_index, const lx_lightmap *map,
                        uint32_t first, uint32_t count, uint32_t light_index, lx_vec3 *accum,
                        lx_sh4 *sh)
 {
     const lx_light *light = &b->lights[light_index];
+    const float floor_c = lx_light_is_area(light) ? 0.1f : 1e-3f; /* lx_sh4_add_lit_floor */
     lx_ray rays[LX_TILE * LX_TILE];
     pending_ray pending[LX_TILE * LX_TILE];
     uint8_t occluded[LX_TILE * LX_TILE];
@@ -122,14 +123,14 @@ static void light_tile(const lx_baker *b, uint32_t map_index, const lx_lightmap 
         if (light->shadow == LX_SHADOW_NONE) {
             accum[k] = lx_add(accum[k], e.illuminance);
             if (sh)
-                lx_sh4_add_lit(&sh[k], e.illuminance, nn, e.to_light);
+                lx_sh4_add_lit_floor(&sh[k], e.illuminance, nn, e.to_light, floor_c);
             continue;
         }
         if (light->shadow == LX_SHADOW_SOFT) {
             float vis = soft_visibility(b, map_index, map, i, light_index, light);
             accum[k] = lx_add(accum[k], lx_scale(e.illuminance, vis));
             if (sh)
-                lx_sh4_add_lit(&sh[k], lx_scale(e.illuminance, vis), nn, e.to_light);
+                lx_sh4_add_lit_floor(&sh[k], lx_scale(e.illuminance, vis), nn, e.to_light, floor_c);
             continue;
         }
         rays[n] = lx_shadow_ray(b, map->world_position[i], map->world_geometric_normal[i], &e);
@@ -141,7 +142,7 @@ static void light_tile(const lx_baker *b, uint32_t map_index, const lx_lightmap 
             float vis = isfinite(d_occ) ? lx_light_blur_visibility(light, d_occ, d_light) : 1.0f;
             accum[k] = lx_add(accum[k], lx_scale(e.illuminance, vis));
             if (sh)
-                lx_sh4_add_lit(&sh[k], lx_scale(e.illuminance, vis), nn, e.to_light);
+                lx_sh4_add_lit_floor(&sh[k], lx_scale(e.illuminance, vis), nn, e.to_light, floor_c);
             continue;
         }
         n++;
@@ -154,8 +155,8 @@ static void light_tile(const lx_baker *b, uint32_t map_index, const lx_lightmap 
             uint32_t k = pending[j].texel;
             accum[k] = lx_add(accum[k], pending[j].illuminance);
             if (sh)
-                lx_sh4_add_lit(&sh[k], pending[j].illuminance, map->world_normal[first + k],
-                               rays[j].dir);
+                lx_sh4_add_lit_floor(&sh[k], pending[j].illuminance,
+                                     map->world_normal[first + k], rays[j].dir, floor_c);
         }
 }
 
