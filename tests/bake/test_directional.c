@@ -274,7 +274,10 @@ static void bake_room(int threads, baked *out)
     sun.intensity = 500.0f;
     sun.shadow = LX_SHADOW_HARD;
     assert_int_equal(lx_scene_add_light(scene, &sun), LX_OK);
-    lx_bake_desc d = {.padding = 2, .threads = threads, .bounces = 1, .gi_samples = 16,
+    lx_bake_desc d = {.padding = 2,
+                      .threads = threads,
+                      .bounces = 1,
+                      .gi_samples = 16,
                       .denoise = LX_DENOISE_INDIRECT};
     d.sky.environment = &env;
     d.sky.shadows = true;
@@ -389,11 +392,14 @@ int main(void)
 {
     lx_test_watchdog(600);
     const struct CMUnitTest tests[] = {
-        cmocka_unit_test(test_directional_light), cmocka_unit_test(test_ambient),
-        cmocka_unit_test(test_sky_unshadowed),    cmocka_unit_test(test_sky_shadowed),
+        cmocka_unit_test(test_directional_light),
+        cmocka_unit_test(test_ambient),
+        cmocka_unit_test(test_sky_unshadowed),
+        cmocka_unit_test(test_sky_shadowed),
         cmocka_unit_test(test_sky_linear),
         cmocka_unit_test(test_threads),
-        cmocka_unit_test(test_denoise_keeps_direction),           cmocka_unit_test(test_refused),
+        cmocka_unit_test(test_denoise_keeps_direction),
+        cmocka_unit_test(test_refused),
     };
     return cmocka_run_group_tests(tests, NULL, NULL);
 }

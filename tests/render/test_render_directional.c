@@ -91,7 +91,9 @@ static lx_scene *make_scene(void)
  * for `mode` into dir. */
 static void bake_to(lx_scene *scene, lx_directional_mode mode, const char *dir)
 {
-    lx_bake_desc desc = {.resolution = 16, .padding = 2, .threads = 2,
+    lx_bake_desc desc = {.resolution = 16,
+                         .padding = 2,
+                         .threads = 2,
                          .directional = mode ? mode : LX_DIRECTIONAL_SH};
     lx_baker *baker;
     assert_int_equal(lx_baker_create(scene, &desc, &baker), LX_OK);
