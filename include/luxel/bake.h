@@ -122,6 +122,14 @@ typedef enum lx_denoise_mode {
     LX_DENOISE_ALL       /* the sum: out = F(direct + indirect) */
 } lx_denoise_mode;
 
+/* Directional lightmaps (`luxel bake --directional sh|dominant`), for
+ * normal-mapped surfaces at run time; docs/directional.md. */
+typedef enum lx_directional_mode {
+    LX_DIRECTIONAL_OFF = 0, /* irradiance only */
+    LX_DIRECTIONAL_SH,      /* L1 spherical harmonics per texel (lx_baker_sh) */
+    LX_DIRECTIONAL_DOMINANT /* a dominant direction per texel (lx_baker_dominant) */
+} lx_directional_mode;
+
 typedef struct lx_sky_desc {
     const lx_cubemap *environment; /* NULL = no sky; read by lx_baker_create only */
     float intensity;               /* multiplier, 0 = 1 */
@@ -183,6 +191,12 @@ typedef struct lx_bake_desc {
                               (each texel's albedo and emission, the meshes'
                               UVs: 12-24 bytes a texel), kept anyway with
                               bounces > 0 */
+    lx_directional_mode directional; /* OFF (default), SH or DOMINANT: the baked
+                              light's directions kept per texel (48 bytes a
+                              texel more); either mode allows both
+                              lx_baker_sh and lx_baker_dominant. Texels are
+                              then baked with the interpolated vertex normal:
+                              normal maps are left to run time */
     lx_progress_fn progress;
     void *progress_user;
 } lx_bake_desc;
@@ -253,7 +267,9 @@ const uint8_t *lx_baker_mask(const lx_baker *baker, uint32_t map);
  * draws it). Dynamic lights get one bounce in lx_baker_update when
  * desc.dynamic_bounce_samples > 0 (see there). Memory while baking:
  * about 50 bytes a texel (albedo, validity, the sources and two
- * irradiance buffers), plus 12 per texel of an emissive material. */
+ * irradiance buffers), plus 12 per texel of an emissive material; with
+ * desc.directional 48 more a texel, kept (the SH), and 48 during the
+ * bounces. */
 lx_status lx_baker_bake(lx_baker *baker);
 
 /* Light access: index as in scene->lights. Changing a static light takes
@@ -316,6 +332,38 @@ bool lx_baker_texel(const lx_baker *baker, uint32_t map, int x, int y, lx_texel_
  * (lx_ev100_from_luminance). *lit gets false, and *ev100 0, when that mean
  * is 0: every lightmap is black. */
 void lx_baker_meter_ev100(const lx_baker *baker, float *ev100, bool *lit);
+
+/* ---- directional lightmaps ---------------------------------------------------
+ * With desc.directional set, lx_baker_bake keeps per texel the order-1
+ * spherical harmonics of the baked (static) light's incoming radiance, in
+ * nits, world space, in luxel's SH basis (ibl.h): L00 (Y00 = 0.282095),
+ * L1-1 (0.488603 y), L10 (0.488603 z), L11 (0.488603 x); L_lm = int
+ * L(w) Y_lm(w) dw. Lights, ambient and sky seen directly and the bounces
+ * all count, each as the irradiance holds it: a light as a delta from its
+ * direction at the texel (area lights from their centre), the ambient
+ * terms as a uniform radiance over the sphere, an unshadowed sky as its
+ * own L0 and L1, sky and gather rays over the texel's hemisphere. The
+ * irradiance for a unit normal n is (Ramamoorthi & Hanrahan's cosine
+ * lobe) E(n) = pi Y00 L00 + 2 pi / 3 (L1-1 Y1-1(n) + L10 Y10(n) + L11
+ * Y11(n)). Real-time (dynamic) lights are not in it. Denoising filters
+ * the coefficients with the guides' weights alone (docs/directional.md). */
+
+/* The 4 coefficient images of lightmap `map` (RGB each, the lightmap's
+ * size, allocated here: free each with lx_image_free): out[0] L00, out[1]
+ * L1-1 (y), out[2] L10 (z), out[3] L11 (x), padded and stitched like
+ * lx_baker_apply, 0 outside the charts. LX_ERR_INVALID when the baker was
+ * made without desc.directional or map is out of range; out zeroed on
+ * failure. */
+lx_status lx_baker_sh(const lx_baker *baker, uint32_t map, lx_image out[4]);
+
+/* Unity's directional lightmap of `map` (RGBA, allocated here): rgb = d /
+ * 2 + 1/2, d the luminance-weighted mean direction the light comes from
+ * (|d| <= 1 is its directionality: 1 for a single light, 0 for light from
+ * every side equally), a = the half-Lambert of the texel's normal n,
+ * (n . d) / 2 + 1/2 (Unity's rebalancing coefficient). A shader draws
+ * lightmap x ((n' . d) / 2 + 1/2) / a for the normal-mapped n'. Padded
+ * like lx_baker_apply; fails as lx_baker_sh. */
+lx_status lx_baker_dominant(const lx_baker *baker, uint32_t map, lx_image *out);
 
 /* ---- ambient occlusion lightmaps --------------------------------------------
  * The share of a texel's cosine-weighted hemisphere that is open within

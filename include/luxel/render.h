@@ -110,6 +110,15 @@ typedef struct lx_lightmap_page {
     char *file; /* path of the page (the manifest's folder joined) */
     int width, height;
     lx_image image; /* linear RGB as stored (width 0 when not loaded) */
+    /* directional data (docs/directional.md), NULL / width 0 when none:
+     * "sh": sh[0] E0 = pi Y00 L00 and sh[1..3] E1 = 2 pi / 3 Y1 L1 for
+     * L1-1 (y), L10 (z), L11 (x), all in the page's units (normalized files
+     * are decoded to these); the irradiance of unit normal n is E0 + E1y
+     * n.y + E1z n.z + E1x n.x. "dir": Unity's RGBA dominant direction. */
+    char *sh_files[4];
+    lx_image sh[4];
+    char *dir_file;
+    lx_image dir;
 } lx_lightmap_page;
 
 typedef struct lx_lightmap_node {
@@ -132,6 +141,10 @@ typedef struct lx_lightmaps {
     int padding;          /* texel rings each chart owns (-1 when absent) */
     int atlas_size;       /* largest page side asked for (0 when absent) */
     char *sky;            /* the sky environment as the bake was given it, or NULL */
+    lx_directional_mode directional; /* the manifest's "directional" mode (OFF
+                                        when absent) */
+    bool sh_normalized;   /* the sh files hold L1 / (sqrt 3 L00) as codes
+                             (decoded to E1 when loaded) */
     float sky_intensity;  /* its multiplier (1 when absent) */
     lx_lightmap_page *pages;
     uint32_t page_count;
@@ -195,7 +208,14 @@ typedef struct lx_render_desc {
 lx_render_desc lx_render_desc_defaults(const lx_render_desc *desc);
 
 /* Renders scene with lightmaps lm into out (3 channels, linear radiance in
- * nits, allocated here). tracer may be NULL (one is built and destroyed
+ * nits, allocated here). With directional lightmaps (lm->directional), a
+ * surface whose material has a normal map is lit for its normal-mapped
+ * normal n' (MikkTSpace tangents, or the mesh's): the lightmap's E times
+ * f(n') / f(n), n the interpolated vertex normal, f the L1 irradiance E0 +
+ * E1 . n (sh; f(n') clamped at 0, and no change where f(n) is not above
+ * 0) or Unity's half-Lambert (n' . d) / 2 + 1/2 over the stored rebalancing
+ * (dominant); other surfaces, or lightmaps without directional data, as
+ * before. tracer may be NULL (one is built and destroyed
  * here), else it must have been made from scene. Checks lm against the
  * scene first (lx_lightmaps_check), and lm must have its images loaded.
  * Scene nodes without a lightmap are drawn black. On failure out is

@@ -16,7 +16,8 @@ float **lx_bake_denoise_keep(const lx_baker *b, lx_status *st)
     *st = LX_OK;
     if (b->desc.denoise != LX_DENOISE_INDIRECT || b->desc.bounces == 0)
         return NULL;
-    float **direct = calloc(b->map_count + 1, sizeof *direct);
+    /* [m]: map m's baked buffer, [map_count + m]: its directional data */
+    float **direct = calloc(2 * (size_t)b->map_count + 1, sizeof *direct);
     if (!direct) {
         *st = lx_fail(LX_ERR_NOMEM, "out of memory keeping the direct light for denoising");
         return NULL;
@@ -32,6 +33,17 @@ float **lx_bake_denoise_keep(const lx_baker *b, lx_status *st)
             return NULL;
         }
         memcpy(direct[m], map->baked, sizeof(float) * n);
+        if (!map->sh)
+            continue;
+        size_t k = n / 3 * LX_SH_FLOATS;
+        if (!(direct[b->map_count + m] = malloc(sizeof(float) * k))) {
+            lx_bake_denoise_free(b, direct);
+            *st = lx_fail(LX_ERR_NOMEM, "lightmap '%s': out of memory keeping its direct light "
+                                        "for denoising",
+                          map->name);
+            return NULL;
+        }
+        memcpy(direct[b->map_count + m], map->sh, sizeof(float) * k);
     }
     return direct;
 }
@@ -40,7 +52,7 @@ void lx_bake_denoise_free(const lx_baker *b, float **direct)
 {
     if (!direct)
         return;
-    for (uint32_t m = 0; m < b->map_count; m++)
+    for (uint32_t m = 0; m < 2 * b->map_count; m++)
         free(direct[m]);
     free(direct);
 }
@@ -54,6 +66,48 @@ static bool share_progress(void *user, float fraction)
 {
     const share *s = user;
     return s->b->desc.progress(s->b->desc.progress_user, s->from + s->span * fraction);
+}
+
+/* The directional data of a map, filtered as its irradiance is (the same
+ * mode, guides and settings) but without the luminance weight: the four
+ * coefficient planes then get the same weights, set by the guides alone,
+ * so the direction and its share survive the filter (a weight that
+ * followed each plane's values would filter L0 and L1 apart and bend the
+ * directions). sh_direct: the directional data before the bounces
+ * (INDIRECT), else NULL. */
+static lx_status denoise_sh(const lx_baker *b, lx_lightmap *map, const lx_denoise_guides *g,
+                            const float *sh_direct)
+{
+    size_t pixels = (size_t)map->info.width * map->info.height;
+    float *plane = malloc(sizeof(float) * 3 * pixels);
+    float *part = sh_direct ? malloc(sizeof(float) * 3 * pixels) : NULL;
+    if (!plane || (sh_direct && !part)) {
+        free(plane);
+        free(part);
+        return lx_fail(LX_ERR_NOMEM, "out of memory for denoising the directional data");
+    }
+    lx_denoise_desc dd = {.threads = b->desc.threads, .ignore_luminance = true};
+    lx_status st = LX_OK;
+    for (int c = 0; c < 4 && st == LX_OK; c++) {
+        for (size_t p = 0; p < pixels; p++)
+            for (int k = 0; k < 3; k++) {
+                float v = map->sh[p * LX_SH_FLOATS + (size_t)(3 * c + k)];
+                if (sh_direct) {
+                    float d = sh_direct[p * LX_SH_FLOATS + (size_t)(3 * c + k)];
+                    part[3 * p + (size_t)k] = d;
+                    v -= d;
+                }
+                plane[3 * p + (size_t)k] = v;
+            }
+        st = sh_direct ? lx_denoise_combine(LX_DENOISE_INDIRECT, g, part, plane, plane, &dd)
+                       : lx_denoise(g, plane, plane, &dd);
+        for (size_t p = 0; p < pixels && st == LX_OK; p++)
+            for (int k = 0; k < 3; k++)
+                map->sh[p * LX_SH_FLOATS + (size_t)(3 * c + k)] = plane[3 * p + (size_t)k];
+    }
+    free(plane);
+    free(part);
+    return st;
 }
 
 lx_status lx_bake_denoise(lx_baker *b, float **direct, float progress_base, float progress_span)
@@ -89,6 +143,9 @@ lx_status lx_bake_denoise(lx_baker *b, float **direct, float progress_base, floa
         } else {
             st = lx_denoise(&g, map->baked, map->baked, &dd);
         }
+        if (st == LX_OK && map->sh)
+            st = denoise_sh(b, map, &g,
+                            mode == LX_DENOISE_INDIRECT ? direct[b->map_count + m] : NULL);
         lx_denoise_guides_free(&g);
         if (st != LX_OK && st != LX_ERR_CANCELLED) {
             char what[300];

@@ -6,6 +6,95 @@
 #include "luxel/maps.h"
 #include "luxel/trace.h"
 
+/* ---- directional data (directional.c) ----------------------------------
+ * Per texel, the order-1 spherical harmonics of the incoming radiance
+ * (nits), world space, luxel's SH basis (ibl.h): 4 RGB coefficients, L00,
+ * L1-1 (y), L10 (z), L11 (x), 12 floats. */
+#define LX_SH_FLOATS 12
+#define LX_SH_Y0 0.282095f
+#define LX_SH_Y1 0.488603f
+
+typedef struct lx_sh4 {
+    float c[LX_SH_FLOATS];
+} lx_sh4;
+
+/* Radiance e (a delta: e is the illuminance on a surface facing it) from
+ * unit direction d. */
+static inline void lx_sh4_add_delta(lx_sh4 *s, lx_vec3 e, lx_vec3 d)
+{
+    float y[4] = {LX_SH_Y0, LX_SH_Y1 * d.y, LX_SH_Y1 * d.z, LX_SH_Y1 * d.x};
+    for (int k = 0; k < 4; k++) {
+        s->c[3 * k] += e.x * y[k];
+        s->c[3 * k + 1] += e.y * y[k];
+        s->c[3 * k + 2] += e.z * y[k];
+    }
+}
+
+/* An irradiance a that is the same for every normal (the ambient terms):
+ * a uniform radiance a / pi over the sphere, L00 = 4 Y00 a. */
+static inline void lx_sh4_add_uniform(lx_sh4 *s, lx_vec3 a)
+{
+    s->c[0] += 4.0f * LX_SH_Y0 * a.x;
+    s->c[1] += 4.0f * LX_SH_Y0 * a.y;
+    s->c[2] += 4.0f * LX_SH_Y0 * a.z;
+}
+
+/* A contribution e (irradiance at the texel's normal n, lux) of light
+ * arriving from unit direction d: a delta of e / (n . d), n . d taken as
+ * at least `floor` (a point-like light is only lit above the horizon,
+ * floor 1e-3; an area light's centre may sit below it while part of the
+ * light is above, floor 0.1 keeps its delta within 10 e). */
+static inline void lx_sh4_add_lit_floor(lx_sh4 *s, lx_vec3 e, lx_vec3 n, lx_vec3 d, float floor)
+{
+    float c = lx_dot(n, d);
+    c = c > floor ? c : floor;
+    float k = 1.0f / c;
+    float y[4] = {LX_SH_Y0, LX_SH_Y1 * d.y, LX_SH_Y1 * d.z, LX_SH_Y1 * d.x};
+    for (int i = 0; i < 4; i++) {
+        s->c[3 * i] += e.x * k * y[i];
+        s->c[3 * i + 1] += e.y * k * y[i];
+        s->c[3 * i + 2] += e.z * k * y[i];
+    }
+}
+
+static inline void lx_sh4_add_lit(lx_sh4 *s, lx_vec3 e, lx_vec3 n, lx_vec3 d)
+{
+    lx_sh4_add_lit_floor(s, e, n, d, 1e-3f);
+}
+
+static inline void lx_sh4_scale(lx_sh4 *s, float k)
+{
+    for (int i = 0; i < LX_SH_FLOATS; i++)
+        s->c[i] *= k;
+}
+
+/* What gather ray k (of sx x sy cells, lx_cosine_direction about the
+ * unit normal n) in unit direction d adds, times its radiance / N, to the
+ * estimate of int L Y dw over the hemisphere (directional.c): *w0 for
+ * L00 / Y00 and *v for L1 / Y1. Not 1 / pdf = pi / c (c = d . n), whose
+ * variance has no bound toward the horizon, but per elevation stratum
+ * (u = 1 - c^2 in [i / sx, (i + 1) / sx)) the means over it: L00 the mean
+ * of pi / c, L1 along n pi (the cosine estimator), L1 across n the mean of
+ * pi s / c over the mean of s (s = sqrt(u), the sine). Bounded, exact for
+ * a constant sky, unbiased for radiance that does not change with
+ * elevation within a stratum. */
+static inline void lx_sh_ray_weight(uint32_t k, uint32_t sx, lx_vec3 d, lx_vec3 n, float *w0,
+                                    lx_vec3 *v)
+{
+    uint32_t i = k % sx;
+    double a = (double)i / sx, b = (double)(i + 1) / sx;
+    if (b > 1.0)
+        b = 1.0;
+    double ca = sqrt(1.0 - a), cb = sqrt(1.0 - b), sa = sqrt(a), sb = sqrt(b);
+    *w0 = (float)(2.0 * LX_PI * sx * (ca - cb));
+    /* int sqrt(u / (1 - u)) du = asin(sqrt u) - sqrt(u (1 - u)) */
+    double fa = asin(sa) - sa * ca, fb = asin(sb) - sb * cb;
+    double mean_s = 2.0 / 3.0 * (sb * sb * sb - sa * sa * sa) * sx;
+    double wt = mean_s > 0.0 ? LX_PI * (fb - fa) * sx / mean_s : 0.0;
+    float c = lx_dot(d, n);
+    *v = lx_add(lx_scale(n, LX_PI), lx_scale(lx_sub(d, lx_scale(n, c)), (float)wt));
+}
+
 /* Texels are stored in tiles of TILE x TILE for coherent rays; a tile is
  * also the unit of parallel work, so results do not depend on threads. */
 #define LX_TILE 8
@@ -76,6 +165,9 @@ typedef struct lx_lightmap {
     float *baked;    /* width * height * 3 */
     float *realtime; /* width * height * 3; NULL (reads as zero) until the
                         first update with dynamic lights */
+    float *sh;       /* width * height * LX_SH_FLOATS: the baked light's L1
+                        spherical harmonics (directional.c); NULL unless
+                        desc.directional */
     lx_seam_stitch *stitch; /* NULL: not asked, or no seams */
 } lx_lightmap;
 
@@ -234,9 +326,10 @@ void lx_sky_peak_sh(const lx_baker *b, lx_vec3 p, uint32_t seed, uint32_t index,
  * when sky->environment is NULL (sky.c). */
 lx_status lx_sky_prepare(lx_baker *b, const lx_sky_desc *sky);
 void lx_sky_free(lx_baker *b);
-/* Adds the sky's irradiance to accum for count texels from first. */
+/* Adds the sky's irradiance to accum for count texels from first, and
+ * its directional data to sh (NULL: none). */
 void lx_sky_tile(const lx_baker *b, uint32_t map_index, const lx_lightmap *map, uint32_t first,
-                 uint32_t count, lx_vec3 *accum);
+                 uint32_t count, lx_vec3 *accum, lx_sh4 *sh);
 
 /* A mesh of a page for stitch.c: its lightmap UV set and the scale and
  * offset that take it into the page. */
@@ -287,11 +380,11 @@ lx_vec3 lx_gi_lookup(const lx_lightmap *map, const uint8_t *valid, const float *
                      float fy);
 /* The validity test: true when most of texel i's rays hit back faces. */
 bool lx_gi_texel_inside(const lx_baker *b, uint32_t map_index, uint32_t i);
-/* Gives the invalid texels (per texel flags) of buf (3 floats a pixel) the
- * average of their valid (per pixel flags) or already filled neighbours,
- * ring by ring. */
+/* Gives the invalid texels (per texel flags) of buf (`channels` floats a
+ * pixel, at most LX_SH_FLOATS) the average of their valid (per pixel
+ * flags) or already filled neighbours, ring by ring. */
 lx_status lx_gi_fill_invalid(const lx_lightmap *map, const uint8_t *valid, const uint8_t *invalid,
-                             float *buf);
+                             float *buf, int channels);
 /* emitters.c: next-event estimation of the emissive triangles' light
  * (direct light, when desc.bounces > 0 and an emitter exists), added into
  * the baked buffers within [progress_base, progress_base + progress_span]. */

@@ -56,6 +56,8 @@ static lx_status validate_desc(const lx_bake_desc *d)
         return lx_fail(LX_ERR_INVALID, "shadow bias must be finite and >= 0");
     if (d->bounces < 0 || d->bounces > LX_MAX_BOUNCES)
         return lx_fail(LX_ERR_INVALID, "bounces %d is outside 0..%d", d->bounces, LX_MAX_BOUNCES);
+    if ((unsigned)d->directional > (unsigned)LX_DIRECTIONAL_DOMINANT)
+        return lx_fail(LX_ERR_INVALID, "unknown directional mode %d", (int)d->directional);
     if ((unsigned)d->denoise > (unsigned)LX_DENOISE_ALL)
         return lx_fail(LX_ERR_INVALID, "unknown denoise mode %d", (int)d->denoise);
     if (d->gi_samples < 1 || d->gi_samples > LX_MAX_GI_SAMPLES)
@@ -471,6 +473,8 @@ static void clear_buffers(lx_baker *b, bool realtime)
         float *buf = realtime ? map->realtime : map->baked;
         if (buf)
             memset(buf, 0, n * sizeof(float));
+        if (!realtime && map->sh)
+            memset(map->sh, 0, n / 3 * LX_SH_FLOATS * sizeof(float));
     }
 }
 
@@ -480,6 +484,27 @@ lx_status lx_baker_bake(lx_baker *b)
     if (!idx)
         return lx_fail(LX_ERR_NOMEM, "out of memory");
     uint32_t n = select_lights(b, false, idx);
+    /* the directional data: made by the first bake that asks (48 bytes a
+     * texel), every texel written by the direct pass */
+    uint64_t sh_bytes = 0;
+    for (uint32_t m = 0; m < b->map_count && b->desc.directional; m++)
+        if (!b->maps[m].sh)
+            sh_bytes += (uint64_t)b->maps[m].info.width * (uint64_t)b->maps[m].info.height *
+                        LX_SH_FLOATS * sizeof(float);
+    if (sh_bytes && lx_check_memory(sh_bytes, "the directional lightmaps") != LX_OK) {
+        free(idx);
+        return LX_ERR_NOMEM;
+    }
+    for (uint32_t m = 0; m < b->map_count && b->desc.directional; m++) {
+        lx_lightmap *map = &b->maps[m];
+        size_t count = (size_t)map->info.width * map->info.height * LX_SH_FLOATS;
+        if (!map->sh && !(map->sh = calloc(count, sizeof(float)))) {
+            free(idx);
+            return lx_fail(LX_ERR_NOMEM,
+                           "lightmap '%s': out of memory for its directional data (%zu bytes)",
+                           map->name, count * sizeof(float));
+        }
+    }
     /* progress: the direct pass, then the indirect one's gathers (a
      * validity pass and a gather a bounce, each about as long) */
     bool denoise = b->desc.denoise == LX_DENOISE_ALL ||

@@ -92,10 +92,14 @@ static float soft_visibility(const lx_baker *b, uint32_t map_index, const lx_lig
     return total > 0.0 ? (float)(visible / total) : 0.0f;
 }
 
+/* sh (NULL: no directional data) gets what accum gets, with its
+ * direction (lx_sh4_add_lit_floor). */
 static void light_tile(const lx_baker *b, uint32_t map_index, const lx_lightmap *map,
-                       uint32_t first, uint32_t count, uint32_t light_index, lx_vec3 *accum)
+                       uint32_t first, uint32_t count, uint32_t light_index, lx_vec3 *accum,
+                       lx_sh4 *sh)
 {
     const lx_light *light = &b->lights[light_index];
+    const float floor_c = lx_light_is_area(light) ? 0.1f : 1e-3f; /* lx_sh4_add_lit_floor */
     lx_ray rays[LX_TILE * LX_TILE];
     pending_ray pending[LX_TILE * LX_TILE];
     uint8_t occluded[LX_TILE * LX_TILE];
@@ -109,17 +113,24 @@ static void light_tile(const lx_baker *b, uint32_t map_index, const lx_lightmap 
          * and a product by 1 changes no bit) */
         const lx_texel_horizon *h = map->horizon && map->horizon[i].flags ? &map->horizon[i] : NULL;
         accum[k] = lx_add(accum[k], h ? lx_scale(e.ambient, h->ao) : e.ambient);
+        if (sh)
+            lx_sh4_add_uniform(&sh[k], h ? lx_scale(e.ambient, h->ao) : e.ambient);
         if (!direct)
             continue;
         if (h)
             e.illuminance = lx_scale(e.illuminance, lx_texel_horizon_factor(h, e.to_light));
+        lx_vec3 nn = map->world_normal[i];
         if (light->shadow == LX_SHADOW_NONE) {
             accum[k] = lx_add(accum[k], e.illuminance);
+            if (sh)
+                lx_sh4_add_lit_floor(&sh[k], e.illuminance, nn, e.to_light, floor_c);
             continue;
         }
         if (light->shadow == LX_SHADOW_SOFT) {
             float vis = soft_visibility(b, map_index, map, i, light_index, light);
             accum[k] = lx_add(accum[k], lx_scale(e.illuminance, vis));
+            if (sh)
+                lx_sh4_add_lit_floor(&sh[k], lx_scale(e.illuminance, vis), nn, e.to_light, floor_c);
             continue;
         }
         rays[n] = lx_shadow_ray(b, map->world_position[i], map->world_geometric_normal[i], &e);
@@ -130,6 +141,8 @@ static void light_tile(const lx_baker *b, uint32_t map_index, const lx_lightmap 
             float d_light = isfinite(e.distance) ? e.distance : b->scene_diagonal;
             float vis = isfinite(d_occ) ? lx_light_blur_visibility(light, d_occ, d_light) : 1.0f;
             accum[k] = lx_add(accum[k], lx_scale(e.illuminance, vis));
+            if (sh)
+                lx_sh4_add_lit_floor(&sh[k], lx_scale(e.illuminance, vis), nn, e.to_light, floor_c);
             continue;
         }
         n++;
@@ -138,8 +151,13 @@ static void light_tile(const lx_baker *b, uint32_t map_index, const lx_lightmap 
         return;
     lx_tracer_occluded_batch(b->tracer, rays, n, true, occluded);
     for (uint32_t j = 0; j < n; j++)
-        if (!occluded[j])
-            accum[pending[j].texel] = lx_add(accum[pending[j].texel], pending[j].illuminance);
+        if (!occluded[j]) {
+            uint32_t k = pending[j].texel;
+            accum[k] = lx_add(accum[k], pending[j].illuminance);
+            if (sh)
+                lx_sh4_add_lit_floor(&sh[k], pending[j].illuminance,
+                                     map->world_normal[first + k], rays[j].dir, floor_c);
+        }
 }
 
 /* ---- the lean loop: punctual lights with hard or no shadows ---------------
@@ -381,7 +399,7 @@ shade_lanes(const fast_light *f, tile_soa *t, uint32_t base, lx_ray_packet *pk, 
 __attribute__((target_clones("avx512f", "avx2", "default")))
 #endif
 static void
-fast_light_tile(const lx_baker *b, const fast_light *f, tile_soa *t)
+fast_light_tile(const lx_baker *b, const fast_light *f, tile_soa *t, lx_sh4 *sh)
 {
     lx_ray_packet pk;
     float e[3][LX_RAY_PACKET];
@@ -414,6 +432,17 @@ fast_light_tile(const lx_baker *b, const fast_light *f, tile_soa *t)
         for (int c = 0; c < 3; c++) {
             v16f a = vload(t->acc[c] + base);
             vstore(t->acc[c] + base, vsel(m, a + vload(e[c]), a));
+        }
+        if (!sh)
+            continue;
+        /* the directions: scalar, lane by lane (a directional bake only) */
+        for (uint32_t j = 0; j < LX_RAY_PACKET; j++) {
+            if (!((add >> j) & 1u))
+                continue;
+            uint32_t k = base + j;
+            lx_vec3 d = lx_v3(pk.dir_x[j], pk.dir_y[j], pk.dir_z[j]);
+            lx_vec3 n = lx_v3(t->nx[k], t->ny[k], t->nz[k]);
+            lx_sh4_add_lit(&sh[t->texel[k]], lx_v3(e[0][j], e[1][j], e[2][j]), n, d);
         }
     }
 }
@@ -464,8 +493,15 @@ lx_status lx_bake_lights(lx_baker *b, const uint32_t *lights, uint32_t light_cou
         free(map_first_tile);
         return lx_fail(LX_ERR_NOMEM, "out of memory");
     }
-    for (uint32_t l = 0; l < light_count; l++)
+    /* directional data of the baked buffers only; a fast light's ambient
+     * would need its lanes' range window: such lights take the general
+     * path then */
+    bool directional = !to_realtime && b->desc.directional != LX_DIRECTIONAL_OFF;
+    for (uint32_t l = 0; l < light_count; l++) {
         is_fast[l] = fast_light_init(&b->lights[lights[l]], &fast[l]);
+        if (directional && (fast[l].mr != 0.0f || fast[l].mg != 0.0f || fast[l].mb != 0.0f))
+            is_fast[l] = false;
+    }
     int tiles = (int)map_first_tile[b->map_count];
     int threads = lx_thread_count(b->desc.threads);
     bool report = b->desc.progress != NULL;
@@ -487,7 +523,18 @@ lx_status lx_bake_lights(lx_baker *b, const uint32_t *lights, uint32_t light_cou
         if (count) {
             tile_soa t;
             lx_vec3 accum[TILE_TEXELS];
+            lx_sh4 shs[TILE_TEXELS];
+            lx_sh4 *sh = directional ? shs : NULL;
             tile_load(b, map, first, count, &t);
+            if (sh) {
+                memset(shs, 0, sizeof shs);
+                for (uint32_t k = 0; k < count; k++) {
+                    const lx_texel_horizon *h = map->horizon && map->horizon[first + k].flags
+                                                    ? &map->horizon[first + k]
+                                                    : NULL;
+                    lx_sh4_add_uniform(&shs[k], h ? lx_scale(ambient, h->ao) : ambient);
+                }
+            }
             for (uint32_t k = 0; k < TILE_TEXELS; k++)
                 t.acc[0][k] = ambient.x, t.acc[1][k] = ambient.y, t.acc[2][k] = ambient.z;
             /* a tile with texels under a height takes the general path,
@@ -504,28 +551,37 @@ lx_status lx_bake_lights(lx_baker *b, const uint32_t *lights, uint32_t light_cou
                 }
             for (uint32_t l = 0; l < light_count; l++) {
                 if (is_fast[l] && !horizon) {
-                    fast_light_tile(b, &fast[l], &t);
+                    fast_light_tile(b, &fast[l], &t, sh);
                     continue;
                 }
                 acc_to_vec3(&t, accum);
-                light_tile(b, m, map, first, count, lights[l], accum);
+                light_tile(b, m, map, first, count, lights[l], accum, sh);
                 vec3_to_acc(accum, &t);
             }
             if (!to_realtime && b->has_sky && !horizon) {
                 acc_to_vec3(&t, accum);
-                lx_sky_tile(b, m, map, first, count, accum);
+                lx_sky_tile(b, m, map, first, count, accum, sh);
                 vec3_to_acc(accum, &t);
             } else if (!to_realtime && b->has_sky) {
                 /* the sky alone, then added as lx_sky_tile adds it (times
                  * the AO under a height) */
                 lx_vec3 sky[TILE_TEXELS];
+                lx_sh4 sky_sh[TILE_TEXELS];
                 for (uint32_t k = 0; k < count; k++)
                     sky[k] = lx_v3(0.0f, 0.0f, 0.0f);
-                lx_sky_tile(b, m, map, first, count, sky);
+                if (sh)
+                    memset(sky_sh, 0, sizeof sky_sh);
+                lx_sky_tile(b, m, map, first, count, sky, sh ? sky_sh : NULL);
                 acc_to_vec3(&t, accum);
                 for (uint32_t k = 0; k < count; k++) {
                     const lx_texel_horizon *h = &map->horizon[first + k];
                     accum[k] = lx_add(accum[k], h->flags ? lx_scale(sky[k], h->ao) : sky[k]);
+                    if (sh) {
+                        if (h->flags)
+                            lx_sh4_scale(&sky_sh[k], h->ao);
+                        for (int c = 0; c < LX_SH_FLOATS; c++)
+                            shs[k].c[c] += sky_sh[k].c[c];
+                    }
                 }
                 vec3_to_acc(accum, &t);
             }
@@ -537,6 +593,10 @@ lx_status lx_bake_lights(lx_baker *b, const uint32_t *lights, uint32_t light_cou
                 px[0] = t.acc[0][k];
                 px[1] = t.acc[1][k];
                 px[2] = t.acc[2][k];
+                if (sh)
+                    memcpy(map->sh + (size_t)map->texels[first + (uint32_t)t.texel[k]].pixel *
+                                         LX_SH_FLOATS,
+                           &shs[t.texel[k]], sizeof(lx_sh4));
             }
         }
         if (report) {

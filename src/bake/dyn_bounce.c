@@ -218,6 +218,6 @@ lx_status lx_dyn_bounce_update(lx_baker *b)
     }
     for (uint32_t m = 0; m < b->map_count && st == LX_OK && d->invalid_texels; m++)
         st = lx_gi_fill_invalid(&b->maps[m], d->maps[m].valid, d->maps[m].invalid,
-                                b->maps[m].realtime);
+                                b->maps[m].realtime, 3);
     return st;
 }

@@ -150,6 +150,8 @@ typedef struct gi_map {
     float *source;    /* width * height * 3: exitant radiance of the last bounce */
     lx_vec3 *prev;    /* per texel: the last bounce's irradiance */
     lx_vec3 *next;    /* per texel: this bounce's */
+    lx_sh4 *next_sh;  /* per texel: this bounce's directional data (NULL
+                         unless desc.directional) */
     uint8_t *invalid; /* per texel, from the validity pass */
 } gi_map;
 
@@ -296,15 +298,18 @@ bool lx_gi_texel_inside(const lx_baker *b, uint32_t map_index, uint32_t i)
     return 2 * back > cells;
 }
 
-/* One gather for one texel: pi / N x the radiance its rays bring. */
-static lx_vec3 texel_gather(const gi_run *run, uint32_t map_index, uint32_t i, uint32_t key)
+/* One gather for one texel: pi / N x the radiance its rays bring; with
+ * sh, the same rays' estimate of int L Y dw (lx_sh_ray_weight / N x L Y,
+ * directional.c). */
+static lx_vec3 texel_gather(const gi_run *run, uint32_t map_index, uint32_t i, uint32_t key,
+                            lx_sh4 *sh)
 {
     const lx_baker *b = run->b;
     const lx_lightmap *map = &b->maps[map_index];
     uint32_t sx, sy;
     lx_cosine_strata(b->desc.gi_samples, &sx, &sy);
     uint32_t cells = sx * sy;
-    double sum[3] = {0.0, 0.0, 0.0};
+    double sum[3] = {0.0, 0.0, 0.0}, shs[LX_SH_FLOATS] = {0};
     lx_gather_frame f = lx_gather_frame_of(b, map_index, map, i);
     for (uint32_t k = 0; k < cells; k++) {
         lx_ray ray;
@@ -318,7 +323,22 @@ static lx_vec3 texel_gather(const gi_run *run, uint32_t map_index, uint32_t i, u
         sum[0] += l.x;
         sum[1] += l.y;
         sum[2] += l.z;
+        if (sh) {
+            lx_vec3 d = ray.dir;
+            float w0;
+            lx_vec3 v;
+            lx_sh_ray_weight(k, sx, d, f.n, &w0, &v);
+            double y[4] = {LX_SH_Y0 * w0, LX_SH_Y1 * v.y, LX_SH_Y1 * v.z, LX_SH_Y1 * v.x};
+            for (int c = 0; c < 4; c++) {
+                shs[3 * c] += l.x * y[c];
+                shs[3 * c + 1] += l.y * y[c];
+                shs[3 * c + 2] += l.z * y[c];
+            }
+        }
     }
+    if (sh)
+        for (int c = 0; c < LX_SH_FLOATS; c++)
+            sh->c[c] = (float)(shs[c] / (double)cells);
     double scale = LX_PI / (double)cells;
     return lx_v3((float)(sum[0] * scale), (float)(sum[1] * scale), (float)(sum[2] * scale));
 }
@@ -347,8 +367,10 @@ static bool run_pass(gi_run *run, bool validity, uint32_t key, float from, float
                 g->invalid[i] = lx_gi_texel_inside(b, m, i);
             } else if (g->invalid[i]) {
                 g->next[i] = lx_v3(0.0f, 0.0f, 0.0f);
+                if (g->next_sh)
+                    memset(&g->next_sh[i], 0, sizeof(lx_sh4));
             } else {
-                g->next[i] = texel_gather(run, m, i, key);
+                g->next[i] = texel_gather(run, m, i, key, g->next_sh ? &g->next_sh[i] : NULL);
             }
         }
         if (report) {
@@ -371,12 +393,12 @@ static bool run_pass(gi_run *run, bool validity, uint32_t key, float from, float
  * what the previous one left; texels no valid texel reaches keep their
  * value. Sequential: invalid texels are few. */
 lx_status lx_gi_fill_invalid(const lx_lightmap *map, const uint8_t *valid, const uint8_t *invalid,
-                             float *buf)
+                             float *buf, int channels)
 {
     int w = map->info.width, h = map->info.height;
     uint32_t n = map->info.used_texels, open = 0;
     uint32_t *todo = malloc(sizeof(uint32_t) * (n + 1));
-    float *vals = malloc(sizeof(float) * 3 * (n + 1));
+    float *vals = malloc(sizeof(float) * (size_t)channels * (n + 1));
     uint8_t *filled = malloc((size_t)w * (size_t)h);
     if (!todo || !vals || !filled) {
         free(todo);
@@ -393,7 +415,7 @@ lx_status lx_gi_fill_invalid(const lx_lightmap *map, const uint8_t *valid, const
         for (uint32_t k = 0; k < open; k++) {
             uint32_t p = todo[k];
             int x = (int)(p % (uint32_t)w), y = (int)(p / (uint32_t)w);
-            float s[3] = {0.0f, 0.0f, 0.0f};
+            float s[LX_SH_FLOATS] = {0};
             int c = 0;
             for (int dy = -1; dy <= 1; dy++)
                 for (int dx = -1; dx <= 1; dx++) {
@@ -403,13 +425,13 @@ lx_status lx_gi_fill_invalid(const lx_lightmap *map, const uint8_t *valid, const
                     size_t q = (size_t)yy * (size_t)w + (size_t)xx;
                     if (filled[q] != 1)
                         continue;
-                    for (int ch = 0; ch < 3; ch++)
-                        s[ch] += buf[3 * q + ch];
+                    for (int ch = 0; ch < channels; ch++)
+                        s[ch] += buf[(size_t)channels * q + (size_t)ch];
                     c++;
                 }
             if (c) {
-                for (int ch = 0; ch < 3; ch++)
-                    vals[3 * k + ch] = s[ch] / (float)c;
+                for (int ch = 0; ch < channels; ch++)
+                    vals[(size_t)channels * k + (size_t)ch] = s[ch] / (float)c;
                 filled[p] = 2; /* this pass: not read until it ends */
                 got++;
             }
@@ -420,7 +442,8 @@ lx_status lx_gi_fill_invalid(const lx_lightmap *map, const uint8_t *valid, const
         for (uint32_t k = 0; k < open; k++) {
             uint32_t p = todo[k];
             if (filled[p] == 2) {
-                memcpy(buf + 3 * (size_t)p, vals + 3 * k, sizeof(float) * 3);
+                memcpy(buf + (size_t)channels * p, vals + (size_t)channels * k,
+                       sizeof(float) * (size_t)channels);
                 filled[p] = 1;
             } else {
                 todo[left++] = p;
@@ -450,6 +473,8 @@ lx_status lx_bake_indirect(lx_baker *b, float progress_base, float progress_span
         const lx_lightmap *map = &b->maps[m];
         uint64_t pixels = (uint64_t)map->info.width * (uint64_t)map->info.height;
         bytes += pixels * 13 + (uint64_t)map->info.used_texels * 25;
+        if (map->sh)
+            bytes += (uint64_t)map->info.used_texels * sizeof(lx_sh4);
     }
     if (st == LX_OK)
         st = lx_check_memory(bytes, "global illumination's buffers");
@@ -465,7 +490,9 @@ lx_status lx_bake_indirect(lx_baker *b, float progress_base, float progress_span
         g->prev = malloc(sizeof(lx_vec3) * used);
         g->next = malloc(sizeof(lx_vec3) * used);
         g->invalid = malloc(used);
-        if (!g->valid || !g->source || !g->prev || !g->next || !g->invalid)
+        g->next_sh = map->sh ? malloc(sizeof(lx_sh4) * used) : NULL;
+        if (!g->valid || !g->source || !g->prev || !g->next || !g->invalid ||
+            (map->sh && !g->next_sh))
             st = lx_fail(LX_ERR_NOMEM, "lightmap '%s': out of memory for global illumination",
                          map->name);
         run.sources[m].valid = g->valid;
@@ -521,6 +548,11 @@ lx_status lx_bake_indirect(lx_baker *b, float progress_base, float progress_span
                 px[0] += g->next[i].x;
                 px[1] += g->next[i].y;
                 px[2] += g->next[i].z;
+                if (g->next_sh) {
+                    float *q = map->sh + (size_t)map->texels[i].pixel * LX_SH_FLOATS;
+                    for (int c = 0; c < LX_SH_FLOATS; c++)
+                        q[c] += g->next_sh[i].c[c];
+                }
             }
             lx_vec3 *swap = g->prev;
             g->prev = g->next;
@@ -529,8 +561,13 @@ lx_status lx_bake_indirect(lx_baker *b, float progress_base, float progress_span
     }
     for (uint32_t m = 0; m < count && st == LX_OK; m++)
         if (b->gi_invalid_texels)
+        {
             st = lx_gi_fill_invalid(&b->maps[m], run.maps[m].valid, run.maps[m].invalid,
-                                    b->maps[m].baked);
+                                    b->maps[m].baked, 3);
+            if (st == LX_OK && b->maps[m].sh)
+                st = lx_gi_fill_invalid(&b->maps[m], run.maps[m].valid, run.maps[m].invalid,
+                                        b->maps[m].sh, LX_SH_FLOATS);
+        }
     if (st == LX_OK && b->gi_invalid_texels)
         lx_log(LX_LOG_INFO,
                "global illumination: %llu texels sit inside geometry (their rays mostly hit back "
@@ -542,6 +579,7 @@ lx_status lx_bake_indirect(lx_baker *b, float progress_base, float progress_span
         free(run.maps[m].prev);
         free(run.maps[m].next);
         free(run.maps[m].invalid);
+        free(run.maps[m].next_sh);
     }
     free(run.maps);
     free(run.sources);

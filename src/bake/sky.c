@@ -248,8 +248,10 @@ lx_vec3 lx_cosine_direction(lx_vec3 t, lx_vec3 bt, lx_vec3 n, uint32_t map, uint
 }
 
 /* Casts m rays (directions in rays[], weights per channel in w[]) and adds
- * the weights of those that escape to sum. */
-static void cast(const lx_baker *b, lx_ray *rays, const lx_vec3 *w, uint32_t m, double sum[3])
+ * the weights of those that escape to sum; with shs, also w x (Y00 shw,
+ * Y1 shv) to shs (4 x RGB). */
+static void cast(const lx_baker *b, lx_ray *rays, const lx_vec3 *w, uint32_t m, double sum[3],
+                 const float *shw, const lx_vec3 *shv, double *shs)
 {
     uint8_t occluded[64];
     lx_tracer_occluded_batch(b->tracer, rays, m, false, occluded);
@@ -258,6 +260,16 @@ static void cast(const lx_baker *b, lx_ray *rays, const lx_vec3 *w, uint32_t m, 
             sum[0] += w[j].x;
             sum[1] += w[j].y;
             sum[2] += w[j].z;
+            if (!shs)
+                continue;
+            lx_vec3 v = shv[j];
+            double y[4] = {LX_SH_Y0 * shw[j], LX_SH_Y1 * v.y, LX_SH_Y1 * v.z, LX_SH_Y1 * v.x};
+            for (int k = 0; k < 4; k++) {
+                double f = y[k];
+                shs[3 * k] += w[j].x * f;
+                shs[3 * k + 1] += w[j].y * f;
+                shs[3 * k + 2] += w[j].z * f;
+            }
         }
 }
 
@@ -266,7 +278,7 @@ static void cast(const lx_baker *b, lx_ray *rays, const lx_vec3 *w, uint32_t m, 
  * gives the same rays; directions below the geometric surface are blocked
  * by it. */
 static lx_vec3 sky_visible(const lx_baker *b, uint32_t map_index, const lx_lightmap *map,
-                           uint32_t texel)
+                           uint32_t texel, lx_sh4 *sh)
 {
     const lx_cubemap *lookup = &b->sky_lookup;
     int n = lookup->size;
@@ -278,6 +290,9 @@ static lx_vec3 sky_visible(const lx_baker *b, uint32_t map_index, const lx_light
     enum { BATCH = 64 };
     lx_ray rays[BATCH];
     lx_vec3 w[BATCH];
+    float shw[BATCH];
+    lx_vec3 shv[BATCH];
+    double shs_base[LX_SH_FLOATS] = {0}, shs_peak[LX_SH_FLOATS] = {0};
     lx_vec3 result = lx_v3(0.0f, 0.0f, 0.0f);
 
     /* base: stratified cosine-weighted directions, pi / N sum base(w) */
@@ -293,18 +308,28 @@ static lx_vec3 sky_visible(const lx_baker *b, uint32_t map_index, const lx_light
         const float *l = lookup->data + 3 * texel_index(n, d);
         lx_light_eval e = {.to_light = d, .distance = INFINITY};
         rays[m] = lx_shadow_ray(b, p, ng, &e);
+        /* the SH estimate's weight over pi (the irradiance's), see
+         * directional.c */
+        lx_sh_ray_weight(k, sx, d, nrm, &shw[m], &shv[m]);
+        shw[m] /= LX_PI;
+        shv[m] = lx_scale(shv[m], 1.0f / LX_PI);
         w[m++] = lx_v3(l[0], l[1], l[2]);
         if (m == BATCH) {
-            cast(b, rays, w, m, sum);
+            cast(b, rays, w, m, sum, shw, shv, sh ? shs_base : NULL);
             m = 0;
         }
     }
     if (m)
-        cast(b, rays, w, m, sum);
+        cast(b, rays, w, m, sum, shw, shv, sh ? shs_base : NULL);
     double scale = LX_PI / (double)cells;
+    if (sh)
+        for (int c = 0; c < LX_SH_FLOATS; c++)
+            sh->c[c] += (float)(shs_base[c] * scale);
     result = lx_v3((float)(sum[0] * scale), (float)(sum[1] * scale), (float)(sum[2] * scale));
     if (!b->sky_peak)
         return result;
+    /* the peak's rays: pdf luminance x solid angle / P, so L Y / pdf is
+     * the ray's weight / cos x P / M x Y */
 
     /* peak: texels by importance, P / M sum chroma cos over escaping rays */
     size_t texels = (size_t)6 * n * n;
@@ -332,31 +357,41 @@ static lx_vec3 sky_visible(const lx_baker *b, uint32_t map_index, const lx_light
         float chroma = (float)(cos_n / lx_luminance(l));
         lx_light_eval e = {.to_light = d, .distance = INFINITY};
         rays[m] = lx_shadow_ray(b, p, ng, &e);
+        shw[m] = 1.0f / cos_n;
+        shv[m] = lx_scale(d, shw[m]);
         w[m++] = lx_v3(l[0] * chroma, l[1] * chroma, l[2] * chroma);
         if (m == BATCH) {
-            cast(b, rays, w, m, sum);
+            cast(b, rays, w, m, sum, shw, shv, sh ? shs_peak : NULL);
             m = 0;
         }
     }
     if (m)
-        cast(b, rays, w, m, sum);
+        cast(b, rays, w, m, sum, shw, shv, sh ? shs_peak : NULL);
     scale = total / (double)peaks;
+    if (sh)
+        for (int c = 0; c < LX_SH_FLOATS; c++)
+            sh->c[c] += (float)(shs_peak[c] * scale);
     return lx_add(result,
                   lx_v3((float)(sum[0] * scale), (float)(sum[1] * scale), (float)(sum[2] * scale)));
 }
 
 void lx_sky_tile(const lx_baker *b, uint32_t map_index, const lx_lightmap *map, uint32_t first,
-                 uint32_t count, lx_vec3 *accum)
+                 uint32_t count, lx_vec3 *accum, lx_sh4 *sh)
 {
     for (uint32_t k = 0; k < count; k++) {
         uint32_t i = first + k;
         lx_vec3 e;
         if (b->sky_shadows) {
-            e = sky_visible(b, map_index, map, i);
+            e = sky_visible(b, map_index, map, i, sh ? &sh[k] : NULL);
         } else {
-            float sh[3];
-            lx_sh_irradiance(&b->sky_sh, map->world_normal[i], sh);
-            e = lx_v3(fmaxf(sh[0], 0.0f), fmaxf(sh[1], 0.0f), fmaxf(sh[2], 0.0f));
+            /* unshadowed: nothing blocks any direction, so the texel's
+             * directional data is the sky's own L0 and L1 */
+            for (int c = 0; sh && c < 4; c++)
+                for (int ch = 0; ch < 3; ch++)
+                    sh[k].c[3 * c + ch] += b->sky_sh.c[c][ch];
+            float irr[3];
+            lx_sh_irradiance(&b->sky_sh, map->world_normal[i], irr);
+            e = lx_v3(fmaxf(irr[0], 0.0f), fmaxf(irr[1], 0.0f), fmaxf(irr[2], 0.0f));
         }
         accum[k] = lx_add(accum[k], e);
     }

@@ -808,7 +808,9 @@ lx_status lx_texel_map_build(const lx_scene *scene, const lx_page_spec *page,
                            lx_scale(m->normals[i[2]], w2));
                 nrm = lx_length(nrm) > 1e-12f ? lx_normalize(nrm) : geometric;
                 const lx_material *mat = material_of(scene, m);
-                if (tangents[s])
+                /* a directional bake leaves normal maps to run time (its
+                 * directional data brings them in at full resolution) */
+                if (tangents[s] && desc->directional == LX_DIRECTIONAL_OFF)
                     sample_normal_map(mat, m, tangents[s], i, w0, w1, w2, &nrm);
                 if (map->albedo)
                     map->albedo[k] = sample_albedo(mat, m, i, w0, w1, w2);
@@ -920,6 +922,7 @@ void lx_texel_map_free(lx_lightmap *map)
     free(map->mask);
     free(map->baked);
     free(map->realtime);
+    free(map->sh);
     lx_seam_stitch_free(map->stitch);
     memset(map, 0, sizeof *map);
 }

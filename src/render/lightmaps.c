@@ -24,6 +24,12 @@ void lx_lightmaps_free(lx_lightmaps *lm)
     for (uint32_t i = 0; i < lm->page_count; i++) {
         free(lm->pages[i].file);
         lx_image_free(&lm->pages[i].image);
+        for (int c = 0; c < 4; c++) {
+            free(lm->pages[i].sh_files[c]);
+            lx_image_free(&lm->pages[i].sh[c]);
+        }
+        free(lm->pages[i].dir_file);
+        lx_image_free(&lm->pages[i].dir);
     }
     for (uint32_t i = 0; i < lm->node_count; i++)
         free(lm->nodes[i].name);
@@ -86,6 +92,27 @@ static lx_status parse_pages(const char *file, const char *dir, const cJSON *roo
             return lx_fail(LX_ERR_NOMEM, "%s: out of memory", file);
         lm->pages[i].width = (int)w->valuedouble;
         lm->pages[i].height = (int)h->valuedouble;
+        const cJSON *sh = cJSON_GetObjectItemCaseSensitive(p, "sh");
+        const cJSON *dir_file = cJSON_GetObjectItemCaseSensitive(p, "dir");
+        if (lm->directional == LX_DIRECTIONAL_SH) {
+            if (!cJSON_IsArray(sh) || cJSON_GetArraySize(sh) != 4)
+                return lx_fail(LX_ERR_FORMAT, "%s: pages[%d]: \"sh\" must be 4 file names", file,
+                               i);
+            for (int c = 0; c < 4; c++) {
+                const cJSON *it = cJSON_GetArrayItem(sh, c);
+                if (!cJSON_IsString(it) || !it->valuestring[0])
+                    return lx_fail(LX_ERR_FORMAT, "%s: pages[%d]: \"sh\" must be 4 file names",
+                                   file, i);
+                if (!(lm->pages[i].sh_files[c] = lx_path_join(dir, it->valuestring)))
+                    return lx_fail(LX_ERR_NOMEM, "%s: out of memory", file);
+            }
+        } else if (lm->directional == LX_DIRECTIONAL_DOMINANT) {
+            if (!cJSON_IsString(dir_file) || !dir_file->valuestring[0])
+                return lx_fail(LX_ERR_FORMAT, "%s: pages[%d]: \"dir\" must be a file name", file,
+                               i);
+            if (!(lm->pages[i].dir_file = lx_path_join(dir, dir_file->valuestring)))
+                return lx_fail(LX_ERR_NOMEM, "%s: out of memory", file);
+        }
         i++;
     }
     return LX_OK;
@@ -214,6 +241,27 @@ static lx_status parse_manifest(const char *file, const char *dir, const cJSON *
             return LX_ERR_FORMAT;
         lm->sky_intensity = (float)v;
     }
+    const cJSON *dj = cJSON_GetObjectItemCaseSensitive(root, "directional");
+    if (dj && !cJSON_IsNull(dj)) {
+        const cJSON *mode = cJSON_GetObjectItemCaseSensitive(dj, "mode");
+        const cJSON *enc = cJSON_GetObjectItemCaseSensitive(dj, "encoding");
+        if (cJSON_IsString(mode) && strcmp(mode->valuestring, "sh") == 0)
+            lm->directional = LX_DIRECTIONAL_SH;
+        else if (cJSON_IsString(mode) && strcmp(mode->valuestring, "dominant") == 0)
+            lm->directional = LX_DIRECTIONAL_DOMINANT;
+        else
+            return lx_fail(LX_ERR_FORMAT, "%s: \"directional\": \"mode\" must be sh or dominant",
+                           file);
+        if (lm->directional == LX_DIRECTIONAL_SH) {
+            if (cJSON_IsString(enc) && strcmp(enc->valuestring, "normalized") == 0)
+                lm->sh_normalized = true;
+            else if (!(cJSON_IsString(enc) && strcmp(enc->valuestring, "irradiance") == 0))
+                return lx_fail(LX_ERR_FORMAT,
+                               "%s: \"directional\": \"encoding\" must be irradiance or "
+                               "normalized",
+                               file);
+        }
+    }
     lx_status st = parse_pages(file, dir, root, lm);
     if (st == LX_OK)
         st = parse_nodes(file, root, lm);
@@ -252,6 +300,56 @@ static lx_status load_page(const char *manifest, uint32_t i, lx_lightmap_page *p
     return LX_OK;
 }
 
+/* One directional image of page i: its size checked, finite values
+ * (raw codes for 8-bit files unless scale8 > 0, then scaled as a page). */
+static lx_status load_extra(const char *manifest, uint32_t i, const lx_lightmap_page *p,
+                            const char *path, int channels, float scale8, lx_image *out)
+{
+    lx_image_load_desc ld = {.channels = channels, .raw_8bit = !(scale8 > 0.0f)};
+    lx_status st = lx_image_load(path, &ld, out);
+    if (st != LX_OK) {
+        lx_error_prefix(manifest);
+        return st;
+    }
+    if (out->width != p->width || out->height != p->height)
+        return lx_fail(LX_ERR_FORMAT, "%s: page %u: %s is %dx%d, the manifest says %dx%d", manifest,
+                       i, path, out->width, out->height, p->width, p->height);
+    lx_image_format f = lx_image_format_from_path(path);
+    size_t n = (size_t)p->width * (size_t)p->height * (size_t)channels;
+    if (scale8 > 0.0f && (f == LX_IMAGE_PNG || f == LX_IMAGE_JPG || f == LX_IMAGE_TGA))
+        for (size_t k = 0; k < n; k++)
+            out->data[k] *= scale8;
+    return LX_OK;
+}
+
+/* The directional data of page i (lm->directional), decoded to E0, E1. */
+static lx_status load_directional(const char *manifest, const lx_lightmaps *lm, uint32_t i,
+                                  lx_lightmap_page *p, float scale8)
+{
+    lx_status st = LX_OK;
+    if (lm->directional == LX_DIRECTIONAL_DOMINANT)
+        return load_extra(manifest, i, p, p->dir_file, 4, 0.0f, &p->dir);
+    if (lm->directional != LX_DIRECTIONAL_SH)
+        return LX_OK;
+    for (int c = 0; c < 4 && st == LX_OK; c++)
+        st = load_extra(manifest, i, p, p->sh_files[c], 3,
+                        c == 0 || !lm->sh_normalized ? scale8 : 0.0f, &p->sh[c]);
+    if (st != LX_OK)
+        return st;
+    size_t n = (size_t)p->width * (size_t)p->height * 3;
+    for (size_t k = 0; k < n; k++) {
+        float e0 = p->sh[0].data[k];
+        if (!(e0 >= 0.0f))
+            return lx_fail(LX_ERR_FORMAT, "%s: page %u: %s: texel (%zu, %zu) is negative",
+                           manifest, i, p->sh_files[0], (k / 3) % (size_t)p->width,
+                           (k / 3) / (size_t)p->width);
+        /* codes r / 2 + 1/2, r = L1 / (sqrt 3 L00): E1 = 2 E0 r */
+        for (int c = 1; c < 4 && lm->sh_normalized; c++)
+            p->sh[c].data[k] = 2.0f * e0 * (2.0f * p->sh[c].data[k] - 1.0f);
+    }
+    return LX_OK;
+}
+
 lx_status lx_lightmaps_load(const char *dir, const lx_lightmaps_load_desc *desc, lx_lightmaps *out)
 {
     memset(out, 0, sizeof *out);
@@ -282,7 +380,11 @@ lx_status lx_lightmaps_load(const char *dir, const lx_lightmaps_load_desc *desc,
         st = parse_manifest(file, dir, root, &lm);
     cJSON_Delete(root);
     for (uint32_t i = 0; st == LX_OK && !d.skip_images && i < lm.page_count; i++)
+    {
         st = load_page(file, i, &lm.pages[i], eight_bit_scale(&lm));
+        if (st == LX_OK)
+            st = load_directional(file, &lm, i, &lm.pages[i], eight_bit_scale(&lm));
+    }
     free(file);
     if (st != LX_OK) {
         lx_lightmaps_free(&lm);

@@ -5,6 +5,7 @@
  * "bicubic lightmap sampling" in engines; weights as in Mitchell &
  * Netravali's B = 1, C = 0 family member). */
 #include "render_internal.h"
+#include "luxel/maps.h"
 
 #include <math.h>
 #include <omp.h>
@@ -100,6 +101,28 @@ static void sample_bicubic(const lx_image *img, float u, float v, float out[3])
         out[k] = acc[k] > 0.0f ? acc[k] : 0.0f;
 }
 
+/* Bilinear lookup of an image of `channels` floats a texel (clamp to
+ * edge), for the directional data (signed: no clamping at 0). */
+static void sample_bilinear_n(const lx_image *img, float u, float v, int channels, float *out)
+{
+    float x, y;
+    page_coords(img, u, v, &x, &y);
+    float fx = floorf(x), fy = floorf(y), tx = x - fx, ty = y - fy;
+    int x0 = (int)fx, y0 = (int)fy;
+    for (int k = 0; k < channels; k++)
+        out[k] = 0.0f;
+    for (int j = 0; j < 2; j++)
+        for (int i = 0; i < 2; i++) {
+            int xx = x0 + i, yy = y0 + j;
+            xx = xx < 0 ? 0 : (xx >= img->width ? img->width - 1 : xx);
+            yy = yy < 0 ? 0 : (yy >= img->height ? img->height - 1 : yy);
+            const float *t = img->data + ((size_t)yy * (size_t)img->width + (size_t)xx) * channels;
+            float w = (i ? tx : 1.0f - tx) * (j ? ty : 1.0f - ty);
+            for (int k = 0; k < channels; k++)
+                out[k] += w * t[k];
+        }
+}
+
 /* ---- shading --------------------------------------------------------------- */
 
 typedef struct render_ctx {
@@ -112,6 +135,10 @@ typedef struct render_ctx {
     float *det_sign; /* per scene node: the sign of its world matrix's determinant */
     lx_vec3 background;
     float inv_pre_exposure;
+    /* directional lightmaps: per mesh its normal map's tangents (NULL: no
+     * normal map), per node its normal matrix */
+    lx_vec4 **tangents;
+    lx_mat4 *normal_matrix;
 } render_ctx;
 
 static const lx_material white = {.name = "default", .base_color = {1, 1, 1, 1}};
@@ -133,6 +160,69 @@ static lx_vec3 albedo(const lx_scene *scene, const lx_mesh *m, const uint32_t *i
         a = lx_mul(a, lx_v3(c[0], c[1], c[2]));
     }
     return a;
+}
+
+/* The factor by which a normal map changes the lightmap's irradiance at
+ * a hit (lx_render_view's contract): per channel, from the page's
+ * directional data at page UV (u, v). 1 without a normal map or data. */
+static lx_vec3 directional_factor(const render_ctx *c, const lx_lightmap_page *page,
+                                  const lx_node *node, uint32_t node_index, const lx_mesh *m,
+                                  uint32_t mesh_index, const uint32_t *i, float w0, float w1,
+                                  float w2, float u, float v)
+{
+    lx_vec3 one = lx_v3(1.0f, 1.0f, 1.0f);
+    const lx_vec4 *tg = c->tangents ? c->tangents[mesh_index] : NULL;
+    if (!tg || !m->normals)
+        return one;
+    const lx_material *mat = &c->scene->materials[m->material];
+    const lx_vec2 *uv = m->uv[mat->normal_uv_set];
+    float tu = uv[i[0]].x * w0 + uv[i[1]].x * w1 + uv[i[2]].x * w2;
+    float tv = uv[i[0]].y * w0 + uv[i[1]].y * w1 + uv[i[2]].y * w2;
+    lx_vec2 at = lx_uv_transform_apply(&mat->normal_transform, lx_v2(tu, tv));
+    float nc[4] = {0.5f, 0.5f, 1.0f, 1.0f};
+    lx_image_sample_bilinear(&mat->normal_map, at.x, at.y, nc);
+    lx_vec3 n = lx_add(lx_add(lx_scale(m->normals[i[0]], w0), lx_scale(m->normals[i[1]], w1)),
+                       lx_scale(m->normals[i[2]], w2));
+    if (!(lx_length(n) > 1e-12f))
+        return one;
+    n = lx_normalize(n);
+    lx_vec3 t = lx_v3(0, 0, 0);
+    for (int k = 0; k < 3; k++) {
+        float wk = k == 0 ? w0 : (k == 1 ? w1 : w2);
+        t = lx_madd(t, lx_v3(tg[i[k]].x, tg[i[k]].y, tg[i[k]].z), wk);
+    }
+    lx_vec3 mn = lx_v3((2.0f * nc[0] - 1.0f) * mat->normal_scale,
+                       (2.0f * nc[1] - 1.0f) * mat->normal_scale, 2.0f * nc[2] - 1.0f);
+    lx_vec3 np = lx_tangent_to_world(mn, n, lx_v4(t.x, t.y, t.z, tg[i[0]].w));
+    const lx_mat4 *nm = &c->normal_matrix[node_index];
+    (void)node;
+    n = lx_normalize(lx_mat4_vector(nm, n));
+    np = lx_normalize(lx_mat4_vector(nm, np));
+    if (!lx_vec3_finite(n) || !lx_vec3_finite(np))
+        return one;
+    if (c->lm->directional == LX_DIRECTIONAL_DOMINANT) {
+        if (page->dir.width <= 0)
+            return one;
+        float d[4];
+        sample_bilinear_n(&page->dir, u, v, 4, d);
+        lx_vec3 dir = lx_v3(2.0f * d[0] - 1.0f, 2.0f * d[1] - 1.0f, 2.0f * d[2] - 1.0f);
+        /* Unity's DecodeDirectionalLightmap */
+        float f = (0.5f * lx_dot(np, dir) + 0.5f) / fmaxf(1e-4f, d[3]);
+        return lx_v3(f, f, f);
+    }
+    if (page->sh[0].width <= 0)
+        return one;
+    float e[4][3];
+    for (int k = 0; k < 4; k++)
+        sample_bilinear_n(&page->sh[k], u, v, 3, e[k]);
+    float out[3];
+    for (int ch = 0; ch < 3; ch++) {
+        /* E1 along y, z, x in sh[1..3] */
+        lx_vec3 e1 = lx_v3(e[3][ch], e[1][ch], e[2][ch]);
+        float base = e[0][ch] + lx_dot(e1, n), bent = e[0][ch] + lx_dot(e1, np);
+        out[ch] = base > 1e-6f * e[0][ch] && base > 0.0f ? fmaxf(bent, 0.0f) / base : 1.0f;
+    }
+    return lx_v3(out[0], out[1], out[2]);
 }
 
 /* Radiance seen along ray r (dir unit length); *hit tells whether it
@@ -183,6 +273,9 @@ static lx_vec3 shade(const render_ctx *c, lx_ray r, bool *hit)
         else
             sample_bilinear(page, u, v, e);
         lx_vec3 value = lx_scale(lx_v3(e[0], e[1], e[2]), c->inv_pre_exposure);
+        if (c->tangents)
+            value = lx_mul(value, directional_factor(c, &c->lm->pages[ln->page], node, h.node, m,
+                                                     h.mesh, i, w0, w1, w2, u, v));
         if (c->lm->quantity == LX_QUANTITY_RADIANCE)
             return value;
         return lx_scale(lx_mul(value, albedo(scene, m, i, w0, w1, w2)), 1.0f / LX_PI);
@@ -194,6 +287,56 @@ static lx_vec3 shade(const render_ctx *c, lx_ray r, bool *hit)
         return lx_scale(lx_v3(s[0], s[1], s[2]), c->d->sky_intensity);
     }
     return c->background;
+}
+
+/* Per mesh the tangents of its normal map (the mesh's, else MikkTSpace's
+ * from the map's UV set; NULL without a normal map), per node its normal
+ * matrix. */
+static lx_status prepare_directional(const lx_scene *scene, lx_vec4 ***tangents, bool **own,
+                                     lx_mat4 **normal_matrix)
+{
+    uint32_t nm = scene->mesh_count, nn = scene->node_count;
+    *tangents = calloc(nm + 1, sizeof **tangents);
+    *own = calloc(nm + 1, sizeof **own);
+    *normal_matrix = malloc((nn + 1) * sizeof **normal_matrix);
+    if (!*tangents || !*own || !*normal_matrix)
+        return lx_fail(LX_ERR_NOMEM, "render: out of memory");
+    for (uint32_t n = 0; n < nn; n++)
+        if (!lx_mat4_normal_matrix(&scene->nodes[n].world, &(*normal_matrix)[n]))
+            (*normal_matrix)[n] = lx_mat4_identity();
+    for (uint32_t k = 0; k < nm; k++) {
+        const lx_mesh *m = &scene->meshes[k];
+        if (m->material >= scene->material_count)
+            continue;
+        const lx_material *mat = &scene->materials[m->material];
+        if (mat->normal_map.width <= 0 || mat->normal_uv_set < 0 ||
+            mat->normal_uv_set >= LX_MAX_UV_SETS || !m->uv[mat->normal_uv_set] || !m->normals)
+            continue;
+        if (m->tangents) {
+            (*tangents)[k] = m->tangents;
+            continue;
+        }
+        lx_vec4 *t = malloc(sizeof(lx_vec4) * (m->vertex_count + 1));
+        if (!t)
+            return lx_fail(LX_ERR_NOMEM, "render: out of memory for tangents");
+        (*tangents)[k] = t;
+        (*own)[k] = true;
+        lx_status st = lx_compute_tangents(m, mat->normal_uv_set, t);
+        if (st != LX_OK)
+            return st;
+    }
+    return LX_OK;
+}
+
+static void free_directional(const lx_scene *scene, lx_vec4 **tangents, bool *own,
+                             lx_mat4 *normal_matrix)
+{
+    for (uint32_t k = 0; tangents && own && k < scene->mesh_count; k++)
+        if (own[k])
+            free(tangents[k]);
+    free(tangents);
+    free(own);
+    free(normal_matrix);
 }
 
 static void render_tile(const render_ctx *c, int tile, int tiles_x, lx_image *out)
@@ -323,13 +466,30 @@ lx_status lx_render_view(const lx_scene *scene, const lx_lightmaps *lm, const lx
         return st;
     }
 
+    /* directional lightmaps: the tangents of normal-mapped meshes */
+    lx_vec4 **tangents = NULL;
+    bool *own_tangents = NULL;
+    lx_mat4 *normal_matrix = NULL;
+    if (lm->directional != LX_DIRECTIONAL_OFF)
+        st = prepare_directional(scene, &tangents, &own_tangents, &normal_matrix);
+    if (st != LX_OK) {
+        free_directional(scene, tangents, own_tangents, normal_matrix);
+        free(map);
+        free(det_sign);
+        lx_tracer_destroy(own);
+        lx_image_free(out);
+        return st;
+    }
+
     render_ctx c = {.scene = scene,
                     .lm = lm,
                     .tracer = tracer,
                     .node_map = map,
                     .d = &d,
                     .det_sign = det_sign,
-                    .inv_pre_exposure = 1.0f / lm->pre_exposure};
+                    .inv_pre_exposure = 1.0f / lm->pre_exposure,
+                    .tangents = tangents,
+                    .normal_matrix = normal_matrix};
     lx_camera_basis(&d.camera, d.width, d.height, &c.cam);
     c.background = d.background;
 
@@ -353,6 +513,7 @@ lx_status lx_render_view(const lx_scene *scene, const lx_lightmaps *lm, const lx
     free(map);
     free(det_sign);
     lx_tracer_destroy(own);
+    free_directional(scene, tangents, own_tangents, normal_matrix);
     if (atomic_load(&cancel)) {
         lx_image_free(out);
         return lx_fail(LX_ERR_CANCELLED, "render: cancelled");

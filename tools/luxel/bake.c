@@ -70,6 +70,10 @@ static const char *bake_usage =
     "                          DIR/<name>_ao.png (grey, linear: 1 open, 0 closed)\n"
     "  --ao-distance D         metres within which surfaces occlude (default %g)\n"
     "  --ao-samples N          AO rays per texel (default %u)\n"
+    "  --directional M         off (default); sh: L1 spherical harmonics per\n"
+    "                          texel, DIR/<name>_sh0..3.<ext>; dominant: Unity's\n"
+    "                          dominant direction, DIR/<name>_dir.png (normal maps\n"
+    "                          are then applied at run time: docs/directional.md)\n"
     "  --exposure EV100        exposure of the PNG preview (default: automatic)\n"
     "  --tonemap C             tone curve of the PNG preview: filmic (default),\n"
     "                          aces or clamp\n"
@@ -111,7 +115,8 @@ enum {
     OPT_NO_STITCH,
     OPT_AO,
     OPT_AO_DISTANCE,
-    OPT_AO_SAMPLES
+    OPT_AO_SAMPLES,
+    OPT_DIRECTIONAL
 };
 
 static int parse_args(int argc, char **argv, bake_args *a)
@@ -132,6 +137,7 @@ static int parse_args(int argc, char **argv, bake_args *a)
         {"ao", no_argument, NULL, OPT_AO},
         {"ao-distance", required_argument, NULL, OPT_AO_DISTANCE},
         {"ao-samples", required_argument, NULL, OPT_AO_SAMPLES},
+        {"directional", required_argument, NULL, OPT_DIRECTIONAL},
         {"quiet", no_argument, NULL, 'q'},
         {"verbose", no_argument, NULL, 'v'},
         {"help", no_argument, NULL, 'h'},
@@ -196,6 +202,18 @@ static int parse_args(int argc, char **argv, bake_args *a)
         case OPT_NO_STITCH:
             a->desc.stitch_seams = false;
             break;
+        case OPT_DIRECTIONAL:
+            if (strcmp(optarg, "off") == 0)
+                a->desc.directional = LX_DIRECTIONAL_OFF;
+            else if (strcmp(optarg, "sh") == 0)
+                a->desc.directional = LX_DIRECTIONAL_SH;
+            else if (strcmp(optarg, "dominant") == 0)
+                a->desc.directional = LX_DIRECTIONAL_DOMINANT;
+            else
+                return cli_usage_error("bake",
+                                       "--directional must be off, sh or dominant, not '%s'",
+                                       optarg);
+            break;
         case OPT_AO:
             a->ao = true;
             break;
@@ -247,6 +265,9 @@ static int parse_args(int argc, char **argv, bake_args *a)
         return cli_usage_error("bake", "--pre-expose applies to float formats, not png");
     if (a->ao_option && !a->ao)
         return cli_usage_error("bake", "%s needs --ao", a->ao_option);
+    if (a->desc.directional && a->desc.quantity == LX_QUANTITY_RADIANCE)
+        return cli_usage_error("bake", "--directional keeps irradiance: it needs --quantity "
+                                       "irradiance");
     return 0;
 }
 
@@ -287,7 +308,7 @@ static float preview_scale(const bake_args *a)
 }
 
 static cJSON *page_entry(const lx_lightmap_info *info, const char *file, const char *preview,
-                         const char *ao)
+                         const char *ao, char sh[4][300], const char *dir)
 {
     cJSON *e = cJSON_CreateObject();
     cJSON_AddStringToObject(e, "file", file);
@@ -295,6 +316,13 @@ static cJSON *page_entry(const lx_lightmap_info *info, const char *file, const c
         cJSON_AddStringToObject(e, "preview", preview);
     if (ao)
         cJSON_AddStringToObject(e, "ao", ao);
+    if (sh) {
+        cJSON *list = cJSON_AddArrayToObject(e, "sh");
+        for (int c = 0; c < 4; c++)
+            cJSON_AddItemToArray(list, cJSON_CreateString(sh[c]));
+    }
+    if (dir)
+        cJSON_AddStringToObject(e, "dir", dir);
     cJSON_AddNumberToObject(e, "width", info->width);
     cJSON_AddNumberToObject(e, "height", info->height);
     cJSON_AddNumberToObject(e, "used_texels", info->used_texels);
@@ -365,13 +393,65 @@ static bool half_fits(const bake_args *a, const lx_image *images, uint32_t maps,
     return true;
 }
 
+/* ---- directional lightmaps (docs/directional.md) ---------------------- */
+
+#define DIR_FILES 4
+/* sh: L1 in the files as the irradiance it adds along each axis, or
+ * normalized by L0 for 8-bit files */
+#define SH_E0 0.886227f /* pi Y00 = sqrt(pi) / 2 */
+#define SH_E1 1.023327f /* 2 pi / 3 Y1 = sqrt(pi / 3) */
+
+/* The directional files of a lightmap: sh0..sh3 (sh) or dir (dominant);
+ * returns how many. */
+static int directional_names(const bake_args *a, const char *stem, char out[DIR_FILES][300])
+{
+    if (a->desc.directional == LX_DIRECTIONAL_DOMINANT) {
+        snprintf(out[0], 300, "%s_dir.png", stem);
+        return 1;
+    }
+    if (a->desc.directional != LX_DIRECTIONAL_SH)
+        return 0;
+    for (int c = 0; c < 4; c++)
+        snprintf(out[c], 300, "%s_sh%d.%s", stem, c, lx_image_format_extension(a->format));
+    return 4;
+}
+
+/* Whether the files hold L1 normalized by L0 in [0, 1] (8-bit and RGBE
+ * files, which keep no negative values) rather than as irradiance. */
+static bool sh_normalized(const bake_args *a)
+{
+    return a->format != LX_IMAGE_EXR && a->format != LX_IMAGE_PFM;
+}
+
+/* The library's coefficients (nits) as the files hold them: sh[0] E0 =
+ * pi Y00 L00 (lux), sh[1..3] either E1 = 2 pi / 3 Y1 L1 (lux, signed) or
+ * r = L1 / (sqrt 3 L00) as r / 2 + 1/2 (normalized), in place. */
+static void sh_encode(lx_image sh[4], bool normalized)
+{
+    size_t n = (size_t)sh[0].width * sh[0].height * 3;
+    for (size_t i = 0; i < n; i++) {
+        float l0 = sh[0].data[i];
+        for (int c = 1; c < 4; c++) {
+            float v = sh[c].data[i];
+            if (!normalized) {
+                sh[c].data[i] = v * SH_E1;
+            } else {
+                float r = l0 > 0.0f ? v / (1.7320508f * l0) : 0.0f;
+                r = r < -1.0f ? -1.0f : (r > 1.0f ? 1.0f : r);
+                sh[c].data[i] = 0.5f * r + 0.5f;
+            }
+        }
+        sh[0].data[i] = l0 > 0.0f ? l0 * SH_E0 : 0.0f;
+    }
+}
+
 /* The earlier bake's files in the output folder that this one does not
  * write (cli_stale_find), from the stems of this bake's outputs. */
 static bool find_stale(const bake_args *a, char **stems, uint32_t maps, const char *uvs_name,
                        cli_stale *out)
 {
     uint32_t n = 0;
-    char **names = calloc(3 * (size_t)maps + 2, sizeof *names);
+    char **names = calloc(8 * (size_t)maps + 2, sizeof *names);
     bool ok = names != NULL;
     if (ok && uvs_name[0]) /* the scene with luxel's UVs, written again */
         ok = (names[n++] = cli_strdup(uvs_name)) != NULL;
@@ -383,6 +463,10 @@ static bool find_stale(const bake_args *a, char **stems, uint32_t maps, const ch
         ok = ok && (names[n++] = cli_strdup(name)) != NULL;
         snprintf(name, sizeof name, "%s_ao.png", stems[m]);
         ok = ok && (!a->ao || (names[n++] = cli_strdup(name)) != NULL);
+        char dn[DIR_FILES][300];
+        int k = directional_names(a, stems[m], dn);
+        for (int j = 0; j < k; j++)
+            ok = ok && (names[n++] = cli_strdup(dn[j])) != NULL;
     }
     if (!ok)
         cli_error("out of memory");
@@ -403,7 +487,7 @@ int cmd_bake(int argc, char **argv)
 
     lx_scene *scene = NULL;
     lx_baker *baker = NULL;
-    lx_image *images = NULL, *ao_images = NULL;
+    lx_image *images = NULL, *ao_images = NULL, *dir_images = NULL;
     char **stems = NULL;
     uint32_t maps = 0;
     cli_stage stage = {0};
@@ -433,8 +517,9 @@ int cmd_bake(int argc, char **argv)
      * one fails now, not after minutes of work */
     images = calloc(maps, sizeof *images);
     ao_images = calloc(maps, sizeof *ao_images);
+    dir_images = calloc((size_t)maps * DIR_FILES, sizeof *dir_images);
     stems = calloc(maps, sizeof *stems);
-    if (!images || !ao_images || !stems) {
+    if (!images || !ao_images || !dir_images || !stems) {
         cli_error("out of memory");
         goto done;
     }
@@ -459,6 +544,11 @@ int cmd_bake(int argc, char **argv)
         snprintf(name, sizeof name, "%s_ao.png", stem);
         if (a.ao && !cli_stage_check(&stage, name))
             goto done;
+        char dn[DIR_FILES][300];
+        int k = directional_names(&a, stem, dn);
+        for (int j = 0; j < k; j++)
+            if (!cli_stage_check(&stage, dn[j]))
+                goto done;
     }
     if (!cli_stage_check(&stage, "manifest.json"))
         goto done;
@@ -524,6 +614,17 @@ int cmd_bake(int argc, char **argv)
         }
         cli_progress_finish(&progress);
     }
+    for (uint32_t m = 0; m < maps && a.desc.directional; m++) {
+        st = a.desc.directional == LX_DIRECTIONAL_SH
+                 ? lx_baker_sh(baker, m, &dir_images[(size_t)m * DIR_FILES])
+                 : lx_baker_dominant(baker, m, &dir_images[(size_t)m * DIR_FILES]);
+        if (st != LX_OK) {
+            cli_error("%s", lx_last_error());
+            goto done;
+        }
+        if (a.desc.directional == LX_DIRECTIONAL_SH)
+            sh_encode(&dir_images[(size_t)m * DIR_FILES], sh_normalized(&a));
+    }
     float metered;
     bool lit;
     lx_baker_meter_ev100(baker, &metered, &lit);
@@ -579,6 +680,14 @@ int cmd_bake(int argc, char **argv)
     }
     cJSON_AddBoolToObject(manifest, "seams_stitched", a.desc.stitch_seams);
     cJSON_AddStringToObject(manifest, "denoise", lx_denoise_mode_name(a.desc.denoise));
+    if (a.desc.directional) {
+        cJSON *dj = cJSON_AddObjectToObject(manifest, "directional");
+        bool sh = a.desc.directional == LX_DIRECTIONAL_SH;
+        cJSON_AddStringToObject(dj, "mode", sh ? "sh" : "dominant");
+        if (sh)
+            cJSON_AddStringToObject(dj, "encoding",
+                                    sh_normalized(&a) ? "normalized" : "irradiance");
+    }
     if (unwrap) { /* what luxel render needs to make the same UVs again */
         cJSON_AddNumberToObject(manifest, "padding", a.desc.padding);
         cJSON_AddNumberToObject(manifest, "atlas_size",
@@ -635,8 +744,30 @@ int cmd_bake(int argc, char **argv)
                                       .threads = a.desc.threads};
             failed = !cli_stage_image(&stage, ao_file, &ao_images[m], &ad);
         }
-        cJSON_AddItemToArray(list, page_entry(info, file, want_preview ? preview : NULL,
-                                              a.ao ? ao_file : NULL));
+        char dn[DIR_FILES][300];
+        int dk = directional_names(&a, stems[m], dn);
+        lx_image *di = &dir_images[(size_t)m * DIR_FILES];
+        for (int j = 0; j < dk && !failed; j++) {
+            /* sh0 is written as the lightmap is (its units, exposure and
+             * pre-exposure); L1 as values (irradiance) or linear codes
+             * (normalized); the dominant direction as linear codes */
+            lx_image_write_desc dd = wd;
+            dd.progress = NULL;
+            if (a.desc.directional == LX_DIRECTIONAL_DOMINANT) {
+                dd = (lx_image_write_desc){.format = LX_IMAGE_PNG, .linear = true,
+                                           .threads = a.desc.threads};
+            } else if (j > 0 && sh_normalized(&a)) {
+                dd = (lx_image_write_desc){.format = a.format, .linear = true,
+                                           .threads = a.desc.threads};
+            }
+            failed = !cli_stage_image(&stage, dn[j], &di[j], &dd);
+        }
+        cJSON_AddItemToArray(list,
+                             page_entry(info, file, want_preview ? preview : NULL,
+                                        a.ao ? ao_file : NULL,
+                                        a.desc.directional == LX_DIRECTIONAL_SH ? dn : NULL,
+                                        a.desc.directional == LX_DIRECTIONAL_DOMINANT ? dn[0]
+                                                                                      : NULL));
     }
     cJSON_AddItemToObject(manifest, "nodes", node_entries(scene, baker, unwrap, &a));
     int with_uvs = !failed && uvs_name[0] ? cli_stage_scene_with_uvs(&stage, uvs_name, scene, unwrap)
@@ -701,6 +832,10 @@ done:
         for (uint32_t m = 0; m < maps; m++)
             lx_image_free(&ao_images[m]);
     free(ao_images);
+    if (dir_images)
+        for (size_t k = 0; k < (size_t)maps * DIR_FILES; k++)
+            lx_image_free(&dir_images[k]);
+    free(dir_images);
     if (stems)
         for (uint32_t m = 0; m < maps; m++)
             free(stems[m]);
