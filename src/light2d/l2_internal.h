@@ -58,7 +58,7 @@ typedef struct l2_polar {
      * distance of level l whose penumbra window is at most gap[l][b] bins
      * wide on each side sees no open ray (fully shadowed) */
     float *qocc;
-    uint16_t *gap; /* depth_levels x n */
+    float *gap; /* depth_levels x n, whole numbers (floats, for gathers) */
     int depth_levels;
     int gap_capacity;
     float *tmin, *tmax; /* levels x n */
@@ -159,8 +159,9 @@ float l2_filter(const l2_polar *pm, float c, float k, float d);
 
 /* Whether the light leaves every pixel of the block [x0, x1) x [y0, y1)
  * dark (exactly what shading them would give: out of reach, or in a hard
- * shadow whose penumbra window holds no open ray); has_caster: the block
- * holds a caster pixel (polar.c). */
+ * shadow whose penumbra window holds no open ray, and no caster pixel
+ * within a ray's first caster run); has_caster: the block holds a caster
+ * pixel (polar.c). */
 bool l2_block_dark(const l2_prep *p, int x0, int y0, int x1, int y1, bool has_caster);
 
 #endif

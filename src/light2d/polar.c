@@ -96,7 +96,7 @@ static lx_status reserve(l2_polar *pm, int n, int levels, int depth_levels)
 {
     size_t g = (size_t)n * depth_levels;
     if (g > (size_t)pm->gap_capacity) {
-        uint16_t *a = realloc(pm->gap, g * sizeof *a);
+        float *a = realloc(pm->gap, g * sizeof *a);
         if (!a)
             return lx_fail(LX_ERR_NOMEM, "light2d: out of memory for a polar map of %d rays", n);
         pm->gap = a;
@@ -187,7 +187,7 @@ static void open_gaps(l2_polar *pm, int lv)
     } t = {(uint32_t)((lv >> 1) + 127) << 23 | ((lv & 1) ? 0x3504f3u : 0u)};
     float thr = t.f * L2_DEPTH0;
     const float *occ = pm->occ;
-    uint16_t *g = pm->gap + (size_t)lv * n;
+    float *g = pm->gap + (size_t)lv * n;
     const int none = 1 << 30;
     int run = none; /* bins since the last open ray */
     for (int lap = 0; lap < 2; lap++)
@@ -197,7 +197,7 @@ static void open_gaps(l2_polar *pm, int lv)
             else if (run < none)
                 run++;
             if (lap)
-                g[i] = (uint16_t)(run == 0 ? 0 : (run - 1 < 65535 ? run - 1 : 65535));
+                g[i] = (float)(run == 0 ? 0 : (run - 1 < 65535 ? run - 1 : 65535));
         }
     run = none;
     for (int lap = 0; lap < 2; lap++)
@@ -208,8 +208,8 @@ static void open_gaps(l2_polar *pm, int lv)
                 run++;
             if (lap) {
                 int v = run == 0 ? 0 : (run - 1 < 65535 ? run - 1 : 65535);
-                if (v < g[i])
-                    g[i] = (uint16_t)v;
+                if ((float)v < g[i])
+                    g[i] = (float)v;
             }
         }
 }
@@ -410,8 +410,11 @@ bool l2_block_dark(const l2_prep *p, int x0, int y0, int x1, int y1, bool has_ca
     float dmin2 = nx * nx + ny * ny;
     if (dmin2 >= p->r2)
         return true; /* out of reach: no falloff */
-    if (!l->shadow || (has_caster && !l->self_shadow) || dmin2 < 4.0f)
+    if (!l->shadow || dmin2 < 4.0f)
         return false;
+    /* caster pixels lit on their face: only where a ray's first caster
+     * run reaches the block */
+    bool faces = has_caster && !l->self_shadow;
     float fx = l2_max(ax * ax, bx * bx), fy = l2_max(ay * ay, by * by);
     float dmin = sqrtf(dmin2), dmax = sqrtf(fx + fy);
     /* the rays of the pixels, one more each side for rounding */
@@ -426,6 +429,10 @@ bool l2_block_dark(const l2_prep *p, int x0, int y0, int x1, int y1, bool has_ca
     float before = dmin * (1.0f - 1e-5f);
     if (range_query(pm, pm->tmax, b0, b1, true) >= before)
         return false;
+    if (faces)
+        for (int b = b0; b <= b1; b++)
+            if (pm->ex[wrap(b, n)] >= before)
+                return false;
     if (l->softness <= 0.0f)
         return true;
     /* and, as shade.c tests each pixel, no open ray in the penumbra window
@@ -448,12 +455,12 @@ bool l2_block_dark(const l2_prep *p, int x0, int y0, int x1, int y1, bool has_ca
         u2max = 1.0f;
     float sc = 1.0f + u2max * (1.0f + 1e-5f), inv = 1.0f / dmax;
     float kcap = 0.5f * (float)n - 1.0f;
-    const uint16_t *g = pm->gap + (size_t)l2_depth_level(dmin, pm->depth_levels - 1) * n;
+    const float *g = pm->gap + (size_t)l2_depth_level(dmin, pm->depth_levels - 1) * n;
     for (int b = b0; b <= b1; b++) {
         int i = wrap(b, n);
         float k = l->softness * (pm->qocc[i] - inv) * sc * pm->bins_per_p;
         k = l2_min(k, kcap);
-        if (k >= 0.5f && k > (float)g[i])
+        if (k >= 0.5f && k > g[i])
             return false;
     }
     return true;

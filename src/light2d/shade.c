@@ -16,9 +16,43 @@
 #include <omp.h>
 #endif
 
+/* Pass 2a of a soft light (shade_span): each pixel's case, branch-free and
+ * over restrict pointers so that it vectorizes with gathers from the map. */
+L2_CLONES __attribute__((noinline))
+static void classify(const float *restrict occ, const float *restrict ex,
+                     const float *restrict lit, const float *restrict qocc,
+                     const float *restrict gap, int nb, int n, bool face_ok, float s, float kcap,
+                            float bpp, int dtop, const uint8_t *restrict caster,
+                            const float *restrict da, const float *restrict ca,
+                            const float *restrict ua, float *restrict fa, float *restrict dea,
+                            float *restrict ka, uint8_t *restrict code)
+{
+    for (int i = 0; i < n; i++) {
+        float d = da[i];
+        int b = (int)ca[i];
+        b = b >= nb ? b - nb : b;
+        float o = occ[b];
+        bool face = face_ok & (caster[i] != 0) & (d <= ex[b]);
+        float de = face ? l2_max(l2_min(d, o - 0.5f), 0.5f) : d;
+        bool pen = !(de * lit[b] < 1.0f);
+        bool reach = face | (d < o);
+        float u2 = ua[i] * ua[i];
+        float k = s * (qocc[b] - 1.0f / d) * (1.0f + u2) * bpp;
+        k = l2_min(k, kcap);
+        int lv = l2_depth_level(l2_max(d, L2_DEPTH0), dtop);
+        bool closed = (k < 0.5f) | ((d >= L2_DEPTH0) & (k <= gap[lv * nb + b]));
+        bool active = (fa[i] > 0.0f) & (d > 0.0f) & pen;
+        bool dark = active & !reach & closed;
+        fa[i] = dark ? 0.0f : fa[i];
+        code[i] = (uint8_t)(active & !dark ? (reach ? 1 : 2) : 0);
+        dea[i] = de;
+        ka[i] = k;
+    }
+}
+
 /* Adds the light's contribution to the pixels [xs, xe) of row y into acc
  * (the row's width*3 floats), and to its cache row when it is a static
- * light being re-lit (the caller cleared that row); scratch holds 4*width
+ * light being re-lit (the caller cleared that row); scratch holds 8*width
  * floats. */
 L2_CLONES
 static void shade_span(const lx_light2d *ctx, const l2_prep *p, int y, int xs, int xe,
@@ -83,47 +117,49 @@ static void shade_span(const lx_light2d *ctx, const l2_prep *p, int y, int xs, i
         }
     }
     /* pass 2: shadows from the polar map */
-    if (l->shadow) {
+    if (l->shadow && l->softness <= 0.0f) {
         const uint8_t *caster = ctx->caster + (size_t)y * ctx->width + xa;
         const l2_polar *pm = &p->polar;
         int nb = pm->n;
-        bool soft = l->softness > 0.0f, face_ok = !l->self_shadow;
-        float kcap = 0.5f * (float)nb - 1.0f;
-        int dtop = pm->depth_levels - 1;
+        bool face_ok = !l->self_shadow;
         for (int i = 0; i < n; i++) {
-            if (fa[i] <= 0.0f)
-                continue;
             float d = da[i];
-            if (d <= 0.0f)
-                continue;
             int b = (int)ca[i];
-            if (b >= nb)
-                b -= nb;
-            float o = pm->occ[b];
-            bool face = face_ok && caster[i] && d <= pm->ex[b];
-            if (!soft) {
-                if (!(d < o || face))
-                    fa[i] = 0.0f;
-                continue;
-            }
-            float de = face ? l2_max(l2_min(d, o - 0.5f), 0.5f) : d;
-            if (de * pm->lit[b] < 1.0f)
-                continue; /* in no occluder's penumbra */
-            float u2 = ua[i] * ua[i];
-            if (face || d < o) {
-                fa[i] *= l2_soft_visibility(pm, l->softness, ca[i], u2, de);
-                continue;
-            }
-            /* in the hard shadow of its ray's occluder o: the penumbra of
-             * o, fully shadowed when the window holds no open ray */
-            float k = l->softness * (pm->qocc[b] - 1.0f / d) * (1.0f + u2) * bpp;
-            k = l2_min(k, kcap);
-            if (k < 0.5f || (d >= L2_DEPTH0 &&
-                             k <= (float)pm->gap[(size_t)l2_depth_level(d, dtop) * nb + b])) {
-                fa[i] = 0.0f;
-                continue;
-            }
-            fa[i] *= l2_filter(pm, ca[i], k, d);
+            b = b >= nb ? b - nb : b;
+            bool face = face_ok & (caster[i] != 0) & (d <= pm->ex[b]);
+            bool keep = (d < pm->occ[b]) | face | (d <= 0.0f);
+            fa[i] = keep ? fa[i] : 0.0f;
+        }
+    } else if (l->shadow) {
+        /* 2a, branch-free so that it vectorizes (gathers from the map):
+         * each pixel's case. Fully lit pixels (in no occluder's penumbra)
+         * keep their light, fully shadowed ones (in the hard shadow, with
+         * no open ray in the penumbra window) drop it; the others are
+         * listed for 2b: those their ray reaches (or lit on their face)
+         * for the nearest occluder's penumbra, those in the hard shadow
+         * for their own occluder's filter (window ka). */
+        const uint8_t *caster = ctx->caster + (size_t)y * ctx->width + xa;
+        const l2_polar *pm = &p->polar;
+        int nb = pm->n;
+        bool face_ok = !l->self_shadow;
+        float kcap = 0.5f * (float)nb - 1.0f, s = l->softness;
+        int dtop = pm->depth_levels - 1;
+        float *dea = scratch + 4 * ctx->width, *ka = scratch + 5 * ctx->width;
+        int32_t *list = (int32_t *)(scratch + 6 * ctx->width);
+        uint8_t *code = (uint8_t *)(scratch + 7 * ctx->width);
+        classify(pm->occ, pm->ex, pm->lit, pm->qocc, pm->gap, nb, n, face_ok, s, kcap, bpp, dtop, caster, da, ca, ua, fa, dea, ka, code);
+        int m = 0;
+        for (int i = 0; i < n; i++) {
+            list[m] = i;
+            m += code[i] != 0;
+        }
+        /* 2b: the penumbrae */
+        for (int j = 0; j < m; j++) {
+            int i = list[j];
+            if (code[i] == 1)
+                fa[i] *= l2_soft_visibility(pm, s, ca[i], ua[i] * ua[i], dea[i]);
+            else
+                fa[i] *= l2_filter(pm, ca[i], ka[i], da[i]);
         }
     }
     float cr = p->rgb.x, cg = p->rgb.y, cb = p->rgb.z;
@@ -238,9 +274,9 @@ lx_status lx_light2d_render(lx_light2d *ctx, lx_vec3 ambient, const lx_image *al
     }
     if (st != LX_OK)
         return st;
-    /* per thread: a band of accumulated rows, four rows of scratch and the
+    /* per thread: a band of accumulated rows, eight rows of scratch and the
      * runs of a band */
-    size_t band = (size_t)L2_BLOCK * w * 3, per = band + (size_t)w * 4;
+    size_t band = (size_t)L2_BLOCK * w * 3, per = band + (size_t)w * 8;
     size_t nruns = 2 * ((size_t)ctx->blocks_x + 1);
     float *rows = malloc((size_t)threads * (per * sizeof(float) + nruns * sizeof(int)));
     if (!rows)
