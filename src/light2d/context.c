@@ -307,9 +307,9 @@ lx_status lx_light2d_set_normals(lx_light2d *ctx, const lx_image *normals, bool 
             z = 1.0f;
             len = 1.0f;
         }
-        n[3 * i] = x / len;
-        n[3 * i + 1] = y / len;
-        n[3 * i + 2] = z / len;
+        n[i] = x / len;
+        n[count + i] = y / len;
+        n[2 * count + i] = z / len;
     }
     free(ctx->normals);
     ctx->normals = n;

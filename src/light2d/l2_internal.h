@@ -128,8 +128,9 @@ struct lx_light2d {
     l2_edge *edges;
     int blocks_x, blocks_y;
     uint8_t *block_caster; /* blocks_x*blocks_y: 1 when the block holds a caster */
-    float *normals; /* width*height*3 unit vectors in pixel space (x right,
-                       y down, z towards the viewer), or NULL */
+    float *normals; /* unit vectors in pixel space (x right, y down, z
+                       towards the viewer) as three planes of width*height
+                       floats (x, y, z), or NULL */
     l2_prep *preps;
     int count, prep_capacity;
     int relit;

@@ -106,11 +106,13 @@ static void shade_span(const lx_light2d *ctx, const l2_prep *p, int y, int xs, i
         }
     }
     if (ctx->normals) {
-        const float *nn = ctx->normals + ((size_t)y * ctx->width + xa) * 3;
+        size_t plane = (size_t)ctx->width * ctx->height;
+        const float *nx = ctx->normals + (size_t)y * ctx->width + xa, *ny = nx + plane,
+                    *nz = nx + 2 * plane;
         float h = l->height, h2 = h * h;
         for (int i = 0; i < n; i++) {
             float dx = (float)(xa + i) + 0.5f - lx;
-            float ndl = -dx * nn[3 * i] - dy * nn[3 * i + 1] + h * nn[3 * i + 2];
+            float ndl = -dx * nx[i] - dy * ny[i] + h * nz[i];
             float len = sqrtf(da[i] * da[i] + h2);
             float v = ndl / l2_max(len, 1e-30f);
             fa[i] *= ndl > 0.0f ? v : 0.0f;
@@ -145,48 +147,57 @@ static void shade_span(const lx_light2d *ctx, const l2_prep *p, int y, int xs, i
         float kcap = 0.5f * (float)nb - 1.0f, s = l->softness;
         int dtop = pm->depth_levels - 1;
         float *dea = scratch + 4 * ctx->width, *ka = scratch + 5 * ctx->width;
-        int32_t *list = (int32_t *)(scratch + 6 * ctx->width);
-        uint8_t *code = (uint8_t *)(scratch + 7 * ctx->width);
+        uint8_t *code = (uint8_t *)(scratch + 6 * ctx->width); /* 4 width bytes */
         classify(pm->occ, pm->ex, pm->lit, pm->qocc, pm->gap, nb, n, face_ok, s, kcap, bpp, dtop, caster, da, ca, ua, fa, dea, ka, code);
-        int m = 0;
-        for (int i = 0; i < n; i++) {
-            list[m] = i;
-            m += code[i] != 0;
-        }
-        /* 2b: the penumbrae */
-        for (int j = 0; j < m; j++) {
-            int i = list[j];
-            if (code[i] == 1)
-                fa[i] *= l2_soft_visibility(pm, s, ca[i], ua[i] * ua[i], dea[i]);
-            else
-                fa[i] *= l2_filter(pm, ca[i], ka[i], da[i]);
+        /* 2b: the penumbrae, skipping eight pixels at a time where none is
+         * listed */
+        int n8 = (n + 7) & ~7;
+        for (int i = n; i < n8; i++)
+            code[i] = 0;
+        for (int i0 = 0; i0 < n8; i0 += 8) {
+            uint64_t word;
+            memcpy(&word, code + i0, sizeof word);
+            if (!word)
+                continue;
+            for (int i = i0; i < i0 + 8; i++) {
+                if (code[i] == 1)
+                    fa[i] *= l2_soft_visibility(pm, s, ca[i], ua[i] * ua[i], dea[i]);
+                else if (code[i] == 2)
+                    fa[i] *= l2_filter(pm, ca[i], ka[i], da[i]);
+            }
         }
     }
+    /* the row's three planes of light (and the cache row's) */
     float cr = p->rgb.x, cg = p->rgb.y, cb = p->rgb.z;
-    float *a = acc + 3 * xa;
+    int w = ctx->width;
     if (cache) {
-        float *c = cache + 3 * (xa - p->x0);
+        int cw = p->x1 - p->x0;
+        float *c = cache + (xa - p->x0);
         for (int i = 0; i < n; i++) {
-            c[3 * i] = cr * fa[i];
-            c[3 * i + 1] = cg * fa[i];
-            c[3 * i + 2] = cb * fa[i];
+            c[i] = cr * fa[i];
+            c[cw + i] = cg * fa[i];
+            c[2 * cw + i] = cb * fa[i];
         }
     }
+    float *ar = acc + xa, *ag = ar + w, *ab = ar + 2 * w;
     for (int i = 0; i < n; i++) {
-        a[3 * i] += cr * fa[i];
-        a[3 * i + 1] += cg * fa[i];
-        a[3 * i + 2] += cb * fa[i];
+        ar[i] += cr * fa[i];
+        ag[i] += cg * fa[i];
+        ab[i] += cb * fa[i];
     }
 }
 
 /* Adds a cached light's row. */
-static void add_cached(const l2_prep *p, int y, float *acc)
+static void add_cached(const lx_light2d *ctx, const l2_prep *p, int y, float *acc)
 {
-    const float *c = p->cache + (size_t)(y - p->y0) * (p->x1 - p->x0) * 3;
-    float *a = acc + 3 * p->x0;
-    int n = (p->x1 - p->x0) * 3;
-    for (int i = 0; i < n; i++)
-        a[i] += c[i];
+    int cw = p->x1 - p->x0, w = ctx->width;
+    const float *c = p->cache + (size_t)(y - p->y0) * cw * 3;
+    for (int k = 0; k < 3; k++) {
+        float *a = acc + (size_t)k * w + p->x0;
+        const float *ck = c + (size_t)k * cw;
+        for (int i = 0; i < cw; i++)
+            a[i] += ck[i];
+    }
 }
 
 /* Adds light p to the rows [y0, y1) of a band (acc: the band's rows,
@@ -202,7 +213,7 @@ static void shade_band(const lx_light2d *ctx, const l2_prep *p, int y0, int y1, 
         return;
     if (!p->relight) {
         for (int y = ya; y < yb; y++)
-            add_cached(p, y, acc + (size_t)(y - y0) * w * 3);
+            add_cached(ctx, p, y, acc + (size_t)(y - y0) * w * 3);
         return;
     }
     if (p->cache)
@@ -296,27 +307,45 @@ lx_status lx_light2d_render(lx_light2d *ctx, lx_vec3 ambient, const lx_image *al
 #pragma omp for schedule(dynamic, 1)
         for (int bi = 0; bi < bands; bi++) {
             int y0 = bi * L2_BLOCK, y1 = y0 + L2_BLOCK < hgt ? y0 + L2_BLOCK : hgt;
-            size_t len = (size_t)(y1 - y0) * w;
-            for (size_t x = 0; x < len; x++) {
-                acc[3 * x] = ambient.x;
-                acc[3 * x + 1] = ambient.y;
-                acc[3 * x + 2] = ambient.z;
+            /* each row as three planes: r, g, b */
+            for (int y = y0; y < y1; y++) {
+                float *r = acc + (size_t)(y - y0) * w * 3;
+                for (int x = 0; x < w; x++) {
+                    r[x] = ambient.x;
+                    r[w + x] = ambient.y;
+                    r[2 * w + x] = ambient.z;
+                }
             }
             /* every pixel adds its lights in their order */
             for (int i = 0; i < count; i++)
                 shade_band(ctx, &ctx->preps[i], y0, y1, acc, scratch, runs);
-            size_t row = (size_t)y0 * w * 3;
-            if (light_map)
-                memcpy(light_map + row, acc, len * 3 * sizeof *acc);
-            if (out) {
-                float *o = out + row;
-                if (albedo) {
-                    const float *a = albedo->data + (size_t)y0 * w * ach;
-                    for (size_t x = 0; x < len; x++)
-                        for (int k = 0; k < 3; k++)
-                            o[3 * x + k] = a[ach * x + k] * acc[3 * x + k];
-                } else {
-                    memcpy(o, acc, len * 3 * sizeof *acc);
+            for (int y = y0; y < y1; y++) {
+                const float *r = acc + (size_t)(y - y0) * w * 3, *g = r + w, *b = g + w;
+                size_t row = (size_t)y * w * 3;
+                if (light_map) {
+                    float *lm = light_map + row;
+                    for (int x = 0; x < w; x++) {
+                        lm[3 * x] = r[x];
+                        lm[3 * x + 1] = g[x];
+                        lm[3 * x + 2] = b[x];
+                    }
+                }
+                if (out) {
+                    float *o = out + row;
+                    if (albedo) {
+                        const float *a = albedo->data + (size_t)y * w * ach;
+                        for (int x = 0; x < w; x++) {
+                            o[3 * x] = a[ach * x] * r[x];
+                            o[3 * x + 1] = a[ach * x + 1] * g[x];
+                            o[3 * x + 2] = a[ach * x + 2] * b[x];
+                        }
+                    } else {
+                        for (int x = 0; x < w; x++) {
+                            o[3 * x] = r[x];
+                            o[3 * x + 1] = g[x];
+                            o[3 * x + 2] = b[x];
+                        }
+                    }
                 }
             }
         }
