@@ -372,6 +372,7 @@ static inline bool l2_gather_ok(void)
 #endif
 
 /* Fraction of the window [c - k, c + k] (in bins) whose rays reach past d. */
+L2_CLONES
 float l2_filter(const l2_polar *pm, float c, float k, float d)
 {
     int n = pm->n;
@@ -410,6 +411,7 @@ float l2_filter(const l2_polar *pm, float c, float k, float d)
  * would need), then the filter over the half-angle softness (d - o) /
  * (d o), the angle a light of radius softness subtends behind o, with o
  * the nearest occluder inside that window. */
+L2_CLONES
 float l2_soft_visibility(const l2_polar *pm, float s, float c, float u2, float d)
 {
     float scale = (1.0f + u2) * pm->bins_per_p; /* bins per radian */
