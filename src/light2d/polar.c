@@ -378,10 +378,11 @@ float l2_filter(const l2_polar *pm, float c, float k, float d)
     int n = pm->n;
     float lo = c - k, hi = c + k;
     int b0 = l2_floor(lo), b1 = l2_floor(hi);
+    /* (no ray of the window reaches past d: no light; the callers' windows
+     * always hold a ray that does not, so the filter never gives 1 from
+     * the window's minimum alone) */
     if (range_query(pm, pm->tmax, b0, b1, true) < d)
         return 0.0f;
-    if (range_query(pm, pm->tmin, b0, b1, false) >= d)
-        return 1.0f;
     const float *occ = pm->occx + n; /* b in [-n, 2n) */
     if (b1 - b0 + 1 <= L2_MAX_TAPS) {
         float lit = 0.0f;
