@@ -165,4 +165,10 @@ float l2_filter(const l2_polar *pm, float c, float k, float d);
  * pixel (polar.c). */
 bool l2_block_dark(const l2_prep *p, int x0, int y0, int x1, int y1, bool has_caster);
 
+/* Whether the light's shadows leave every pixel of the block [x0, x1) x
+ * [y0, y1) its full light (each before its ray's occluder and, for soft
+ * lights, in no occluder's penumbra wedge), so that shading them may skip
+ * the shadow pass; has_caster as for l2_block_dark (polar.c). */
+bool l2_block_lit(const l2_prep *p, int x0, int y0, int x1, int y1, bool has_caster);
+
 #endif

@@ -523,3 +523,40 @@ bool l2_block_dark(const l2_prep *p, int x0, int y0, int x1, int y1, bool has_ca
         }
     return true;
 }
+
+bool l2_block_lit(const l2_prep *p, int x0, int y0, int x1, int y1, bool has_caster)
+{
+    const lx_light2d_light *l = &p->l;
+    const l2_polar *pm = &p->polar;
+    int n = pm->n;
+    if (!l->shadow || (has_caster && !l->self_shadow))
+        return false;
+    /* the pixel centres, relative to the light, as shade.c computes them */
+    float ax = (float)x0 + 0.5f - l->x, bx = (float)(x1 - 1) + 0.5f - l->x;
+    float ay = (float)y0 + 0.5f - l->y, by = (float)(y1 - 1) + 0.5f - l->y;
+    float nx = ax > 0.0f ? ax : (bx < 0.0f ? bx : 0.0f);
+    float ny = ay > 0.0f ? ay : (by < 0.0f ? by : 0.0f);
+    if (nx * nx + ny * ny < 4.0f)
+        return false;
+    float fx = l2_max(ax * ax, bx * bx), fy = l2_max(ay * ay, by * by);
+    /* no pixel is farther (squares and sums round monotonically); a margin
+     * for the rounding of the products with it */
+    float dmax = sqrtf(fx + fy) * (1.0f + 1e-5f);
+    int b0, b1;
+    square_bins(pm, ax, bx, ay, by, &b0, &b1);
+    b0--;
+    b1++;
+    if (b1 - b0 + 1 >= n)
+        return false;
+    /* every pixel before its ray's occluder */
+    if (range_query(pm, pm->tmin, b0, b1, false) <= dmax)
+        return false;
+    if (l->softness <= 0.0f)
+        return true;
+    /* and in no occluder's penumbra wedge (shade.c: d x lit[b] < 1) */
+    int a = wrap(b0, n), e = a + (b1 - b0);
+    float most = 0.0f;
+    for (int b = a; b <= e; b++)
+        most = l2_max(most, pm->lit[b < n ? b : b - n]);
+    return dmax * most < 1.0f;
+}

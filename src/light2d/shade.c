@@ -56,7 +56,7 @@ static void classify(const float *restrict occ, const float *restrict ex,
  * floats. */
 L2_CLONES
 static void shade_span(const lx_light2d *ctx, const l2_prep *p, int y, int xs, int xe,
-                       float *acc, float *scratch)
+                       float *acc, float *scratch, bool shadows)
 {
     const lx_light2d_light *l = &p->l;
     float dy = (float)y + 0.5f - l->y;
@@ -119,7 +119,9 @@ static void shade_span(const lx_light2d *ctx, const l2_prep *p, int y, int xs, i
         }
     }
     /* pass 2: shadows from the polar map */
-    if (l->shadow && l->softness <= 0.0f) {
+    if (!shadows) {
+        /* the block test found every pixel lit */
+    } else if (l->shadow && l->softness <= 0.0f) {
         const uint8_t *caster = ctx->caster + (size_t)y * ctx->width + xa;
         const l2_polar *pm = &p->polar;
         int nb = pm->n;
@@ -203,7 +205,7 @@ static void add_cached(const lx_light2d *ctx, const l2_prep *p, int y, float *ac
 /* Adds light p to the rows [y0, y1) of a band (acc: the band's rows,
  * width*3 floats each, from row y0): the blocks the light leaves dark are
  * skipped, the rest shaded in runs of neighbouring blocks. runs holds
- * 2*(blocks_x+1) ints. */
+ * 3*(blocks_x+1) ints. */
 static void shade_band(const lx_light2d *ctx, const l2_prep *p, int y0, int y1, float *acc,
                        float *scratch, int *runs)
 {
@@ -220,7 +222,9 @@ static void shade_band(const lx_light2d *ctx, const l2_prep *p, int y0, int y1, 
         for (int y = ya; y < yb; y++)
             memset(p->cache + (size_t)(y - p->y0) * (p->x1 - p->x0) * 3, 0,
                    (size_t)(p->x1 - p->x0) * 3 * sizeof(float));
-    /* the band's blocks under the light, merged into runs of lit ones */
+    /* the band's blocks under the light: dark ones dropped, the others
+     * merged into runs of the same kind (wholly lit, needing no shadow
+     * pass, or not); runs[3 r + 2]: the kind */
     int by = y0 / L2_BLOCK, count = 0;
     int bx0 = p->x0 / L2_BLOCK, bx1 = (p->x1 - 1) / L2_BLOCK;
     for (int bx = bx0; bx <= bx1; bx++) {
@@ -230,18 +234,20 @@ static void shade_band(const lx_light2d *ctx, const l2_prep *p, int y0, int y1, 
         bool caster = ctx->block_caster[(size_t)by * ctx->blocks_x + bx] != 0;
         if (l2_block_dark(p, xs, ya, xe, yb, caster))
             continue;
-        if (count > 0 && runs[2 * count - 1] == xs)
-            runs[2 * count - 1] = xe;
+        int kind = l2_block_lit(p, xs, ya, xe, yb, caster) ? 0 : 1;
+        if (count > 0 && runs[3 * count - 2] == xs && runs[3 * count - 1] == kind)
+            runs[3 * count - 2] = xe;
         else {
-            runs[2 * count] = xs;
-            runs[2 * count + 1] = xe;
+            runs[3 * count] = xs;
+            runs[3 * count + 1] = xe;
+            runs[3 * count + 2] = kind;
             count++;
         }
     }
     for (int y = ya; y < yb; y++)
         for (int r = 0; r < count; r++)
-            shade_span(ctx, p, y, runs[2 * r], runs[2 * r + 1], acc + (size_t)(y - y0) * w * 3,
-                       scratch);
+            shade_span(ctx, p, y, runs[3 * r], runs[3 * r + 1], acc + (size_t)(y - y0) * w * 3,
+                       scratch, runs[3 * r + 2] != 0);
 }
 
 lx_status lx_light2d_render(lx_light2d *ctx, lx_vec3 ambient, const lx_image *albedo, float *out,
@@ -288,7 +294,7 @@ lx_status lx_light2d_render(lx_light2d *ctx, lx_vec3 ambient, const lx_image *al
     /* per thread: a band of accumulated rows, eight rows of scratch and the
      * runs of a band */
     size_t band = (size_t)L2_BLOCK * w * 3, per = band + (size_t)w * 8;
-    size_t nruns = 2 * ((size_t)ctx->blocks_x + 1);
+    size_t nruns = 3 * ((size_t)ctx->blocks_x + 1);
     float *rows = malloc((size_t)threads * (per * sizeof(float) + nruns * sizeof(int)));
     if (!rows)
         return lx_fail(LX_ERR_NOMEM, "light2d: out of memory for %d bands", threads);
