@@ -269,6 +269,7 @@ void lx_light2d_destroy(lx_light2d *ctx)
     free(ctx->tile_start);
     free(ctx->edges);
     free(ctx->normals);
+    free(ctx->work);
     free(ctx);
 }
 

@@ -134,6 +134,8 @@ struct lx_light2d {
     l2_prep *preps;
     int count, prep_capacity;
     int relit;
+    float *work; /* the render's bands and scratch, kept between frames */
+    size_t work_size;
 };
 
 /* Rebuilds the tile lists of boundary caster pixels (context.c). */
@@ -155,7 +157,9 @@ float l2_soft_visibility(const l2_polar *pm, float s, float c, float u2, float d
  * rays reach past d: the percentage-closer filter (polar.c). For a point
  * in its ray's hard shadow (ray b, occluder o), the window is that
  * occluder's penumbra, k = min(s (1/max(o, 0.5) - 1/d) x scale, n/2 - 1),
- * scale the bins per radian there. */
+ * scale the bins per radian there. The window must hold a ray that does
+ * not reach past d (both callers' windows do): a window whose every ray
+ * reaches past it would not be found fully lit from its minimum. */
 float l2_filter(const l2_polar *pm, float c, float k, float d);
 
 /* Whether the light leaves every pixel of the block [x0, x1) x [y0, y1)

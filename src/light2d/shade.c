@@ -295,9 +295,18 @@ lx_status lx_light2d_render(lx_light2d *ctx, lx_vec3 ambient, const lx_image *al
      * runs of a band */
     size_t band = (size_t)L2_BLOCK * w * 3, per = band + (size_t)w * 8;
     size_t nruns = 3 * ((size_t)ctx->blocks_x + 1);
-    float *rows = malloc((size_t)threads * (per * sizeof(float) + nruns * sizeof(int)));
-    if (!rows)
-        return lx_fail(LX_ERR_NOMEM, "light2d: out of memory for %d bands", threads);
+    /* kept from frame to frame (a fresh block of this size would be new
+     * pages, faulted in and cleared every frame) */
+    size_t need = (size_t)threads * (per * sizeof(float) + nruns * sizeof(int));
+    if (need > ctx->work_size) {
+        float *a = malloc(need);
+        if (!a)
+            return lx_fail(LX_ERR_NOMEM, "light2d: out of memory for %d bands", threads);
+        free(ctx->work);
+        ctx->work = a;
+        ctx->work_size = need;
+    }
+    float *rows = ctx->work;
     int *all_runs = (int *)(rows + (size_t)threads * per);
     int ach = albedo ? albedo->channels : 0;
     int bands = (hgt + L2_BLOCK - 1) / L2_BLOCK;
@@ -356,7 +365,6 @@ lx_status lx_light2d_render(lx_light2d *ctx, lx_vec3 ambient, const lx_image *al
             }
         }
     }
-    free(rows);
     for (int i = 0; i < count; i++)
         if (ctx->preps[i].cache)
             ctx->preps[i].relight = false;
