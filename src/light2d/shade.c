@@ -22,10 +22,10 @@ L2_CLONES __attribute__((noinline))
 static void classify(const float *restrict occ, const float *restrict ex,
                      const float *restrict lit, const float *restrict qocc,
                      const float *restrict gap, int nb, int n, bool face_ok, float s, float kcap,
-                            float bpp, int dtop, const uint8_t *restrict caster,
-                            const float *restrict da, const float *restrict ca,
-                            const float *restrict ua, float *restrict fa, float *restrict dea,
-                            float *restrict ka, uint8_t *restrict code)
+                     float bpp, int dtop, const uint8_t *restrict caster,
+                     const float *restrict da, const float *restrict ca,
+                     const float *restrict ua, float *restrict fa, float *restrict dea,
+                     float *restrict ka, uint8_t *restrict code)
 {
     for (int i = 0; i < n; i++) {
         float d = da[i];
@@ -150,7 +150,8 @@ static void shade_span(const lx_light2d *ctx, const l2_prep *p, int y, int xs, i
         int dtop = pm->depth_levels - 1;
         float *dea = scratch + 4 * ctx->width, *ka = scratch + 5 * ctx->width;
         uint8_t *code = (uint8_t *)(scratch + 6 * ctx->width); /* 4 width bytes */
-        classify(pm->occ, pm->ex, pm->lit, pm->qocc, pm->gap, nb, n, face_ok, s, kcap, bpp, dtop, caster, da, ca, ua, fa, dea, ka, code);
+        classify(pm->occ, pm->ex, pm->lit, pm->qocc, pm->gap, nb, n, face_ok, s, kcap, bpp, dtop,
+                 caster, da, ca, ua, fa, dea, ka, code);
         /* 2b: the penumbrae, skipping eight pixels at a time where none is
          * listed */
         int n8 = (n + 7) & ~7;
