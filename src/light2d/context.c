@@ -269,6 +269,7 @@ void lx_light2d_destroy(lx_light2d *ctx)
     free(ctx->tile_start);
     free(ctx->edges);
     free(ctx->normals);
+    free(ctx->work);
     free(ctx);
 }
 
@@ -307,9 +308,9 @@ lx_status lx_light2d_set_normals(lx_light2d *ctx, const lx_image *normals, bool 
             z = 1.0f;
             len = 1.0f;
         }
-        n[3 * i] = x / len;
-        n[3 * i + 1] = y / len;
-        n[3 * i + 2] = z / len;
+        n[i] = x / len;
+        n[count + i] = y / len;
+        n[2 * count + i] = z / len;
     }
     free(ctx->normals);
     ctx->normals = n;

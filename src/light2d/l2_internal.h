@@ -58,7 +58,7 @@ typedef struct l2_polar {
      * distance of level l whose penumbra window is at most gap[l][b] bins
      * wide on each side sees no open ray (fully shadowed) */
     float *qocc;
-    uint16_t *gap; /* depth_levels x n */
+    float *gap; /* depth_levels x n, whole numbers (floats, for gathers) */
     int depth_levels;
     int gap_capacity;
     float *tmin, *tmax; /* levels x n */
@@ -128,11 +128,14 @@ struct lx_light2d {
     l2_edge *edges;
     int blocks_x, blocks_y;
     uint8_t *block_caster; /* blocks_x*blocks_y: 1 when the block holds a caster */
-    float *normals; /* width*height*3 unit vectors in pixel space (x right,
-                       y down, z towards the viewer), or NULL */
+    float *normals; /* unit vectors in pixel space (x right, y down, z
+                       towards the viewer) as three planes of width*height
+                       floats (x, y, z), or NULL */
     l2_prep *preps;
     int count, prep_capacity;
     int relit;
+    float *work; /* the render's bands and scratch, kept between frames */
+    size_t work_size;
 };
 
 /* Rebuilds the tile lists of boundary caster pixels (context.c). */
@@ -154,13 +157,22 @@ float l2_soft_visibility(const l2_polar *pm, float s, float c, float u2, float d
  * rays reach past d: the percentage-closer filter (polar.c). For a point
  * in its ray's hard shadow (ray b, occluder o), the window is that
  * occluder's penumbra, k = min(s (1/max(o, 0.5) - 1/d) x scale, n/2 - 1),
- * scale the bins per radian there. */
+ * scale the bins per radian there. The window must hold a ray that does
+ * not reach past d (both callers' windows do): a window whose every ray
+ * reaches past it would not be found fully lit from its minimum. */
 float l2_filter(const l2_polar *pm, float c, float k, float d);
 
 /* Whether the light leaves every pixel of the block [x0, x1) x [y0, y1)
  * dark (exactly what shading them would give: out of reach, or in a hard
- * shadow whose penumbra window holds no open ray); has_caster: the block
- * holds a caster pixel (polar.c). */
+ * shadow whose penumbra window holds no open ray, and no caster pixel
+ * within a ray's first caster run); has_caster: the block holds a caster
+ * pixel (polar.c). */
 bool l2_block_dark(const l2_prep *p, int x0, int y0, int x1, int y1, bool has_caster);
+
+/* Whether the light's shadows leave every pixel of the block [x0, x1) x
+ * [y0, y1) its full light (each before its ray's occluder and, for soft
+ * lights, in no occluder's penumbra wedge), so that shading them may skip
+ * the shadow pass; has_caster as for l2_block_dark (polar.c). */
+bool l2_block_lit(const l2_prep *p, int x0, int y0, int x1, int y1, bool has_caster);
 
 #endif

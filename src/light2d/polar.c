@@ -18,6 +18,13 @@
 #include <string.h>
 
 #define L2_FAR 1e30f
+
+/* AVX2 gathers for the sampled filter where the CPU has them (GCC or
+ * clang on x86-64). */
+#if defined(__GNUC__) && defined(__x86_64__) && !defined(L2_NO_CLONES)
+#define L2_GATHER 1
+#include <immintrin.h>
+#endif
 /* Filter taps beyond which a penumbra window is sampled, not summed. */
 #define L2_MAX_TAPS 32
 
@@ -96,7 +103,7 @@ static lx_status reserve(l2_polar *pm, int n, int levels, int depth_levels)
 {
     size_t g = (size_t)n * depth_levels;
     if (g > (size_t)pm->gap_capacity) {
-        uint16_t *a = realloc(pm->gap, g * sizeof *a);
+        float *a = realloc(pm->gap, g * sizeof *a);
         if (!a)
             return lx_fail(LX_ERR_NOMEM, "light2d: out of memory for a polar map of %d rays", n);
         pm->gap = a;
@@ -175,7 +182,7 @@ static void penumbra_reach(l2_polar *pm, float s)
 
 /* gap[lv]: per ray, the whole bins between it and the nearest ray whose
  * occluder is at the level's distance or beyond (a 1D distance transform
- * around the circle: twice round each way). */
+ * around the circle: once round each way from an open ray). */
 static void open_gaps(l2_polar *pm, int lv)
 {
     int n = pm->n;
@@ -187,31 +194,40 @@ static void open_gaps(l2_polar *pm, int lv)
     } t = {(uint32_t)((lv >> 1) + 127) << 23 | ((lv & 1) ? 0x3504f3u : 0u)};
     float thr = t.f * L2_DEPTH0;
     const float *occ = pm->occ;
-    uint16_t *g = pm->gap + (size_t)lv * n;
-    const int none = 1 << 30;
-    int run = none; /* bins since the last open ray */
-    for (int lap = 0; lap < 2; lap++)
-        for (int i = 0; i < n; i++) {
-            if (occ[i] >= thr)
-                run = 0;
-            else if (run < none)
-                run++;
-            if (lap)
-                g[i] = (uint16_t)(run == 0 ? 0 : (run - 1 < 65535 ? run - 1 : 65535));
+    float *g = pm->gap + (size_t)lv * n;
+    int s0 = -1;
+    for (int i = 0; i < n; i++)
+        if (occ[i] >= thr) {
+            s0 = i;
+            break;
         }
-    run = none;
-    for (int lap = 0; lap < 2; lap++)
-        for (int i = n - 1; i >= 0; i--) {
-            if (occ[i] >= thr)
-                run = 0;
-            else if (run < none)
-                run++;
-            if (lap) {
-                int v = run == 0 ? 0 : (run - 1 < 65535 ? run - 1 : 65535);
-                if (v < g[i])
-                    g[i] = (uint16_t)v;
-            }
-        }
+    if (s0 < 0) {
+        for (int i = 0; i < n; i++)
+            g[i] = 65535.0f;
+        return;
+    }
+    /* forward from the open ray s0: bins since the last open ray */
+    float run = 0.0f;
+    for (int i = s0; i < n; i++) {
+        run = occ[i] >= thr ? 0.0f : run + 1.0f;
+        g[i] = run;
+    }
+    for (int i = 0; i < s0; i++) {
+        run = occ[i] >= thr ? 0.0f : run + 1.0f;
+        g[i] = run;
+    }
+    /* backward from it: the nearer of the two, less the bin itself */
+    run = 0.0f;
+    for (int i = s0; i >= 0; i--) {
+        run = occ[i] >= thr ? 0.0f : run + 1.0f;
+        float m = l2_min(run, g[i]);
+        g[i] = m == 0.0f ? 0.0f : l2_min(m - 1.0f, 65535.0f);
+    }
+    for (int i = n - 1; i > s0; i--) {
+        run = occ[i] >= thr ? 0.0f : run + 1.0f;
+        float m = l2_min(run, g[i]);
+        g[i] = m == 0.0f ? 0.0f : l2_min(m - 1.0f, 65535.0f);
+    }
 }
 
 lx_status l2_polar_build(const lx_light2d *ctx, l2_prep *p)
@@ -330,6 +346,31 @@ static inline float range_query(const l2_polar *pm, const float *table, int lo, 
     return max ? l2_max(t[a], t[b]) : l2_min(t[a], t[b]);
 }
 
+#ifdef L2_GATHER
+/* The sampled filter's taps with AVX2 gathers, 8 at a time: the same
+ * floats (i x step, then + base; truncated) and the same comparisons as
+ * the scalar loop, so the same count. */
+__attribute__((target("avx2"))) static int taps_gather(const float *occx, float base, float step,
+                                                       float d)
+{
+    const __m256 lane = _mm256_setr_ps(0.0f, 1.0f, 2.0f, 3.0f, 4.0f, 5.0f, 6.0f, 7.0f);
+    const __m256 vb = _mm256_set1_ps(base), vs = _mm256_set1_ps(step), vd = _mm256_set1_ps(d);
+    int lit = 0;
+    for (int i = 0; i < L2_MAX_TAPS; i += 8) {
+        __m256 t = _mm256_add_ps(_mm256_set1_ps((float)i), lane);
+        __m256i idx = _mm256_cvttps_epi32(_mm256_add_ps(vb, _mm256_mul_ps(t, vs)));
+        __m256 o = _mm256_i32gather_ps(occx, idx, 4);
+        lit += __builtin_popcount((unsigned)_mm256_movemask_ps(_mm256_cmp_ps(o, vd, _CMP_GE_OQ)));
+    }
+    return lit;
+}
+
+static inline bool l2_gather_ok(void)
+{
+    return __builtin_cpu_supports("avx2");
+}
+#endif
+
 /* Fraction of the window [c - k, c + k] (in bins) whose rays reach past d. */
 L2_CLONES
 float l2_filter(const l2_polar *pm, float c, float k, float d)
@@ -337,10 +378,11 @@ float l2_filter(const l2_polar *pm, float c, float k, float d)
     int n = pm->n;
     float lo = c - k, hi = c + k;
     int b0 = l2_floor(lo), b1 = l2_floor(hi);
+    /* (no ray of the window reaches past d: no light; the callers' windows
+     * always hold a ray that does not, so the filter never gives 1 from
+     * the window's minimum alone) */
     if (range_query(pm, pm->tmax, b0, b1, true) < d)
         return 0.0f;
-    if (range_query(pm, pm->tmin, b0, b1, false) >= d)
-        return 1.0f;
     const float *occ = pm->occx + n; /* b in [-n, 2n) */
     if (b1 - b0 + 1 <= L2_MAX_TAPS) {
         float lit = 0.0f;
@@ -353,9 +395,13 @@ float l2_filter(const l2_polar *pm, float c, float k, float d)
     /* taps at the centres of L2_MAX_TAPS equal parts */
     /* from the start of occx (lo + n > 0: c >= 0, k < n/2), where
      * truncation floors */
-    int lit = 0;
     float step = (hi - lo) / L2_MAX_TAPS;
     float base = lo + 0.5f * step + (float)n;
+#ifdef L2_GATHER
+    if (l2_gather_ok())
+        return (float)taps_gather(pm->occx, base, step, d) / L2_MAX_TAPS;
+#endif
+    int lit = 0;
     for (int i = 0; i < L2_MAX_TAPS; i++)
         lit += pm->occx[(int)(base + (float)i * step)] >= d;
     return (float)lit / L2_MAX_TAPS;
@@ -366,6 +412,7 @@ float l2_filter(const l2_polar *pm, float c, float k, float d)
  * would need), then the filter over the half-angle softness (d - o) /
  * (d o), the angle a light of radius softness subtends behind o, with o
  * the nearest occluder inside that window. */
+L2_CLONES
 float l2_soft_visibility(const l2_polar *pm, float s, float c, float u2, float d)
 {
     float scale = (1.0f + u2) * pm->bins_per_p; /* bins per radian */
@@ -410,8 +457,11 @@ bool l2_block_dark(const l2_prep *p, int x0, int y0, int x1, int y1, bool has_ca
     float dmin2 = nx * nx + ny * ny;
     if (dmin2 >= p->r2)
         return true; /* out of reach: no falloff */
-    if (!l->shadow || (has_caster && !l->self_shadow) || dmin2 < 4.0f)
+    if (!l->shadow || dmin2 < 4.0f)
         return false;
+    /* caster pixels lit on their face: only where a ray's first caster
+     * run reaches the block */
+    bool faces = has_caster && !l->self_shadow;
     float fx = l2_max(ax * ax, bx * bx), fy = l2_max(ay * ay, by * by);
     float dmin = sqrtf(dmin2), dmax = sqrtf(fx + fy);
     /* the rays of the pixels, one more each side for rounding */
@@ -426,6 +476,21 @@ bool l2_block_dark(const l2_prep *p, int x0, int y0, int x1, int y1, bool has_ca
     float before = dmin * (1.0f - 1e-5f);
     if (range_query(pm, pm->tmax, b0, b1, true) >= before)
         return false;
+    /* the bins [b0, b1] as up to two runs without wrapping */
+    int r0[2], r1[2], runs = 1;
+    r0[0] = wrap(b0, n);
+    r1[0] = r0[0] + (b1 - b0);
+    if (r1[0] >= n) {
+        r0[1] = 0;
+        r1[1] = r1[0] - n;
+        r1[0] = n - 1;
+        runs = 2;
+    }
+    if (faces)
+        for (int r = 0; r < runs; r++)
+            for (int b = r0[r]; b <= r1[r]; b++)
+                if (pm->ex[b] >= before)
+                    return false;
     if (l->softness <= 0.0f)
         return true;
     /* and, as shade.c tests each pixel, no open ray in the penumbra window
@@ -448,13 +513,50 @@ bool l2_block_dark(const l2_prep *p, int x0, int y0, int x1, int y1, bool has_ca
         u2max = 1.0f;
     float sc = 1.0f + u2max * (1.0f + 1e-5f), inv = 1.0f / dmax;
     float kcap = 0.5f * (float)n - 1.0f;
-    const uint16_t *g = pm->gap + (size_t)l2_depth_level(dmin, pm->depth_levels - 1) * n;
-    for (int b = b0; b <= b1; b++) {
-        int i = wrap(b, n);
-        float k = l->softness * (pm->qocc[i] - inv) * sc * pm->bins_per_p;
-        k = l2_min(k, kcap);
-        if (k >= 0.5f && k > (float)g[i])
-            return false;
-    }
+    const float *g = pm->gap + (size_t)l2_depth_level(dmin, pm->depth_levels - 1) * n;
+    for (int r = 0; r < runs; r++)
+        for (int i = r0[r]; i <= r1[r]; i++) {
+            float k = l->softness * (pm->qocc[i] - inv) * sc * pm->bins_per_p;
+            k = l2_min(k, kcap);
+            if (k >= 0.5f && k > g[i])
+                return false;
+        }
     return true;
+}
+
+bool l2_block_lit(const l2_prep *p, int x0, int y0, int x1, int y1, bool has_caster)
+{
+    const lx_light2d_light *l = &p->l;
+    const l2_polar *pm = &p->polar;
+    int n = pm->n;
+    if (!l->shadow || (has_caster && !l->self_shadow))
+        return false;
+    /* the pixel centres, relative to the light, as shade.c computes them */
+    float ax = (float)x0 + 0.5f - l->x, bx = (float)(x1 - 1) + 0.5f - l->x;
+    float ay = (float)y0 + 0.5f - l->y, by = (float)(y1 - 1) + 0.5f - l->y;
+    float nx = ax > 0.0f ? ax : (bx < 0.0f ? bx : 0.0f);
+    float ny = ay > 0.0f ? ay : (by < 0.0f ? by : 0.0f);
+    if (nx * nx + ny * ny < 4.0f)
+        return false;
+    float fx = l2_max(ax * ax, bx * bx), fy = l2_max(ay * ay, by * by);
+    /* no pixel is farther (squares and sums round monotonically); a margin
+     * for the rounding of the products with it */
+    float dmax = sqrtf(fx + fy) * (1.0f + 1e-5f);
+    int b0, b1;
+    square_bins(pm, ax, bx, ay, by, &b0, &b1);
+    b0--;
+    b1++;
+    if (b1 - b0 + 1 >= n)
+        return false;
+    /* every pixel before its ray's occluder */
+    if (range_query(pm, pm->tmin, b0, b1, false) <= dmax)
+        return false;
+    if (l->softness <= 0.0f)
+        return true;
+    /* and in no occluder's penumbra wedge (shade.c: d x lit[b] < 1) */
+    int a = wrap(b0, n), e = a + (b1 - b0);
+    float most = 0.0f;
+    for (int b = a; b <= e; b++)
+        most = l2_max(most, pm->lit[b < n ? b : b - n]);
+    return dmax * most < 1.0f;
 }

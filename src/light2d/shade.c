@@ -16,13 +16,47 @@
 #include <omp.h>
 #endif
 
+/* Pass 2a of a soft light (shade_span): each pixel's case, branch-free and
+ * over restrict pointers so that it vectorizes with gathers from the map. */
+L2_CLONES __attribute__((noinline))
+static void classify(const float *restrict occ, const float *restrict ex,
+                     const float *restrict lit, const float *restrict qocc,
+                     const float *restrict gap, int nb, int n, bool face_ok, float s, float kcap,
+                     float bpp, int dtop, const uint8_t *restrict caster,
+                     const float *restrict da, const float *restrict ca,
+                     const float *restrict ua, float *restrict fa, float *restrict dea,
+                     float *restrict ka, uint8_t *restrict code)
+{
+    for (int i = 0; i < n; i++) {
+        float d = da[i];
+        int b = (int)ca[i];
+        b = b >= nb ? b - nb : b;
+        float o = occ[b];
+        bool face = face_ok & (caster[i] != 0) & (d <= ex[b]);
+        float de = face ? l2_max(l2_min(d, o - 0.5f), 0.5f) : d;
+        bool pen = !(de * lit[b] < 1.0f);
+        bool reach = face | (d < o);
+        float u2 = ua[i] * ua[i];
+        float k = s * (qocc[b] - 1.0f / d) * (1.0f + u2) * bpp;
+        k = l2_min(k, kcap);
+        int lv = l2_depth_level(l2_max(d, L2_DEPTH0), dtop);
+        bool closed = (k < 0.5f) | ((d >= L2_DEPTH0) & (k <= gap[lv * nb + b]));
+        bool active = (fa[i] > 0.0f) & (d > 0.0f) & pen;
+        bool dark = active & !reach & closed;
+        fa[i] = dark ? 0.0f : fa[i];
+        code[i] = (uint8_t)(active & !dark ? (reach ? 1 : 2) : 0);
+        dea[i] = de;
+        ka[i] = k;
+    }
+}
+
 /* Adds the light's contribution to the pixels [xs, xe) of row y into acc
  * (the row's width*3 floats), and to its cache row when it is a static
- * light being re-lit (the caller cleared that row); scratch holds 4*width
+ * light being re-lit (the caller cleared that row); scratch holds 8*width
  * floats. */
 L2_CLONES
 static void shade_span(const lx_light2d *ctx, const l2_prep *p, int y, int xs, int xe,
-                       float *acc, float *scratch)
+                       float *acc, float *scratch, bool shadows)
 {
     const lx_light2d_light *l = &p->l;
     float dy = (float)y + 0.5f - l->y;
@@ -72,91 +106,107 @@ static void shade_span(const lx_light2d *ctx, const l2_prep *p, int y, int xs, i
         }
     }
     if (ctx->normals) {
-        const float *nn = ctx->normals + ((size_t)y * ctx->width + xa) * 3;
+        size_t plane = (size_t)ctx->width * ctx->height;
+        const float *nx = ctx->normals + (size_t)y * ctx->width + xa, *ny = nx + plane,
+                    *nz = nx + 2 * plane;
         float h = l->height, h2 = h * h;
         for (int i = 0; i < n; i++) {
             float dx = (float)(xa + i) + 0.5f - lx;
-            float ndl = -dx * nn[3 * i] - dy * nn[3 * i + 1] + h * nn[3 * i + 2];
+            float ndl = -dx * nx[i] - dy * ny[i] + h * nz[i];
             float len = sqrtf(da[i] * da[i] + h2);
             float v = ndl / l2_max(len, 1e-30f);
             fa[i] *= ndl > 0.0f ? v : 0.0f;
         }
     }
     /* pass 2: shadows from the polar map */
-    if (l->shadow) {
+    if (!shadows) {
+        /* the block test found every pixel lit */
+    } else if (l->shadow && l->softness <= 0.0f) {
         const uint8_t *caster = ctx->caster + (size_t)y * ctx->width + xa;
         const l2_polar *pm = &p->polar;
         int nb = pm->n;
-        bool soft = l->softness > 0.0f, face_ok = !l->self_shadow;
-        float kcap = 0.5f * (float)nb - 1.0f;
-        int dtop = pm->depth_levels - 1;
+        bool face_ok = !l->self_shadow;
         for (int i = 0; i < n; i++) {
-            if (fa[i] <= 0.0f)
-                continue;
             float d = da[i];
-            if (d <= 0.0f)
-                continue;
             int b = (int)ca[i];
-            if (b >= nb)
-                b -= nb;
-            float o = pm->occ[b];
-            bool face = face_ok && caster[i] && d <= pm->ex[b];
-            if (!soft) {
-                if (!(d < o || face))
-                    fa[i] = 0.0f;
+            b = b >= nb ? b - nb : b;
+            bool face = face_ok & (caster[i] != 0) & (d <= pm->ex[b]);
+            bool keep = (d < pm->occ[b]) | face | (d <= 0.0f);
+            fa[i] = keep ? fa[i] : 0.0f;
+        }
+    } else if (l->shadow) {
+        /* 2a, branch-free so that it vectorizes (gathers from the map):
+         * each pixel's case. Fully lit pixels (in no occluder's penumbra)
+         * keep their light, fully shadowed ones (in the hard shadow, with
+         * no open ray in the penumbra window) drop it; the others are
+         * listed for 2b: those their ray reaches (or lit on their face)
+         * for the nearest occluder's penumbra, those in the hard shadow
+         * for their own occluder's filter (window ka). */
+        const uint8_t *caster = ctx->caster + (size_t)y * ctx->width + xa;
+        const l2_polar *pm = &p->polar;
+        int nb = pm->n;
+        bool face_ok = !l->self_shadow;
+        float kcap = 0.5f * (float)nb - 1.0f, s = l->softness;
+        int dtop = pm->depth_levels - 1;
+        float *dea = scratch + 4 * ctx->width, *ka = scratch + 5 * ctx->width;
+        uint8_t *code = (uint8_t *)(scratch + 6 * ctx->width); /* 4 width bytes */
+        classify(pm->occ, pm->ex, pm->lit, pm->qocc, pm->gap, nb, n, face_ok, s, kcap, bpp, dtop,
+                 caster, da, ca, ua, fa, dea, ka, code);
+        /* 2b: the penumbrae, skipping eight pixels at a time where none is
+         * listed */
+        int n8 = (n + 7) & ~7;
+        for (int i = n; i < n8; i++)
+            code[i] = 0;
+        for (int i0 = 0; i0 < n8; i0 += 8) {
+            uint64_t word;
+            memcpy(&word, code + i0, sizeof word);
+            if (!word)
                 continue;
+            for (int i = i0; i < i0 + 8; i++) {
+                if (code[i] == 1)
+                    fa[i] *= l2_soft_visibility(pm, s, ca[i], ua[i] * ua[i], dea[i]);
+                else if (code[i] == 2)
+                    fa[i] *= l2_filter(pm, ca[i], ka[i], da[i]);
             }
-            float de = face ? l2_max(l2_min(d, o - 0.5f), 0.5f) : d;
-            if (de * pm->lit[b] < 1.0f)
-                continue; /* in no occluder's penumbra */
-            float u2 = ua[i] * ua[i];
-            if (face || d < o) {
-                fa[i] *= l2_soft_visibility(pm, l->softness, ca[i], u2, de);
-                continue;
-            }
-            /* in the hard shadow of its ray's occluder o: the penumbra of
-             * o, fully shadowed when the window holds no open ray */
-            float k = l->softness * (pm->qocc[b] - 1.0f / d) * (1.0f + u2) * bpp;
-            k = l2_min(k, kcap);
-            if (k < 0.5f || (d >= L2_DEPTH0 &&
-                             k <= (float)pm->gap[(size_t)l2_depth_level(d, dtop) * nb + b])) {
-                fa[i] = 0.0f;
-                continue;
-            }
-            fa[i] *= l2_filter(pm, ca[i], k, d);
         }
     }
+    /* the row's three planes of light (and the cache row's) */
     float cr = p->rgb.x, cg = p->rgb.y, cb = p->rgb.z;
-    float *a = acc + 3 * xa;
+    int w = ctx->width;
     if (cache) {
-        float *c = cache + 3 * (xa - p->x0);
+        int cw = p->x1 - p->x0;
+        float *c = cache + (xa - p->x0);
         for (int i = 0; i < n; i++) {
-            c[3 * i] = cr * fa[i];
-            c[3 * i + 1] = cg * fa[i];
-            c[3 * i + 2] = cb * fa[i];
+            c[i] = cr * fa[i];
+            c[cw + i] = cg * fa[i];
+            c[2 * cw + i] = cb * fa[i];
         }
     }
+    float *ar = acc + xa, *ag = ar + w, *ab = ar + 2 * w;
     for (int i = 0; i < n; i++) {
-        a[3 * i] += cr * fa[i];
-        a[3 * i + 1] += cg * fa[i];
-        a[3 * i + 2] += cb * fa[i];
+        ar[i] += cr * fa[i];
+        ag[i] += cg * fa[i];
+        ab[i] += cb * fa[i];
     }
 }
 
 /* Adds a cached light's row. */
-static void add_cached(const l2_prep *p, int y, float *acc)
+static void add_cached(const lx_light2d *ctx, const l2_prep *p, int y, float *acc)
 {
-    const float *c = p->cache + (size_t)(y - p->y0) * (p->x1 - p->x0) * 3;
-    float *a = acc + 3 * p->x0;
-    int n = (p->x1 - p->x0) * 3;
-    for (int i = 0; i < n; i++)
-        a[i] += c[i];
+    int cw = p->x1 - p->x0, w = ctx->width;
+    const float *c = p->cache + (size_t)(y - p->y0) * cw * 3;
+    for (int k = 0; k < 3; k++) {
+        float *a = acc + (size_t)k * w + p->x0;
+        const float *ck = c + (size_t)k * cw;
+        for (int i = 0; i < cw; i++)
+            a[i] += ck[i];
+    }
 }
 
 /* Adds light p to the rows [y0, y1) of a band (acc: the band's rows,
  * width*3 floats each, from row y0): the blocks the light leaves dark are
  * skipped, the rest shaded in runs of neighbouring blocks. runs holds
- * 2*(blocks_x+1) ints. */
+ * 3*(blocks_x+1) ints. */
 static void shade_band(const lx_light2d *ctx, const l2_prep *p, int y0, int y1, float *acc,
                        float *scratch, int *runs)
 {
@@ -166,14 +216,16 @@ static void shade_band(const lx_light2d *ctx, const l2_prep *p, int y0, int y1, 
         return;
     if (!p->relight) {
         for (int y = ya; y < yb; y++)
-            add_cached(p, y, acc + (size_t)(y - y0) * w * 3);
+            add_cached(ctx, p, y, acc + (size_t)(y - y0) * w * 3);
         return;
     }
     if (p->cache)
         for (int y = ya; y < yb; y++)
             memset(p->cache + (size_t)(y - p->y0) * (p->x1 - p->x0) * 3, 0,
                    (size_t)(p->x1 - p->x0) * 3 * sizeof(float));
-    /* the band's blocks under the light, merged into runs of lit ones */
+    /* the band's blocks under the light: dark ones dropped, the others
+     * merged into runs of the same kind (wholly lit, needing no shadow
+     * pass, or not); runs[3 r + 2]: the kind */
     int by = y0 / L2_BLOCK, count = 0;
     int bx0 = p->x0 / L2_BLOCK, bx1 = (p->x1 - 1) / L2_BLOCK;
     for (int bx = bx0; bx <= bx1; bx++) {
@@ -183,18 +235,20 @@ static void shade_band(const lx_light2d *ctx, const l2_prep *p, int y0, int y1, 
         bool caster = ctx->block_caster[(size_t)by * ctx->blocks_x + bx] != 0;
         if (l2_block_dark(p, xs, ya, xe, yb, caster))
             continue;
-        if (count > 0 && runs[2 * count - 1] == xs)
-            runs[2 * count - 1] = xe;
+        int kind = l2_block_lit(p, xs, ya, xe, yb, caster) ? 0 : 1;
+        if (count > 0 && runs[3 * count - 2] == xs && runs[3 * count - 1] == kind)
+            runs[3 * count - 2] = xe;
         else {
-            runs[2 * count] = xs;
-            runs[2 * count + 1] = xe;
+            runs[3 * count] = xs;
+            runs[3 * count + 1] = xe;
+            runs[3 * count + 2] = kind;
             count++;
         }
     }
     for (int y = ya; y < yb; y++)
         for (int r = 0; r < count; r++)
-            shade_span(ctx, p, y, runs[2 * r], runs[2 * r + 1], acc + (size_t)(y - y0) * w * 3,
-                       scratch);
+            shade_span(ctx, p, y, runs[3 * r], runs[3 * r + 1], acc + (size_t)(y - y0) * w * 3,
+                       scratch, runs[3 * r + 2] != 0);
 }
 
 lx_status lx_light2d_render(lx_light2d *ctx, lx_vec3 ambient, const lx_image *albedo, float *out,
@@ -238,13 +292,22 @@ lx_status lx_light2d_render(lx_light2d *ctx, lx_vec3 ambient, const lx_image *al
     }
     if (st != LX_OK)
         return st;
-    /* per thread: a band of accumulated rows, four rows of scratch and the
+    /* per thread: a band of accumulated rows, eight rows of scratch and the
      * runs of a band */
-    size_t band = (size_t)L2_BLOCK * w * 3, per = band + (size_t)w * 4;
-    size_t nruns = 2 * ((size_t)ctx->blocks_x + 1);
-    float *rows = malloc((size_t)threads * (per * sizeof(float) + nruns * sizeof(int)));
-    if (!rows)
-        return lx_fail(LX_ERR_NOMEM, "light2d: out of memory for %d bands", threads);
+    size_t band = (size_t)L2_BLOCK * w * 3, per = band + (size_t)w * 8;
+    size_t nruns = 3 * ((size_t)ctx->blocks_x + 1);
+    /* kept from frame to frame (a fresh block of this size would be new
+     * pages, faulted in and cleared every frame) */
+    size_t need = (size_t)threads * (per * sizeof(float) + nruns * sizeof(int));
+    if (need > ctx->work_size) {
+        float *a = malloc(need);
+        if (!a)
+            return lx_fail(LX_ERR_NOMEM, "light2d: out of memory for %d bands", threads);
+        free(ctx->work);
+        ctx->work = a;
+        ctx->work_size = need;
+    }
+    float *rows = ctx->work;
     int *all_runs = (int *)(rows + (size_t)threads * per);
     int ach = albedo ? albedo->channels : 0;
     int bands = (hgt + L2_BLOCK - 1) / L2_BLOCK;
@@ -260,32 +323,49 @@ lx_status lx_light2d_render(lx_light2d *ctx, lx_vec3 ambient, const lx_image *al
 #pragma omp for schedule(dynamic, 1)
         for (int bi = 0; bi < bands; bi++) {
             int y0 = bi * L2_BLOCK, y1 = y0 + L2_BLOCK < hgt ? y0 + L2_BLOCK : hgt;
-            size_t len = (size_t)(y1 - y0) * w;
-            for (size_t x = 0; x < len; x++) {
-                acc[3 * x] = ambient.x;
-                acc[3 * x + 1] = ambient.y;
-                acc[3 * x + 2] = ambient.z;
+            /* each row as three planes: r, g, b */
+            for (int y = y0; y < y1; y++) {
+                float *r = acc + (size_t)(y - y0) * w * 3;
+                for (int x = 0; x < w; x++) {
+                    r[x] = ambient.x;
+                    r[w + x] = ambient.y;
+                    r[2 * w + x] = ambient.z;
+                }
             }
             /* every pixel adds its lights in their order */
             for (int i = 0; i < count; i++)
                 shade_band(ctx, &ctx->preps[i], y0, y1, acc, scratch, runs);
-            size_t row = (size_t)y0 * w * 3;
-            if (light_map)
-                memcpy(light_map + row, acc, len * 3 * sizeof *acc);
-            if (out) {
-                float *o = out + row;
-                if (albedo) {
-                    const float *a = albedo->data + (size_t)y0 * w * ach;
-                    for (size_t x = 0; x < len; x++)
-                        for (int k = 0; k < 3; k++)
-                            o[3 * x + k] = a[ach * x + k] * acc[3 * x + k];
-                } else {
-                    memcpy(o, acc, len * 3 * sizeof *acc);
+            for (int y = y0; y < y1; y++) {
+                const float *r = acc + (size_t)(y - y0) * w * 3, *g = r + w, *b = g + w;
+                size_t row = (size_t)y * w * 3;
+                if (light_map) {
+                    float *lm = light_map + row;
+                    for (int x = 0; x < w; x++) {
+                        lm[3 * x] = r[x];
+                        lm[3 * x + 1] = g[x];
+                        lm[3 * x + 2] = b[x];
+                    }
+                }
+                if (out) {
+                    float *o = out + row;
+                    if (albedo) {
+                        const float *a = albedo->data + (size_t)y * w * ach;
+                        for (int x = 0; x < w; x++) {
+                            o[3 * x] = a[ach * x] * r[x];
+                            o[3 * x + 1] = a[ach * x + 1] * g[x];
+                            o[3 * x + 2] = a[ach * x + 2] * b[x];
+                        }
+                    } else {
+                        for (int x = 0; x < w; x++) {
+                            o[3 * x] = r[x];
+                            o[3 * x + 1] = g[x];
+                            o[3 * x + 2] = b[x];
+                        }
+                    }
                 }
             }
         }
     }
-    free(rows);
     for (int i = 0; i < count; i++)
         if (ctx->preps[i].cache)
             ctx->preps[i].relight = false;
