@@ -35,6 +35,8 @@ lx_bake_desc lx_bake_desc_defaults(const lx_bake_desc *desc)
         d.gi_samples = LX_GI_SAMPLES_DEFAULT;
     if (d.emissive_scale == 0.0f)
         d.emissive_scale = 1.0f;
+    if (d.supersample == 0)
+        d.supersample = 1;
     return d;
 }
 
@@ -61,6 +63,9 @@ static lx_status validate_desc(const lx_bake_desc *d)
     if (d->gi_samples < 1 || d->gi_samples > LX_MAX_GI_SAMPLES)
         return lx_fail(LX_ERR_INVALID, "gi samples %u is outside 1..%u", d->gi_samples,
                        LX_MAX_GI_SAMPLES);
+    if (d->supersample < 1 || d->supersample > LX_MAX_SUPERSAMPLE)
+        return lx_fail(LX_ERR_INVALID, "supersample %d is outside 1..%d", d->supersample,
+                       LX_MAX_SUPERSAMPLE);
     if (!(d->emissive_scale > 0.0f) || !isfinite(d->emissive_scale))
         return lx_fail(LX_ERR_INVALID, "emissive scale must be a finite number > 0");
     if (d->quantity != LX_QUANTITY_IRRADIANCE && d->quantity != LX_QUANTITY_RADIANCE)
@@ -355,6 +360,9 @@ lx_status lx_baker_create(const lx_scene *scene, const lx_bake_desc *in, lx_bake
                          .progress = desc.progress ? bvh_progress : NULL,
                          .progress_user = &desc};
     st = lx_tracer_create(scene, &td, &b->tracer);
+    /* samples inside geometry move out (straddle.c) */
+    if (st == LX_OK)
+        st = lx_bake_straddle(b);
     if (st != LX_OK) {
         lx_baker_destroy(b);
         return st;
