@@ -70,6 +70,31 @@ static bool inverse_vector(const lx_mat4 *m, lx_vec3 v, lx_vec3 *out)
     return true;
 }
 
+/* Whether texel i's sample may move to `to`: its own surface (the same
+ * node's mesh) is under it, and none of the footprint's rays from there
+ * meets a back face first, however far (it is inside no other solid;
+ * seen from behind, single-sided geometry counts as a solid, so moves
+ * stay conservative). A texel sandwiched between two solids, or one whose way out
+ * leaves its own surface (a face buried in a wall up to its edge), stays
+ * where it is: the bounces' validity test finds it inside and leaves it
+ * out. */
+static bool acceptable(const lx_baker *b, const lx_lightmap *map, uint32_t i, lx_vec3 to,
+                       lx_vec3 ng, float lift, const lx_vec3 *dirs, uint32_t nd)
+{
+    lx_ray down = {.origin = lx_madd(to, ng, lift), .dir = lx_neg(ng), .tmin = 0.0f,
+                   .tmax = 2.0f * lift};
+    lx_hit hit;
+    if (!lx_tracer_closest(b->tracer, &down, &hit) || hit.node != map->texels[i].node ||
+        hit.mesh != map->texels[i].mesh)
+        return false;
+    for (uint32_t k = 0; k < nd; k++) {
+        float t;
+        if (first_hit(b->tracer, to, ng, lift, dirs[k], b->scene_diagonal, &t) < 0)
+            return false;
+    }
+    return true;
+}
+
 /* One texel: moves its sample when it is inside geometry and marks its
  * hidden supersampling points; returns whether it moved. */
 static bool straddle_texel(const lx_baker *b, lx_lightmap *map, uint32_t i)
@@ -93,24 +118,33 @@ static bool straddle_texel(const lx_baker *b, lx_lightmap *map, uint32_t i)
     for (int k = 0; k < 8; k++)
         if (along_surface(step[k], ng, &dirs[nd]))
             nd++;
-    /* the sample: the nearest back face within the half-diagonal; any hit
-     * within the diagonal says geometry is near (then the points look) */
-    float best = INFINITY;
-    lx_vec3 best_dir = lx_v3(0.0f, 0.0f, 0.0f);
+    /* the sample: the back faces within the half-diagonal, nearest
+     * first; any hit within the diagonal says geometry is near (then the
+     * points look) */
+    float dist[8];
+    uint32_t order[8], exits = 0;
     bool near = false;
     for (uint32_t k = 0; k < nd; k++) {
         float t;
         int h = first_hit(b->tracer, p, ng, lift, dirs[k], 2.0f * half, &t);
         near |= h != 0;
-        if (h < 0 && t <= half && t < best) {
-            best = t;
-            best_dir = dirs[k];
+        if (h < 0 && t <= half) {
+            uint32_t j = exits++;
+            for (; j > 0 && dist[j - 1] > t; j--) {
+                dist[j] = dist[j - 1];
+                order[j] = order[j - 1];
+            }
+            dist[j] = t;
+            order[j] = k;
         }
     }
     bool moved = false;
-    if (isfinite(best)) {
-        lx_vec3 offset = lx_scale(best_dir, best + 2.0f * lift);
-        map->world_position[i] = lx_add(p, offset);
+    for (uint32_t e = 0; e < exits && !moved; e++) {
+        lx_vec3 offset = lx_scale(dirs[order[e]], dist[e] + 2.0f * lift);
+        lx_vec3 to = lx_add(p, offset);
+        if (!acceptable(b, map, i, to, ng, lift, dirs, nd))
+            continue;
+        map->world_position[i] = to;
         if (map->object_position) {
             lx_vec3 local;
             if (inverse_vector(&b->node_world[map->texels[i].node], offset, &local))
