@@ -199,6 +199,12 @@ typedef struct lx_lightmap_info {
 } lx_lightmap_info;
 
 /* Builds the texel maps of every node with UVs and the ray structures.
+ * A texel sample that lies inside geometry (a floor texel whose centre is
+ * under a wall standing on the floor) moves along its surface to the
+ * visible side, within its texel, when its own surface continues there
+ * outside every solid (docs/ARCHITECTURE.md, the texel map); it then
+ * bakes like its visible part instead of dark. lx_baker_texel reports
+ * the moved position.
  * Lights are copied from scene->lights, ambient from scene->ambient.
  * desc->progress, when set, hears the texel maps (the first 90%) and the
  * BVH build (the rest) and may stop either (LX_ERR_CANCELLED, *out stays
