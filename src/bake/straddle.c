@@ -10,7 +10,8 @@
  * world map of its triangle), lifted off the surface by the shadow bias;
  * when the first thing one of them hits within the texel's half-diagonal
  * is a back face, the sample sits inside that geometry and moves, along
- * the surface, to just past the nearest such hit: the visible side of the
+ * the surface, to just past the nearest such hit where its own surface
+ * continues outside every solid (acceptable()): the visible side of the
  * wall, still within the texel's footprint. A supersampling point whose
  * first hit along one of the footprint's four axis directions, within the
  * texel's whole diagonal, is a back face lies under the wall: it is left
