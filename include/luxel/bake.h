@@ -176,8 +176,8 @@ typedef struct lx_bake_desc {
                               light (lights, ambient, sky) is the mean over the
                               N x N stratified points of its footprint that a
                               triangle covers (thin features, hard shadow
-                              edges); gathers and AO keep the texel's one
-                              point. Costs N^2 times the direct pass and about
+                              edges); gathers, AO and the dynamic lights'
+                              real-time buffers keep the texel's one point. Costs N^2 times the direct pass and about
                               40 N^2 bytes a texel more (72 N^2 for a map of a
                               node away from the identity) */
     lx_progress_fn progress;
