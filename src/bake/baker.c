@@ -88,11 +88,15 @@ static float maps_from(const lx_baker *b)
 }
 
 /* Bytes a w x h lightmap takes per texel, with the texel's horizon record
- * when a material on it has a height. */
-static uint64_t map_bytes(int w, int h, bool horizon)
+ * when a material on it has a height, its footprint axes (until the
+ * samples are checked, straddle.c) and its supersampling points (three
+ * vectors and a flag each). */
+static uint64_t map_bytes(int w, int h, bool horizon, int supersample)
 {
+    uint64_t points = supersample > 1 ? (uint64_t)supersample * supersample : 0;
     return (uint64_t)w * (uint64_t)h *
-           (LX_BYTES_PER_TEXEL + (horizon ? sizeof(lx_texel_horizon) : 0));
+           (LX_BYTES_PER_TEXEL + (horizon ? sizeof(lx_texel_horizon) : 0) + 2 * sizeof(lx_vec3) +
+            points * (3 * sizeof(lx_vec3) + 1));
 }
 
 static bool bvh_progress(void *user, float fraction)
@@ -111,7 +115,8 @@ static lx_status build_node_maps(lx_baker *b, const lx_scene *scene, const lx_ba
     for (uint32_t n = 0; n < scene->node_count; n++) {
         int w, h;
         lx_texel_map_size(scene, n, desc, &w, &h);
-        bytes += map_bytes(w, h, lx_bake_node_has_horizon(scene, b->horizon_materials, n));
+        bytes += map_bytes(w, h, lx_bake_node_has_horizon(scene, b->horizon_materials, n),
+                           desc->supersample);
         largest = w > largest ? w : largest;
         with_uvs += w > 0;
     }
@@ -172,7 +177,8 @@ static lx_status build_pages(lx_baker *b, const lx_scene *scene, const lx_bake_d
         for (uint32_t n = 0; n < scene->node_count && !horizon; n++)
             horizon = atlas->nodes[n].page == p &&
                       lx_bake_node_has_horizon(scene, b->horizon_materials, n);
-        bytes += map_bytes(atlas->pages[p].width, atlas->pages[p].height, horizon);
+        bytes += map_bytes(atlas->pages[p].width, atlas->pages[p].height, horizon,
+                           desc->supersample);
     }
     char what[400];
     snprintf(what, sizeof what, "%s: baking %u atlas pages", scene->path, atlas->page_count);
