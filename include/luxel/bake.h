@@ -115,6 +115,10 @@ int lx_bake_uv_set(const lx_scene *scene, uint32_t node, lx_uv_choice choice);
 #define LX_DYNAMIC_BOUNCE_SAMPLES_RECOMMENDED 16u
 #define LX_MAX_DYNAMIC_BOUNCE_SAMPLES 1024u
 
+/* Texel supersampling (lx_bake_desc.supersample): at most this many
+ * sample points a side, N x N a texel. */
+#define LX_MAX_SUPERSAMPLE 16
+
 /* What a bake's denoising filters (`luxel bake --denoise off|indirect|all`). */
 typedef enum lx_denoise_mode {
     LX_DENOISE_OFF = 0,  /* nothing: out = direct + indirect */
@@ -197,6 +201,14 @@ typedef struct lx_bake_desc {
                               lx_baker_sh and lx_baker_dominant. Texels are
                               then baked with the interpolated vertex normal:
                               normal maps are left to run time */
+    int supersample;       /* 1..LX_MAX_SUPERSAMPLE, 0 = 1: each texel's direct
+                              light (lights, ambient, sky) is the mean over the
+                              N x N stratified points of its footprint that a
+                              triangle covers (thin features, hard shadow
+                              edges); gathers, AO and the dynamic lights'
+                              real-time buffers keep the texel's one point. Costs N^2 times the direct pass and about
+                              40 N^2 bytes a texel more (72 N^2 for a map of a
+                              node away from the identity) */
     lx_progress_fn progress;
     void *progress_user;
 } lx_bake_desc;
@@ -216,6 +228,12 @@ typedef struct lx_lightmap_info {
 } lx_lightmap_info;
 
 /* Builds the texel maps of every node with UVs and the ray structures.
+ * A texel sample that lies inside geometry (a floor texel whose centre is
+ * under a wall standing on the floor) moves along its surface to the
+ * visible side, within its texel, when its own surface continues there
+ * outside every solid (docs/ARCHITECTURE.md, the texel map); it then
+ * bakes like its visible part instead of dark. lx_baker_texel reports
+ * the moved position.
  * Lights are copied from scene->lights, ambient from scene->ambient.
  * desc->progress, when set, hears the texel maps (the first 90%) and the
  * BVH build (the rest) and may stop either (LX_ERR_CANCELLED, *out stays

@@ -169,6 +169,19 @@ typedef struct lx_lightmap {
                         spherical harmonics (directional.c); NULL unless
                         desc.directional */
     lx_seam_stitch *stitch; /* NULL: not asked, or no seams */
+    /* Texel supersampling (desc.supersample = N > 1): sub_count = N^2
+     * points a texel, point s of texel i at [s * used_texels + i] (so
+     * the arrays from s * used_texels on read like world_position);
+     * sub_covered 0 where no triangle covers point s (it then holds the
+     * texel's own sample and is left out of the mean). Object-space
+     * copies exactly when the texel's are kept. sub_count 0: none. */
+    uint32_t sub_count;
+    lx_vec3 *sub_position, *sub_normal, *sub_geometric_normal;
+    lx_vec3 *sub_object_position, *sub_object_normal, *sub_object_geometric_normal;
+    uint8_t *sub_covered;
+    /* per texel until lx_bake_straddle has run (then NULL): the world
+     * step of one texel along x and along y, [2 i] and [2 i + 1] */
+    lx_vec3 *texel_axes;
 } lx_lightmap;
 
 struct lx_baker {
@@ -283,6 +296,12 @@ lx_status lx_texel_map_keep_object_space(lx_lightmap *map);
  * transform; the map has its object-space copies
  * (lx_texel_map_keep_object_space). */
 void lx_texel_map_transform(lx_lightmap *map, uint32_t node, const lx_mat4 *world);
+
+/* straddle.c: moves every texel sample that lies inside geometry (a
+ * floor texel half under a wall standing on it) to the visible side and
+ * leaves such supersampling points out; frees the maps' texel_axes.
+ * Needs the committed tracer. */
+lx_status lx_bake_straddle(lx_baker *b);
 
 /* Adds the given lights (indices into baker->lights) into target
  * (width*height*3 floats per map), plus `ambient` at every texel

@@ -35,6 +35,8 @@ lx_bake_desc lx_bake_desc_defaults(const lx_bake_desc *desc)
         d.gi_samples = LX_GI_SAMPLES_DEFAULT;
     if (d.emissive_scale == 0.0f)
         d.emissive_scale = 1.0f;
+    if (d.supersample == 0)
+        d.supersample = 1;
     return d;
 }
 
@@ -63,6 +65,9 @@ static lx_status validate_desc(const lx_bake_desc *d)
     if (d->gi_samples < 1 || d->gi_samples > LX_MAX_GI_SAMPLES)
         return lx_fail(LX_ERR_INVALID, "gi samples %u is outside 1..%u", d->gi_samples,
                        LX_MAX_GI_SAMPLES);
+    if (d->supersample < 1 || d->supersample > LX_MAX_SUPERSAMPLE)
+        return lx_fail(LX_ERR_INVALID, "supersample %d is outside 1..%d", d->supersample,
+                       LX_MAX_SUPERSAMPLE);
     if (!(d->emissive_scale > 0.0f) || !isfinite(d->emissive_scale))
         return lx_fail(LX_ERR_INVALID, "emissive scale must be a finite number > 0");
     if (d->dynamic_bounce_samples > LX_MAX_DYNAMIC_BOUNCE_SAMPLES)
@@ -88,11 +93,15 @@ static float maps_from(const lx_baker *b)
 }
 
 /* Bytes a w x h lightmap takes per texel, with the texel's horizon record
- * when a material on it has a height. */
-static uint64_t map_bytes(int w, int h, bool horizon)
+ * when a material on it has a height, its footprint axes (until the
+ * samples are checked, straddle.c) and its supersampling points (three
+ * vectors and a flag each). */
+static uint64_t map_bytes(int w, int h, bool horizon, int supersample)
 {
+    uint64_t points = supersample > 1 ? (uint64_t)supersample * supersample : 0;
     return (uint64_t)w * (uint64_t)h *
-           (LX_BYTES_PER_TEXEL + (horizon ? sizeof(lx_texel_horizon) : 0));
+           (LX_BYTES_PER_TEXEL + (horizon ? sizeof(lx_texel_horizon) : 0) + 2 * sizeof(lx_vec3) +
+            points * (3 * sizeof(lx_vec3) + 1));
 }
 
 static bool bvh_progress(void *user, float fraction)
@@ -111,7 +120,8 @@ static lx_status build_node_maps(lx_baker *b, const lx_scene *scene, const lx_ba
     for (uint32_t n = 0; n < scene->node_count; n++) {
         int w, h;
         lx_texel_map_size(scene, n, desc, &w, &h);
-        bytes += map_bytes(w, h, lx_bake_node_has_horizon(scene, b->horizon_materials, n));
+        bytes += map_bytes(w, h, lx_bake_node_has_horizon(scene, b->horizon_materials, n),
+                           desc->supersample);
         largest = w > largest ? w : largest;
         with_uvs += w > 0;
     }
@@ -172,7 +182,8 @@ static lx_status build_pages(lx_baker *b, const lx_scene *scene, const lx_bake_d
         for (uint32_t n = 0; n < scene->node_count && !horizon; n++)
             horizon = atlas->nodes[n].page == p &&
                       lx_bake_node_has_horizon(scene, b->horizon_materials, n);
-        bytes += map_bytes(atlas->pages[p].width, atlas->pages[p].height, horizon);
+        bytes += map_bytes(atlas->pages[p].width, atlas->pages[p].height, horizon,
+                           desc->supersample);
     }
     char what[400];
     snprintf(what, sizeof what, "%s: baking %u atlas pages", scene->path, atlas->page_count);
@@ -360,6 +371,9 @@ lx_status lx_baker_create(const lx_scene *scene, const lx_bake_desc *in, lx_bake
                          .progress = desc.progress ? bvh_progress : NULL,
                          .progress_user = &desc};
     st = lx_tracer_create(scene, &td, &b->tracer);
+    /* samples inside geometry move out (straddle.c) */
+    if (st == LX_OK)
+        st = lx_bake_straddle(b);
     if (st != LX_OK) {
         lx_baker_destroy(b);
         return st;

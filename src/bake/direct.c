@@ -464,6 +464,135 @@ static void vec3_to_acc(const lx_vec3 *accum, tile_soa *t)
         }
 }
 
+/* A tile's direct light, ambient, lights and (for the baked buffers) the
+ * sky, into t->acc lane by lane, and with sh (TILE_TEXELS, by texel of
+ * the tile) their directions; seed keys its random numbers (the map's
+ * index, or a supersampling point's). */
+static void shade_tile(const lx_baker *b, uint32_t seed, const lx_lightmap *map, uint32_t first,
+                       uint32_t count, const uint32_t *lights, uint32_t light_count,
+                       const fast_light *fast, const bool *is_fast, lx_vec3 ambient,
+                       bool to_realtime, tile_soa *t, lx_sh4 *sh)
+{
+    lx_vec3 accum[TILE_TEXELS];
+    tile_load(b, map, first, count, t);
+    if (sh) {
+        memset(sh, 0, sizeof(lx_sh4) * TILE_TEXELS);
+        for (uint32_t k = 0; k < count; k++) {
+            const lx_texel_horizon *h =
+                map->horizon && map->horizon[first + k].flags ? &map->horizon[first + k] : NULL;
+            lx_sh4_add_uniform(&sh[k], h ? lx_scale(ambient, h->ao) : ambient);
+        }
+    }
+    for (uint32_t k = 0; k < TILE_TEXELS; k++)
+        t->acc[0][k] = ambient.x, t->acc[1][k] = ambient.y, t->acc[2][k] = ambient.z;
+    /* a tile with texels under a height takes the general path,
+     * which scales their terms (light_tile) */
+    bool horizon = lx_tile_has_horizon(map, first, count);
+    if (horizon)
+        for (int k = 0; k < TILE_TEXELS; k++) {
+            const lx_texel_horizon *h =
+                t->texel[k] >= 0 ? &map->horizon[first + (uint32_t)t->texel[k]] : NULL;
+            if (h && h->flags) {
+                lx_vec3 a = lx_scale(ambient, h->ao);
+                t->acc[0][k] = a.x, t->acc[1][k] = a.y, t->acc[2][k] = a.z;
+            }
+        }
+    for (uint32_t l = 0; l < light_count; l++) {
+        if (is_fast[l] && !horizon) {
+            fast_light_tile(b, &fast[l], t, sh);
+            continue;
+        }
+        acc_to_vec3(t, accum);
+        light_tile(b, seed, map, first, count, lights[l], accum, sh);
+        vec3_to_acc(accum, t);
+    }
+    if (!to_realtime && b->has_sky && !horizon) {
+        acc_to_vec3(t, accum);
+        lx_sky_tile(b, seed, map, first, count, accum, sh);
+        vec3_to_acc(accum, t);
+    } else if (!to_realtime && b->has_sky) {
+        /* the sky alone, then added as lx_sky_tile adds it (times
+         * the AO under a height) */
+        lx_vec3 sky[TILE_TEXELS];
+        lx_sh4 sky_sh[TILE_TEXELS];
+        for (uint32_t k = 0; k < count; k++)
+            sky[k] = lx_v3(0.0f, 0.0f, 0.0f);
+        if (sh)
+            memset(sky_sh, 0, sizeof sky_sh);
+        lx_sky_tile(b, seed, map, first, count, sky, sh ? sky_sh : NULL);
+        acc_to_vec3(t, accum);
+        for (uint32_t k = 0; k < count; k++) {
+            const lx_texel_horizon *h = &map->horizon[first + k];
+            accum[k] = lx_add(accum[k], h->flags ? lx_scale(sky[k], h->ao) : sky[k]);
+            if (sh) {
+                if (h->flags)
+                    lx_sh4_scale(&sky_sh[k], h->ao);
+                for (int c = 0; c < LX_SH_FLOATS; c++)
+                    sh[k].c[c] += sky_sh[k].c[c];
+            }
+        }
+        vec3_to_acc(accum, t);
+    }
+}
+
+/* Texel supersampling: the tile shaded at each of its points s (a view
+ * of the map whose samples are point s's, random numbers keyed apart),
+ * each texel the mean over its covered points, summed in double in point
+ * order (the same light at every point gives back its exact value); a
+ * texel no point covers keeps its own sample's light. */
+static void shade_supersampled(const lx_baker *b, uint32_t map_index, const lx_lightmap *map,
+                               uint32_t first, uint32_t count, const uint32_t *lights,
+                               uint32_t light_count, const fast_light *fast, const bool *is_fast,
+                               lx_vec3 ambient, tile_soa *t, lx_sh4 *sh)
+{
+    double sum[TILE_TEXELS][3], sh_sum[TILE_TEXELS][LX_SH_FLOATS];
+    uint32_t covered[TILE_TEXELS];
+    lx_sh4 point_sh[TILE_TEXELS];
+    memset(sum, 0, sizeof sum);
+    memset(sh_sum, 0, sizeof sh_sum);
+    memset(covered, 0, sizeof covered);
+    size_t used = map->info.used_texels;
+    for (uint32_t s = 0; s < map->sub_count; s++) {
+        lx_lightmap view = *map;
+        view.world_position = map->sub_position + s * used;
+        view.world_normal = map->sub_normal + s * used;
+        view.world_geometric_normal = map->sub_geometric_normal + s * used;
+        const uint8_t *on = map->sub_covered + s * used + first;
+        bool any = false;
+        for (uint32_t j = 0; j < count && !any; j++)
+            any = on[j] != 0;
+        if (!any)
+            continue;
+        shade_tile(b, map_index ^ (s << 16), &view, first, count, lights, light_count, fast,
+                   is_fast, ambient, false, t, sh ? point_sh : NULL);
+        for (int k = 0; k < TILE_TEXELS; k++) {
+            int32_t j = t->texel[k];
+            if (j < 0 || !on[j])
+                continue;
+            for (int c = 0; c < 3; c++)
+                sum[j][c] += (double)t->acc[c][k];
+            for (int c = 0; sh && c < LX_SH_FLOATS; c++)
+                sh_sum[j][c] += (double)point_sh[j].c[c];
+            covered[j]++;
+        }
+    }
+    bool missing = false;
+    for (uint32_t j = 0; j < count; j++)
+        missing |= covered[j] == 0;
+    if (missing)
+        shade_tile(b, map_index, map, first, count, lights, light_count, fast, is_fast, ambient,
+                   false, t, sh);
+    for (int k = 0; k < TILE_TEXELS; k++) {
+        int32_t j = t->texel[k];
+        if (j < 0 || covered[j] == 0)
+            continue;
+        for (int c = 0; c < 3; c++)
+            t->acc[c][k] = (float)(sum[j][c] / (double)covered[j]);
+        for (int c = 0; sh && c < LX_SH_FLOATS; c++)
+            sh[j].c[c] = (float)(sh_sum[j][c] / (double)covered[j]);
+    }
+}
+
 lx_status lx_bake_lights(lx_baker *b, const uint32_t *lights, uint32_t light_count, lx_vec3 ambient,
                          bool to_realtime, float progress_base, float progress_span)
 {
@@ -522,69 +651,14 @@ lx_status lx_bake_lights(lx_baker *b, const uint32_t *lights, uint32_t light_cou
         uint32_t count = map->tile_start[tile + 1] - first;
         if (count) {
             tile_soa t;
-            lx_vec3 accum[TILE_TEXELS];
             lx_sh4 shs[TILE_TEXELS];
             lx_sh4 *sh = directional ? shs : NULL;
-            tile_load(b, map, first, count, &t);
-            if (sh) {
-                memset(shs, 0, sizeof shs);
-                for (uint32_t k = 0; k < count; k++) {
-                    const lx_texel_horizon *h = map->horizon && map->horizon[first + k].flags
-                                                    ? &map->horizon[first + k]
-                                                    : NULL;
-                    lx_sh4_add_uniform(&shs[k], h ? lx_scale(ambient, h->ao) : ambient);
-                }
-            }
-            for (uint32_t k = 0; k < TILE_TEXELS; k++)
-                t.acc[0][k] = ambient.x, t.acc[1][k] = ambient.y, t.acc[2][k] = ambient.z;
-            /* a tile with texels under a height takes the general path,
-             * which scales their terms (light_tile) */
-            bool horizon = lx_tile_has_horizon(map, first, count);
-            if (horizon)
-                for (int k = 0; k < TILE_TEXELS; k++) {
-                    const lx_texel_horizon *h =
-                        t.texel[k] >= 0 ? &map->horizon[first + (uint32_t)t.texel[k]] : NULL;
-                    if (h && h->flags) {
-                        lx_vec3 a = lx_scale(ambient, h->ao);
-                        t.acc[0][k] = a.x, t.acc[1][k] = a.y, t.acc[2][k] = a.z;
-                    }
-                }
-            for (uint32_t l = 0; l < light_count; l++) {
-                if (is_fast[l] && !horizon) {
-                    fast_light_tile(b, &fast[l], &t, sh);
-                    continue;
-                }
-                acc_to_vec3(&t, accum);
-                light_tile(b, m, map, first, count, lights[l], accum, sh);
-                vec3_to_acc(accum, &t);
-            }
-            if (!to_realtime && b->has_sky && !horizon) {
-                acc_to_vec3(&t, accum);
-                lx_sky_tile(b, m, map, first, count, accum, sh);
-                vec3_to_acc(accum, &t);
-            } else if (!to_realtime && b->has_sky) {
-                /* the sky alone, then added as lx_sky_tile adds it (times
-                 * the AO under a height) */
-                lx_vec3 sky[TILE_TEXELS];
-                lx_sh4 sky_sh[TILE_TEXELS];
-                for (uint32_t k = 0; k < count; k++)
-                    sky[k] = lx_v3(0.0f, 0.0f, 0.0f);
-                if (sh)
-                    memset(sky_sh, 0, sizeof sky_sh);
-                lx_sky_tile(b, m, map, first, count, sky, sh ? sky_sh : NULL);
-                acc_to_vec3(&t, accum);
-                for (uint32_t k = 0; k < count; k++) {
-                    const lx_texel_horizon *h = &map->horizon[first + k];
-                    accum[k] = lx_add(accum[k], h->flags ? lx_scale(sky[k], h->ao) : sky[k]);
-                    if (sh) {
-                        if (h->flags)
-                            lx_sh4_scale(&sky_sh[k], h->ao);
-                        for (int c = 0; c < LX_SH_FLOATS; c++)
-                            shs[k].c[c] += sky_sh[k].c[c];
-                    }
-                }
-                vec3_to_acc(accum, &t);
-            }
+            if (map->sub_count > 1 && !to_realtime)
+                shade_supersampled(b, m, map, first, count, lights, light_count, fast, is_fast,
+                                   ambient, &t, sh);
+            else
+                shade_tile(b, m, map, first, count, lights, light_count, fast, is_fast, ambient,
+                           to_realtime, &t, sh);
             /* every texel belongs to one tile: plain stores, no clearing */
             for (int k = 0; k < TILE_TEXELS; k++) {
                 if (t.texel[k] < 0)

@@ -25,6 +25,7 @@ typedef struct raster_ctx {
     uint8_t *strict; /* centre strictly inside the owner */
     uint32_t overlap;
     uint32_t *slot_overlap; /* overlapping texels counted by the later mesh */
+    bool centres_only;      /* pass 1 alone (the supersampling points) */
 } raster_ctx;
 
 /* One mesh of one node on the page. */
@@ -303,7 +304,7 @@ static lx_status raster_bands(raster_ctx *r, const slot *slots, uint32_t slot_co
         br.row1 = br.row0 + RASTER_BAND < r->height ? br.row0 + RASTER_BAND : r->height;
         br.overlap = 0;
         br.slot_overlap = counts + (size_t)k * (slot_count + 1);
-        for (int pass = 0; pass < 2; pass++)
+        for (int pass = 0; pass < (r->centres_only ? 1 : 2); pass++)
             for (uint32_t e = band_start[k]; e < band_start[k + 1]; e++) {
                 uint32_t id = list[e], s = tri_slot[id];
                 const lx_mesh *m = slots[s].mesh;
@@ -584,6 +585,147 @@ static lx_status build_stitch(const slot *slots, uint32_t slot_count, lx_lightma
     return st;
 }
 
+/* The surface at barycentrics (w0, w1, w2) of triangle t of a slot's
+ * mesh, in object space: position, shading normal (normal map applied
+ * when tangents is not NULL) and geometric normal. */
+static void surface_point(const lx_scene *scene, const slot *sl, const lx_vec4 *tangents,
+                          uint32_t t, float w0, float w1, float w2, lx_vec3 *position,
+                          lx_vec3 *normal, lx_vec3 *geometric)
+{
+    const lx_mesh *m = sl->mesh;
+    const uint32_t *i = &m->indices[3 * t];
+    lx_vec3 pa = m->positions[i[0]], pb = m->positions[i[1]], pc = m->positions[i[2]];
+    *position = lx_add(lx_add(lx_scale(pa, w0), lx_scale(pb, w1)), lx_scale(pc, w2));
+    *geometric = lx_normalize(lx_cross(lx_sub(pb, pa), lx_sub(pc, pa)));
+    lx_vec3 nrm = lx_add(lx_add(lx_scale(m->normals[i[0]], w0), lx_scale(m->normals[i[1]], w1)),
+                         lx_scale(m->normals[i[2]], w2));
+    nrm = lx_length(nrm) > 1e-12f ? lx_normalize(nrm) : *geometric;
+    if (tangents)
+        sample_normal_map(material_of(scene, m), m, tangents, i, w0, w1, w2, &nrm);
+    *normal = nrm;
+}
+
+/* The world step of one texel along x and along y on triangle t of a
+ * slot (the inverse of its UV-to-texel map): zero for a triangle without
+ * UV area. */
+static void texel_axes(const raster_ctx *r, const slot *sl, uint32_t t, const lx_mat4 *world,
+                       lx_vec3 axes[2])
+{
+    const lx_mesh *m = sl->mesh;
+    const uint32_t *i = &m->indices[3 * t];
+    double a[2], b[2], c[2];
+    uv_to_texel(r, sl, sl->uv[i[0]], a);
+    uv_to_texel(r, sl, sl->uv[i[1]], b);
+    uv_to_texel(r, sl, sl->uv[i[2]], c);
+    double t1x = b[0] - a[0], t1y = b[1] - a[1], t2x = c[0] - a[0], t2y = c[1] - a[1];
+    double det = t1x * t2y - t2x * t1y;
+    axes[0] = axes[1] = lx_v3(0.0f, 0.0f, 0.0f);
+    if (!(fabs(det) > 0.0) || !isfinite(det))
+        return;
+    lx_vec3 e1 = lx_sub(m->positions[i[1]], m->positions[i[0]]);
+    lx_vec3 e2 = lx_sub(m->positions[i[2]], m->positions[i[0]]);
+    /* [e1 e2] = [dP/dx dP/dy] [t1 t2] */
+    lx_vec3 dx = lx_scale(lx_sub(lx_scale(e1, (float)t2y), lx_scale(e2, (float)t1y)),
+                          (float)(1.0 / det));
+    lx_vec3 dy = lx_scale(lx_sub(lx_scale(e2, (float)t1x), lx_scale(e1, (float)t2x)),
+                          (float)(1.0 / det));
+    axes[0] = lx_mat4_vector(world, dx);
+    axes[1] = lx_mat4_vector(world, dy);
+}
+
+/* Texel supersampling: the page rasterized again, centres only, at N
+ * times its resolution; sub-texel (x N + b, y N + a) is point s = a N + b
+ * of texel (x, y), the centre of cell (b, a) of its N x N grid, so the
+ * points are stratified over its footprint and each has the position
+ * and normals of the triangle covering it. A point no triangle covers
+ * keeps the texel's own sample and is marked uncovered. */
+static lx_status build_subsamples(const lx_scene *scene, const lx_bake_desc *desc,
+                                  const slot *slots, uint32_t slot_count, const uint8_t *skip,
+                                  uint32_t total_triangles, lx_vec4 *const *tangents,
+                                  const lx_mat4 *nms, const uint32_t *slot_node,
+                                  lx_texel_progress progress, const char *what, lx_lightmap *map)
+{
+    int n = desc->supersample, w = map->info.width, h = map->info.height;
+    uint32_t used = map->info.used_texels, count = (uint32_t)(n * n);
+    size_t pixels = (size_t)w * n * (size_t)h * n, total = (size_t)count * used;
+    raster_ctx r = {.width = w * n, .height = h * n, .row1 = h * n, .centres_only = true};
+    unsigned char *block = malloc(17 * pixels);
+    r.slot_overlap = calloc(slot_count, sizeof(uint32_t));
+    size_t bytes = sizeof(lx_vec3) * (total ? total : 1);
+    map->sub_position = malloc(bytes);
+    map->sub_normal = malloc(bytes);
+    map->sub_geometric_normal = malloc(bytes);
+    map->sub_covered = malloc(total ? total : 1);
+    bool object = map->object_position != NULL;
+    if (object) {
+        map->sub_object_position = malloc(bytes);
+        map->sub_object_normal = malloc(bytes);
+        map->sub_object_geometric_normal = malloc(bytes);
+    }
+    lx_status st = LX_OK;
+    if (!block || !r.slot_overlap || !map->sub_position || !map->sub_normal ||
+        !map->sub_geometric_normal || !map->sub_covered ||
+        (object && (!map->sub_object_position || !map->sub_object_normal ||
+                    !map->sub_object_geometric_normal))) {
+        st = lx_fail(LX_ERR_NOMEM, "%s: out of memory for %dx%d supersampling", what, n, n);
+        goto done;
+    }
+    map->sub_count = count;
+    r.owner = (uint32_t *)block;
+    r.b1 = (float *)(block + 4 * pixels);
+    r.b2 = (float *)(block + 8 * pixels);
+    r.distance = (float *)(block + 12 * pixels);
+    r.strict = block + 16 * pixels;
+    memset(r.strict, 0, pixels);
+    memset(r.owner, 0xFF, sizeof(uint32_t) * pixels);
+    st = raster_bands(&r, slots, slot_count, skip, total_triangles, desc, progress, what);
+    if (st != LX_OK)
+        goto done;
+    int64_t texels = used;
+#pragma omp parallel for schedule(static) num_threads(lx_thread_count(desc->threads))
+    for (int64_t k = 0; k < texels; k++) {
+        uint32_t pixel = map->texels[k].pixel;
+        size_t x = pixel % (uint32_t)w, y = pixel / (uint32_t)w;
+        for (uint32_t s = 0; s < count; s++) {
+            size_t q = (y * n + s / n) * (size_t)r.width + x * n + s % n;
+            size_t at = (size_t)s * used + (size_t)k;
+            uint32_t id = r.owner[q];
+            if (id == UINT32_MAX) {
+                map->sub_position[at] = map->world_position[k];
+                map->sub_normal[at] = map->world_normal[k];
+                map->sub_geometric_normal[at] = map->world_geometric_normal[k];
+                if (object) {
+                    map->sub_object_position[at] = map->object_position[k];
+                    map->sub_object_normal[at] = map->object_normal[k];
+                    map->sub_object_geometric_normal[at] = map->object_geometric_normal[k];
+                }
+                map->sub_covered[at] = 0;
+                continue;
+            }
+            uint32_t sl = slot_of(slots, slot_count, id);
+            float w1 = r.b1[q], w2 = r.b2[q];
+            lx_vec3 position, normal, geometric;
+            surface_point(scene, &slots[sl], tangents[sl], id - slots[sl].first_triangle,
+                          1.0f - w1 - w2, w1, w2, &position, &normal, &geometric);
+            const lx_mat4 *world = &scene->nodes[slots[sl].node].world;
+            const lx_mat4 *nm = &nms[slot_node[sl]];
+            map->sub_position[at] = lx_mat4_point(world, position);
+            map->sub_normal[at] = lx_normalize(lx_mat4_vector(nm, normal));
+            map->sub_geometric_normal[at] = lx_normalize(lx_mat4_vector(nm, geometric));
+            if (object) {
+                map->sub_object_position[at] = position;
+                map->sub_object_normal[at] = normal;
+                map->sub_object_geometric_normal[at] = geometric;
+            }
+            map->sub_covered[at] = 1;
+        }
+    }
+done:
+    free(block);
+    free(r.slot_overlap);
+    return st;
+}
+
 lx_status lx_texel_map_build(const lx_scene *scene, const lx_page_spec *page,
                              const lx_bake_desc *desc, lx_texel_progress progress,
                              const lx_horizon_material *horizon, lx_lightmap *map)
@@ -631,8 +773,13 @@ lx_status lx_texel_map_build(const lx_scene *scene, const lx_page_spec *page,
     bool horizon_texels = false;
     for (uint32_t k = 0; k < page->node_count && !horizon_texels; k++)
         horizon_texels = lx_bake_node_has_horizon(scene, horizon, page->nodes[k].node);
+    /* supersampling N: the raster again at N^2 the pixels (17 bytes each,
+     * freed after) and 2 x 3 vectors and a flag a point */
+    uint64_t sub = desc->supersample > 1 ? (uint64_t)desc->supersample * desc->supersample : 0;
     lx_status st = lx_check_memory(
-        pixels * (LX_BYTES_PER_TEXEL + (horizon_texels ? sizeof(lx_texel_horizon) : 0)), what);
+        pixels * (LX_BYTES_PER_TEXEL + (horizon_texels ? sizeof(lx_texel_horizon) : 0) +
+                  2 * sizeof(lx_vec3) + sub * (17 + 6 * sizeof(lx_vec3) + 1)),
+        what);
     if (st != LX_OK) {
         free(slots);
         return st;
@@ -666,7 +813,11 @@ lx_status lx_texel_map_build(const lx_scene *scene, const lx_page_spec *page,
     if (st != LX_OK)
         goto done;
 
-    st = raster_bands(&r, slots, slot_count, skip, total_triangles, desc, progress, what);
+    /* with supersampling its raster takes the later three quarters */
+    lx_texel_progress main_progress = progress, sub_progress = progress;
+    if (sub)
+        main_progress.to = sub_progress.from = progress.from + 0.25f * (progress.to - progress.from);
+    st = raster_bands(&r, slots, slot_count, skip, total_triangles, desc, main_progress, what);
     if (st != LX_OK)
         goto done;
     map->info.overlap_texels = r.overlap;
@@ -692,6 +843,7 @@ lx_status lx_texel_map_build(const lx_scene *scene, const lx_page_spec *page,
     map->world_position = malloc(sizeof(lx_vec3) * (used ? used : 1));
     map->world_normal = malloc(sizeof(lx_vec3) * (used ? used : 1));
     map->world_geometric_normal = malloc(sizeof(lx_vec3) * (used ? used : 1));
+    map->texel_axes = malloc(2 * sizeof(lx_vec3) * (used ? used : 1));
     bool want_albedo = desc->quantity == LX_QUANTITY_RADIANCE || lx_bake_keeps_surfaces(desc);
     if (want_albedo)
         map->albedo = malloc(sizeof(lx_vec3) * (used ? used : 1));
@@ -704,7 +856,7 @@ lx_status lx_texel_map_build(const lx_scene *scene, const lx_page_spec *page,
     if (emits)
         map->emission = malloc(sizeof(lx_vec3) * (used ? used : 1));
     if (!map->texels || !map->tile_start || !map->mask || !map->world_position ||
-        !map->world_normal || !map->world_geometric_normal || (want_albedo && !map->albedo) ||
+        !map->world_normal || !map->world_geometric_normal || !map->texel_axes || (want_albedo && !map->albedo) ||
         (emits && !map->emission)) {
         st = lx_fail(LX_ERR_NOMEM, "%s: out of memory", what);
         goto done;
@@ -721,7 +873,10 @@ lx_status lx_texel_map_build(const lx_scene *scene, const lx_page_spec *page,
     for (uint32_t s = 0; s < slot_count && st == LX_OK; s++) {
         const lx_mesh *m = slots[s].mesh;
         const lx_material *mat = material_of(scene, m);
-        if (mat->normal_map.width <= 0 || !m->uv[mat->normal_uv_set])
+        /* a directional bake leaves normal maps to run time (its
+         * directional data brings them in at full resolution) */
+        if (mat->normal_map.width <= 0 || !m->uv[mat->normal_uv_set] ||
+            desc->directional != LX_DIRECTIONAL_OFF)
             continue;
         if (m->tangents) {
             tangents[s] = m->tangents;
@@ -799,19 +954,12 @@ lx_status lx_texel_map_build(const lx_scene *scene, const lx_page_spec *page,
                 tx_->mesh = slots[s].mesh_index;
                 tx_->triangle = t;
                 tx_->node = slots[s].node;
-                lx_vec3 pa = m->positions[i[0]], pb = m->positions[i[1]], pc = m->positions[i[2]];
-                lx_vec3 position =
-                    lx_add(lx_add(lx_scale(pa, w0), lx_scale(pb, w1)), lx_scale(pc, w2));
-                lx_vec3 geometric = lx_normalize(lx_cross(lx_sub(pb, pa), lx_sub(pc, pa)));
-                lx_vec3 nrm =
-                    lx_add(lx_add(lx_scale(m->normals[i[0]], w0), lx_scale(m->normals[i[1]], w1)),
-                           lx_scale(m->normals[i[2]], w2));
-                nrm = lx_length(nrm) > 1e-12f ? lx_normalize(nrm) : geometric;
+                lx_vec3 position, nrm, geometric;
+                surface_point(scene, &slots[s], tangents[s], t, w0, w1, w2, &position, &nrm,
+                              &geometric);
+                texel_axes(&r, &slots[s], t, &scene->nodes[slots[s].node].world,
+                           &map->texel_axes[2 * (size_t)k]);
                 const lx_material *mat = material_of(scene, m);
-                /* a directional bake leaves normal maps to run time (its
-                 * directional data brings them in at full resolution) */
-                if (tangents[s] && desc->directional == LX_DIRECTIONAL_OFF)
-                    sample_normal_map(mat, m, tangents[s], i, w0, w1, w2, &nrm);
                 if (map->albedo)
                     map->albedo[k] = sample_albedo(mat, m, i, w0, w1, w2);
                 if (map->emission)
@@ -823,6 +971,9 @@ lx_status lx_texel_map_build(const lx_scene *scene, const lx_page_spec *page,
             }
     }
     map->info.used_texels = n;
+    if (st == LX_OK && sub)
+        st = build_subsamples(scene, desc, slots, slot_count, skip, total_triangles, tangents, nms,
+                              slot_node, sub_progress, what, map);
     if (st == LX_OK)
         st = lx_bake_horizon_texels(scene, horizon, map, r.b1, r.b2, desc->threads);
     if (st == LX_OK && desc->stitch_seams)
@@ -887,6 +1038,25 @@ lx_status lx_texel_map_keep_object_space(lx_lightmap *map)
     map->object_position = p;
     map->object_normal = n;
     map->object_geometric_normal = g;
+    if (map->sub_count) {
+        size_t sub = sizeof(lx_vec3) * map->sub_count * (size_t)map->info.used_texels;
+        lx_vec3 *sp = malloc(sub ? sub : 1), *sn = malloc(sub ? sub : 1),
+                *sg = malloc(sub ? sub : 1);
+        if (!sp || !sn || !sg) {
+            free(sp);
+            free(sn);
+            free(sg);
+            return lx_fail(LX_ERR_NOMEM,
+                           "lightmap '%s': out of memory for its supersampling's object space",
+                           map->name);
+        }
+        memcpy(sp, map->sub_position, sub);
+        memcpy(sn, map->sub_normal, sub);
+        memcpy(sg, map->sub_geometric_normal, sub);
+        map->sub_object_position = sp;
+        map->sub_object_normal = sn;
+        map->sub_object_geometric_normal = sg;
+    }
     return LX_OK;
 }
 
@@ -902,6 +1072,13 @@ void lx_texel_map_transform(lx_lightmap *map, uint32_t node, const lx_mat4 *worl
         map->world_normal[i] = lx_normalize(lx_mat4_vector(&nm, map->object_normal[i]));
         map->world_geometric_normal[i] =
             lx_normalize(lx_mat4_vector(&nm, map->object_geometric_normal[i]));
+        for (uint32_t s = 0; s < map->sub_count; s++) {
+            size_t at = (size_t)s * map->info.used_texels + i;
+            map->sub_position[at] = lx_mat4_point(world, map->sub_object_position[at]);
+            map->sub_normal[at] = lx_normalize(lx_mat4_vector(&nm, map->sub_object_normal[at]));
+            map->sub_geometric_normal[at] =
+                lx_normalize(lx_mat4_vector(&nm, map->sub_object_geometric_normal[at]));
+        }
     }
 }
 
@@ -924,5 +1101,13 @@ void lx_texel_map_free(lx_lightmap *map)
     free(map->realtime);
     free(map->sh);
     lx_seam_stitch_free(map->stitch);
+    free(map->sub_position);
+    free(map->sub_normal);
+    free(map->sub_geometric_normal);
+    free(map->sub_object_position);
+    free(map->sub_object_normal);
+    free(map->sub_object_geometric_normal);
+    free(map->sub_covered);
+    free(map->texel_axes);
     memset(map, 0, sizeof *map);
 }

@@ -1,5 +1,5 @@
 # End-to-end tests of `luxel bake`'s indirect light (--bounces,
-# --gi-samples, --emissive-scale), run on the real binary with its own
+# --gi-samples, --emissive-scale, --supersample), run on the real binary with its own
 # defaults (LUXEL_REAL): the default bake has two bounces and says so in
 # the manifest; --bounces 0 ignores the other GI settings, byte for byte;
 # 1 and 2 threads give the same bytes; an emissive material alone lights a
@@ -76,9 +76,23 @@ check "--emissive-scale 2 doubles every value exactly" \
          { if (!($1 == 0 && a[FNR] == 0) && $1 != a[FNR] + 8388608) bad = 1 } END { exit bad }' \
     <(bits "$WORK/glow1/plates.pfm") <(bits "$WORK/glow2/plates.pfm")
 
+# ---- supersampling -----------------------------------------------------------------
+run "$BIN" bake "$ROOM" "${SMALL[@]}" --bounces 0 --supersample 3 -o "$WORK/ss3"
+expect_rc 0 "--supersample 3"
+check "manifest: the supersampling" grep -Eq '"supersample":[[:space:]]*3' \
+    "$WORK/ss3/manifest.json"
+check "--supersample 3 changes room.exr (its shadow edges)" \
+    sh -c "! cmp -s '$WORK/direct/room.exr' '$WORK/ss3/room.exr'"
+run "$BIN" bake "$ROOM" "${SMALL[@]}" --bounces 0 --supersample 1 -o "$WORK/ss1"
+expect_rc 0 "--supersample 1"
+for n in room tall_box short_box; do
+    check "$n.exr: --supersample 1 is the plain bake" cmp -s "$WORK/direct/$n.exr" "$WORK/ss1/$n.exr"
+done
+
 # ---- bad values -------------------------------------------------------------------
 for bad in "--bounces -1" "--bounces 65" "--bounces two" "--gi-samples 0" "--gi-samples 70000" \
-    "--emissive-scale 0" "--emissive-scale -2" "--emissive-scale nan"; do
+    "--emissive-scale 0" "--emissive-scale -2" "--emissive-scale nan" "--supersample 0" \
+    "--supersample 17" "--supersample two"; do
     # shellcheck disable=SC2086
     run "$BIN" bake "$ROOM" $bad -q -o "$WORK/bad"
     expect_rc 2 "$bad"

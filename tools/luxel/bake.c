@@ -57,6 +57,10 @@ static const char *bake_usage =
     "  --bounces N             indirect diffuse bounces, 0..%d; 0 bakes direct\n"
     "                          light only (default %d)\n"
     "  --gi-samples N          gather rays per texel per bounce (default %u)\n"
+    "  --supersample N         direct light of each texel averaged over N x N\n"
+    "                          points of its footprint, 1..%d (default 1): thin\n"
+    "                          features, smooth hard-shadow edges; N^2 times the\n"
+    "                          direct light's rays and about 37 N^2 bytes a texel\n"
     "  --emissive-scale X      multiplier on emissive materials' radiance (nits),\n"
     "                          for files not authored in physical units\n"
     "                          (default 1); emitters light through the bounces\n"
@@ -112,6 +116,7 @@ enum {
     OPT_RENDER,
     OPT_TONEMAP,
     OPT_CLEAN,
+    OPT_SUPERSAMPLE,
     OPT_NO_STITCH,
     OPT_AO,
     OPT_AO_DISTANCE,
@@ -133,6 +138,7 @@ static int parse_args(int argc, char **argv, bake_args *a)
         {"render", no_argument, NULL, OPT_RENDER},
         {"tonemap", required_argument, NULL, OPT_TONEMAP},
         {"clean", no_argument, NULL, OPT_CLEAN},
+        {"supersample", required_argument, NULL, OPT_SUPERSAMPLE},
         {"no-stitch", no_argument, NULL, OPT_NO_STITCH},
         {"ao", no_argument, NULL, OPT_AO},
         {"ao-distance", required_argument, NULL, OPT_AO_DISTANCE},
@@ -231,6 +237,12 @@ static int parse_args(int argc, char **argv, bake_args *a)
             a->ao_desc.samples = (uint32_t)n;
             a->ao_option = "--ao-samples";
             break;
+        case OPT_SUPERSAMPLE:
+            if (!cli_parse_int(optarg, 1, LX_MAX_SUPERSAMPLE, &n))
+                return cli_usage_error("bake", "--supersample must be an integer in 1..%d, not '%s'",
+                                       LX_MAX_SUPERSAMPLE, optarg);
+            a->desc.supersample = (int)n;
+            break;
         case 'h': {
             /* the defaults shown are the library's */
             lx_bake_desc d = lx_bake_desc_defaults(NULL);
@@ -238,7 +250,8 @@ static int parse_args(int argc, char **argv, bake_args *a)
             printf(bake_usage, d.resolution, CLI_ATLAS_RESOLUTION, d.max_resolution,
                    d.quantity == LX_QUANTITY_RADIANCE ? "radiance" : "irradiance",
                    (double)d.sky.intensity, d.sky.samples, LX_MAX_BOUNCES,
-                   LX_BOUNCES_RECOMMENDED, d.gi_samples, (double)LX_AO_DISTANCE_DEFAULT,
+                   LX_BOUNCES_RECOMMENDED, d.gi_samples, LX_MAX_SUPERSAMPLE,
+                   (double)LX_AO_DISTANCE_DEFAULT,
                    LX_AO_SAMPLES_DEFAULT, LX_PADDING_RECOMMENDED, u.atlas_size);
             return -1;
         }
@@ -678,6 +691,8 @@ int cmd_bake(int argc, char **argv)
         lx_ao_desc ad = lx_ao_desc_defaults(&a.ao_desc);
         cJSON_AddNumberToObject(manifest, "ao_distance", ad.distance);
     }
+    if (a.desc.supersample > 1)
+        cJSON_AddNumberToObject(manifest, "supersample", a.desc.supersample);
     cJSON_AddBoolToObject(manifest, "seams_stitched", a.desc.stitch_seams);
     cJSON_AddStringToObject(manifest, "denoise", lx_denoise_mode_name(a.desc.denoise));
     if (a.desc.directional) {
