@@ -6,8 +6,9 @@
  * the lightmap as the cache). Bounce k: every valid texel casts N
  * stratified cosine-weighted rays (Malley's method, as sky.c); a ray that
  * hits the front face of a lightmapped surface reads that surface's bounce
- * k-1 exitant radiance, albedo / pi x E_{k-1} (plus its emission at the
- * first gather), bilinearly over the valid texels of its lightmap; the
+ * k-1 exitant radiance, albedo / pi x E_{k-1} (emission is not picked up:
+ * emitters are direct light, emitters.c, already in E_0), bilinearly over
+ * the valid texels of its lightmap; the
  * texel's E_k = pi / N x sum (the cosine-weighted estimator of the
  * irradiance integral). Escaping rays and back faces bring nothing.
  * Validity (Unity's "backface tolerance"): a texel whose rays mostly hit
