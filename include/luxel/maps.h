@@ -375,6 +375,35 @@ lx_status lx_compute_tangents(const lx_mesh *mesh, int uv_set, lx_vec4 *out);
  * and tangent t (w = handedness); normalized. */
 lx_vec3 lx_tangent_to_world(lx_vec3 m, lx_vec3 n, lx_vec4 t);
 
+/* ---- materials at a point ---------------------------------------------------
+ * A glTF material's values at a point of a mesh (barycentrics w0, w1, w2
+ * of the triangle with vertex indices i[3]): each texture read bilinearly
+ * at the point's UVs moved by its KHR_texture_transform. The baker reads
+ * texel centres and luxel render its ray hits through these, so both see
+ * a material alike. */
+
+/* The mesh's material; a mesh without one (or a scene built without
+ * materials) reads as white, non-emissive and unmapped. */
+const lx_material *lx_mesh_material(const lx_scene *scene, const lx_mesh *m);
+
+/* A material's emitted radiance in nits times scale, without texture. */
+lx_vec3 lx_material_emission(const lx_material *mat, float scale);
+
+/* Base colour factor x base-colour texture (linear RGB). */
+lx_vec3 lx_material_albedo_at(const lx_material *mat, const lx_mesh *m, const uint32_t *i,
+                              float w0, float w1, float w2);
+
+/* lx_material_emission times the emissive texture's RGB. */
+lx_vec3 lx_material_emission_at(const lx_material *mat, const lx_mesh *m, const uint32_t *i,
+                                float w0, float w1, float w2, float scale);
+
+/* *normal (object space, unit) bent by the material's normal map through
+ * the vertex tangents (xyz, w = handedness, of the map's UV set, e.g.
+ * from lx_compute_tangents); unchanged without that UV set. The caller
+ * checks that the material has a normal map. */
+void lx_material_normal_at(const lx_material *mat, const lx_mesh *m, const lx_vec4 *tangents,
+                           const uint32_t *i, float w0, float w1, float w2, lx_vec3 *normal);
+
 #ifdef __cplusplus
 }
 #endif

@@ -146,6 +146,9 @@ typedef struct lx_lightmaps {
     bool sh_normalized;   /* the sh files hold L1 / (sqrt 3 L00) as codes
                              (decoded to E1 when loaded) */
     float sky_intensity;  /* its multiplier (1 when absent) */
+    float emissive_scale; /* the bake's --emissive-scale (1 when absent): the
+                             render draws emissive materials' radiance
+                             times it */
     lx_lightmap_page *pages;
     uint32_t page_count;
     lx_lightmap_node *nodes;

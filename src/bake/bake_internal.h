@@ -433,8 +433,6 @@ static inline bool lx_bake_keeps_surfaces(const lx_bake_desc *desc)
 {
     return desc->bounces > 0 || desc->dynamic_bounce_samples > 0 || desc->probes;
 }
-/* A material's emitted radiance in nits times scale, without texture. */
-lx_vec3 lx_material_emission(const lx_material *mat, float scale);
 
 /* bake_denoise.c: a copy of every map's baked buffer before the bounces
  * when desc.denoise is INDIRECT with bounces (else NULL, *st LX_OK);

@@ -32,11 +32,6 @@
 /* rings searched for a valid texel when none of the four bilinear ones is */
 #define LOOKUP_RINGS 3
 
-lx_vec3 lx_material_emission(const lx_material *mat, float scale)
-{
-    return lx_scale(mat->emissive, scale);
-}
-
 lx_status lx_gi_prepare(lx_baker *b, const lx_scene *scene)
 {
     b->mesh_count = scene->mesh_count;

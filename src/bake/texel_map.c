@@ -432,68 +432,6 @@ static uint32_t slot_of(const slot *slots, uint32_t count, uint32_t id)
     return lo;
 }
 
-/* A mesh's material; a scene built without materials bakes as white. */
-static const lx_material *material_of(const lx_scene *scene, const lx_mesh *m)
-{
-    static const lx_material white = {
-        .name = "default", .base_color = {1, 1, 1, 1}, .normal_scale = 1.0f};
-    return m->material < scene->material_count ? &scene->materials[m->material] : &white;
-}
-
-static void sample_normal_map(const lx_material *mat, const lx_mesh *m, const lx_vec4 *tangents,
-                              const uint32_t *i, float w0, float w1, float w2, lx_vec3 *normal)
-{
-    const lx_vec2 *uv = m->uv[mat->normal_uv_set];
-    float u = uv[i[0]].x * w0 + uv[i[1]].x * w1 + uv[i[2]].x * w2;
-    float v = uv[i[0]].y * w0 + uv[i[1]].y * w1 + uv[i[2]].y * w2;
-    /* KHR_texture_transform moves where the map is read; the tangent frame
-     * stays the UV set's own (scene.h) */
-    lx_vec2 at = lx_uv_transform_apply(&mat->normal_transform, lx_v2(u, v));
-    float c[4];
-    lx_image_sample_bilinear(&mat->normal_map, at.x, at.y, c);
-    lx_vec3 t = lx_v3(0, 0, 0);
-    for (int k = 0; k < 3; k++) {
-        float wk = k == 0 ? w0 : (k == 1 ? w1 : w2);
-        t = lx_madd(t, lx_v3(tangents[i[k]].x, tangents[i[k]].y, tangents[i[k]].z), wk);
-    }
-    lx_vec3 mn = lx_v3((2.0f * c[0] - 1.0f) * mat->normal_scale,
-                       (2.0f * c[1] - 1.0f) * mat->normal_scale, 2.0f * c[2] - 1.0f);
-    *normal = lx_tangent_to_world(mn, *normal, lx_v4(t.x, t.y, t.z, tangents[i[0]].w));
-}
-
-static lx_vec3 sample_albedo(const lx_material *mat, const lx_mesh *m, const uint32_t *i, float w0,
-                             float w1, float w2)
-{
-    lx_vec3 a = lx_v3(mat->base_color.x, mat->base_color.y, mat->base_color.z);
-    const lx_vec2 *uv = m->uv[mat->base_color_uv_set];
-    if (mat->base_color_map.width > 0 && uv) {
-        float u = uv[i[0]].x * w0 + uv[i[1]].x * w1 + uv[i[2]].x * w2;
-        float v = uv[i[0]].y * w0 + uv[i[1]].y * w1 + uv[i[2]].y * w2;
-        lx_vec2 at = lx_uv_transform_apply(&mat->base_color_transform, lx_v2(u, v));
-        float c[4] = {1, 1, 1, 1};
-        lx_image_sample_bilinear(&mat->base_color_map, at.x, at.y, c);
-        a = lx_mul(a, lx_v3(c[0], c[1], c[2]));
-    }
-    return a;
-}
-
-/* The emitted radiance at a point of a mesh: the material's emission
- * (lx_material_emission) times its emissive texture there. */
-static lx_vec3 sample_emission(const lx_material *mat, const lx_mesh *m, const uint32_t *i,
-                               float w0, float w1, float w2, float scale)
-{
-    lx_vec3 e = lx_material_emission(mat, scale);
-    const lx_vec2 *uv = m->uv[mat->emissive_uv_set];
-    if (mat->emissive_map.width > 0 && uv && (e.x > 0.0f || e.y > 0.0f || e.z > 0.0f)) {
-        float u = uv[i[0]].x * w0 + uv[i[1]].x * w1 + uv[i[2]].x * w2;
-        float v = uv[i[0]].y * w0 + uv[i[1]].y * w1 + uv[i[2]].y * w2;
-        lx_vec2 at = lx_uv_transform_apply(&mat->emissive_transform, lx_v2(u, v));
-        float c[4] = {1, 1, 1, 1};
-        lx_image_sample_bilinear(&mat->emissive_map, at.x, at.y, c);
-        e = lx_mul(e, lx_v3(c[0], c[1], c[2]));
-    }
-    return e;
-}
 
 /* Texel n's world-space position and normals under world (nm: its normal
  * matrix), as lx_texel_map_transform computes them, and its object space
@@ -601,7 +539,7 @@ static void surface_point(const lx_scene *scene, const slot *sl, const lx_vec4 *
                          lx_scale(m->normals[i[2]], w2));
     nrm = lx_length(nrm) > 1e-12f ? lx_normalize(nrm) : *geometric;
     if (tangents)
-        sample_normal_map(material_of(scene, m), m, tangents, i, w0, w1, w2, &nrm);
+        lx_material_normal_at(lx_mesh_material(scene, m), m, tangents, i, w0, w1, w2, &nrm);
     *normal = nrm;
 }
 
@@ -850,7 +788,7 @@ lx_status lx_texel_map_build(const lx_scene *scene, const lx_page_spec *page,
     /* emission per texel: for the gather, when a material here emits */
     bool emits = false;
     for (uint32_t s = 0; s < slot_count && lx_bake_keeps_surfaces(desc); s++) {
-        lx_vec3 e = lx_material_emission(material_of(scene, slots[s].mesh), desc->emissive_scale);
+        lx_vec3 e = lx_material_emission(lx_mesh_material(scene, slots[s].mesh), desc->emissive_scale);
         emits |= e.x > 0.0f || e.y > 0.0f || e.z > 0.0f;
     }
     if (emits)
@@ -872,7 +810,7 @@ lx_status lx_texel_map_build(const lx_scene *scene, const lx_page_spec *page,
     }
     for (uint32_t s = 0; s < slot_count && st == LX_OK; s++) {
         const lx_mesh *m = slots[s].mesh;
-        const lx_material *mat = material_of(scene, m);
+        const lx_material *mat = lx_mesh_material(scene, m);
         /* a directional bake leaves normal maps to run time (its
          * directional data brings them in at full resolution) */
         if (mat->normal_map.width <= 0 || !m->uv[mat->normal_uv_set] ||
@@ -959,12 +897,12 @@ lx_status lx_texel_map_build(const lx_scene *scene, const lx_page_spec *page,
                               &geometric);
                 texel_axes(&r, &slots[s], t, &scene->nodes[slots[s].node].world,
                            &map->texel_axes[2 * (size_t)k]);
-                const lx_material *mat = material_of(scene, m);
+                const lx_material *mat = lx_mesh_material(scene, m);
                 if (map->albedo)
-                    map->albedo[k] = sample_albedo(mat, m, i, w0, w1, w2);
+                    map->albedo[k] = lx_material_albedo_at(mat, m, i, w0, w1, w2);
                 if (map->emission)
                     map->emission[k] =
-                        sample_emission(mat, m, i, w0, w1, w2, desc->emissive_scale);
+                        lx_material_emission_at(mat, m, i, w0, w1, w2, desc->emissive_scale);
                 place_texel(map, k++, &scene->nodes[slots[s].node].world, &nms[slot_node[s]],
                             position, nrm, geometric);
                 map->mask[p] = 1;

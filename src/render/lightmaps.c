@@ -241,6 +241,14 @@ static lx_status parse_manifest(const char *file, const char *dir, const cJSON *
             return LX_ERR_FORMAT;
         lm->sky_intensity = (float)v;
     }
+    lm->emissive_scale = 1.0f;
+    const cJSON *indirect = cJSON_GetObjectItemCaseSensitive(root, "indirect");
+    if (cJSON_IsObject(indirect)) {
+        v = 1.0;
+        if (!opt_number(file, indirect, "emissive_scale", 1e-30, 1e30, &v))
+            return LX_ERR_FORMAT;
+        lm->emissive_scale = (float)v;
+    }
     const cJSON *dj = cJSON_GetObjectItemCaseSensitive(root, "directional");
     if (dj && !cJSON_IsNull(dj)) {
         const cJSON *mode = cJSON_GetObjectItemCaseSensitive(dj, "mode");

@@ -141,27 +141,6 @@ typedef struct render_ctx {
     lx_mat4 *normal_matrix;
 } render_ctx;
 
-static const lx_material white = {.name = "default", .base_color = {1, 1, 1, 1}};
-
-static lx_vec3 albedo(const lx_scene *scene, const lx_mesh *m, const uint32_t *i, float w0,
-                      float w1, float w2)
-{
-    const lx_material *mat =
-        m->material < scene->material_count ? &scene->materials[m->material] : &white;
-    lx_vec3 a = lx_v3(mat->base_color.x, mat->base_color.y, mat->base_color.z);
-    int set = mat->base_color_uv_set;
-    const lx_vec2 *uv = set >= 0 && set < LX_MAX_UV_SETS ? m->uv[set] : NULL;
-    if (mat->base_color_map.width > 0 && uv) {
-        lx_vec2 t = lx_v2(uv[i[0]].x * w0 + uv[i[1]].x * w1 + uv[i[2]].x * w2,
-                          uv[i[0]].y * w0 + uv[i[1]].y * w1 + uv[i[2]].y * w2);
-        t = lx_uv_transform_apply(&mat->base_color_transform, t);
-        float c[4] = {1, 1, 1, 1};
-        lx_image_sample_bilinear(&mat->base_color_map, t.x, t.y, c);
-        a = lx_mul(a, lx_v3(c[0], c[1], c[2]));
-    }
-    return a;
-}
-
 /* The factor by which a normal map changes the lightmap's irradiance at
  * a hit (lx_render_view's contract): per channel, from the page's
  * directional data at page UV (u, v). 1 without a normal map or data. */
@@ -174,26 +153,14 @@ static lx_vec3 directional_factor(const render_ctx *c, const lx_lightmap_page *p
     const lx_vec4 *tg = c->tangents ? c->tangents[mesh_index] : NULL;
     if (!tg || !m->normals)
         return one;
-    const lx_material *mat = &c->scene->materials[m->material];
-    const lx_vec2 *uv = m->uv[mat->normal_uv_set];
-    float tu = uv[i[0]].x * w0 + uv[i[1]].x * w1 + uv[i[2]].x * w2;
-    float tv = uv[i[0]].y * w0 + uv[i[1]].y * w1 + uv[i[2]].y * w2;
-    lx_vec2 at = lx_uv_transform_apply(&mat->normal_transform, lx_v2(tu, tv));
-    float nc[4] = {0.5f, 0.5f, 1.0f, 1.0f};
-    lx_image_sample_bilinear(&mat->normal_map, at.x, at.y, nc);
+    const lx_material *mat = lx_mesh_material(c->scene, m);
     lx_vec3 n = lx_add(lx_add(lx_scale(m->normals[i[0]], w0), lx_scale(m->normals[i[1]], w1)),
                        lx_scale(m->normals[i[2]], w2));
     if (!(lx_length(n) > 1e-12f))
         return one;
     n = lx_normalize(n);
-    lx_vec3 t = lx_v3(0, 0, 0);
-    for (int k = 0; k < 3; k++) {
-        float wk = k == 0 ? w0 : (k == 1 ? w1 : w2);
-        t = lx_madd(t, lx_v3(tg[i[k]].x, tg[i[k]].y, tg[i[k]].z), wk);
-    }
-    lx_vec3 mn = lx_v3((2.0f * nc[0] - 1.0f) * mat->normal_scale,
-                       (2.0f * nc[1] - 1.0f) * mat->normal_scale, 2.0f * nc[2] - 1.0f);
-    lx_vec3 np = lx_tangent_to_world(mn, n, lx_v4(t.x, t.y, t.z, tg[i[0]].w));
+    lx_vec3 np = n;
+    lx_material_normal_at(mat, m, tg, i, w0, w1, w2, &np);
     const lx_mat4 *nm = &c->normal_matrix[node_index];
     (void)node;
     n = lx_normalize(lx_mat4_vector(nm, n));
@@ -276,9 +243,15 @@ static lx_vec3 shade(const render_ctx *c, lx_ray r, bool *hit)
         if (c->tangents)
             value = lx_mul(value, directional_factor(c, &c->lm->pages[ln->page], node, h.node, m,
                                                      h.mesh, i, w0, w1, w2, u, v));
+        /* what the surface emits (nits, as the bake scaled it) is not in
+         * the lightmap: an emitter's lightmap holds the light it receives */
+        const lx_material *mat = lx_mesh_material(scene, m);
+        lx_vec3 emitted = lx_material_emission_at(mat, m, i, w0, w1, w2, c->lm->emissive_scale);
         if (c->lm->quantity == LX_QUANTITY_RADIANCE)
-            return value;
-        return lx_scale(lx_mul(value, albedo(scene, m, i, w0, w1, w2)), 1.0f / LX_PI);
+            return lx_add(value, emitted);
+        return lx_add(lx_scale(lx_mul(value, lx_material_albedo_at(mat, m, i, w0, w1, w2)),
+                               1.0f / LX_PI),
+                      emitted);
     }
     *hit = false;
     if (c->d->sky) {

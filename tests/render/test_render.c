@@ -280,6 +280,52 @@ static void test_radiance_page(void **state)
     lx_scene_destroy(s);
 }
 
+/* An emissive material draws its own radiance on top of what it reflects:
+ * L = base / pi x E + emission x the bake's emissive_scale (manifest
+ * "indirect"), nits, as any glTF viewer draws emissiveFactor. */
+static void test_emissive_plane(void **state)
+{
+    (void)state;
+    const char *dir = lx_test_dir("render_emissive");
+    const double E = 40.0, base = 0.5, emit[3] = {2.0, 1.0, 0.5}, scale = 30.0;
+    write_constant_page(join(dir, "floor.exr"), 8, 8, (float)E, (float)E, (float)E);
+    char text[1024];
+    snprintf(text, sizeof text, plane_manifest, 1.0);
+    /* the bake's emissive scale, in the manifest's "indirect" */
+    char *tail = strrchr(text, '}');
+    assert_non_null(tail);
+    snprintf(tail, sizeof text - (size_t)(tail - text),
+             ",\"indirect\":{\"bounces\":2,\"gi_samples\":16,\"emissive_scale\":%g}}", scale);
+    write_text(join(dir, "manifest.json"), text);
+    lx_scene *s = lx_test_new_scene("plane");
+    lx_material mat = {.name = "panel",
+                       .base_color = {(float)base, (float)base, (float)base, 1.0f},
+                       .emissive = {(float)emit[0], (float)emit[1], (float)emit[2]},
+                       .normal_scale = 1.0f};
+    uint32_t mi;
+    assert_int_equal(lx_scene_add_material(s, &mat, &mi), LX_OK);
+    lx_mesh m = lx_test_plane("floor", 2.0f, 0.0f, 0.0f, 0.0f, 2);
+    m.material = mi;
+    lx_test_add(s, &m);
+    lx_test_mesh_free(&m);
+    lx_lightmaps lm;
+    assert_int_equal(lx_lightmaps_load(dir, NULL, &lm), LX_OK);
+    assert_true(fabs(lm.emissive_scale - scale) < 1e-6 * scale);
+    lx_render_desc d = {.width = 8, .height = 8, .samples = 2};
+    d.camera = (lx_camera){
+        .eye = {0, 2, 0}, .target = {0, 0, 0}, .up = {0, 0, -1}, .fov = 20.0f * LX_PI / 180.0f};
+    lx_image img;
+    assert_int_equal(lx_render_view(s, &lm, NULL, &d, &img), LX_OK);
+    for (int k = 0; k < 8 * 8 * 3; k++) {
+        double want = base * E / PI_D + emit[k % 3] * scale;
+        /* float sums of equal texels: a few ulps */
+        assert_true(fabs(img.data[k] - want) < 4e-6 * want);
+    }
+    lx_image_free(&img);
+    lx_lightmaps_free(&lm);
+    lx_scene_destroy(s);
+}
+
 /* ---- a cube baked under uniform light, through generated UVs -------------- */
 
 #define AMBIENT 50.0f
@@ -545,7 +591,8 @@ int main(void)
     lx_test_watchdog(600);
     const struct CMUnitTest tests[] = {
         cmocka_unit_test(test_plane_constant), cmocka_unit_test(test_png_page),
-        cmocka_unit_test(test_radiance_page),  cmocka_unit_test(test_cube_no_seams),
+        cmocka_unit_test(test_radiance_page),
+        cmocka_unit_test(test_emissive_plane),  cmocka_unit_test(test_cube_no_seams),
         cmocka_unit_test(test_framing),        cmocka_unit_test(test_threads_identical),
         cmocka_unit_test(test_other_scene),    cmocka_unit_test(test_cancel),
     };
