@@ -19,11 +19,12 @@ configure: deps
 
 # Generate the example scenes and sky, bake the room and the courtyard by
 # night and by day (sky light), each with a view of the lit scene
-# (view.png, bake --render), filter the sky for image-based lighting, and
-# place light probes in the room.
+# (view.png, bake --render; the room's lamp casts hard shadows, smoothed
+# across texels by --supersample), filter the sky for image-based
+# lighting, and place light probes in the room.
 demo: all
 	$(BUILD)/bin/gen_scenes examples/scenes
-	$(BUILD)/bin/luxel bake examples/scenes/room.glb -o lightmaps/room --render
+	$(BUILD)/bin/luxel bake examples/scenes/room.glb -o lightmaps/room --supersample 4 --render
 	$(BUILD)/bin/luxel bake examples/scenes/retro.glb --texel-density 8 \
 		--lights examples/retro-night.json -o lightmaps/retro --render
 	$(BUILD)/bin/luxel bake examples/scenes/retro.glb --texel-density 8 \
