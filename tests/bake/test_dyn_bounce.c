@@ -30,16 +30,6 @@
 #define N_SAMPLES 16u
 #endif
 
-static uint32_t add_material(lx_scene *scene, const char *name, float rho)
-{
-    lx_material mat = {.name = (char *)name,
-                       .base_color = {rho, rho, rho, 1.0f},
-                       .normal_scale = 1.0f};
-    uint32_t idx;
-    assert_int_equal(lx_scene_add_material(scene, &mat, &idx), LX_OK);
-    return idx;
-}
-
 /* A 4 x 3 x 4 m room (walls of albedo 0.6, inward) with a 1 m block of
  * albedo 0.3 sunk half a metre into its floor (the floor texels inside it
  * are invalid) and one point light. */
@@ -47,8 +37,8 @@ static uint32_t add_material(lx_scene *scene, const char *name, float rho)
 static lx_scene *room_with_block(lx_vec3 light_at, bool dynamic, float half)
 {
     lx_scene *scene = lx_test_new_scene("room");
-    uint32_t walls = add_material(scene, "walls", 0.6f);
-    uint32_t block = add_material(scene, "block", 0.3f);
+    uint32_t walls = lx_test_grey_material(scene, "walls", 0.6f, 0.0f);
+    uint32_t block = lx_test_grey_material(scene, "block", 0.3f, 0.0f);
     lx_mesh box = lx_test_box("room", lx_v3(-2, 0, -2), lx_v3(2, 3, 2), true);
     box.material = walls;
     lx_test_add(scene, &box);

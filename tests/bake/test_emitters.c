@@ -29,16 +29,6 @@
 
 #define PI_D 3.14159265358979323846
 
-/* Form factor from a point to a parallel rectangle of sides a, b with one
- * corner straight across at distance c (Howell C-11); signed sides give
- * the signed superposition below. */
-static double corner_factor(double a, double b, double c)
-{
-    double x = a / c, y = b / c;
-    double sx = sqrt(1.0 + x * x), sy = sqrt(1.0 + y * y);
-    return (x / sx * atan(y / sx) + y / sy * atan(x / sy)) / (2.0 * PI_D);
-}
-
 /* ... to the rectangle [x0, x1] x [z0, z1] at height c above (px, pz),
  * anywhere: the four corner rectangles, signed (the corner formula is odd
  * in each side). Zero for an empty rectangle. */
@@ -47,19 +37,10 @@ static double rect_factor(double px, double pz, double x0, double x1, double z0,
 {
     if (!(x1 > x0) || !(z1 > z0))
         return 0.0;
-    return corner_factor(x1 - px, z1 - pz, c) - corner_factor(x0 - px, z1 - pz, c) -
-           corner_factor(x1 - px, z0 - pz, c) + corner_factor(x0 - px, z0 - pz, c);
-}
-
-static uint32_t add_material(lx_scene *scene, const char *name, float rho, float le)
-{
-    lx_material mat = {.name = (char *)name,
-                       .base_color = {rho, rho, rho, 1.0f},
-                       .emissive = {le, le, le},
-                       .normal_scale = 1.0f};
-    uint32_t idx;
-    assert_int_equal(lx_scene_add_material(scene, &mat, &idx), LX_OK);
-    return idx;
+    return lx_test_corner_form_factor(x1 - px, z1 - pz, c) -
+           lx_test_corner_form_factor(x0 - px, z1 - pz, c) -
+           lx_test_corner_form_factor(x1 - px, z0 - pz, c) +
+           lx_test_corner_form_factor(x0 - px, z0 - pz, c);
 }
 
 typedef struct rect {
@@ -72,8 +53,8 @@ typedef struct rect {
 static lx_scene *emitter_scene(rect r, float le, rect plate, int sub)
 {
     lx_scene *scene = lx_test_new_scene("emitter");
-    uint32_t black = add_material(scene, "black", 0.0f, 0.0f);
-    uint32_t glow = add_material(scene, "glow", 0.0f, le);
+    uint32_t black = lx_test_grey_material(scene, "black", 0.0f, 0.0f);
+    uint32_t glow = lx_test_grey_material(scene, "glow", 0.0f, le);
     lx_mesh floor = lx_test_plane("floor", 4.0f, 0.0f, 0.0f, 0.0f, 4);
     floor.material = black;
     lx_test_add(scene, &floor);

@@ -36,25 +36,6 @@
 
 #define PI_D 3.14159265358979323846
 
-/* A material of albedo rho (grey) and emission le (nits, grey). */
-static uint32_t add_material(lx_scene *scene, const char *name, float rho, float le)
-{
-    lx_material mat = {.name = (char *)name,
-                       .base_color = {rho, rho, rho, 1.0f},
-                       .emissive = {le, le, le},
-                       .normal_scale = 1.0f};
-    uint32_t idx;
-    assert_int_equal(lx_scene_add_material(scene, &mat, &idx), LX_OK);
-    return idx;
-}
-
-static void add_with_material(lx_scene *scene, lx_mesh *mesh, uint32_t material)
-{
-    mesh->material = material;
-    lx_test_add(scene, mesh);
-    lx_test_mesh_free(mesh);
-}
-
 static lx_baker *bake(lx_scene *scene, lx_bake_desc *desc)
 {
     lx_baker *b;
@@ -80,9 +61,9 @@ static double worst_error(const lx_baker *b, uint32_t map, double want)
 static lx_scene *furnace_scene(float rho, float le, float ambient)
 {
     lx_scene *scene = lx_test_new_scene("furnace");
-    uint32_t mat = add_material(scene, "walls", rho, le);
+    uint32_t mat = lx_test_grey_material(scene, "walls", rho, le);
     lx_mesh box = lx_test_box("box", lx_v3(-1, -1, -1), lx_v3(1, 1, 1), true);
-    add_with_material(scene, &box, mat);
+    lx_test_add_with_material(scene, &box, mat);
     scene->ambient = lx_v3(ambient, ambient, ambient);
     return scene;
 }
@@ -237,7 +218,8 @@ static void open_floor_under_sky_gets_no_indirect(void **state)
         for (int bounces = 0; bounces <= 2; bounces += 2) {
             lx_scene *scene = lx_test_new_scene("open");
             lx_mesh floor = lx_test_plane("floor", 1.0f, 0.0f, 0.0f, 0.0f, 1);
-            add_with_material(scene, &floor, add_material(scene, "white", 1.0f, 0.0f));
+            lx_test_add_with_material(scene, &floor,
+                                      lx_test_grey_material(scene, "white", 1.0f, 0.0f));
             lx_bake_desc d = {.resolution = 8, .bounces = bounces, .gi_samples = 16};
             d.sky.environment = &env;
             d.sky.shadows = shadows;
@@ -257,22 +239,15 @@ static void open_floor_under_sky_gets_no_indirect(void **state)
     lx_cubemap_free(&env);
 }
 
-/* Form factor from a point to a parallel rectangle of sides a, b with one
- * corner straight across at distance c (Howell C-11). */
-static double corner_factor(double a, double b, double c)
-{
-    double x = a / c, y = b / c;
-    double sx = sqrt(1.0 + x * x), sy = sqrt(1.0 + y * y);
-    return (x / sx * atan(y / sx) + y / sy * atan(x / sy)) / (2.0 * PI_D);
-}
-
 /* ... to the rectangle [x0, x1] x [z0, z1] straight across from (px, pz),
  * inside it: four corner rectangles. */
 static double point_factor(double px, double pz, double x0, double x1, double z0, double z1,
                            double c)
 {
-    return corner_factor(px - x0, pz - z0, c) + corner_factor(x1 - px, pz - z0, c) +
-           corner_factor(px - x0, z1 - pz, c) + corner_factor(x1 - px, z1 - pz, c);
+    return lx_test_corner_form_factor(px - x0, pz - z0, c) +
+           lx_test_corner_form_factor(x1 - px, pz - z0, c) +
+           lx_test_corner_form_factor(px - x0, z1 - pz, c) +
+           lx_test_corner_form_factor(x1 - px, z1 - pz, c);
 }
 
 /* Between equal parallel rectangles a x b, c apart (Howell C-11). */
@@ -292,7 +267,7 @@ static void facing_squares_match_the_form_factor(void **state)
     const int res = 16;
     lx_scene *scene = lx_test_new_scene("plates");
     lx_mesh lower = lx_test_plane("lower", side, 0.0f, 0.0f, 0.0f, 1);
-    add_with_material(scene, &lower, add_material(scene, "white", 1.0f, 0.0f));
+    lx_test_add_with_material(scene, &lower, lx_test_grey_material(scene, "white", 1.0f, 0.0f));
     lx_mesh upper = lx_test_plane("upper", side, gap, 0.0f, 0.0f, 1);
     for (uint32_t v = 0; v < upper.vertex_count; v++)
         upper.normals[v] = lx_v3(0.0f, -1.0f, 0.0f);
@@ -301,7 +276,7 @@ static void facing_squares_match_the_form_factor(void **state)
         upper.indices[t + 1] = upper.indices[t + 2];
         upper.indices[t + 2] = k;
     }
-    add_with_material(scene, &upper, add_material(scene, "grey", rho, 0.0f));
+    lx_test_add_with_material(scene, &upper, lx_test_grey_material(scene, "grey", rho, 0.0f));
     scene->ambient = lx_v3(a, a, a);
     lx_bake_desc d = {.resolution = res, .bounces = 1, .gi_samples = 1024};
     lx_baker *b = bake(scene, &d);
@@ -345,9 +320,9 @@ static void facing_squares_match_the_form_factor(void **state)
 static lx_scene *leak_scene(void)
 {
     lx_scene *scene = lx_test_new_scene("leak");
-    uint32_t white = add_material(scene, "white", 0.8f, 0.0f);
+    uint32_t white = lx_test_grey_material(scene, "white", 0.8f, 0.0f);
     lx_mesh floor = lx_test_plane("floor", 6.0f, 0.0f, 0.0f, 0.0f, 1);
-    add_with_material(scene, &floor, white);
+    lx_test_add_with_material(scene, &floor, white);
     const float lo[5][3] = {{-1.3f, -0.1f, -1.3f},
                             {1.0f, -0.1f, -1.3f},
                             {-1.0f, -0.1f, -1.3f},
@@ -360,7 +335,7 @@ static lx_scene *leak_scene(void)
     for (int k = 0; k < 5; k++) {
         lx_mesh box = lx_test_box(names[k], lx_v3(lo[k][0], lo[k][1], lo[k][2]),
                                   lx_v3(hi[k][0], hi[k][1], hi[k][2]), false);
-        add_with_material(scene, &box, white);
+        lx_test_add_with_material(scene, &box, white);
     }
     lx_light sun = lx_light_defaults(LX_LIGHT_DIRECTIONAL);
     sun.direction = lx_normalize(lx_v3(0.5f, -1.0f, 0.3f));

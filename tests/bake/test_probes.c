@@ -63,24 +63,6 @@ static double irradiance(const lx_sh9 *sh, int c, double x, double y, double z)
     return e;
 }
 
-static uint32_t add_material(lx_scene *scene, const char *name, float rho, float le)
-{
-    lx_material mat = {.name = (char *)name,
-                       .base_color = {rho, rho, rho, 1.0f},
-                       .emissive = {le, le, le},
-                       .normal_scale = 1.0f};
-    uint32_t idx;
-    assert_int_equal(lx_scene_add_material(scene, &mat, &idx), LX_OK);
-    return idx;
-}
-
-static void add_with_material(lx_scene *scene, lx_mesh *mesh, uint32_t material)
-{
-    mesh->material = material;
-    lx_test_add(scene, mesh);
-    lx_test_mesh_free(mesh);
-}
-
 /* A black speck of a plane far below: the baker has a lightmap, and the
  * probes around the origin see nothing of it (1e-4 m^2 at 100 m: 1e-8
  * sr). */
@@ -88,7 +70,7 @@ static lx_scene *empty_scene(void)
 {
     lx_scene *scene = lx_test_new_scene("empty");
     lx_mesh speck = lx_test_plane("speck", 0.01f, -100.0f, 0.0f, 0.0f, 1);
-    add_with_material(scene, &speck, add_material(scene, "black", 0.0f, 0.0f));
+    lx_test_add_with_material(scene, &speck, lx_test_grey_material(scene, "black", 0.0f, 0.0f));
     return scene;
 }
 
@@ -170,7 +152,7 @@ static void furnace_is_a_geometric_series(void **state)
     for (int n = 0; n <= 3; n++) {
         lx_scene *scene = lx_test_new_scene("furnace");
         lx_mesh box = lx_test_box("box", lx_v3(-1, -1, -1), lx_v3(1, 1, 1), true);
-        add_with_material(scene, &box, add_material(scene, "walls", rho, le));
+        lx_test_add_with_material(scene, &box, lx_test_grey_material(scene, "walls", rho, le));
         lx_bake_desc d = {.resolution = 24, .bounces = n, .gi_samples = 16, .threads = 2};
         lx_baker *b = bake(scene, &d);
         lx_scene_destroy(scene);
@@ -210,7 +192,7 @@ static void inside_a_solid_cube_is_invalid(void **state)
     (void)state;
     lx_scene *scene = lx_test_new_scene("solid");
     lx_mesh cube = lx_test_box("cube", lx_v3(-1, -1, -1), lx_v3(1, 1, 1), false);
-    add_with_material(scene, &cube, add_material(scene, "grey", 0.5f, 0.0f));
+    lx_test_add_with_material(scene, &cube, lx_test_grey_material(scene, "grey", 0.5f, 0.0f));
     scene->ambient = lx_v3(1.0f, 1.0f, 1.0f);
     lx_bake_desc d = {.resolution = 8, .bounces = 0};
     lx_baker *b = bake(scene, &d);
@@ -274,7 +256,7 @@ static void blocked_point_light_adds_nothing(void **state)
     assert_int_equal(lx_scene_add_light(scene, &l), LX_OK);
     /* a black box across the line from the probe to the light */
     lx_mesh box = lx_test_box("blocker", lx_v3(0.3f, 1.2f, 0.0f), lx_v3(0.7f, 1.6f, 0.4f), false);
-    add_with_material(scene, &box, add_material(scene, "black2", 0.0f, 0.0f));
+    lx_test_add_with_material(scene, &box, lx_test_grey_material(scene, "black2", 0.0f, 0.0f));
     lx_bake_desc d = {.resolution = 4, .bounces = 1, .gi_samples = 4};
     lx_baker *b = bake(scene, &d);
     lx_scene_destroy(scene);
@@ -433,9 +415,9 @@ static void threads_give_the_same_bytes(void **state)
     (void)state;
     lx_scene *scene = lx_test_new_scene("room");
     lx_mesh box = lx_test_box("room", lx_v3(-2, 0, -2), lx_v3(2, 3, 2), true);
-    add_with_material(scene, &box, add_material(scene, "walls", 0.7f, 0.0f));
+    lx_test_add_with_material(scene, &box, lx_test_grey_material(scene, "walls", 0.7f, 0.0f));
     lx_mesh block = lx_test_box("block", lx_v3(-0.75f, 0, -0.75f), lx_v3(0.75f, 1, 0.75f), false);
-    add_with_material(scene, &block, add_material(scene, "block", 0.4f, 0.0f));
+    lx_test_add_with_material(scene, &block, lx_test_grey_material(scene, "block", 0.4f, 0.0f));
     lx_light l = point_light();
     assert_int_equal(lx_scene_add_light(scene, &l), LX_OK);
     lx_bake_desc d = {.resolution = 16, .bounces = 2, .gi_samples = 16, .threads = 2};

@@ -238,3 +238,28 @@ lx_ies_profile *lx_test_parse_ies(const char *text)
     assert_non_null(p);
     return p;
 }
+
+uint32_t lx_test_grey_material(lx_scene *scene, const char *name, float rho, float le)
+{
+    lx_material mat = {.name = (char *)name,
+                       .base_color = {rho, rho, rho, 1.0f},
+                       .emissive = {le, le, le},
+                       .normal_scale = 1.0f};
+    uint32_t idx;
+    assert_int_equal(lx_scene_add_material(scene, &mat, &idx), LX_OK);
+    return idx;
+}
+
+void lx_test_add_with_material(lx_scene *scene, lx_mesh *mesh, uint32_t material)
+{
+    mesh->material = material;
+    lx_test_add(scene, mesh);
+    lx_test_mesh_free(mesh);
+}
+
+double lx_test_corner_form_factor(double a, double b, double c)
+{
+    double x = a / c, y = b / c;
+    double sx = sqrt(1.0 + x * x), sy = sqrt(1.0 + y * y);
+    return (x / sx * atan(y / sx) + y / sy * atan(x / sy)) / (2.0 * 3.14159265358979323846);
+}

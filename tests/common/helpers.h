@@ -46,6 +46,17 @@ uint32_t lx_test_map_of(const lx_baker *baker, uint32_t node);
  * (and a default material when the scene has none). */
 void lx_test_add(lx_scene *scene, lx_mesh *mesh);
 
+/* A material of albedo rho (grey) and emission le (nits, grey); its index. */
+uint32_t lx_test_grey_material(lx_scene *scene, const char *name, float rho, float le);
+
+/* lx_test_add with the mesh's material set first; frees the mesh. */
+void lx_test_add_with_material(lx_scene *scene, lx_mesh *mesh, uint32_t material);
+
+/* Form factor from a point to a parallel rectangle of sides a, b with one
+ * corner straight across at distance c (Howell's catalogue, C-11); odd in
+ * a and in b, so signed sides superpose rectangles anywhere. */
+double lx_test_corner_form_factor(double a, double b, double c);
+
 /* Ends the process with a failure message on stderr (exit status 1) when
  * it is still running after `seconds`: a hang in the code under test then
  * fails the test instead of stalling the whole run. */
