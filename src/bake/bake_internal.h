@@ -68,7 +68,20 @@ typedef struct lx_lightmap {
     float *realtime; /* width * height * 3; NULL (reads as zero) until the
                         first update with dynamic lights */
     lx_seam_stitch *stitch; /* NULL: not asked, or no seams */
+    /* Whether the texel map (texels, tiles, positions, normals, albedo,
+     * emission, horizon, stitch) is in memory. A tiled baker
+     * (bake_tiles.c) keeps only name, info, mask, baked and realtime of
+     * the maps outside the tile it works on, and rebuilds the rest. */
+    bool loaded;
+    bool horizon_page; /* a node on it has a height (its texels may take records) */
 } lx_lightmap;
+
+/* How to build a lightmap again (a tiled baker): its page. */
+typedef struct lx_tile_page {
+    int width, height; /* 0: the node's own size */
+    struct lx_page_node *nodes;
+    uint32_t node_count;
+} lx_tile_page;
 
 struct lx_baker {
     lx_bake_desc desc;
@@ -103,9 +116,19 @@ struct lx_baker {
     uint32_t *mesh_triangles;
     lx_vec3 *mesh_emission;
     uint64_t gi_invalid_texels; /* found by the last bake */
-    /* during lx_baker_create only: each material's horizon layers and AO */
+    /* during lx_baker_create only (for the baker's life when tiled): each
+     * material's horizon layers and AO */
     lx_horizon_material *horizon_materials;
     uint32_t horizon_material_count;
+    /* tiles (bake_tiles.c): consecutive groups of whole lightmaps whose
+     * working set fits the memory limit; one tile when everything fits */
+    uint32_t tile_count;
+    uint32_t *tile_first_map; /* tile_count + 1 */
+    uint32_t loaded_tile;     /* the tile in memory when tiled; UINT32_MAX none */
+    bool tiled;               /* more than one tile: maps are rebuilt */
+    lx_scene *tile_scene;     /* tiled: the copy texel maps are rebuilt from */
+    lx_tile_page *pages;      /* tiled: per map, its page */
+    uint64_t memory_limit;    /* the limit tiles were planned for */
 };
 
 /* Bytes a lightmap needs per texel at most: raster scratch, mask, baked and
@@ -232,5 +255,38 @@ lx_status lx_bake_denoise(lx_baker *b, float **direct, float progress_base, floa
 lx_status lx_bake_lights(lx_baker *baker, const uint32_t *lights, uint32_t light_count,
                          lx_vec3 ambient, bool to_realtime, float progress_base,
                          float progress_span);
+
+/* ---- memory and tiles (bake_tiles.c) ----------------------------------------
+ * The one list of the bake's per-texel buffers (bytes per lightmap pixel:
+ * the covered texels are bounded by the pixels), split into what stays in
+ * memory for the whole bake (resident) and what a tile of lightmaps needs
+ * while it is worked on. A new per-texel buffer is a line in that list. */
+typedef struct lx_bake_texel_bytes {
+    uint32_t resident; /* per pixel of every lightmap, for the whole bake */
+    uint32_t tile;     /* per pixel of the lightmaps of the tile worked on */
+} lx_bake_texel_bytes;
+/* The bytes per pixel of a lightmap under desc: horizon when a node on it
+ * has a height, dynamic when the scene has dynamic lights, tiled for a
+ * bake in several tiles (its baked buffers stay resident). */
+lx_bake_texel_bytes lx_bake_texel_bytes_of(const lx_bake_desc *desc, bool horizon, bool dynamic,
+                                           bool tiled);
+/* What the scene copy, the BVH and the gathers' mesh copies take. */
+uint64_t lx_bake_scene_bytes(const lx_scene *scene, bool copy);
+/* Makes sure the texel map of `map` is in memory: in a tiled baker, the
+ * tile in memory is let go and map's tile rebuilt. */
+lx_status lx_bake_tile_need(lx_baker *b, uint32_t map);
+/* Lets go of a map's texel map, keeping what stays resident. */
+void lx_bake_map_unload(lx_lightmap *map);
+/* The progress share of tile t within [from, to] (by pixels). */
+void lx_bake_tile_share(const lx_baker *b, uint32_t t, float from, float to, float *tfrom,
+                        float *tto);
+/* Groups the maps into tiles under b->memory_limit (after the maps are
+ * built): resident bytes are counted for every map, tile bytes per tile. */
+lx_status lx_bake_plan_tiles(lx_baker *b, const lx_scene *scene, bool dynamic);
+/* A copy of the scene's meshes, materials and nodes (what texel maps are
+ * built from), for a tiled baker. */
+lx_status lx_bake_scene_copy(const lx_scene *scene, lx_scene **out);
+/* The progress callback's answer at fraction f (true: go on). */
+bool lx_bake_report(const lx_baker *b, float f);
 
 #endif

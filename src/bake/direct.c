@@ -453,8 +453,10 @@ lx_status lx_bake_lights(lx_baker *b, const uint32_t *lights, uint32_t light_cou
     map_first_tile[0] = 0;
     for (uint32_t m = 0; m < b->map_count; m++) {
         map_first_tile[m + 1] = map_first_tile[m] + b->maps[m].tile_count;
-        /* progress counts texels, plus one per tile so empty tiles count */
-        total_work += b->maps[m].info.used_texels + b->maps[m].tile_count;
+        /* progress counts texels, plus one per tile so empty tiles count;
+         * a tiled baker works on the maps in memory */
+        if (b->maps[m].loaded)
+            total_work += b->maps[m].info.used_texels + b->maps[m].tile_count;
     }
     fast_light *fast = malloc(sizeof(fast_light) * (light_count + 1));
     bool *is_fast = malloc(sizeof(bool) * (light_count + 1));
@@ -544,7 +546,7 @@ lx_status lx_bake_lights(lx_baker *b, const uint32_t *lights, uint32_t light_cou
 #pragma omp atomic capture
             done = done_work += count + 1;
             if (omp_get_thread_num() == 0 && (global & 15) == 0) {
-                double f = (double)done / (double)total_work;
+                double f = (double)done / (double)(total_work ? total_work : 1);
                 if (!b->desc.progress(b->desc.progress_user,
                                       progress_base + progress_span * (float)f))
                     cancelled = 1;

@@ -102,13 +102,14 @@ void lx_gi_free(lx_baker *b)
     b->node_uv_set = NULL;
 }
 
-/* Per map during the indirect pass. */
+/* Per map during the indirect pass: what every gather reads (resident for
+ * the whole pass, every map) and what a tile of maps works with. */
 typedef struct gi_map {
-    uint8_t *valid;   /* width * height: covered and not inside geometry */
-    float *source;    /* width * height * 3: exitant radiance of the last bounce */
-    lx_vec3 *prev;    /* per texel: the last bounce's irradiance */
-    lx_vec3 *next;    /* per texel: this bounce's */
-    uint8_t *invalid; /* per texel, from the validity pass */
+    uint8_t *valid;      /* width * height: covered and not inside geometry */
+    float *source;       /* width * height * 3: exitant radiance of the last bounce */
+    float *source_next;  /* width * height * 3: the next bounce's, made as tiles finish */
+    lx_vec3 *next;       /* tile: per texel, this bounce's irradiance */
+    uint8_t *invalid;    /* tile: per texel, inside geometry */
 } gi_map;
 
 typedef struct gi_run {
@@ -287,6 +288,16 @@ static lx_vec3 texel_gather(const gi_run *run, uint32_t map_index, uint32_t i, u
 static bool run_pass(gi_run *run, bool validity, uint32_t key, float from, float to)
 {
     lx_baker *b = run->b;
+    /* the tiles of the maps in memory */
+    run->map_first_tile[0] = 0;
+    run->total_work = 0;
+    for (uint32_t m = 0; m < b->map_count; m++) {
+        const lx_lightmap *map = &b->maps[m];
+        run->map_first_tile[m + 1] = run->map_first_tile[m] + map->tile_count;
+        if (map->loaded)
+            run->total_work += map->info.used_texels + map->tile_count;
+    }
+    run->tiles = (int)run->map_first_tile[b->map_count];
     bool report = b->desc.progress != NULL;
     volatile int cancelled = 0;
     uint64_t done_work = 0;
@@ -315,9 +326,8 @@ static bool run_pass(gi_run *run, bool validity, uint32_t key, float from, float
 #pragma omp atomic capture
             done = done_work += count + 1;
             if (omp_get_thread_num() == 0) {
-                double f = (double)done / (double)run->total_work;
-                if (!b->desc.progress(b->desc.progress_user,
-                                      run->base + run->span * (from + (to - from) * (float)f)))
+                double f = (double)done / (double)(run->total_work ? run->total_work : 1);
+                if (!b->desc.progress(b->desc.progress_user, from + (to - from) * (float)f))
                     cancelled = 1;
             }
         }
@@ -392,6 +402,63 @@ static lx_status fill_invalid(const lx_lightmap *map, const gi_map *g)
     return LX_OK;
 }
 
+/* The per-texel buffers of the maps of tile t (the maps in memory):
+ * this bounce's irradiance and the inside flags, from the valid mask. */
+static lx_status tile_begin(gi_run *run, uint32_t t, bool from_valid)
+{
+    lx_baker *b = run->b;
+    lx_status st = lx_bake_tile_need(b, b->tile_first_map[t]);
+    for (uint32_t m = b->tile_first_map[t]; m < b->tile_first_map[t + 1] && st == LX_OK; m++) {
+        const lx_lightmap *map = &b->maps[m];
+        gi_map *g = &run->maps[m];
+        size_t used = map->info.used_texels + 1;
+        g->next = malloc(sizeof(lx_vec3) * used);
+        g->invalid = malloc(used);
+        if (!g->next || !g->invalid) {
+            st = lx_fail(LX_ERR_NOMEM, "lightmap '%s': out of memory for global illumination",
+                         map->name);
+            break;
+        }
+        if (from_valid)
+            for (uint32_t i = 0; i < map->info.used_texels; i++)
+                g->invalid[i] = !g->valid[map->texels[i].pixel];
+    }
+    return st;
+}
+
+static void tile_end(gi_run *run, uint32_t t)
+{
+    for (uint32_t m = run->b->tile_first_map[t]; m < run->b->tile_first_map[t + 1]; m++) {
+        free(run->maps[m].next);
+        free(run->maps[m].invalid);
+        run->maps[m].next = NULL;
+        run->maps[m].invalid = NULL;
+    }
+}
+
+/* A source buffer from per-texel irradiance e: albedo / pi x e (+ the
+ * emission at the first gather) at valid texels, 0 elsewhere. */
+static void make_source(const lx_lightmap *map, const gi_map *g, const lx_vec3 *e, bool emission,
+                        float *dst)
+{
+    memset(dst, 0, sizeof(float) * 3 * (size_t)map->info.width * (size_t)map->info.height);
+    for (uint32_t i = 0; i < map->info.used_texels; i++) {
+        if (g->invalid[i])
+            continue;
+        lx_vec3 l = lx_scale(lx_mul(map->albedo[i], e[i]), 1.0f / LX_PI);
+        if (emission && map->emission)
+            l = lx_add(l, map->emission[i]);
+        float *px = dst + 3 * (size_t)map->texels[i].pixel;
+        px[0] = l.x, px[1] = l.y, px[2] = l.z;
+    }
+}
+
+/* Bounce k's passes run tile by tile (one tile when the maps fit the
+ * memory together): the validity pass makes each map's valid mask and
+ * first sources from its direct light; each bounce gathers a tile's
+ * texels against every map's sources of the last bounce, adds the result
+ * and makes the tile's sources of the next; the last bounce fills the
+ * invalid texels. Every value is the one the maps would get all at once. */
 lx_status lx_bake_indirect(lx_baker *b, float progress_base, float progress_span)
 {
     uint32_t count = b->map_count;
@@ -403,89 +470,89 @@ lx_status lx_bake_indirect(lx_baker *b, float progress_base, float progress_span
     if (!run.maps || !run.map_first_tile)
         st = lx_fail(LX_ERR_NOMEM, "out of memory for global illumination");
     uint64_t bytes = 0;
-    for (uint32_t m = 0; m < count && st == LX_OK; m++) {
-        const lx_lightmap *map = &b->maps[m];
-        uint64_t pixels = (uint64_t)map->info.width * (uint64_t)map->info.height;
-        bytes += pixels * 13 + (uint64_t)map->info.used_texels * 25;
-    }
+    for (uint32_t m = 0; m < count && st == LX_OK; m++)
+        bytes += (uint64_t)b->maps[m].info.width * (uint64_t)b->maps[m].info.height * 25;
     if (st == LX_OK)
         st = lx_check_memory(bytes, "global illumination's buffers");
-    run.map_first_tile[0] = 0;
     for (uint32_t m = 0; m < count && st == LX_OK; m++) {
         const lx_lightmap *map = &b->maps[m];
         gi_map *g = &run.maps[m];
         size_t pixels = (size_t)map->info.width * (size_t)map->info.height;
-        size_t used = map->info.used_texels + 1;
         g->valid = malloc(pixels);
         g->source = malloc(sizeof(float) * 3 * pixels);
-        g->prev = malloc(sizeof(lx_vec3) * used);
-        g->next = malloc(sizeof(lx_vec3) * used);
-        g->invalid = malloc(used);
-        if (!g->valid || !g->source || !g->prev || !g->next || !g->invalid)
+        g->source_next = b->desc.bounces > 1 ? malloc(sizeof(float) * 3 * pixels) : NULL;
+        if (!g->valid || !g->source || (b->desc.bounces > 1 && !g->source_next))
             st = lx_fail(LX_ERR_NOMEM, "lightmap '%s': out of memory for global illumination",
                          map->name);
-        run.map_first_tile[m + 1] = run.map_first_tile[m] + map->tile_count;
-        run.total_work += map->info.used_texels + map->tile_count;
     }
-    run.tiles = st == LX_OK ? (int)run.map_first_tile[count] : 0;
     float passes = (float)(b->desc.bounces + 1);
-    /* validity */
-    if (st == LX_OK && !run_pass(&run, true, 0, 0.0f, 1.0f / passes))
-        st = lx_fail(LX_ERR_CANCELLED, "bake cancelled");
+    float span = progress_span / passes;
+    /* validity, and the first sources: albedo / pi x direct + emission */
     b->gi_invalid_texels = 0;
-    for (uint32_t m = 0; m < count && st == LX_OK; m++) {
-        const lx_lightmap *map = &b->maps[m];
-        gi_map *g = &run.maps[m];
-        memcpy(g->valid, map->mask, (size_t)map->info.width * (size_t)map->info.height);
-        for (uint32_t i = 0; i < map->info.used_texels; i++) {
-            size_t p = map->texels[i].pixel;
-            if (g->invalid[i]) {
-                g->valid[p] = 0;
-                b->gi_invalid_texels++;
-            }
-            g->prev[i] = lx_v3(map->baked[3 * p], map->baked[3 * p + 1], map->baked[3 * p + 2]);
-        }
-    }
-    for (int k = 1; k <= b->desc.bounces && st == LX_OK; k++) {
-        /* the sources: albedo / pi x the last bounce (+ emission, first) */
-        run.first_gather = k == 1;
-        for (uint32_t m = 0; m < count; m++) {
-            const lx_lightmap *map = &b->maps[m];
-            gi_map *g = &run.maps[m];
-            memset(g->source, 0,
-                   sizeof(float) * 3 * (size_t)map->info.width * (size_t)map->info.height);
-            for (uint32_t i = 0; i < map->info.used_texels; i++) {
-                if (g->invalid[i])
-                    continue;
-                lx_vec3 l = lx_scale(lx_mul(map->albedo[i], g->prev[i]), 1.0f / LX_PI);
-                if (k == 1 && map->emission)
-                    l = lx_add(l, map->emission[i]);
-                float *dst = g->source + 3 * (size_t)map->texels[i].pixel;
-                dst[0] = l.x, dst[1] = l.y, dst[2] = l.z;
-            }
-        }
-        if (!run_pass(&run, false, GI_KEY + 2u * (uint32_t)k, (float)k / passes,
-                      (float)(k + 1) / passes)) {
-            st = lx_fail(LX_ERR_CANCELLED, "bake cancelled");
+    for (uint32_t t = 0; t < b->tile_count && st == LX_OK; t++) {
+        float tf, tt;
+        lx_bake_tile_share(b, t, progress_base, progress_base + span, &tf, &tt);
+        if (!lx_bake_report(b, tf) || (st = tile_begin(&run, t, false)) != LX_OK ||
+            !run_pass(&run, true, 0, tf, tt)) {
+            if (st == LX_OK)
+                st = lx_fail(LX_ERR_CANCELLED, "bake cancelled");
+            tile_end(&run, t);
             break;
         }
-        for (uint32_t m = 0; m < count; m++) {
-            lx_lightmap *map = &b->maps[m];
+        for (uint32_t m = b->tile_first_map[t]; m < b->tile_first_map[t + 1]; m++) {
+            const lx_lightmap *map = &b->maps[m];
             gi_map *g = &run.maps[m];
+            memcpy(g->valid, map->mask, (size_t)map->info.width * (size_t)map->info.height);
             for (uint32_t i = 0; i < map->info.used_texels; i++) {
-                float *px = map->baked + 3 * (size_t)map->texels[i].pixel;
-                px[0] += g->next[i].x;
-                px[1] += g->next[i].y;
-                px[2] += g->next[i].z;
+                size_t p = map->texels[i].pixel;
+                g->next[i] = lx_v3(map->baked[3 * p], map->baked[3 * p + 1], map->baked[3 * p + 2]);
+                if (g->invalid[i]) {
+                    g->valid[p] = 0;
+                    b->gi_invalid_texels++;
+                }
             }
-            lx_vec3 *swap = g->prev;
-            g->prev = g->next;
-            g->next = swap;
+            make_source(map, g, g->next, true, g->source);
+        }
+        tile_end(&run, t);
+    }
+    for (int k = 1; k <= b->desc.bounces && st == LX_OK; k++) {
+        bool last = k == b->desc.bounces;
+        run.first_gather = k == 1;
+        float from = progress_base + span * (float)k;
+        for (uint32_t t = 0; t < b->tile_count && st == LX_OK; t++) {
+            float tf, tt;
+            lx_bake_tile_share(b, t, from, from + span, &tf, &tt);
+            if (!lx_bake_report(b, tf) || (st = tile_begin(&run, t, true)) != LX_OK ||
+                !run_pass(&run, false, GI_KEY + 2u * (uint32_t)k, tf, tt)) {
+                if (st == LX_OK)
+                    st = lx_fail(LX_ERR_CANCELLED, "bake cancelled");
+                tile_end(&run, t);
+                break;
+            }
+            for (uint32_t m = b->tile_first_map[t]; m < b->tile_first_map[t + 1] && st == LX_OK;
+                 m++) {
+                lx_lightmap *map = &b->maps[m];
+                gi_map *g = &run.maps[m];
+                for (uint32_t i = 0; i < map->info.used_texels; i++) {
+                    float *px = map->baked + 3 * (size_t)map->texels[i].pixel;
+                    px[0] += g->next[i].x;
+                    px[1] += g->next[i].y;
+                    px[2] += g->next[i].z;
+                }
+                if (!last)
+                    make_source(map, g, g->next, false, g->source_next);
+                else if (b->gi_invalid_texels)
+                    st = fill_invalid(map, g);
+            }
+            tile_end(&run, t);
+        }
+        /* the next bounce reads what this one made */
+        for (uint32_t m = 0; m < count && st == LX_OK && !last; m++) {
+            float *swap = run.maps[m].source;
+            run.maps[m].source = run.maps[m].source_next;
+            run.maps[m].source_next = swap;
         }
     }
-    for (uint32_t m = 0; m < count && st == LX_OK; m++)
-        if (b->gi_invalid_texels)
-            st = fill_invalid(&b->maps[m], &run.maps[m]);
     if (st == LX_OK && b->gi_invalid_texels)
         lx_log(LX_LOG_INFO,
                "global illumination: %llu texels sit inside geometry (their rays mostly hit back "
@@ -494,7 +561,7 @@ lx_status lx_bake_indirect(lx_baker *b, float progress_base, float progress_span
     for (uint32_t m = 0; run.maps && m < count; m++) {
         free(run.maps[m].valid);
         free(run.maps[m].source);
-        free(run.maps[m].prev);
+        free(run.maps[m].source_next);
         free(run.maps[m].next);
         free(run.maps[m].invalid);
     }

@@ -89,6 +89,10 @@ static const char *bake_usage =
     "  --render                also DIR/view.png: the scene with its lightmaps from\n"
     "                          the default camera (luxel render)\n"
     "  --threads N             worker threads (default: all cores)\n"
+    "  --memory-limit SIZE     memory the bake may take, e.g. 512M or 4G (default:\n"
+    "                          what the machine has: RAM, control group, ulimit);\n"
+    "                          lightmaps that do not fit together are baked in\n"
+    "                          tiles, to the same bytes (docs/bake.md)\n"
     "  --skip-degenerate       accepted for old scripts: zero-area triangles are\n"
     "                          always left out with a warning\n"
     "  --strict                fail on any warning (suspect units, tiny spot\n"
@@ -131,7 +135,8 @@ enum {
     OPT_DENOISE,
     OPT_AO,
     OPT_AO_DISTANCE,
-    OPT_AO_SAMPLES
+    OPT_AO_SAMPLES,
+    OPT_MEMORY_LIMIT
 };
 
 typedef enum unwrap_choice { UNWRAP_AUTO, UNWRAP_ALWAYS, UNWRAP_NEVER } unwrap_choice;
@@ -229,6 +234,7 @@ static int parse_args(int argc, char **argv, bake_args *a)
         {"ao", no_argument, NULL, OPT_AO},
         {"ao-distance", required_argument, NULL, OPT_AO_DISTANCE},
         {"ao-samples", required_argument, NULL, OPT_AO_SAMPLES},
+        {"memory-limit", required_argument, NULL, OPT_MEMORY_LIMIT},
         {"quiet", no_argument, NULL, 'q'},
         {"verbose", no_argument, NULL, 'v'},
         {"help", no_argument, NULL, 'h'},
@@ -422,6 +428,12 @@ static int parse_args(int argc, char **argv, bake_args *a)
                                        LX_MAX_AO_SAMPLES, optarg);
             a->ao_desc.samples = (uint32_t)n;
             a->ao_option = "--ao-samples";
+            break;
+        case OPT_MEMORY_LIMIT:
+            if (!cli_parse_size(optarg, &a->desc.memory_limit))
+                return cli_usage_error("bake",
+                                       "--memory-limit must be a size such as 512M or 4G, not '%s'",
+                                       optarg);
             break;
         case OPT_GI_SAMPLES:
             if (!cli_parse_int(optarg, 1, (long)LX_MAX_GI_SAMPLES, &n))
@@ -986,6 +998,8 @@ int cmd_bake(int argc, char **argv)
     if (strict_failed(&a))
         goto done;
 
+    /* the applied lightmaps (RGB float) and AO maps stay until written */
+    a.desc.caller_bytes_per_texel = 12 + (a.ao ? 4 : 0);
     cli_progress progress;
     cli_progress_init(&progress, "texel maps", a.quiet);
     a.desc.progress = cli_progress_update;

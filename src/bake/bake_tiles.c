@@ -1,0 +1,300 @@
+/* The bake under a memory limit: lightmaps baked tile by tile, a tile
+ * being a run of whole lightmaps whose working set (texel maps, the
+ * gathers' per-texel buffers, the denoiser's scratch) fits beside what
+ * stays in memory for the whole bake (every map's mask and baked light,
+ * the bounces' sources, the scene and its BVH). Out-of-core lightmapping
+ * as production bakers do it (Bakery's and Unity's "tiled baking" bound
+ * the texels in flight, not the lightmaps' total): the texel maps of a
+ * tile are rebuilt from a copy of the scene whenever a pass needs them
+ * again, so each pass reads every map's resident light and works on one
+ * tile's texels at a time. Every texel's work is keyed by (map, texel)
+ * and every sum runs in the same order whatever the tiles, so the bytes
+ * equal the untiled bake's. */
+#include "bake_internal.h"
+#include "core/internal.h"
+
+#include <stdio.h>
+#include <stdlib.h>
+#include <string.h>
+
+/* ---- the per-texel buffers ------------------------------------------------
+ * Bytes a lightmap pixel (covered texels are at most the pixels). Each
+ * line names a buffer, what it takes, whether it stays for the whole bake
+ * and when it exists. docs/bake.md's table is this list. A new per-texel
+ * buffer (directional coefficients, supersampling's sub-texels...) is one
+ * more line and, when it only exists under an option, one more flag. */
+enum {
+    WHEN_ALWAYS = 0,
+    WHEN_ALBEDO = 1u << 0,   /* radiance output or bounces */
+    WHEN_GI = 1u << 1,       /* bounces > 0 */
+    WHEN_HORIZON = 1u << 2,  /* a material on the map has a height */
+    WHEN_DYNAMIC = 1u << 3,  /* the scene has dynamic lights */
+    WHEN_DENOISE = 1u << 4,  /* the bake denoises something */
+    WHEN_KEEP = 1u << 5,     /* denoise indirect with bounces: direct kept */
+    WHEN_PADDING = 1u << 6,  /* padding > 0 */
+};
+
+typedef struct texel_buffer {
+    const char *name;
+    uint32_t bytes;
+    bool resident;
+    uint32_t when; /* every flag must hold */
+} texel_buffer;
+
+static const texel_buffer texel_buffers[] = {
+    /* resident: the whole bake */
+    {"coverage mask", 1, true, WHEN_ALWAYS},
+    {"baked light (RGB float)", 12, true, WHEN_ALWAYS},
+    {"real-time light (RGB float)", 12, true, WHEN_DYNAMIC},
+    {"bounces: validity", 1, true, WHEN_GI},
+    {"bounces: exitant radiance of the last and the next bounce", 24, true, WHEN_GI},
+    {"denoising: the direct light kept", 12, true, WHEN_GI | WHEN_KEEP},
+    /* a tile's working set */
+    {"texel map: raster scratch while building (12 of it the baked buffer)", 17, false,
+     WHEN_ALWAYS},
+    {"texel map: texel record (pixel, mesh, triangle, node)", 16, false, WHEN_ALWAYS},
+    {"texel map: world position, shading and geometric normal", 36, false, WHEN_ALWAYS},
+    {"texel map: tile offsets", 1, false, WHEN_ALWAYS},
+    {"texel map: albedo", 12, false, WHEN_ALBEDO},
+    {"texel map: emission", 12, false, WHEN_GI},
+    {"texel map: horizon record (layers, AO, frame)", (uint32_t)sizeof(lx_texel_horizon), false,
+     WHEN_HORIZON},
+    {"bounces: this bounce's irradiance and the inside flag", 13, false, WHEN_GI},
+    {"bounces: filling invalid texels", 17, false, WHEN_GI},
+    {"denoising: guides, scratch and the indirect part", 29 + 80 + 12, false, WHEN_DENOISE},
+    {"padding: the mask's copy and frontiers", 9, false, WHEN_PADDING},
+};
+
+lx_bake_texel_bytes lx_bake_texel_bytes_of(const lx_bake_desc *d, bool horizon, bool dynamic,
+                                           bool tiled)
+{
+    bool gi = d->bounces > 0;
+    uint32_t have = WHEN_ALWAYS;
+    have |= (gi || d->quantity == LX_QUANTITY_RADIANCE) ? WHEN_ALBEDO : 0;
+    have |= gi ? WHEN_GI : 0;
+    have |= horizon ? WHEN_HORIZON : 0;
+    have |= dynamic ? WHEN_DYNAMIC : 0;
+    have |= (d->denoise == LX_DENOISE_ALL || (d->denoise == LX_DENOISE_INDIRECT && gi))
+                ? WHEN_DENOISE
+                : 0;
+    have |= d->denoise == LX_DENOISE_INDIRECT ? WHEN_KEEP : 0;
+    have |= d->padding > 0 ? WHEN_PADDING : 0;
+    (void)tiled; /* the same buffers either way; tiled, the tile's are let go */
+    lx_bake_texel_bytes out = {d->caller_bytes_per_texel, 0};
+    for (size_t i = 0; i < sizeof texel_buffers / sizeof texel_buffers[0]; i++) {
+        const texel_buffer *t = &texel_buffers[i];
+        if ((t->when & have) != t->when)
+            continue;
+        if (t->resident)
+            out.resident += t->bytes;
+        else
+            out.tile += t->bytes;
+    }
+    return out;
+}
+
+uint64_t lx_bake_scene_bytes(const lx_scene *scene, bool copy)
+{
+    uint64_t vertices = 0, triangles = 0, vertex_bytes = 0, textures = 0;
+    for (uint32_t m = 0; m < scene->mesh_count; m++) {
+        const lx_mesh *mesh = &scene->meshes[m];
+        uint64_t per = 24 + (mesh->tangents ? 16 : 0);
+        for (int s = 0; s < LX_MAX_UV_SETS; s++)
+            per += mesh->uv[s] ? 8 : 0;
+        vertices += mesh->vertex_count;
+        vertex_bytes += per * mesh->vertex_count;
+        triangles += mesh->triangle_count;
+    }
+    for (uint32_t k = 0; k < scene->material_count; k++) {
+        const lx_material *mat = &scene->materials[k];
+        const lx_image *im[3] = {&mat->normal_map, &mat->base_color_map, &mat->emissive_map};
+        for (int i = 0; i < 3; i++)
+            textures += (uint64_t)(im[i]->width > 0 ? im[i]->width : 0) *
+                        (uint64_t)(im[i]->height > 0 ? im[i]->height : 0) *
+                        (uint64_t)(im[i]->channels > 0 ? im[i]->channels : 0) * 4;
+    }
+    /* Embree's copy of the world vertices (16 bytes padded) and triangles
+     * (12), and its BVH (about 64 bytes a triangle at high quality); the
+     * gathers' copy of UVs and indices is within the scene's size */
+    uint64_t bvh = vertices * 16 + triangles * (12 + 64);
+    uint64_t own = vertex_bytes + triangles * 12 + textures;
+    return bvh + own + (copy ? own : 0);
+}
+
+/* ---- tiles ------------------------------------------------------------------ */
+
+static uint64_t map_pixels(const lx_lightmap *m)
+{
+    return (uint64_t)m->info.width * (uint64_t)m->info.height;
+}
+
+lx_status lx_bake_plan_tiles(lx_baker *b, const lx_scene *scene, bool dynamic)
+{
+    uint64_t resident = lx_bake_scene_bytes(scene, b->tiled);
+    for (uint32_t m = 0; m < b->map_count; m++) {
+        lx_bake_texel_bytes tb = lx_bake_texel_bytes_of(&b->desc, b->maps[m].horizon_page,
+                                                        dynamic, b->tiled);
+        resident += map_pixels(&b->maps[m]) * tb.resident;
+    }
+    free(b->tile_first_map);
+    b->tile_first_map = malloc(sizeof(uint32_t) * (b->map_count + 2));
+    if (!b->tile_first_map)
+        return lx_fail(LX_ERR_NOMEM, "out of memory planning the bake's tiles");
+    b->tile_count = 0;
+    b->tile_first_map[0] = 0;
+    if (!b->tiled) {
+        b->tile_count = 1;
+        b->tile_first_map[1] = b->map_count;
+        return LX_OK;
+    }
+    uint64_t room = b->memory_limit > resident ? b->memory_limit - resident : 0, used = 0;
+    for (uint32_t m = 0; m < b->map_count; m++) {
+        lx_bake_texel_bytes tb = lx_bake_texel_bytes_of(&b->desc, b->maps[m].horizon_page,
+                                                        dynamic, b->tiled);
+        uint64_t need = map_pixels(&b->maps[m]) * tb.tile;
+        if (m > b->tile_first_map[b->tile_count] && used + need > room) {
+            b->tile_first_map[++b->tile_count] = m;
+            used = 0;
+        }
+        used += need;
+    }
+    b->tile_first_map[++b->tile_count] = b->map_count;
+    return LX_OK;
+}
+
+void lx_bake_tile_share(const lx_baker *b, uint32_t t, float from, float to, float *tfrom,
+                        float *tto)
+{
+    uint64_t before = 0, in = 0, total = 0;
+    for (uint32_t m = 0; m < b->map_count; m++) {
+        uint64_t p = map_pixels(&b->maps[m]) + 1;
+        total += p;
+        if (m < b->tile_first_map[t])
+            before += p;
+        else if (m < b->tile_first_map[t + 1])
+            in += p;
+    }
+    double span = (double)(to - from);
+    *tfrom = from + (float)(span * (double)before / (double)(total ? total : 1));
+    *tto = t + 1 == b->tile_count ? to
+                                  : from + (float)(span * (double)(before + in) /
+                                                   (double)(total ? total : 1));
+}
+
+bool lx_bake_report(const lx_baker *b, float f)
+{
+    return !b->desc.progress || b->desc.progress(b->desc.progress_user, f);
+}
+
+void lx_bake_map_unload(lx_lightmap *map)
+{
+    free(map->texels);
+    free(map->tile_start);
+    free(map->world_position);
+    free(map->world_normal);
+    free(map->world_geometric_normal);
+    free(map->object_position);
+    free(map->object_normal);
+    free(map->object_geometric_normal);
+    free(map->albedo);
+    free(map->emission);
+    free(map->horizon);
+    lx_seam_stitch_free(map->stitch);
+    map->texels = NULL;
+    map->tile_start = NULL;
+    map->tile_count = 0;
+    map->world_position = map->world_normal = map->world_geometric_normal = NULL;
+    map->object_position = map->object_normal = map->object_geometric_normal = NULL;
+    map->albedo = map->emission = NULL;
+    map->horizon = NULL;
+    map->stitch = NULL;
+    map->loaded = false;
+}
+
+/* Builds map m again from its page, keeping its resident buffers. */
+static lx_status map_load(lx_baker *b, uint32_t m)
+{
+    lx_lightmap *map = &b->maps[m];
+    const lx_tile_page *pg = &b->pages[m];
+    lx_page_spec page = {map->name, pg->width, pg->height, pg->nodes, pg->node_count};
+    lx_bake_desc d = b->desc;
+    d.progress = NULL; /* the pass reports; a rebuild is part of it */
+    lx_lightmap fresh;
+    lx_log_mute(true); /* its warnings were given when it was first built */
+    lx_status st = lx_texel_map_build(b->tile_scene, &page, &d, (lx_texel_progress){0, 0},
+                                      b->horizon_materials, &fresh);
+    lx_log_mute(false);
+    if (st == LX_OK && (fresh.info.width != map->info.width ||
+                        fresh.info.height != map->info.height ||
+                        fresh.info.used_texels != map->info.used_texels))
+        st = lx_fail(LX_ERR_INVALID, "lightmap '%s': rebuilt with %u texels where it had %u",
+                     map->name, fresh.info.used_texels, map->info.used_texels);
+    if (st != LX_OK) {
+        lx_texel_map_free(&fresh);
+        return st;
+    }
+    /* the resident parts stay where callers hold them */
+    free(fresh.name);
+    free(fresh.mask);
+    free(fresh.baked);
+    free(fresh.realtime);
+    fresh.name = map->name;
+    fresh.info = map->info;
+    fresh.mask = map->mask;
+    fresh.baked = map->baked;
+    fresh.realtime = map->realtime;
+    fresh.horizon_page = map->horizon_page;
+    fresh.loaded = true;
+    *map = fresh;
+    return LX_OK;
+}
+
+lx_status lx_bake_tile_need(lx_baker *b, uint32_t map)
+{
+    if (map >= b->map_count || b->maps[map].loaded)
+        return LX_OK;
+    if (b->loaded_tile != UINT32_MAX) {
+        for (uint32_t m = b->tile_first_map[b->loaded_tile];
+             m < b->tile_first_map[b->loaded_tile + 1]; m++)
+            lx_bake_map_unload(&b->maps[m]);
+        b->loaded_tile = UINT32_MAX;
+    }
+    uint32_t t = 0;
+    while (b->tile_first_map[t + 1] <= map)
+        t++;
+    lx_status st = LX_OK;
+    for (uint32_t m = b->tile_first_map[t]; m < b->tile_first_map[t + 1] && st == LX_OK; m++)
+        st = map_load(b, m);
+    if (st != LX_OK) {
+        for (uint32_t m = b->tile_first_map[t]; m < b->tile_first_map[t + 1]; m++)
+            lx_bake_map_unload(&b->maps[m]);
+        char what[300];
+        snprintf(what, sizeof what, "rebuilding lightmap '%s' for its tile", b->maps[map].name);
+        lx_error_prefix(what);
+        return st;
+    }
+    b->loaded_tile = t;
+    return LX_OK;
+}
+
+lx_status lx_bake_scene_copy(const lx_scene *s, lx_scene **out)
+{
+    lx_scene *c;
+    lx_status st = lx_scene_create(s->path, &c);
+    if (st != LX_OK)
+        return st;
+    for (uint32_t k = 0; k < s->material_count && st == LX_OK; k++)
+        st = lx_scene_add_material(c, &s->materials[k], NULL);
+    for (uint32_t k = 0; k < s->mesh_count && st == LX_OK; k++)
+        st = lx_scene_add_mesh(c, &s->meshes[k], NULL);
+    for (uint32_t k = 0; k < s->node_count && st == LX_OK; k++)
+        st = lx_scene_add_node(c, s->nodes[k].name, &s->nodes[k].world, s->nodes[k].meshes,
+                               s->nodes[k].mesh_count, NULL);
+    if (st != LX_OK) {
+        lx_scene_destroy(c);
+        return lx_fail(LX_ERR_NOMEM, "%s: out of memory keeping the scene for a tiled bake",
+                       s->path);
+    }
+    *out = c;
+    return LX_OK;
+}
