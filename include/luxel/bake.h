@@ -205,12 +205,13 @@ void lx_baker_destroy(lx_baker *baker);
 
 /* MEMORY AND TILES  lx_baker_create adds up what the bake takes (the
  * scene, its BVH, and per lightmap pixel the buffers listed in
- * docs/bake.md: about 200 bytes a texel with bounces and denoising). When
+ * docs/bake.md: 316 bytes a pixel with luxel bake's defaults). When
  * that exceeds desc.memory_limit (default: what the machine has) the
  * lightmaps are baked in tiles: runs of whole lightmaps whose texel maps
  * and working buffers fit beside what stays for the whole bake (each
  * map's mask and baked light, the bounces' sources: 38 bytes a pixel
- * with bounces, plus caller_bytes_per_texel, and a copy of the scene).
+ * with bounces, 50 denoising their part, plus caller_bytes_per_texel,
+ * and a copy of the scene).
  * Each pass (direct light, validity, each bounce, denoising, update,
  * apply, AO, metering, lx_baker_texel) builds a tile's texel maps again
  * from that copy, works on it and lets it go, so the light is exactly the

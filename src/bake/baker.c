@@ -145,9 +145,10 @@ static lx_status plan_memory(lx_baker *b, const lx_scene *scene, const candidate
         lx_memory_limit_describe(&ml, bound, sizeof bound);
     }
     return lx_fail(LX_ERR_NOMEM,
-                   "%s: baking %u lightmaps (%s kept for the whole bake, %s for lightmap '%s' "
+                   "%s: baking %u lightmap%s (%s kept for the whole bake, %s for lightmap '%s' "
                    "alone) needs %s of memory, %s",
-                   scene->path, count, keep, tile, c[largest_at].name, need, bound);
+                   scene->path, count, count == 1 ? "" : "s", keep, tile, c[largest_at].name, need,
+                   bound);
 }
 
 /* Builds the candidates' texel maps (a tiled baker lets each go once
