@@ -48,6 +48,25 @@ check "the bakes wrote several lightmaps and AO maps ($files files)" test "$file
 check "the tiled bake wrote no other file" \
     test "$(ls "$WORK/tiled" | wc -l)" -eq "$files"
 
+# ---- Ctrl-C in a tiled bake: the run stops, nothing written ----------------------
+# paused at the bake's first report (the test hook LUXEL_TEST_PAUSE, as
+# test_cli_interrupt.sh uses it), then SIGINT
+: >"$ERR"
+LUXEL_TEST_PAUSE=bake "$BIN" bake "$ROOM" "${ARGS[@]}" --memory-limit "$limit" \
+    -o "$WORK/stopped" >"$OUT" 2>"$ERR" </dev/null &
+pid=$!
+for ((i = 0; i < 6000; i++)); do
+    grep -qs '^luxel: test: paused at ' "$ERR" && break
+    kill -0 "$pid" 2>/dev/null || break
+    sleep 0.01
+done
+kill -INT "$pid" 2>/dev/null
+wait "$pid"
+RC=$?
+expect_rc 130 "SIGINT in a tiled bake"
+expect_error "SIGINT in a tiled bake" "interrupted"
+expect_no_output "SIGINT in a tiled bake" "$WORK/stopped"
+
 # ---- sizes --------------------------------------------------------------------------
 run "$BIN" bake "$ROOM" --resolution 16 --bounces 0 -q --memory-limit 1.5G -o "$WORK/big"
 expect_rc 0 "--memory-limit 1.5G"
