@@ -205,7 +205,7 @@ void lx_baker_destroy(lx_baker *baker);
 
 /* MEMORY AND TILES  lx_baker_create adds up what the bake takes (the
  * scene, its BVH, and per lightmap pixel the buffers listed in
- * docs/bake.md: 316 bytes a pixel with luxel bake's defaults). When
+ * docs/bake.md: 260 bytes a pixel with luxel bake's defaults). When
  * that exceeds desc.memory_limit (default: what the machine has) the
  * lightmaps are baked in tiles: runs of whole lightmaps whose texel maps
  * and working buffers fit beside what stays for the whole bake (each

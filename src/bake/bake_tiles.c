@@ -19,10 +19,10 @@
 
 /* ---- the per-texel buffers ------------------------------------------------
  * Bytes a lightmap pixel (covered texels are at most the pixels). Each
- * line names a buffer, what it takes, whether it stays for the whole bake
- * and when it exists. docs/bake.md's table is this list. A new per-texel
- * buffer (directional coefficients, supersampling's sub-texels...) is one
- * more line and, when it only exists under an option, one more flag. */
+ * line names a buffer, what it takes, how long it lives and when it
+ * exists. docs/bake.md's table is this list. A new per-texel buffer
+ * (directional coefficients, supersampling's sub-texels...) is one more
+ * line and, when it only exists under an option, one more flag. */
 enum {
     WHEN_ALWAYS = 0,
     WHEN_ALBEDO = 1u << 0,   /* radiance output or bounces */
@@ -34,35 +34,47 @@ enum {
     WHEN_PADDING = 1u << 6,  /* padding > 0 */
 };
 
+/* Where a buffer lives: the whole bake, a tile's texel maps (while the
+ * tile is in memory), or one step's scratch beside them (the steps do not
+ * overlap: a tile takes the largest). */
+typedef enum buffer_life {
+    LIFE_RESIDENT,
+    LIFE_TEXEL_MAP,
+    LIFE_BUILD,   /* rasterizing a texel map */
+    LIFE_GATHER,  /* a bounce's gathers */
+    LIFE_FILL,    /* filling invalid texels */
+    LIFE_DENOISE, /* denoising a map */
+    LIFE_APPLY,   /* padding */
+    LIFE_COUNT
+} buffer_life;
+
 typedef struct texel_buffer {
     const char *name;
     uint32_t bytes;
-    bool resident;
+    buffer_life life;
     uint32_t when; /* every flag must hold */
 } texel_buffer;
 
 static const texel_buffer texel_buffers[] = {
-    /* resident: the whole bake */
-    {"coverage mask", 1, true, WHEN_ALWAYS},
-    {"baked light (RGB float)", 12, true, WHEN_ALWAYS},
-    {"real-time light (RGB float)", 12, true, WHEN_DYNAMIC},
-    {"bounces: validity", 1, true, WHEN_GI},
-    {"bounces: exitant radiance of the last and the next bounce", 24, true, WHEN_GI},
-    {"denoising: the direct light kept", 12, true, WHEN_GI | WHEN_KEEP},
-    /* a tile's working set */
-    {"texel map: raster scratch while building (12 of it the baked buffer)", 17, false,
-     WHEN_ALWAYS},
-    {"texel map: texel record (pixel, mesh, triangle, node)", 16, false, WHEN_ALWAYS},
-    {"texel map: world position, shading and geometric normal", 36, false, WHEN_ALWAYS},
-    {"texel map: tile offsets", 1, false, WHEN_ALWAYS},
-    {"texel map: albedo", 12, false, WHEN_ALBEDO},
-    {"texel map: emission", 12, false, WHEN_GI},
-    {"texel map: horizon record (layers, AO, frame)", (uint32_t)sizeof(lx_texel_horizon), false,
-     WHEN_HORIZON},
-    {"bounces: this bounce's irradiance and the inside flag", 13, false, WHEN_GI},
-    {"bounces: filling invalid texels", 17, false, WHEN_GI},
-    {"denoising: guides, scratch and the indirect part", 29 + 80 + 12, false, WHEN_DENOISE},
-    {"padding: the mask's copy and frontiers", 9, false, WHEN_PADDING},
+    {"coverage mask", 1, LIFE_RESIDENT, WHEN_ALWAYS},
+    {"baked light (RGB float)", 12, LIFE_RESIDENT, WHEN_ALWAYS},
+    {"real-time light (RGB float)", 12, LIFE_RESIDENT, WHEN_DYNAMIC},
+    {"bounces: validity", 1, LIFE_RESIDENT, WHEN_GI},
+    {"bounces: exitant radiance of the last and the next bounce", 24, LIFE_RESIDENT, WHEN_GI},
+    {"denoising: the direct light kept", 12, LIFE_RESIDENT, WHEN_GI | WHEN_KEEP},
+    {"texel map: texel record (pixel, mesh, triangle, node)", 16, LIFE_TEXEL_MAP, WHEN_ALWAYS},
+    {"texel map: world position, shading and geometric normal", 36, LIFE_TEXEL_MAP, WHEN_ALWAYS},
+    {"texel map: tile offsets", 1, LIFE_TEXEL_MAP, WHEN_ALWAYS},
+    {"texel map: albedo", 12, LIFE_TEXEL_MAP, WHEN_ALBEDO},
+    {"texel map: emission", 12, LIFE_TEXEL_MAP, WHEN_GI},
+    {"texel map: horizon record (layers, AO, frame)", (uint32_t)sizeof(lx_texel_horizon),
+     LIFE_TEXEL_MAP, WHEN_HORIZON},
+    {"building: raster scratch (12 of it becomes the baked buffer)", 17, LIFE_BUILD, WHEN_ALWAYS},
+    {"bounces: this bounce's irradiance and the inside flag", 13, LIFE_GATHER, WHEN_GI},
+    {"bounces: filling invalid texels, beside the gather's buffers", 17 + 13, LIFE_FILL, WHEN_GI},
+    {"denoising: guides, scratch and the indirect part", 29 + 80 + 12, LIFE_DENOISE,
+     WHEN_DENOISE},
+    {"padding: the mask's copy and frontiers", 9, LIFE_APPLY, WHEN_PADDING},
 };
 
 lx_bake_texel_bytes lx_bake_texel_bytes_of(const lx_bake_desc *d, bool horizon, bool dynamic,
@@ -80,16 +92,17 @@ lx_bake_texel_bytes lx_bake_texel_bytes_of(const lx_bake_desc *d, bool horizon, 
     have |= d->denoise == LX_DENOISE_INDIRECT ? WHEN_KEEP : 0;
     have |= d->padding > 0 ? WHEN_PADDING : 0;
     (void)tiled; /* the same buffers either way; tiled, the tile's are let go */
-    lx_bake_texel_bytes out = {d->caller_bytes_per_texel, 0};
+    uint32_t life[LIFE_COUNT] = {0};
     for (size_t i = 0; i < sizeof texel_buffers / sizeof texel_buffers[0]; i++) {
         const texel_buffer *t = &texel_buffers[i];
-        if ((t->when & have) != t->when)
-            continue;
-        if (t->resident)
-            out.resident += t->bytes;
-        else
-            out.tile += t->bytes;
+        if ((t->when & have) == t->when)
+            life[t->life] += t->bytes;
     }
+    uint32_t step = 0;
+    for (int k = LIFE_BUILD; k < LIFE_COUNT; k++)
+        step = life[k] > step ? life[k] : step;
+    lx_bake_texel_bytes out = {d->caller_bytes_per_texel + life[LIFE_RESIDENT],
+                               life[LIFE_TEXEL_MAP] + step};
     return out;
 }
 
