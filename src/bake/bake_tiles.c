@@ -305,8 +305,10 @@ lx_status lx_bake_scene_copy(const lx_scene *s, lx_scene **out)
                                s->nodes[k].mesh_count, NULL);
     if (st != LX_OK) {
         lx_scene_destroy(c);
-        return lx_fail(LX_ERR_NOMEM, "%s: out of memory keeping the scene for a tiled bake",
-                       s->path);
+        char what[300];
+        snprintf(what, sizeof what, "%s: keeping the scene for a tiled bake", s->path);
+        lx_error_prefix(what);
+        return st;
     }
     *out = c;
     return LX_OK;
