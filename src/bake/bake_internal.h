@@ -280,6 +280,19 @@ void lx_bake_map_unload(lx_lightmap *map);
 /* The progress share of tile t within [from, to] (by pixels). */
 void lx_bake_tile_share(const lx_baker *b, uint32_t t, float from, float to, float *tfrom,
                         float *tto);
+/* A lightmap lx_baker_create will build: its page, name and size. */
+typedef struct lx_tile_candidate {
+    char *name;
+    lx_tile_page page;
+    bool horizon;
+    uint64_t pixels;
+} lx_tile_candidate;
+/* Decides whether the candidates fit the memory limit together or are
+ * baked in tiles (b->tiled, b->memory_limit), and fails with one line
+ * when even the resident part and the largest lightmap's working set do
+ * not fit. */
+lx_status lx_bake_plan_memory(lx_baker *b, const lx_scene *scene, const lx_tile_candidate *c,
+                              uint32_t count, bool dynamic);
 /* Groups the maps into tiles under b->memory_limit (after the maps are
  * built): resident bytes are counted for every map, tile bytes per tile. */
 lx_status lx_bake_plan_tiles(lx_baker *b, const lx_scene *scene, bool dynamic);

@@ -136,6 +136,54 @@ uint64_t lx_bake_scene_bytes(const lx_scene *scene, bool copy)
 
 /* ---- tiles ------------------------------------------------------------------ */
 
+/* Decides whether the lightmaps fit the memory limit together or are
+ * baked in tiles (b->tiled), and fails with one line when even the part
+ * that stays for the whole bake and the largest lightmap's working set do
+ * not fit. */
+lx_status lx_bake_plan_memory(lx_baker *b, const lx_scene *scene, const lx_tile_candidate *c,
+                              uint32_t count, bool dynamic)
+{
+    lx_memory_limit ml;
+    uint64_t avail = lx_memory_available(&ml);
+    bool asked = b->desc.memory_limit > 0 && b->desc.memory_limit < avail;
+    uint64_t limit = asked ? b->desc.memory_limit : avail;
+    b->memory_limit = limit;
+    uint64_t together = lx_bake_scene_bytes(scene, false);
+    uint64_t resident = lx_bake_scene_bytes(scene, true), largest = 0;
+    uint32_t largest_at = 0;
+    for (uint32_t i = 0; i < count; i++) {
+        lx_bake_texel_bytes tb = lx_bake_texel_bytes_of(&b->desc, c[i].horizon, dynamic, false);
+        together += c[i].pixels * (tb.resident + tb.tile);
+        lx_bake_texel_bytes tt = lx_bake_texel_bytes_of(&b->desc, c[i].horizon, dynamic, true);
+        resident += c[i].pixels * tt.resident;
+        if (c[i].pixels * tt.tile > largest) {
+            largest = c[i].pixels * tt.tile;
+            largest_at = i;
+        }
+    }
+    b->tiled = together > limit;
+    if (!b->tiled || resident + largest <= limit)
+        return LX_OK;
+    char need[32], keep[32], tile[32], bound[200];
+    lx_format_bytes(resident + largest, need, sizeof need);
+    lx_format_bytes(resident, keep, sizeof keep);
+    lx_format_bytes(largest, tile, sizeof tile);
+    if (asked) {
+        char lim[32];
+        lx_format_bytes(limit, lim, sizeof lim);
+        snprintf(bound, sizeof bound, "the memory limit asked for is %s", lim);
+    } else {
+        lx_memory_limit_describe(&ml, bound, sizeof bound);
+    }
+    return lx_fail(LX_ERR_NOMEM,
+                   "%s: baking %u lightmap%s (%s kept for the whole bake, %s for lightmap '%s' "
+                   "alone) needs %s of memory, %s",
+                   scene->path, count, count == 1 ? "" : "s", keep, tile, c[largest_at].name, need,
+                   bound);
+}
+
+
+
 static uint64_t map_pixels(const lx_lightmap *m)
 {
     return (uint64_t)m->info.width * (uint64_t)m->info.height;

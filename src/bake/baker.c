@@ -88,15 +88,7 @@ static bool bvh_progress(void *user, float fraction)
     return d->progress(d->progress_user, TEXEL_MAPS_SHARE + (1.0f - TEXEL_MAPS_SHARE) * fraction);
 }
 
-/* A lightmap to build: its page (name, size, nodes). */
-typedef struct candidate {
-    char *name;
-    lx_tile_page page;
-    bool horizon;
-    uint64_t pixels;
-} candidate;
-
-static void candidates_free(candidate *c, uint32_t count)
+static void candidates_free(lx_tile_candidate *c, uint32_t count)
 {
     for (uint32_t i = 0; c && i < count; i++) {
         free(c[i].name);
@@ -105,62 +97,16 @@ static void candidates_free(candidate *c, uint32_t count)
     free(c);
 }
 
-/* Decides whether the lightmaps fit the memory limit together or are
- * baked in tiles (b->tiled), and fails with one line when even the part
- * that stays for the whole bake and the largest lightmap's working set do
- * not fit. */
-static lx_status plan_memory(lx_baker *b, const lx_scene *scene, const candidate *c,
-                             uint32_t count, bool dynamic)
-{
-    lx_memory_limit ml;
-    uint64_t avail = lx_memory_available(&ml);
-    bool asked = b->desc.memory_limit > 0 && b->desc.memory_limit < avail;
-    uint64_t limit = asked ? b->desc.memory_limit : avail;
-    b->memory_limit = limit;
-    uint64_t together = lx_bake_scene_bytes(scene, false);
-    uint64_t resident = lx_bake_scene_bytes(scene, true), largest = 0;
-    uint32_t largest_at = 0;
-    for (uint32_t i = 0; i < count; i++) {
-        lx_bake_texel_bytes tb = lx_bake_texel_bytes_of(&b->desc, c[i].horizon, dynamic, false);
-        together += c[i].pixels * (tb.resident + tb.tile);
-        lx_bake_texel_bytes tt = lx_bake_texel_bytes_of(&b->desc, c[i].horizon, dynamic, true);
-        resident += c[i].pixels * tt.resident;
-        if (c[i].pixels * tt.tile > largest) {
-            largest = c[i].pixels * tt.tile;
-            largest_at = i;
-        }
-    }
-    b->tiled = together > limit;
-    if (!b->tiled || resident + largest <= limit)
-        return LX_OK;
-    char need[32], keep[32], tile[32], bound[200];
-    lx_format_bytes(resident + largest, need, sizeof need);
-    lx_format_bytes(resident, keep, sizeof keep);
-    lx_format_bytes(largest, tile, sizeof tile);
-    if (asked) {
-        char lim[32];
-        lx_format_bytes(limit, lim, sizeof lim);
-        snprintf(bound, sizeof bound, "the memory limit asked for is %s", lim);
-    } else {
-        lx_memory_limit_describe(&ml, bound, sizeof bound);
-    }
-    return lx_fail(LX_ERR_NOMEM,
-                   "%s: baking %u lightmap%s (%s kept for the whole bake, %s for lightmap '%s' "
-                   "alone) needs %s of memory, %s",
-                   scene->path, count, count == 1 ? "" : "s", keep, tile, c[largest_at].name, need,
-                   bound);
-}
-
 /* Builds the candidates' texel maps (a tiled baker lets each go once
  * built, keeping what stays resident), marking the nodes that cover a
  * texel in hit. */
 static lx_status build_maps(lx_baker *b, const lx_scene *scene, const lx_bake_desc *desc,
-                            candidate *c, uint32_t count, uint8_t *hit)
+                            lx_tile_candidate *c, uint32_t count, uint8_t *hit)
 {
     bool dynamic = false;
     for (uint32_t l = 0; l < scene->light_count; l++)
         dynamic |= scene->lights[l].dynamic;
-    lx_status st = plan_memory(b, scene, c, count, dynamic);
+    lx_status st = lx_bake_plan_memory(b, scene, c, count, dynamic);
     if (st == LX_OK && b->tiled) {
         st = lx_bake_scene_copy(scene, &b->tile_scene);
         b->pages = calloc(count + 1, sizeof *b->pages);
@@ -229,7 +175,7 @@ static bool page_has_horizon(const lx_baker *b, const lx_scene *scene, const lx_
 static lx_status build_node_maps(lx_baker *b, const lx_scene *scene, const lx_bake_desc *desc,
                                  uint8_t *hit)
 {
-    candidate *c = calloc(scene->node_count + 1, sizeof *c);
+    lx_tile_candidate *c = calloc(scene->node_count + 1, sizeof *c);
     if (!c)
         return lx_fail(LX_ERR_NOMEM, "out of memory creating a baker");
     uint32_t count = 0;
@@ -237,7 +183,7 @@ static lx_status build_node_maps(lx_baker *b, const lx_scene *scene, const lx_ba
     for (uint32_t n = 0; n < scene->node_count && st == LX_OK; n++) {
         int w, h;
         lx_texel_map_size(scene, n, desc, &w, &h);
-        candidate *k = &c[count++];
+        lx_tile_candidate *k = &c[count++];
         k->name = lx_strdup(scene->nodes[n].name);
         k->page.nodes = malloc(sizeof *k->page.nodes);
         if (!k->name || !k->page.nodes) {
@@ -276,13 +222,13 @@ static lx_status build_pages(lx_baker *b, const lx_scene *scene, const lx_bake_d
             return lx_fail(LX_ERR_INVALID, "%s: node '%s': atlas page %u out of range (count %u)",
                            scene->path, scene->nodes[n].name, un->page, atlas->page_count);
     }
-    candidate *c = calloc(atlas->page_count + 1, sizeof *c);
+    lx_tile_candidate *c = calloc(atlas->page_count + 1, sizeof *c);
     if (!c)
         return lx_fail(LX_ERR_NOMEM, "out of memory creating a baker");
     lx_status st = LX_OK;
     uint32_t count = 0;
     for (uint32_t p = 0; p < atlas->page_count && st == LX_OK; p++) {
-        candidate *k = &c[count++];
+        lx_tile_candidate *k = &c[count++];
         char name[32];
         snprintf(name, sizeof name, "lightmap-%u", p);
         k->name = lx_strdup(name);
