@@ -209,6 +209,15 @@ typedef struct lx_bake_desc {
                               real-time buffers keep the texel's one point. Costs N^2 times the direct pass and about
                               40 N^2 bytes a texel more (72 N^2 for a map of a
                               node away from the identity) */
+    /* Memory and scale (see "MEMORY AND TILES" above lx_baker_tile_count). */
+    uint64_t memory_limit;  /* bytes the bake may take; 0 (or more than the
+                               machine has) = what the machine has: its
+                               physical memory, control group and rlimits */
+    uint32_t caller_bytes_per_texel; /* bytes the caller holds per lightmap
+                               pixel while the baker lives (luxel bake: the
+                               applied RGB float images it keeps until it
+                               writes them, 12, and AO's 4): counted as
+                               resident in the limit; 0 = none */
     lx_progress_fn progress;
     void *progress_user;
 } lx_bake_desc;
@@ -240,6 +249,27 @@ typedef struct lx_lightmap_info {
  * NULL). */
 lx_status lx_baker_create(const lx_scene *scene, const lx_bake_desc *desc, lx_baker **out);
 void lx_baker_destroy(lx_baker *baker);
+
+/* MEMORY AND TILES  lx_baker_create adds up what the bake takes (the
+ * scene, its BVH, and per lightmap pixel the buffers listed in
+ * docs/bake.md: 260 bytes a pixel with luxel bake's defaults). When
+ * that exceeds desc.memory_limit (default: what the machine has) the
+ * lightmaps are baked in tiles: runs of whole lightmaps whose texel maps
+ * and working buffers fit beside what stays for the whole bake (each
+ * map's mask and baked light, the bounces' sources: 38 bytes a pixel
+ * with bounces, 50 denoising their part, plus caller_bytes_per_texel,
+ * and a copy of the scene).
+ * Each pass (direct light, validity, each bounce, denoising, update,
+ * apply, AO, metering, lx_baker_texel) builds a tile's texel maps again
+ * from that copy, works on it and lets it go, so the light is exactly the
+ * untiled bake's (same bytes) at the cost of rebuilding texel maps. When
+ * even the resident part and the largest lightmap's working set do not
+ * fit, lx_baker_create fails with LX_ERR_NOMEM and one line naming the
+ * memory needed and available; a single lightmap is never split. Moving
+ * a node (lx_baker_set_node_transform) in a tiled baker moves it in the
+ * copy: texel maps are then built where it stands. */
+/* The tiles the baker works in: 1 when every lightmap fits at once. */
+uint32_t lx_baker_tile_count(const lx_baker *baker);
 
 uint32_t lx_baker_lightmap_count(const lx_baker *baker);
 /* Borrowed until lx_baker_destroy. */

@@ -75,6 +75,9 @@ lx_status lx_baker_ao(lx_baker *b, uint32_t map_index, const lx_ao_desc *desc, l
         return lx_fail(LX_ERR_INVALID, "lx_baker_ao: lightmap %u out of range (count %u)",
                        map_index, b ? b->map_count : 0u);
     lx_ao_desc d = lx_ao_desc_defaults(desc);
+    lx_status need = lx_bake_tile_need(b, map_index); /* a tiled baker builds it again */
+    if (need != LX_OK)
+        return need;
     const lx_lightmap *map = &b->maps[map_index];
     if (!isfinite(d.distance) || !(d.distance > 0.0f))
         return lx_fail(LX_ERR_INVALID, "lightmap '%s': AO distance %g must be a number > 0",

@@ -116,15 +116,23 @@ lx_status lx_bake_denoise(lx_baker *b, float **direct, float progress_base, floa
     if (mode == LX_DENOISE_OFF || (mode == LX_DENOISE_INDIRECT && !direct))
         return LX_OK;
     lx_status st = LX_OK;
-    for (uint32_t m = 0; m < b->map_count && st == LX_OK; m++) {
+    /* the maps in memory (a tiled baker's tile), each its share */
+    uint32_t first = UINT32_MAX, last = 0;
+    for (uint32_t m = 0; m < b->map_count; m++)
+        if (b->maps[m].loaded) {
+            first = first == UINT32_MAX ? m : first;
+            last = m + 1;
+        }
+    uint32_t span_maps = first == UINT32_MAX ? 1 : last - first;
+    for (uint32_t m = first; m < last && st == LX_OK; m++) {
         lx_lightmap *map = &b->maps[m];
         size_t n = (size_t)map->info.width * map->info.height * 3;
         lx_denoise_guides g;
         st = lx_baker_denoise_guides(b, m, &g);
         if (st != LX_OK)
             break;
-        share sh = {b, progress_base + progress_span * (float)m / (float)b->map_count,
-                    progress_span / (float)b->map_count};
+        share sh = {b, progress_base + progress_span * (float)(m - first) / (float)span_maps,
+                    progress_span / (float)span_maps};
         lx_denoise_desc dd = {.threads = b->desc.threads,
                               .progress = b->desc.progress ? share_progress : NULL,
                               .progress_user = &sh};

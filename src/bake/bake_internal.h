@@ -182,7 +182,20 @@ typedef struct lx_lightmap {
     /* per texel until lx_bake_straddle has run (then NULL): the world
      * step of one texel along x and along y, [2 i] and [2 i + 1] */
     lx_vec3 *texel_axes;
+    /* Whether the texel map (texels, tiles, positions, normals, albedo,
+     * emission, horizon, stitch) is in memory. A tiled baker
+     * (bake_tiles.c) keeps only name, info, mask, baked and realtime of
+     * the maps outside the tile it works on, and rebuilds the rest. */
+    bool loaded;
+    bool horizon_page; /* a node on it has a height (its texels may take records) */
 } lx_lightmap;
+
+/* How to build a lightmap again (a tiled baker): its page. */
+typedef struct lx_tile_page {
+    int width, height; /* 0: the node's own size */
+    struct lx_page_node *nodes;
+    uint32_t node_count;
+} lx_tile_page;
 
 struct lx_baker {
     lx_bake_desc desc;
@@ -228,9 +241,19 @@ struct lx_baker {
      * update that needs it */
     lx_dyn_bounce *dyn;
     bool dyn_stale; /* a node moved: the cached hits are rebuilt */
-    /* during lx_baker_create only: each material's horizon layers and AO */
+    /* during lx_baker_create only (for the baker's life when tiled): each
+     * material's horizon layers and AO */
     lx_horizon_material *horizon_materials;
     uint32_t horizon_material_count;
+    /* tiles (bake_tiles.c): consecutive groups of whole lightmaps whose
+     * working set fits the memory limit; one tile when everything fits */
+    uint32_t tile_count;
+    uint32_t *tile_first_map; /* tile_count + 1 */
+    uint32_t loaded_tile;     /* the tile in memory when tiled; UINT32_MAX none */
+    bool tiled;               /* more than one tile: maps are rebuilt */
+    lx_scene *tile_scene;     /* tiled: the copy texel maps are rebuilt from */
+    lx_tile_page *pages;      /* tiled: per map, its page */
+    uint64_t memory_limit;    /* the limit tiles were planned for */
 };
 
 /* Bytes a lightmap needs per texel at most: raster scratch, mask, baked and
@@ -405,9 +428,16 @@ bool lx_gi_texel_inside(const lx_baker *b, uint32_t map_index, uint32_t i);
 lx_status lx_gi_fill_invalid(const lx_lightmap *map, const uint8_t *valid, const uint8_t *invalid,
                              float *buf, int channels);
 /* emitters.c: next-event estimation of the emissive triangles' light
- * (direct light, when desc.bounces > 0 and an emitter exists), added into
- * the baked buffers within [progress_base, progress_base + progress_span]. */
-lx_status lx_bake_emitters(lx_baker *b, float progress_base, float progress_span);
+ * (direct light, when desc.bounces > 0 and an emitter exists). The set of
+ * emissive triangles is made once (NULL when nothing emits; a tiled
+ * baker builds every map again to read textured emission), then each
+ * tile's texels get their light added into the baked buffers of the maps
+ * in memory, within [progress_base, progress_base + progress_span]. */
+typedef struct lx_emitter_set lx_emitter_set;
+lx_status lx_emitter_set_create(lx_baker *b, lx_emitter_set **out);
+void lx_emitter_set_destroy(const lx_baker *b, lx_emitter_set *set);
+lx_status lx_bake_emitters(lx_baker *b, const lx_emitter_set *set, float progress_base,
+                           float progress_span);
 /* dyn_bounce.c: one bounce of the real-time buffers' light (the dynamic
  * lights' direct light) added into them; its cache's release. */
 lx_status lx_dyn_bounce_update(lx_baker *b);
@@ -444,5 +474,90 @@ lx_status lx_bake_denoise(lx_baker *b, float **direct, float progress_base, floa
 lx_status lx_bake_lights(lx_baker *baker, const uint32_t *lights, uint32_t light_count,
                          lx_vec3 ambient, bool to_realtime, float progress_base,
                          float progress_span);
+
+/* ---- memory and tiles (bake_tiles.c) ----------------------------------------
+ * The one list of the bake's per-texel buffers (bytes per lightmap pixel:
+ * the covered texels are bounded by the pixels), split into what stays in
+ * memory for the whole bake (resident) and what a tile of lightmaps needs
+ * while it is worked on. A new per-texel buffer is a line in that list. */
+typedef struct lx_bake_texel_bytes {
+    uint32_t resident; /* per pixel of every lightmap, for the whole bake */
+    uint32_t tile;     /* per pixel of the lightmaps of the tile worked on */
+} lx_bake_texel_bytes;
+/* What the scene asks of a bake beyond its desc (lx_bake_scene_needs). */
+enum {
+    LX_SCENE_NEEDS_DYNAMIC = 1u << 0,          /* a dynamic light */
+    LX_SCENE_NEEDS_EMISSIVE_TEXTURE = 1u << 1, /* an emissive material with a texture */
+};
+uint32_t lx_bake_scene_needs(const lx_scene *scene);
+/* The bytes per pixel of a lightmap under desc: horizon when a node on it
+ * has a height; needs from lx_bake_scene_needs. The same buffers whether
+ * the bake is tiled or not; tiled, a tile's are let go. */
+lx_bake_texel_bytes lx_bake_texel_bytes_of(const lx_bake_desc *desc, bool horizon,
+                                           uint32_t scene_needs);
+/* What the scene copy, the BVH and the gathers' mesh copies take. */
+uint64_t lx_bake_scene_bytes(const lx_scene *scene, bool copy);
+/* Makes sure the texel map of `map` is in memory: in a tiled baker, the
+ * tile in memory is let go and map's tile rebuilt. */
+lx_status lx_bake_tile_need(lx_baker *b, uint32_t map);
+/* Lets go of a map's texel map, keeping what stays resident. */
+void lx_bake_map_unload(lx_lightmap *map);
+/* The progress share of tile t within [from, to] (by pixels). */
+void lx_bake_tile_share(const lx_baker *b, uint32_t t, float from, float to, float *tfrom,
+                        float *tto);
+/* A lightmap lx_baker_create will build: its page, name and size. */
+typedef struct lx_tile_candidate {
+    char *name;
+    lx_tile_page page;
+    bool horizon;
+    uint64_t pixels;
+} lx_tile_candidate;
+/* Decides whether the candidates fit the memory limit together or are
+ * baked in tiles (b->tiled, b->memory_limit), and fails with one line
+ * when even the resident part and the largest lightmap's working set do
+ * not fit. */
+lx_status lx_bake_plan_memory(lx_baker *b, const lx_scene *scene, const lx_tile_candidate *c,
+                              uint32_t count, uint32_t scene_needs);
+/* Groups the maps into tiles under b->memory_limit (after the maps are
+ * built): resident bytes are counted for every map, tile bytes per tile. */
+lx_status lx_bake_plan_tiles(lx_baker *b, const lx_scene *scene, uint32_t scene_needs);
+/* A copy of the scene's meshes, materials and nodes (what texel maps are
+ * built from), for a tiled baker. */
+lx_status lx_bake_scene_copy(const lx_scene *scene, lx_scene **out);
+/* The progress callback's answer at fraction f (true: go on). */
+bool lx_bake_report(const lx_baker *b, float f);
+
+/* One parallel loop over the texel tiles of every map in memory (every
+ * map unless the baker is tiled), as each pass walks them: a global tile
+ * index per iteration, progress counted in texels plus one per tile (so
+ * empty tiles count), reported by thread 0 every `every` tiles within
+ * [base, base + span]; cancelled once the callback says stop.
+ *
+ *     lx_tile_walk w;
+ *     if ((st = lx_tile_walk_begin(b, base, span, 1, &w)) != LX_OK) return st;
+ *     #pragma omp parallel for schedule(dynamic, 1) num_threads(threads)
+ *     for (int g = 0; g < w.tiles; g++) {
+ *         if (w.cancelled) continue;
+ *         uint32_t m, first, count;
+ *         lx_tile_walk_at(&w, g, &m, &first, &count);
+ *         ...texels first .. first + count - 1 of map m...
+ *         lx_tile_walk_done(&w, g, count);
+ *     }
+ *     return lx_tile_walk_end(&w); (LX_ERR_CANCELLED when cancelled) */
+typedef struct lx_tile_walk {
+    const lx_baker *b;
+    uint32_t *map_first_tile; /* map_count + 1 */
+    int tiles;
+    int every;
+    uint64_t total_work, done_work;
+    float base, span;
+    volatile int cancelled;
+} lx_tile_walk;
+lx_status lx_tile_walk_begin(const lx_baker *b, float base, float span, int every,
+                             lx_tile_walk *w);
+void lx_tile_walk_at(const lx_tile_walk *w, int global, uint32_t *map, uint32_t *first,
+                     uint32_t *count);
+void lx_tile_walk_done(lx_tile_walk *w, int global, uint32_t count);
+lx_status lx_tile_walk_end(lx_tile_walk *w);
 
 #endif

@@ -92,51 +92,45 @@ static float maps_from(const lx_baker *b)
     return b->horizon_materials ? HORIZON_SHARE : 0.0f;
 }
 
-/* Bytes a w x h lightmap takes per texel, with the texel's horizon record
- * when a material on it has a height, its footprint axes (until the
- * samples are checked, straddle.c) and its supersampling points (three
- * vectors and a flag each). */
-static uint64_t map_bytes(int w, int h, bool horizon, int supersample)
-{
-    uint64_t points = supersample > 1 ? (uint64_t)supersample * supersample : 0;
-    return (uint64_t)w * (uint64_t)h *
-           (LX_BYTES_PER_TEXEL + (horizon ? sizeof(lx_texel_horizon) : 0) + 2 * sizeof(lx_vec3) +
-            points * (3 * sizeof(lx_vec3) + 1));
-}
-
 static bool bvh_progress(void *user, float fraction)
 {
     const lx_bake_desc *d = user;
     return d->progress(d->progress_user, TEXEL_MAPS_SHARE + (1.0f - TEXEL_MAPS_SHARE) * fraction);
 }
 
-/* A lightmap per node with UVs, sized by the resolution or the density. */
-static lx_status build_node_maps(lx_baker *b, const lx_scene *scene, const lx_bake_desc *desc)
+static void candidates_free(lx_tile_candidate *c, uint32_t count)
 {
-    /* memory for every lightmap together, before allocating any */
-    uint64_t bytes = 0;
-    int largest = 0;
-    uint32_t with_uvs = 0;
-    for (uint32_t n = 0; n < scene->node_count; n++) {
-        int w, h;
-        lx_texel_map_size(scene, n, desc, &w, &h);
-        bytes += map_bytes(w, h, lx_bake_node_has_horizon(scene, b->horizon_materials, n),
-                           desc->supersample);
-        largest = w > largest ? w : largest;
-        with_uvs += w > 0;
+    for (uint32_t i = 0; c && i < count; i++) {
+        free(c[i].name);
+        free(c[i].page.nodes);
     }
-    char what[400];
-    snprintf(what, sizeof what, "%s: baking %u lightmaps (the largest %dx%d)", scene->path,
-             with_uvs, largest, largest);
-    lx_status st = lx_check_memory(bytes, what);
-    for (uint32_t n = 0; n < scene->node_count && st == LX_OK; n++) {
+    free(c);
+}
+
+/* Builds the candidates' texel maps (a tiled baker lets each go once
+ * built, keeping what stays resident), marking the nodes that cover a
+ * texel in hit. */
+static lx_status build_maps(lx_baker *b, const lx_scene *scene, const lx_bake_desc *desc,
+                            lx_tile_candidate *c, uint32_t count, uint8_t *hit)
+{
+    uint32_t needs = lx_bake_scene_needs(scene);
+    lx_status st = lx_bake_plan_memory(b, scene, c, count, needs);
+    if (st == LX_OK && b->tiled) {
+        st = lx_bake_scene_copy(scene, &b->tile_scene);
+        b->pages = calloc(count + 1, sizeof *b->pages);
+        if (st == LX_OK && !b->pages)
+            st = lx_fail(LX_ERR_NOMEM, "out of memory creating a baker");
+    }
+    /* a tiled baker builds from its copy, as it will build again */
+    const lx_scene *from_scene = b->tiled ? b->tile_scene : scene;
+    for (uint32_t i = 0; i < count && st == LX_OK; i++) {
         lx_lightmap *map = &b->maps[b->map_count];
         float from = maps_from(b), span = TEXEL_MAPS_SHARE - from;
-        lx_texel_progress share = {from + span * (float)n / (float)scene->node_count,
-                                   from + span * (float)(n + 1) / (float)scene->node_count};
-        lx_page_node pn = {n, (int)desc->uv_set - 1, {1.0f, 1.0f, 0.0f, 0.0f}};
-        lx_page_spec page = {scene->nodes[n].name, 0, 0, &pn, 1};
-        st = lx_texel_map_build(scene, &page, desc, share, b->horizon_materials, map);
+        lx_texel_progress share = {from + span * (float)i / (float)count,
+                                   from + span * (float)(i + 1) / (float)count};
+        lx_page_spec page = {c[i].name, c[i].page.width, c[i].page.height, c[i].page.nodes,
+                             c[i].page.node_count};
+        st = lx_texel_map_build(from_scene, &page, desc, share, b->horizon_materials, map);
         if (st != LX_OK) {
             lx_texel_map_free(map);
             break;
@@ -145,24 +139,84 @@ static lx_status build_node_maps(lx_baker *b, const lx_scene *scene, const lx_ba
             lx_texel_map_free(map); /* no UVs: nothing to bake */
             continue;
         }
-        b->node_map[n] = b->map_count++;
-        if (b->node_uv_set)
-            b->node_uv_set[n] = (int8_t)lx_bake_uv_set(scene, n, desc->uv_set);
+        map->loaded = true;
+        map->horizon_page = c[i].horizon;
+        for (uint32_t t = 0; t < map->info.used_texels; t++)
+            hit[map->texels[t].node] = 1;
+        for (uint32_t k = 0; k < c[i].page.node_count; k++) {
+            const lx_page_node *pn = &c[i].page.nodes[k];
+            b->node_map[pn->node] = b->map_count;
+            if (b->node_uv_set)
+                b->node_uv_set[pn->node] = (int8_t)(
+                    pn->uv_set >= 0 ? pn->uv_set
+                                    : lx_bake_uv_set(scene, pn->node,
+                                                     c[i].page.width ? LX_UV_SET_AUTO
+                                                                     : desc->uv_set));
+            memcpy(b->node_scale_offset[pn->node], pn->scale_offset, sizeof pn->scale_offset);
+        }
+        if (b->tiled) {
+            b->pages[b->map_count] = c[i].page; /* the nodes move to the baker */
+            c[i].page.nodes = NULL;
+            lx_bake_map_unload(map);
+        }
+        b->map_count++;
         /* building large texel maps takes long enough to report and stop */
         if (desc->progress && !desc->progress(desc->progress_user, share.to))
             st = lx_fail(LX_ERR_CANCELLED, "bake cancelled");
     }
+    if (st == LX_OK)
+        st = lx_bake_plan_tiles(b, scene, needs);
+    b->loaded_tile = b->tiled ? UINT32_MAX : 0;
+    return st;
+}
+
+static bool page_has_horizon(const lx_baker *b, const lx_scene *scene, const lx_page_node *nodes,
+                             uint32_t count)
+{
+    for (uint32_t k = 0; k < count; k++)
+        if (lx_bake_node_has_horizon(scene, b->horizon_materials, nodes[k].node))
+            return true;
+    return false;
+}
+
+/* A lightmap per node with UVs, sized by the resolution or the density. */
+static lx_status build_node_maps(lx_baker *b, const lx_scene *scene, const lx_bake_desc *desc,
+                                 uint8_t *hit)
+{
+    lx_tile_candidate *c = calloc(scene->node_count + 1, sizeof *c);
+    if (!c)
+        return lx_fail(LX_ERR_NOMEM, "out of memory creating a baker");
+    uint32_t count = 0;
+    lx_status st = LX_OK;
+    for (uint32_t n = 0; n < scene->node_count && st == LX_OK; n++) {
+        int w, h;
+        lx_texel_map_size(scene, n, desc, &w, &h);
+        lx_tile_candidate *k = &c[count++];
+        k->name = lx_strdup(scene->nodes[n].name);
+        k->page.nodes = malloc(sizeof *k->page.nodes);
+        if (!k->name || !k->page.nodes) {
+            st = lx_fail(LX_ERR_NOMEM, "out of memory creating a baker");
+            break;
+        }
+        *k->page.nodes = (lx_page_node){n, (int)desc->uv_set - 1, {1.0f, 1.0f, 0.0f, 0.0f}};
+        k->page.node_count = 1;
+        k->pixels = (uint64_t)w * (uint64_t)h;
+        k->horizon = page_has_horizon(b, scene, k->page.nodes, 1);
+    }
+    if (st == LX_OK)
+        st = build_maps(b, scene, desc, c, count, hit);
+    candidates_free(c, count);
     return st;
 }
 
 /* A lightmap per page of the atlas, holding the nodes placed on it. */
-static lx_status build_pages(lx_baker *b, const lx_scene *scene, const lx_bake_desc *desc)
+static lx_status build_pages(lx_baker *b, const lx_scene *scene, const lx_bake_desc *desc,
+                             uint8_t *hit)
 {
     const lx_unwrap *atlas = desc->atlas;
     if (atlas->node_count != scene->node_count)
         return lx_fail(LX_ERR_INVALID, "%s: the atlas places %u nodes, the scene has %u",
                        scene->path, atlas->node_count, scene->node_count);
-    uint64_t bytes = 0;
     for (uint32_t p = 0; p < atlas->page_count; p++) {
         const lx_unwrap_page *pg = &atlas->pages[p];
         if (pg->width < 1 || pg->height < 1 || pg->width > LX_MAX_LIGHTMAP_SIZE ||
@@ -176,95 +230,60 @@ static lx_status build_pages(lx_baker *b, const lx_scene *scene, const lx_bake_d
             return lx_fail(LX_ERR_INVALID, "%s: node '%s': atlas page %u out of range (count %u)",
                            scene->path, scene->nodes[n].name, un->page, atlas->page_count);
     }
-    for (uint32_t p = 0; p < atlas->page_count; p++) {
-        /* a page takes horizon records when a node on it has a height */
-        bool horizon = false;
-        for (uint32_t n = 0; n < scene->node_count && !horizon; n++)
-            horizon = atlas->nodes[n].page == p &&
-                      lx_bake_node_has_horizon(scene, b->horizon_materials, n);
-        bytes += map_bytes(atlas->pages[p].width, atlas->pages[p].height, horizon,
-                           desc->supersample);
-    }
-    char what[400];
-    snprintf(what, sizeof what, "%s: baking %u atlas pages", scene->path, atlas->page_count);
-    lx_status st = lx_check_memory(bytes, what);
-    lx_page_node *nodes = malloc(sizeof *nodes * (scene->node_count + 1));
-    if (st == LX_OK && !nodes)
-        st = lx_fail(LX_ERR_NOMEM, "out of memory creating a baker");
+    lx_tile_candidate *c = calloc(atlas->page_count + 1, sizeof *c);
+    if (!c)
+        return lx_fail(LX_ERR_NOMEM, "out of memory creating a baker");
+    lx_status st = LX_OK;
+    uint32_t count = 0;
     for (uint32_t p = 0; p < atlas->page_count && st == LX_OK; p++) {
-        uint32_t count = 0;
+        lx_tile_candidate *k = &c[count++];
+        char name[32];
+        snprintf(name, sizeof name, "lightmap-%u", p);
+        k->name = lx_strdup(name);
+        k->page.nodes = malloc(sizeof *k->page.nodes * (scene->node_count + 1));
+        if (!k->name || !k->page.nodes) {
+            st = lx_fail(LX_ERR_NOMEM, "out of memory creating a baker");
+            break;
+        }
         for (uint32_t n = 0; n < scene->node_count; n++) {
             const lx_unwrap_node *un = &atlas->nodes[n];
             if (un->page != p)
                 continue;
-            lx_page_node *pn = &nodes[count++];
+            lx_page_node *pn = &k->page.nodes[k->page.node_count++];
             pn->node = n;
             /* generated UVs are TEXCOORD_1 once applied, in page coordinates */
             pn->uv_set = un->mode == LX_UNWRAP_KEEP ? un->uv_set : 1;
             memcpy(pn->scale_offset, un->scale_offset, sizeof pn->scale_offset);
         }
-        char name[32];
-        snprintf(name, sizeof name, "lightmap-%u", p);
-        lx_page_spec page = {name, atlas->pages[p].width, atlas->pages[p].height, nodes, count};
-        float from = maps_from(b), span = TEXEL_MAPS_SHARE - from;
-        lx_texel_progress share = {from + span * (float)p / (float)atlas->page_count,
-                                   from + span * (float)(p + 1) / (float)atlas->page_count};
-        lx_lightmap *map = &b->maps[b->map_count];
-        st = lx_texel_map_build(scene, &page, desc, share, b->horizon_materials, map);
-        if (st != LX_OK) {
-            lx_texel_map_free(map);
-            break;
-        }
-        if (map->info.width == 0) {
-            lx_texel_map_free(map);
-            continue;
-        }
-        for (uint32_t k = 0; k < count; k++) {
-            b->node_map[nodes[k].node] = b->map_count;
-            if (b->node_uv_set)
-                b->node_uv_set[nodes[k].node] =
-                    (int8_t)(nodes[k].uv_set >= 0
-                                 ? nodes[k].uv_set
-                                 : lx_bake_uv_set(scene, nodes[k].node, LX_UV_SET_AUTO));
-            memcpy(b->node_scale_offset[nodes[k].node], nodes[k].scale_offset,
-                   sizeof nodes[k].scale_offset);
-        }
-        b->map_count++;
-        if (desc->progress && !desc->progress(desc->progress_user, share.to))
-            st = lx_fail(LX_ERR_CANCELLED, "bake cancelled");
+        k->page.width = atlas->pages[p].width;
+        k->page.height = atlas->pages[p].height;
+        k->pixels = (uint64_t)k->page.width * (uint64_t)k->page.height;
+        k->horizon = page_has_horizon(b, scene, k->page.nodes, k->page.node_count);
     }
-    free(nodes);
+    if (st == LX_OK)
+        st = build_maps(b, scene, desc, c, count, hit);
+    candidates_free(c, count);
     return st;
 }
 
 /* A lightmap with no covered texel bakes to a black file: when no node
  * covers a texel the bake fails; a node that covers none while others do
- * is a warning naming it. */
-static lx_status check_coverage(const lx_baker *b, const lx_scene *scene)
+ * is a warning naming it. hit: the nodes that cover a texel. */
+static lx_status check_coverage(const lx_baker *b, const lx_scene *scene, const uint8_t *hit)
 {
-    uint8_t *hit = calloc(scene->node_count + 1, 1);
-    if (!hit)
-        return lx_fail(LX_ERR_NOMEM, "out of memory creating a baker");
     uint64_t total = 0;
-    for (uint32_t m = 0; m < b->map_count; m++) {
-        const lx_lightmap *map = &b->maps[m];
-        total += map->info.used_texels;
-        for (uint32_t i = 0; i < map->info.used_texels; i++)
-            hit[map->texels[i].node] = 1;
-    }
+    for (uint32_t m = 0; m < b->map_count; m++)
+        total += b->maps[m].info.used_texels;
     uint32_t empty = 0, first = UINT32_MAX;
     for (uint32_t n = 0; n < scene->node_count; n++)
         if (b->node_map[n] != UINT32_MAX && !hit[n]) {
             empty++;
             first = first == UINT32_MAX ? n : first;
         }
-    if (empty == 0) {
-        free(hit);
+    if (empty == 0)
         return LX_OK;
-    }
     const lx_lightmap_info *info = &b->maps[b->node_map[first]].info;
-    if (total == 0) {
-        free(hit);
+    if (total == 0)
         return lx_fail(LX_ERR_INVALID,
                        "%s: node '%s'%s: its lightmap UVs (TEXCOORD_%d) cover no texel of the "
                        "%dx%d lightmap (are they outside [0,1]?): it would be black",
@@ -272,7 +291,6 @@ static lx_status check_coverage(const lx_baker *b, const lx_scene *scene)
                        empty > 1 ? " and every other node" : "",
                        info->uv_set == LX_UV_SET_MIXED ? 1 : info->uv_set, info->width,
                        info->height);
-    }
     for (uint32_t n = 0; n < scene->node_count; n++)
         if (b->node_map[n] != UINT32_MAX && !hit[n]) {
             const lx_lightmap *map = &b->maps[b->node_map[n]];
@@ -282,7 +300,6 @@ static lx_status check_coverage(const lx_baker *b, const lx_scene *scene)
                    scene->path, scene->nodes[n].name, map->name, map->info.width,
                    map->info.height);
         }
-    free(hit);
     return LX_OK;
 }
 
@@ -356,17 +373,27 @@ lx_status lx_baker_create(const lx_scene *scene, const lx_bake_desc *in, lx_bake
     b->horizon_material_count = scene->material_count;
     st = lx_bake_horizon_load(scene, &desc, (lx_texel_progress){0.0f, HORIZON_SHARE},
                               &b->horizon_materials);
+    uint8_t *hit = calloc(scene->node_count + 1, 1);
+    if (st == LX_OK && !hit)
+        st = lx_fail(LX_ERR_NOMEM, "out of memory creating a baker");
     if (st == LX_OK)
-        st = desc.atlas ? build_pages(b, scene, &desc) : build_node_maps(b, scene, &desc);
-    /* the texels keep what they need of them */
-    lx_bake_horizon_free(b->horizon_materials, b->horizon_material_count);
-    b->horizon_materials = NULL;
+        st = desc.atlas ? build_pages(b, scene, &desc, hit) : build_node_maps(b, scene, &desc, hit);
+    /* the texels keep what they need of them; a tiled baker builds again */
+    if (!b->tiled) {
+        lx_bake_horizon_free(b->horizon_materials, b->horizon_material_count);
+        b->horizon_materials = NULL;
+    }
     if (st == LX_OK)
-        st = check_coverage(b, scene);
+        st = check_coverage(b, scene, hit);
+    free(hit);
     if (st != LX_OK) {
         lx_baker_destroy(b);
         return st;
     }
+    if (b->tiled)
+        lx_log(LX_LOG_INFO,
+               "%s: the lightmaps do not fit the memory together: baking them in %u tiles",
+               scene->path, b->tile_count);
     lx_tracer_desc td = {.threads = desc.threads,
                          .progress = desc.progress ? bvh_progress : NULL,
                          .progress_user = &desc};
@@ -392,6 +419,12 @@ void lx_baker_destroy(lx_baker *b)
     lx_sky_free(b);
     lx_dyn_bounce_free(b);
     lx_gi_free(b);
+    lx_bake_horizon_free(b->horizon_materials, b->horizon_material_count);
+    lx_scene_destroy(b->tile_scene);
+    for (uint32_t m = 0; b->pages && m < b->map_count; m++)
+        free(b->pages[m].nodes);
+    free(b->pages);
+    free(b->tile_first_map);
     free(b->maps);
     free(b->node_map);
     free(b->node_scale_offset);
@@ -400,6 +433,11 @@ void lx_baker_destroy(lx_baker *b)
         lx_ies_free((lx_ies_profile *)b->lights[l].profile);
     free(b->lights);
     free(b);
+}
+
+uint32_t lx_baker_tile_count(const lx_baker *b)
+{
+    return b->tile_count;
 }
 
 uint32_t lx_baker_lightmap_count(const lx_baker *b)
@@ -455,7 +493,11 @@ lx_status lx_baker_set_node_transform(lx_baker *b, uint32_t node, const lx_mat4 
         return lx_fail(LX_ERR_INVALID, "node %u out of range (count %u)", node, b->node_count);
     /* the object space a move needs, before anything changes */
     lx_status st = LX_OK;
-    if (b->node_map[node] != UINT32_MAX &&
+    /* a tiled baker builds its maps again from its copy: there the node
+     * moves too */
+    if (b->tile_scene)
+        b->tile_scene->nodes[node].world = *world;
+    if (b->node_map[node] != UINT32_MAX && b->maps[b->node_map[node]].loaded &&
         (st = lx_texel_map_keep_object_space(&b->maps[b->node_map[node]])) != LX_OK)
         return st;
     st = lx_tracer_set_node_transform(b->tracer, node, world);
@@ -464,7 +506,7 @@ lx_status lx_baker_set_node_transform(lx_baker *b, uint32_t node, const lx_mat4 
     b->node_world[node] = *world;
     b->tracer_dirty = true;
     b->dyn_stale = true; /* the dynamic bounce's cached hits */
-    if (b->node_map[node] != UINT32_MAX)
+    if (b->node_map[node] != UINT32_MAX && b->maps[b->node_map[node]].loaded)
         lx_texel_map_transform(&b->maps[b->node_map[node]], node, world);
     return LX_OK;
 }
@@ -490,6 +532,30 @@ static void clear_buffers(lx_baker *b, bool realtime)
         if (!realtime && map->sh)
             memset(map->sh, 0, n / 3 * LX_SH_FLOATS * sizeof(float));
     }
+}
+
+/* The static lights, then the emitters (with bounces), into every map's
+ * baked buffer, tile by tile, within [from, to] of the progress. */
+static lx_status bake_direct(lx_baker *b, const uint32_t *idx, uint32_t n, float from, float to)
+{
+    lx_emitter_set *emitters = NULL;
+    lx_status st = b->desc.bounces > 0 ? lx_emitter_set_create(b, &emitters) : LX_OK;
+    for (uint32_t t = 0; t < b->tile_count && st == LX_OK; t++) {
+        float tf, tt;
+        lx_bake_tile_share(b, t, from, to, &tf, &tt);
+        if (!lx_bake_report(b, tf)) {
+            st = lx_fail(LX_ERR_CANCELLED, "bake cancelled");
+            break;
+        }
+        float lights_end = emitters ? 0.5f * (tf + tt) : tt;
+        st = lx_bake_tile_need(b, b->tile_first_map[t]);
+        if (st == LX_OK)
+            st = lx_bake_lights(b, idx, n, b->ambient, false, tf, lights_end - tf);
+        if (st == LX_OK && emitters)
+            st = lx_bake_emitters(b, emitters, lights_end, tt - lights_end);
+    }
+    lx_emitter_set_destroy(b, emitters);
+    return st;
 }
 
 lx_status lx_baker_bake(lx_baker *b)
@@ -526,17 +592,18 @@ lx_status lx_baker_bake(lx_baker *b)
     float end = denoise ? 0.9f : 1.0f; /* the last tenth denoises */
     float direct = b->desc.bounces > 0 ? end / (float)(b->desc.bounces + 2) : end;
     float **kept = NULL;
-    /* emitters (with bounces): direct light, sampled after the lights */
-    float lights_end = b->emitter_count && b->desc.bounces > 0 ? 0.5f * direct : direct;
-    lx_status st = lx_bake_lights(b, idx, n, b->ambient, false, 0.0f, lights_end);
-    if (st == LX_OK && b->desc.bounces > 0)
-        st = lx_bake_emitters(b, lights_end, direct - lights_end);
+    lx_status st = bake_direct(b, idx, n, 0.0f, direct);
     if (st == LX_OK)
         kept = lx_bake_denoise_keep(b, &st);
     if (st == LX_OK && b->desc.bounces > 0)
         st = lx_bake_indirect(b, direct, end - direct);
-    if (st == LX_OK && denoise)
-        st = lx_bake_denoise(b, kept, end, 1.0f - end);
+    for (uint32_t t = 0; t < b->tile_count && st == LX_OK && denoise; t++) {
+        float tf, tt;
+        lx_bake_tile_share(b, t, end, 1.0f, &tf, &tt);
+        st = lx_bake_tile_need(b, b->tile_first_map[t]);
+        if (st == LX_OK)
+            st = lx_bake_denoise(b, kept, tf, tt - tf);
+    }
     lx_bake_denoise_free(b, kept);
     if (st != LX_OK)
         clear_buffers(b, false);
@@ -569,8 +636,14 @@ lx_status lx_baker_update(lx_baker *b)
                              map->name);
         }
         bool bounce = b->desc.dynamic_bounce_samples > 0;
-        if (st == LX_OK)
-            st = lx_bake_lights(b, idx, n, lx_v3(0, 0, 0), true, 0.0f, bounce ? 0.5f : 1.0f);
+        float lights_end = bounce ? 0.5f : 1.0f;
+        for (uint32_t t = 0; t < b->tile_count && st == LX_OK; t++) {
+            float tf, tt;
+            lx_bake_tile_share(b, t, 0.0f, lights_end, &tf, &tt);
+            st = lx_bake_tile_need(b, b->tile_first_map[t]);
+            if (st == LX_OK)
+                st = lx_bake_lights(b, idx, n, lx_v3(0, 0, 0), true, tf, tt - tf);
+        }
         if (st == LX_OK && bounce) {
             st = lx_dyn_bounce_update(b);
             if (st == LX_OK && b->desc.progress && !b->desc.progress(b->desc.progress_user, 1.0f))
@@ -589,6 +662,11 @@ lx_status lx_baker_apply(const lx_baker *b, uint32_t map_index, lx_image *out)
     if (map_index >= b->map_count)
         return lx_fail(LX_ERR_INVALID, "lightmap %u out of range (count %u)", map_index,
                        b->map_count);
+    /* a tiled baker builds the map's tile again (the baker is used from
+     * one thread at a time: its cache of texel maps may change here) */
+    lx_status need = lx_bake_tile_need((lx_baker *)b, map_index);
+    if (need != LX_OK)
+        return need;
     const lx_lightmap *map = &b->maps[map_index];
     int w = map->info.width, h = map->info.height;
     if (!out || out->width != w || out->height != h || out->channels != 3 || !out->data)
@@ -697,6 +775,13 @@ void lx_baker_meter_ev100(const lx_baker *b, float *ev100, bool *lit)
     uint64_t n = 0;
     for (uint32_t m = 0; m < b->map_count; m++) {
         const lx_lightmap *map = &b->maps[m];
+        if (lx_bake_tile_need((lx_baker *)b, m) != LX_OK) {
+            /* a tiled baker that cannot build the map again: meter
+             * nothing rather than part of the scene */
+            *lit = false;
+            *ev100 = 0.0f;
+            return;
+        }
         for (uint32_t i = 0; i < map->info.used_texels; i++) {
             const lx_texel *t = &map->texels[i];
             size_t p = (size_t)t->pixel * 3;
@@ -726,7 +811,7 @@ bool lx_baker_texel(const lx_baker *b, uint32_t map_index, int x, int y, lx_texe
     if (x < 0 || y < 0 || x >= map->info.width || y >= map->info.height)
         return false;
     uint32_t pixel = (uint32_t)y * (uint32_t)map->info.width + (uint32_t)x;
-    if (!map->mask[pixel])
+    if (!map->mask[pixel] || lx_bake_tile_need((lx_baker *)b, map_index) != LX_OK)
         return false;
     /* texels are stored by tile; find the tile, then scan its few texels */
     int tiles_x = (map->info.width + LX_TILE - 1) / LX_TILE;

@@ -35,6 +35,10 @@ lx_status lx_baker_denoise_guides(const lx_baker *b, uint32_t map_index, lx_deno
     if (map_index >= b->map_count)
         return lx_fail(LX_ERR_INVALID, "denoise guides: lightmap %u out of range (count %u)",
                        map_index, b->map_count);
+    /* a tiled baker builds the map's tile again */
+    lx_status need = lx_bake_tile_need((lx_baker *)b, map_index);
+    if (need != LX_OK)
+        return need;
     const lx_lightmap *map = &b->maps[map_index];
     int w = map->info.width, h = map->info.height;
     size_t n = (size_t)w * h;

@@ -604,22 +604,16 @@ lx_status lx_bake_lights(lx_baker *b, const uint32_t *lights, uint32_t light_cou
     }
     /* One parallel loop over every tile of every map: fork and join once
      * per pass, which matters for the per-frame update. */
-    uint32_t *map_first_tile = malloc(sizeof(uint32_t) * (b->map_count + 1));
-    if (!map_first_tile)
-        return lx_fail(LX_ERR_NOMEM, "out of memory");
-    uint64_t total_work = 0;
-    map_first_tile[0] = 0;
-    for (uint32_t m = 0; m < b->map_count; m++) {
-        map_first_tile[m + 1] = map_first_tile[m] + b->maps[m].tile_count;
-        /* progress counts texels, plus one per tile so empty tiles count */
-        total_work += b->maps[m].info.used_texels + b->maps[m].tile_count;
-    }
+    lx_tile_walk w;
+    lx_status st = lx_tile_walk_begin(b, progress_base, progress_span, 16, &w);
+    if (st != LX_OK)
+        return st;
     fast_light *fast = malloc(sizeof(fast_light) * (light_count + 1));
     bool *is_fast = malloc(sizeof(bool) * (light_count + 1));
     if (!fast || !is_fast) {
         free(fast);
         free(is_fast);
-        free(map_first_tile);
+        lx_tile_walk_end(&w);
         return lx_fail(LX_ERR_NOMEM, "out of memory");
     }
     /* directional data of the baked buffers only; a fast light's ambient
@@ -631,24 +625,16 @@ lx_status lx_bake_lights(lx_baker *b, const uint32_t *lights, uint32_t light_cou
         if (directional && (fast[l].mr != 0.0f || fast[l].mg != 0.0f || fast[l].mb != 0.0f))
             is_fast[l] = false;
     }
-    int tiles = (int)map_first_tile[b->map_count];
     int threads = lx_thread_count(b->desc.threads);
-    bool report = b->desc.progress != NULL;
-    volatile int cancelled = 0;
-    uint64_t done_work = 0;
 
 #pragma omp parallel for schedule(dynamic, 4) num_threads(threads)
-    for (int global = 0; global < tiles; global++) {
-        if (cancelled)
+    for (int global = 0; global < w.tiles; global++) {
+        if (w.cancelled)
             continue;
-        uint32_t m = 0;
-        while (map_first_tile[m + 1] <= (uint32_t)global)
-            m++;
+        uint32_t m, first, count;
+        lx_tile_walk_at(&w, global, &m, &first, &count);
         const lx_lightmap *map = &b->maps[m];
-        uint32_t tile = (uint32_t)global - map_first_tile[m];
         float *target = to_realtime ? map->realtime : map->baked;
-        uint32_t first = map->tile_start[tile];
-        uint32_t count = map->tile_start[tile + 1] - first;
         if (count) {
             tile_soa t;
             lx_sh4 shs[TILE_TEXELS];
@@ -673,24 +659,13 @@ lx_status lx_bake_lights(lx_baker *b, const uint32_t *lights, uint32_t light_cou
                            &shs[t.texel[k]], sizeof(lx_sh4));
             }
         }
-        if (report) {
-            uint64_t done;
-#pragma omp atomic capture
-            done = done_work += count + 1;
-            if (omp_get_thread_num() == 0 && (global & 15) == 0) {
-                double f = (double)done / (double)total_work;
-                if (!b->desc.progress(b->desc.progress_user,
-                                      progress_base + progress_span * (float)f))
-                    cancelled = 1;
-            }
-        }
+        lx_tile_walk_done(&w, global, count);
     }
-    free(map_first_tile);
     free(fast);
     free(is_fast);
-    if (cancelled)
-        return lx_fail(LX_ERR_CANCELLED, "bake cancelled");
-    if (report && !b->desc.progress(b->desc.progress_user, progress_base + progress_span))
+    if ((st = lx_tile_walk_end(&w)) != LX_OK)
+        return st;
+    if (b->desc.progress && !b->desc.progress(b->desc.progress_user, progress_base + progress_span))
         return lx_fail(LX_ERR_CANCELLED, "bake cancelled");
     return LX_OK;
 }

@@ -44,7 +44,9 @@ static lx_status check(const lx_baker *b, uint32_t map_index, const char *what)
         return lx_fail(LX_ERR_INVALID,
                        "lightmap '%s': no directional data for %s (bake with desc.directional)",
                        map->name, what);
-    return LX_OK;
+    /* a tiled baker builds the map's tile again (one thread at a time uses
+     * a baker: its cache of texel maps may change here) */
+    return lx_bake_tile_need((lx_baker *)b, map_index);
 }
 
 /* Pads and stitches img (channels per texel) as lx_baker_apply does. */

@@ -71,6 +71,12 @@ void lx_dyn_bounce_free(lx_baker *b)
 
 static lx_status dyn_build(lx_baker *b)
 {
+    if (b->tiled)
+        return lx_fail(LX_ERR_NOMEM,
+                       "the dynamic lights' bounce keeps every lightmap's texels in memory, and "
+                       "this baker bakes its lightmaps in %u tiles to fit its memory limit: give "
+                       "it more memory or no dynamic bounce samples",
+                       b->tile_count);
     lx_dyn_bounce *d = calloc(1, sizeof *d);
     if (!d)
         return lx_fail(LX_ERR_NOMEM, "out of memory for the dynamic lights' bounce");

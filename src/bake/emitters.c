@@ -54,14 +54,16 @@ typedef struct emitter_tri {
     bool textured;
 } emitter_tri;
 
-typedef struct emitter_set {
+struct lx_emitter_set {
     emitter_tri *tri;
     uint32_t count;
     double *cdf; /* cumulative pick weights; cdf[count - 1] = total */
     double total;
     bool exact;
-    float **emission; /* per map: emitted radiance per pixel, or NULL */
-} emitter_set;
+    float **emission; /* per map: emitted radiance per pixel, or NULL (all NULL
+                         when no emitter has a texture) */
+};
+typedef struct lx_emitter_set emitter_set;
 
 static float max3(lx_vec3 v)
 {
@@ -93,7 +95,7 @@ static void emitter_set_free(const lx_baker *b, emitter_set *set)
     free(set->cdf);
 }
 
-static lx_status emitter_set_build(const lx_baker *b, emitter_set *set)
+static lx_status emitter_set_build(lx_baker *b, emitter_set *set)
 {
     memset(set, 0, sizeof *set);
     uint64_t n = 0;
@@ -112,8 +114,17 @@ static lx_status emitter_set_build(const lx_baker *b, emitter_set *set)
         emitter_set_free(b, set);
         return lx_fail(LX_ERR_NOMEM, "out of memory for the emitters");
     }
-    /* the emitting maps' emission per pixel, for textured emitters */
-    for (uint32_t m = 0; m < b->map_count; m++) {
+    /* the emitting maps' emission per pixel, for textured emitters (a
+     * tiled baker builds each map's texels again to read it) */
+    bool textured = false;
+    for (uint32_t e = 0; e < b->emitter_count; e++)
+        textured |= b->mesh_emission_textured[b->emitters[e].mesh] != 0;
+    for (uint32_t m = 0; m < b->map_count && textured; m++) {
+        lx_status need = lx_bake_tile_need(b, m);
+        if (need != LX_OK) {
+            emitter_set_free(b, set);
+            return need;
+        }
         const lx_lightmap *map = &b->maps[m];
         if (!map->emission)
             continue;
@@ -329,70 +340,62 @@ static lx_vec3 texel_emitters(const lx_baker *b, const emitter_set *set, uint32_
                  (float)fmax(exact[2] + sum[2] * inv, 0.0));
 }
 
-lx_status lx_bake_emitters(lx_baker *b, float progress_base, float progress_span)
+lx_status lx_emitter_set_create(lx_baker *b, lx_emitter_set **out)
 {
+    *out = NULL;
     if (b->emitter_count == 0)
         return LX_OK;
+    emitter_set *set = malloc(sizeof *set);
+    if (!set)
+        return lx_fail(LX_ERR_NOMEM, "out of memory for the emitters");
+    lx_status st = emitter_set_build(b, set);
+    if (st != LX_OK) {
+        free(set);
+        return st;
+    }
+    if (set->count == 0) {
+        lx_emitter_set_destroy(b, set);
+        return LX_OK;
+    }
+    *out = set;
+    return LX_OK;
+}
+
+void lx_emitter_set_destroy(const lx_baker *b, lx_emitter_set *set)
+{
+    if (!set)
+        return;
+    emitter_set_free(b, set);
+    free(set);
+}
+
+lx_status lx_bake_emitters(lx_baker *b, const lx_emitter_set *set, float progress_base,
+                           float progress_span)
+{
     if (b->tracer_dirty) {
         lx_status st = lx_tracer_commit(b->tracer);
         if (st != LX_OK)
             return st;
         b->tracer_dirty = false;
     }
-    emitter_set set;
-    lx_status st = emitter_set_build(b, &set);
+    lx_tile_walk w;
+    lx_status st = lx_tile_walk_begin(b, progress_base, progress_span, 1, &w);
     if (st != LX_OK)
         return st;
-    if (set.count == 0) {
-        emitter_set_free(b, &set);
-        return LX_OK;
-    }
-    uint32_t *map_first_tile = malloc(sizeof(uint32_t) * (b->map_count + 1));
-    if (!map_first_tile) {
-        emitter_set_free(b, &set);
-        return lx_fail(LX_ERR_NOMEM, "out of memory");
-    }
-    uint64_t total_work = 0;
-    map_first_tile[0] = 0;
-    for (uint32_t m = 0; m < b->map_count; m++) {
-        map_first_tile[m + 1] = map_first_tile[m] + b->maps[m].tile_count;
-        total_work += b->maps[m].info.used_texels + b->maps[m].tile_count;
-    }
-    int tiles = (int)map_first_tile[b->map_count];
     int threads = lx_thread_count(b->desc.threads);
-    bool report = b->desc.progress != NULL;
-    volatile int cancelled = 0;
-    uint64_t done_work = 0;
 #pragma omp parallel for schedule(dynamic, 1) num_threads(threads)
-    for (int global = 0; global < tiles; global++) {
-        if (cancelled)
+    for (int global = 0; global < w.tiles; global++) {
+        if (w.cancelled)
             continue;
-        uint32_t m = 0;
-        while (map_first_tile[m + 1] <= (uint32_t)global)
-            m++;
+        uint32_t m, first, count;
+        lx_tile_walk_at(&w, global, &m, &first, &count);
         lx_lightmap *map = &b->maps[m];
-        uint32_t tile = (uint32_t)global - map_first_tile[m];
-        uint32_t first = map->tile_start[tile], count = map->tile_start[tile + 1] - first;
         for (uint32_t i = first; i < first + count; i++) {
-            lx_vec3 e = texel_emitters(b, &set, m, map, i);
+            lx_vec3 e = texel_emitters(b, set, m, map, i);
             float *px = map->baked + 3 * (size_t)map->texels[i].pixel;
             px[0] += e.x, px[1] += e.y, px[2] += e.z;
         }
-        if (report) {
-            uint64_t done;
-#pragma omp atomic capture
-            done = done_work += count + 1;
-            if (omp_get_thread_num() == 0) {
-                double f = (double)done / (double)total_work;
-                if (!b->desc.progress(b->desc.progress_user,
-                                      progress_base + progress_span * (float)f))
-                    cancelled = 1;
-            }
-        }
+        lx_tile_walk_done(&w, global, count);
     }
-    free(map_first_tile);
-    emitter_set_free(b, &set);
-    if (cancelled)
-        return lx_fail(LX_ERR_CANCELLED, "bake cancelled");
-    return LX_OK;
+    return lx_tile_walk_end(&w);
 }

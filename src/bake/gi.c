@@ -140,27 +140,23 @@ void lx_gi_free(lx_baker *b)
     b->node_uv_set = NULL;
 }
 
-/* Per map during the indirect pass. */
+/* Per map during the indirect pass: what every gather reads (resident for
+ * the whole pass, every map) and what a tile of maps works with. */
 typedef struct gi_map {
-    uint8_t *valid;   /* width * height: covered and not inside geometry */
-    float *source;    /* width * height * 3: exitant radiance of the last bounce */
-    lx_vec3 *prev;    /* per texel: the last bounce's irradiance */
-    lx_vec3 *next;    /* per texel: this bounce's */
-    lx_sh4 *next_sh;  /* per texel: this bounce's directional data (NULL
-                         unless desc.directional) */
-    uint8_t *invalid; /* per texel, from the validity pass */
+    uint8_t *valid;     /* width * height: covered and not inside geometry */
+    float *source;      /* width * height * 3: exitant radiance of the last bounce */
+    float *source_next; /* width * height * 3: the next bounce's, made as tiles finish */
+    lx_vec3 *next;      /* tile: per texel, this bounce's irradiance */
+    lx_sh4 *next_sh;    /* tile: per texel, this bounce's directional data
+                           (NULL unless desc.directional) */
+    uint8_t *invalid;   /* tile: per texel, inside geometry */
 } gi_map;
 
 typedef struct gi_run {
     lx_baker *b;
     gi_map *maps;
     lx_radiance_source *sources; /* each map's valid and source, for lx_hit_radiance */
-    uint32_t *map_first_tile;
-    int tiles;
     int threads;
-    /* progress */
-    uint64_t total_work;
-    float base, span;
 } gi_run;
 
 lx_gather_frame lx_gather_frame_of(const lx_baker *b, uint32_t map_index, const lx_lightmap *map,
@@ -339,25 +335,23 @@ static lx_vec3 texel_gather(const gi_run *run, uint32_t map_index, uint32_t i, u
     return lx_v3((float)(sum[0] * scale), (float)(sum[1] * scale), (float)(sum[2] * scale));
 }
 
-/* One pass over every tile of every map: the validity pass (validity) or
- * a gather into gi_map.next (keyed by key). false when cancelled. */
-static bool run_pass(gi_run *run, bool validity, uint32_t key, float from, float to)
+/* One pass over every tile of every map in memory: the validity pass
+ * (validity) or a gather into gi_map.next (keyed by key), within [from,
+ * to] of the progress. */
+static lx_status run_pass(gi_run *run, bool validity, uint32_t key, float from, float to)
 {
     lx_baker *b = run->b;
-    bool report = b->desc.progress != NULL;
-    volatile int cancelled = 0;
-    uint64_t done_work = 0;
+    lx_tile_walk w;
+    lx_status st = lx_tile_walk_begin(b, from, to - from, 1, &w);
+    if (st != LX_OK)
+        return st;
 #pragma omp parallel for schedule(dynamic, 1) num_threads(run->threads)
-    for (int global = 0; global < run->tiles; global++) {
-        if (cancelled)
+    for (int global = 0; global < w.tiles; global++) {
+        if (w.cancelled)
             continue;
-        uint32_t m = 0;
-        while (run->map_first_tile[m + 1] <= (uint32_t)global)
-            m++;
-        const lx_lightmap *map = &b->maps[m];
+        uint32_t m, first, count;
+        lx_tile_walk_at(&w, global, &m, &first, &count);
         gi_map *g = &run->maps[m];
-        uint32_t tile = (uint32_t)global - run->map_first_tile[m];
-        uint32_t first = map->tile_start[tile], count = map->tile_start[tile + 1] - first;
         for (uint32_t i = first; i < first + count; i++) {
             if (validity) {
                 g->invalid[i] = lx_gi_texel_inside(b, m, i);
@@ -369,19 +363,9 @@ static bool run_pass(gi_run *run, bool validity, uint32_t key, float from, float
                 g->next[i] = texel_gather(run, m, i, key, g->next_sh ? &g->next_sh[i] : NULL);
             }
         }
-        if (report) {
-            uint64_t done;
-#pragma omp atomic capture
-            done = done_work += count + 1;
-            if (omp_get_thread_num() == 0) {
-                double f = (double)done / (double)run->total_work;
-                if (!b->desc.progress(b->desc.progress_user,
-                                      run->base + run->span * (from + (to - from) * (float)f)))
-                    cancelled = 1;
-            }
-        }
+        lx_tile_walk_done(&w, global, count);
     }
-    return !cancelled;
+    return lx_tile_walk_end(&w);
 }
 
 /* Gives invalid texels the average of their valid (or already filled)
@@ -453,117 +437,185 @@ lx_status lx_gi_fill_invalid(const lx_lightmap *map, const uint8_t *valid, const
     return LX_OK;
 }
 
+/* The per-texel buffers of the maps of tile t (the maps in memory):
+ * this bounce's irradiance (and directional data) and the inside flags,
+ * from the valid mask once the validity pass has made it. */
+static lx_status tile_begin(gi_run *run, uint32_t t, bool from_valid)
+{
+    lx_baker *b = run->b;
+    lx_status st = lx_bake_tile_need(b, b->tile_first_map[t]);
+    for (uint32_t m = b->tile_first_map[t]; m < b->tile_first_map[t + 1] && st == LX_OK; m++) {
+        const lx_lightmap *map = &b->maps[m];
+        gi_map *g = &run->maps[m];
+        size_t used = map->info.used_texels + 1;
+        g->next = malloc(sizeof(lx_vec3) * used);
+        g->invalid = malloc(used);
+        g->next_sh = map->sh ? malloc(sizeof(lx_sh4) * used) : NULL;
+        if (!g->next || !g->invalid || (map->sh && !g->next_sh)) {
+            st = lx_fail(LX_ERR_NOMEM, "lightmap '%s': out of memory for global illumination",
+                         map->name);
+            break;
+        }
+        if (from_valid)
+            for (uint32_t i = 0; i < map->info.used_texels; i++)
+                g->invalid[i] = !g->valid[map->texels[i].pixel];
+    }
+    return st;
+}
+
+static void tile_end(gi_run *run, uint32_t t)
+{
+    for (uint32_t m = run->b->tile_first_map[t]; m < run->b->tile_first_map[t + 1]; m++) {
+        gi_map *g = &run->maps[m];
+        free(g->next);
+        free(g->invalid);
+        free(g->next_sh);
+        g->next = NULL;
+        g->invalid = NULL;
+        g->next_sh = NULL;
+    }
+}
+
+/* A source buffer from per-texel irradiance e: albedo / pi x e at valid
+ * texels, 0 elsewhere (emission is direct light, emitters.c: already in
+ * the first bounce's e). */
+static void make_source(const lx_lightmap *map, const gi_map *g, const lx_vec3 *e, float *dst)
+{
+    memset(dst, 0, sizeof(float) * 3 * (size_t)map->info.width * (size_t)map->info.height);
+    for (uint32_t i = 0; i < map->info.used_texels; i++) {
+        if (g->invalid[i])
+            continue;
+        lx_vec3 l = lx_scale(lx_mul(map->albedo[i], e[i]), 1.0f / LX_PI);
+        float *px = dst + 3 * (size_t)map->texels[i].pixel;
+        px[0] = l.x, px[1] = l.y, px[2] = l.z;
+    }
+}
+
+/* Adds a tile map's bounce to its baked light (and directional data). */
+static void add_bounce(lx_lightmap *map, const gi_map *g)
+{
+    for (uint32_t i = 0; i < map->info.used_texels; i++) {
+        size_t p = map->texels[i].pixel;
+        float *px = map->baked + 3 * p;
+        px[0] += g->next[i].x;
+        px[1] += g->next[i].y;
+        px[2] += g->next[i].z;
+        if (g->next_sh) {
+            float *q = map->sh + p * LX_SH_FLOATS;
+            for (int c = 0; c < LX_SH_FLOATS; c++)
+                q[c] += g->next_sh[i].c[c];
+        }
+    }
+}
+
+static lx_status fill_invalid(lx_lightmap *map, const gi_map *g)
+{
+    lx_status st = lx_gi_fill_invalid(map, g->valid, g->invalid, map->baked, 3);
+    if (st == LX_OK && map->sh)
+        st = lx_gi_fill_invalid(map, g->valid, g->invalid, map->sh, LX_SH_FLOATS);
+    return st;
+}
+
+/* One pass over tile t with the gi_map buffers of its maps: false and
+ * *st set when it fails or is cancelled (its buffers let go). */
+static bool tile_pass(gi_run *run, uint32_t t, bool validity, uint32_t key, float from, float to,
+                      lx_status *st)
+{
+    float tf, tt;
+    lx_bake_tile_share(run->b, t, from, to, &tf, &tt);
+    if (!lx_bake_report(run->b, tf) || (*st = tile_begin(run, t, !validity)) != LX_OK ||
+        (*st = run_pass(run, validity, key, tf, tt)) != LX_OK) {
+        if (*st == LX_OK)
+            *st = lx_fail(LX_ERR_CANCELLED, "bake cancelled");
+        tile_end(run, t);
+        return false;
+    }
+    return true;
+}
+
+/* The passes run tile by tile (one tile when the maps fit the memory
+ * together): the validity pass makes each map's valid mask and first
+ * sources from its direct light; each bounce gathers a tile's texels
+ * against every map's sources of the last bounce, adds the result and
+ * makes the tile's sources of the next; the last bounce fills the invalid
+ * texels. Every value is the one the maps would get all at once. */
 lx_status lx_bake_indirect(lx_baker *b, float progress_base, float progress_span)
 {
     uint32_t count = b->map_count;
-    gi_run run = {.b = b, .base = progress_base, .span = progress_span};
+    gi_run run = {.b = b};
     run.threads = lx_thread_count(b->desc.threads);
     run.maps = calloc(count + 1, sizeof(gi_map));
     run.sources = calloc(count + 1, sizeof(lx_radiance_source));
-    run.map_first_tile = malloc(sizeof(uint32_t) * (count + 1));
     lx_status st = LX_OK;
-    if (!run.maps || !run.sources || !run.map_first_tile)
+    if (!run.maps || !run.sources)
         st = lx_fail(LX_ERR_NOMEM, "out of memory for global illumination");
     uint64_t bytes = 0;
-    for (uint32_t m = 0; m < count && st == LX_OK; m++) {
-        const lx_lightmap *map = &b->maps[m];
-        uint64_t pixels = (uint64_t)map->info.width * (uint64_t)map->info.height;
-        bytes += pixels * 13 + (uint64_t)map->info.used_texels * 25;
-        if (map->sh)
-            bytes += (uint64_t)map->info.used_texels * sizeof(lx_sh4);
-    }
+    for (uint32_t m = 0; m < count && st == LX_OK; m++)
+        bytes += (uint64_t)b->maps[m].info.width * (uint64_t)b->maps[m].info.height *
+                 (b->desc.bounces > 1 ? 25 : 13);
     if (st == LX_OK)
         st = lx_check_memory(bytes, "global illumination's buffers");
-    if (run.map_first_tile)
-        run.map_first_tile[0] = 0;
     for (uint32_t m = 0; m < count && st == LX_OK; m++) {
         const lx_lightmap *map = &b->maps[m];
         gi_map *g = &run.maps[m];
         size_t pixels = (size_t)map->info.width * (size_t)map->info.height;
-        size_t used = map->info.used_texels + 1;
         g->valid = malloc(pixels);
         g->source = malloc(sizeof(float) * 3 * pixels);
-        g->prev = malloc(sizeof(lx_vec3) * used);
-        g->next = malloc(sizeof(lx_vec3) * used);
-        g->invalid = malloc(used);
-        g->next_sh = map->sh ? malloc(sizeof(lx_sh4) * used) : NULL;
-        if (!g->valid || !g->source || !g->prev || !g->next || !g->invalid ||
-            (map->sh && !g->next_sh))
+        g->source_next = b->desc.bounces > 1 ? malloc(sizeof(float) * 3 * pixels) : NULL;
+        if (!g->valid || !g->source || (b->desc.bounces > 1 && !g->source_next))
             st = lx_fail(LX_ERR_NOMEM, "lightmap '%s': out of memory for global illumination",
                          map->name);
         run.sources[m].valid = g->valid;
-        run.sources[m].source = g->source;
-        run.map_first_tile[m + 1] = run.map_first_tile[m] + map->tile_count;
-        run.total_work += map->info.used_texels + map->tile_count;
     }
-    run.tiles = st == LX_OK ? (int)run.map_first_tile[count] : 0;
-    float passes = (float)(b->desc.bounces + 1);
-    /* validity */
-    if (st == LX_OK && !run_pass(&run, true, 0, 0.0f, 1.0f / passes))
-        st = lx_fail(LX_ERR_CANCELLED, "bake cancelled");
+    float span = progress_span / (float)(b->desc.bounces + 1);
+    /* validity, and the first sources: albedo / pi x the direct light */
     b->gi_invalid_texels = 0;
-    for (uint32_t m = 0; m < count && st == LX_OK; m++) {
-        const lx_lightmap *map = &b->maps[m];
-        gi_map *g = &run.maps[m];
-        memcpy(g->valid, map->mask, (size_t)map->info.width * (size_t)map->info.height);
-        for (uint32_t i = 0; i < map->info.used_texels; i++) {
-            size_t p = map->texels[i].pixel;
-            if (g->invalid[i]) {
-                g->valid[p] = 0;
-                b->gi_invalid_texels++;
-            }
-            g->prev[i] = lx_v3(map->baked[3 * p], map->baked[3 * p + 1], map->baked[3 * p + 2]);
-        }
-    }
-    for (int k = 1; k <= b->desc.bounces && st == LX_OK; k++) {
-        /* the sources: albedo / pi x the last bounce (emission is direct
-         * light, emitters.c: already in the first) */
-        for (uint32_t m = 0; m < count; m++) {
+    for (uint32_t t = 0; t < b->tile_count && st == LX_OK; t++) {
+        if (!tile_pass(&run, t, true, 0, progress_base, progress_base + span, &st))
+            break;
+        for (uint32_t m = b->tile_first_map[t]; m < b->tile_first_map[t + 1]; m++) {
             const lx_lightmap *map = &b->maps[m];
             gi_map *g = &run.maps[m];
-            memset(g->source, 0,
-                   sizeof(float) * 3 * (size_t)map->info.width * (size_t)map->info.height);
+            memcpy(g->valid, map->mask, (size_t)map->info.width * (size_t)map->info.height);
             for (uint32_t i = 0; i < map->info.used_texels; i++) {
-                if (g->invalid[i])
-                    continue;
-                lx_vec3 l = lx_scale(lx_mul(map->albedo[i], g->prev[i]), 1.0f / LX_PI);
-                float *dst = g->source + 3 * (size_t)map->texels[i].pixel;
-                dst[0] = l.x, dst[1] = l.y, dst[2] = l.z;
-            }
-        }
-        if (!run_pass(&run, false, GI_KEY + 2u * (uint32_t)k, (float)k / passes,
-                      (float)(k + 1) / passes)) {
-            st = lx_fail(LX_ERR_CANCELLED, "bake cancelled");
-            break;
-        }
-        for (uint32_t m = 0; m < count; m++) {
-            lx_lightmap *map = &b->maps[m];
-            gi_map *g = &run.maps[m];
-            for (uint32_t i = 0; i < map->info.used_texels; i++) {
-                float *px = map->baked + 3 * (size_t)map->texels[i].pixel;
-                px[0] += g->next[i].x;
-                px[1] += g->next[i].y;
-                px[2] += g->next[i].z;
-                if (g->next_sh) {
-                    float *q = map->sh + (size_t)map->texels[i].pixel * LX_SH_FLOATS;
-                    for (int c = 0; c < LX_SH_FLOATS; c++)
-                        q[c] += g->next_sh[i].c[c];
+                size_t p = map->texels[i].pixel;
+                g->next[i] = lx_v3(map->baked[3 * p], map->baked[3 * p + 1], map->baked[3 * p + 2]);
+                if (g->invalid[i]) {
+                    g->valid[p] = 0;
+                    b->gi_invalid_texels++;
                 }
             }
-            lx_vec3 *swap = g->prev;
-            g->prev = g->next;
-            g->next = swap;
+            make_source(map, g, g->next, g->source);
+        }
+        tile_end(&run, t);
+    }
+    for (int k = 1; k <= b->desc.bounces && st == LX_OK; k++) {
+        bool last = k == b->desc.bounces;
+        float from = progress_base + span * (float)k;
+        for (uint32_t m = 0; m < count; m++)
+            run.sources[m].source = run.maps[m].source;
+        for (uint32_t t = 0; t < b->tile_count && st == LX_OK; t++) {
+            if (!tile_pass(&run, t, false, GI_KEY + 2u * (uint32_t)k, from, from + span, &st))
+                break;
+            for (uint32_t m = b->tile_first_map[t]; m < b->tile_first_map[t + 1] && st == LX_OK;
+                 m++) {
+                lx_lightmap *map = &b->maps[m];
+                gi_map *g = &run.maps[m];
+                add_bounce(map, g);
+                if (!last)
+                    make_source(map, g, g->next, g->source_next);
+                else if (b->gi_invalid_texels)
+                    st = fill_invalid(map, g);
+            }
+            tile_end(&run, t);
+        }
+        /* the next bounce reads what this one made */
+        for (uint32_t m = 0; m < count && st == LX_OK && !last; m++) {
+            float *swap = run.maps[m].source;
+            run.maps[m].source = run.maps[m].source_next;
+            run.maps[m].source_next = swap;
         }
     }
-    for (uint32_t m = 0; m < count && st == LX_OK; m++)
-        if (b->gi_invalid_texels)
-        {
-            st = lx_gi_fill_invalid(&b->maps[m], run.maps[m].valid, run.maps[m].invalid,
-                                    b->maps[m].baked, 3);
-            if (st == LX_OK && b->maps[m].sh)
-                st = lx_gi_fill_invalid(&b->maps[m], run.maps[m].valid, run.maps[m].invalid,
-                                        b->maps[m].sh, LX_SH_FLOATS);
-        }
     if (st == LX_OK && b->gi_invalid_texels)
         lx_log(LX_LOG_INFO,
                "global illumination: %llu texels sit inside geometry (their rays mostly hit back "
@@ -572,13 +624,12 @@ lx_status lx_bake_indirect(lx_baker *b, float progress_base, float progress_span
     for (uint32_t m = 0; run.maps && m < count; m++) {
         free(run.maps[m].valid);
         free(run.maps[m].source);
-        free(run.maps[m].prev);
+        free(run.maps[m].source_next);
         free(run.maps[m].next);
         free(run.maps[m].invalid);
         free(run.maps[m].next_sh);
     }
     free(run.maps);
     free(run.sources);
-    free(run.map_first_tile);
     return st;
 }

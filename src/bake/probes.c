@@ -257,6 +257,9 @@ static lx_status make_sources(const lx_baker *b, lx_radiance_source *src, float 
     if (st != LX_OK)
         return st;
     for (uint32_t m = 0; m < b->map_count; m++) {
+        /* a tiled baker builds each tile's texels again, in order */
+        if ((st = lx_bake_tile_need((lx_baker *)b, m)) != LX_OK)
+            return st;
         const lx_lightmap *map = &b->maps[m];
         size_t pixels = (size_t)map->info.width * (size_t)map->info.height;
         bufs[m] = calloc(pixels * 3 + 1, sizeof(float));

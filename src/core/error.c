@@ -91,8 +91,18 @@ void lx_set_log_callback(lx_log_fn fn, void *user)
     pthread_mutex_unlock(&log_lock);
 }
 
+/* Muted on this thread (lx_log_mute): messages are dropped. */
+static _Thread_local int log_muted;
+
+void lx_log_mute(bool mute)
+{
+    log_muted += mute ? 1 : -1;
+}
+
 void lx_log(lx_log_level level, const char *fmt, ...)
 {
+    if (log_muted > 0)
+        return;
     char line[LX_ERROR_MAX];
     va_list ap;
     va_start(ap, fmt);

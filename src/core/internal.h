@@ -104,6 +104,10 @@ lx_status lx_read_file(const char *path, size_t max_size, char **out, size_t *ou
 char *lx_path_dirname(const char *path);
 /* a/b joined (malloc'd); b returned as-is when absolute. */
 char *lx_path_join(const char *a, const char *b);
+/* Mutes lx_log on the calling thread while true (nested calls count):
+ * the baker rebuilding a texel map it built before says nothing twice. */
+void lx_log_mute(bool mute);
+
 /* strdup that reports running out of memory by NULL. */
 char *lx_strdup(const char *s);
 

@@ -98,6 +98,10 @@ static const char *bake_usage =
     "  --render                also DIR/view.png: the scene with its lightmaps from\n"
     "                          the default camera (luxel render)\n"
     "  --threads N             worker threads (default: all cores)\n"
+    "  --memory-limit SIZE     memory the bake may take, e.g. 512M or 4G (default:\n"
+    "                          what the machine has: RAM, control group, ulimit);\n"
+    "                          lightmaps that do not fit together are baked in\n"
+    "                          tiles, to the same bytes (docs/bake.md)\n"
     "  --skip-degenerate       accepted for old scripts: zero-area triangles are\n"
     "                          always left out with a warning\n"
     "  --strict                fail on any warning (suspect units, tiny spot\n"
@@ -516,6 +520,12 @@ int cmd_bake(int argc, char **argv)
     if (!cli_stage_begin(&stage, a.output))
         goto done;
 
+    /* the applied lightmaps (RGB float), AO maps (grey float) and
+     * directional maps (four RGB or one RGBA float) stay until written */
+    a.desc.caller_bytes_per_texel = 12 + (a.ao ? 4 : 0) +
+                                    (a.desc.directional == LX_DIRECTIONAL_SH        ? 48
+                                     : a.desc.directional == LX_DIRECTIONAL_DOMINANT ? 16
+                                                                                     : 0);
     int prepared = cli_bake_prepare(&a, &progress, &scene, &sky, &unwrap, &atlas, &baker);
     if (prepared != EXIT_OK) {
         status = prepared;

@@ -432,6 +432,12 @@ int cli_bake_option(bake_args *a, int c, const char *optarg)
                                    "--emissive-scale must be a number above 0, not '%s'", optarg);
         a->desc.emissive_scale = (float)f;
         break;
+    case OPT_MEMORY_LIMIT:
+        if (!cli_parse_size(optarg, &a->desc.memory_limit))
+            return cli_usage_error(a->command,
+                                   "--memory-limit must be a size such as 512M or 4G, not '%s'",
+                                   optarg);
+        break;
     case OPT_STRICT:
         a->strict = true;
         a->desc.strict = true; /* zero-area triangles refused, in space and in UV */

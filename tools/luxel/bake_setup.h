@@ -44,6 +44,7 @@ enum {
     OPT_GI_SAMPLES,
     OPT_EMISSIVE_SCALE,
     OPT_DENOISE,
+    OPT_MEMORY_LIMIT,
     BAKE_OPT_OWN
 };
 
@@ -70,8 +71,9 @@ enum {
         {"bounces", required_argument, NULL, OPT_BOUNCES},                                         \
         {"gi-samples", required_argument, NULL, OPT_GI_SAMPLES},                                   \
         {"emissive-scale", required_argument, NULL, OPT_EMISSIVE_SCALE},                           \
+        {"denoise", required_argument, NULL, OPT_DENOISE},                                         \
     {                                                                                              \
-        "denoise", required_argument, NULL, OPT_DENOISE                                            \
+        "memory-limit", required_argument, NULL, OPT_MEMORY_LIMIT                                  \
     }
 
 /* The options of a bake (bake's own fields are read by bake.c only). */

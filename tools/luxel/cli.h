@@ -80,6 +80,9 @@ int cli_common_option(const char *command, int c, char **argv, int *threads, boo
 /* Strict number parsing: the whole string, finite, within [lo, hi]. */
 bool cli_parse_int(const char *s, long lo, long hi, long *out);
 bool cli_parse_float(const char *s, double lo, double hi, double *out);
+/* A memory size: 512M, 4G, 1.5G, 64KiB, 1000000 (bytes); K, M, G, T are
+ * powers of 1024. At least one byte. */
+bool cli_parse_size(const char *s, uint64_t *out);
 /* The float image formats and PNG: "exr", "hdr", "pfm" or "png". */
 bool cli_parse_format(const char *s, lx_image_format *out);
 /* "R,G,B" with finite components >= 0. */

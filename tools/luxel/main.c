@@ -99,6 +99,38 @@ bool cli_parse_float(const char *s, double lo, double hi, double *out)
     return true;
 }
 
+bool cli_parse_size(const char *s, uint64_t *out)
+{
+    /* digits (a decimal point allowed), then K, M, G or T (powers of 1024,
+     * an optional trailing B or iB), or bytes */
+    char *end;
+    errno = 0;
+    if (!s || !((s[0] >= '0' && s[0] <= '9') || s[0] == '.'))
+        return false;
+    double v = strtod(s, &end);
+    if (errno || end == s || !isfinite(v) || v < 0.0)
+        return false;
+    double scale = 1.0;
+    switch (*end) {
+    case 'k': case 'K': scale = 1024.0; end++; break;
+    case 'm': case 'M': scale = 1024.0 * 1024.0; end++; break;
+    case 'g': case 'G': scale = 1024.0 * 1024.0 * 1024.0; end++; break;
+    case 't': case 'T': scale = 1024.0 * 1024.0 * 1024.0 * 1024.0; end++; break;
+    default: break;
+    }
+    if (scale > 1.0 && *end == 'i')
+        end++;
+    if (*end == 'B' || *end == 'b')
+        end++;
+    if (*end)
+        return false;
+    double bytes = v * scale;
+    if (!(bytes >= 1.0) || bytes >= 18446744073709549568.0)
+        return false;
+    *out = (uint64_t)bytes;
+    return true;
+}
+
 bool cli_parse_format(const char *s, lx_image_format *out)
 {
     static const struct {

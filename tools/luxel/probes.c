@@ -42,7 +42,7 @@ static const char *probes_usage =
     "--sky, --sky-intensity, --sky-shadows, --no-sky-shadows, --sky-samples,\n"
     "--bounces, --gi-samples, --emissive-scale, --denoise, --resolution,\n"
     "--texel-density, --max-resolution, --padding, --unwrap, --uv-set, --atlas,\n"
-    "--no-atlas, --atlas-size, --strict\n";
+    "--no-atlas, --atlas-size, --memory-limit, --strict\n";
 
 enum { OPT_GRID = BAKE_OPT_OWN, OPT_POINTS, OPT_SAMPLES };
 
