@@ -473,8 +473,14 @@ lx_status lx_bake_scene_copy(const lx_scene *s, lx_scene **out)
         return st;
     for (uint32_t k = 0; k < s->material_count && st == LX_OK; k++)
         st = lx_scene_add_material(c, &s->materials[k], NULL);
-    for (uint32_t k = 0; k < s->mesh_count && st == LX_OK; k++)
+    for (uint32_t k = 0; k < s->mesh_count && st == LX_OK; k++) {
         st = lx_scene_add_mesh(c, &s->meshes[k], NULL);
+        /* adding renormalizes the normals (a unit vector may move by an
+         * ulp): the copy keeps the very floats the untiled bake reads */
+        const lx_mesh *from = &s->meshes[k];
+        if (st == LX_OK && from->normals)
+            memcpy(c->meshes[k].normals, from->normals, sizeof(lx_vec3) * from->vertex_count);
+    }
     for (uint32_t k = 0; k < s->node_count && st == LX_OK; k++)
         st = lx_scene_add_node(c, s->nodes[k].name, &s->nodes[k].world, s->nodes[k].meshes,
                                s->nodes[k].mesh_count, NULL);
