@@ -10,7 +10,8 @@
  * What the passes add (bake_internal.h's lx_sh4_*):
  * - a light whose irradiance at the texel is e from direction d (the
  *   texel's normal n): a delta of e / (n . d), its illuminance facing it
- *   (an area light from its centre, n . d at least 0.1);
+ *   (an area light from its centre, n . d at least 0.1; emitters from
+ *   their mean direction, emitters.c);
  * - ambient terms (an irradiance for every normal): a uniform radiance
  *   a / pi over the sphere, L00 = 4 Y00 a;
  * - an unshadowed sky: the sky's own L0 and L1 (nothing blocks it);

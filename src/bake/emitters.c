@@ -256,12 +256,16 @@ static lx_ray shadow_ray(const lx_baker *b, lx_vec3 p, lx_vec3 ng, lx_vec3 x, lx
 
 /* The emitters' irradiance at texel i of map. */
 static lx_vec3 texel_emitters(const lx_baker *b, const emitter_set *set, uint32_t map_index,
-                              const lx_lightmap *map, uint32_t i)
+                              const lx_lightmap *map, uint32_t i, lx_vec3 *towards)
 {
     lx_vec3 p = map->world_position[i], n = map->world_normal[i];
     lx_vec3 ng = map->world_geometric_normal[i];
     uint32_t pixel = map->texels[i].pixel;
     double sum[3] = {0.0, 0.0, 0.0}, exact[3] = {0.0, 0.0, 0.0};
+    /* where the light comes from, for the directional data: the exact
+     * sum's triangles by their share (towards their centroids), else the
+     * visible samples by theirs */
+    double dir[3] = {0.0, 0.0, 0.0};
     if (set->exact)
         for (uint32_t j = 0; j < set->count; j++) {
             const emitter_tri *t = &set->tri[j];
@@ -269,6 +273,10 @@ static lx_vec3 texel_emitters(const lx_baker *b, const emitter_set *set, uint32_
                 continue;
             double f = triangle_transfer(t, p, n);
             exact[0] += f * t->le.x, exact[1] += f * t->le.y, exact[2] += f * t->le.z;
+            lx_vec3 c = lx_add(t->p0, lx_scale(lx_add(t->e1, t->e2), 1.0f / 3.0f));
+            lx_vec3 u = lx_normalize(lx_sub(c, p));
+            double w = f * (double)max3(t->le);
+            dir[0] += w * u.x, dir[1] += w * u.y, dir[2] += w * u.z;
         }
     uint32_t want = b->desc.gi_samples < NEE_SAMPLES_MAX ? b->desc.gi_samples : NEE_SAMPLES_MAX;
     uint32_t sx, sy;
@@ -277,6 +285,7 @@ static lx_vec3 texel_emitters(const lx_baker *b, const emitter_set *set, uint32_
     enum { BATCH = 64 };
     lx_ray rays[BATCH];
     lx_vec3 on[BATCH], off[BATCH]; /* what a visible and a blocked sample add */
+    lx_vec3 ways[BATCH];
     uint8_t occluded[BATCH];
     uint32_t k = 0;
     while (k < cells) {
@@ -324,6 +333,8 @@ static lx_vec3 texel_emitters(const lx_baker *b, const emitter_set *set, uint32_
             on[m] = lx_v3((float)((le.x - base.x) * g), (float)((le.y - base.y) * g),
                           (float)((le.z - base.z) * g));
             off[m] = lx_v3((float)(-base.x * g), (float)(-base.y * g), (float)(-base.z * g));
+            /* the sample's direction weighted by what it brings when seen */
+            ways[m] = lx_scale(d, (float)((double)max3(le) * g) / dist);
             rays[m] = shadow_ray(b, p, ng, x, t->n, d);
             m++;
         }
@@ -333,8 +344,13 @@ static lx_vec3 texel_emitters(const lx_baker *b, const emitter_set *set, uint32_
         for (uint32_t j = 0; j < m; j++) {
             lx_vec3 c = occluded[j] ? off[j] : on[j];
             sum[0] += c.x, sum[1] += c.y, sum[2] += c.z;
+            if (!set->exact && !occluded[j])
+                dir[0] += ways[j].x, dir[1] += ways[j].y, dir[2] += ways[j].z;
         }
     }
+    double len = sqrt(dir[0] * dir[0] + dir[1] * dir[1] + dir[2] * dir[2]);
+    *towards = len > 0.0 ? lx_v3((float)(dir[0] / len), (float)(dir[1] / len), (float)(dir[2] / len))
+                         : n;
     double inv = 1.0 / (double)cells;
     return lx_v3((float)fmax(exact[0] + sum[0] * inv, 0.0), (float)fmax(exact[1] + sum[1] * inv, 0.0),
                  (float)fmax(exact[2] + sum[2] * inv, 0.0));
@@ -391,9 +407,19 @@ lx_status lx_bake_emitters(lx_baker *b, const lx_emitter_set *set, float progres
         lx_tile_walk_at(&w, global, &m, &first, &count);
         lx_lightmap *map = &b->maps[m];
         for (uint32_t i = first; i < first + count; i++) {
-            lx_vec3 e = texel_emitters(b, set, m, map, i);
-            float *px = map->baked + 3 * (size_t)map->texels[i].pixel;
+            lx_vec3 towards;
+            lx_vec3 e = texel_emitters(b, set, m, map, i, &towards);
+            size_t pixel = map->texels[i].pixel;
+            float *px = map->baked + 3 * pixel;
             px[0] += e.x, px[1] += e.y, px[2] += e.z;
+            if (map->sh) {
+                /* as an area light's: its irradiance from its mean direction */
+                lx_sh4 add = {{0}};
+                lx_sh4_add_lit_floor(&add, e, map->world_normal[i], towards, 0.1f);
+                float *q = map->sh + pixel * LX_SH_FLOATS;
+                for (int c = 0; c < LX_SH_FLOATS; c++)
+                    q[c] += add.c[c];
+            }
         }
         lx_tile_walk_done(&w, global, count);
     }

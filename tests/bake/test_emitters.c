@@ -265,6 +265,60 @@ static void small_bright_emitter_is_less_noisy(void **state)
     lx_scene_destroy(scene);
 }
 
+/* Directional data of an emitter's light (desc.directional): each floor
+ * texel under the rect gets it as an area light's, a delta of E / (n . d)
+ * from the light's mean direction d (docs/directional.md), so L00 / Y00
+ * and |L1| / Y1 are the same number, E / d.y with E the closed form, and d
+ * leans towards the rect's middle (its horizontal part points from the
+ * texel to the centre, by symmetry of what it weights). */
+static void emitter_directional_data(void **state)
+{
+    (void)state;
+    rect r = {-0.8, 0.8, -0.5, 0.5, 1.0}, none = {0};
+    const float le = 1000.0f;
+    lx_scene *scene = emitter_scene(r, le, none, 1);
+    lx_bake_desc d = {.resolution = 24, .bounces = 1, .gi_samples = 16,
+                      .directional = LX_DIRECTIONAL_SH};
+    lx_baker *b;
+    assert_int_equal(lx_baker_create(scene, &d, &b), LX_OK);
+    assert_int_equal(lx_baker_bake(b), LX_OK);
+    lx_scene_destroy(scene);
+    uint32_t map = lx_test_map_of(b, 0);
+    lx_image sh[4];
+    assert_int_equal(lx_baker_sh(b, map, sh), LX_OK);
+    const double y0 = 0.28209479177387814, y1 = 0.4886025119029199;
+    double worst = 0.0;
+    int texels = 0, leaning = 0;
+    for (int y = 0; y < sh[0].height; y++)
+        for (int x = 0; x < sh[0].width; x++) {
+            lx_texel_sample t;
+            if (!lx_baker_texel(b, map, x, y, &t))
+                continue;
+            size_t p = 3 * ((size_t)y * sh[0].width + x);
+            double l00 = sh[0].data[p], ly = sh[1].data[p], lz = sh[2].data[p], lx = sh[3].data[p];
+            double len = sqrt(lx * lx + ly * ly + lz * lz);
+            assert_true(len > 0.0);
+            double dy = ly / len, dx = lx / len, dz = lz / len;
+            double want = closed_form(r, le, none, t.position.x, t.position.z) / fmax(dy, 0.1);
+            worst = fmax(worst, fabs(l00 / y0 - want) / want);
+            worst = fmax(worst, fabs(len / y1 - want) / want);
+            double cx = -t.position.x, cz = -t.position.z; /* to the rect's middle */
+            if (fabs(cx) > 0.1 && fabs(cz) > 0.1) {
+                assert_true(dx * cx > 0.0 && dz * cz > 0.0);
+                leaning++;
+            }
+            texels++;
+        }
+    printf("emitter SH: %d floor texels (%d off the middle's axes), worst relative error %.3g\n",
+           texels, leaning, worst);
+    assert_true(texels > 100 && leaning > 50);
+    /* the irradiance's own error (7.5e-8) and float rounding of the SH */
+    assert_true(worst < 1e-5);
+    for (int c = 0; c < 4; c++)
+        lx_image_free(&sh[c]);
+    lx_baker_destroy(b);
+}
+
 int main(void)
 {
     const struct CMUnitTest tests[] = {
@@ -272,6 +326,7 @@ int main(void)
         cmocka_unit_test(many_triangles_sample_the_rect_light),
         cmocka_unit_test(plate_shadow_matches_the_closed_form),
         cmocka_unit_test(small_bright_emitter_is_less_noisy),
+        cmocka_unit_test(emitter_directional_data),
     };
     return cmocka_run_group_tests(tests, NULL, NULL);
 }
