@@ -155,12 +155,13 @@ static void assert_same(const outputs *a, const outputs *b)
     assert_memory_equal(&a->ev, &b->ev, sizeof a->ev);
 }
 
-/* The smallest memory limit lx_baker_create accepts for the scene. */
-static uint64_t smallest_limit(lx_scene *scene, int threads)
+/* The smallest memory limit lx_baker_create accepts for the scene under
+ * d (its memory_limit aside). */
+static uint64_t smallest_limit_for(lx_scene *scene, lx_bake_desc d)
 {
     uint64_t lo = 1, hi = (uint64_t)1 << 32; /* lo fails, hi bakes */
-    lx_bake_desc d = room_desc(threads, lo);
     lx_baker *b;
+    d.memory_limit = lo;
     assert_int_equal(lx_baker_create(scene, &d, &b), LX_ERR_NOMEM);
     while (hi - lo > 1) {
         uint64_t mid = lo + (hi - lo) / 2;
@@ -175,6 +176,11 @@ static uint64_t smallest_limit(lx_scene *scene, int threads)
         }
     }
     return hi;
+}
+
+static uint64_t smallest_limit(lx_scene *scene, int threads)
+{
+    return smallest_limit_for(scene, room_desc(threads, 0));
 }
 
 static void tiles_match_untiled(void **state)
@@ -300,22 +306,8 @@ static void later_passes_tiled(void **state)
         d.directional = LX_DIRECTIONAL_SH;
         d.supersample = 2;
         d.probes = true;
-        if (pass) {
-            /* smallest limit that bakes these settings */
-            uint64_t lo = 1, hi = (uint64_t)1 << 32;
-            while (hi - lo > 1) {
-                uint64_t mid = lo + (hi - lo) / 2;
-                d.memory_limit = mid;
-                lx_baker *t;
-                if (lx_baker_create(scene, &d, &t) == LX_OK) {
-                    lx_baker_destroy(t);
-                    hi = mid;
-                } else {
-                    lo = mid;
-                }
-            }
-            d.memory_limit = hi;
-        }
+        if (pass)
+            d.memory_limit = smallest_limit_for(scene, d);
         lx_baker *b;
         assert_int_equal(lx_baker_create(scene, &d, &b), LX_OK);
         maps[pass] = lx_baker_lightmap_count(b);
@@ -349,19 +341,7 @@ static void later_passes_tiled(void **state)
     /* the dynamic bounce: refused tiled, one line */
     lx_bake_desc d = room_desc(2, 0);
     d.dynamic_bounce_samples = 4;
-    uint64_t lo = 1, hi = (uint64_t)1 << 32;
-    while (hi - lo > 1) {
-        uint64_t mid = lo + (hi - lo) / 2;
-        d.memory_limit = mid;
-        lx_baker *t;
-        if (lx_baker_create(scene, &d, &t) == LX_OK) {
-            lx_baker_destroy(t);
-            hi = mid;
-        } else {
-            lo = mid;
-        }
-    }
-    d.memory_limit = hi;
+    d.memory_limit = smallest_limit_for(scene, d);
     lx_baker *b;
     assert_int_equal(lx_baker_create(scene, &d, &b), LX_OK);
     assert_true(lx_baker_tile_count(b) > 1);
