@@ -320,11 +320,12 @@ lx_status lx_texel_map_keep_object_space(lx_lightmap *map);
  * (lx_texel_map_keep_object_space). */
 void lx_texel_map_transform(lx_lightmap *map, uint32_t node, const lx_mat4 *world);
 
-/* straddle.c: moves every texel sample that lies inside geometry (a
- * floor texel half under a wall standing on it) to the visible side and
- * leaves such supersampling points out; frees the maps' texel_axes.
- * Needs the committed tracer. */
-lx_status lx_bake_straddle(lx_baker *b);
+/* straddle.c: moves every texel sample of the maps in memory that lies
+ * inside geometry (a floor texel half under a wall standing on it) to the
+ * visible side and leaves such supersampling points out; frees their
+ * texel_axes. Reports within [progress_base, + progress_span] when
+ * report (LX_ERR_CANCELLED when told to stop). */
+lx_status lx_bake_straddle(lx_baker *b, float progress_base, float progress_span, bool report);
 
 /* Adds the given lights (indices into baker->lights) into target
  * (width*height*3 floats per map), plus `ambient` at every texel
@@ -549,6 +550,7 @@ typedef struct lx_tile_walk {
     uint32_t *map_first_tile; /* map_count + 1 */
     int tiles;
     int every;
+    bool quiet; /* no progress reports (nor cancel) */
     uint64_t total_work, done_work;
     float base, span;
     volatile int cancelled;

@@ -351,7 +351,7 @@ void lx_tile_walk_at(const lx_tile_walk *w, int global, uint32_t *map, uint32_t 
 void lx_tile_walk_done(lx_tile_walk *w, int global, uint32_t count)
 {
     const lx_baker *b = w->b;
-    if (!b->desc.progress)
+    if (!b->desc.progress || w->quiet)
         return;
     uint64_t done;
 #pragma omp atomic capture
@@ -450,7 +450,7 @@ lx_status lx_bake_tile_need(lx_baker *b, uint32_t map)
      * (before the tracer exists, lx_baker_create does it) */
     if (st == LX_OK && b->tracer) {
         lx_log_mute(true);
-        st = lx_bake_straddle(b);
+        st = lx_bake_straddle(b, 0.0f, 0.0f, false);
         lx_log_mute(false);
     }
     if (st != LX_OK) {

@@ -82,8 +82,10 @@ static lx_status validate_desc(const lx_bake_desc *d)
 
 /* lx_baker_create's progress: the materials' horizon maps (when any
  * material has a height: up to HORIZON_SHARE), the texel maps (up to
- * TEXEL_MAPS_SHARE), then the BVH build. */
-#define TEXEL_MAPS_SHARE 0.9f
+ * TEXEL_MAPS_SHARE), the BVH build (up to BVH_SHARE), then the samples
+ * moved out of walls (straddle.c). */
+#define TEXEL_MAPS_SHARE 0.8f
+#define BVH_SHARE 0.9f
 #define HORIZON_SHARE 0.3f
 
 /* Where the texel maps' progress starts. */
@@ -95,7 +97,7 @@ static float maps_from(const lx_baker *b)
 static bool bvh_progress(void *user, float fraction)
 {
     const lx_bake_desc *d = user;
-    return d->progress(d->progress_user, TEXEL_MAPS_SHARE + (1.0f - TEXEL_MAPS_SHARE) * fraction);
+    return d->progress(d->progress_user, TEXEL_MAPS_SHARE + (BVH_SHARE - TEXEL_MAPS_SHARE) * fraction);
 }
 
 static void candidates_free(lx_tile_candidate *c, uint32_t count)
@@ -400,7 +402,7 @@ lx_status lx_baker_create(const lx_scene *scene, const lx_bake_desc *in, lx_bake
     st = lx_tracer_create(scene, &td, &b->tracer);
     /* samples inside geometry move out (straddle.c) */
     if (st == LX_OK)
-        st = lx_bake_straddle(b);
+        st = lx_bake_straddle(b, BVH_SHARE, 1.0f - BVH_SHARE, true);
     if (st != LX_OK) {
         lx_baker_destroy(b);
         return st;

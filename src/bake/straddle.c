@@ -175,7 +175,7 @@ static bool straddle_texel(const lx_baker *b, lx_lightmap *map, uint32_t i)
     return moved;
 }
 
-lx_status lx_bake_straddle(lx_baker *b)
+lx_status lx_bake_straddle(lx_baker *b, float progress_base, float progress_span, bool report)
 {
     if (b->tracer_dirty) {
         lx_status st = lx_tracer_commit(b->tracer);
@@ -183,20 +183,32 @@ lx_status lx_bake_straddle(lx_baker *b)
             return st;
         b->tracer_dirty = false;
     }
-    for (uint32_t m = 0; m < b->map_count; m++) {
-        lx_lightmap *map = &b->maps[m];
-        if (!map->texel_axes)
-            continue;
-        int64_t n = map->info.used_texels, moved = 0;
-#pragma omp parallel for schedule(dynamic, 256) reduction(+ : moved)                           \
+    lx_tile_walk w;
+    lx_status st = lx_tile_walk_begin(b, progress_base, progress_span, 1, &w);
+    if (st != LX_OK)
+        return st;
+    if (!report)
+        w.quiet = true;
+    int64_t moved = 0;
+#pragma omp parallel for schedule(dynamic, 1) reduction(+ : moved)                             \
     num_threads(lx_thread_count(b->desc.threads))
-        for (int64_t i = 0; i < n; i++)
-            moved += straddle_texel(b, map, (uint32_t)i);
-        if (moved)
-            lx_log(LX_LOG_INFO, "lightmap '%s': %lld texel samples moved out of geometry",
-                   map->name, (long long)moved);
-        free(map->texel_axes);
-        map->texel_axes = NULL;
+    for (int global = 0; global < w.tiles; global++) {
+        if (w.cancelled)
+            continue;
+        uint32_t m, first, count;
+        lx_tile_walk_at(&w, global, &m, &first, &count);
+        lx_lightmap *map = &b->maps[m];
+        for (uint32_t i = first; map->texel_axes && i < first + count; i++)
+            moved += straddle_texel(b, map, i);
+        lx_tile_walk_done(&w, global, count);
+    }
+    if ((st = lx_tile_walk_end(&w)) != LX_OK)
+        return st;
+    if (moved)
+        lx_log(LX_LOG_INFO, "%lld texel samples moved out of geometry", (long long)moved);
+    for (uint32_t m = 0; m < b->map_count; m++) {
+        free(b->maps[m].texel_axes);
+        b->maps[m].texel_axes = NULL;
     }
     return LX_OK;
 }
