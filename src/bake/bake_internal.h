@@ -169,6 +169,9 @@ typedef struct lx_lightmap {
                         spherical harmonics (directional.c); NULL unless
                         desc.directional */
     lx_seam_stitch *stitch; /* NULL: not asked, or no seams */
+    uint8_t *gi_valid; /* width * height, after a bake with bounces in which
+                          a texel lay inside geometry (else NULL): 0 at
+                          those texels, left out of the denoiser; resident */
     /* Texel supersampling (desc.supersample = N > 1): sub_count = N^2
      * points a texel, point s of texel i at [s * used_texels + i] (so
      * the arrays from s * used_texels on read like world_position);

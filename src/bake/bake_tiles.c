@@ -75,7 +75,7 @@ static const texel_buffer texel_buffers[] = {
     {"real-time light (RGB float)", 12, PER_TEXEL, LIFE_RESIDENT, WHEN_DYNAMIC},
     {"directional: L1 SH of the baked light (12 floats)", 48, PER_TEXEL, LIFE_RESIDENT,
      WHEN_DIRECTIONAL},
-    {"bounces: validity", 1, PER_TEXEL, LIFE_RESIDENT, WHEN_GI},
+    {"bounces: validity (kept for the denoiser)", 1, PER_TEXEL, LIFE_RESIDENT, WHEN_GI},
     {"bounces: exitant radiance of the last and the next bounce", 24, PER_TEXEL, LIFE_RESIDENT,
      WHEN_GI},
     {"emitters: textured emission", 12, PER_TEXEL, LIFE_RESIDENT,
@@ -379,6 +379,7 @@ void lx_bake_map_unload(lx_lightmap *map)
     map->name = NULL;
     map->mask = NULL;
     map->baked = map->realtime = map->sh = NULL;
+    map->gi_valid = NULL;
     lx_texel_map_free(map);
     map->name = keep.name;
     map->info = keep.info;
@@ -386,6 +387,7 @@ void lx_bake_map_unload(lx_lightmap *map)
     map->baked = keep.baked;
     map->realtime = keep.realtime;
     map->sh = keep.sh;
+    map->gi_valid = keep.gi_valid;
     map->horizon_page = keep.horizon_page;
     map->loaded = false;
 }
@@ -418,12 +420,14 @@ static lx_status map_load(lx_baker *b, uint32_t m)
     free(fresh.baked);
     free(fresh.realtime);
     free(fresh.sh);
+    free(fresh.gi_valid);
     fresh.name = map->name;
     fresh.info = map->info;
     fresh.mask = map->mask;
     fresh.baked = map->baked;
     fresh.realtime = map->realtime;
     fresh.sh = map->sh;
+    fresh.gi_valid = map->gi_valid;
     fresh.horizon_page = map->horizon_page;
     fresh.loaded = true;
     *map = fresh;

@@ -64,7 +64,8 @@ lx_status lx_baker_denoise_guides(const lx_baker *b, uint32_t map_index, lx_deno
     for (int tile = 0; tile < (int)map->tile_count; tile++)
         for (uint32_t i = map->tile_start[tile]; i < map->tile_start[tile + 1]; i++) {
             const lx_texel *t = &map->texels[i];
-            valid[t->pixel] = 1;
+            /* a texel inside geometry keeps the light its neighbours gave it */
+            valid[t->pixel] = !map->gi_valid || map->gi_valid[t->pixel];
             position[t->pixel] = map->world_position[i];
             normal[t->pixel] = map->world_normal[i];
             chart[t->pixel] = t->node;

@@ -622,7 +622,14 @@ lx_status lx_bake_indirect(lx_baker *b, float progress_base, float progress_span
                "faces); they take their valid neighbours' light",
                (unsigned long long)b->gi_invalid_texels);
     for (uint32_t m = 0; run.maps && m < count; m++) {
-        free(run.maps[m].valid);
+        /* the valid mask stays for the denoiser (invalid texels keep their
+         * filled light), when a texel is invalid */
+        free(b->maps[m].gi_valid);
+        b->maps[m].gi_valid = NULL;
+        if (st == LX_OK && b->gi_invalid_texels)
+            b->maps[m].gi_valid = run.maps[m].valid;
+        else
+            free(run.maps[m].valid);
         free(run.maps[m].source);
         free(run.maps[m].source_next);
         free(run.maps[m].next);
