@@ -37,7 +37,7 @@
  *   if (lx_scene_load("room.glb", NULL, &scene) != LX_OK) return 1;
  *   if (lx_lightmaps_load("lightmaps/room", NULL, &lm) == LX_OK) {
  *       lx_image img;
- *       lx_render_desc d = lx_render_desc_defaults(NULL); // 1280x720, iso framing
+ *       lx_render_desc d = lx_render_desc_defaults(NULL); // 1280x720, lx_camera_auto
  *       if (lx_render_view(scene, &lm, NULL, &d, &img) == LX_OK) {
  *           lx_image_write_desc w = {.tonemap = LX_TONEMAP_ACES,
  *                                    .exposure = lx_exposure_from_ev100(lm.preview_ev100)};
@@ -103,6 +103,39 @@ bool lx_camera_project(const lx_camera *cam, int width, int height, lx_vec3 p, f
 /* LX_OK when the camera can make an image: finite, eye != target, up not
  * along the view, fov in (0, pi). The message names the problem. */
 lx_status lx_camera_check(const lx_camera *cam);
+
+/* The view of a camera the scene file placed (scene.h, lx_scene_camera):
+ * eye, target eye + forward, its up and its yfov. The file's aspectRatio
+ * is not used: the image's width / height is (as glTF asks of a renderer
+ * whose viewport differs). An orthographic camera gives its frame with fov
+ * 0 (the default): lx_render_view draws perspective views only. */
+lx_camera lx_camera_from_scene(const lx_scene_camera *camera);
+
+/* What lx_camera_auto saw and chose. */
+typedef struct lx_camera_auto_info {
+    float outside_hit;  /* fraction of the iso view's probe rays that meet the scene */
+    float outside_back; /* of those, the fraction whose first surface is a back face */
+    bool moved;         /* another view was taken (it sees more front faces) */
+    bool inside;        /* ... and it is inside the bounds */
+    float score;        /* fraction of the taken view's probe rays that meet a front face */
+    char placement[48]; /* "iso", "inside, looking along +X", "front", ... */
+} lx_camera_auto_info;
+
+/* The default camera of a scene that brings none: lx_camera_frame(...,
+ * LX_VIEW_ISO, ...) of its bounds, checked with 32 x 18 probe rays through
+ * tracer (made from scene). When more probes meet back faces first than
+ * front faces - a closed room seen from outside, its walls facing in -
+ * four views from inside the bounds (eye at 55% of the height, 15% in from
+ * one end of a horizontal axis, looking along it; the longer axis first)
+ * and the framings from front, back, left, right and top are probed too,
+ * and the one whose probes meet the most front faces (a hit nearer than
+ * 2% of the bounds' diagonal counts as none) is taken when it beats the
+ * iso view. Deterministic: the same scene gives the same camera. tracer
+ * NULL: the iso framing unchecked. fov radians (0 = 50 degrees), aspect
+ * width / height (0 = 16/9). info may be NULL. LX_ERR_INVALID for an
+ * empty scene. */
+lx_status lx_camera_auto(const lx_scene *scene, const lx_tracer *tracer, float fov, float aspect,
+                         lx_camera *out, lx_camera_auto_info *info);
 
 /* ---- lightmaps of a bake (manifest.json) ------------------------------ */
 
@@ -188,8 +221,10 @@ typedef enum lx_lightmap_filter {
 
 typedef struct lx_render_desc {
     int width, height;         /* pixels, 0 = 1280 x 720 */
-    lx_camera camera;          /* eye == target (zeroed): lx_camera_frame of the
-                                  scene's bounds, LX_VIEW_ISO, at camera.fov */
+    lx_camera camera;          /* eye == target (zeroed): lx_camera_auto (the iso
+                                  framing of the scene's bounds, or a view
+                                  from inside when that sees back faces), at
+                                  camera.fov */
     int samples;               /* per pixel, 1..4096, 0 = 4 */
     lx_lightmap_filter filter; /* lightmap lookups */
     bool two_sided;            /* false: back faces are culled (rays go through) */

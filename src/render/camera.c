@@ -127,3 +127,11 @@ lx_camera lx_camera_frame(lx_vec3 lo, lx_vec3 hi, lx_view view, float fov, float
     cam.up = b.up;
     return cam;
 }
+
+lx_camera lx_camera_from_scene(const lx_scene_camera *sc)
+{
+    lx_camera cam = {.eye = sc->eye, .target = lx_add(sc->eye, sc->forward), .up = sc->up};
+    if (sc->type == LX_SCENE_CAMERA_PERSPECTIVE)
+        cam.fov = sc->yfov;
+    return cam;
+}

@@ -395,17 +395,16 @@ lx_status lx_render_view(const lx_scene *scene, const lx_lightmaps *lm, const lx
             return lx_fail(LX_ERR_INVALID,
                            "render: lightmap node '%s': page or UV set out of range",
                            lm->nodes[n].name);
-    if (d.camera.eye.x == d.camera.target.x && d.camera.eye.y == d.camera.target.y &&
-        d.camera.eye.z == d.camera.target.z) {
+    bool frame = d.camera.eye.x == d.camera.target.x && d.camera.eye.y == d.camera.target.y &&
+                 d.camera.eye.z == d.camera.target.z;
+    if (frame) {
         lx_vec3 lo, hi;
         if (!lx_scene_bounds(scene, &lo, &hi))
             return lx_fail(LX_ERR_INVALID, "%s: the scene is empty: nothing to frame",
                            scene->path ? scene->path : "render");
-        d.camera =
-            lx_camera_frame(lo, hi, LX_VIEW_ISO, d.camera.fov, (float)d.width / (float)d.height);
-    }
-    if ((st = lx_camera_check(&d.camera)) != LX_OK)
+    } else if ((st = lx_camera_check(&d.camera)) != LX_OK) {
         return st;
+    }
 
     uint32_t nn = scene->node_count;
     uint32_t *map = malloc((nn ? nn : 1) * sizeof *map);
@@ -429,6 +428,13 @@ lx_status lx_render_view(const lx_scene *scene, const lx_lightmaps *lm, const lx
         lx_tracer_desc td = {.threads = d.threads};
         if ((st = lx_tracer_create(scene, &td, &own)) == LX_OK)
             tracer = own;
+    }
+    /* the default camera is probed through the tracer */
+    if (st == LX_OK && frame) {
+        st = lx_camera_auto(scene, tracer, d.camera.fov, (float)d.width / (float)d.height,
+                            &d.camera, NULL);
+        if (st == LX_OK)
+            st = lx_camera_check(&d.camera);
     }
     if (st == LX_OK)
         st = lx_image_alloc(out, d.width, d.height, 3);

@@ -1375,6 +1375,8 @@ static lx_status import_scene(const char *path, const import_source *src,
     }
     if (st == LX_OK && gltf)
         st = lx_gltf_lights_from_json(c.scene, path, gltf);
+    if (st == LX_OK && gltf)
+        st = lx_gltf_cameras_from_json(c.scene, path, gltf);
     else if (st == LX_OK && ai->mNumLights)
         lx_log(LX_LOG_WARN,
                "%s: %u lights left out: luxel reads lights from glTF files only (give them with "
