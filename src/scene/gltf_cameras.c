@@ -145,6 +145,39 @@ static lx_status add(lx_scene *scene, lx_scene_camera *c, const char *base)
     return LX_OK;
 }
 
+lx_status lx_gltf_check_cameras(const char *file, const cJSON *root)
+{
+    const cJSON *list = lx_gltf_get(root, "cameras");
+    const cJSON *nodes = lx_gltf_get(root, "nodes");
+    size_t count = (size_t)(cJSON_IsArray(list) ? cJSON_GetArraySize(list) : 0), k = 0;
+    char who[128];
+    for (const cJSON *c = count ? list->child : NULL; c; c = c->next, k++) {
+        lx_gltf_label(who, sizeof who, "camera", k, c);
+        const char *type = lx_gltf_get_string(c, "type");
+        if (!cJSON_IsObject(c))
+            return lx_fail(LX_ERR_FORMAT, "%s: %s is not an object", file, who);
+        if (!type || (strcmp(type, "perspective") != 0 && strcmp(type, "orthographic") != 0))
+            return lx_fail(LX_ERR_FORMAT,
+                           "%s: %s: type %s%.40s%s is not perspective or orthographic", file, who,
+                           type ? "'" : "", type ? type : "missing", type ? "'" : "");
+        if (!cJSON_IsObject(lx_gltf_get(c, type)))
+            return lx_fail(LX_ERR_FORMAT, "%s: %s: no '%s' object", file, who, type);
+    }
+    k = 0;
+    for (const cJSON *n = cJSON_IsArray(nodes) ? nodes->child : NULL; n; n = n->next, k++) {
+        const cJSON *ref = lx_gltf_get(n, "camera");
+        size_t ci;
+        if (!ref || lx_gltf_index(ref, count, &ci))
+            continue;
+        lx_gltf_label(who, sizeof who, "node", k, n);
+        if (cJSON_IsNumber(ref))
+            return lx_fail(LX_ERR_FORMAT, "%s: %s: camera %g is not in the file (%zu %s)", file,
+                           who, ref->valuedouble, count, count == 1 ? "camera" : "cameras");
+        return lx_fail(LX_ERR_FORMAT, "%s: %s: 'camera' is not a camera index", file, who);
+    }
+    return LX_OK;
+}
+
 lx_status lx_gltf_cameras_from_json(lx_scene *scene, const char *file, const cJSON *root)
 {
     const cJSON *list = lx_gltf_get(root, "cameras");

@@ -71,6 +71,11 @@ lx_status lx_gltf_lights_from_json(lx_scene *scene, const char *file, const cJSO
 /* glTF cameras placed by the default scene's nodes (gltf_cameras.c); bad
  * ones are left out with a warning, never failing the load. */
 lx_status lx_gltf_cameras_from_json(lx_scene *scene, const char *file, const cJSON *root);
+/* Fails (LX_ERR_FORMAT, naming the camera or node) when a camera is not
+ * an object with a known type and its parameters object, or a node's
+ * "camera" is not an index into "cameras": assimp refuses such files with
+ * a message that names neither, so this is checked before it reads one. */
+lx_status lx_gltf_check_cameras(const char *file, const cJSON *root);
 
 /* What the JSON says about one texture of a material (gltf_textures.c). */
 typedef struct lx_gltf_texture_ref {

@@ -1461,6 +1461,8 @@ lx_status lx_scene_load(const char *path, const lx_scene_load_desc *in, lx_scene
         if (st == LX_OK)
             st = lx_gltf_check_lfs(path, gltf);
         if (st == LX_OK && lx_gltf_is_v2(gltf))
+            st = lx_gltf_check_cameras(path, gltf);
+        if (st == LX_OK && lx_gltf_is_v2(gltf))
             st = lx_gltf_rewrite(path, gltf, &glb, &glb_size);
         /* assimp tells GLB from glTF text by the name */
         if (st == LX_OK && glb && !has_extension(path, ".glb")) {

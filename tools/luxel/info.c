@@ -231,21 +231,21 @@ int cmd_info(int argc, char **argv)
     if (s->camera_count)
         printf("cameras: %u (luxel render --gltf-camera N|NAME)\n", s->camera_count);
     for (uint32_t i = 0; i < s->camera_count; i++) {
-        const lx_scene_camera *c = &s->cameras[i];
-        printf("  %-3u %-20s ", i, c->name);
-        if (c->type == LX_SCENE_CAMERA_PERSPECTIVE)
-            printf("perspective, yfov %s deg", cli_num_digits(LX_RAD2DEG(c->yfov), 4));
+        const lx_scene_camera *cam = &s->cameras[i];
+        printf("  %-3u %-20s ", i, cam->name);
+        if (cam->type == LX_SCENE_CAMERA_PERSPECTIVE)
+            printf("perspective, yfov %s deg", cli_num_digits(LX_RAD2DEG(cam->yfov), 4));
         else
             printf("orthographic %s x %s m (not drawn by luxel render)",
-                   cli_num_digits(2.0 * c->xmag, 4), cli_num_digits(2.0 * c->ymag, 4));
-        printf("  at (%s, %s, %s)", cli_num_digits(c->eye.x, 4), cli_num_digits(c->eye.y, 4),
-               cli_num_digits(c->eye.z, 4));
-        printf("  looking (%s, %s, %s)", cli_num_digits(c->forward.x, 3),
-               cli_num_digits(c->forward.y, 3), cli_num_digits(c->forward.z, 3));
-        printf("  up (%s, %s, %s)", cli_num_digits(c->up.x, 3), cli_num_digits(c->up.y, 3),
-               cli_num_digits(c->up.z, 3));
-        if (c->node_name)
-            printf("  node '%s'", c->node_name);
+                   cli_num_digits(2.0 * cam->xmag, 4), cli_num_digits(2.0 * cam->ymag, 4));
+        printf("  at (%s, %s, %s)", cli_num_digits(cam->eye.x, 4), cli_num_digits(cam->eye.y, 4),
+               cli_num_digits(cam->eye.z, 4));
+        printf("  looking (%s, %s, %s)", cli_num_digits(cam->forward.x, 3),
+               cli_num_digits(cam->forward.y, 3), cli_num_digits(cam->forward.z, 3));
+        printf("  up (%s, %s, %s)", cli_num_digits(cam->up.x, 3), cli_num_digits(cam->up.y, 3),
+               cli_num_digits(cam->up.z, 3));
+        if (cam->node_name)
+            printf("  node '%s'", cam->node_name);
         printf("\n");
     }
     if (s->ambient.x > 0 || s->ambient.y > 0 || s->ambient.z > 0)
