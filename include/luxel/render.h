@@ -111,32 +111,6 @@ lx_status lx_camera_check(const lx_camera *cam);
  * 0 (the default): lx_render_view draws perspective views only. */
 lx_camera lx_camera_from_scene(const lx_scene_camera *camera);
 
-/* What lx_camera_auto saw and chose. */
-typedef struct lx_camera_auto_info {
-    float outside_hit;  /* fraction of the iso view's probe rays that meet the scene */
-    float outside_back; /* of those, the fraction whose first surface is a back face */
-    bool moved;         /* another view was taken (it sees more front faces) */
-    bool inside;        /* ... and it is inside the bounds */
-    float score;        /* fraction of the taken view's probe rays that meet a front face */
-    char placement[48]; /* "iso", "inside, looking along +X", "front", ... */
-} lx_camera_auto_info;
-
-/* The default camera of a scene that brings none: lx_camera_frame(...,
- * LX_VIEW_ISO, ...) of its bounds, checked with 32 x 18 probe rays through
- * tracer (made from scene). When more probes meet back faces first than
- * front faces - a closed room seen from outside, its walls facing in -
- * four views from inside the bounds (eye at 55% of the height, 15% in from
- * one end of a horizontal axis, looking along it; the longer axis first)
- * and the framings from front, back, left, right and top are probed too,
- * and the one whose probes meet the most front faces (a hit nearer than
- * 2% of the bounds' diagonal counts as none) is taken when it beats the
- * iso view. Deterministic: the same scene gives the same camera. tracer
- * NULL: the iso framing unchecked. fov radians (0 = 50 degrees), aspect
- * width / height (0 = 16/9). info may be NULL. LX_ERR_INVALID for an
- * empty scene. */
-lx_status lx_camera_auto(const lx_scene *scene, const lx_tracer *tracer, float fov, float aspect,
-                         lx_camera *out, lx_camera_auto_info *info);
-
 /* ---- lightmaps of a bake (manifest.json) ------------------------------ */
 
 typedef struct lx_lightmap_page {
@@ -211,6 +185,40 @@ void lx_lightmaps_free(lx_lightmaps *lm);
  * Else LX_ERR_INVALID: "lightmaps/room/manifest.json: node 'floor' is not
  * in scene.glb: the lightmaps of another scene?". */
 lx_status lx_lightmaps_check(const lx_lightmaps *lm, const lx_scene *scene);
+
+/* ---- the default camera ---------------------------------------------- */
+
+/* What lx_camera_auto saw and chose. */
+typedef struct lx_camera_auto_info {
+    float outside_hit;   /* fraction of the iso view's probes that meet the scene */
+    float outside_back;  /* of those, the fraction whose first surface is a back face */
+    float outside_unlit; /* ... and the fraction on a front face that is not lit */
+    float outside_score; /* fraction of the iso view's probes on a lit front face */
+    bool moved;          /* a view from inside was taken */
+    bool inside;         /* (so far the same as moved) */
+    float score;         /* the taken view's fraction of probes on a lit front face */
+    char placement[48];  /* "iso" or "inside, looking along +X", ... */
+} lx_camera_auto_info;
+
+/* The default camera of a scene that brings none. Starts from
+ * lx_camera_frame(..., LX_VIEW_ISO, ...) of the bounds and probes it with a
+ * grid of 18 rows of rays (as many columns as the aspect asks, at most
+ * 64) through tracer (made from scene): a probe scores when the first
+ * surface it meets, either face, is a front face that is lit - lit judged
+ * with lm by a 1-sample render of the same grid (luminance above 1% of
+ * the brightest probed view's median); lm NULL, or every view black:
+ * front faces only. Four views from inside the bounds (eye at 55% of the
+ * height, 15% in from one end of a horizontal axis, looking along it; the
+ * longer axis first; a hit nearer than 2% of the bounds' diagonal scores
+ * nothing) are probed the same way, and the best is taken when it scores
+ * at least 0.25 above the iso view: a closed room seen from outside shows
+ * the back faces of walls that face in, or the unlit outside of walls
+ * with two sides. Deterministic: the same scene and lightmaps give the
+ * same camera. tracer NULL: the iso framing unchecked. fov radians (0 =
+ * 50 degrees), aspect width / height (0 = 16/9). info may be NULL.
+ * LX_ERR_INVALID for an empty scene; lx_render_view's errors for lm. */
+lx_status lx_camera_auto(const lx_scene *scene, const lx_lightmaps *lm, const lx_tracer *tracer,
+                         float fov, float aspect, lx_camera *out, lx_camera_auto_info *info);
 
 /* ---- rendering -------------------------------------------------------- */
 

@@ -377,6 +377,13 @@ static lx_status check_desc(const lx_render_desc *d)
 lx_status lx_render_view(const lx_scene *scene, const lx_lightmaps *lm, const lx_tracer *tracer,
                          const lx_render_desc *desc, lx_image *out)
 {
+    return lx_render_view_quiet(scene, lm, tracer, desc, out, false);
+}
+
+lx_status lx_render_view_quiet(const lx_scene *scene, const lx_lightmaps *lm,
+                               const lx_tracer *tracer, const lx_render_desc *desc, lx_image *out,
+                               bool quiet)
+{
     memset(out, 0, sizeof *out);
     lx_render_desc d = lx_render_desc_defaults(desc);
     lx_status st = check_desc(&d);
@@ -420,7 +427,7 @@ lx_status lx_render_view(const lx_scene *scene, const lx_lightmaps *lm, const lx
         det_sign[n] = lx_mat4_det3(&scene->nodes[n].world) < 0.0f ? -1.0f : 1.0f;
         unlit += map[n] == UINT32_MAX && scene->nodes[n].mesh_count > 0;
     }
-    if (st == LX_OK && unlit)
+    if (st == LX_OK && unlit && !quiet)
         lx_log(LX_LOG_WARN, "%s: %u nodes have no lightmap and are drawn black",
                scene->path ? scene->path : "render", unlit);
     lx_tracer *own = NULL;
@@ -431,7 +438,7 @@ lx_status lx_render_view(const lx_scene *scene, const lx_lightmaps *lm, const lx
     }
     /* the default camera is probed through the tracer */
     if (st == LX_OK && frame) {
-        st = lx_camera_auto(scene, tracer, d.camera.fov, (float)d.width / (float)d.height,
+        st = lx_camera_auto(scene, lm, tracer, d.camera.fov, (float)d.width / (float)d.height,
                             &d.camera, NULL);
         if (st == LX_OK)
             st = lx_camera_check(&d.camera);

@@ -18,4 +18,10 @@ void lx_camera_basis(const lx_camera *cam, int width, int height, lx_camera_basi
  * lights it (UINT32_MAX: none). map may be NULL. */
 lx_status lx_lightmaps_bind(const lx_lightmaps *lm, const lx_scene *scene, uint32_t *map);
 
+/* lx_render_view; quiet: no warnings through lx_log (lx_camera_auto's
+ * small probe renders). */
+lx_status lx_render_view_quiet(const lx_scene *scene, const lx_lightmaps *lm,
+                               const lx_tracer *tracer, const lx_render_desc *desc, lx_image *out,
+                               bool quiet);
+
 #endif

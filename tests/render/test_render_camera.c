@@ -70,7 +70,7 @@ static void test_closed_room_inside(void **state)
     assert_int_equal(lx_tracer_create(s, NULL, &tr), LX_OK);
     lx_camera cam;
     lx_camera_auto_info info;
-    assert_int_equal(lx_camera_auto(s, tr, 0.0f, 16.0f / 9.0f, &cam, &info), LX_OK);
+    assert_int_equal(lx_camera_auto(s, NULL, tr, 0.0f, 16.0f / 9.0f, &cam, &info), LX_OK);
     /* from outside, the faces toward the eye look away from it */
     assert_true(info.outside_back > 0.5f);
     assert_true(info.moved);
@@ -95,7 +95,7 @@ static void test_closed_object_outside(void **state)
     lx_camera cam;
     lx_camera_auto_info info;
     float fov = 0.6f;
-    assert_int_equal(lx_camera_auto(s, tr, fov, 2.0f, &cam, &info), LX_OK);
+    assert_int_equal(lx_camera_auto(s, NULL, tr, fov, 2.0f, &cam, &info), LX_OK);
     assert_false(info.moved);
     assert_true(info.outside_back == 0.0f);
     assert_true(info.outside_hit > 0.0f);
@@ -132,7 +132,7 @@ static void test_default_render_is_auto(void **state)
         assert_true(coverage[i] == 1.0f);
     lx_tracer *tr;
     assert_int_equal(lx_tracer_create(s, NULL, &tr), LX_OK);
-    assert_int_equal(lx_camera_auto(s, tr, 0.0f, 48.0f / 27.0f, &d.camera, NULL), LX_OK);
+    assert_int_equal(lx_camera_auto(s, &lm, tr, 0.0f, 48.0f / 27.0f, &d.camera, NULL), LX_OK);
     d.coverage = NULL;
     assert_int_equal(lx_render_view(s, &lm, tr, &d, &b), LX_OK);
     assert_memory_equal(a.data, b.data, sizeof(float) * 48 * 27 * 3);

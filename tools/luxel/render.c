@@ -480,7 +480,8 @@ static void camera_list(char *buf, size_t size, const lx_scene *scene)
 /* Places a->desc.camera unless --camera did: --view's framing, the glTF
  * camera --gltf-camera names or else the file's first perspective camera,
  * or lx_camera_auto. Says which on stderr (unless quiet). */
-static int choose_camera(render_args *a, const lx_scene *scene, const lx_tracer *tracer)
+static int choose_camera(render_args *a, const lx_scene *scene, const lx_lightmaps *lm,
+                         const lx_tracer *tracer)
 {
     if (a->has_camera)
         return EXIT_OK;
@@ -542,18 +543,28 @@ static int choose_camera(render_args *a, const lx_scene *scene, const lx_tracer 
         return EXIT_OK;
     }
     lx_camera_auto_info info;
-    if (lx_camera_auto(scene, tracer, a->desc.camera.fov, aspect, &a->desc.camera, &info) !=
+    if (lx_camera_auto(scene, lm, tracer, a->desc.camera.fov, aspect, &a->desc.camera, &info) !=
         LX_OK) {
         cli_error("%s: %s", a->scene, lx_last_error());
         return EXIT_FAILED;
     }
-    if (info.moved && !a->quiet)
+    if (info.moved && !a->quiet) {
+        char what[160];
+        if (info.outside_unlit > 0.0f && info.outside_back > 0.0f)
+            snprintf(what, sizeof what, "back faces (%s%%) and unlit surfaces (%s%%)",
+                     cli_num_digits(100.0 * info.outside_back, 2),
+                     cli_num_digits(100.0 * info.outside_unlit, 2));
+        else if (info.outside_unlit > 0.0f)
+            snprintf(what, sizeof what, "unlit surfaces (%s%%)",
+                     cli_num_digits(100.0 * info.outside_unlit, 2));
+        else
+            snprintf(what, sizeof what, "back faces (%s%%)",
+                     cli_num_digits(100.0 * info.outside_back, 2));
         fprintf(stderr,
-                "luxel: the default view from outside sees back faces first (%s%% of what it "
-                "meets: a closed room?): the camera is placed %s%s (--view iso keeps the "
-                "outside view)\n",
-                cli_num_digits(100.0 * info.outside_back, 3),
-                info.inside ? "" : "for the view from the ", info.placement);
+                "luxel: the default view from outside sees mostly %s of what it meets: a "
+                "closed room? The camera is placed %s (--view iso keeps the outside view)\n",
+                what, info.placement);
+    }
     return EXIT_OK;
 }
 
@@ -584,7 +595,7 @@ static int render_and_write(render_args *a, const lx_lightmaps *lm, const lx_sce
         cli_error("%s: %s", a->scene, lx_last_error());
         return EXIT_FAILED;
     }
-    int chosen = choose_camera(a, scene, tracer);
+    int chosen = choose_camera(a, scene, lm, tracer);
     if (chosen != EXIT_OK) {
         lx_tracer_destroy(tracer);
         return chosen;
