@@ -194,10 +194,11 @@ typedef struct lx_camera_auto_info {
     float outside_back;  /* of those, the fraction whose first surface is a back face */
     float outside_unlit; /* ... and the fraction on a front face that is not lit */
     float outside_score; /* fraction of the iso view's probes on a lit front face */
-    bool moved;          /* a view from inside was taken */
-    bool inside;         /* (so far the same as moved) */
+    bool moved;          /* another view was taken */
+    bool inside;         /* ... from inside the bounds (else a side's framing) */
     float score;         /* the taken view's fraction of probes on a lit front face */
-    char placement[48];  /* "iso" or "inside, looking along +X", ... */
+    char placement[48];  /* "iso", "front", "back", "left", "right" or
+                            "inside, looking along +X" (-X, +Z, -Z) */
 } lx_camera_auto_info;
 
 /* The default camera of a scene that brings none. Starts from
@@ -207,15 +208,20 @@ typedef struct lx_camera_auto_info {
  * surface it meets, either face, is a front face that is lit - lit judged
  * with lm by a 1-sample render of the same grid (luminance above 1% of
  * the brightest probed view's median); lm NULL, or every view black:
- * front faces only. Four views from inside the bounds (eye at 55% of the
- * height, 15% in from one end of a horizontal axis, looking along it; the
- * longer axis first; a hit nearer than 2% of the bounds' diagonal scores
- * nothing) are probed the same way, and the best is taken when it scores
- * at least 0.25 above the iso view: a closed room seen from outside shows
- * the back faces of walls that face in, or the unlit outside of walls
- * with two sides. Deterministic: the same scene and lightmaps give the
- * same camera. tracer NULL: the iso framing unchecked. fov radians (0 =
- * 50 degrees), aspect width / height (0 = 16/9). info may be NULL.
+ * front faces only. The framings from the front, back, left and right
+ * (lx_camera_frame), then four views from inside the bounds (eye at 55%
+ * of the height, 15% in from one end of a horizontal axis, looking along
+ * it; the longer axis first) are probed the same way (a hit nearer than 2%
+ * of the bounds' diagonal scores nothing) when less than half of the
+ * probes that meet the scene score in the iso view. Of the side framings
+ * in which at least half of what the probes meet scores, the one with the
+ * most scoring probes is taken; when there is none, of the inside views
+ * so; when there is none either, the iso view stays: a closed room seen from
+ * outside shows the back faces of walls that face in, or the unlit
+ * outside of walls with two sides; a box open on one side is seen
+ * through it. Deterministic: the same scene and lightmaps give the same
+ * camera. tracer NULL: the iso framing unchecked. fov radians (0 = 50
+ * degrees), aspect width / height (0 = 16/9). info may be NULL.
  * LX_ERR_INVALID for an empty scene; lx_render_view's errors for lm. */
 lx_status lx_camera_auto(const lx_scene *scene, const lx_lightmaps *lm, const lx_tracer *tracer,
                          float fov, float aspect, lx_camera *out, lx_camera_auto_info *info);

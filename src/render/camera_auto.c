@@ -3,11 +3,15 @@
  * through the view finds the first surface along each (both faces); with
  * the bake's lightmaps, a small render of the same view (one sample a
  * pixel on the same grid) tells which of those surfaces are lit. A probe
- * scores when its first surface is a front face and lit. Views from inside
- * the bounds - raised, near one end of a horizontal axis, looking along it
- * - are scored too, and one of them is taken when it clearly beats the
- * outside view: a closed room seen from outside shows the back faces of
- * walls that face in, or the unlit outside of thick walls. */
+ * scores when its first surface is a front face and lit. When less than
+ * half of what the iso view meets scores, the framings from the four
+ * sides, then views from inside the bounds - raised, near one end of a
+ * horizontal axis, looking along it - are scored too, and the first group
+ * with a view of which at least half scores gives the one with the most
+ * scoring probes: a closed room seen from
+ * outside shows the back faces of walls that face in, or the unlit
+ * outside of walls with two sides; a box open on one side is best seen
+ * through that side. */
 #include "render_internal.h"
 
 #include <math.h>
@@ -26,8 +30,11 @@
  * as a fraction of the bounds' extent on that axis (0.35: 15% of the way
  * in from the wall behind it) */
 #define INSIDE_BACK 0.35f
-/* how much more of its probes an inside view must score to be taken */
-#define INSIDE_MARGIN 0.25f
+/* a view is right when at least this fraction of what it meets is lit
+ * front faces */
+#define GOOD 0.5f
+/* iso, four side framings, four inside views */
+#define VIEWS 9
 /* lit: luminance above this fraction of the brightest view's median */
 #define LIT_FRACTION 0.01
 
@@ -96,12 +103,16 @@ static lx_status probe(const lx_scene *scene, const lx_lightmaps *lm, const lx_t
     return LX_OK;
 }
 
-/* the fraction of probes on a lit front face */
-static float score(const view_probe *v, bool use_light, double lit)
+/* the fraction of probes on a lit front face; *of_hits: the fraction of
+ * the probes that meet something */
+static float score(const view_probe *v, bool use_light, double lit, float *of_hits)
 {
-    int n = 0, count = v->nx * PROBES_Y;
-    for (int p = 0; p < count; p++)
+    int n = 0, hits = 0, count = v->nx * PROBES_Y;
+    for (int p = 0; p < count; p++) {
         n += v->kind[p] == FRONT && (!use_light || v->lum[p] > lit);
+        hits += v->kind[p] != MISS;
+    }
+    *of_hits = hits ? (float)n / (float)hits : 0.0f;
     return (float)n / (float)count;
 }
 
@@ -128,16 +139,22 @@ lx_status lx_camera_auto(const lx_scene *scene, const lx_lightmaps *lm, const lx
         return LX_OK;
     float near = 0.02f * diag;
 
-    /* view 0: iso; 1..4: inside, along the longer horizontal axis first */
-    view_probe *v = calloc(5, sizeof *v);
+    /* view 0: iso; 1..4: framed from the front, back, left and right;
+     * 5..8: inside, along the longer horizontal axis first */
+    view_probe *v = calloc(VIEWS, sizeof *v);
     if (!v)
         return lx_fail(LX_ERR_NOMEM, "render: out of memory probing the default view");
-    char names[5][48];
+    char names[VIEWS][48];
     int nx = (int)lrintf((float)PROBES_Y * aspect);
     nx = nx < 2 ? 2 : nx > MAX_X ? MAX_X : nx;
-    for (int k = 0; k < 5; k++)
+    for (int k = 0; k < VIEWS; k++)
         v[k].nx = nx;
     v[0].cam = *out;
+    static const lx_view sides[4] = {LX_VIEW_FRONT, LX_VIEW_BACK, LX_VIEW_LEFT, LX_VIEW_RIGHT};
+    for (int k = 0; k < 4; k++) {
+        v[k + 1].cam = lx_camera_frame(lo, hi, sides[k], fov, aspect);
+        snprintf(names[k + 1], sizeof names[k + 1], "%s", lx_view_name(sides[k]));
+    }
     lx_vec3 c = lx_scale(lx_add(lo, hi), 0.5f);
     int axes[2] = {e.x >= e.z ? 0 : 2, e.x >= e.z ? 2 : 0};
     for (int k = 0; k < 4; k++) {
@@ -147,14 +164,14 @@ lx_status lx_camera_auto(const lx_scene *scene, const lx_lightmaps *lm, const lx
         float extent = axis == 0 ? e.x : e.z;
         lx_vec3 eye = lx_sub(c, lx_scale(dir, INSIDE_BACK * extent));
         eye.y = lo.y + INSIDE_HEIGHT * e.y;
-        v[k + 1].cam =
+        v[k + 5].cam =
             (lx_camera){.eye = eye, .target = lx_add(eye, dir), .up = lx_v3(0, 1, 0), .fov = fov};
-        snprintf(names[k + 1], sizeof names[k + 1], "inside, looking along %c%c",
+        snprintf(names[k + 5], sizeof names[k + 5], "inside, looking along %c%c",
                  sign > 0.0f ? '+' : '-', axis == 0 ? 'X' : 'Z');
     }
     lx_status st = LX_OK;
     double brightest = 0.0;
-    for (int k = 0; k < 5 && st == LX_OK; k++) {
+    for (int k = 0; k < VIEWS && st == LX_OK; k++) {
         st = probe(scene, lm, tracer, near, &v[k]);
         brightest = fmax(brightest, v[k].median);
     }
@@ -174,21 +191,32 @@ lx_status lx_camera_auto(const lx_scene *scene, const lx_lightmaps *lm, const lx
     info->outside_hit = (float)hits / (float)count;
     info->outside_back = hits ? (float)back / (float)hits : 0.0f;
     info->outside_unlit = hits ? (float)unlit / (float)hits : 0.0f;
-    info->outside_score = info->score = score(&v[0], use_light, lit);
-    int best = 0;
-    float best_score = info->score;
-    for (int k = 1; k < 5; k++) {
-        float s = score(&v[k], use_light, lit);
-        if (s > best_score) {
-            best = k;
-            best_score = s;
-        }
+    float good;
+    info->outside_score = info->score = score(&v[0], use_light, lit, &good);
+    if (hits == 0 || good >= GOOD) {
+        free(v);
+        return LX_OK;
     }
-    if (best != 0 && best_score >= info->outside_score + INSIDE_MARGIN) {
-        *out = v[best].cam;
-        info->moved = info->inside = true;
-        info->score = best_score;
-        snprintf(info->placement, sizeof info->placement, "%s", names[best]);
+    /* the iso view shows mostly the wrong side: the side framing that
+     * shows the most of the right side (the whole scene stays in view),
+     * else the best inside view; each must be right itself */
+    for (int group = 0; group < 2 && !info->moved; group++) {
+        int best = 0;
+        float best_score = info->outside_score;
+        for (int k = 1 + 4 * group; k < 5 + 4 * group; k++) {
+            float s = score(&v[k], use_light, lit, &good);
+            if (good >= GOOD && s > best_score) {
+                best = k;
+                best_score = s;
+            }
+        }
+        if (best != 0) {
+            *out = v[best].cam;
+            info->moved = true;
+            info->inside = group == 1;
+            info->score = best_score;
+            snprintf(info->placement, sizeof info->placement, "%s", names[best]);
+        }
     }
     free(v);
     return LX_OK;

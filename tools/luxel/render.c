@@ -562,8 +562,9 @@ static int choose_camera(render_args *a, const lx_scene *scene, const lx_lightma
                      cli_num_digits(100.0 * info.outside_back, 2));
         fprintf(stderr,
                 "luxel: the default view from outside sees mostly %s of what it meets: a "
-                "closed room? The camera is placed %s (--view iso keeps the outside view)\n",
-                what, info.placement);
+                "closed room? %s%s%s (--view iso keeps it)\n",
+                what, info.inside ? "The camera is placed " : "The view from the ",
+                info.placement, info.inside ? "" : " is taken instead");
     }
     return EXIT_OK;
 }
