@@ -70,6 +70,9 @@ typedef struct lx_camera {
     lx_vec3 up;     /* roughly up in the image; zero = +Y (-Z looking straight
                        up or down) */
     float fov;      /* vertical field of view in radians, 0 = 50 degrees */
+    float ortho_height; /* > 0: an orthographic camera whose image is this many
+                           metres tall (rays parallel to the view, starting in
+                           the plane through eye; fov unused); 0 = perspective */
 } lx_camera;
 
 #define LX_RENDER_DEFAULT_FOV_DEGREES 50.0f
@@ -101,14 +104,16 @@ lx_camera lx_camera_frame(lx_vec3 lo, lx_vec3 hi, lx_view view, float fov, float
 bool lx_camera_project(const lx_camera *cam, int width, int height, lx_vec3 p, float *x, float *y);
 
 /* LX_OK when the camera can make an image: finite, eye != target, up not
- * along the view, fov in (0, pi). The message names the problem. */
+ * along the view, fov in (0, pi), ortho_height >= 0. The message names
+ * the problem. */
 lx_status lx_camera_check(const lx_camera *cam);
 
 /* The view of a camera the scene file placed (scene.h, lx_scene_camera):
  * eye, target eye + forward, its up and its yfov. The file's aspectRatio
  * is not used: the image's width / height is (as glTF asks of a renderer
  * whose viewport differs). An orthographic camera gives its frame with fov
- * 0 (the default): lx_render_view draws perspective views only. */
+ * 0 (the default); an orthographic one ortho_height 2 x |ymag| (its xmag
+ * is not used either: the image's aspect sets the width). */
 lx_camera lx_camera_from_scene(const lx_scene_camera *camera);
 
 /* ---- lightmaps of a bake (manifest.json) ------------------------------ */

@@ -164,7 +164,7 @@ typedef struct lx_scene_sky {
  * 2.0, 3.10); eye, forward and up are that frame in world space. */
 typedef enum lx_scene_camera_type {
     LX_SCENE_CAMERA_PERSPECTIVE = 0,
-    LX_SCENE_CAMERA_ORTHOGRAPHIC /* read and listed; luxel render draws perspective only */
+    LX_SCENE_CAMERA_ORTHOGRAPHIC
 } lx_scene_camera_type;
 
 typedef struct lx_scene_camera {

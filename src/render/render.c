@@ -336,10 +336,14 @@ static void render_tile(const render_ctx *c, int tile, int tiles_x, lx_image *ou
                     ((float)(s / sx) + lx_random(d->seed, pixel, (uint32_t)s, 1)) / (float)sy;
                 float px = (2.0f * ((float)x + jx) * inv_w - 1.0f) * c->cam.tan_x;
                 float py = (1.0f - 2.0f * ((float)y + jy) * inv_h) * c->cam.tan_y;
-                lx_vec3 dir =
-                    lx_add(c->cam.fwd, lx_add(lx_scale(c->cam.right, px), lx_scale(c->cam.up, py)));
-                lx_ray r = {
-                    .origin = c->cam.eye, .tmin = 0.0f, .dir = lx_normalize(dir), .tmax = INFINITY};
+                lx_vec3 off = lx_add(lx_scale(c->cam.right, px), lx_scale(c->cam.up, py));
+                lx_ray r = {.origin = c->cam.eye, .tmin = 0.0f, .tmax = INFINITY};
+                if (c->cam.ortho) {
+                    r.origin = lx_add(c->cam.eye, off);
+                    r.dir = c->cam.fwd;
+                } else {
+                    r.dir = lx_normalize(lx_add(c->cam.fwd, off));
+                }
                 bool hit;
                 lx_vec3 L = shade(c, r, &hit);
                 hits += hit;

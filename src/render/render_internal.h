@@ -8,7 +8,9 @@
 
 typedef struct lx_camera_basis_t {
     lx_vec3 eye, fwd, right, up; /* orthonormal, right-handed */
-    float tan_x, tan_y;          /* half-extent of the image plane at depth 1 */
+    float tan_x, tan_y;          /* half-extent of the image plane at depth 1;
+                                    orthographic: of the image, in metres */
+    bool ortho;                  /* rays along fwd from the plane through eye */
 } lx_camera_basis_t;
 
 /* The basis of a checked camera (lx_camera_check) for a width x height image. */

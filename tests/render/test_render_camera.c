@@ -8,7 +8,9 @@
  * - lx_render_view's zeroed camera is lx_camera_auto's (same bytes);
  * - a render from a glTF file's camera equals, byte for byte, the render
  *   from the lx_camera written here from the node's matrix (entries 0 and
- *   +-1 and a translation, exact in float) and the yfov. */
+ *   +-1 and a translation, exact in float) and the yfov;
+ * - an orthographic glTF camera sees a floor at the size its ymag says,
+ *   and the same image from any height. */
 #define _POSIX_C_SOURCE 200809L
 #include <setjmp.h>
 #include <stdarg.h>
@@ -21,6 +23,7 @@
 #include "helpers.h"
 #include "luxel/render.h"
 
+#include <float.h>
 #include <math.h>
 #include <stdio.h>
 #include <stdlib.h>
@@ -204,6 +207,71 @@ static void test_gltf_camera_render(void **state)
     lx_scene_destroy(s);
 }
 
+/* An orthographic camera (ortho_height 8 m, square 32 x 32 image) straight
+ * above the 4 m floor: the floor covers exactly the middle 16 x 16 pixels
+ * (4 m of 8), and the image does not change with the height of the eye
+ * (parallel rays), to float rounding of where the rays start. */
+static void test_orthographic_render(void **state)
+{
+    (void)state;
+    const char *dir = lx_test_dir("render_camera_ortho");
+    static const float pos[] = {-2, 0, -2, -2, 0, 2, 2, 0, 2, 2, 0, -2};
+    static const float nrm[] = {0, 1, 0, 0, 1, 0, 0, 1, 0, 0, 1, 0};
+    static const float uv[] = {0, 0, 0, 1, 1, 1, 1, 0};
+    static const uint32_t idx[] = {0, 1, 2, 0, 2, 3};
+    lx_test_primitive p = {.vertex_count = 4, .position = pos, .normal = nrm, .uv0 = uv,
+                           .uv1 = uv, .index_count = 6, .indices = idx, .material = -1};
+    lx_test_gltf *g = lx_test_gltf_new();
+    lx_test_gltf_node(g, "floor", lx_test_gltf_mesh(g, "floor", &p, 1), "");
+    /* 90 degrees about X: local -Z looks down -Y, local +Y is -Z */
+    lx_test_gltf_node(g, "top", -1,
+                      "\"matrix\":[1,0,0,0, 0,0,-1,0, 0,1,0,0, 0,2,0,1],\"camera\":0");
+    lx_test_gltf_top(g, "\"cameras\":[{\"type\":\"orthographic\",\"orthographic\":"
+                        "{\"xmag\":4,\"ymag\":4,\"znear\":0,\"zfar\":10}}]");
+    char path[4096];
+    snprintf(path, sizeof path, "%s/floor.gltf", dir);
+    lx_test_gltf_write(g, path);
+    lx_test_gltf_free(g);
+    lx_scene *s;
+    if (lx_scene_load(path, NULL, &s) != LX_OK)
+        fail_msg("%s", lx_last_error());
+    assert_int_equal(s->camera_count, 1);
+    snprintf(path, sizeof path, "%s/floor.exr", dir);
+    write_page(path, 8, 8);
+    snprintf(path, sizeof path, "%s/manifest.json", dir);
+    write_text(path, "{\"scene\":\"floor.gltf\",\"quantity\":\"irradiance\",\"unit\":\"lx\","
+                     "\"pages\":[{\"file\":\"floor.exr\",\"width\":8,\"height\":8}],"
+                     "\"nodes\":[{\"node\":\"floor\",\"meshes\":[\"floor\"],\"page\":0,"
+                     "\"scale_offset\":[1,1,0,0],\"uv_set\":\"TEXCOORD_1\"}]}");
+    lx_lightmaps lm;
+    if (lx_lightmaps_load(dir, NULL, &lm) != LX_OK)
+        fail_msg("%s", lx_last_error());
+    float coverage[32 * 32];
+    lx_render_desc d = {.width = 32, .height = 32, .samples = 4, .coverage = coverage};
+    d.camera = lx_camera_from_scene(&s->cameras[0]);
+    assert_true(d.camera.ortho_height == 8.0f); /* 2 x ymag */
+    lx_image a, b;
+    assert_int_equal(lx_render_view(s, &lm, NULL, &d, &a), LX_OK);
+    for (int y = 0; y < 32; y++)
+        for (int x = 0; x < 32; x++) {
+            bool in = x >= 8 && x < 24 && y >= 8 && y < 24;
+            if (coverage[y * 32 + x] != (in ? 1.0f : 0.0f))
+                fail_msg("pixel (%d, %d): coverage %g", x, y, coverage[y * 32 + x]);
+        }
+    d.coverage = NULL;
+    d.camera = (lx_camera){.eye = {0, 5, 0}, .target = {0, 4, 0}, .up = {0, 0, -1},
+                           .ortho_height = 8.0f};
+    assert_int_equal(lx_render_view(s, &lm, NULL, &d, &b), LX_OK);
+    /* the same points seen: the same values (measured: identical bytes;
+     * a few ulps allowed for the barycentrics of rays that start apart) */
+    for (int i = 0; i < 32 * 32 * 3; i++)
+        assert_true(fabsf(a.data[i] - b.data[i]) <= 4.0f * FLT_EPSILON * fabsf(a.data[i]));
+    lx_image_free(&a);
+    lx_image_free(&b);
+    lx_lightmaps_free(&lm);
+    lx_scene_destroy(s);
+}
+
 int main(void)
 {
     const struct CMUnitTest tests[] = {
@@ -211,6 +279,7 @@ int main(void)
         cmocka_unit_test(test_closed_object_outside),
         cmocka_unit_test(test_default_render_is_auto),
         cmocka_unit_test(test_gltf_camera_render),
+        cmocka_unit_test(test_orthographic_render),
     };
     return cmocka_run_group_tests(tests, NULL, NULL);
 }

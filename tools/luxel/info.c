@@ -236,7 +236,7 @@ int cmd_info(int argc, char **argv)
         if (cam->type == LX_SCENE_CAMERA_PERSPECTIVE)
             printf("perspective, yfov %s deg", cli_num_digits(LX_RAD2DEG(cam->yfov), 4));
         else
-            printf("orthographic %s x %s m (not drawn by luxel render)",
+            printf("orthographic %s x %s m",
                    cli_num_digits(2.0 * cam->xmag, 4), cli_num_digits(2.0 * cam->ymag, 4));
         printf("  at (%s, %s, %s)", cli_num_digits(cam->eye.x, 4), cli_num_digits(cam->eye.y, 4),
                cli_num_digits(cam->eye.z, 4));

@@ -28,9 +28,9 @@ static const char *render_usage =
     "                          keep the linear radiance in nits\n"
     "  --camera E,T[,U]        eye and target points (and an up vector), 6 or 9\n"
     "                          comma-separated numbers in metres\n"
-    "  --gltf-camera N|NAME    a camera of the glTF file, by its number in\n"
-    "                          'luxel info' or its name (default: the first\n"
-    "                          perspective camera when the file has one)\n"
+    "  --gltf-camera N|NAME    a camera of the glTF file (perspective or\n"
+    "                          orthographic), by its number in 'luxel info' or\n"
+    "                          its name (default: the first, when it has one)\n"
     "  --view V                iso, front, back, left, right or top: framed on\n"
     "                          the scene's bounds (default without cameras: iso,\n"
     "                          or a view from inside when iso sees back faces)\n"
@@ -505,28 +505,18 @@ static int choose_camera(render_args *a, const lx_scene *scene, const lx_lightma
                       a->gltf_camera, list);
             return EXIT_USAGE;
         }
-        if (scene->cameras[pick].type != LX_SCENE_CAMERA_PERSPECTIVE) {
-            camera_label(label, sizeof label, scene, pick);
-            cli_error("%s: --gltf-camera %s: %s is orthographic; luxel render draws perspective "
-                      "views only",
-                      a->scene, a->gltf_camera, label);
-            return EXIT_USAGE;
-        }
-    } else {
-        for (uint32_t i = 0; i < scene->camera_count && pick == UINT32_MAX; i++)
-            if (scene->cameras[i].type == LX_SCENE_CAMERA_PERSPECTIVE)
-                pick = i;
-        if (scene->camera_count && pick == UINT32_MAX)
-            lx_log(LX_LOG_WARN,
-                   "%s: its %s orthographic and luxel render draws perspective views only: "
-                   "the default view instead",
-                   a->scene, scene->camera_count == 1 ? "camera is" : "cameras are");
+    } else if (scene->camera_count) {
+        pick = 0;
     }
     if (pick != UINT32_MAX) {
         const lx_scene_camera *c = &scene->cameras[pick];
         float fov = a->desc.camera.fov;
         a->desc.camera = lx_camera_from_scene(c);
-        if (a->has_fov)
+        bool ortho = c->type == LX_SCENE_CAMERA_ORTHOGRAPHIC;
+        if (a->has_fov && ortho)
+            lx_log(LX_LOG_WARN, "%s: --fov does not apply to an orthographic camera: ignored",
+                   a->scene);
+        else if (a->has_fov)
             a->desc.camera.fov = fov;
         if (lx_camera_check(&a->desc.camera) != LX_OK) {
             camera_label(label, sizeof label, scene, pick);
@@ -535,8 +525,15 @@ static int choose_camera(render_args *a, const lx_scene *scene, const lx_lightma
         }
         if (!a->quiet) {
             camera_label(label, sizeof label, scene, pick);
-            fprintf(stderr, "luxel: %s of %s, %s field of view %s degrees%s\n", label, a->scene,
-                    a->has_fov ? "--fov" : "its", cli_num_digits(LX_RAD2DEG(a->desc.camera.fov), 4),
+            char what[80];
+            if (ortho)
+                snprintf(what, sizeof what, "orthographic, %s m tall",
+                         cli_num_digits(a->desc.camera.ortho_height, 4));
+            else
+                snprintf(what, sizeof what, "%s field of view %s degrees",
+                         a->has_fov ? "--fov" : "its",
+                         cli_num_digits(LX_RAD2DEG(a->desc.camera.fov), 4));
+            fprintf(stderr, "luxel: %s of %s, %s%s\n", label, a->scene, what,
                     a->gltf_camera || scene->camera_count == 1 ? ""
                                                                : " (--gltf-camera picks another)");
         }
