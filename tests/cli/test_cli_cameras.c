@@ -7,7 +7,8 @@
  *   render from --camera with the eye, target and up worked out here from
  *   the node's matrix (entries 0 and +-1, exact) and --fov 40, the file's
  *   yfov being written as the float luxel makes of 40 degrees;
- * - --gltf-camera 1 equals --camera of camera 1's pose;
+ * - --gltf-camera 1 equals --camera of camera 1's pose; --fov replaces
+ *   the file's yfov;
  * - a bad index or name fails with status 2, one error line that counts
  *   and names the cameras, and no image; --gltf-camera with --view too;
  * - luxel info lists both cameras;
@@ -235,6 +236,18 @@ static void default_is_first_camera(void **state)
     expect_same_file(in_dir("default.png"), in_dir("manual0.png"));
 }
 
+/* --fov replaces the camera's yfov */
+static void fov_override(void **state)
+{
+    (void)state;
+    const char *with_fov[] = {"--gltf-camera", "Main", "--fov", "65", NULL};
+    render_ok("fov65.png", with_fov);
+    expect_in(err_log, "--fov field of view 65 degrees");
+    const char *manual[] = {"--camera", "-2.5,1.5,0.25,-1.5,1.5,0.25,0,1,0", "--fov", "65", NULL};
+    render_ok("manual65.png", manual);
+    expect_same_file(in_dir("fov65.png"), in_dir("manual65.png"));
+}
+
 static void second_camera(void **state)
 {
     (void)state;
@@ -333,12 +346,23 @@ static void no_camera_goes_inside(void **state)
     err = slurp(err_log, NULL);
     assert_null(strstr(err, "back faces"));
     free(err);
+    /* a camera asked of a file without any: status 2, one line */
+    const char *none[] = {"render", plain_gltf, "--lightmaps", plain_maps, "-o",
+                          in_dir("none.png"), "--gltf-camera", "0", NULL};
+    assert_int_equal(run(none), 2);
+    err = slurp(err_log, NULL);
+    if (!strstr(err, "plain.gltf: --gltf-camera 0: the scene has no cameras") ||
+        strchr(err, '\n')[1] != '\0')
+        fail_msg("'%s'", err);
+    free(err);
+    assert_int_equal(access(in_dir("none.png"), F_OK), -1);
 }
 
 int main(void)
 {
     const struct CMUnitTest tests[] = {
-        cmocka_unit_test(default_is_first_camera), cmocka_unit_test(second_camera),
+        cmocka_unit_test(default_is_first_camera), cmocka_unit_test(fov_override),
+        cmocka_unit_test(second_camera),
         cmocka_unit_test(bad_selection),           cmocka_unit_test(info_lists_cameras),
         cmocka_unit_test(no_camera_goes_inside),
     };

@@ -5,6 +5,8 @@
  *   every pixel of a render sees a front face (coverage 1, worked out
  *   here: the eye is inside a closed box);
  * - a closed object (faces out) keeps the iso framing, bit for bit;
+ * - a room with thick walls (faces in and out), black outside and lit
+ *   inside as a bake leaves it, is entered when the lightmaps are given;
  * - lx_render_view's zeroed camera is lx_camera_auto's (same bytes);
  * - a render from a glTF file's camera equals, byte for byte, the render
  *   from the lx_camera written here from the node's matrix (entries 0 and
@@ -105,6 +107,64 @@ static void test_closed_object_outside(void **state)
     lx_camera iso = lx_camera_frame(lx_v3(-3, 0, -2), lx_v3(3, 3, 2), LX_VIEW_ISO, fov, 2.0f);
     assert_memory_equal(&cam, &iso, sizeof cam);
     lx_tracer_destroy(tr);
+    lx_scene_destroy(s);
+}
+
+/* A room with thick walls: the inward box lit (its page a gradient), an
+ * outward box 0.2 m larger around it black (its page zeros), as a bake of
+ * a room lit from inside leaves them. Faces alone cannot tell it from a
+ * plain box; the lightmaps can: with them the camera goes inside, without
+ * them the iso view stays. */
+static void test_thick_walls(void **state)
+{
+    (void)state;
+    const char *dir = lx_test_dir("render_camera_thick");
+    char path[4096];
+    snprintf(path, sizeof path, "%s/inner.exr", dir);
+    write_page(path, 16, 16);
+    lx_image black;
+    assert_int_equal(lx_image_alloc(&black, 16, 16, 3), LX_OK);
+    memset(black.data, 0, sizeof(float) * 16 * 16 * 3);
+    snprintf(path, sizeof path, "%s/outer.exr", dir);
+    assert_int_equal(lx_image_write(path, &black, NULL), LX_OK);
+    lx_image_free(&black);
+    snprintf(path, sizeof path, "%s/manifest.json", dir);
+    write_text(path, "{\"scene\":\"thick\",\"quantity\":\"irradiance\",\"unit\":\"lx\","
+                     "\"pages\":[{\"file\":\"inner.exr\",\"width\":16,\"height\":16},"
+                     "{\"file\":\"outer.exr\",\"width\":16,\"height\":16}],"
+                     "\"nodes\":[{\"node\":\"inner\",\"meshes\":[\"inner\"],\"page\":0,"
+                     "\"scale_offset\":[1,1,0,0],\"uv_set\":\"TEXCOORD_1\"},"
+                     "{\"node\":\"outer\",\"meshes\":[\"outer\"],\"page\":1,"
+                     "\"scale_offset\":[1,1,0,0],\"uv_set\":\"TEXCOORD_1\"}]}");
+    lx_scene *s = lx_test_new_scene("thick");
+    lx_material mat = {.name = "white", .base_color = {0.8f, 0.8f, 0.8f, 1.0f},
+                       .normal_scale = 1.0f};
+    uint32_t mi;
+    assert_int_equal(lx_scene_add_material(s, &mat, &mi), LX_OK);
+    lx_mesh in = lx_test_box("inner", lx_v3(-3, 0, -2), lx_v3(3, 3, 2), true);
+    lx_mesh out = lx_test_box("outer", lx_v3(-3.2f, -0.2f, -2.2f), lx_v3(3.2f, 3.2f, 2.2f), false);
+    in.material = out.material = mi;
+    lx_test_add(s, &in);
+    lx_test_add(s, &out);
+    lx_test_mesh_free(&in);
+    lx_test_mesh_free(&out);
+    lx_lightmaps lm;
+    if (lx_lightmaps_load(dir, NULL, &lm) != LX_OK)
+        fail_msg("%s", lx_last_error());
+    lx_tracer *tr;
+    assert_int_equal(lx_tracer_create(s, NULL, &tr), LX_OK);
+    lx_camera cam;
+    lx_camera_auto_info info;
+    assert_int_equal(lx_camera_auto(s, &lm, tr, 0.0f, 16.0f / 9.0f, &cam, &info), LX_OK);
+    assert_true(info.outside_back == 0.0f);
+    assert_true(info.outside_unlit == 1.0f); /* all it meets is the black outside */
+    assert_true(info.moved && info.inside);
+    assert_true(cam.eye.x > -3 && cam.eye.x < 3 && cam.eye.y > 0 && cam.eye.y < 3 &&
+                cam.eye.z > -2 && cam.eye.z < 2);
+    assert_int_equal(lx_camera_auto(s, NULL, tr, 0.0f, 16.0f / 9.0f, &cam, &info), LX_OK);
+    assert_false(info.moved);
+    lx_tracer_destroy(tr);
+    lx_lightmaps_free(&lm);
     lx_scene_destroy(s);
 }
 
@@ -277,6 +337,7 @@ int main(void)
     const struct CMUnitTest tests[] = {
         cmocka_unit_test(test_closed_room_inside),
         cmocka_unit_test(test_closed_object_outside),
+        cmocka_unit_test(test_thick_walls),
         cmocka_unit_test(test_default_render_is_auto),
         cmocka_unit_test(test_gltf_camera_render),
         cmocka_unit_test(test_orthographic_render),

@@ -314,6 +314,42 @@ static void test_bad_cameras(void **state)
                     "zero scale");
 }
 
+/* lx_scene_add_camera: copies, names the unnamed, refuses bad frames,
+ * angles and taken names with a message naming the scene */
+static void test_add_camera(void **state)
+{
+    (void)state;
+    lx_scene *s = lx_test_new_scene("built");
+    lx_scene_camera c = {.eye = {1, 2, 3}, .forward = {0, 0, -1}, .up = {0, 1, 0},
+                         .yfov = 0.9f, .source_camera = -1, .source_node = -1};
+    assert_int_equal(lx_scene_add_camera(s, &c), LX_OK);
+    assert_string_equal(s->cameras[0].name, "camera0");
+    assert_null(s->cameras[0].node_name);
+    char name[] = "Hall";
+    c.name = name;
+    assert_int_equal(lx_scene_add_camera(s, &c), LX_OK);
+    name[0] = 'X'; /* copied */
+    assert_string_equal(s->cameras[1].name, "Hall");
+    c.name = "Hall";
+    assert_int_equal(lx_scene_add_camera(s, &c), LX_ERR_INVALID);
+    assert_non_null(strstr(lx_last_error(), "'Hall' is taken"));
+    c.name = "bad";
+    c.yfov = 0.0f;
+    assert_int_equal(lx_scene_add_camera(s, &c), LX_ERR_INVALID);
+    assert_non_null(strstr(lx_last_error(), "built: camera 'bad': yfov 0"));
+    c.yfov = 0.9f;
+    c.up = lx_v3(0, 0, -1); /* along forward */
+    assert_int_equal(lx_scene_add_camera(s, &c), LX_ERR_INVALID);
+    c.up = lx_v3(0, 1, 0);
+    c.eye.x = NAN;
+    assert_int_equal(lx_scene_add_camera(s, &c), LX_ERR_INVALID);
+    c.eye.x = 0.0f;
+    c.type = LX_SCENE_CAMERA_ORTHOGRAPHIC; /* xmag, ymag 0 */
+    assert_int_equal(lx_scene_add_camera(s, &c), LX_ERR_INVALID);
+    assert_int_equal(s->camera_count, 2);
+    lx_scene_destroy(s);
+}
+
 int main(void)
 {
     const struct CMUnitTest tests[] = {
@@ -321,6 +357,7 @@ int main(void)
         cmocka_unit_test(test_orthographic),
         cmocka_unit_test(test_bad_cameras),
         cmocka_unit_test(test_missing_camera),
+        cmocka_unit_test(test_add_camera),
     };
     return cmocka_run_group_tests(tests, NULL, NULL);
 }

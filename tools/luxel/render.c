@@ -478,7 +478,7 @@ static void camera_list(char *buf, size_t size, const lx_scene *scene)
 }
 
 /* Places a->desc.camera unless --camera did: --view's framing, the glTF
- * camera --gltf-camera names or else the file's first perspective camera,
+ * camera --gltf-camera names or else the file's first camera,
  * or lx_camera_auto. Says which on stderr (unless quiet). */
 static int choose_camera(render_args *a, const lx_scene *scene, const lx_lightmaps *lm,
                          const lx_tracer *tracer)
