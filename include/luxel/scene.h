@@ -218,11 +218,14 @@ lx_scene_load_desc lx_scene_load_desc_defaults(const lx_scene_load_desc *desc);
  * Other names fail with LX_ERR_UNSUPPORTED. desc may be NULL.
  * glTF cameras placed by the default scene's nodes become scene->cameras
  * (perspective and orthographic; world transforms of the nodes). A camera
- * that cannot be used - a yfov that is not a finite angle in (0, pi), a
- * node naming a camera the file lacks, a transform with no -Z or +Y axis
- * (zero scale) - is left out with one warning through lx_log naming the
- * file and the camera or node; it never fails the load. Camera fields
- * luxel does not read (extras, extensions) are ignored.
+ * that cannot be used - a yfov that is not a finite angle in (0, pi) or
+ * missing, an orthographic xmag or ymag of 0, a node transform with no -Z
+ * or +Y axis (zero scale) - is left out with one warning through lx_log
+ * naming the file and the camera or node, and does not fail the load; a
+ * camera of an unknown type or without its parameters object and a node
+ * naming a camera the file lacks fail it (LX_ERR_FORMAT, naming the
+ * camera or node: assimp refuses such files). Camera fields luxel does
+ * not read (extras, extensions) are ignored.
  * glTF extensions: KHR_mesh_quantization, EXT_meshopt_compression (decoded
  * by luxel before assimp reads the file), KHR_texture_transform,
  * KHR_materials_emissive_strength and KHR_lights_punctual are read; a file

@@ -5,7 +5,7 @@
  * rotation formula v' = v + 2w (q x v) + 2 q x (q x v), in double,
  * independently of the library's matrices; extra fields and extensions
  * ignored; and bad cameras (yfov 0, above pi, out of float range, missing,
- * zero scale) left out with one warning each naming the file, the load
+ * an orthographic xmag of 0, zero scale) left out with one warning each naming the file, the load
  * still succeeding; a node naming a camera the file lacks, an unknown type
  * or missing parameters fail the load with one line naming the file and
  * the node or camera. */
@@ -308,6 +308,10 @@ static void test_bad_cameras(void **state)
                     "\"cameras\":[" GOOD ",{\"type\":\"perspective\",\"perspective\":"
                     "{\"znear\":0.1}}]",
                     "no yfov");
+    expect_left_out("ortho0.gltf", "\"camera\":1",
+                    "\"cameras\":[" GOOD ",{\"type\":\"orthographic\",\"orthographic\":"
+                    "{\"xmag\":0,\"ymag\":1,\"znear\":0,\"zfar\":5}}]",
+                    "xmag and ymag must be finite numbers other than 0");
     expect_left_out("zeroscale.gltf", "\"scale\":[0,0,0],\"camera\":0", "\"cameras\":[" GOOD "]",
                     "zero scale");
     expect_left_out("flat.gltf", "\"scale\":[1,0,1],\"camera\":0", "\"cameras\":[" GOOD "]",
