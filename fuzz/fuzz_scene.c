@@ -1,7 +1,8 @@
 /* libFuzzer harness for scene import: the bytes become a .glb, .gltf,
  * .obj, .dae, .fbx, .ply or .stl file (chosen by the first byte) loaded
  * through lx_scene_load, which runs assimp plus luxel's own validation,
- * its glTF rewrite (meshopt, quantization) and KHR_lights_punctual reader. */
+ * its glTF rewrite (meshopt, quantization), KHR_lights_punctual and camera
+ * readers (fuzz/corpus/scene/cameras.gltf seeds the cameras). */
 #define _POSIX_C_SOURCE 200809L
 #include "luxel/scene.h"
 

@@ -37,7 +37,7 @@
  *   if (lx_scene_load("room.glb", NULL, &scene) != LX_OK) return 1;
  *   if (lx_lightmaps_load("lightmaps/room", NULL, &lm) == LX_OK) {
  *       lx_image img;
- *       lx_render_desc d = lx_render_desc_defaults(NULL); // 1280x720, iso framing
+ *       lx_render_desc d = lx_render_desc_defaults(NULL); // 1280x720, lx_camera_auto
  *       if (lx_render_view(scene, &lm, NULL, &d, &img) == LX_OK) {
  *           lx_image_write_desc w = {.tonemap = LX_TONEMAP_ACES,
  *                                    .exposure = lx_exposure_from_ev100(lm.preview_ev100)};
@@ -70,6 +70,9 @@ typedef struct lx_camera {
     lx_vec3 up;     /* roughly up in the image; zero = +Y (-Z looking straight
                        up or down) */
     float fov;      /* vertical field of view in radians, 0 = 50 degrees */
+    float ortho_height; /* > 0: an orthographic camera whose image is this many
+                           metres tall (rays parallel to the view, starting in
+                           the plane through eye; fov unused); 0 = perspective */
 } lx_camera;
 
 #define LX_RENDER_DEFAULT_FOV_DEGREES 50.0f
@@ -101,8 +104,17 @@ lx_camera lx_camera_frame(lx_vec3 lo, lx_vec3 hi, lx_view view, float fov, float
 bool lx_camera_project(const lx_camera *cam, int width, int height, lx_vec3 p, float *x, float *y);
 
 /* LX_OK when the camera can make an image: finite, eye != target, up not
- * along the view, fov in (0, pi). The message names the problem. */
+ * along the view, fov in (0, pi), ortho_height >= 0. The message names
+ * the problem. */
 lx_status lx_camera_check(const lx_camera *cam);
+
+/* The view of a camera the scene file placed (scene.h, lx_scene_camera):
+ * eye, target eye + forward, its up and its yfov. The file's aspectRatio
+ * is not used: the image's width / height is (as glTF asks of a renderer
+ * whose viewport differs). An orthographic camera gives its frame with fov
+ * 0 (the default); an orthographic one ortho_height 2 x |ymag| (its xmag
+ * is not used either: the image's aspect sets the width). */
+lx_camera lx_camera_from_scene(const lx_scene_camera *camera);
 
 /* ---- lightmaps of a bake (manifest.json) ------------------------------ */
 
@@ -179,6 +191,46 @@ void lx_lightmaps_free(lx_lightmaps *lm);
  * in scene.glb: the lightmaps of another scene?". */
 lx_status lx_lightmaps_check(const lx_lightmaps *lm, const lx_scene *scene);
 
+/* ---- the default camera ---------------------------------------------- */
+
+/* What lx_camera_auto saw and chose. */
+typedef struct lx_camera_auto_info {
+    float outside_hit;   /* fraction of the iso view's probes that meet the scene */
+    float outside_back;  /* of those, the fraction whose first surface is a back face */
+    float outside_unlit; /* ... and the fraction on a front face that is not lit */
+    float outside_score; /* fraction of the iso view's probes on a lit front face */
+    bool moved;          /* another view was taken */
+    bool inside;         /* ... from inside the bounds (else a side's framing) */
+    float score;         /* the taken view's fraction of probes on a lit front face */
+    char placement[48];  /* "iso", "front", "back", "left", "right" or
+                            "inside, looking along +X" (-X, +Z, -Z) */
+} lx_camera_auto_info;
+
+/* The default camera of a scene that brings none. Starts from
+ * lx_camera_frame(..., LX_VIEW_ISO, ...) of the bounds and probes it with a
+ * grid of 18 rows of rays (as many columns as the aspect asks, at most
+ * 64) through tracer (made from scene): a probe scores when the first
+ * surface it meets, either face, is a front face that is lit - lit judged
+ * with lm by a 1-sample render of the same grid (luminance above 1% of
+ * the brightest probed view's median); lm NULL, or every view black:
+ * front faces only. The framings from the front, back, left and right
+ * (lx_camera_frame), then four views from inside the bounds (eye at 55%
+ * of the height, 15% in from one end of a horizontal axis, looking along
+ * it; the longer axis first) are probed the same way (a hit nearer than 2%
+ * of the bounds' diagonal scores nothing) when less than half of the
+ * probes that meet the scene score in the iso view. Of the side framings
+ * in which at least half of what the probes meet scores, the one with the
+ * most scoring probes is taken; when there is none, of the inside views
+ * so; when there is none either, the iso view stays: a closed room seen from
+ * outside shows the back faces of walls that face in, or the unlit
+ * outside of walls with two sides; a box open on one side is seen
+ * through it. Deterministic: the same scene and lightmaps give the same
+ * camera. tracer NULL: the iso framing unchecked. fov radians (0 = 50
+ * degrees), aspect width / height (0 = 16/9). info may be NULL.
+ * LX_ERR_INVALID for an empty scene; lx_render_view's errors for lm. */
+lx_status lx_camera_auto(const lx_scene *scene, const lx_lightmaps *lm, const lx_tracer *tracer,
+                         float fov, float aspect, lx_camera *out, lx_camera_auto_info *info);
+
 /* ---- rendering -------------------------------------------------------- */
 
 typedef enum lx_lightmap_filter {
@@ -188,8 +240,10 @@ typedef enum lx_lightmap_filter {
 
 typedef struct lx_render_desc {
     int width, height;         /* pixels, 0 = 1280 x 720 */
-    lx_camera camera;          /* eye == target (zeroed): lx_camera_frame of the
-                                  scene's bounds, LX_VIEW_ISO, at camera.fov */
+    lx_camera camera;          /* eye == target (zeroed): lx_camera_auto (the iso
+                                  framing of the scene's bounds, or a view
+                                  from inside when that sees back faces), at
+                                  camera.fov */
     int samples;               /* per pixel, 1..4096, 0 = 4 */
     lx_lightmap_filter filter; /* lightmap lookups */
     bool two_sided;            /* false: back faces are culled (rays go through) */

@@ -159,6 +159,30 @@ typedef struct lx_scene_sky {
     uint32_t samples; /* 1..LX_MAX_SKY_SAMPLES, 0 = the baker's default */
 } lx_scene_sky;
 
+/* A camera a scene file places (glTF "cameras" and the nodes that refer
+ * to them). It looks down its node's local -Z with local +Y up (glTF
+ * 2.0, 3.10); eye, forward and up are that frame in world space. */
+typedef enum lx_scene_camera_type {
+    LX_SCENE_CAMERA_PERSPECTIVE = 0,
+    LX_SCENE_CAMERA_ORTHOGRAPHIC
+} lx_scene_camera_type;
+
+typedef struct lx_scene_camera {
+    char *name;      /* the glTF camera's name, else its node's, else "camera<N>";
+                        unique within the scene (repeats get "_2", "_3"...) */
+    char *node_name; /* the node that places it, or NULL when unnamed */
+    int32_t source_camera, source_node; /* glTF indices, -1 when not glTF */
+    lx_scene_camera_type type;
+    lx_vec3 eye;     /* world position */
+    lx_vec3 forward; /* unit world direction of local -Z */
+    lx_vec3 up;      /* unit, orthogonal to forward: local +Y made so */
+    float yfov;      /* perspective: vertical field of view, radians, in (0, pi) */
+    float aspect;    /* width / height the file states, 0 = none (a renderer
+                        uses its image's) */
+    float znear, zfar; /* metres; zfar 0 = infinite */
+    float xmag, ymag;  /* orthographic: half width and height, metres */
+} lx_scene_camera;
+
 typedef struct lx_scene {
     char *path; /* file the scene came from, or a given name */
     lx_mesh *meshes;
@@ -173,6 +197,8 @@ typedef struct lx_scene {
     lx_scene_sky sky;          /* from the lights JSON; loading it is the caller's */
     lx_ies_profile **profiles; /* photometric profiles the lights point to */
     uint32_t profile_count;
+    lx_scene_camera *cameras; /* the file's cameras, in glTF node order */
+    uint32_t camera_count;
 } lx_scene;
 
 typedef struct lx_scene_load_desc {
@@ -190,6 +216,16 @@ lx_scene_load_desc lx_scene_load_desc_defaults(const lx_scene_load_desc *desc);
  * KHR_lights_punctual lights of glTF files (other formats' lights are not
  * read: one warning when a file has some; the lights JSON adds them).
  * Other names fail with LX_ERR_UNSUPPORTED. desc may be NULL.
+ * glTF cameras placed by the default scene's nodes become scene->cameras
+ * (perspective and orthographic; world transforms of the nodes). A camera
+ * that cannot be used - a yfov that is not a finite angle in (0, pi) or
+ * missing, an orthographic xmag or ymag of 0, a node transform with no -Z
+ * or +Y axis (zero scale) - is left out with one warning through lx_log
+ * naming the file and the camera or node, and does not fail the load; a
+ * camera of an unknown type or without its parameters object and a node
+ * naming a camera the file lacks fail it (LX_ERR_FORMAT, naming the
+ * camera or node: assimp refuses such files). Camera fields luxel does
+ * not read (extras, extensions) are ignored.
  * glTF extensions: KHR_mesh_quantization, EXT_meshopt_compression (decoded
  * by luxel before assimp reads the file), KHR_texture_transform,
  * KHR_materials_emissive_strength and KHR_lights_punctual are read; a file
@@ -223,6 +259,12 @@ lx_status lx_scene_adopt_profile(lx_scene *scene, lx_ies_profile *profile);
 /* Adds a copy of light after validating it; a light whose name matches an
  * existing light's replaces it. */
 lx_status lx_scene_add_light(lx_scene *scene, const lx_light *light);
+
+/* Adds a copy of camera (names copied) after checking it: finite, forward
+ * and up unit and orthogonal (within 1e-3), a perspective yfov in (0, pi),
+ * an orthographic xmag and ymag not 0. A NULL or empty name becomes
+ * "camera<N>"; a name already taken fails (LX_ERR_INVALID). */
+lx_status lx_scene_add_camera(lx_scene *scene, const lx_scene_camera *camera);
 
 /* True when triangle abc has negligible area next to its edges (its normal
  * cannot be trusted). */

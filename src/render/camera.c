@@ -39,8 +39,11 @@ static lx_vec3 up_hint(lx_vec3 fwd, lx_vec3 up)
 lx_status lx_camera_check(const lx_camera *cam)
 {
     if (!lx_vec3_finite(cam->eye) || !lx_vec3_finite(cam->target) || !lx_vec3_finite(cam->up) ||
-        !isfinite(cam->fov))
+        !isfinite(cam->fov) || !isfinite(cam->ortho_height))
         return lx_fail(LX_ERR_INVALID, "camera: eye, target, up and fov must be finite");
+    if (cam->ortho_height < 0.0f)
+        return lx_fail(LX_ERR_INVALID, "camera: ortho_height %g is negative",
+                       (double)cam->ortho_height);
     float fov = camera_fov(cam);
     if (fov >= LX_PI)
         return lx_fail(LX_ERR_INVALID,
@@ -64,7 +67,8 @@ void lx_camera_basis(const lx_camera *cam, int width, int height, lx_camera_basi
     b->fwd = lx_normalize(lx_sub(cam->target, cam->eye));
     b->right = lx_normalize(lx_cross(b->fwd, lx_normalize(up_hint(b->fwd, cam->up))));
     b->up = lx_cross(b->right, b->fwd);
-    b->tan_y = tanf(0.5f * camera_fov(cam));
+    b->ortho = cam->ortho_height > 0.0f;
+    b->tan_y = b->ortho ? 0.5f * cam->ortho_height : tanf(0.5f * camera_fov(cam));
     b->tan_x = b->tan_y * (float)width / (float)height;
 }
 
@@ -76,6 +80,8 @@ bool lx_camera_project(const lx_camera *cam, int width, int height, lx_vec3 p, f
     float z = lx_dot(r, b.fwd);
     if (!(z > 0.0f))
         return false;
+    if (b.ortho)
+        z = 1.0f;
     *x = 0.5f * (float)width * (1.0f + lx_dot(r, b.right) / (z * b.tan_x));
     *y = 0.5f * (float)height * (1.0f - lx_dot(r, b.up) / (z * b.tan_y));
     return true;
@@ -125,5 +131,15 @@ lx_camera lx_camera_frame(lx_vec3 lo, lx_vec3 hi, lx_view view, float fov, float
     cam.target = lx_add(c, lx_add(lx_scale(b.right, (float)sx), lx_scale(b.up, (float)sy)));
     cam.eye = lx_sub(cam.target, lx_scale(b.fwd, (float)dist));
     cam.up = b.up;
+    return cam;
+}
+
+lx_camera lx_camera_from_scene(const lx_scene_camera *sc)
+{
+    lx_camera cam = {.eye = sc->eye, .target = lx_add(sc->eye, sc->forward), .up = sc->up};
+    if (sc->type == LX_SCENE_CAMERA_PERSPECTIVE)
+        cam.fov = sc->yfov;
+    else
+        cam.ortho_height = 2.0f * fabsf(sc->ymag);
     return cam;
 }

@@ -336,10 +336,14 @@ static void render_tile(const render_ctx *c, int tile, int tiles_x, lx_image *ou
                     ((float)(s / sx) + lx_random(d->seed, pixel, (uint32_t)s, 1)) / (float)sy;
                 float px = (2.0f * ((float)x + jx) * inv_w - 1.0f) * c->cam.tan_x;
                 float py = (1.0f - 2.0f * ((float)y + jy) * inv_h) * c->cam.tan_y;
-                lx_vec3 dir =
-                    lx_add(c->cam.fwd, lx_add(lx_scale(c->cam.right, px), lx_scale(c->cam.up, py)));
-                lx_ray r = {
-                    .origin = c->cam.eye, .tmin = 0.0f, .dir = lx_normalize(dir), .tmax = INFINITY};
+                lx_vec3 off = lx_add(lx_scale(c->cam.right, px), lx_scale(c->cam.up, py));
+                lx_ray r = {.origin = c->cam.eye, .tmin = 0.0f, .tmax = INFINITY};
+                if (c->cam.ortho) {
+                    r.origin = lx_add(c->cam.eye, off);
+                    r.dir = c->cam.fwd;
+                } else {
+                    r.dir = lx_normalize(lx_add(c->cam.fwd, off));
+                }
                 bool hit;
                 lx_vec3 L = shade(c, r, &hit);
                 hits += hit;
@@ -377,6 +381,13 @@ static lx_status check_desc(const lx_render_desc *d)
 lx_status lx_render_view(const lx_scene *scene, const lx_lightmaps *lm, const lx_tracer *tracer,
                          const lx_render_desc *desc, lx_image *out)
 {
+    return lx_render_view_quiet(scene, lm, tracer, desc, out, false);
+}
+
+lx_status lx_render_view_quiet(const lx_scene *scene, const lx_lightmaps *lm,
+                               const lx_tracer *tracer, const lx_render_desc *desc, lx_image *out,
+                               bool quiet)
+{
     memset(out, 0, sizeof *out);
     lx_render_desc d = lx_render_desc_defaults(desc);
     lx_status st = check_desc(&d);
@@ -395,17 +406,16 @@ lx_status lx_render_view(const lx_scene *scene, const lx_lightmaps *lm, const lx
             return lx_fail(LX_ERR_INVALID,
                            "render: lightmap node '%s': page or UV set out of range",
                            lm->nodes[n].name);
-    if (d.camera.eye.x == d.camera.target.x && d.camera.eye.y == d.camera.target.y &&
-        d.camera.eye.z == d.camera.target.z) {
+    bool frame = d.camera.eye.x == d.camera.target.x && d.camera.eye.y == d.camera.target.y &&
+                 d.camera.eye.z == d.camera.target.z;
+    if (frame) {
         lx_vec3 lo, hi;
         if (!lx_scene_bounds(scene, &lo, &hi))
             return lx_fail(LX_ERR_INVALID, "%s: the scene is empty: nothing to frame",
                            scene->path ? scene->path : "render");
-        d.camera =
-            lx_camera_frame(lo, hi, LX_VIEW_ISO, d.camera.fov, (float)d.width / (float)d.height);
-    }
-    if ((st = lx_camera_check(&d.camera)) != LX_OK)
+    } else if ((st = lx_camera_check(&d.camera)) != LX_OK) {
         return st;
+    }
 
     uint32_t nn = scene->node_count;
     uint32_t *map = malloc((nn ? nn : 1) * sizeof *map);
@@ -421,7 +431,7 @@ lx_status lx_render_view(const lx_scene *scene, const lx_lightmaps *lm, const lx
         det_sign[n] = lx_mat4_det3(&scene->nodes[n].world) < 0.0f ? -1.0f : 1.0f;
         unlit += map[n] == UINT32_MAX && scene->nodes[n].mesh_count > 0;
     }
-    if (st == LX_OK && unlit)
+    if (st == LX_OK && unlit && !quiet)
         lx_log(LX_LOG_WARN, "%s: %u nodes have no lightmap and are drawn black",
                scene->path ? scene->path : "render", unlit);
     lx_tracer *own = NULL;
@@ -429,6 +439,13 @@ lx_status lx_render_view(const lx_scene *scene, const lx_lightmaps *lm, const lx
         lx_tracer_desc td = {.threads = d.threads};
         if ((st = lx_tracer_create(scene, &td, &own)) == LX_OK)
             tracer = own;
+    }
+    /* the default camera is probed through the tracer */
+    if (st == LX_OK && frame) {
+        st = lx_camera_auto(scene, lm, tracer, d.camera.fov, (float)d.width / (float)d.height,
+                            &d.camera, NULL);
+        if (st == LX_OK)
+            st = lx_camera_check(&d.camera);
     }
     if (st == LX_OK)
         st = lx_image_alloc(out, d.width, d.height, 3);

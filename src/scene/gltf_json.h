@@ -42,10 +42,40 @@ bool lx_gltf_index(const cJSON *item, size_t count, size_t *out);
 /* "node 3 ('Lamp')" for messages. */
 void lx_gltf_label(char *buf, size_t size, const char *what, size_t index, const cJSON *obj);
 
+/* ---- the node hierarchy (gltf_nodes.c) ---------------------------------- */
+
+typedef struct lx_gltf_graph {
+    size_t count;
+    const cJSON **nodes; /* count */
+    int64_t *parent;     /* -1 for roots */
+    lx_mat4 *world;
+    bool *included; /* in the scene being loaded (lx_gltf_graph_select) */
+    size_t *order;  /* nodes parents first; reached entries */
+    size_t reached;
+} lx_gltf_graph;
+
+/* Checks "nodes" and their children and computes every world matrix;
+ * fails naming the node (a malformed transform, a cycle...). Free g with
+ * lx_gltf_graph_free, also after a failure. */
+lx_status lx_gltf_graph_build(const char *file, const cJSON *root, lx_gltf_graph *g);
+/* Marks the nodes of the default scene ("scene", else scenes[0]), or every
+ * node when the file has no scenes. */
+lx_status lx_gltf_graph_select(const char *file, const cJSON *root, lx_gltf_graph *g);
+void lx_gltf_graph_free(lx_gltf_graph *g);
+
 /* ---- readers -------------------------------------------------------------- */
 
 /* KHR_lights_punctual from a parsed glTF (gltf_lights.c). */
 lx_status lx_gltf_lights_from_json(lx_scene *scene, const char *file, const cJSON *root);
+
+/* glTF cameras placed by the default scene's nodes (gltf_cameras.c); bad
+ * ones are left out with a warning, never failing the load. */
+lx_status lx_gltf_cameras_from_json(lx_scene *scene, const char *file, const cJSON *root);
+/* Fails (LX_ERR_FORMAT, naming the camera or node) when a camera is not
+ * an object with a known type and its parameters object, or a node's
+ * "camera" is not an index into "cameras": assimp refuses such files with
+ * a message that names neither, so this is checked before it reads one. */
+lx_status lx_gltf_check_cameras(const char *file, const cJSON *root);
 
 /* What the JSON says about one texture of a material (gltf_textures.c). */
 typedef struct lx_gltf_texture_ref {

@@ -1375,6 +1375,8 @@ static lx_status import_scene(const char *path, const import_source *src,
     }
     if (st == LX_OK && gltf)
         st = lx_gltf_lights_from_json(c.scene, path, gltf);
+    if (st == LX_OK && gltf)
+        st = lx_gltf_cameras_from_json(c.scene, path, gltf);
     else if (st == LX_OK && ai->mNumLights)
         lx_log(LX_LOG_WARN,
                "%s: %u lights left out: luxel reads lights from glTF files only (give them with "
@@ -1458,6 +1460,8 @@ lx_status lx_scene_load(const char *path, const lx_scene_load_desc *in, lx_scene
             st = lx_gltf_check_required(path, gltf);
         if (st == LX_OK)
             st = lx_gltf_check_lfs(path, gltf);
+        if (st == LX_OK && lx_gltf_is_v2(gltf))
+            st = lx_gltf_check_cameras(path, gltf);
         if (st == LX_OK && lx_gltf_is_v2(gltf))
             st = lx_gltf_rewrite(path, gltf, &glb, &glb_size);
         /* assimp tells GLB from glTF text by the name */

@@ -3,6 +3,7 @@
 #include "luxel/scene.h"
 #include "core/internal.h"
 
+#include <math.h>
 #include <stddef.h>
 #include <stdio.h>
 #include <stdlib.h>
@@ -13,6 +14,7 @@
 typedef struct scene_store {
     lx_scene scene;
     uint32_t mesh_capacity, material_capacity, node_capacity, light_capacity, profile_capacity;
+    uint32_t camera_capacity;
 } scene_store;
 
 static scene_store *store_of(lx_scene *s)
@@ -93,6 +95,11 @@ void lx_scene_destroy(lx_scene *s)
         lx_ies_free(s->profiles[i]);
     free(s->profiles);
     free(s->lights);
+    for (uint32_t i = 0; i < s->camera_count; i++) {
+        free(s->cameras[i].name);
+        free(s->cameras[i].node_name);
+    }
+    free(s->cameras);
     free(s->sky.environment);
     free(s->path);
     free(store_of(s));
@@ -335,6 +342,49 @@ lx_status lx_scene_add_light(lx_scene *s, const lx_light *light)
     if (st != LX_OK)
         return st;
     s->lights[s->light_count++] = *light;
+    return LX_OK;
+}
+
+lx_status lx_scene_add_camera(lx_scene *s, const lx_scene_camera *camera)
+{
+    const lx_scene_camera *c = camera;
+    const char *who = c->name && c->name[0] ? c->name : "(unnamed)";
+    if (!lx_vec3_finite(c->eye) || !lx_vec3_finite(c->forward) || !lx_vec3_finite(c->up) ||
+        !isfinite(c->yfov) || !isfinite(c->aspect) || !isfinite(c->znear) ||
+        !isfinite(c->zfar) || !isfinite(c->xmag) || !isfinite(c->ymag))
+        return lx_fail(LX_ERR_INVALID, "%s: camera '%s': a value is not finite", s->path, who);
+    if (fabsf(lx_length(c->forward) - 1.0f) > 1e-3f || fabsf(lx_length(c->up) - 1.0f) > 1e-3f ||
+        fabsf(lx_dot(c->forward, c->up)) > 1e-3f)
+        return lx_fail(LX_ERR_INVALID,
+                       "%s: camera '%s': forward and up must be unit and orthogonal", s->path, who);
+    if (c->type == LX_SCENE_CAMERA_PERSPECTIVE && !(c->yfov > 0.0f && c->yfov < LX_PI))
+        return lx_fail(LX_ERR_INVALID, "%s: camera '%s': yfov %g is not in (0, pi)", s->path, who,
+                       (double)c->yfov);
+    if (c->type == LX_SCENE_CAMERA_ORTHOGRAPHIC && (c->xmag == 0.0f || c->ymag == 0.0f))
+        return lx_fail(LX_ERR_INVALID, "%s: camera '%s': xmag and ymag must not be 0", s->path,
+                       who);
+    if (c->type != LX_SCENE_CAMERA_PERSPECTIVE && c->type != LX_SCENE_CAMERA_ORTHOGRAPHIC)
+        return lx_fail(LX_ERR_INVALID, "%s: camera '%s': unknown type %d", s->path, who,
+                       (int)c->type);
+    char fallback[32];
+    snprintf(fallback, sizeof fallback, "camera%u", s->camera_count);
+    const char *name = c->name && c->name[0] ? c->name : fallback;
+    for (uint32_t i = 0; i < s->camera_count; i++)
+        if (strcmp(s->cameras[i].name, name) == 0)
+            return lx_fail(LX_ERR_INVALID, "%s: camera name '%s' is taken", s->path, name);
+    lx_status st = grow((void **)&s->cameras, &store_of(s)->camera_capacity, s->camera_count,
+                        sizeof(lx_scene_camera), "cameras");
+    if (st != LX_OK)
+        return st;
+    lx_scene_camera copy = *c;
+    copy.name = lx_strdup(name);
+    copy.node_name = c->node_name ? lx_strdup(c->node_name) : NULL;
+    if (!copy.name || (c->node_name && !copy.node_name)) {
+        free(copy.name);
+        free(copy.node_name);
+        return lx_fail(LX_ERR_NOMEM, "out of memory adding a camera");
+    }
+    s->cameras[s->camera_count++] = copy;
     return LX_OK;
 }
 

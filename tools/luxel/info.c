@@ -1,6 +1,6 @@
 /* luxel info: what a scene holds, as luxel sees it after import: meshes
  * with their triangles and UV sets, materials, nodes, lights with their
- * physical units, and bounds. */
+ * physical units, cameras, and bounds. */
 #define _POSIX_C_SOURCE 200809L
 #include "cli.h"
 
@@ -12,12 +12,12 @@ static const char *info_usage =
     "usage: luxel info SCENE [options]\n"
     "\n"
     "Lists the meshes (triangles, UV sets), materials, nodes, lights (type and\n"
-    "physical units), the sky and bounds of a glTF 2.0 or OBJ scene, and the\n"
-    "health of every mesh's UV sets as lightmap UVs: their range, the share of\n"
-    "covered texels two triangles overlap at --resolution, zero-area and\n"
-    "flipped triangles, and whether luxel bake would use them (--unwrap auto\n"
-    "makes new ones when not). Zero-area triangles in space are dropped with a\n"
-    "warning.\n"
+    "physical units), cameras, the sky and bounds of a glTF 2.0 or OBJ scene,\n"
+    "and the health of every mesh's UV sets as lightmap UVs: their range, the\n"
+    "share of covered texels two triangles overlap at --resolution, zero-area\n"
+    "and flipped triangles, and whether luxel bake would use them (--unwrap\n"
+    "auto makes new ones when not). Zero-area triangles in space are dropped\n"
+    "with a warning.\n"
     "\n"
     "options:\n"
     "  --lights FILE.json   apply a lights file first (docs/lights-json.md)\n"
@@ -227,6 +227,26 @@ int cmd_info(int argc, char **argv)
                    "%s: spot light '%s' has a cone of %.3g degrees from its axis: radians "
                    "typed as degrees? (lights files give angles in degrees)",
                    path, l->name[0] ? l->name : "-", LX_RAD2DEG(l->outer_angle));
+    }
+    if (s->camera_count)
+        printf("cameras: %u (luxel render --gltf-camera N|NAME)\n", s->camera_count);
+    for (uint32_t i = 0; i < s->camera_count; i++) {
+        const lx_scene_camera *cam = &s->cameras[i];
+        printf("  %-3u %-20s ", i, cam->name);
+        if (cam->type == LX_SCENE_CAMERA_PERSPECTIVE)
+            printf("perspective, yfov %s deg", cli_num_digits(LX_RAD2DEG(cam->yfov), 4));
+        else
+            printf("orthographic %s x %s m",
+                   cli_num_digits(2.0 * cam->xmag, 4), cli_num_digits(2.0 * cam->ymag, 4));
+        printf("  at (%s, %s, %s)", cli_num_digits(cam->eye.x, 4), cli_num_digits(cam->eye.y, 4),
+               cli_num_digits(cam->eye.z, 4));
+        printf("  looking (%s, %s, %s)", cli_num_digits(cam->forward.x, 3),
+               cli_num_digits(cam->forward.y, 3), cli_num_digits(cam->forward.z, 3));
+        printf("  up (%s, %s, %s)", cli_num_digits(cam->up.x, 3), cli_num_digits(cam->up.y, 3),
+               cli_num_digits(cam->up.z, 3));
+        if (cam->node_name)
+            printf("  node '%s'", cam->node_name);
+        printf("\n");
     }
     if (s->ambient.x > 0 || s->ambient.y > 0 || s->ambient.z > 0)
         printf("ambient: (%.3g, %.3g, %.3g) lx\n", s->ambient.x, s->ambient.y, s->ambient.z);

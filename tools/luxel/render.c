@@ -28,9 +28,14 @@ static const char *render_usage =
     "                          keep the linear radiance in nits\n"
     "  --camera E,T[,U]        eye and target points (and an up vector), 6 or 9\n"
     "                          comma-separated numbers in metres\n"
-    "  --view V                iso (default), front, back, left, right or top:\n"
-    "                          framed on the scene's bounds\n"
-    "  --fov DEG               vertical field of view (default %g)\n"
+    "  --gltf-camera N|NAME    a camera of the glTF file (perspective or\n"
+    "                          orthographic), by its number in 'luxel info' or\n"
+    "                          its name (default: the first, when it has one)\n"
+    "  --view V                iso, front, back, left, right or top: framed on\n"
+    "                          the scene's bounds (default without cameras: iso,\n"
+    "                          or a view from inside when iso sees back faces)\n"
+    "  --fov DEG               vertical field of view (default %g, or the glTF\n"
+    "                          camera's yfov)\n"
     "  --size WxH              image size in pixels (default %dx%d)\n"
     "  --exposure EV100        exposure (default: metered on the view, the\n"
     "                          log-average luminance of what the camera sees\n"
@@ -62,14 +67,16 @@ enum {
     OPT_TONEMAP,
     OPT_FILTER,
     OPT_SAMPLES,
-    OPT_TWO_SIDED
+    OPT_TWO_SIDED,
+    OPT_GLTF_CAMERA
 };
 
 typedef struct render_args {
     const char *scene;
     const char *lightmaps;
     const char *output;
-    bool has_camera, has_view, has_exposure, bake_exposure, quiet;
+    bool has_camera, has_view, has_fov, has_exposure, bake_exposure, quiet;
+    const char *gltf_camera; /* --gltf-camera, or NULL */
     bool no_summary; /* bake --render: the bake prints its own */
     lx_view view;
     double fov_degrees;
@@ -131,6 +138,8 @@ static int parse_args(int argc, char **argv, render_args *a)
                                             {"output", required_argument, NULL, 'o'},
                                             {"camera", required_argument, NULL, OPT_CAMERA},
                                             {"view", required_argument, NULL, OPT_VIEW},
+                                            {"gltf-camera", required_argument, NULL,
+                                             OPT_GLTF_CAMERA},
                                             {"fov", required_argument, NULL, OPT_FOV},
                                             {"size", required_argument, NULL, OPT_SIZE},
                                             {"exposure", required_argument, NULL, OPT_EXPOSURE},
@@ -181,11 +190,17 @@ static int parse_args(int argc, char **argv, render_args *a)
                                        optarg);
             a->has_view = true;
             break;
+        case OPT_GLTF_CAMERA:
+            if (!*optarg)
+                return cli_usage_error("render", "--gltf-camera needs a camera number or name");
+            a->gltf_camera = optarg;
+            break;
         case OPT_FOV:
             if (!cli_parse_float(optarg, 0.01, 179.0, &f))
                 return cli_usage_error("render", "--fov must be degrees in 0.01..179, not '%s'",
                                        optarg);
             a->fov_degrees = f;
+            a->has_fov = true;
             break;
         case OPT_SIZE:
             if (!parse_size(optarg, &a->desc.width, &a->desc.height))
@@ -250,8 +265,11 @@ static int parse_args(int argc, char **argv, render_args *a)
     a->scene = argv[optind];
     if (!a->lightmaps)
         return cli_usage_error("render", "--lightmaps DIR is required (the bake's output folder)");
-    if (a->has_camera && a->has_view)
-        return cli_usage_error("render", "--camera and --view both place the camera: give one");
+    if (a->has_camera + a->has_view + (a->gltf_camera != NULL) > 1)
+        return cli_usage_error("render", "%s place the camera: give one",
+                               a->gltf_camera ? (a->has_camera ? "--camera and --gltf-camera both"
+                                                               : "--view and --gltf-camera both")
+                                              : "--camera and --view both");
     a->desc.camera.fov = LX_DEG2RAD((float)a->fov_degrees);
     if (a->has_camera && lx_camera_check(&a->desc.camera) != LX_OK)
         return cli_usage_error("render", "--camera: %s", lx_last_error());
@@ -408,6 +426,146 @@ static bool meter_view(const lx_image *img, const float *coverage, double *ev100
     return isfinite(*ev100);
 }
 
+/* ---- the camera ------------------------------------------------------------- */
+
+/* "camera 1 'Side' (node 'CamNode')" */
+static void camera_label(char *buf, size_t size, const lx_scene *scene, uint32_t i)
+{
+    const lx_scene_camera *c = &scene->cameras[i];
+    if (c->node_name && strcmp(c->node_name, c->name) != 0)
+        snprintf(buf, size, "camera %u '%s' (node '%s')", i, c->name, c->node_name);
+    else
+        snprintf(buf, size, "camera %u '%s'", i, c->name);
+}
+
+/* The scene camera --gltf-camera names: a number in 0..count-1, else a
+ * camera name, else the name of the node that places it. */
+static bool find_camera(const lx_scene *scene, const char *spec, uint32_t *out)
+{
+    long n;
+    if (cli_parse_int(spec, 0, (long)UINT32_MAX, &n)) {
+        if ((uint32_t)n >= scene->camera_count)
+            return false;
+        *out = (uint32_t)n;
+        return true;
+    }
+    for (uint32_t i = 0; i < scene->camera_count; i++)
+        if (strcmp(scene->cameras[i].name, spec) == 0) {
+            *out = i;
+            return true;
+        }
+    for (uint32_t i = 0; i < scene->camera_count; i++)
+        if (scene->cameras[i].node_name && strcmp(scene->cameras[i].node_name, spec) == 0) {
+            *out = i;
+            return true;
+        }
+    return false;
+}
+
+/* "2 cameras: 0 'Main', 1 'Side'" (the first few) */
+static void camera_list(char *buf, size_t size, const lx_scene *scene)
+{
+    size_t len = (size_t)snprintf(buf, size, "%u %s", scene->camera_count,
+                                  cli_plural(scene->camera_count, "camera", "cameras"));
+    for (uint32_t i = 0; i < scene->camera_count && len + 1 < size; i++) {
+        if (i == 8) {
+            snprintf(buf + len, size - len, ", ...");
+            break;
+        }
+        len += (size_t)snprintf(buf + len, size - len, "%s%u '%s'", i ? ", " : ": ", i,
+                                scene->cameras[i].name);
+    }
+}
+
+/* Places a->desc.camera unless --camera did: --view's framing, the glTF
+ * camera --gltf-camera names or else the file's first camera,
+ * or lx_camera_auto. Says which on stderr (unless quiet). */
+static int choose_camera(render_args *a, const lx_scene *scene, const lx_lightmaps *lm,
+                         const lx_tracer *tracer)
+{
+    if (a->has_camera)
+        return EXIT_OK;
+    float aspect = (float)a->desc.width / (float)a->desc.height;
+    lx_vec3 lo, hi;
+    lx_scene_bounds(scene, &lo, &hi);
+    if (a->has_view) {
+        a->desc.camera = lx_camera_frame(lo, hi, a->view, a->desc.camera.fov, aspect);
+        return EXIT_OK;
+    }
+    char label[300], list[400];
+    uint32_t pick = UINT32_MAX;
+    if (a->gltf_camera) {
+        camera_list(list, sizeof list, scene);
+        if (scene->camera_count == 0) {
+            cli_error("%s: --gltf-camera %s: the scene has no cameras", a->scene, a->gltf_camera);
+            return EXIT_USAGE;
+        }
+        if (!find_camera(scene, a->gltf_camera, &pick)) {
+            cli_error("%s: --gltf-camera %s: no such camera; the scene has %s", a->scene,
+                      a->gltf_camera, list);
+            return EXIT_USAGE;
+        }
+    } else if (scene->camera_count) {
+        pick = 0;
+    }
+    if (pick != UINT32_MAX) {
+        const lx_scene_camera *c = &scene->cameras[pick];
+        float fov = a->desc.camera.fov;
+        a->desc.camera = lx_camera_from_scene(c);
+        bool ortho = c->type == LX_SCENE_CAMERA_ORTHOGRAPHIC;
+        if (a->has_fov && ortho)
+            lx_log(LX_LOG_WARN, "%s: --fov does not apply to an orthographic camera: ignored",
+                   a->scene);
+        else if (a->has_fov)
+            a->desc.camera.fov = fov;
+        if (lx_camera_check(&a->desc.camera) != LX_OK) {
+            camera_label(label, sizeof label, scene, pick);
+            cli_error("%s: %s: %s", a->scene, label, lx_last_error());
+            return EXIT_FAILED;
+        }
+        if (!a->quiet) {
+            camera_label(label, sizeof label, scene, pick);
+            char what[80];
+            if (ortho)
+                snprintf(what, sizeof what, "orthographic, %s m tall",
+                         cli_num_digits(a->desc.camera.ortho_height, 4));
+            else
+                snprintf(what, sizeof what, "%s field of view %s degrees",
+                         a->has_fov ? "--fov" : "its",
+                         cli_num_digits(LX_RAD2DEG(a->desc.camera.fov), 4));
+            fprintf(stderr, "luxel: %s of %s, %s%s\n", label, a->scene, what,
+                    a->gltf_camera || scene->camera_count == 1 ? ""
+                                                               : " (--gltf-camera picks another)");
+        }
+        return EXIT_OK;
+    }
+    lx_camera_auto_info info;
+    if (lx_camera_auto(scene, lm, tracer, a->desc.camera.fov, aspect, &a->desc.camera, &info) !=
+        LX_OK) {
+        cli_error("%s: %s", a->scene, lx_last_error());
+        return EXIT_FAILED;
+    }
+    if (info.moved && !a->quiet) {
+        char what[160];
+        if (info.outside_unlit > 0.0f && info.outside_back > 0.0f)
+            snprintf(what, sizeof what, "back faces (%s%%) and unlit surfaces (%s%%)",
+                     cli_num_digits(100.0 * info.outside_back, 2),
+                     cli_num_digits(100.0 * info.outside_unlit, 2));
+        else if (info.outside_unlit > 0.0f)
+            snprintf(what, sizeof what, "unlit surfaces (%s%%)",
+                     cli_num_digits(100.0 * info.outside_unlit, 2));
+        else
+            snprintf(what, sizeof what, "back faces (%s%%)",
+                     cli_num_digits(100.0 * info.outside_back, 2));
+        fprintf(stderr,
+                "luxel: the default view from outside sees mostly %s of what it meets: a "
+                "closed room? %s%s%s (--view iso keeps it)\n",
+                what, info.inside ? "The camera is placed " : "The view from the ",
+                info.placement, info.inside ? "" : " is taken instead");
+    }
+    return EXIT_OK;
+}
+
 /* Renders scene (already carrying the lightmaps' UVs) and writes output. */
 static int render_and_write(render_args *a, const lx_lightmaps *lm, const lx_scene *scene)
 {
@@ -424,14 +582,21 @@ static int render_and_write(render_args *a, const lx_lightmaps *lm, const lx_sce
     }
     if (!lit)
         lx_log(LX_LOG_WARN, "%s: every lightmap is black: the scene will be", lm->dir);
-    float aspect = (float)a->desc.width / (float)a->desc.height;
-    if (!a->has_camera) {
-        lx_vec3 lo, hi;
-        if (!lx_scene_bounds(scene, &lo, &hi)) {
-            cli_error("%s: the scene is empty: nothing to render", a->scene);
-            return EXIT_FAILED;
-        }
-        a->desc.camera = lx_camera_frame(lo, hi, a->view, a->desc.camera.fov, aspect);
+    lx_vec3 lo, hi;
+    if (!a->has_camera && !lx_scene_bounds(scene, &lo, &hi)) {
+        cli_error("%s: the scene is empty: nothing to render", a->scene);
+        return EXIT_FAILED;
+    }
+    lx_tracer *tracer = NULL;
+    lx_tracer_desc td = {.threads = a->desc.threads};
+    if (lx_tracer_create(scene, &td, &tracer) != LX_OK) {
+        cli_error("%s: %s", a->scene, lx_last_error());
+        return EXIT_FAILED;
+    }
+    int chosen = choose_camera(a, scene, lm, tracer);
+    if (chosen != EXIT_OK) {
+        lx_tracer_destroy(tracer);
+        return chosen;
     }
     /* the sky the bake was lit by, as the background */
     lx_cubemap sky = {0};
@@ -441,8 +606,10 @@ static int render_and_write(render_args *a, const lx_lightmaps *lm, const lx_sce
         if (constant || file_exists(lm->sky)) {
             int loaded = cli_load_environment_run("render", lm->sky, 0.0f, CLI_RENDER_SKY_SIZE,
                                                   a->desc.threads, a->quiet, &sky);
-            if (loaded != EXIT_OK)
+            if (loaded != EXIT_OK) {
+                lx_tracer_destroy(tracer);
                 return loaded;
+            }
             a->desc.sky = &sky;
             a->desc.sky_intensity = lm->sky_intensity;
             have_sky = true;
@@ -461,11 +628,13 @@ static int render_and_write(render_args *a, const lx_lightmaps *lm, const lx_sce
     float *coverage = NULL;
     if (!(coverage = malloc((size_t)a->desc.width * (size_t)a->desc.height * sizeof *coverage))) {
         lx_cubemap_free(&sky);
+        lx_tracer_destroy(tracer);
         cli_error("out of memory");
         return EXIT_FAILED;
     }
     a->desc.coverage = coverage;
-    lx_status st = lx_render_view(scene, lm, NULL, &a->desc, &img);
+    lx_status st = lx_render_view(scene, lm, tracer, &a->desc, &img);
+    lx_tracer_destroy(tracer);
     cli_progress_finish(&progress);
     lx_cubemap_free(&sky);
     a->desc.sky = NULL;
