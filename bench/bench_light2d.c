@@ -6,7 +6,8 @@
  * mask (the visibility the tests check against), timed on a slice of rows
  * and scaled to a frame.
  *
- * usage: bench_light2d [--threads N] [--seconds S] */
+ * usage: bench_light2d [--threads N] [--seconds S] [--frames N]
+ * (at least N frames, default 10, and at least S seconds, default 3) */
 #include "luxel/light2d.h"
 
 #include <math.h>
@@ -112,11 +113,14 @@ int main(int argc, char **argv)
 {
     int threads = 2;
     double seconds = 3.0;
+    int min_frames = 10;
     for (int i = 1; i + 1 < argc; i += 2) {
         if (strcmp(argv[i], "--threads") == 0)
             threads = atoi(argv[i + 1]);
         else if (strcmp(argv[i], "--seconds") == 0)
             seconds = atof(argv[i + 1]);
+        else if (strcmp(argv[i], "--frames") == 0)
+            min_frames = atoi(argv[i + 1]);
     }
     lx_image casters, normals;
     make_scene(&casters, &normals);
@@ -131,7 +135,7 @@ int main(int argc, char **argv)
     lx_light2d_light ls[LIGHTS];
     int frames = 0;
     double t0 = now(), t = t0;
-    while (t - t0 < seconds || frames < 10) {
+    while (t - t0 < seconds || frames < min_frames) {
         place_lights(ls, frames);
         if (lx_light2d_set_lights(ctx, ls, LIGHTS) != LX_OK ||
             lx_light2d_render(ctx, lx_v3(0.02f, 0.02f, 0.03f), NULL, out, NULL) != LX_OK) {
