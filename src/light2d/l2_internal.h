@@ -51,6 +51,8 @@ typedef struct l2_polar {
      * inverse distance per ray: a pixel on ray b at distance d with
      * d * lit[b] < 1 lies in no occluder's penumbra (fully lit) */
     float *lit;
+    uint8_t *sel; /* per ray, the cone of penumbra_reach (polar.c) for n = sel_n */
+    int sel_n;
     /* soft lights: 1 / max(occ, 0.5) per ray, and per depth level l (the
      * distances from L2_DEPTH0 x 2^(l/2) on) the whole bins between each
      * ray and the nearest ray whose occluder lies at that distance or

@@ -58,6 +58,7 @@ void l2_polar_free(l2_polar *pm)
     free(pm->ex);
     free(pm->lit);
     free(pm->occx);
+    free(pm->sel);
     free(pm->qocc);
     free(pm->gap);
     free(pm->tmin);
@@ -125,7 +126,11 @@ static lx_status reserve(l2_polar *pm, int n, int levels, int depth_levels)
         float *occx = realloc(pm->occx, (size_t)n * 3 * sizeof *occx);
         if (occx)
             pm->occx = occx;
-        if (!occ || !ex || !lit || !qocc || !occx)
+        uint8_t *sel = realloc(pm->sel, (size_t)n);
+        if (sel)
+            pm->sel = sel;
+        pm->sel_n = 0;
+        if (!occ || !ex || !lit || !qocc || !occx || !sel)
             return lx_fail(LX_ERR_NOMEM, "light2d: out of memory for a polar map of %d rays", n);
         pm->capacity = n;
     }
@@ -146,38 +151,86 @@ static lx_status reserve(l2_polar *pm, int n, int levels, int depth_levels)
 
 /* The penumbra wedges' reach (l2_polar.lit). The occluder of ray j, at
  * inverse distance q_j = 1/occ[j], casts a penumbra over the points at
- * inverse distance q whose window s (q_j - q) x scale (in bins, scale the
- * bins per radian at the point) reaches ray j: with g the whole bins
- * between rays b and j, a point of ray b can be in it only when q < q_j -
- * g / (s x scale). scale is at most n/4 (where the pseudo-angle's slope is
- * 1), so lit[b] = max_j (q_j - g / (s n/4)) bounds every wedge reaching ray
- * b: a distance transform with a linear cone, one pass each way around the
- * circle (twice round, so that wedges wrap). */
-static void penumbra_reach(l2_polar *pm, float s)
+ * inverse distance q whose window s (q_j - q) x scale (in bins, scale =
+ * (1 + u^2) n/8 the bins per radian at the point, u the pseudo-angle's
+ * slope there) reaches ray j: with g the whole bins between rays b and j,
+ * a point of ray b can be in it only when q < q_j - g / (s x scale). So
+ * lit[b] = max_j (q_j - g c_b) bounds every wedge reaching ray b, c_b =
+ * 1 / (s n/8 (1 + u_b^2)) with u_b^2 the largest over ray b's bin. c_b
+ * lies in [c, 2c], c = 1 / (s n/4): four distance transforms with linear
+ * cones of slopes c 2^(k/4), k = 0..3, one pass each way around the circle
+ * (twice round, so that wedges wrap), and each ray takes the steepest
+ * cone not steeper than its own c_b. */
+static void penumbra_reach(l2_polar *pm, float s, float *q)
 {
     int n = pm->n;
     const float *occ = pm->occ;
     float *lit = pm->lit;
-    float step = 1.0f / (s * 0.25f * (float)n);
-    for (int i = 0; i < n; i++)
-        lit[i] = occ[i] >= L2_FAR ? 0.0f : 1.0f / l2_max(occ[i], 1e-6f);
-    /* g: the best wedge arriving from the bins before i, its gap counted */
-    float g = 0.0f;
+    const uint8_t *sel = pm->sel;
+    float step[4];
+    for (int k = 0; k < 4; k++)
+        step[k] = (float)(exp2(0.25 * k) / (s * 0.25 * (double)n));
+    for (int i = 0; i < n; i++) {
+        q[i] = occ[i] >= L2_FAR ? 0.0f : 1.0f / l2_max(occ[i], 1e-6f);
+        lit[i] = q[i];
+    }
+
+    /* g: the best wedge of each slope arriving from the bins before i,
+     * its gap counted */
+    float g0 = 0.0f, g1 = 0.0f, g2 = 0.0f, g3 = 0.0f;
     for (int lap = 0; lap < 2; lap++)
         for (int i = 0; i < n; i++) {
-            float q = occ[i] >= L2_FAR ? 0.0f : 1.0f / l2_max(occ[i], 1e-6f);
-            if (lap)
-                lit[i] = l2_max(lit[i], g);
-            g = l2_max(q, g - step);
+            if (lap) {
+                int k = sel[i];
+                float v = k == 0 ? g0 : (k == 1 ? g1 : (k == 2 ? g2 : g3));
+                lit[i] = l2_max(lit[i], v);
+            }
+            float qi = q[i];
+            g0 = l2_max(qi, g0 - step[0]);
+            g1 = l2_max(qi, g1 - step[1]);
+            g2 = l2_max(qi, g2 - step[2]);
+            g3 = l2_max(qi, g3 - step[3]);
         }
-    g = 0.0f;
+    g0 = g1 = g2 = g3 = 0.0f;
     for (int lap = 0; lap < 2; lap++)
         for (int i = n - 1; i >= 0; i--) {
-            float q = occ[i] >= L2_FAR ? 0.0f : 1.0f / l2_max(occ[i], 1e-6f);
-            if (lap)
-                lit[i] = l2_max(lit[i], g);
-            g = l2_max(q, g - step);
+            if (lap) {
+                int k = sel[i];
+                float v = k == 0 ? g0 : (k == 1 ? g1 : (k == 2 ? g2 : g3));
+                lit[i] = l2_max(lit[i], v);
+            }
+            float qi = q[i];
+            g0 = l2_max(qi, g0 - step[0]);
+            g1 = l2_max(qi, g1 - step[1]);
+            g2 = l2_max(qi, g2 - step[2]);
+            g3 = l2_max(qi, g3 - step[3]);
         }
+}
+
+/* l2_polar.sel: per ray b, the steepest of the four cones of
+ * penumbra_reach not steeper than c_b (it depends on n alone). */
+static void cone_select(l2_polar *pm)
+{
+    int n = pm->n;
+    double bpp = (double)n / 8.0;
+    for (int i = 0; i < n; i++) {
+        /* the bin's pseudo-angles [p0, p1] and the face centre (odd) of p0 */
+        double p0 = i / bpp, p1 = (i + 1) / bpp;
+        double cen = 2.0 * floor(p0 * 0.5) + 1.0;
+        double u2 = 1.0;
+        if (p1 <= cen + 1.0) {
+            double a = p0 - cen, b = p1 - cen;
+            u2 = a * a > b * b ? a * a : b * b;
+        }
+        /* margins for the rounding of the pixels' pseudo-angles and
+         * windows */
+        double ratio = 2.0 / (1.0 + u2 + 1e-4) * (1.0 - 1e-4);
+        int k = 0;
+        while (k < 3 && exp2(0.25 * (k + 1)) <= ratio)
+            k++;
+        pm->sel[i] = (uint8_t)k;
+    }
+    pm->sel_n = n;
 }
 
 /* gap[lv]: per ray, the whole bins between it and the nearest ray whose
@@ -310,7 +363,10 @@ lx_status l2_polar_build(const lx_light2d *ctx, l2_prep *p)
         for (int b = 0; b < n; b++)
             occ[b] = 0.0f;
     if (soft) {
-        penumbra_reach(pm, l->softness);
+        if (pm->sel_n != n)
+            cone_select(pm);
+        /* scratch: the sparse table, built below */
+        penumbra_reach(pm, l->softness, pm->tmin);
         for (int i = 0; i < n; i++)
             pm->qocc[i] = 1.0f / l2_max(occ[i], 0.5f);
         for (int lv = 0; lv < depth_levels; lv++)
