@@ -35,6 +35,13 @@ typedef struct l2_edge {
     uint8_t free;
 } l2_edge;
 
+/* A boundary pixel where rays leave their caster run: its bins [b0, b1]
+ * (b1 may pass n: wrap) and the distance of its far corner. */
+typedef struct l2_exit {
+    int b0, b1;
+    float df;
+} l2_exit;
+
 /* A light's polar shadow map: n rays over the pseudo-angle p in [0, 8)
  * (the point where the ray meets the unit square around the light, walked
  * counter-clockwise: p = 1 + dy/dx on the +x face, 3 - dx/dy on +y, 5 +
@@ -65,6 +72,8 @@ typedef struct l2_polar {
     int gap_capacity;
     float *tmin, *tmax; /* levels x n */
     int levels;
+    l2_exit *exits; /* scratch of l2_polar_build */
+    size_t exit_capacity;
     int capacity; /* floats allocated per array (occ, ex: n; tables: levels*n) */
     int table_capacity;
 } l2_polar;

@@ -59,6 +59,7 @@ void l2_polar_free(l2_polar *pm)
     free(pm->lit);
     free(pm->occx);
     free(pm->sel);
+    free(pm->exits);
     free(pm->qocc);
     free(pm->gap);
     free(pm->tmin);
@@ -312,50 +313,69 @@ lx_status l2_polar_build(const lx_light2d *ctx, l2_prep *p)
     int tx1 = (int)fmin(ctx->tiles_x - 1, floor((l->x + r + 1.0) / L2_TILE));
     int ty1 = (int)fmin(ctx->tiles_y - 1, floor((l->y + r + 1.0) / L2_TILE));
     bool face = !l->self_shadow;
-    for (int pass = 0; pass < (face ? 2 : 1); pass++)
+    /* the boundary pixels where a ray leaves its caster run, listed with
+     * their bins for the second pass (at most every pixel of the tiles) */
+    size_t most = 0;
+    if (face)
         for (int ty = ty0; ty <= ty1; ty++)
             for (int tx = tx0; tx <= tx1; tx++) {
                 size_t t = (size_t)ty * ctx->tiles_x + tx;
-                for (uint32_t e = ctx->tile_start[t]; e < ctx->tile_start[t + 1]; e++) {
-                    const l2_edge *ed = &ctx->edges[e];
-                    float ax = (float)ed->x - lx, bx = ax + 1.0f;
-                    float ay = (float)ed->y - ly, by = ay + 1.0f;
-                    float nx = ax > 0.0f ? ax : (bx < 0.0f ? -bx : 0.0f);
-                    float ny = ay > 0.0f ? ay : (by < 0.0f ? -by : 0.0f);
-                    float dn2 = nx * nx + ny * ny;
-                    if (dn2 >= r2)
-                        continue;
-                    bool inside = nx == 0.0f && ny == 0.0f;
-                    if (pass == 1) {
-                        float cx = ax + 0.5f, cy = ay + 0.5f;
-                        bool exit = ((ed->free & L2_FREE_RIGHT) && cx > 0.0f) ||
-                                    ((ed->free & L2_FREE_LEFT) && cx < 0.0f) ||
-                                    ((ed->free & L2_FREE_DOWN) && cy > 0.0f) ||
-                                    ((ed->free & L2_FREE_UP) && cy < 0.0f) || inside;
-                        if (!exit)
-                            continue;
-                    }
-                    int b0 = 0, b1 = n - 1;
-                    if (!inside)
-                        square_bins(pm, ax, bx, ay, by, &b0, &b1);
-                    if (pass == 0) {
-                        float dn = sqrtf(dn2);
-                        for (int b = b0; b <= b1; b++) {
-                            int i = b >= n ? b - n : b;
-                            if (dn < occ[i])
-                                occ[i] = dn;
-                        }
-                    } else {
+                most += ctx->tile_start[t + 1] - ctx->tile_start[t];
+            }
+    if (most > pm->exit_capacity) {
+        l2_exit *a = realloc(pm->exits, most * sizeof *a);
+        if (!a)
+            return lx_fail(LX_ERR_NOMEM, "light2d: out of memory for a polar map of %d rays", n);
+        pm->exits = a;
+        pm->exit_capacity = most;
+    }
+    size_t exits = 0;
+    for (int ty = ty0; ty <= ty1; ty++)
+        for (int tx = tx0; tx <= tx1; tx++) {
+            size_t t = (size_t)ty * ctx->tiles_x + tx;
+            for (uint32_t e = ctx->tile_start[t]; e < ctx->tile_start[t + 1]; e++) {
+                const l2_edge *ed = &ctx->edges[e];
+                float ax = (float)ed->x - lx, bx = ax + 1.0f;
+                float ay = (float)ed->y - ly, by = ay + 1.0f;
+                float nx = ax > 0.0f ? ax : (bx < 0.0f ? -bx : 0.0f);
+                float ny = ay > 0.0f ? ay : (by < 0.0f ? -by : 0.0f);
+                float dn2 = nx * nx + ny * ny;
+                if (dn2 >= r2)
+                    continue;
+                bool inside = nx == 0.0f && ny == 0.0f;
+                int b0 = 0, b1 = n - 1;
+                if (!inside)
+                    square_bins(pm, ax, bx, ay, by, &b0, &b1);
+                float dn = sqrtf(dn2);
+                for (int b = b0; b <= b1; b++) {
+                    int i = b >= n ? b - n : b;
+                    if (dn < occ[i])
+                        occ[i] = dn;
+                }
+                if (face) {
+                    float cx = ax + 0.5f, cy = ay + 0.5f;
+                    bool exit = ((ed->free & L2_FREE_RIGHT) && cx > 0.0f) ||
+                                ((ed->free & L2_FREE_LEFT) && cx < 0.0f) ||
+                                ((ed->free & L2_FREE_DOWN) && cy > 0.0f) ||
+                                ((ed->free & L2_FREE_UP) && cy < 0.0f) || inside;
+                    if (exit) {
                         float fx = l2_max(ax * ax, bx * bx), fy = l2_max(ay * ay, by * by);
-                        float df = sqrtf(fx + fy);
-                        for (int b = b0; b <= b1; b++) {
-                            int i = b >= n ? b - n : b;
-                            if (df >= occ[i] && df < ex[i])
-                                ex[i] = df;
-                        }
+                        pm->exits[exits++] = (l2_exit){b0, b1, sqrtf(fx + fy)};
                     }
                 }
             }
+        }
+    /* where the first caster run of each ray ends: the nearest far corner
+     * of an exit pixel at or beyond the ray's occluder */
+    for (size_t x = 0; x < exits; x++) {
+        const l2_exit *ev = &pm->exits[x];
+        float df = ev->df;
+        for (int b = ev->b0; b <= ev->b1; b++) {
+            int i = b >= n ? b - n : b;
+            if (df >= occ[i] && df < ex[i])
+                ex[i] = df;
+        }
+    }
     /* a light inside a caster pixel that is not on a boundary */
     int ix = (int)floorf(lx), iy = (int)floorf(ly);
     if (ix >= 0 && iy >= 0 && ix < ctx->width && iy < ctx->height &&
@@ -379,9 +399,14 @@ lx_status l2_polar_build(const lx_light2d *ctx, l2_prep *p)
     for (int k = 1; k < levels; k++) {
         const float *a = pm->tmin + (size_t)(k - 1) * n, *b = pm->tmax + (size_t)(k - 1) * n;
         float *c = pm->tmin + (size_t)k * n, *d = pm->tmax + (size_t)k * n;
-        int h = 1 << (k - 1);
-        for (int i = 0; i < n; i++) {
-            int j = i + h >= n ? i + h - n : i + h;
+        int h = 1 << (k - 1), m = n - h > 0 ? n - h : 0;
+        /* without wrapping (so that it vectorizes), then the wrapped tail */
+        for (int i = 0; i < m; i++) {
+            c[i] = l2_min(a[i], a[i + h]);
+            d[i] = l2_max(b[i], b[i + h]);
+        }
+        for (int i = m; i < n; i++) {
+            int j = (i + h) % n;
             c[i] = l2_min(a[i], a[j]);
             d[i] = l2_max(b[i], b[j]);
         }
