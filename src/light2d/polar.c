@@ -452,17 +452,27 @@ static inline bool l2_gather_ok(void)
 }
 #endif
 
-/* Fraction of the window [c - k, c + k] (in bins) whose rays reach past d. */
-L2_CLONES
-float l2_filter(const l2_polar *pm, float c, float k, float d)
+/* floor(x) for |x| < 2^31 in the clones of the filter and the search:
+ * one rounding instruction where the clone's target has SSE4.1 (a call
+ * to floorf in the default clone); the same value as l2_floor. */
+static inline int floor_clone(float x)
+{
+    return (int)__builtin_floorf(x);
+}
+
+/* Fraction of the window [c - k, c + k] (in bins) whose rays reach past
+ * d; reaches: the caller expects a ray of the window (its own) to reach
+ * past d, so the shortcut for windows where none does (which gives the
+ * same 0 as the taps would) is not worth its range query. */
+static inline float filter(const l2_polar *pm, float c, float k, float d, bool reaches)
 {
     int n = pm->n;
     float lo = c - k, hi = c + k;
-    int b0 = l2_floor(lo), b1 = l2_floor(hi);
+    int b0 = floor_clone(lo), b1 = floor_clone(hi);
     /* (no ray of the window reaches past d: no light; the callers' windows
      * always hold a ray that does not, so the filter never gives 1 from
      * the window's minimum alone) */
-    if (range_query(pm, pm->tmax, b0, b1, true) < d)
+    if (!reaches && range_query(pm, pm->tmax, b0, b1, true) < d)
         return 0.0f;
     const float *occ = pm->occx + n; /* b in [-n, 2n) */
     if (b1 - b0 + 1 <= L2_MAX_TAPS) {
@@ -488,6 +498,12 @@ float l2_filter(const l2_polar *pm, float c, float k, float d)
     return (float)lit / L2_MAX_TAPS;
 }
 
+L2_CLONES
+float l2_filter(const l2_polar *pm, float c, float k, float d)
+{
+    return filter(pm, c, k, d, false);
+}
+
 /* Soft visibility at distance d on the ray at continuous bin c: the
  * nearest occluder o in a search window (the window an occluder at d/8
  * would need), then the filter over the half-angle softness (d - o) /
@@ -499,7 +515,7 @@ float l2_soft_visibility(const l2_polar *pm, float s, float c, float u2, float d
     float scale = (1.0f + u2) * pm->bins_per_p; /* bins per radian */
     float cap = 0.5f * (float)pm->n - 1.0f;
     float ks = l2_min(7.0f * s / d * scale, cap);
-    int b0 = l2_floor(c - ks), b1 = l2_floor(c + ks);
+    int b0 = floor_clone(c - ks), b1 = floor_clone(c + ks);
     float m = range_query(pm, pm->tmin, b0, b1, false);
     if (m >= d)
         return 1.0f;
@@ -512,7 +528,7 @@ float l2_soft_visibility(const l2_polar *pm, float s, float c, float u2, float d
         k = l2_min(s * (d - o) / (d * o) * scale, cap);
         if (k < 0.5f)
             break;
-        float m2 = range_query(pm, pm->tmin, l2_floor(c - k), l2_floor(c + k), false);
+        float m2 = range_query(pm, pm->tmin, floor_clone(c - k), floor_clone(c + k), false);
         if (m2 >= d)
             return 1.0f;
         if (m2 == m)
@@ -520,8 +536,10 @@ float l2_soft_visibility(const l2_polar *pm, float s, float c, float u2, float d
         m = m2;
     }
     if (k < 0.5f)
-        return pm->occx[pm->n + l2_floor(c)] >= d ? 1.0f : 0.0f;
-    return l2_filter(pm, c, k, d);
+        return pm->occx[pm->n + floor_clone(c)] >= d ? 1.0f : 0.0f;
+    /* the point's own ray reaches past it (d is before its occluder, or
+     * on its lit face) and lies in the window (k >= 0.5) */
+    return filter(pm, c, k, d, true);
 }
 
 bool l2_block_dark(const l2_prep *p, int x0, int y0, int x1, int y1, bool has_caster)
