@@ -173,17 +173,15 @@ float l2_soft_visibility(const l2_polar *pm, float s, float c, float u2, float d
  * reaches past it would not be found fully lit from its minimum. */
 float l2_filter(const l2_polar *pm, float c, float k, float d);
 
-/* Whether the light leaves every pixel of the block [x0, x1) x [y0, y1)
- * dark (exactly what shading them would give: out of reach, or in a hard
- * shadow whose penumbra window holds no open ray, and no caster pixel
- * within a ray's first caster run); has_caster: the block holds a caster
- * pixel (polar.c). */
-bool l2_block_dark(const l2_prep *p, int x0, int y0, int x1, int y1, bool has_caster);
-
-/* Whether the light's shadows leave every pixel of the block [x0, x1) x
- * [y0, y1) its full light (each before its ray's occluder and, for soft
- * lights, in no occluder's penumbra wedge), so that shading them may skip
- * the shadow pass; has_caster as for l2_block_dark (polar.c). */
-bool l2_block_lit(const l2_prep *p, int x0, int y0, int x1, int y1, bool has_caster);
+/* What the light does to the pixels of the block [x0, x1) x [y0, y1),
+ * exactly as shading them would find (polar.c): L2_BLOCK_DARK, it leaves
+ * every one dark (out of reach, or in a hard shadow whose penumbra window
+ * holds no open ray, and no caster pixel within a ray's first caster
+ * run); L2_BLOCK_LIT, its shadows leave every one its full light (each
+ * before its ray's occluder and, for soft lights, in no occluder's
+ * penumbra wedge), so that shading may skip the shadow pass; else
+ * L2_BLOCK_MIXED. has_caster: the block holds a caster pixel. */
+enum { L2_BLOCK_DARK = 0, L2_BLOCK_LIT = 1, L2_BLOCK_MIXED = 2 };
+int l2_block_kind(const l2_prep *p, int x0, int y0, int x1, int y1, bool has_caster);
 
 #endif

@@ -542,34 +542,49 @@ float l2_soft_visibility(const l2_polar *pm, float s, float c, float u2, float d
     return filter(pm, c, k, d, true);
 }
 
-bool l2_block_dark(const l2_prep *p, int x0, int y0, int x1, int y1, bool has_caster)
+/* The bins [b0, b1] of a square from its corners' pseudo-angles p[4]
+ * (square_bins' second half). */
+static void corner_bins(const l2_polar *pm, const float p[4], int *b0, int *b1)
+{
+    float lo = p[0], hi = p[0];
+    for (int k = 1; k < 4; k++) {
+        lo = l2_min(lo, p[k]);
+        hi = l2_max(hi, p[k]);
+    }
+    if (hi - lo > 4.0f) { /* the square straddles p = 0 */
+        lo = 8.0f;
+        hi = 0.0f;
+        for (int k = 0; k < 4; k++) {
+            float q = p[k] < 4.0f ? p[k] + 8.0f : p[k];
+            lo = l2_min(lo, q);
+            hi = l2_max(hi, q);
+        }
+    }
+    int n = pm->n;
+    int a = (int)(lo * pm->bins_per_p), b = (int)(hi * pm->bins_per_p);
+    if (a >= n) {
+        a -= n;
+        b -= n;
+    }
+    if (b > a + n - 1)
+        b = a + n - 1;
+    *b0 = a;
+    *b1 = b;
+}
+
+/* Whether the light leaves every pixel of the block dark (as shading
+ * them would), given the block's geometry: its pixel centres' nearest and
+ * farthest distance, rays [b0, b1] (one more each side) and the corners'
+ * pseudo-angles pa and slopes u. */
+static bool block_dark(const l2_prep *p, bool has_caster, float dmin, float dmax, int b0, int b1,
+                       const float pa[4], const float u[4])
 {
     const lx_light2d_light *l = &p->l;
     const l2_polar *pm = &p->polar;
     int n = pm->n;
-    /* the pixel centres, relative to the light, as shade.c computes them */
-    float ax = (float)x0 + 0.5f - l->x, bx = (float)(x1 - 1) + 0.5f - l->x;
-    float ay = (float)y0 + 0.5f - l->y, by = (float)(y1 - 1) + 0.5f - l->y;
-    float nx = ax > 0.0f ? ax : (bx < 0.0f ? bx : 0.0f);
-    float ny = ay > 0.0f ? ay : (by < 0.0f ? by : 0.0f);
-    /* squares and sums round monotonically: no pixel is nearer */
-    float dmin2 = nx * nx + ny * ny;
-    if (dmin2 >= p->r2)
-        return true; /* out of reach: no falloff */
-    if (!l->shadow || dmin2 < 4.0f)
-        return false;
     /* caster pixels lit on their face: only where a ray's first caster
      * run reaches the block */
     bool faces = has_caster && !l->self_shadow;
-    float fx = l2_max(ax * ax, bx * bx), fy = l2_max(ay * ay, by * by);
-    float dmin = sqrtf(dmin2), dmax = sqrtf(fx + fy);
-    /* the rays of the pixels, one more each side for rounding */
-    int b0, b1;
-    square_bins(pm, ax, bx, ay, by, &b0, &b1);
-    b0--;
-    b1++;
-    if (b1 - b0 + 1 >= n)
-        return false;
     /* every ray blocked before the nearest pixel (with a margin for the
      * rounding of d x 1/occ) */
     float before = dmin * (1.0f - 1e-5f);
@@ -599,13 +614,11 @@ bool l2_block_dark(const l2_prep *p, int x0, int y0, int x1, int y1, bool has_ca
      * at the level of dmin */
     if (dmin < L2_DEPTH0)
         return false;
-    float u, u2max = 0.0f, plo = 8.0f, phi = 0.0f;
-    float cx[4] = {ax, bx, ax, bx}, cy[4] = {ay, ay, by, by};
+    float u2max = 0.0f, plo = 8.0f, phi = 0.0f;
     for (int c = 0; c < 4; c++) {
-        float pa = pseudo_angle(cx[c], cy[c], &u);
-        u2max = l2_max(u2max, u * u);
-        plo = l2_min(plo, pa);
-        phi = l2_max(phi, pa);
+        u2max = l2_max(u2max, u[c] * u[c]);
+        plo = l2_min(plo, pa[c]);
+        phi = l2_max(phi, pa[c]);
     }
     /* a face's edge (|u| = 1) at p = 0, 2, 4, 6 between the corners */
     if (phi - plo > 4.0f || (int)(plo * 0.5f) != (int)(phi * 0.5f))
@@ -623,30 +636,19 @@ bool l2_block_dark(const l2_prep *p, int x0, int y0, int x1, int y1, bool has_ca
     return true;
 }
 
-bool l2_block_lit(const l2_prep *p, int x0, int y0, int x1, int y1, bool has_caster)
+/* Whether the light's shadows leave every pixel of the block its full
+ * light, given the block's geometry (fx, fy: the largest squares of its
+ * pixel centres' offsets; rays [b0, b1] as for block_dark). */
+static bool block_lit(const l2_prep *p, bool has_caster, float fx, float fy, int b0, int b1)
 {
     const lx_light2d_light *l = &p->l;
     const l2_polar *pm = &p->polar;
     int n = pm->n;
-    if (!l->shadow || (has_caster && !l->self_shadow))
+    if (has_caster && !l->self_shadow)
         return false;
-    /* the pixel centres, relative to the light, as shade.c computes them */
-    float ax = (float)x0 + 0.5f - l->x, bx = (float)(x1 - 1) + 0.5f - l->x;
-    float ay = (float)y0 + 0.5f - l->y, by = (float)(y1 - 1) + 0.5f - l->y;
-    float nx = ax > 0.0f ? ax : (bx < 0.0f ? bx : 0.0f);
-    float ny = ay > 0.0f ? ay : (by < 0.0f ? by : 0.0f);
-    if (nx * nx + ny * ny < 4.0f)
-        return false;
-    float fx = l2_max(ax * ax, bx * bx), fy = l2_max(ay * ay, by * by);
     /* no pixel is farther (squares and sums round monotonically); a margin
      * for the rounding of the products with it */
     float dmax = sqrtf(fx + fy) * (1.0f + 1e-5f);
-    int b0, b1;
-    square_bins(pm, ax, bx, ay, by, &b0, &b1);
-    b0--;
-    b1++;
-    if (b1 - b0 + 1 >= n)
-        return false;
     /* every pixel before its ray's occluder */
     if (range_query(pm, pm->tmin, b0, b1, false) <= dmax)
         return false;
@@ -658,4 +660,39 @@ bool l2_block_lit(const l2_prep *p, int x0, int y0, int x1, int y1, bool has_cas
     for (int b = a; b <= e; b++)
         most = l2_max(most, pm->lit[b < n ? b : b - n]);
     return dmax * most < 1.0f;
+}
+
+int l2_block_kind(const l2_prep *p, int x0, int y0, int x1, int y1, bool has_caster)
+{
+    const lx_light2d_light *l = &p->l;
+    const l2_polar *pm = &p->polar;
+    int n = pm->n;
+    /* the pixel centres, relative to the light, as shade.c computes them */
+    float ax = (float)x0 + 0.5f - l->x, bx = (float)(x1 - 1) + 0.5f - l->x;
+    float ay = (float)y0 + 0.5f - l->y, by = (float)(y1 - 1) + 0.5f - l->y;
+    float nx = ax > 0.0f ? ax : (bx < 0.0f ? bx : 0.0f);
+    float ny = ay > 0.0f ? ay : (by < 0.0f ? by : 0.0f);
+    /* squares and sums round monotonically: no pixel is nearer */
+    float dmin2 = nx * nx + ny * ny;
+    if (dmin2 >= p->r2)
+        return L2_BLOCK_DARK; /* out of reach: no falloff */
+    if (!l->shadow || dmin2 < 4.0f)
+        return L2_BLOCK_MIXED;
+    float fx = l2_max(ax * ax, bx * bx), fy = l2_max(ay * ay, by * by);
+    float dmin = sqrtf(dmin2), dmax = sqrtf(fx + fy);
+    /* the corners' pseudo-angles, and the rays of the pixels, one more
+     * each side for rounding */
+    float pa[4], u[4];
+    float cx[4] = {ax, bx, ax, bx}, cy[4] = {ay, ay, by, by};
+    for (int c = 0; c < 4; c++)
+        pa[c] = pseudo_angle(cx[c], cy[c], &u[c]);
+    int b0, b1;
+    corner_bins(pm, pa, &b0, &b1);
+    b0--;
+    b1++;
+    if (b1 - b0 + 1 >= n)
+        return L2_BLOCK_MIXED;
+    if (block_dark(p, has_caster, dmin, dmax, b0, b1, pa, u))
+        return L2_BLOCK_DARK;
+    return block_lit(p, has_caster, fx, fy, b0, b1) ? L2_BLOCK_LIT : L2_BLOCK_MIXED;
 }

@@ -233,9 +233,10 @@ static void shade_band(const lx_light2d *ctx, const l2_prep *p, int y0, int y1, 
         xs = xs > p->x0 ? xs : p->x0;
         xe = xe < p->x1 ? xe : p->x1;
         bool caster = ctx->block_caster[(size_t)by * ctx->blocks_x + bx] != 0;
-        if (l2_block_dark(p, xs, ya, xe, yb, caster))
+        int bk = l2_block_kind(p, xs, ya, xe, yb, caster);
+        if (bk == L2_BLOCK_DARK)
             continue;
-        int kind = l2_block_lit(p, xs, ya, xe, yb, caster) ? 0 : 1;
+        int kind = bk == L2_BLOCK_LIT ? 0 : 1;
         if (count > 0 && runs[3 * count - 2] == xs && runs[3 * count - 1] == kind)
             runs[3 * count - 2] = xe;
         else {
