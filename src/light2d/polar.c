@@ -234,53 +234,63 @@ static void cone_select(l2_polar *pm)
     pm->sel_n = n;
 }
 
-/* gap[lv]: per ray, the whole bins between it and the nearest ray whose
- * occluder is at the level's distance or beyond (a 1D distance transform
- * around the circle: once round each way from an open ray). */
-static void open_gaps(l2_polar *pm, int lv)
+/* gap[lv] for every depth level: per ray, the whole bins between it and
+ * the nearest ray whose occluder is at the level's distance or beyond
+ * (65535 when none): a 1D distance transform around the circle, the
+ * bins since the last open ray counted once round each way (twice round,
+ * so that the count wraps; whole numbers, exact). Eight levels at a time
+ * on vector lanes; fw (8 n ints) keeps the forward counts. */
+typedef float l2_v8f __attribute__((vector_size(32)));
+typedef int32_t l2_v8i __attribute__((vector_size(32)));
+L2_CLONES static void open_gaps(l2_polar *pm, int32_t *fw)
 {
     int n = pm->n;
-    /* the level's distance, as l2_depth_level counts: 2^(lv/2) exactly
-     * for even lv, the float just at or above 2^(lv/2) sqrt(2) for odd */
-    union {
-        uint32_t u;
-        float f;
-    } t = {(uint32_t)((lv >> 1) + 127) << 23 | ((lv & 1) ? 0x3504f3u : 0u)};
-    float thr = t.f * L2_DEPTH0;
     const float *occ = pm->occ;
-    float *g = pm->gap + (size_t)lv * n;
-    int s0 = -1;
-    for (int i = 0; i < n; i++)
-        if (occ[i] >= thr) {
-            s0 = i;
-            break;
+    for (int l0 = 0; l0 < pm->depth_levels; l0 += 8) {
+        /* the levels' distances, as l2_depth_level counts: 2^(lv/2) exactly
+         * for even lv, the float just at or above 2^(lv/2) sqrt(2) for odd;
+         * lanes past the last level never open */
+        l2_v8f thr;
+        for (int j = 0; j < 8; j++) {
+            int lv = l0 + j;
+            union {
+                uint32_t u;
+                float f;
+            } t = {(uint32_t)((lv >> 1) + 127) << 23 | ((lv & 1) ? 0x3504f3u : 0u)};
+            thr[j] = lv < pm->depth_levels ? t.f * L2_DEPTH0 : INFINITY;
         }
-    if (s0 < 0) {
-        for (int i = 0; i < n; i++)
-            g[i] = 65535.0f;
-        return;
-    }
-    /* forward from the open ray s0: bins since the last open ray */
-    float run = 0.0f;
-    for (int i = s0; i < n; i++) {
-        run = occ[i] >= thr ? 0.0f : run + 1.0f;
-        g[i] = run;
-    }
-    for (int i = 0; i < s0; i++) {
-        run = occ[i] >= thr ? 0.0f : run + 1.0f;
-        g[i] = run;
-    }
-    /* backward from it: the nearer of the two, less the bin itself */
-    run = 0.0f;
-    for (int i = s0; i >= 0; i--) {
-        run = occ[i] >= thr ? 0.0f : run + 1.0f;
-        float m = l2_min(run, g[i]);
-        g[i] = m == 0.0f ? 0.0f : l2_min(m - 1.0f, 65535.0f);
-    }
-    for (int i = n - 1; i > s0; i--) {
-        run = occ[i] >= thr ? 0.0f : run + 1.0f;
-        float m = l2_min(run, g[i]);
-        g[i] = m == 0.0f ? 0.0f : l2_min(m - 1.0f, 65535.0f);
+        const l2_v8i one = {1, 1, 1, 1, 1, 1, 1, 1};
+        l2_v8i run = one * (1 << 22);
+        for (int lap = 0; lap < 2; lap++)
+            for (int i = 0; i < n; i++) {
+                l2_v8f o = {occ[i], occ[i], occ[i], occ[i], occ[i], occ[i], occ[i], occ[i]};
+                l2_v8i open = o >= thr;
+                run = (run + one) & ~open;
+                if (lap)
+                    memcpy(fw + (size_t)i * 8, &run, sizeof run);
+            }
+        run = one * (1 << 22);
+        int top = pm->depth_levels - l0 < 8 ? pm->depth_levels - l0 : 8;
+        for (int lap = 0; lap < 2; lap++)
+            for (int i = n - 1; i >= 0; i--) {
+                l2_v8f o = {occ[i], occ[i], occ[i], occ[i], occ[i], occ[i], occ[i], occ[i]};
+                l2_v8i open = o >= thr;
+                run = (run + one) & ~open;
+                if (!lap)
+                    continue;
+                l2_v8i f;
+                memcpy(&f, fw + (size_t)i * 8, sizeof f);
+                l2_v8i lt = f < run;
+                l2_v8i m = (f & lt) | (run & ~lt);
+                /* the nearer of the two, less the bin itself */
+                m = m - one;
+                l2_v8i neg = m < 0 * one;
+                m = m & ~neg;
+                l2_v8i big = m > one * 65535;
+                m = (m & ~big) | ((one * 65535) & big);
+                for (int j = 0; j < top; j++)
+                    pm->gap[(size_t)(l0 + j) * n + i] = (float)m[j];
+            }
     }
 }
 
@@ -389,8 +399,8 @@ lx_status l2_polar_build(const lx_light2d *ctx, l2_prep *p)
         penumbra_reach(pm, l->softness, pm->tmin);
         for (int i = 0; i < n; i++)
             pm->qocc[i] = 1.0f / l2_max(occ[i], 0.5f);
-        for (int lv = 0; lv < depth_levels; lv++)
-            open_gaps(pm, lv);
+        /* scratch: the sparse table (levels x n >= 8 n floats) */
+        open_gaps(pm, (int32_t *)pm->tmax);
     }
     for (int rep = 0; rep < 3; rep++)
         memcpy(pm->occx + (size_t)rep * n, occ, (size_t)n * sizeof *occ);
