@@ -582,6 +582,37 @@ static void corner_bins(const l2_polar *pm, const float p[4], int *b0, int *b1)
     *b1 = b;
 }
 
+/* Loops of the block tests over a run of rays [i0, i1] without an early
+ * exit, so that they vectorize (the same comparisons, order free). */
+L2_CLONES static bool any_at_least(const float *restrict v, int i0, int i1, float x)
+{
+    int any = 0;
+    for (int i = i0; i <= i1; i++)
+        any |= v[i] >= x;
+    return any != 0;
+}
+
+L2_CLONES static float run_max(const float *restrict v, int i0, int i1, float m)
+{
+    for (int i = i0; i <= i1; i++)
+        m = l2_max(m, v[i]);
+    return m;
+}
+
+/* Whether some ray of [i0, i1] has an open ray within its penumbra window
+ * at the block (block_dark). */
+L2_CLONES static bool any_window_open(const float *restrict qocc, const float *restrict g, int i0,
+                                      int i1, float s, float inv, float sc, float bpp, float kcap)
+{
+    int any = 0;
+    for (int i = i0; i <= i1; i++) {
+        float k = s * (qocc[i] - inv) * sc * bpp;
+        k = l2_min(k, kcap);
+        any |= (k >= 0.5f) & (k > g[i]);
+    }
+    return any != 0;
+}
+
 /* Whether the light leaves every pixel of the block dark (as shading
  * them would), given the block's geometry: its pixel centres' nearest and
  * farthest distance, rays [b0, b1] (one more each side) and the corners'
@@ -612,9 +643,8 @@ static bool block_dark(const l2_prep *p, bool has_caster, float dmin, float dmax
     }
     if (faces)
         for (int r = 0; r < runs; r++)
-            for (int b = r0[r]; b <= r1[r]; b++)
-                if (pm->ex[b] >= before)
-                    return false;
+            if (any_at_least(pm->ex, r0[r], r1[r], before))
+                return false;
     if (l->softness <= 0.0f)
         return true;
     /* and, as shade.c tests each pixel, no open ray in the penumbra window
@@ -637,12 +667,8 @@ static bool block_dark(const l2_prep *p, bool has_caster, float dmin, float dmax
     float kcap = 0.5f * (float)n - 1.0f;
     const float *g = pm->gap + (size_t)l2_depth_level(dmin, pm->depth_levels - 1) * n;
     for (int r = 0; r < runs; r++)
-        for (int i = r0[r]; i <= r1[r]; i++) {
-            float k = l->softness * (pm->qocc[i] - inv) * sc * pm->bins_per_p;
-            k = l2_min(k, kcap);
-            if (k >= 0.5f && k > g[i])
-                return false;
-        }
+        if (any_window_open(pm->qocc, g, r0[r], r1[r], l->softness, inv, sc, pm->bins_per_p, kcap))
+            return false;
     return true;
 }
 
@@ -666,9 +692,9 @@ static bool block_lit(const l2_prep *p, bool has_caster, float fx, float fy, int
         return true;
     /* and in no occluder's penumbra wedge (shade.c: d x lit[b] < 1) */
     int a = wrap(b0, n), e = a + (b1 - b0);
-    float most = 0.0f;
-    for (int b = a; b <= e; b++)
-        most = l2_max(most, pm->lit[b < n ? b : b - n]);
+    float most = run_max(pm->lit, a, e < n ? e : n - 1, 0.0f);
+    if (e >= n)
+        most = run_max(pm->lit, 0, e - n, most);
     return dmax * most < 1.0f;
 }
 
