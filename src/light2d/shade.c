@@ -190,6 +190,17 @@ static void shade_span(const lx_light2d *ctx, const l2_prep *p, int y, int xs, i
     }
 }
 
+/* A row's three planes as RGB triples (restrict: it vectorizes). */
+L2_CLONES static void interleave(float *restrict o, const float *restrict r,
+                                 const float *restrict g, const float *restrict b, int w)
+{
+    for (int x = 0; x < w; x++) {
+        o[3 * x] = r[x];
+        o[3 * x + 1] = g[x];
+        o[3 * x + 2] = b[x];
+    }
+}
+
 /* Adds a cached light's row. */
 static void add_cached(const lx_light2d *ctx, const l2_prep *p, int y, float *acc)
 {
@@ -339,14 +350,8 @@ lx_status lx_light2d_render(lx_light2d *ctx, lx_vec3 ambient, const lx_image *al
             for (int y = y0; y < y1; y++) {
                 const float *r = acc + (size_t)(y - y0) * w * 3, *g = r + w, *b = g + w;
                 size_t row = (size_t)y * w * 3;
-                if (light_map) {
-                    float *lm = light_map + row;
-                    for (int x = 0; x < w; x++) {
-                        lm[3 * x] = r[x];
-                        lm[3 * x + 1] = g[x];
-                        lm[3 * x + 2] = b[x];
-                    }
-                }
+                if (light_map)
+                    interleave(light_map + row, r, g, b, w);
                 if (out) {
                     float *o = out + row;
                     if (albedo) {
@@ -356,13 +361,8 @@ lx_status lx_light2d_render(lx_light2d *ctx, lx_vec3 ambient, const lx_image *al
                             o[3 * x + 1] = a[ach * x + 1] * g[x];
                             o[3 * x + 2] = a[ach * x + 2] * b[x];
                         }
-                    } else {
-                        for (int x = 0; x < w; x++) {
-                            o[3 * x] = r[x];
-                            o[3 * x + 1] = g[x];
-                            o[3 * x + 2] = b[x];
-                        }
-                    }
+                    } else
+                        interleave(o, r, g, b, w);
                 }
             }
         }
