@@ -37,7 +37,9 @@ static void classify(const float *restrict occ, const float *restrict ex,
         bool pen = !(de * lit[b] < 1.0f);
         bool reach = face | (d < o);
         float u2 = ua[i] * ua[i];
-        float k = s * (qocc[b] - 1.0f / d) * (1.0f + u2) * bpp;
+        /* qocc[b], computed again (the same operation) rather than
+         * gathered */
+        float k = s * (1.0f / l2_max(o, 0.5f) - 1.0f / d) * (1.0f + u2) * bpp;
         k = l2_min(k, kcap);
         int lv = l2_depth_level(l2_max(d, L2_DEPTH0), dtop);
         bool closed = (k < 0.5f) | ((d >= L2_DEPTH0) & (k <= gap[lv * nb + b]));
