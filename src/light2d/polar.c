@@ -431,9 +431,13 @@ static inline float range_query(const l2_polar *pm, const float *table, int lo, 
     int len = hi - lo + 1;
     int k = 31 - __builtin_clz((unsigned)len);
     const float *t = table + (size_t)k * n;
-    /* windows are under n rays and centred in [0, n]: one wrap at most */
-    int a = wrap(lo, n);
-    int b = wrap(hi - (1 << k) + 1, n);
+    /* windows are under n rays and centred in [0, n]: one wrap at most,
+     * and most windows need none */
+    int a = lo, b = hi - (1 << k) + 1;
+    if (lo < 0 || hi >= n) {
+        a = wrap(a, n);
+        b = wrap(b, n);
+    }
     return max ? l2_max(t[a], t[b]) : l2_min(t[a], t[b]);
 }
 
