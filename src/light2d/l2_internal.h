@@ -26,6 +26,17 @@ static inline float l2_max(float a, float b)
  * drops the blocks of L2_BLOCK x L2_BLOCK pixels it leaves wholly dark. */
 #define L2_BLOCK 8
 
+/* The per-pixel passes of a span run over whole vectors of 8 pixels: the
+ * caster mask and the normal planes are allocated with this many spare
+ * (zero) values after them, and the scratch arrays of a span are
+ * l2_scratch_stride floats apart. Lanes past the span are computed and
+ * dropped. */
+#define L2_PAD 8
+static inline size_t l2_scratch_stride(int width)
+{
+    return ((size_t)width + L2_PAD + 7) & ~(size_t)7;
+}
+
 /* Which 4-neighbours of a boundary pixel are free (not casters, or outside
  * the image). */
 enum { L2_FREE_LEFT = 1, L2_FREE_RIGHT = 2, L2_FREE_UP = 4, L2_FREE_DOWN = 8 };
