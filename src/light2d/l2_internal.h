@@ -170,19 +170,18 @@ int l2_ray_count(const lx_light2d *ctx, float radius);
 lx_status l2_polar_build(const lx_light2d *ctx, l2_prep *p);
 void l2_polar_free(l2_polar *pm);
 
-/* Soft visibility at distance d on the ray at continuous bin c, u2 the
- * squared slope of the pseudo-angle there, for a point its own ray reaches
- * (d before the ray's occluder, or on a lit face): the penumbra of the
- * nearest occluder whose window holds it (polar.c). */
-float l2_soft_visibility(const l2_polar *pm, float s, float c, float u2, float d);
-/* Fraction of the window [c - k, c + k] (in bins, 0.5 <= k < n/2) whose
- * rays reach past d: the percentage-closer filter (polar.c). For a point
- * in its ray's hard shadow (ray b, occluder o), the window is that
- * occluder's penumbra, k = min(s (1/max(o, 0.5) - 1/d) x scale, n/2 - 1),
- * scale the bins per radian there. The window must hold a ray that does
- * not reach past d (both callers' windows do): a window whose every ray
- * reaches past it would not be found fully lit from its minimum. */
-float l2_filter(const l2_polar *pm, float c, float k, float d);
+/* The penumbra pixels of a span of a soft light (polar.c): fa[i] times
+ * the pixel's visibility where code[i] (n8 bytes, a multiple of 8) says
+ * 1 or 2. code 1, a pixel its own ray reaches (da before the ray's
+ * occluder, or dea on a lit face): the penumbra of the nearest occluder
+ * whose window holds it, found by range minima and then filtered. code
+ * 2, a pixel in its ray's hard shadow: the percentage-closer filter over
+ * its occluder's window [c - k, c + k] (ka, in bins, 0.5 <= k < n/2), the
+ * fraction of its rays that reach past da; k = min(s (1/max(o, 0.5) -
+ * 1/d) x scale, n/2 - 1), scale the bins per radian there. ca: the pixels'
+ * continuous bins, ua the slopes of their pseudo-angles. */
+void l2_penumbrae(const l2_polar *pm, float s, int n8, const uint8_t *code, const float *ca,
+                  const float *ua, const float *dea, const float *da, const float *ka, float *fa);
 
 /* What the light does to the pixels of the block [x0, x1) x [y0, y1),
  * exactly as shading them would find (polar.c): L2_BLOCK_DARK, it leaves

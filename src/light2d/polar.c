@@ -512,19 +512,12 @@ static inline float filter(const l2_polar *pm, float c, float k, float d, bool r
     return (float)lit / L2_MAX_TAPS;
 }
 
-L2_CLONES
-float l2_filter(const l2_polar *pm, float c, float k, float d)
-{
-    return filter(pm, c, k, d, false);
-}
-
 /* Soft visibility at distance d on the ray at continuous bin c: the
  * nearest occluder o in a search window (the window an occluder at d/8
  * would need), then the filter over the half-angle softness (d - o) /
  * (d o), the angle a light of radius softness subtends behind o, with o
  * the nearest occluder inside that window. */
-L2_CLONES
-float l2_soft_visibility(const l2_polar *pm, float s, float c, float u2, float d)
+static inline float soft_visibility(const l2_polar *pm, float s, float c, float u2, float d)
 {
     float scale = (1.0f + u2) * pm->bins_per_p; /* bins per radian */
     float cap = 0.5f * (float)pm->n - 1.0f;
@@ -554,6 +547,24 @@ float l2_soft_visibility(const l2_polar *pm, float s, float c, float u2, float d
     /* the point's own ray reaches past it (d is before its occluder, or
      * on its lit face) and lies in the window (k >= 0.5) */
     return filter(pm, c, k, d, true);
+}
+
+L2_CLONES
+void l2_penumbrae(const l2_polar *pm, float s, int n8, const uint8_t *code, const float *ca,
+                  const float *ua, const float *dea, const float *da, const float *ka, float *fa)
+{
+    for (int i0 = 0; i0 < n8; i0 += 8) {
+        uint64_t word;
+        memcpy(&word, code + i0, sizeof word);
+        if (!word)
+            continue;
+        for (int i = i0; i < i0 + 8; i++) {
+            if (code[i] == 1)
+                fa[i] *= soft_visibility(pm, s, ca[i], ua[i] * ua[i], dea[i]);
+            else if (code[i] == 2)
+                fa[i] *= filter(pm, ca[i], ka[i], da[i], false);
+        }
+    }
 }
 
 /* The bins [b0, b1] of a square from its corners' pseudo-angles p[4]

@@ -160,18 +160,7 @@ static void shade_span(const lx_light2d *ctx, const l2_prep *p, int y, int xs, i
          * pixels at a time where none is listed */
         for (int i = n; i < n8; i++)
             code[i] = 0;
-        for (int i0 = 0; i0 < n8; i0 += 8) {
-            uint64_t word;
-            memcpy(&word, code + i0, sizeof word);
-            if (!word)
-                continue;
-            for (int i = i0; i < i0 + 8; i++) {
-                if (code[i] == 1)
-                    fa[i] *= l2_soft_visibility(pm, s, ca[i], ua[i] * ua[i], dea[i]);
-                else if (code[i] == 2)
-                    fa[i] *= l2_filter(pm, ca[i], ka[i], da[i]);
-            }
-        }
+        l2_penumbrae(pm, s, n8, code, ca, ua, dea, da, ka, fa);
     }
     /* the row's three planes of light (and the cache row's) */
     float cr = p->rgb.x, cg = p->rgb.y, cb = p->rgb.z;
