@@ -230,7 +230,7 @@ lx_status lx_light2d_create(const lx_image *casters, const lx_light2d_desc *desc
     ctx->tiles_y = (ctx->height + L2_TILE - 1) / L2_TILE;
     ctx->blocks_x = (ctx->width + L2_BLOCK - 1) / L2_BLOCK;
     ctx->blocks_y = (ctx->height + L2_BLOCK - 1) / L2_BLOCK;
-    ctx->caster = malloc((size_t)ctx->width * ctx->height);
+    ctx->caster = calloc((size_t)ctx->width * ctx->height + L2_PAD, 1);
     ctx->block_caster = malloc((size_t)ctx->blocks_x * ctx->blocks_y);
     if (!ctx->caster || !ctx->block_caster) {
         free(ctx->caster);
@@ -288,7 +288,7 @@ lx_status lx_light2d_set_normals(lx_light2d *ctx, const lx_image *normals, bool 
         return lx_fail(LX_ERR_INVALID, "normals: %d channel%s, not RGB", normals->channels,
                        normals->channels == 1 ? "" : "s");
     size_t count = (size_t)ctx->width * ctx->height;
-    float *n = malloc(count * 3 * sizeof *n);
+    float *n = calloc(count * 3 + L2_PAD, sizeof *n);
     if (!n)
         return lx_fail(LX_ERR_NOMEM, "normals: out of memory");
     int ch = normals->channels;

@@ -26,6 +26,17 @@ static inline float l2_max(float a, float b)
  * drops the blocks of L2_BLOCK x L2_BLOCK pixels it leaves wholly dark. */
 #define L2_BLOCK 8
 
+/* The per-pixel passes of a span run over whole vectors of 8 pixels: the
+ * caster mask and the normal planes are allocated with this many spare
+ * (zero) values after them, and the scratch arrays of a span are
+ * l2_scratch_stride floats apart. Lanes past the span are computed and
+ * dropped. */
+#define L2_PAD 8
+static inline size_t l2_scratch_stride(int width)
+{
+    return ((size_t)width + L2_PAD + 7) & ~(size_t)7;
+}
+
 /* Which 4-neighbours of a boundary pixel are free (not casters, or outside
  * the image). */
 enum { L2_FREE_LEFT = 1, L2_FREE_RIGHT = 2, L2_FREE_UP = 4, L2_FREE_DOWN = 8 };
@@ -34,6 +45,13 @@ typedef struct l2_edge {
     uint16_t x, y;
     uint8_t free;
 } l2_edge;
+
+/* A boundary pixel where rays leave their caster run: its bins [b0, b1]
+ * (b1 may pass n: wrap) and the distance of its far corner. */
+typedef struct l2_exit {
+    int b0, b1;
+    float df;
+} l2_exit;
 
 /* A light's polar shadow map: n rays over the pseudo-angle p in [0, 8)
  * (the point where the ray meets the unit square around the light, walked
@@ -51,6 +69,8 @@ typedef struct l2_polar {
      * inverse distance per ray: a pixel on ray b at distance d with
      * d * lit[b] < 1 lies in no occluder's penumbra (fully lit) */
     float *lit;
+    uint8_t *sel; /* per ray, the cone of penumbra_reach (polar.c) for n = sel_n */
+    int sel_n;
     /* soft lights: 1 / max(occ, 0.5) per ray, and per depth level l (the
      * distances from L2_DEPTH0 x 2^(l/2) on) the whole bins between each
      * ray and the nearest ray whose occluder lies at that distance or
@@ -63,6 +83,8 @@ typedef struct l2_polar {
     int gap_capacity;
     float *tmin, *tmax; /* levels x n */
     int levels;
+    l2_exit *exits; /* scratch of l2_polar_build */
+    size_t exit_capacity;
     int capacity; /* floats allocated per array (occ, ex: n; tables: levels*n) */
     int table_capacity;
 } l2_polar;
@@ -148,31 +170,28 @@ int l2_ray_count(const lx_light2d *ctx, float radius);
 lx_status l2_polar_build(const lx_light2d *ctx, l2_prep *p);
 void l2_polar_free(l2_polar *pm);
 
-/* Soft visibility at distance d on the ray at continuous bin c, u2 the
- * squared slope of the pseudo-angle there, for a point its own ray reaches
- * (d before the ray's occluder, or on a lit face): the penumbra of the
- * nearest occluder whose window holds it (polar.c). */
-float l2_soft_visibility(const l2_polar *pm, float s, float c, float u2, float d);
-/* Fraction of the window [c - k, c + k] (in bins, 0.5 <= k < n/2) whose
- * rays reach past d: the percentage-closer filter (polar.c). For a point
- * in its ray's hard shadow (ray b, occluder o), the window is that
- * occluder's penumbra, k = min(s (1/max(o, 0.5) - 1/d) x scale, n/2 - 1),
- * scale the bins per radian there. The window must hold a ray that does
- * not reach past d (both callers' windows do): a window whose every ray
- * reaches past it would not be found fully lit from its minimum. */
-float l2_filter(const l2_polar *pm, float c, float k, float d);
+/* The penumbra pixels of a span of a soft light (polar.c): fa[i] times
+ * the pixel's visibility where code[i] (n8 bytes, a multiple of 8) says
+ * 1 or 2. code 1, a pixel its own ray reaches (da before the ray's
+ * occluder, or dea on a lit face): the penumbra of the nearest occluder
+ * whose window holds it, found by range minima and then filtered. code
+ * 2, a pixel in its ray's hard shadow: the percentage-closer filter over
+ * its occluder's window [c - k, c + k] (ka, in bins, 0.5 <= k < n/2), the
+ * fraction of its rays that reach past da; k = min(s (1/max(o, 0.5) -
+ * 1/d) x scale, n/2 - 1), scale the bins per radian there. ca: the pixels'
+ * continuous bins, ua the slopes of their pseudo-angles. */
+void l2_penumbrae(const l2_polar *pm, float s, int n8, const uint8_t *code, const float *ca,
+                  const float *ua, const float *dea, const float *da, const float *ka, float *fa);
 
-/* Whether the light leaves every pixel of the block [x0, x1) x [y0, y1)
- * dark (exactly what shading them would give: out of reach, or in a hard
- * shadow whose penumbra window holds no open ray, and no caster pixel
- * within a ray's first caster run); has_caster: the block holds a caster
- * pixel (polar.c). */
-bool l2_block_dark(const l2_prep *p, int x0, int y0, int x1, int y1, bool has_caster);
-
-/* Whether the light's shadows leave every pixel of the block [x0, x1) x
- * [y0, y1) its full light (each before its ray's occluder and, for soft
- * lights, in no occluder's penumbra wedge), so that shading them may skip
- * the shadow pass; has_caster as for l2_block_dark (polar.c). */
-bool l2_block_lit(const l2_prep *p, int x0, int y0, int x1, int y1, bool has_caster);
+/* What the light does to the pixels of the block [x0, x1) x [y0, y1),
+ * exactly as shading them would find (polar.c): L2_BLOCK_DARK, it leaves
+ * every one dark (out of reach, or in a hard shadow whose penumbra window
+ * holds no open ray, and no caster pixel within a ray's first caster
+ * run); L2_BLOCK_LIT, its shadows leave every one its full light (each
+ * before its ray's occluder and, for soft lights, in no occluder's
+ * penumbra wedge), so that shading may skip the shadow pass; else
+ * L2_BLOCK_MIXED. has_caster: the block holds a caster pixel. */
+enum { L2_BLOCK_DARK = 0, L2_BLOCK_LIT = 1, L2_BLOCK_MIXED = 2 };
+int l2_block_kind(const l2_prep *p, int x0, int y0, int x1, int y1, bool has_caster);
 
 #endif

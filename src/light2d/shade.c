@@ -37,7 +37,9 @@ static void classify(const float *restrict occ, const float *restrict ex,
         bool pen = !(de * lit[b] < 1.0f);
         bool reach = face | (d < o);
         float u2 = ua[i] * ua[i];
-        float k = s * (qocc[b] - 1.0f / d) * (1.0f + u2) * bpp;
+        /* qocc[b], computed again (the same operation) rather than
+         * gathered */
+        float k = s * (1.0f / l2_max(o, 0.5f) - 1.0f / d) * (1.0f + u2) * bpp;
         k = l2_min(k, kcap);
         int lv = l2_depth_level(l2_max(d, L2_DEPTH0), dtop);
         bool closed = (k < 0.5f) | ((d >= L2_DEPTH0) & (k <= gap[lv * nb + b]));
@@ -52,8 +54,8 @@ static void classify(const float *restrict occ, const float *restrict ex,
 
 /* Adds the light's contribution to the pixels [xs, xe) of row y into acc
  * (the row's width*3 floats), and to its cache row when it is a static
- * light being re-lit (the caller cleared that row); scratch holds 8*width
- * floats. */
+ * light being re-lit (the caller cleared that row); scratch holds 8
+ * arrays of l2_scratch_stride(width) floats. */
 L2_CLONES
 static void shade_span(const lx_light2d *ctx, const l2_prep *p, int y, int xs, int xe,
                        float *acc, float *scratch, bool shadows)
@@ -70,14 +72,16 @@ static void shade_span(const lx_light2d *ctx, const l2_prep *p, int y, int xs, i
     int n = xb - xa;
     if (n <= 0)
         return;
+    /* the vector passes run over whole vectors (L2_PAD) */
+    int n8 = (n + 7) & ~7;
+    size_t ws = l2_scratch_stride(ctx->width);
     /* pass 1, branch-free so that it vectorizes: distance, falloff and the
      * continuous polar bin of every pixel of the span */
-    float *fa = scratch, *da = scratch + ctx->width, *ca = scratch + 2 * ctx->width,
-          *ua = scratch + 3 * ctx->width;
+    float *fa = scratch, *da = scratch + ws, *ca = scratch + 2 * ws, *ua = scratch + 3 * ws;
     float lx = l->x, r2 = p->r2, inv_r = p->inv_r, inv_r2 = p->inv_r2;
     float bpp = p->polar.bins_per_p;
     int kind = (int)l->falloff;
-    for (int i = 0; i < n; i++) {
+    for (int i = 0; i < n8; i++) {
         float dx = (float)(xa + i) + 0.5f - lx;
         float d2 = dx * dx + dy2;
         float d = sqrtf(d2);
@@ -96,7 +100,7 @@ static void shade_span(const lx_light2d *ctx, const l2_prep *p, int y, int xs, i
     }
     if (p->spot) {
         float cx = p->dir_x, cy = p->dir_y, co = p->cos_outer, ci = p->cos_inner, k = p->inv_fade;
-        for (int i = 0; i < n; i++) {
+        for (int i = 0; i < n8; i++) {
             float dx = (float)(xa + i) + 0.5f - lx;
             float d = da[i];
             float c = d > 0.0f ? (dx * cx + dy * cy) / d : 1.0f;
@@ -110,7 +114,7 @@ static void shade_span(const lx_light2d *ctx, const l2_prep *p, int y, int xs, i
         const float *nx = ctx->normals + (size_t)y * ctx->width + xa, *ny = nx + plane,
                     *nz = nx + 2 * plane;
         float h = l->height, h2 = h * h;
-        for (int i = 0; i < n; i++) {
+        for (int i = 0; i < n8; i++) {
             float dx = (float)(xa + i) + 0.5f - lx;
             float ndl = -dx * nx[i] - dy * ny[i] + h * nz[i];
             float len = sqrtf(da[i] * da[i] + h2);
@@ -148,27 +152,15 @@ static void shade_span(const lx_light2d *ctx, const l2_prep *p, int y, int xs, i
         bool face_ok = !l->self_shadow;
         float kcap = 0.5f * (float)nb - 1.0f, s = l->softness;
         int dtop = pm->depth_levels - 1;
-        float *dea = scratch + 4 * ctx->width, *ka = scratch + 5 * ctx->width;
-        uint8_t *code = (uint8_t *)(scratch + 6 * ctx->width); /* 4 width bytes */
-        classify(pm->occ, pm->ex, pm->lit, pm->qocc, pm->gap, nb, n, face_ok, s, kcap, bpp, dtop,
+        float *dea = scratch + 4 * ws, *ka = scratch + 5 * ws;
+        uint8_t *code = (uint8_t *)(scratch + 6 * ws); /* 4 ws bytes */
+        classify(pm->occ, pm->ex, pm->lit, pm->qocc, pm->gap, nb, n8, face_ok, s, kcap, bpp, dtop,
                  caster, da, ca, ua, fa, dea, ka, code);
-        /* 2b: the penumbrae, skipping eight pixels at a time where none is
-         * listed */
-        int n8 = (n + 7) & ~7;
+        /* 2b: the penumbrae (of the span's pixels alone), skipping eight
+         * pixels at a time where none is listed */
         for (int i = n; i < n8; i++)
             code[i] = 0;
-        for (int i0 = 0; i0 < n8; i0 += 8) {
-            uint64_t word;
-            memcpy(&word, code + i0, sizeof word);
-            if (!word)
-                continue;
-            for (int i = i0; i < i0 + 8; i++) {
-                if (code[i] == 1)
-                    fa[i] *= l2_soft_visibility(pm, s, ca[i], ua[i] * ua[i], dea[i]);
-                else if (code[i] == 2)
-                    fa[i] *= l2_filter(pm, ca[i], ka[i], da[i]);
-            }
-        }
+        l2_penumbrae(pm, s, n8, code, ca, ua, dea, da, ka, fa);
     }
     /* the row's three planes of light (and the cache row's) */
     float cr = p->rgb.x, cg = p->rgb.y, cb = p->rgb.z;
@@ -187,6 +179,17 @@ static void shade_span(const lx_light2d *ctx, const l2_prep *p, int y, int xs, i
         ar[i] += cr * fa[i];
         ag[i] += cg * fa[i];
         ab[i] += cb * fa[i];
+    }
+}
+
+/* A row's three planes as RGB triples (restrict: it vectorizes). */
+L2_CLONES static void interleave(float *restrict o, const float *restrict r,
+                                 const float *restrict g, const float *restrict b, int w)
+{
+    for (int x = 0; x < w; x++) {
+        o[3 * x] = r[x];
+        o[3 * x + 1] = g[x];
+        o[3 * x + 2] = b[x];
     }
 }
 
@@ -233,9 +236,10 @@ static void shade_band(const lx_light2d *ctx, const l2_prep *p, int y0, int y1, 
         xs = xs > p->x0 ? xs : p->x0;
         xe = xe < p->x1 ? xe : p->x1;
         bool caster = ctx->block_caster[(size_t)by * ctx->blocks_x + bx] != 0;
-        if (l2_block_dark(p, xs, ya, xe, yb, caster))
+        int bk = l2_block_kind(p, xs, ya, xe, yb, caster);
+        if (bk == L2_BLOCK_DARK)
             continue;
-        int kind = l2_block_lit(p, xs, ya, xe, yb, caster) ? 0 : 1;
+        int kind = bk == L2_BLOCK_LIT ? 0 : 1;
         if (count > 0 && runs[3 * count - 2] == xs && runs[3 * count - 1] == kind)
             runs[3 * count - 2] = xe;
         else {
@@ -294,7 +298,7 @@ lx_status lx_light2d_render(lx_light2d *ctx, lx_vec3 ambient, const lx_image *al
         return st;
     /* per thread: a band of accumulated rows, eight rows of scratch and the
      * runs of a band */
-    size_t band = (size_t)L2_BLOCK * w * 3, per = band + (size_t)w * 8;
+    size_t band = (size_t)L2_BLOCK * w * 3, per = band + l2_scratch_stride(w) * 8;
     size_t nruns = 3 * ((size_t)ctx->blocks_x + 1);
     /* kept from frame to frame (a fresh block of this size would be new
      * pages, faulted in and cleared every frame) */
@@ -338,14 +342,8 @@ lx_status lx_light2d_render(lx_light2d *ctx, lx_vec3 ambient, const lx_image *al
             for (int y = y0; y < y1; y++) {
                 const float *r = acc + (size_t)(y - y0) * w * 3, *g = r + w, *b = g + w;
                 size_t row = (size_t)y * w * 3;
-                if (light_map) {
-                    float *lm = light_map + row;
-                    for (int x = 0; x < w; x++) {
-                        lm[3 * x] = r[x];
-                        lm[3 * x + 1] = g[x];
-                        lm[3 * x + 2] = b[x];
-                    }
-                }
+                if (light_map)
+                    interleave(light_map + row, r, g, b, w);
                 if (out) {
                     float *o = out + row;
                     if (albedo) {
@@ -355,13 +353,8 @@ lx_status lx_light2d_render(lx_light2d *ctx, lx_vec3 ambient, const lx_image *al
                             o[3 * x + 1] = a[ach * x + 1] * g[x];
                             o[3 * x + 2] = a[ach * x + 2] * b[x];
                         }
-                    } else {
-                        for (int x = 0; x < w; x++) {
-                            o[3 * x] = r[x];
-                            o[3 * x + 1] = g[x];
-                            o[3 * x + 2] = b[x];
-                        }
-                    }
+                    } else
+                        interleave(o, r, g, b, w);
                 }
             }
         }
