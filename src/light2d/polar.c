@@ -67,14 +67,10 @@ void l2_polar_free(l2_polar *pm)
     memset(pm, 0, sizeof *pm);
 }
 
-/* The bins [b0, b1] (b1 may pass n: wrap) the square [ax,bx] x [ay,by]
- * (relative to the light, not containing it) covers. */
-static void square_bins(const l2_polar *pm, float ax, float bx, float ay, float by, int *b0,
-                        int *b1)
+/* The bins [b0, b1] of a square from its corners' pseudo-angles p[4]
+ * (the second half of square_bins). */
+static void corner_bins(const l2_polar *pm, const float p[4], int *b0, int *b1)
 {
-    float u;
-    float p[4] = {pseudo_angle(ax, ay, &u), pseudo_angle(bx, ay, &u), pseudo_angle(ax, by, &u),
-                  pseudo_angle(bx, by, &u)};
     float lo = p[0], hi = p[0];
     for (int k = 1; k < 4; k++) {
         lo = l2_min(lo, p[k]);
@@ -99,6 +95,17 @@ static void square_bins(const l2_polar *pm, float ax, float bx, float ay, float 
         b = a + n - 1;
     *b0 = a;
     *b1 = b;
+}
+
+/* The bins [b0, b1] (b1 may pass n: wrap) the square [ax,bx] x [ay,by]
+ * (relative to the light, not containing it) covers. */
+static void square_bins(const l2_polar *pm, float ax, float bx, float ay, float by, int *b0,
+                        int *b1)
+{
+    float u;
+    float p[4] = {pseudo_angle(ax, ay, &u), pseudo_angle(bx, ay, &u), pseudo_angle(ax, by, &u),
+                  pseudo_angle(bx, by, &u)};
+    corner_bins(pm, p, b0, b1);
 }
 
 static lx_status reserve(l2_polar *pm, int n, int levels, int depth_levels)
@@ -567,35 +574,6 @@ void l2_penumbrae(const l2_polar *pm, float s, int n8, const uint8_t *code, cons
     }
 }
 
-/* The bins [b0, b1] of a square from its corners' pseudo-angles p[4]
- * (square_bins' second half). */
-static void corner_bins(const l2_polar *pm, const float p[4], int *b0, int *b1)
-{
-    float lo = p[0], hi = p[0];
-    for (int k = 1; k < 4; k++) {
-        lo = l2_min(lo, p[k]);
-        hi = l2_max(hi, p[k]);
-    }
-    if (hi - lo > 4.0f) { /* the square straddles p = 0 */
-        lo = 8.0f;
-        hi = 0.0f;
-        for (int k = 0; k < 4; k++) {
-            float q = p[k] < 4.0f ? p[k] + 8.0f : p[k];
-            lo = l2_min(lo, q);
-            hi = l2_max(hi, q);
-        }
-    }
-    int n = pm->n;
-    int a = (int)(lo * pm->bins_per_p), b = (int)(hi * pm->bins_per_p);
-    if (a >= n) {
-        a -= n;
-        b -= n;
-    }
-    if (b > a + n - 1)
-        b = a + n - 1;
-    *b0 = a;
-    *b1 = b;
-}
 
 /* Loops of the block tests over a run of rays [i0, i1] without an early
  * exit, so that they vectorize (the same comparisons, order free). */

@@ -206,15 +206,14 @@ static void test_default_render_is_auto(void **state)
     lx_scene_destroy(s);
 }
 
-/* a 4 m floor at y = 0 with TEXCOORD_1 over the unit square, and camera 0
- * ("Cam", yfov 0.75) at node "rig": matrix with columns x -> (0,0,1),
- * y -> (0,1,0), z -> (-1,0,0) (90 degrees about Y: local -Z looks along
- * +X) and translation (-3, 1.5, 0.25); so eye (-3, 1.5, 0.25), forward
- * (1, 0, 0), up (0, 1, 0), all exact */
-static void test_gltf_camera_render(void **state)
+/* A 4 m floor at y = 0 with TEXCOORD_1 over the unit square, lit by an
+ * 8 x 8 page, and one camera node (`node_json`: its matrix and camera
+ * reference; `cameras_json`: the file's cameras), written to a fresh
+ * folder `name`, loaded into *scene and *lm. */
+static void floor_with_camera(const char *name, const char *node_json, const char *cameras_json,
+                              lx_scene **scene, lx_lightmaps *lm)
 {
-    (void)state;
-    const char *dir = lx_test_dir("render_camera_gltf");
+    const char *dir = lx_test_dir(name);
     static const float pos[] = {-2, 0, -2, -2, 0, 2, 2, 0, 2, 2, 0, -2};
     static const float nrm[] = {0, 1, 0, 0, 1, 0, 0, 1, 0, 0, 1, 0};
     static const float uv[] = {0, 0, 0, 1, 1, 1, 1, 0};
@@ -223,19 +222,15 @@ static void test_gltf_camera_render(void **state)
                            .uv1 = uv, .index_count = 6, .indices = idx, .material = -1};
     lx_test_gltf *g = lx_test_gltf_new();
     lx_test_gltf_node(g, "floor", lx_test_gltf_mesh(g, "floor", &p, 1), "");
-    lx_test_gltf_node(g, "rig", -1,
-                      "\"matrix\":[0,0,1,0, 0,1,0,0, -1,0,0,0, -3,1.5,0.25,1],\"camera\":0");
-    lx_test_gltf_top(g, "\"cameras\":[{\"name\":\"Cam\",\"type\":\"perspective\","
-                        "\"perspective\":{\"yfov\":0.75,\"aspectRatio\":1.0,\"znear\":0.1}}]");
+    lx_test_gltf_node(g, "rig", -1, node_json);
+    lx_test_gltf_top(g, cameras_json);
     char path[4096];
     snprintf(path, sizeof path, "%s/floor.gltf", dir);
     lx_test_gltf_write(g, path);
     lx_test_gltf_free(g);
-    lx_scene *s;
-    if (lx_scene_load(path, NULL, &s) != LX_OK)
+    if (lx_scene_load(path, NULL, scene) != LX_OK)
         fail_msg("%s", lx_last_error());
-    assert_int_equal(s->camera_count, 1);
-
+    assert_int_equal((*scene)->camera_count, 1);
     snprintf(path, sizeof path, "%s/floor.exr", dir);
     write_page(path, 8, 8);
     snprintf(path, sizeof path, "%s/manifest.json", dir);
@@ -243,9 +238,25 @@ static void test_gltf_camera_render(void **state)
                      "\"pages\":[{\"file\":\"floor.exr\",\"width\":8,\"height\":8}],"
                      "\"nodes\":[{\"node\":\"floor\",\"meshes\":[\"floor\"],\"page\":0,"
                      "\"scale_offset\":[1,1,0,0],\"uv_set\":\"TEXCOORD_1\"}]}");
-    lx_lightmaps lm;
-    if (lx_lightmaps_load(dir, NULL, &lm) != LX_OK)
+    if (lx_lightmaps_load(dir, NULL, lm) != LX_OK)
         fail_msg("%s", lx_last_error());
+}
+
+/* the floor with camera 0 ("Cam", yfov 0.75) at node "rig": matrix with
+ * columns x -> (0,0,1),
+ * y -> (0,1,0), z -> (-1,0,0) (90 degrees about Y: local -Z looks along
+ * +X) and translation (-3, 1.5, 0.25); so eye (-3, 1.5, 0.25), forward
+ * (1, 0, 0), up (0, 1, 0), all exact */
+static void test_gltf_camera_render(void **state)
+{
+    (void)state;
+    lx_scene *s;
+    lx_lightmaps lm;
+    floor_with_camera("render_camera_gltf",
+                      "\"matrix\":[0,0,1,0, 0,1,0,0, -1,0,0,0, -3,1.5,0.25,1],\"camera\":0",
+                      "\"cameras\":[{\"name\":\"Cam\",\"type\":\"perspective\","
+                      "\"perspective\":{\"yfov\":0.75,\"aspectRatio\":1.0,\"znear\":0.1}}]",
+                      &s, &lm);
     float coverage[40 * 30];
     lx_render_desc d = {.width = 40, .height = 30, .samples = 2, .coverage = coverage};
     d.camera = lx_camera_from_scene(&s->cameras[0]);
@@ -274,38 +285,14 @@ static void test_gltf_camera_render(void **state)
 static void test_orthographic_render(void **state)
 {
     (void)state;
-    const char *dir = lx_test_dir("render_camera_ortho");
-    static const float pos[] = {-2, 0, -2, -2, 0, 2, 2, 0, 2, 2, 0, -2};
-    static const float nrm[] = {0, 1, 0, 0, 1, 0, 0, 1, 0, 0, 1, 0};
-    static const float uv[] = {0, 0, 0, 1, 1, 1, 1, 0};
-    static const uint32_t idx[] = {0, 1, 2, 0, 2, 3};
-    lx_test_primitive p = {.vertex_count = 4, .position = pos, .normal = nrm, .uv0 = uv,
-                           .uv1 = uv, .index_count = 6, .indices = idx, .material = -1};
-    lx_test_gltf *g = lx_test_gltf_new();
-    lx_test_gltf_node(g, "floor", lx_test_gltf_mesh(g, "floor", &p, 1), "");
     /* 90 degrees about X: local -Z looks down -Y, local +Y is -Z */
-    lx_test_gltf_node(g, "top", -1,
-                      "\"matrix\":[1,0,0,0, 0,0,-1,0, 0,1,0,0, 0,2,0,1],\"camera\":0");
-    lx_test_gltf_top(g, "\"cameras\":[{\"type\":\"orthographic\",\"orthographic\":"
-                        "{\"xmag\":4,\"ymag\":4,\"znear\":0,\"zfar\":10}}]");
-    char path[4096];
-    snprintf(path, sizeof path, "%s/floor.gltf", dir);
-    lx_test_gltf_write(g, path);
-    lx_test_gltf_free(g);
     lx_scene *s;
-    if (lx_scene_load(path, NULL, &s) != LX_OK)
-        fail_msg("%s", lx_last_error());
-    assert_int_equal(s->camera_count, 1);
-    snprintf(path, sizeof path, "%s/floor.exr", dir);
-    write_page(path, 8, 8);
-    snprintf(path, sizeof path, "%s/manifest.json", dir);
-    write_text(path, "{\"scene\":\"floor.gltf\",\"quantity\":\"irradiance\",\"unit\":\"lx\","
-                     "\"pages\":[{\"file\":\"floor.exr\",\"width\":8,\"height\":8}],"
-                     "\"nodes\":[{\"node\":\"floor\",\"meshes\":[\"floor\"],\"page\":0,"
-                     "\"scale_offset\":[1,1,0,0],\"uv_set\":\"TEXCOORD_1\"}]}");
     lx_lightmaps lm;
-    if (lx_lightmaps_load(dir, NULL, &lm) != LX_OK)
-        fail_msg("%s", lx_last_error());
+    floor_with_camera("render_camera_ortho",
+                      "\"matrix\":[1,0,0,0, 0,0,-1,0, 0,1,0,0, 0,2,0,1],\"camera\":0",
+                      "\"cameras\":[{\"type\":\"orthographic\",\"orthographic\":"
+                      "{\"xmag\":4,\"ymag\":4,\"znear\":0,\"zfar\":10}}]",
+                      &s, &lm);
     float coverage[32 * 32];
     lx_render_desc d = {.width = 32, .height = 32, .samples = 4, .coverage = coverage};
     d.camera = lx_camera_from_scene(&s->cameras[0]);
