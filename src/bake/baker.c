@@ -97,7 +97,8 @@ static float maps_from(const lx_baker *b)
 static bool bvh_progress(void *user, float fraction)
 {
     const lx_bake_desc *d = user;
-    return d->progress(d->progress_user, TEXEL_MAPS_SHARE + (BVH_SHARE - TEXEL_MAPS_SHARE) * fraction);
+    float f = TEXEL_MAPS_SHARE + (BVH_SHARE - TEXEL_MAPS_SHARE) * fraction;
+    return d->progress(d->progress_user, f);
 }
 
 static void candidates_free(lx_tile_candidate *c, uint32_t count)

@@ -349,7 +349,8 @@ static lx_vec3 texel_emitters(const lx_baker *b, const emitter_set *set, uint32_
         }
     }
     double len = sqrt(dir[0] * dir[0] + dir[1] * dir[1] + dir[2] * dir[2]);
-    *towards = len > 0.0 ? lx_v3((float)(dir[0] / len), (float)(dir[1] / len), (float)(dir[2] / len))
+    *towards = len > 0.0 ? lx_v3((float)(dir[0] / len), (float)(dir[1] / len),
+                                 (float)(dir[2] / len))
                          : n;
     double inv = 1.0 / (double)cells;
     return lx_v3((float)fmax(exact[0] + sum[0] * inv, 0.0), (float)fmax(exact[1] + sum[1] * inv, 0.0),

@@ -533,9 +533,9 @@ static int choose_camera(render_args *a, const lx_scene *scene, const lx_lightma
                 snprintf(what, sizeof what, "%s field of view %s degrees",
                          a->has_fov ? "--fov" : "its",
                          cli_num_digits(LX_RAD2DEG(a->desc.camera.fov), 4));
+            bool others = !a->gltf_camera && scene->camera_count > 1;
             fprintf(stderr, "luxel: %s of %s, %s%s\n", label, a->scene, what,
-                    a->gltf_camera || scene->camera_count == 1 ? ""
-                                                               : " (--gltf-camera picks another)");
+                    others ? " (luxel render --gltf-camera picks another)" : "");
         }
         return EXIT_OK;
     }
