@@ -37,16 +37,8 @@ static char scenes[PATH_MAX];
 static int setup(void **state)
 {
     (void)state;
-    char self[PATH_MAX], gen[PATH_MAX + 16];
-    ssize_t len = readlink("/proc/self/exe", self, sizeof self - 1);
-    assert_true(len > 0);
-    self[len] = '\0';
-    char *slash = strrchr(self, '/');
-    assert_non_null(slash);
-    *slash = '\0';
-    snprintf(gen, sizeof gen, "%s/gen_scenes", self);
-    if (access(gen, X_OK) != 0)
-        fail_msg("no gen_scenes next to the test: %s", gen);
+    char gen[PATH_MAX + 16];
+    lx_test_sibling("gen_scenes", gen, sizeof gen);
     snprintf(scenes, sizeof scenes, "%s", lx_test_dir("test_unwrap_light"));
     char *argv[] = {gen, scenes, NULL};
     posix_spawn_file_actions_t fa;

@@ -176,16 +176,7 @@ static void bake(const char *scene, const char *out)
 static int setup(void **state)
 {
     (void)state;
-    char self[PATH_MAX];
-    ssize_t len = readlink("/proc/self/exe", self, sizeof self - 1);
-    assert_true(len > 0);
-    self[len] = '\0';
-    char *slash = strrchr(self, '/');
-    assert_non_null(slash);
-    *slash = '\0';
-    snprintf(luxel, sizeof luxel, "%s/luxel", self);
-    if (access(luxel, X_OK) != 0)
-        fail_msg("no luxel executable next to the test: %s", luxel);
+    lx_test_sibling("luxel", luxel, sizeof luxel);
     snprintf(dir, sizeof dir, "%s", lx_test_dir("test_cli_cameras"));
     snprintf(out_log, sizeof out_log, "%s/out.log", dir);
     snprintf(err_log, sizeof err_log, "%s/err.log", dir);

@@ -263,3 +263,17 @@ double lx_test_corner_form_factor(double a, double b, double c)
     double sx = sqrt(1.0 + x * x), sy = sqrt(1.0 + y * y);
     return (x / sx * atan(y / sx) + y / sy * atan(x / sy)) / (2.0 * 3.14159265358979323846);
 }
+
+void lx_test_sibling(const char *name, char *out, size_t size)
+{
+    char self[4096];
+    ssize_t len = readlink("/proc/self/exe", self, sizeof self - 1);
+    assert_true(len > 0);
+    self[len] = '\0';
+    char *slash = strrchr(self, '/');
+    assert_non_null(slash);
+    *slash = '\0';
+    snprintf(out, size, "%s/%s", self, name);
+    if (access(out, X_OK) != 0)
+        fail_msg("no %s executable next to the test: %s", name, out);
+}

@@ -62,4 +62,8 @@ double lx_test_corner_form_factor(double a, double b, double c);
  * fails the test instead of stalling the whole run. */
 void lx_test_watchdog(unsigned seconds);
 
+/* The path of the program `name` built beside the running test (luxel,
+ * gen_scenes...) into out; fails the test when it is not an executable. */
+void lx_test_sibling(const char *name, char *out, size_t size);
+
 #endif
