@@ -268,11 +268,9 @@ static int parse_args(int argc, char **argv, bake_args *a)
         }
         }
     }
-    if (optind >= argc)
-        return cli_usage_error("bake", "no scene given");
-    if (optind + 1 < argc)
-        return cli_usage_error("bake", "one scene at a time ('%s' is extra)", argv[optind + 1]);
-    a->scene = argv[optind];
+    int one = cli_one_scene("bake", argc, argv, &a->scene);
+    if (one != 0)
+        return one;
     if (a->half && a->format != LX_IMAGE_EXR)
         return cli_usage_error("bake", "--half applies to --format exr only");
     int checked = cli_bake_check_args(a);

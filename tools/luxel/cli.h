@@ -77,6 +77,9 @@ int cli_usage_error(const char *command, const char *fmt, ...)
  * switch's default case with getopt's optarg/optind state current. */
 int cli_common_option(const char *command, int c, char **argv, int *threads, bool *quiet);
 
+/* The one scene operand after getopt (argv[optind]) into *scene: 0, or
+ * the usage error (none given, or more than one). */
+int cli_one_scene(const char *command, int argc, char **argv, const char **scene);
 /* Strict number parsing: the whole string, finite, within [lo, hi]. */
 bool cli_parse_int(const char *s, long lo, long hi, long *out);
 bool cli_parse_float(const char *s, double lo, double hi, double *out);

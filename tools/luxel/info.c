@@ -154,11 +154,10 @@ int cmd_info(int argc, char **argv)
         }
         }
     }
-    if (optind >= argc)
-        return cli_usage_error("info", "no scene given");
-    if (optind + 1 < argc)
-        return cli_usage_error("info", "one scene at a time ('%s' is extra)", argv[optind + 1]);
-    const char *path = argv[optind];
+    const char *path = NULL;
+    int one = cli_one_scene("info", argc, argv, &path);
+    if (one != 0)
+        return one;
     lx_scene *s;
     /* listing needs the textures' names, not their pixels; zero-area
      * triangles are dropped with a warning (--strict: refused) */

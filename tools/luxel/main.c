@@ -7,6 +7,7 @@
 #include "maps_cli.h"
 
 #include <errno.h>
+#include <getopt.h>
 #include <math.h>
 #include <pthread.h>
 #include <signal.h>
@@ -97,6 +98,16 @@ bool cli_parse_float(const char *s, double lo, double hi, double *out)
         return false;
     *out = v;
     return true;
+}
+
+int cli_one_scene(const char *command, int argc, char **argv, const char **scene)
+{
+    if (optind >= argc)
+        return cli_usage_error(command, "no scene given");
+    if (optind + 1 < argc)
+        return cli_usage_error(command, "one scene at a time ('%s' is extra)", argv[optind + 1]);
+    *scene = argv[optind];
+    return 0;
 }
 
 bool cli_parse_size(const char *s, uint64_t *out)

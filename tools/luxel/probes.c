@@ -135,11 +135,9 @@ static int parse_args(int argc, char **argv, probes_args *a)
         }
         }
     }
-    if (optind >= argc)
-        return cli_usage_error("probes", "no scene given");
-    if (optind + 1 < argc)
-        return cli_usage_error("probes", "one scene at a time ('%s' is extra)", argv[optind + 1]);
-    a->bake.scene = argv[optind];
+    int one = cli_one_scene("probes", argc, argv, &a->bake.scene);
+    if (one != 0)
+        return one;
     if (a->grid[0] && a->points)
         return cli_usage_error("probes", "--grid and --points both place the probes: give one");
     const char *slash = strrchr(a->output, '/');

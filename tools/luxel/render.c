@@ -258,11 +258,9 @@ static int parse_args(int argc, char **argv, render_args *a)
         }
         }
     }
-    if (optind >= argc)
-        return cli_usage_error("render", "no scene given");
-    if (optind + 1 < argc)
-        return cli_usage_error("render", "one scene at a time ('%s' is extra)", argv[optind + 1]);
-    a->scene = argv[optind];
+    int one = cli_one_scene("render", argc, argv, &a->scene);
+    if (one != 0)
+        return one;
     if (!a->lightmaps)
         return cli_usage_error("render", "--lightmaps DIR is required (the bake's output folder)");
     if (a->has_camera + a->has_view + (a->gltf_camera != NULL) > 1)

@@ -80,12 +80,9 @@ static int parse_args(int argc, char **argv, tangents_args *a)
         }
         }
     }
-    if (optind >= argc)
-        return cli_usage_error("tangents", "no scene given");
-    if (optind + 1 < argc)
-        return cli_usage_error("tangents", "one scene at a time ('%s' is extra)",
-                               argv[optind + 1]);
-    a->scene = argv[optind];
+    int one = cli_one_scene("tangents", argc, argv, &a->scene);
+    if (one != 0)
+        return one;
     if (!a->output)
         return cli_usage_error("tangents", "no output given (-o OUT.glb)");
     size_t len = strlen(a->output);

@@ -124,11 +124,9 @@ static int parse_args(int argc, char **argv, unwrap_args *a)
         }
         }
     }
-    if (optind >= argc)
-        return cli_usage_error("unwrap", "no scene given");
-    if (optind + 1 < argc)
-        return cli_usage_error("unwrap", "one scene at a time ('%s' is extra)", argv[optind + 1]);
-    a->scene = argv[optind];
+    int one = cli_one_scene("unwrap", argc, argv, &a->scene);
+    if (one != 0)
+        return one;
     if (!a->output)
         return cli_usage_error("unwrap", "no output given (-o OUT.glb)");
     if (!ends_with_glb(a->output))
