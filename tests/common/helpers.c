@@ -277,3 +277,26 @@ void lx_test_sibling(const char *name, char *out, size_t size)
     if (access(out, X_OK) != 0)
         fail_msg("no %s executable next to the test: %s", name, out);
 }
+
+static void log_to_book(void *user, lx_log_level level, const char *message)
+{
+    lx_test_logbook *b = user;
+    if (level != LX_LOG_WARN)
+        return;
+    b->warnings++;
+    size_t n = strlen(b->text);
+    snprintf(b->text + n, sizeof b->text - n, "%s\n", message);
+}
+
+lx_scene *lx_test_load_logged(const char *path, const lx_scene_load_desc *desc,
+                              lx_test_logbook *book)
+{
+    memset(book, 0, sizeof *book);
+    lx_set_log_callback(log_to_book, book);
+    lx_scene *s = NULL;
+    lx_status st = lx_scene_load(path, desc, &s);
+    lx_set_log_callback(NULL, NULL);
+    if (st != LX_OK)
+        fail_msg("lx_scene_load(%s): %s", path, lx_last_error());
+    return s;
+}

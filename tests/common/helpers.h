@@ -66,4 +66,15 @@ void lx_test_watchdog(unsigned seconds);
  * gen_scenes...) into out; fails the test when it is not an executable. */
 void lx_test_sibling(const char *name, char *out, size_t size);
 
+/* The warnings the library logs while a scene loads: their count and text
+ * (one a line). */
+typedef struct lx_test_logbook {
+    int warnings;
+    char text[8192];
+} lx_test_logbook;
+/* lx_scene_load(path, desc) with its warnings kept in *book (cleared
+ * first); fails the test when the load fails. */
+lx_scene *lx_test_load_logged(const char *path, const lx_scene_load_desc *desc,
+                              lx_test_logbook *book);
+
 #endif

@@ -28,33 +28,6 @@
 #include <stdlib.h>
 #include <string.h>
 
-typedef struct logbook {
-    int warnings;
-    char text[8192];
-} logbook;
-
-static void on_log(void *user, lx_log_level level, const char *message)
-{
-    logbook *b = user;
-    if (level != LX_LOG_WARN)
-        return;
-    b->warnings++;
-    size_t n = strlen(b->text);
-    snprintf(b->text + n, sizeof b->text - n, "%s\n", message);
-}
-
-static lx_scene *load_logged(const char *path, logbook *book)
-{
-    memset(book, 0, sizeof *book);
-    lx_set_log_callback(on_log, book);
-    lx_scene *s = NULL;
-    lx_status st = lx_scene_load(path, NULL, &s);
-    lx_set_log_callback(NULL, NULL);
-    if (st != LX_OK)
-        fail_msg("lx_scene_load(%s): %s", path, lx_last_error());
-    return s;
-}
-
 /* one triangle, so the file has geometry */
 static void add_triangle(lx_test_gltf *g)
 {
@@ -145,8 +118,8 @@ static void test_two_cameras(void **state)
     lx_test_gltf_write(g, path);
     lx_test_gltf_free(g);
 
-    logbook book;
-    lx_scene *s = load_logged(path, &book);
+    lx_test_logbook book;
+    lx_scene *s = lx_test_load_logged(path, NULL, &book);
     assert_int_equal(book.warnings, 0);
     assert_int_equal(s->camera_count, 3);
 
@@ -195,7 +168,7 @@ static void test_two_cameras(void **state)
     snprintf(path, sizeof path, "%s/cam.glb", dir);
     lx_test_gltf_write_glb(g2, path);
     lx_test_gltf_free(g2);
-    s = load_logged(path, &book);
+    s = lx_test_load_logged(path, NULL, &book);
     assert_int_equal(s->camera_count, 1);
     assert_string_equal(s->cameras[0].name, "cam");
     expect_vec(s->cameras[0].eye, (dvec){0, 1, 5}, "glb eye");
@@ -215,8 +188,8 @@ static void test_orthographic(void **state)
                         "{\"xmag\":2,\"ymag\":1.5,\"znear\":0,\"zfar\":50}}]");
     lx_test_gltf_write(g, path);
     lx_test_gltf_free(g);
-    logbook book;
-    lx_scene *s = load_logged(path, &book);
+    lx_test_logbook book;
+    lx_scene *s = lx_test_load_logged(path, NULL, &book);
     assert_int_equal(book.warnings, 0);
     assert_int_equal(s->camera_count, 1);
     assert_int_equal(s->cameras[0].type, LX_SCENE_CAMERA_ORTHOGRAPHIC);
@@ -238,8 +211,8 @@ static void expect_left_out(const char *name, const char *nodes_members, const c
     lx_test_gltf_top(g, cameras);
     lx_test_gltf_write(g, path);
     lx_test_gltf_free(g);
-    logbook book;
-    lx_scene *s = load_logged(path, &book);
+    lx_test_logbook book;
+    lx_scene *s = lx_test_load_logged(path, NULL, &book);
     if (book.warnings != 1 || !strstr(book.text, name) || !strstr(book.text, needle))
         fail_msg("%s: %d warnings '%s', want one naming the file and '%s'", name, book.warnings,
                  book.text, needle);

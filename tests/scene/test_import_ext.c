@@ -28,33 +28,6 @@
 
 /* ---- warnings ------------------------------------------------------------- */
 
-typedef struct logbook {
-    int warnings;
-    char text[8192];
-} logbook;
-
-static void on_log(void *user, lx_log_level level, const char *message)
-{
-    logbook *b = user;
-    if (level != LX_LOG_WARN)
-        return;
-    b->warnings++;
-    size_t n = strlen(b->text);
-    snprintf(b->text + n, sizeof b->text - n, "%s\n", message);
-}
-
-static lx_scene *load_logged(const char *path, const lx_scene_load_desc *desc, logbook *book)
-{
-    memset(book, 0, sizeof *book);
-    lx_set_log_callback(on_log, book);
-    lx_scene *s = NULL;
-    lx_status st = lx_scene_load(path, desc, &s);
-    lx_set_log_callback(NULL, NULL);
-    if (st != LX_OK)
-        fail_msg("lx_scene_load(%s): %s", path, lx_last_error());
-    return s;
-}
-
 static void load_fails(const char *path, const lx_scene_load_desc *desc, lx_status want,
                        const char *needle1, const char *needle2)
 {
@@ -123,8 +96,8 @@ static void test_zero_area_counted(void **state)
     lx_test_gltf_write(g, path);
     lx_test_gltf_free(g);
 
-    logbook book;
-    lx_scene *s = load_logged(path, NULL, &book);
+    lx_test_logbook book;
+    lx_scene *s = lx_test_load_logged(path, NULL, &book);
     assert_int_equal(book.warnings, 1);
     if (!strstr(book.text, "3 zero-area triangles left out (of 2 meshes)"))
         fail_msg("warning: %s", book.text);
@@ -156,8 +129,8 @@ static void test_zero_uv_area_loads(void **state)
     lx_test_gltf_write(g, path);
     lx_test_gltf_free(g);
     lx_scene_load_desc strict = {.strict = true};
-    logbook book;
-    lx_scene *s = load_logged(path, &strict, &book);
+    lx_test_logbook book;
+    lx_scene *s = lx_test_load_logged(path, &strict, &book);
     assert_int_equal(s->meshes[0].triangle_count, 2);
     lx_scene_destroy(s);
 }
@@ -672,8 +645,8 @@ static void test_lfs_pointers(void **state)
     path_in(path, sizeof path, dir, "lfs.obj");
     write_text(path, "mtllib lfs.mtl\no tri\nv 0 0 0\nv 1 0 0\nv 0 0 -1\nvt 0 0\nvt 1 0\nvt 0 1\n"
                      "usemtl wood\nf 1/1 2/2 3/3\n");
-    logbook book;
-    lx_scene *s = load_logged(path, NULL, &book);
+    lx_test_logbook book;
+    lx_scene *s = lx_test_load_logged(path, NULL, &book);
     if (!strstr(book.text, "wood.png is a Git LFS pointer, not the file: run git lfs pull"))
         fail_msg("warnings: %s", book.text);
     lx_scene_destroy(s);
@@ -698,8 +671,8 @@ static void test_backslash_obj(void **state)
     path_in(path, sizeof path, dir, "windows.obj");
     write_text(path, "mtllib materials\\wood.mtl\r\no tri\r\nv 0 0 0\r\nv 1 0 0\r\nv 0 0 -1\r\n"
                      "vt 0 0\r\nvt 1 0\r\nvt 0 1\r\nusemtl wood\r\nf 1/1 2/2 3/3\r\n");
-    logbook book;
-    lx_scene *s = load_logged(path, NULL, &book);
+    lx_test_logbook book;
+    lx_scene *s = lx_test_load_logged(path, NULL, &book);
     assert_int_equal(book.warnings, 0);
     const lx_material *m = &s->materials[s->meshes[0].material];
     assert_string_equal(m->name, "wood");
@@ -822,8 +795,8 @@ static void test_collada_lights_warned(void **state)
         "<node id=\"lamp_node\" name=\"lamp_node\"><translate>0 2 0</translate>"
         "<instance_light url=\"#lamp\"/></node></visual_scene></library_visual_scenes>\n"
         "<scene><instance_visual_scene url=\"#scene\"/></scene>\n</COLLADA>\n");
-    logbook book;
-    lx_scene *s = load_logged(path, NULL, &book);
+    lx_test_logbook book;
+    lx_scene *s = lx_test_load_logged(path, NULL, &book);
     assert_int_equal(s->light_count, 0);
     assert_true(s->node_count >= 1);
     assert_int_equal(book.warnings, 1);
@@ -853,8 +826,8 @@ static void test_lightmap_set_not_joined(void **state)
     path_in(path, sizeof path, dir, "two_charts.gltf");
     lx_test_gltf_write(g, path);
     lx_test_gltf_free(g);
-    logbook book;
-    lx_scene *s = load_logged(path, NULL, &book);
+    lx_test_logbook book;
+    lx_scene *s = lx_test_load_logged(path, NULL, &book);
     const lx_mesh *m = &s->meshes[0];
     assert_int_equal(m->triangle_count, 2);
     assert_non_null(m->uv[1]);
