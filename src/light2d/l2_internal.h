@@ -18,6 +18,9 @@ static inline float l2_max(float a, float b)
     return a > b ? a : b;
 }
 
+/* Levels of the lit side's horizons of a soft light (polar.c). */
+#define L2_HZ 8
+
 /* Boundary caster pixels are bucketed in square tiles of this many pixels,
  * so a light visits only the tiles under its reach. */
 #define L2_TILE 32
@@ -65,12 +68,17 @@ typedef struct l2_polar {
     float *occ, *ex;
     float *occx; /* occ three times over: occx[n + b] = occ[b mod n] for b
                     in [-n, 2n), so that windows need no wrapping */
-    /* soft lights: the reach of the occluders' penumbra wedges, as an
+    /* soft lights: the horizons' reach (horizons in polar.c), as an
      * inverse distance per ray: a pixel on ray b at distance d with
      * d * lit[b] < 1 lies in no occluder's penumbra (fully lit) */
     float *lit;
-    uint8_t *sel; /* per ray, the cone of penumbra_reach (polar.c) for n = sel_n */
-    int sel_n;
+    /* soft lights: the ray boundaries' angles (n + 1, radians, for n =
+     * theta_n) and the lit side's horizons, 2 L2_HZ floats a ray
+     * (horizons in polar.c), with their levels' r_k / softness */
+    float *theta;
+    int theta_n;
+    float *hz;
+    float hz_inv[L2_HZ];
     /* soft lights: 1 / max(occ, 0.5) per ray, and per depth level l (the
      * distances from L2_DEPTH0 x 2^(l/2) on) the whole bins between each
      * ray and the nearest ray whose occluder lies at that distance or
@@ -173,15 +181,15 @@ void l2_polar_free(l2_polar *pm);
 /* The penumbra pixels of a span of a soft light (polar.c): fa[i] times
  * the pixel's visibility where code[i] (n8 bytes, a multiple of 8) says
  * 1 or 2. code 1, a pixel its own ray reaches (da before the ray's
- * occluder, or dea on a lit face): the penumbra of the nearest occluder
- * whose window holds it, found by range minima and then filtered. code
- * 2, a pixel in its ray's hard shadow: the percentage-closer filter over
- * its occluder's window [c - k, c + k] (ka, in bins, 0.5 <= k < n/2), the
- * fraction of its rays that reach past da; k = min(s (1/max(o, 0.5) -
- * 1/d) x scale, n/2 - 1), scale the bins per radian there. ca: the pixels'
- * continuous bins, ua the slopes of their pseudo-angles. */
-void l2_penumbrae(const l2_polar *pm, float s, int n8, const uint8_t *code, const float *ca,
-                  const float *ua, const float *dea, const float *da, const float *ka, float *fa);
+ * occluder, or dea on a lit face): the mean of the shares of the light's
+ * two sides it sees past the occluders beside it (the horizons of
+ * l2_polar.hz). code 2, a pixel in its ray's hard shadow: the
+ * percentage-closer filter over its occluder's window [c - k, c + k] (ka,
+ * in bins, 0.5 <= k < n/2), the fraction of its rays that reach past da;
+ * k = min(s (1/max(o, 0.5) - 1/d) x scale, n/2 - 1), scale the bins per
+ * radian there. ca: the pixels' continuous bins. */
+void l2_penumbrae(const l2_polar *pm, int n8, const uint8_t *code, const float *ca,
+                  const float *dea, const float *da, const float *ka, float *fa);
 
 /* What the light does to the pixels of the block [x0, x1) x [y0, y1),
  * exactly as shading them would find (polar.c): L2_BLOCK_DARK, it leaves

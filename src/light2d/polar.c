@@ -5,11 +5,15 @@
  * reach is rasterised into the angular bins its square covers, keeping the
  * nearest distance per bin (only boundary pixels can be the first caster a
  * ray meets). A second pass keeps where the first caster run of each ray
- * ends, so casters can be lit on their face. Soft shadows filter the map
- * along the angle (percentage-closer filtering) over a window that grows
- * with the distance behind the occluder, as a light of radius `softness`
- * predicts; sparse tables of the window minimum and maximum skip the
- * filter wherever the window is wholly lit or wholly shadowed. */
+ * ends, so casters can be lit on their face. Soft shadows: in a ray's hard
+ * shadow the map is filtered along the angle (percentage-closer filtering)
+ * over a window that grows with the distance behind the occluder, as a
+ * light of radius `softness` predicts; before the occluder, each side of
+ * the light is seen up to the horizon the occluders beside the ray make
+ * (the tangent from the point to them in angle and inverse distance, the
+ * way horizon maps bound a height field). Sparse tables of the window
+ * minimum and maximum skip the filter wherever the window is wholly lit
+ * or wholly shadowed. */
 #include "l2_internal.h"
 #include "core/internal.h"
 
@@ -18,6 +22,7 @@
 #include <string.h>
 
 #define L2_FAR 1e30f
+#define L2_PI 3.14159265358979323846
 
 /* AVX2 gathers for the sampled filter where the CPU has them (GCC or
  * clang on x86-64). */
@@ -58,7 +63,8 @@ void l2_polar_free(l2_polar *pm)
     free(pm->ex);
     free(pm->lit);
     free(pm->occx);
-    free(pm->sel);
+    free(pm->hz);
+    free(pm->theta);
     free(pm->exits);
     free(pm->qocc);
     free(pm->gap);
@@ -134,11 +140,14 @@ static lx_status reserve(l2_polar *pm, int n, int levels, int depth_levels)
         float *occx = realloc(pm->occx, (size_t)n * 3 * sizeof *occx);
         if (occx)
             pm->occx = occx;
-        uint8_t *sel = realloc(pm->sel, (size_t)n);
-        if (sel)
-            pm->sel = sel;
-        pm->sel_n = 0;
-        if (!occ || !ex || !lit || !qocc || !occx || !sel)
+        float *th = realloc(pm->theta, ((size_t)n + 1) * sizeof *th);
+        if (th)
+            pm->theta = th;
+        pm->theta_n = 0;
+        float *hz = realloc(pm->hz, (size_t)n * 2 * L2_HZ * sizeof *hz);
+        if (hz)
+            pm->hz = hz;
+        if (!occ || !ex || !lit || !qocc || !occx || !th || !hz)
             return lx_fail(LX_ERR_NOMEM, "light2d: out of memory for a polar map of %d rays", n);
         pm->capacity = n;
     }
@@ -157,88 +166,103 @@ static lx_status reserve(l2_polar *pm, int n, int levels, int depth_levels)
     return LX_OK;
 }
 
-/* The penumbra wedges' reach (l2_polar.lit). The occluder of ray j, at
- * inverse distance q_j = 1/occ[j], casts a penumbra over the points at
- * inverse distance q whose window s (q_j - q) x scale (in bins, scale =
- * (1 + u^2) n/8 the bins per radian at the point, u the pseudo-angle's
- * slope there) reaches ray j: with g the whole bins between rays b and j,
- * a point of ray b can be in it only when q < q_j - g / (s x scale). So
- * lit[b] = max_j (q_j - g c_b) bounds every wedge reaching ray b, c_b =
- * 1 / (s n/8 (1 + u_b^2)) with u_b^2 the largest over ray b's bin. c_b
- * lies in [c, 2c], c = 1 / (s n/4): four distance transforms with linear
- * cones of slopes c 2^(k/4), k = 0..3, one pass each way around the circle
- * (twice round, so that wedges wrap), and each ray takes the steepest
- * cone not steeper than its own c_b. */
-static void penumbra_reach(l2_polar *pm, float s, float *q)
-{
-    int n = pm->n;
-    const float *occ = pm->occ;
-    float *lit = pm->lit;
-    const uint8_t *sel = pm->sel;
-    float step[4];
-    for (int k = 0; k < 4; k++)
-        step[k] = (float)(exp2(0.25 * k) / (s * 0.25 * (double)n));
-    for (int i = 0; i < n; i++) {
-        q[i] = occ[i] >= L2_FAR ? 0.0f : 1.0f / l2_max(occ[i], 1e-6f);
-        lit[i] = q[i];
-    }
-
-    /* g: the best wedge of each slope arriving from the bins before i,
-     * its gap counted */
-    float g0 = 0.0f, g1 = 0.0f, g2 = 0.0f, g3 = 0.0f;
-    for (int lap = 0; lap < 2; lap++)
-        for (int i = 0; i < n; i++) {
-            if (lap) {
-                int k = sel[i];
-                float v = k == 0 ? g0 : (k == 1 ? g1 : (k == 2 ? g2 : g3));
-                lit[i] = l2_max(lit[i], v);
-            }
-            float qi = q[i];
-            g0 = l2_max(qi, g0 - step[0]);
-            g1 = l2_max(qi, g1 - step[1]);
-            g2 = l2_max(qi, g2 - step[2]);
-            g3 = l2_max(qi, g3 - step[3]);
-        }
-    g0 = g1 = g2 = g3 = 0.0f;
-    for (int lap = 0; lap < 2; lap++)
-        for (int i = n - 1; i >= 0; i--) {
-            if (lap) {
-                int k = sel[i];
-                float v = k == 0 ? g0 : (k == 1 ? g1 : (k == 2 ? g2 : g3));
-                lit[i] = l2_max(lit[i], v);
-            }
-            float qi = q[i];
-            g0 = l2_max(qi, g0 - step[0]);
-            g1 = l2_max(qi, g1 - step[1]);
-            g2 = l2_max(qi, g2 - step[2]);
-            g3 = l2_max(qi, g3 - step[3]);
-        }
-}
-
-/* l2_polar.sel: per ray b, the steepest of the four cones of
- * penumbra_reach not steeper than c_b (it depends on n alone). */
-static void cone_select(l2_polar *pm)
+/* The ray boundaries' true angles, theta[b] for b in [0, n] (radians,
+ * theta[n] = 2 pi): on the face centred at pseudo-angle 2f + 1 the angle is
+ * f pi/2 + atan(p - 2f - 1). They depend on n alone. */
+static void ray_angles(l2_polar *pm)
 {
     int n = pm->n;
     double bpp = (double)n / 8.0;
-    for (int i = 0; i < n; i++) {
-        /* the bin's pseudo-angles [p0, p1] and the face centre (odd) of p0 */
-        double p0 = i / bpp, p1 = (i + 1) / bpp;
-        double cen = 2.0 * floor(p0 * 0.5) + 1.0;
-        double u2 = 1.0;
-        if (p1 <= cen + 1.0) {
-            double a = p0 - cen, b = p1 - cen;
-            u2 = a * a > b * b ? a * a : b * b;
-        }
-        /* margins for the rounding of the pixels' pseudo-angles and
-         * windows */
-        double ratio = 2.0 / (1.0 + u2 + 1e-4) * (1.0 - 1e-4);
-        int k = 0;
-        while (k < 3 && exp2(0.25 * (k + 1)) <= ratio)
-            k++;
-        pm->sel[i] = (uint8_t)k;
+    for (int b = 0; b <= n; b++) {
+        double p = b / bpp;
+        int f = (int)floor(p * 0.5);
+        f = f > 3 ? 3 : f;
+        pm->theta[b] = (float)(f * (L2_PI / 2.0) + atan(p - (2.0 * f + 1.0)));
     }
-    pm->sel_n = n;
+    pm->theta_n = n;
+}
+
+/* The lit side's horizons (l2_polar.hz and .lit). The line from a point
+ * at angle a and inverse distance w towards the point of the light t x s
+ * to its side (t in [0, 1], s the softness) runs, in the small-angle
+ * limit, through the angles a + t s (w' - w) at inverse distances w' > w.
+ * Counting everything at or beyond a ray's occluder as blocked (its
+ * caster and its shadow), ray j at an angle g past the point (inverse
+ * occluder distance q_j > w) blocks the t >= g / (s (q_j - w)). So the
+ * side's light is visible for t below T = min_j g_j / (s (q_j - w)), and
+ * T <= t exactly when w <= L_t = max_j (q_j - g_j / (t s)): a maximum over
+ * the rays of that side, kept for the L2_HZ levels of r = 1/t of
+ * hz_r. Per ray c, hz[c][k] holds L for a point at c's lower boundary
+ * looking up (rays after c, once round) and hz[c][L2_HZ + k] for a point
+ * at its upper boundary looking down; a point inside the ray adds its
+ * angle from that boundary times r_k / s. Summed in double from the
+ * absolute angles, stored relative to the ray (no cancellation). */
+static const float hz_r[L2_HZ] = {1.0f, 1.5f, 2.0f, 3.0f, 4.0f, 6.0f, 8.0f, 16.0f};
+
+static inline double dmax(double a, double b)
+{
+    return a > b ? a : b;
+}
+
+L2_CLONES static void horizons(l2_polar *pm, float s)
+{
+    int n = pm->n;
+    const float *qo = pm->qocc, *th = pm->theta;
+    const double two_pi = 2.0 * L2_PI;
+    double inv[L2_HZ], run[L2_HZ];
+    for (int k = 0; k < L2_HZ; k++) {
+        inv[k] = (double)hz_r[k] / (double)s;
+        pm->hz_inv[k] = (float)inv[k];
+    }
+    /* looking up: the rays after c (c + 1 .. n - 1 as they are, then 0 ..
+     * c - 1 a turn later) */
+    for (int k = 0; k < L2_HZ; k++)
+        run[k] = -INFINITY;
+    for (int j = 0; j < n; j++) /* the wrapped part, a prefix maximum */
+        for (int k = 0; k < L2_HZ; k++) {
+            float *h = pm->hz + (size_t)j * 2 * L2_HZ;
+            h[k] = (float)run[k]; /* rays 0 .. j - 1 a turn later */
+            run[k] = dmax(run[k], qo[j] - (th[j] + two_pi) * inv[k]);
+        }
+    for (int k = 0; k < L2_HZ; k++)
+        run[k] = -INFINITY;
+    for (int c = n - 1; c >= 0; c--) {
+        float *h = pm->hz + (size_t)c * 2 * L2_HZ;
+        for (int k = 0; k < L2_HZ; k++) {
+            double m = dmax(run[k], (double)h[k]) + th[c] * inv[k];
+            run[k] = dmax(run[k], qo[c] - th[c] * inv[k]);
+            h[k] = (float)m;
+        }
+    }
+    /* looking down: rays c - 1 .. 0, then n - 1 .. c + 1 a turn earlier,
+     * from the upper boundaries theta[j + 1] */
+    for (int k = 0; k < L2_HZ; k++)
+        run[k] = -INFINITY;
+    for (int j = n - 1; j >= 0; j--)
+        for (int k = 0; k < L2_HZ; k++) {
+            float *h = pm->hz + (size_t)j * 2 * L2_HZ + L2_HZ;
+            h[k] = (float)run[k];
+            run[k] = dmax(run[k], qo[j] + (th[j + 1] - two_pi) * inv[k]);
+        }
+    for (int k = 0; k < L2_HZ; k++)
+        run[k] = -INFINITY;
+    for (int c = 0; c < n; c++) {
+        float *h = pm->hz + (size_t)c * 2 * L2_HZ + L2_HZ;
+        for (int k = 0; k < L2_HZ; k++) {
+            double m = dmax(run[k], (double)h[k]) - th[c + 1] * inv[k];
+            run[k] = dmax(run[k], qo[c] + th[c + 1] * inv[k]);
+            h[k] = (float)m;
+        }
+    }
+    /* lit[c]: no point of ray c farther than 1 / lit[c] sees any of the
+     * light blocked (L_1 at the far boundary of each side), nor lies
+     * behind c's own occluder */
+    for (int c = 0; c < n; c++) {
+        const float *h = pm->hz + (size_t)c * 2 * L2_HZ;
+        float wid = (th[c + 1] - th[c]) * pm->hz_inv[0];
+        float own = pm->occ[c] >= L2_FAR ? 0.0f : 1.0f / l2_max(pm->occ[c], 1e-6f);
+        pm->lit[c] = l2_max(own, l2_max(h[0], h[L2_HZ]) + wid);
+    }
 }
 
 /* gap[lv] for every depth level: per ray, the whole bins between it and
@@ -400,12 +424,11 @@ lx_status l2_polar_build(const lx_light2d *ctx, l2_prep *p)
         for (int b = 0; b < n; b++)
             occ[b] = 0.0f;
     if (soft) {
-        if (pm->sel_n != n)
-            cone_select(pm);
-        /* scratch: the sparse table, built below */
-        penumbra_reach(pm, l->softness, pm->tmin);
+        if (pm->theta_n != n)
+            ray_angles(pm);
         for (int i = 0; i < n; i++)
             pm->qocc[i] = 1.0f / l2_max(occ[i], 0.5f);
+        horizons(pm, l->softness);
         /* scratch: the sparse table (levels x n >= 8 n floats) */
         open_gaps(pm, (int32_t *)pm->tmax);
     }
@@ -497,11 +520,15 @@ static inline float filter(const l2_polar *pm, float c, float k, float d, bool r
         return 0.0f;
     const float *occ = pm->occx + n; /* b in [-n, 2n) */
     if (b1 - b0 + 1 <= L2_MAX_TAPS) {
-        float lit = 0.0f;
-        for (int b = b0; b <= b1; b++) {
-            float w = l2_min(hi, (float)(b + 1)) - l2_max(lo, (float)b);
-            lit += occ[b] >= d ? w : 0.0f;
-        }
+        /* the whole rays inside counted (a loop that vectorizes), the two
+         * end rays by the part of them in the window */
+        if (b0 == b1)
+            return occ[b0] >= d ? 1.0f : 0.0f;
+        int inside = 0;
+        for (int b = b0 + 1; b < b1; b++)
+            inside += occ[b] >= d;
+        float lit = (float)inside + (occ[b0] >= d ? (float)(b0 + 1) - lo : 0.0f) +
+                    (occ[b1] >= d ? hi - (float)b1 : 0.0f);
         return lit / (hi - lo);
     }
     /* taps at the centres of L2_MAX_TAPS equal parts */
@@ -519,46 +546,48 @@ static inline float filter(const l2_polar *pm, float c, float k, float d, bool r
     return (float)lit / L2_MAX_TAPS;
 }
 
-/* Soft visibility at distance d on the ray at continuous bin c: the
- * nearest occluder o in a search window (the window an occluder at d/8
- * would need), then the filter over the half-angle softness (d - o) /
- * (d o), the angle a light of radius softness subtends behind o, with o
- * the nearest occluder inside that window. */
-static inline float soft_visibility(const l2_polar *pm, float s, float c, float u2, float d)
+/* The share of one side of the light that a point sees (horizons):
+ * L_k = h[k] + off x inv[k] falls with k; T lies between the r = 1/t of
+ * the last level at or above w and the first below it, interpolated
+ * linearly in r (exact where one ray sets both levels: L is then linear in
+ * r), or extrapolated past the last level. */
+static inline float side_visible(const float *h, const float *inv, float off, float w)
 {
-    float scale = (1.0f + u2) * pm->bins_per_p; /* bins per radian */
-    float cap = 0.5f * (float)pm->n - 1.0f;
-    float ks = l2_min(7.0f * s / d * scale, cap);
-    int b0 = floor_clone(c - ks), b1 = floor_clone(c + ks);
-    float m = range_query(pm, pm->tmin, b0, b1, false);
-    if (m >= d)
-        return 1.0f;
-    /* the nearest occluder's window shrinks as farther occluders are
-     * found nearest inside it: iterate to (close to) the fixed point, where
-     * the window is that of the nearest occluder inside it */
-    float k = 0.0f;
-    for (int it = 0; it < 4; it++) {
-        float o = l2_max(m, 0.5f);
-        k = l2_min(s * (d - o) / (d * o) * scale, cap);
-        if (k < 0.5f)
-            break;
-        float m2 = range_query(pm, pm->tmin, floor_clone(c - k), floor_clone(c + k), false);
-        if (m2 >= d)
-            return 1.0f;
-        if (m2 == m)
-            break;
-        m = m2;
+    float L[L2_HZ];
+    int m = 0;
+    for (int k = 0; k < L2_HZ; k++) {
+        L[k] = h[k] + off * inv[k];
+        m += L[k] >= w;
     }
-    if (k < 0.5f)
-        return pm->occx[pm->n + floor_clone(c)] >= d ? 1.0f : 0.0f;
-    /* the point's own ray reaches past it (d is before its occluder, or
-     * on its lit face) and lies in the window (k >= 0.5) */
-    return filter(pm, c, k, d, true);
+    if (m == 0)
+        return 1.0f;
+    int a = m < L2_HZ ? m - 1 : L2_HZ - 2, b = a + 1;
+    float den = L[a] - L[b];
+    if (!(den > 0.0f))
+        return m < L2_HZ ? 1.0f / hz_r[b] : 0.0f;
+    float r = hz_r[a] + (L[a] - w) / den * (hz_r[b] - hz_r[a]);
+    return l2_min(1.0f / l2_max(r, 1.0f), 1.0f);
+}
+
+/* Soft visibility of a point its own ray reaches (lit side) at continuous
+ * bin c and distance d: the mean of both sides' visible shares. */
+static inline float reached_visibility(const l2_polar *pm, float c, float d)
+{
+    int n = pm->n;
+    int b = floor_clone(c);
+    float f = c - (float)b;
+    b = b >= n ? b - n : (b < 0 ? b + n : b);
+    float wid = pm->theta[b + 1] - pm->theta[b];
+    float w = 1.0f / d;
+    const float *h = pm->hz + (size_t)b * 2 * L2_HZ;
+    float up = side_visible(h, pm->hz_inv, f * wid, w);
+    float down = side_visible(h + L2_HZ, pm->hz_inv, (1.0f - f) * wid, w);
+    return 0.5f * (up + down);
 }
 
 L2_CLONES
-void l2_penumbrae(const l2_polar *pm, float s, int n8, const uint8_t *code, const float *ca,
-                  const float *ua, const float *dea, const float *da, const float *ka, float *fa)
+void l2_penumbrae(const l2_polar *pm, int n8, const uint8_t *code, const float *ca,
+                  const float *dea, const float *da, const float *ka, float *fa)
 {
     for (int i0 = 0; i0 < n8; i0 += 8) {
         uint64_t word;
@@ -567,7 +596,7 @@ void l2_penumbrae(const l2_polar *pm, float s, int n8, const uint8_t *code, cons
             continue;
         for (int i = i0; i < i0 + 8; i++) {
             if (code[i] == 1)
-                fa[i] *= soft_visibility(pm, s, ca[i], ua[i] * ua[i], dea[i]);
+                fa[i] *= reached_visibility(pm, ca[i], dea[i]);
             else if (code[i] == 2)
                 fa[i] *= filter(pm, ca[i], ka[i], da[i], false);
         }

@@ -160,7 +160,7 @@ static void shade_span(const lx_light2d *ctx, const l2_prep *p, int y, int xs, i
          * pixels at a time where none is listed */
         for (int i = n; i < n8; i++)
             code[i] = 0;
-        l2_penumbrae(pm, s, n8, code, ca, ua, dea, da, ka, fa);
+        l2_penumbrae(pm, n8, code, ca, dea, da, ka, fa);
     }
     /* the row's three planes of light (and the cache row's) */
     float cr = p->rgb.x, cg = p->rgb.y, cb = p->rgb.z;
