@@ -20,7 +20,7 @@
  * over restrict pointers so that it vectorizes with gathers from the map. */
 L2_CLONES __attribute__((noinline))
 static void classify(const float *restrict occ, const float *restrict ex,
-                     const float *restrict lit, const float *restrict qocc,
+                     const float *restrict lit,
                      const float *restrict gap, int nb, int n, bool face_ok, float s, float kcap,
                      float bpp, int dtop, const uint8_t *restrict caster,
                      const float *restrict da, const float *restrict ca,
@@ -37,9 +37,11 @@ static void classify(const float *restrict occ, const float *restrict ex,
         bool pen = !(de * lit[b] < 1.0f);
         bool reach = face | (d < o);
         float u2 = ua[i] * ua[i];
-        /* qocc[b], computed again (the same operation) rather than
-         * gathered */
-        float k = s * (1.0f / l2_max(o, 0.5f) - 1.0f / d) * (1.0f + u2) * bpp;
+        /* the window of the far side of the ray's first caster run (where
+         * it is known): a line to the light from behind a caster clears
+         * its back before its front */
+        float ob = face_ok ? l2_max(o, l2_min(ex[b], d)) : o;
+        float k = s * (1.0f / l2_max(ob, 0.5f) - 1.0f / d) * (1.0f + u2) * bpp;
         k = l2_min(k, kcap);
         int lv = l2_depth_level(l2_max(d, L2_DEPTH0), dtop);
         bool closed = (k < 0.5f) | ((d >= L2_DEPTH0) & (k <= gap[lv * nb + b]));
@@ -154,7 +156,7 @@ static void shade_span(const lx_light2d *ctx, const l2_prep *p, int y, int xs, i
         int dtop = pm->depth_levels - 1;
         float *dea = scratch + 4 * ws, *ka = scratch + 5 * ws;
         uint8_t *code = (uint8_t *)(scratch + 6 * ws); /* 4 ws bytes */
-        classify(pm->occ, pm->ex, pm->lit, pm->qocc, pm->gap, nb, n8, face_ok, s, kcap, bpp, dtop,
+        classify(pm->occ, pm->ex, pm->lit, pm->gap, nb, n8, face_ok, s, kcap, bpp, dtop,
                  caster, da, ca, ua, fa, dea, ka, code);
         /* 2b: the penumbrae (of the span's pixels alone), skipping eight
          * pixels at a time where none is listed */

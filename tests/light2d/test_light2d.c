@@ -21,10 +21,10 @@
 #include "luxel/light2d.h"
 
 /* test_soft_against_disk's bounds on the mean difference from a light
- * disk, a small factor above the 0.049 (lit side) and 0.107 (shadow side)
- * measured */
-#define LIT_SIDE_TOL 0.065
-#define SHADOW_SIDE_TOL 0.13
+ * disk, a small factor above the 0.0186 (lit side) and 0.0483 (shadow
+ * side) measured */
+#define LIT_SIDE_TOL 0.025
+#define SHADOW_SIDE_TOL 0.06
 
 /* deterministic random numbers of the test's own */
 static uint32_t rng_state = 12345u;
@@ -405,9 +405,10 @@ static double disk_visibility(const lx_image *img, double px, double py, double 
 }
 
 /* Soft shadows against the light disk itself: over random casters, the
- * mean difference from the brute-force disk visibility of the pixels in a
- * penumbra (either value strictly between 0.02 and 0.98), apart for those
- * the light's centre sees (the lit side) and those in its hard shadow. The
+ * mean difference from the brute-force disk visibility of every pixel
+ * (casters and those within the light's diameter of it aside), apart for
+ * those the light's centre sees (the lit side) and those in its hard
+ * shadow: the penumbrae's error, spread over the pixels of that side. The
  * model (docs/light2d.md) is exact for one caster's straight edge; where
  * casters at several depths or round ones shape a penumbra it is not. */
 static void test_soft_against_disk(void **state)
@@ -439,8 +440,6 @@ static void test_soft_against_disk(void **state)
                     continue;
                 double ref = disk_visibility(&img, x + 0.5, y + 0.5, l.x, l.y, l.softness, 48);
                 double v = lm[3 * (y * 160 + x)];
-                if (!((ref > 0.02 && ref < 0.98) || (v > 0.02 && v < 0.98)))
-                    continue;
                 int side = reference_lit(&img, l.x, l.y, x, y, false) ? 0 : 1;
                 err[side] += fabs(v - ref);
                 count[side]++;
@@ -449,7 +448,7 @@ static void test_soft_against_disk(void **state)
     }
     err[0] /= count[0];
     err[1] /= count[1];
-    print_message("penumbra against the disk: lit side %.4f (%d px), shadow side %.4f (%d px)\n",
+    print_message("against the disk: lit side %.4f (%d px), shadow side %.4f (%d px)\n",
                   err[0], count[0], err[1], count[1]);
     assert_true(count[0] > 300 && count[1] > 300);
     assert_true(err[0] < LIT_SIDE_TOL);
