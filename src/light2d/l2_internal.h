@@ -27,7 +27,7 @@ static inline float l2_max(float a, float b)
 
 /* Frames are shaded in bands of this many rows, and each light first
  * drops the blocks of L2_BLOCK x L2_BLOCK pixels it leaves wholly dark. */
-#define L2_BLOCK 8
+#define L2_BLOCK 16
 
 /* The per-pixel passes of a span run over whole vectors of 8 pixels: the
  * caster mask and the normal planes are allocated with this many spare

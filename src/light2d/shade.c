@@ -33,7 +33,10 @@ static void classify(const float *restrict occ, const float *restrict ex,
         b = b >= nb ? b - nb : b;
         float o = occ[b];
         bool face = face_ok & (caster[i] != 0) & (d <= ex[b]);
-        float de = face ? l2_max(l2_min(d, o - 0.5f), 0.5f) : d;
+        /* clamped on a face, d elsewhere; written as min/max of selected
+         * bounds because a select of the two values leaves GCC a select
+         * of masks it cannot vectorize */
+        float de = l2_max(l2_min(d, face ? o - 0.5f : INFINITY), face ? 0.5f : -INFINITY);
         bool pen = !(de * lit[b] < 1.0f);
         bool reach = face | (d < o);
         float u2 = ua[i] * ua[i];
