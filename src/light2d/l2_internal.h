@@ -103,9 +103,20 @@ typedef struct l2_polar {
  * order (no contraction, sums in order), so are the bytes. */
 #if defined(__GNUC__) && !defined(__clang__) && defined(__x86_64__) && defined(__linux__) && \
     !defined(L2_NO_CLONES)
-#define L2_CLONES __attribute__((target_clones("avx2", "default")))
+#define L2_CLONES __attribute__((target_clones("avx512f", "avx2", "default")))
 #else
 #define L2_CLONES
+#endif
+
+/* AVX2 gathers, written out (GCC's generic tuning never vectorizes with
+ * them), where the CPU has them (GCC or clang on x86-64): the same IEEE
+ * operations in the same order as the scalar loops they stand for. */
+#if defined(__GNUC__) && defined(__x86_64__) && !defined(L2_NO_CLONES)
+#define L2_GATHER 1
+static inline int l2_gather_ok(void)
+{
+    return __builtin_cpu_supports("avx2");
+}
 #endif
 
 /* floor(x) for |x| < 2^31, inline (floorf is a call without SSE4.1). */

@@ -24,10 +24,7 @@
 #define L2_FAR 1e30f
 #define L2_PI 3.14159265358979323846
 
-/* AVX2 gathers for the sampled filter where the CPU has them (GCC or
- * clang on x86-64). */
-#if defined(__GNUC__) && defined(__x86_64__) && !defined(L2_NO_CLONES)
-#define L2_GATHER 1
+#ifdef L2_GATHER
 #include <immintrin.h>
 #endif
 /* Filter taps beyond which a penumbra window is sampled, not summed. */
@@ -488,11 +485,6 @@ __attribute__((target("avx2"))) static int taps_gather(const float *occx, float 
         lit += __builtin_popcount((unsigned)_mm256_movemask_ps(_mm256_cmp_ps(o, vd, _CMP_GE_OQ)));
     }
     return lit;
-}
-
-static inline bool l2_gather_ok(void)
-{
-    return __builtin_cpu_supports("avx2");
 }
 #endif
 

@@ -15,6 +15,9 @@
 #ifdef _OPENMP
 #include <omp.h>
 #endif
+#ifdef L2_GATHER
+#include <immintrin.h>
+#endif
 
 /* Pass 2a of a soft light (shade_span): each pixel's case, branch-free and
  * over restrict pointers so that it vectorizes with gathers from the map. */
@@ -56,6 +59,81 @@ static void classify(const float *restrict occ, const float *restrict ex,
         ka[i] = k;
     }
 }
+
+#ifdef L2_GATHER
+/* classify on AVX2 with its four gathers from the map written out (GCC
+ * emulates them with scalar loads otherwise, most of classify's time): the
+ * scalar loop's operations lane by lane, in its order, so the same bytes.
+ * n is a multiple of 8. */
+__attribute__((target("avx2"))) static void
+classify_avx2(const float *restrict occ, const float *restrict ex, const float *restrict lit,
+              const float *restrict gap, int nb, int n, bool face_ok, float s, float kcap,
+              float bpp, int dtop, const uint8_t *restrict caster, const float *restrict da,
+              const float *restrict ca, const float *restrict ua, float *restrict fa,
+              float *restrict dea, float *restrict ka, uint8_t *restrict code)
+{
+    const __m256 zero = _mm256_setzero_ps(), one = _mm256_set1_ps(1.0f),
+                 half = _mm256_set1_ps(0.5f), inf = _mm256_set1_ps(INFINITY),
+                 ninf = _mm256_set1_ps(-INFINITY), depth0 = _mm256_set1_ps(L2_DEPTH0),
+                 vs = _mm256_set1_ps(s), vcap = _mm256_set1_ps(kcap),
+                 vbpp = _mm256_set1_ps(bpp);
+    const __m256i vnb = _mm256_set1_epi32(nb), vnb1 = _mm256_set1_epi32(nb - 1),
+                  i127 = _mm256_set1_epi32(127), mant = _mm256_set1_epi32(0x7fffff),
+                  sqrt2 = _mm256_set1_epi32(0x3504f3 - 1), vtop = _mm256_set1_epi32(dtop),
+                  i1 = _mm256_set1_epi32(1), i2 = _mm256_set1_epi32(2);
+    const __m256 vface_ok = _mm256_castsi256_ps(_mm256_set1_epi32(face_ok ? -1 : 0));
+    for (int i = 0; i < n; i += 8) {
+        __m256 d = _mm256_loadu_ps(da + i);
+        __m256i b = _mm256_cvttps_epi32(_mm256_loadu_ps(ca + i));
+        b = _mm256_sub_epi32(b, _mm256_and_si256(_mm256_cmpgt_epi32(b, vnb1), vnb));
+        __m256 o = _mm256_i32gather_ps(occ, b, 4);
+        __m256 e = _mm256_i32gather_ps(ex, b, 4);
+        __m256i cast = _mm256_cvtepu8_epi32(_mm_loadl_epi64((const __m128i *)(caster + i)));
+        __m256 is_caster = _mm256_castsi256_ps(
+            _mm256_xor_si256(_mm256_cmpeq_epi32(cast, _mm256_setzero_si256()),
+                             _mm256_set1_epi32(-1)));
+        __m256 face = _mm256_and_ps(_mm256_and_ps(vface_ok, is_caster),
+                                    _mm256_cmp_ps(d, e, _CMP_LE_OQ));
+        __m256 hi_b = _mm256_blendv_ps(inf, _mm256_sub_ps(o, half), face);
+        __m256 lo_b = _mm256_blendv_ps(ninf, half, face);
+        __m256 de = _mm256_max_ps(_mm256_min_ps(d, hi_b), lo_b);
+        __m256 lt = _mm256_i32gather_ps(lit, b, 4);
+        __m256 pen = _mm256_cmp_ps(_mm256_mul_ps(de, lt), one, _CMP_NLT_UQ);
+        __m256 reach = _mm256_or_ps(face, _mm256_cmp_ps(d, o, _CMP_LT_OQ));
+        __m256 u = _mm256_loadu_ps(ua + i);
+        __m256 u2 = _mm256_mul_ps(u, u);
+        __m256 ob = face_ok ? _mm256_max_ps(o, _mm256_min_ps(e, d)) : o;
+        __m256 k = _mm256_sub_ps(_mm256_div_ps(one, _mm256_max_ps(ob, half)),
+                                 _mm256_div_ps(one, d));
+        k = _mm256_mul_ps(_mm256_mul_ps(_mm256_mul_ps(vs, k), _mm256_add_ps(one, u2)), vbpp);
+        k = _mm256_min_ps(k, vcap);
+        /* l2_depth_level of max(d, L2_DEPTH0) */
+        __m256i bits = _mm256_castps_si256(_mm256_div_ps(_mm256_max_ps(d, depth0), depth0));
+        __m256i ex2 = _mm256_sub_epi32(_mm256_srli_epi32(bits, 23), i127);
+        __m256i lv = _mm256_sub_epi32(_mm256_add_epi32(ex2, ex2),
+                                      _mm256_cmpgt_epi32(_mm256_and_si256(bits, mant), sqrt2));
+        lv = _mm256_min_epi32(lv, vtop);
+        __m256 g = _mm256_i32gather_ps(gap, _mm256_add_epi32(_mm256_mullo_epi32(lv, vnb), b), 4);
+        __m256 closed = _mm256_or_ps(
+            _mm256_cmp_ps(k, half, _CMP_LT_OQ),
+            _mm256_and_ps(_mm256_cmp_ps(d, depth0, _CMP_GE_OQ), _mm256_cmp_ps(k, g, _CMP_LE_OQ)));
+        __m256 f = _mm256_loadu_ps(fa + i);
+        __m256 active = _mm256_and_ps(
+            _mm256_and_ps(_mm256_cmp_ps(f, zero, _CMP_GT_OQ), _mm256_cmp_ps(d, zero, _CMP_GT_OQ)),
+            pen);
+        __m256 dark = _mm256_andnot_ps(reach, _mm256_and_ps(active, closed));
+        _mm256_storeu_ps(fa + i, _mm256_andnot_ps(dark, f));
+        /* code: 0, or 1 where reached, 2 where not, for active & !dark */
+        __m256i shown = _mm256_castps_si256(_mm256_andnot_ps(dark, active));
+        __m256i c = _mm256_and_si256(
+            shown, _mm256_blendv_epi8(i2, i1, _mm256_castps_si256(reach)));
+        __m128i c16 = _mm_packs_epi32(_mm256_castsi256_si128(c), _mm256_extracti128_si256(c, 1));
+        _mm_storel_epi64((__m128i *)(code + i), _mm_packus_epi16(c16, c16));
+        _mm256_storeu_ps(dea + i, de);
+        _mm256_storeu_ps(ka + i, k);
+    }
+}
+#endif
 
 /* Adds the light's contribution to the pixels [xs, xe) of row y into acc
  * (the row's width*3 floats), and to its cache row when it is a static
@@ -159,8 +237,14 @@ static void shade_span(const lx_light2d *ctx, const l2_prep *p, int y, int xs, i
         int dtop = pm->depth_levels - 1;
         float *dea = scratch + 4 * ws, *ka = scratch + 5 * ws;
         uint8_t *code = (uint8_t *)(scratch + 6 * ws); /* 4 ws bytes */
-        classify(pm->occ, pm->ex, pm->lit, pm->gap, nb, n8, face_ok, s, kcap, bpp, dtop,
-                 caster, da, ca, ua, fa, dea, ka, code);
+#ifdef L2_GATHER
+        if (l2_gather_ok())
+            classify_avx2(pm->occ, pm->ex, pm->lit, pm->gap, nb, n8, face_ok, s, kcap, bpp,
+                          dtop, caster, da, ca, ua, fa, dea, ka, code);
+        else
+#endif
+            classify(pm->occ, pm->ex, pm->lit, pm->gap, nb, n8, face_ok, s, kcap, bpp, dtop,
+                     caster, da, ca, ua, fa, dea, ka, code);
         /* 2b: the penumbrae (of the span's pixels alone), skipping eight
          * pixels at a time where none is listed */
         for (int i = n; i < n8; i++)
