@@ -89,9 +89,8 @@ classify_avx2(const float *restrict occ, const float *restrict ex, const float *
         __m256 o = _mm256_i32gather_ps(occ, b, 4);
         __m256 e = _mm256_i32gather_ps(ex, b, 4);
         __m256i cast = _mm256_cvtepu8_epi32(_mm_loadl_epi64((const __m128i *)(caster + i)));
-        __m256 is_caster = _mm256_castsi256_ps(
-            _mm256_xor_si256(_mm256_cmpeq_epi32(cast, _mm256_setzero_si256()),
-                             _mm256_set1_epi32(-1)));
+        __m256 is_caster =
+            _mm256_castsi256_ps(_mm256_cmpgt_epi32(cast, _mm256_setzero_si256()));
         __m256 face = _mm256_and_ps(_mm256_and_ps(vface_ok, is_caster),
                                     _mm256_cmp_ps(d, e, _CMP_LE_OQ));
         __m256 hi_b = _mm256_blendv_ps(inf, _mm256_sub_ps(o, half), face);
