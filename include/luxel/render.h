@@ -168,7 +168,10 @@ typedef struct lx_lightmaps {
 } lx_lightmaps;
 
 typedef struct lx_lightmaps_load_desc {
-    bool skip_images; /* read the manifest only: pages keep width 0 images */
+    bool skip_images;    /* read the manifest only: pages keep width 0 images */
+    bool allow_any_path; /* read files the manifest names wherever they are;
+                            by default only files in its folder or below it
+                            are read, others fail the load */
 } lx_lightmaps_load_desc;
 
 /* A copy of desc (or of zeros when NULL) with every default filled in. */

@@ -199,6 +199,9 @@ typedef struct lx_scene {
     uint32_t profile_count;
     lx_scene_camera *cameras; /* the file's cameras, in glTF node order */
     uint32_t camera_count;
+    bool allow_any_path; /* files named by the scene's lights JSON (IES
+                            profiles) may lie outside its folder; set by
+                            lx_scene_load from its desc */
 } lx_scene;
 
 typedef struct lx_scene_load_desc {
@@ -206,6 +209,10 @@ typedef struct lx_scene_load_desc {
                            of dropping them with one warning */
     bool skip_textures; /* name textures (the *_map_path fields) without
                            decoding them: the maps stay empty (luxel info) */
+    bool allow_any_path; /* read files the scene names (buffers, textures,
+                            material libraries) wherever they are; by
+                            default only files in the scene file's folder
+                            or below it are read, others fail the load */
 } lx_scene_load_desc;
 
 /* A copy of desc (or of zeros when NULL) with every default filled in. */

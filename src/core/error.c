@@ -99,6 +99,11 @@ void lx_log_mute(bool mute)
     log_muted += mute ? 1 : -1;
 }
 
+bool lx_log_muted(void)
+{
+    return log_muted > 0;
+}
+
 void lx_log(lx_log_level level, const char *fmt, ...)
 {
     if (log_muted > 0)

@@ -102,11 +102,23 @@ lx_status lx_read_file(const char *path, size_t max_size, char **out, size_t *ou
 
 /* The folder part of a path (malloc'd; "." when none). */
 char *lx_path_dirname(const char *path);
+/* True when path (the file named relative to folder, as written in the
+ * naming file) resolves to folder or a file below it, symbolic links
+ * followed; a path that does not exist is judged by relative's text
+ * (absolute, or ".." above its start: outside). path_policy.c */
+bool lx_path_within(const char *folder, const char *path, const char *relative);
+/* LX_OK when allow_any or path lies within folder; else LX_ERR_INVALID
+ * with "file: what 'named' lies outside folder ...". */
+lx_status lx_path_confine(const char *file, const char *what, const char *named, const char *folder,
+                          const char *path, bool allow_any);
 /* a/b joined (malloc'd); b returned as-is when absolute. */
 char *lx_path_join(const char *a, const char *b);
 /* Mutes lx_log on the calling thread while true (nested calls count):
  * the baker rebuilding a texel map it built before says nothing twice. */
 void lx_log_mute(bool mute);
+/* True while lx_log is muted on the calling thread (a worker it starts
+ * mutes itself alike). */
+bool lx_log_muted(void);
 
 /* strdup that reports running out of memory by NULL. */
 char *lx_strdup(const char *s);

@@ -64,8 +64,21 @@ static bool is_int(const cJSON *it, double lo, double hi)
            it->valuedouble <= hi && floor(it->valuedouble) == it->valuedouble;
 }
 
-static lx_status parse_pages(const char *file, const char *dir, const cJSON *root, lx_lightmaps *lm)
+/* A file the manifest names, joined to its folder into *out; it must lie
+ * in that folder or below unless any_path (lx_path_confine). */
+static lx_status manifest_file(const char *file, const char *dir, const char *what,
+                               const char *name, bool any_path, char **out)
 {
+    if (!(*out = lx_path_join(dir, name)))
+        return lx_fail(LX_ERR_NOMEM, "%s: out of memory", file);
+    return lx_path_confine(file, what, name, dir, *out, any_path);
+}
+
+static lx_status parse_pages(const char *file, const char *dir, bool any_path, const cJSON *root,
+                             lx_lightmaps *lm)
+{
+    char what[64];
+    lx_status st;
     const cJSON *pages = cJSON_GetObjectItemCaseSensitive(root, "pages");
     if (!cJSON_IsArray(pages) || cJSON_GetArraySize(pages) == 0)
         return lx_fail(LX_ERR_FORMAT, "%s: \"pages\" must be a non-empty array", file);
@@ -87,9 +100,10 @@ static lx_status parse_pages(const char *file, const char *dir, const cJSON *roo
             return lx_fail(LX_ERR_FORMAT,
                            "%s: pages[%d]: \"width\" and \"height\" must be integers in 1..%d",
                            file, i, LX_MAX_LIGHTMAP_SIZE);
-        lm->pages[i].file = lx_path_join(dir, f->valuestring);
-        if (!lm->pages[i].file)
-            return lx_fail(LX_ERR_NOMEM, "%s: out of memory", file);
+        snprintf(what, sizeof what, "pages[%d]: file", i);
+        if ((st = manifest_file(file, dir, what, f->valuestring, any_path, &lm->pages[i].file)) !=
+            LX_OK)
+            return st;
         lm->pages[i].width = (int)w->valuedouble;
         lm->pages[i].height = (int)h->valuedouble;
         const cJSON *sh = cJSON_GetObjectItemCaseSensitive(p, "sh");
@@ -103,15 +117,19 @@ static lx_status parse_pages(const char *file, const char *dir, const cJSON *roo
                 if (!cJSON_IsString(it) || !it->valuestring[0])
                     return lx_fail(LX_ERR_FORMAT, "%s: pages[%d]: \"sh\" must be 4 file names",
                                    file, i);
-                if (!(lm->pages[i].sh_files[c] = lx_path_join(dir, it->valuestring)))
-                    return lx_fail(LX_ERR_NOMEM, "%s: out of memory", file);
+                snprintf(what, sizeof what, "pages[%d]: sh[%d]", i, c);
+                if ((st = manifest_file(file, dir, what, it->valuestring, any_path,
+                                        &lm->pages[i].sh_files[c])) != LX_OK)
+                    return st;
             }
         } else if (lm->directional == LX_DIRECTIONAL_DOMINANT) {
             if (!cJSON_IsString(dir_file) || !dir_file->valuestring[0])
                 return lx_fail(LX_ERR_FORMAT, "%s: pages[%d]: \"dir\" must be a file name", file,
                                i);
-            if (!(lm->pages[i].dir_file = lx_path_join(dir, dir_file->valuestring)))
-                return lx_fail(LX_ERR_NOMEM, "%s: out of memory", file);
+            snprintf(what, sizeof what, "pages[%d]: dir", i);
+            if ((st = manifest_file(file, dir, what, dir_file->valuestring, any_path,
+                                    &lm->pages[i].dir_file)) != LX_OK)
+                return st;
         }
         i++;
     }
@@ -188,7 +206,7 @@ static lx_status parse_nodes(const char *file, const cJSON *root, lx_lightmaps *
     return LX_OK;
 }
 
-static lx_status parse_manifest(const char *file, const char *dir, const cJSON *root,
+static lx_status parse_manifest(const char *file, const char *dir, bool any_path, const cJSON *root,
                                 lx_lightmaps *lm)
 {
     if (!cJSON_IsObject(root))
@@ -200,8 +218,10 @@ static lx_status parse_manifest(const char *file, const char *dir, const cJSON *
     if (swu && !cJSON_IsNull(swu)) {
         if (!cJSON_IsString(swu) || !swu->valuestring[0])
             return lx_fail(LX_ERR_FORMAT, "%s: \"scene_with_uvs\" must be a file name", file);
-        if (!(lm->scene_with_uvs = lx_path_join(dir, swu->valuestring)))
-            return lx_fail(LX_ERR_NOMEM, "%s: out of memory", file);
+        lx_status st = manifest_file(file, dir, "scene_with_uvs", swu->valuestring, any_path,
+                                     &lm->scene_with_uvs);
+        if (st != LX_OK)
+            return st;
     }
     const cJSON *q = cJSON_GetObjectItemCaseSensitive(root, "quantity");
     if (!q || (cJSON_IsString(q) && strcmp(q->valuestring, "irradiance") == 0))
@@ -270,7 +290,7 @@ static lx_status parse_manifest(const char *file, const char *dir, const cJSON *
                                file);
         }
     }
-    lx_status st = parse_pages(file, dir, root, lm);
+    lx_status st = parse_pages(file, dir, any_path, root, lm);
     if (st == LX_OK)
         st = parse_nodes(file, root, lm);
     return st;
@@ -385,7 +405,7 @@ lx_status lx_lightmaps_load(const char *dir, const lx_lightmaps_load_desc *desc,
     if (!(lm.dir = lx_strdup(dir)))
         st = lx_fail(LX_ERR_NOMEM, "out of memory");
     else
-        st = parse_manifest(file, dir, root, &lm);
+        st = parse_manifest(file, dir, d.allow_any_path, root, &lm);
     cJSON_Delete(root);
     for (uint32_t i = 0; st == LX_OK && !d.skip_images && i < lm.page_count; i++)
     {

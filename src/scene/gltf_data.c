@@ -208,8 +208,14 @@ lx_status lx_gltf_uri_read(const lx_gltf_file *f, const char *uri, const char *w
     free(name);
     if (!path)
         return lx_fail(LX_ERR_NOMEM, "%s: out of memory", f->path);
+    /* checked at lx_scene_load too; the file may have changed since */
+    lx_status st = lx_path_confine(f->path, what, uri, f->folder, path, f->allow_any_path);
+    if (st != LX_OK) {
+        free(path);
+        return st;
+    }
     char *bytes;
-    lx_status st = lx_read_file(path, LX_GLTF_FILE_MAX, &bytes, size);
+    st = lx_read_file(path, LX_GLTF_FILE_MAX, &bytes, size);
     if (st != LX_OK) {
         st = lx_fail(st, "%s: %s: cannot read '%s'", f->path, what, path);
         free(path);

@@ -35,7 +35,8 @@ typedef struct lx_gltf_file {
     size_t size;
     const uint8_t *bin; /* GLB binary chunk or NULL */
     size_t bin_size;
-    char *folder; /* for relative URIs */
+    char *folder;        /* for relative URIs ... */
+    bool allow_any_path; /* ... which lie in it or below unless this is set */
     /* buffers by index, loaded by lx_gltf_file_buffers */
     uint8_t **buffers;
     size_t *buffer_sizes;

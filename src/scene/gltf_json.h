@@ -133,9 +133,10 @@ lx_status lx_gltf_check_required(const char *file, const cJSON *root);
 /* Whether bytes (or the start of the file at path) are a Git LFS pointer. */
 bool lx_lfs_pointer(const void *bytes, size_t size);
 bool lx_lfs_pointer_file(const char *path);
-/* Fails naming the first buffer or image file (uri) that is a Git LFS
+/* Fails naming the first buffer or image file (uri) that lies outside the
+ * file's folder (unless allow_any_path; lx_path_confine) or is a Git LFS
  * pointer. */
-lx_status lx_gltf_check_lfs(const char *path, const cJSON *root);
+lx_status lx_gltf_check_files(const char *path, const cJSON *root, bool allow_any_path);
 /* When the file uses EXT_meshopt_compression or quantized vertex
  * attributes (KHR_mesh_quantization), decodes them: root is changed in
  * place (the same nodes, meshes, accessors and materials; new buffers and

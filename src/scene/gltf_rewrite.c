@@ -101,7 +101,7 @@ static bool is_data_uri(const char *uri)
     return strncmp(uri, "data:", 5) == 0;
 }
 
-lx_status lx_gltf_check_lfs(const char *path, const cJSON *root)
+lx_status lx_gltf_check_files(const char *path, const cJSON *root, bool allow_any_path)
 {
     static const char *const lists[] = {"buffers", "images"};
     char *folder = lx_path_dirname(path);
@@ -117,7 +117,11 @@ lx_status lx_gltf_check_lfs(const char *path, const cJSON *root)
             if (!uri || is_data_uri(uri))
                 continue;
             char *rel = uri_path(uri), *full = rel ? lx_path_join(folder, rel) : NULL;
-            if (full && lx_lfs_pointer_file(full))
+            char what[32];
+            snprintf(what, sizeof what, "%s %zu", l ? "image" : "buffer", i);
+            if (full)
+                st = lx_path_confine(path, what, uri, folder, full, allow_any_path);
+            if (st == LX_OK && full && lx_lfs_pointer_file(full))
                 st = failf(path, LX_ERR_FORMAT,
                            "%s %zu ('%.200s') is a Git LFS pointer, not the file: run git lfs pull",
                            l ? "image" : "buffer", i, uri);

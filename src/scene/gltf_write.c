@@ -672,6 +672,7 @@ lx_status lx_gltf_write_with_uvs(const lx_scene *scene, const char *path,
     lx_gltf_file f;
     wctx c = {.scene = scene, .f = &f, .out = path};
     lx_status st = lx_gltf_file_open(scene->path, &f);
+    f.allow_any_path = scene->allow_any_path;
     if (st == LX_OK)
         st = write_from_file(&c, d);
     lx_gltf_file_close(&f);

@@ -12,7 +12,9 @@
 #include "core/internal.h"
 
 #include "gltf_json.h"
+#include "import_checks.h"
 #include "json_text.h"
+#include "node_graph.h"
 
 #include <assimp/cfileio.h>
 #include <assimp/cimport.h>
@@ -32,7 +34,13 @@
 #include <sys/stat.h>
 
 #define LX_NAME_MAX 256
-#define LX_NODE_DEPTH_MAX 256
+#define LX_NODE_DEPTH_MAX NODE_DEPTH_MAX
+/* The stack assimp runs on: its readers recurse once per node level and
+ * per level of a file's nesting, both bounded by import_checks.c. With
+ * the bounds lifted, 32 MB held 20,000 levels of glTF, Collada and FBX
+ * nodes (the main thread's 8 MB fell at 10,000 in Collada): 80 times the
+ * 256 levels accepted, whatever stack the caller's thread has. */
+#define IMPORT_STACK_BYTES ((size_t)32 << 20)
 
 typedef struct gltf_map gltf_map;
 
@@ -155,6 +163,9 @@ typedef struct import_source {
     const char *read_path; /* the name assimp is given */
     const uint8_t *bytes;  /* served for read_path when not NULL */
     size_t size;
+    const char *path;    /* the scene file, for messages */
+    const char *folder;  /* other files must lie in it or below ... */
+    bool allow_any_path; /* ... unless this is set (lx_path_confine) */
 } import_source;
 
 typedef struct io_file {
@@ -171,6 +182,8 @@ typedef struct io_file {
 typedef struct io_state {
     const import_source *src;
     io_file *open;
+    char refused[512]; /* why the first file outside the folder was refused */
+    bool read_others;  /* a file besides the scene was opened (an OBJ's mtllib) */
 } io_state;
 
 static size_t io_read(struct aiFile *f, char *buf, size_t size, size_t count)
@@ -260,7 +273,20 @@ static struct aiFile *io_open(struct aiFileIO *io, const char *path, const char 
         h->bytes = src->bytes;
         h->size = src->size;
     } else {
+        /* an OBJ's mtllib, a buffer: only inside the scene's folder */
+        size_t n = strlen(src->folder);
+        const char *named =
+            strncmp(path, src->folder, n) == 0 && path[n] == '/' ? path + n + 1 : path;
+        if (lx_path_confine(src->path, "file named by the scene", named, src->folder, path,
+                            src->allow_any_path) != LX_OK) {
+            if (!state->refused[0])
+                snprintf(state->refused, sizeof state->refused, "%s", lx_last_error());
+            free(h);
+            free(f);
+            return NULL;
+        }
         struct stat sb;
+        state->read_others = true;
         h->fp = open_slashed(path);
         if (!h->fp || fstat(fileno(h->fp), &sb) != 0 || !S_ISREG(sb.st_mode)) {
             if (h->fp)
@@ -310,6 +336,8 @@ static struct aiFileIO io_for(io_state *state, const import_source *src)
 {
     state->src = src;
     state->open = NULL;
+    state->refused[0] = '\0';
+    state->read_others = false;
     struct aiFileIO io = {io_open, io_close, (aiUserData)(void *)state};
     return io;
 }
@@ -320,6 +348,26 @@ static void io_close_leftovers(struct aiFileIO *io)
     io_state *state = (io_state *)(void *)io->UserData;
     while (state->open)
         io_close(io, state->open->file);
+}
+
+/* assimp's message with what it quotes left out, when it may quote a
+ * file other than the one being parsed (an OBJ's material library: a
+ * message must not show another file's content). */
+static void redact_quotes(char *why, size_t size)
+{
+    char out[512];
+    size_t n = 0;
+    for (const char *p = why; *p && n + 6 < sizeof out; p++) {
+        const char *close = *p == '"' || *p == '\'' ? strchr(p + 1, *p) : NULL;
+        if (close) {
+            n += (size_t)snprintf(out + n, sizeof out - n, "%c...%c", *p, *p);
+            p = close;
+        } else {
+            out[n++] = *p;
+        }
+    }
+    out[n] = '\0';
+    snprintf(why, size, "%s", out);
 }
 
 static lx_status import_failed(const char *path, const char *why)
@@ -357,7 +405,16 @@ static lx_status import_exclusive(const char *path, const import_source *src, bo
         aiDetachLogStream(&log);
     char why[512];
     snprintf(why, sizeof why, "%s", im->ai ? "" : aiGetErrorString());
+    if (state.read_others)
+        redact_quotes(why, sizeof why);
     aiReleasePropertyStore(props);
+    if (state.refused[0]) { /* assimp may have gone on without the file */
+        if (im->ai)
+            aiReleaseImport(im->ai);
+        im->ai = NULL;
+        pthread_rwlock_unlock(&assimp_lock);
+        return lx_fail(LX_ERR_INVALID, "%s", state.refused);
+    }
     if (!im->ai) {
         pthread_rwlock_unlock(&assimp_lock);
         return import_failed(path, why);
@@ -384,8 +441,16 @@ static lx_status assimp_import_file(const char *path, const import_source *src, 
     io_close_leftovers(&io);
     char why[512];
     snprintf(why, sizeof why, "%s", ai ? "" : aiGetErrorString());
+    if (state.read_others)
+        redact_quotes(why, sizeof why);
     pthread_mutex_unlock(&reader_lock);
     aiReleasePropertyStore(props);
+    if (state.refused[0]) { /* assimp may have gone on without the file */
+        if (ai)
+            aiReleaseImport(ai);
+        pthread_rwlock_unlock(&assimp_lock);
+        return lx_fail(LX_ERR_INVALID, "%s", state.refused);
+    }
     if (!ai) {
         pthread_rwlock_unlock(&assimp_lock);
         return import_failed(path, why);
@@ -877,6 +942,31 @@ static lx_status material_refs(const import_ctx *c, unsigned i, const char *labe
                    c->path, label);
 }
 
+/* Every texture file a material names lies in the scene's folder or
+ * below it (lx_path_confine), checked before any is read. */
+static lx_status check_texture_paths(const import_ctx *c)
+{
+    static const enum aiTextureType types[] = {aiTextureType_NORMALS, aiTextureType_BASE_COLOR,
+                                               aiTextureType_DIFFUSE, aiTextureType_EMISSIVE};
+    for (unsigned i = 0; i < c->ai->mNumMaterials; i++)
+        for (size_t t = 0; t < sizeof types / sizeof types[0]; t++) {
+            struct aiString tex;
+            if (aiGetMaterialTexture(c->ai->mMaterials[i], types[t], 0, &tex, NULL, NULL, NULL,
+                                     NULL, NULL, NULL) != aiReturn_SUCCESS ||
+                tex.data[0] == '*')
+                continue;
+            char *full = lx_path_join(c->folder, tex.data);
+            if (!full)
+                return lx_fail(LX_ERR_NOMEM, "%s: out of memory", c->path);
+            lx_status st = lx_path_confine(c->path, "texture", tex.data, c->folder, full,
+                                           c->desc->allow_any_path);
+            free(full);
+            if (st != LX_OK)
+                return st;
+        }
+    return LX_OK;
+}
+
 static lx_status import_materials(import_ctx *c)
 {
     for (unsigned i = 0; i < c->ai->mNumMaterials; i++) {
@@ -1358,6 +1448,8 @@ static lx_status import_scene(const char *path, const import_source *src,
         return LX_OK;
     }
     if (st == LX_OK)
+        st = check_texture_paths(&c);
+    if (st == LX_OK)
         st = import_materials(&c);
     for (unsigned i = 0; st == LX_OK && i < ai->mNumMeshes; i++)
         st = import_mesh(&c, i);
@@ -1391,6 +1483,58 @@ static lx_status import_scene(const char *path, const import_source *src,
         return st;
     }
     *out = c.scene;
+    return LX_OK;
+}
+
+/* One scene import, run on a thread of its own (run_import). */
+typedef struct import_job {
+    const char *path;
+    const import_source *src;
+    const lx_scene_load_desc *desc;
+    const cJSON *gltf;
+    bool gltf2;
+    lx_scene **out;
+    bool log_muted; /* the caller's thread's lx_log_mute */
+    lx_status status;
+    char error[1024]; /* the import thread's lx_last_error */
+} import_job;
+
+static void *import_job_run(void *arg)
+{
+    import_job *job = arg;
+    if (job->log_muted)
+        lx_log_mute(true);
+    bool need_log = false;
+    job->status = import_scene(job->path, job->src, job->desc, job->gltf, job->gltf2, false,
+                               &need_log, job->out);
+    /* a mesh the JSON cannot vouch for: assimp's log must tell */
+    if (job->status == LX_OK && need_log)
+        job->status = import_scene(job->path, job->src, job->desc, job->gltf, job->gltf2, true,
+                                   &need_log, job->out);
+    if (job->status != LX_OK)
+        snprintf(job->error, sizeof job->error, "%s", lx_last_error());
+    return NULL;
+}
+
+/* Runs the import on a thread with IMPORT_STACK_BYTES of stack and hands
+ * its error message over to the caller's thread. Log messages go through
+ * the process-wide callback, as from any thread. */
+static lx_status run_import(import_job *job)
+{
+    pthread_attr_t attr;
+    pthread_t thread;
+    if (pthread_attr_init(&attr) != 0)
+        return lx_fail(LX_ERR_NOMEM, "%s: cannot start the import thread", job->path);
+    int err = pthread_attr_setstacksize(&attr, IMPORT_STACK_BYTES);
+    if (err == 0)
+        err = pthread_create(&thread, &attr, import_job_run, job);
+    pthread_attr_destroy(&attr);
+    if (err != 0)
+        return lx_fail(LX_ERR_NOMEM, "%s: cannot start the import thread (%zu MB of stack): %s",
+                       job->path, IMPORT_STACK_BYTES >> 20, strerror(err));
+    pthread_join(thread, NULL);
+    if (job->status != LX_OK)
+        return lx_fail(job->status, "%s", job->error);
     return LX_OK;
 }
 
@@ -1459,7 +1603,9 @@ lx_status lx_scene_load(const char *path, const lx_scene_load_desc *in, lx_scene
         if (st == LX_OK)
             st = lx_gltf_check_required(path, gltf);
         if (st == LX_OK)
-            st = lx_gltf_check_lfs(path, gltf);
+            st = lx_gltf_check_files(path, gltf, desc->allow_any_path);
+        if (st == LX_OK)
+            st = import_check_hierarchy(path, gltf);
         if (st == LX_OK && lx_gltf_is_v2(gltf))
             st = lx_gltf_check_cameras(path, gltf);
         if (st == LX_OK && lx_gltf_is_v2(gltf))
@@ -1478,13 +1624,35 @@ lx_status lx_scene_load(const char *path, const lx_scene_load_desc *in, lx_scene
             return st;
         }
     }
-    import_source src = {.read_path = read_path ? read_path : path, .bytes = glb, .size = glb_size};
-    bool gltf2 = gltf && lx_gltf_is_v2(gltf);
-    bool need_log = false;
-    lx_status st = import_scene(path, &src, desc, gltf, gltf2, false, &need_log, out);
-    /* a mesh the JSON cannot vouch for: assimp's log must tell */
-    if (st == LX_OK && need_log)
-        st = import_scene(path, &src, desc, gltf, gltf2, true, &need_log, out);
+    if (!gltf) {
+        lx_status st = import_check_hierarchy(path, NULL);
+        if (st != LX_OK)
+            return st;
+    }
+    char *folder = lx_path_dirname(path);
+    if (!folder) {
+        cJSON_Delete(gltf);
+        free(glb);
+        free(read_path);
+        return lx_fail(LX_ERR_NOMEM, "%s: out of memory", path);
+    }
+    import_source src = {.read_path = read_path ? read_path : path,
+                         .bytes = glb,
+                         .size = glb_size,
+                         .path = path,
+                         .folder = folder,
+                         .allow_any_path = desc->allow_any_path};
+    import_job job = {.path = path,
+                      .src = &src,
+                      .desc = desc,
+                      .gltf = gltf,
+                      .gltf2 = gltf && lx_gltf_is_v2(gltf),
+                      .out = out,
+                      .log_muted = lx_log_muted()};
+    lx_status st = run_import(&job);
+    if (st == LX_OK)
+        (*out)->allow_any_path = desc->allow_any_path;
+    free(folder);
     cJSON_Delete(gltf);
     free(glb);
     free(read_path);

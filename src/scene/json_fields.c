@@ -124,10 +124,23 @@ lx_status lx_jf_check_keys(const lx_jf_ctx *c, const cJSON *obj, const char *con
 }
 
 /* A path the file gives, relative to the file's folder (malloc'd). */
-char *lx_jf_relative_path(const lx_jf_ctx *c, const char *rel)
+lx_status lx_jf_relative_path(const lx_jf_ctx *c, const char *field, const char *rel, char **out)
 {
+    *out = NULL;
     char *dir = lx_path_dirname(c->file);
     char *path = dir ? lx_path_join(dir, rel) : NULL;
+    if (!path) {
+        free(dir);
+        return lx_jf_fail(c, LX_ERR_NOMEM, "out of memory");
+    }
+    char what[160];
+    snprintf(what, sizeof what, "%s%s%s", c->where, c->where[0] ? ": " : "", field);
+    lx_status st = lx_path_confine(c->file, what, rel, dir, path, c->allow_any_path);
     free(dir);
-    return path;
+    if (st != LX_OK) {
+        free(path);
+        return st;
+    }
+    *out = path;
+    return LX_OK;
 }

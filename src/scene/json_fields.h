@@ -19,6 +19,7 @@ typedef struct lx_jf_ctx {
     char where[128];           /* "lights[2] ('key')" or "" at the root */
     lx_ies_profile **profiles; /* loaded by this file: the scene adopts them */
     uint32_t profile_count;
+    bool allow_any_path; /* files named may lie outside the file's folder */
 } lx_jf_ctx;
 
 /* lx_fail with "<file>: <where>: " in front. */
@@ -46,8 +47,9 @@ lx_status lx_jf_enum(const lx_jf_ctx *c, const cJSON *item, const char *field,
 /* Every key of obj is in allowed, once. */
 lx_status lx_jf_check_keys(const lx_jf_ctx *c, const cJSON *obj, const char *const *allowed,
                            int count);
-/* A path the file gives, relative to the file's folder (malloc'd; NULL
- * when out of memory). */
-char *lx_jf_relative_path(const lx_jf_ctx *c, const char *rel);
+/* A path the file gives in field, relative to the file's folder, into
+ * *out (malloc'd); it must lie in that folder or below unless
+ * c->allow_any_path (lx_path_confine). */
+lx_status lx_jf_relative_path(const lx_jf_ctx *c, const char *field, const char *rel, char **out);
 
 #endif

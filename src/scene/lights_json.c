@@ -332,9 +332,9 @@ static lx_status read_profile(lx_jf_ctx *c, const cJSON *obj, lx_light *l)
         const char *rel = NULL;
         if ((st = lx_jf_string(c, ies, "ies", &rel)) != LX_OK)
             return st;
-        char *path = lx_jf_relative_path(c, rel);
-        if (!path)
-            return lx_jf_fail(c, LX_ERR_NOMEM, "out of memory");
+        char *path = NULL;
+        if ((st = lx_jf_relative_path(c, "ies", rel, &path)) != LX_OK)
+            return st;
         lx_ies_profile *profile = NULL;
         st = lx_ies_load(path, &profile);
         free(path);
@@ -623,15 +623,12 @@ static lx_status read_sky(lx_jf_ctx *c, const cJSON *obj, lx_scene_sky *sky)
                               LX_MAX_SKY_SAMPLES);
         sky->samples = (uint32_t)v;
     }
-    sky->environment = lx_jf_relative_path(c, rel);
-    if (!sky->environment)
-        return lx_jf_fail(c, LX_ERR_NOMEM, "out of memory");
-    return LX_OK;
+    return lx_jf_relative_path(c, "environment", rel, &sky->environment);
 }
 
 static lx_status apply_root(lx_scene *scene, const cJSON *root, const char *file)
 {
-    lx_jf_ctx c = {.file = file, .where = ""};
+    lx_jf_ctx c = {.file = file, .where = "", .allow_any_path = scene->allow_any_path};
     if (!cJSON_IsObject(root))
         return lx_jf_fail(&c, LX_ERR_FORMAT, "the top level must be an object with \"lights\"");
     lx_status st = lx_jf_check_keys(&c, root, root_keys, LX_JF_COUNT(root_keys));

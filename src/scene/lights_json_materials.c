@@ -41,8 +41,7 @@ static lx_status read_path(lx_jf_ctx *c, const cJSON *it, const char *field, cha
         return st;
     if (!rel[0])
         return lx_jf_fail(c, LX_ERR_FORMAT, "%s is an empty path", field);
-    *out = lx_jf_relative_path(c, rel);
-    return *out ? LX_OK : lx_jf_fail(c, LX_ERR_NOMEM, "out of memory");
+    return lx_jf_relative_path(c, field, rel, out);
 }
 
 static lx_status read_material_entry(lx_jf_ctx *c, const cJSON *obj, pending_material *p)

@@ -108,6 +108,7 @@ static const char *bake_usage =
     "                          cones, unusable UVs...) instead of baking\n"
     "  -v, --verbose           the time of each phase, and notes\n"
     "  -q, --quiet             no progress bar or summary\n"
+    "  --allow-any-path        read files the inputs name outside their folders\n"
     "  -h, --help              show this help\n";
 
 /* bake's own options' codes, after the shared ones (bake_setup.h) */
@@ -150,6 +151,7 @@ static int parse_args(int argc, char **argv, bake_args *a)
         {"directional", required_argument, NULL, OPT_DIRECTIONAL},
         {"quiet", no_argument, NULL, 'q'},
         {"verbose", no_argument, NULL, 'v'},
+        CLI_ANY_PATH_OPTION,
         {"help", no_argument, NULL, 'h'},
         {NULL, 0, NULL, 0}};
     cli_bake_args_init(a, "bake");

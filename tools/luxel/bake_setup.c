@@ -470,7 +470,7 @@ int cli_bake_prepare(bake_args *a, cli_progress *progress, lx_scene **scene_out,
     *unwrap = NULL;
     *baker = NULL;
     *atlas = false;
-    lx_scene_load_desc ld = {.strict = a->desc.strict};
+    lx_scene_load_desc ld = {.strict = a->desc.strict, .allow_any_path = cli_allow_any_path()};
     if (lx_scene_load(a->scene, &ld, &scene) != LX_OK) {
         cli_error("%s", lx_last_error());
         goto done;

@@ -69,6 +69,14 @@ int cli_usage_error(const char *command, const char *fmt, ...)
  * character), and the largest worker count a command accepts. */
 #define CLI_OPT_THREADS 0x1000
 #define CLI_MAX_THREADS 1024
+/* --allow-any-path, for the commands that read a scene, a lights JSON or
+ * a manifest: the files these name may lie outside their folders
+ * (cli_allow_any_path). */
+#define CLI_OPT_ANY_PATH 0x1001
+#define CLI_ANY_PATH_OPTION                                                                        \
+    {                                                                                              \
+        "allow-any-path", no_argument, NULL, CLI_OPT_ANY_PATH                                      \
+    }
 /* The end of every command's option switch: --threads N into *threads,
  * -q into *quiet (and cli_set_quiet), -v (cli_set_verbose); getopt's ':'
  * (a missing value) and anything else (an unknown option, or --threads
@@ -111,6 +119,9 @@ void cli_set_quiet(bool quiet);
 void cli_set_strict(bool strict);
 bool cli_quiet(void);
 bool cli_strict(void);
+/* --allow-any-path was given (cli_common_option sets it). */
+void cli_set_allow_any_path(bool any);
+bool cli_allow_any_path(void);
 
 /* The tone curve of 8-bit previews and outputs (bake's PNG previews, ibl's
  * PNG files) when --tonemap does not choose: Hable's filmic curve keeps a

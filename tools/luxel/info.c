@@ -24,6 +24,7 @@ static const char *info_usage =
     "  --resolution N       texels a side overlaps are counted at (default %d)\n"
     "  --threads N          worker threads (default: all cores)\n"
     "  --strict             fail on zero-area triangles and on any warning\n"
+    "  --allow-any-path     read files the inputs name outside their folders\n"
     "  -h, --help           show this help\n";
 
 static void print_light(const lx_light *l)
@@ -114,6 +115,7 @@ int cmd_info(int argc, char **argv)
                                             {"resolution", required_argument, NULL, 'r'},
                                             {"threads", required_argument, NULL, 't'},
                                             {"strict", no_argument, NULL, 's'},
+                                            CLI_ANY_PATH_OPTION,
                                             {"help", no_argument, NULL, 'h'},
                                             {NULL, 0, NULL, 0}};
     const char *lights = NULL;
@@ -161,7 +163,8 @@ int cmd_info(int argc, char **argv)
     lx_scene *s;
     /* listing needs the textures' names, not their pixels; zero-area
      * triangles are dropped with a warning (--strict: refused) */
-    lx_scene_load_desc ld = {.skip_textures = true, .strict = strict};
+    lx_scene_load_desc ld = {
+        .skip_textures = true, .strict = strict, .allow_any_path = cli_allow_any_path()};
     if (lx_scene_load(path, &ld, &s) != LX_OK) {
         cli_error("%s", lx_last_error());
         return EXIT_FAILED;

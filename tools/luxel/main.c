@@ -439,6 +439,18 @@ bool cli_strict(void)
     return strict;
 }
 
+static bool any_path;
+
+void cli_set_allow_any_path(bool any)
+{
+    any_path = any;
+}
+
+bool cli_allow_any_path(void)
+{
+    return any_path;
+}
+
 static void print_log(void *user, lx_log_level level, const char *message)
 {
     (void)user;

@@ -27,6 +27,9 @@ int cli_common_option(const char *command, int c, char **argv, int *threads, boo
     case 'v':
         cli_set_verbose(true);
         return 0;
+    case CLI_OPT_ANY_PATH:
+        cli_set_allow_any_path(true);
+        return 0;
     case ':':
         return cli_usage_error(command, "option '%s' needs a value", argv[optind - 1]);
     default:

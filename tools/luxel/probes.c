@@ -36,6 +36,7 @@ static const char *probes_usage =
     "  --threads N             worker threads (default: all cores)\n"
     "  -v, --verbose           the time of each phase, and notes\n"
     "  -q, --quiet             no progress bar or summary\n"
+    "  --allow-any-path        read files the inputs name outside their folders\n"
     "  -h, --help              show this help\n"
     "\n"
     "scene and lighting, as luxel bake (luxel bake --help): --lights, --ambient,\n"
@@ -87,6 +88,7 @@ static int parse_args(int argc, char **argv, probes_args *a)
                                             {"threads", required_argument, NULL, CLI_OPT_THREADS},
                                             {"quiet", no_argument, NULL, 'q'},
                                             {"verbose", no_argument, NULL, 'v'},
+                                            CLI_ANY_PATH_OPTION,
                                             {"help", no_argument, NULL, 'h'},
                                             {NULL, 0, NULL, 0}};
     memset(a, 0, sizeof *a);

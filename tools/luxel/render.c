@@ -49,6 +49,7 @@ static const char *render_usage =
     "  --threads N             worker threads (default: all cores)\n"
     "  -v, --verbose           the time of each phase\n"
     "  -q, --quiet             no progress bar or summary\n"
+    "  --allow-any-path        read files the inputs name outside their folders\n"
     "  -h, --help              show this help\n";
 
 /* The CLI's tone curve: the bake previews' (Hable's filmic), so a view and
@@ -134,24 +135,25 @@ static bool parse_size(const char *s, int *w, int *h)
 
 static int parse_args(int argc, char **argv, render_args *a)
 {
-    static const struct option options[] = {{"lightmaps", required_argument, NULL, OPT_LIGHTMAPS},
-                                            {"output", required_argument, NULL, 'o'},
-                                            {"camera", required_argument, NULL, OPT_CAMERA},
-                                            {"view", required_argument, NULL, OPT_VIEW},
-                                            {"gltf-camera", required_argument, NULL,
-                                             OPT_GLTF_CAMERA},
-                                            {"fov", required_argument, NULL, OPT_FOV},
-                                            {"size", required_argument, NULL, OPT_SIZE},
-                                            {"exposure", required_argument, NULL, OPT_EXPOSURE},
-                                            {"tonemap", required_argument, NULL, OPT_TONEMAP},
-                                            {"filter", required_argument, NULL, OPT_FILTER},
-                                            {"samples", required_argument, NULL, OPT_SAMPLES},
-                                            {"two-sided", no_argument, NULL, OPT_TWO_SIDED},
-                                            {"threads", required_argument, NULL, CLI_OPT_THREADS},
-                                            {"quiet", no_argument, NULL, 'q'},
-                                            {"verbose", no_argument, NULL, 'v'},
-                                            {"help", no_argument, NULL, 'h'},
-                                            {NULL, 0, NULL, 0}};
+    static const struct option options[] = {
+        {"lightmaps", required_argument, NULL, OPT_LIGHTMAPS},
+        {"output", required_argument, NULL, 'o'},
+        {"camera", required_argument, NULL, OPT_CAMERA},
+        {"view", required_argument, NULL, OPT_VIEW},
+        {"gltf-camera", required_argument, NULL, OPT_GLTF_CAMERA},
+        {"fov", required_argument, NULL, OPT_FOV},
+        {"size", required_argument, NULL, OPT_SIZE},
+        {"exposure", required_argument, NULL, OPT_EXPOSURE},
+        {"tonemap", required_argument, NULL, OPT_TONEMAP},
+        {"filter", required_argument, NULL, OPT_FILTER},
+        {"samples", required_argument, NULL, OPT_SAMPLES},
+        {"two-sided", no_argument, NULL, OPT_TWO_SIDED},
+        {"threads", required_argument, NULL, CLI_OPT_THREADS},
+        {"quiet", no_argument, NULL, 'q'},
+        {"verbose", no_argument, NULL, 'v'},
+        CLI_ANY_PATH_OPTION,
+        {"help", no_argument, NULL, 'h'},
+        {NULL, 0, NULL, 0}};
     memset(a, 0, sizeof *a);
     a->desc = lx_render_desc_defaults(NULL);
     a->output = "view.png";
@@ -712,7 +714,8 @@ int cmd_render(int argc, char **argv)
     if (rc != 0)
         return rc < 0 ? EXIT_OK : rc;
     lx_lightmaps lm;
-    if (lx_lightmaps_load(a.lightmaps, NULL, &lm) != LX_OK) {
+    lx_lightmaps_load_desc lmd = {.allow_any_path = cli_allow_any_path()};
+    if (lx_lightmaps_load(a.lightmaps, &lmd, &lm) != LX_OK) {
         cli_error("%s", lx_last_error());
         return EXIT_FAILED;
     }
@@ -721,7 +724,8 @@ int cmd_render(int argc, char **argv)
     const char *path = with_uvs ? lm.scene_with_uvs : a.scene;
     lx_scene *scene = NULL;
     int status = EXIT_FAILED;
-    if (lx_scene_load(path, NULL, &scene) != LX_OK) {
+    lx_scene_load_desc ld = {.allow_any_path = cli_allow_any_path()};
+    if (lx_scene_load(path, &ld, &scene) != LX_OK) {
         cli_error("%s", lx_last_error());
         goto done;
     }
@@ -758,7 +762,8 @@ int cli_render_bake(const char *dir, const lx_scene *scene, int threads, bool qu
     a.output = out;
     lx_lightmaps lm;
     int status = EXIT_FAILED;
-    if (lx_lightmaps_load(dir, NULL, &lm) != LX_OK)
+    lx_lightmaps_load_desc lmd = {.allow_any_path = cli_allow_any_path()};
+    if (lx_lightmaps_load(dir, &lmd, &lm) != LX_OK)
         cli_error("%s", lx_last_error());
     else
         status = render_and_write(&a, &lm, scene);

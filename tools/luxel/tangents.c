@@ -29,6 +29,7 @@ static const char *tangents_usage =
     "  --method M             mikktspace (default; what glTF specifies) or lengyel\n"
     "  --uv-set N             compute from TEXCOORD_N for every primitive\n"
     "  -q, --quiet            no summary\n"
+    "  --allow-any-path       read files the inputs name outside their folders\n"
     "  -h, --help             show this help\n";
 
 enum { OPT_METHOD = 256, OPT_UV_SET };
@@ -46,6 +47,7 @@ static int parse_args(int argc, char **argv, tangents_args *a)
                                             {"method", required_argument, NULL, OPT_METHOD},
                                             {"uv-set", required_argument, NULL, OPT_UV_SET},
                                             {"quiet", no_argument, NULL, 'q'},
+                                            CLI_ANY_PATH_OPTION,
                                             {"help", no_argument, NULL, 'h'},
                                             {NULL, 0, NULL, 0}};
     memset(a, 0, sizeof *a);
@@ -187,7 +189,8 @@ int cmd_tangents(int argc, char **argv)
     mesh_out *outs = NULL;
     lx_scene_uvs *entries = NULL;
     int status = EXIT_FAILED;
-    if (lx_scene_load(a.scene, NULL, &scene) != LX_OK) {
+    lx_scene_load_desc ld = {.allow_any_path = cli_allow_any_path()};
+    if (lx_scene_load(a.scene, &ld, &scene) != LX_OK) {
         cli_error("%s", lx_last_error());
         goto done;
     }

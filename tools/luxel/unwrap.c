@@ -30,6 +30,7 @@ static const char *unwrap_usage =
     "  --threads N            threads to use (default: all cores)\n"
     "  -q, --quiet            no progress bar and no summary\n"
     "  -v, --verbose          phase times and the unwrapper's figures\n"
+    "  --allow-any-path       read files the inputs name outside their folders\n"
     "  -h, --help             show this help\n";
 
 enum {
@@ -66,6 +67,7 @@ static int parse_args(int argc, char **argv, unwrap_args *a)
         {"threads", required_argument, NULL, CLI_OPT_THREADS},
         {"quiet", no_argument, NULL, 'q'},
         {"verbose", no_argument, NULL, 'v'},
+        CLI_ANY_PATH_OPTION,
         {"help", no_argument, NULL, 'h'},
         {NULL, 0, NULL, 0}};
     memset(a, 0, sizeof *a);
@@ -223,7 +225,7 @@ int cmd_unwrap(int argc, char **argv)
     lx_scene *scene = NULL;
     lx_unwrap *u = NULL;
     int status = EXIT_FAILED;
-    lx_scene_load_desc ld = {.strict = a.strict};
+    lx_scene_load_desc ld = {.strict = a.strict, .allow_any_path = cli_allow_any_path()};
     if (lx_scene_load(a.scene, &ld, &scene) != LX_OK) {
         cli_error("%s", lx_last_error());
         goto done;

@@ -1,0 +1,784 @@
+/* Checks made on a scene file itself before assimp reads it. assimp's
+ * readers and post-processing walk the node hierarchy recursively (and its
+ * Collada and FBX readers recurse over the file's own nesting), copying an
+ * instanced subtree once per reference: a 410 KB glTF or Collada file of
+ * 20,000 nested nodes overflowed the stack inside assimp before luxel's
+ * own walk could refuse it. So each format's hierarchy is measured here,
+ * without recursion (node_graph.c), and refused past NODE_DEPTH_MAX levels,
+ * on a cycle, or past NODE_EXPANDED_MAX nodes once instances are copied:
+ *
+ * - glTF 2.0: "children" (one parent each, gltf_nodes.c); glTF 1.0: the
+ *   same by node id;
+ * - Collada: XML element nesting (at most XML_DEPTH_MAX), <node> nesting
+ *   and <instance_node> references;
+ * - FBX, binary and ASCII: record/brace nesting (at most FBX_NEST_MAX) and
+ *   the Model objects' parent links from the "OO" connections.
+ *
+ * OBJ, PLY and STL have no hierarchy. What assimp does beyond these
+ * bounds is contained by the import thread's stack (import_assimp.c),
+ * sized for them. */
+#define _GNU_SOURCE /* O_CLOEXEC */
+#include "core/internal.h"
+
+#include "gltf_json.h"
+#include "import_checks.h"
+#include "node_graph.h"
+
+#include <cjson/cJSON.h>
+#include <errno.h>
+#include <fcntl.h>
+#include <stdio.h>
+#include <stdlib.h>
+#include <string.h>
+#include <strings.h>
+#include <sys/mman.h>
+#include <sys/stat.h>
+#include <unistd.h>
+
+/* Nodes a hierarchy may expand to with its instances copied. */
+#define NODE_EXPANDED_MAX 1000000u
+/* Nesting of XML elements and of FBX records or braces: well above what
+ * exporters write (Collada ~12 plus the node levels, FBX ~6), well below
+ * what assimp's recursive readers survive on the import thread's stack. */
+#define XML_DEPTH_MAX (NODE_DEPTH_MAX + 64)
+#define FBX_NEST_MAX 64
+
+/* ---- the verdict on a measured graph ------------------------------------- */
+
+typedef void (*node_namer)(const void *user, uint32_t node, char *buf, size_t size);
+
+static lx_status judge_graph(const char *path, const node_graph *g, node_namer name,
+                             const void *user)
+{
+    node_graph_shape shape;
+    if (node_graph_measure(g, &shape) != LX_OK)
+        return lx_fail(LX_ERR_NOMEM, "%s: out of memory measuring %zu nodes", path, g->nodes);
+    char who[160];
+    if (shape.cycle_at != UINT32_MAX) {
+        name(user, shape.cycle_at, who, sizeof who);
+        return lx_fail(LX_ERR_FORMAT, "%s: the node hierarchy has a cycle through %s", path, who);
+    }
+    if (shape.depth > NODE_DEPTH_MAX) {
+        name(user, shape.deepest, who, sizeof who);
+        return lx_fail(LX_ERR_FORMAT,
+                       "%s: node hierarchy deeper than %d levels (a chain of %u nodes from %s)",
+                       path, NODE_DEPTH_MAX, shape.depth, who);
+    }
+    if (shape.expanded > NODE_EXPANDED_MAX) {
+        name(user, shape.largest, who, sizeof who);
+        return lx_fail(LX_ERR_FORMAT,
+                       "%s: %s expands to %s%llu nodes through its instances (at most %u)", path,
+                       who, shape.expanded == NODE_GRAPH_SIZE_CAP ? "over " : "",
+                       (unsigned long long)shape.expanded, NODE_EXPANDED_MAX);
+    }
+    return LX_OK;
+}
+
+/* ---- glTF ------------------------------------------------------------------ */
+
+static lx_status check_gltf2(const char *path, const cJSON *gltf)
+{
+    lx_gltf_graph g = {0};
+    lx_status st = lx_gltf_graph_build(path, gltf, &g); /* one parent each, no cycles */
+    uint32_t *depth = NULL;
+    if (st == LX_OK && g.count > 0 && !(depth = malloc(g.count * sizeof *depth)))
+        st = lx_fail(LX_ERR_NOMEM, "%s: out of memory for %zu nodes", path, g.count);
+    for (size_t i = 0; st == LX_OK && i < g.reached; i++) {
+        size_t k = g.order[i]; /* parents first */
+        depth[k] = g.parent[k] < 0 ? 1 : depth[g.parent[k]] + 1;
+        if (depth[k] > NODE_DEPTH_MAX) {
+            size_t top = k;
+            while (g.parent[top] >= 0)
+                top = (size_t)g.parent[top];
+            char who[128];
+            lx_gltf_label(who, sizeof who, "node", top, g.nodes[top]);
+            st = lx_fail(LX_ERR_FORMAT, "%s: node hierarchy deeper than %d levels (below %s)", path,
+                         NODE_DEPTH_MAX, who);
+        }
+    }
+    free(depth);
+    lx_gltf_graph_free(&g);
+    return st;
+}
+
+/* glTF 1.0 names its nodes by id: "nodes": {"id": {"children": ["id"]}}. */
+typedef struct named_node {
+    const char *id;
+    uint32_t index;
+} named_node;
+
+static int by_id(const void *a, const void *b)
+{
+    return strcmp(((const named_node *)a)->id, ((const named_node *)b)->id);
+}
+
+static void name_gltf1(const void *user, uint32_t node, char *buf, size_t size)
+{
+    const cJSON *nodes = user;
+    const cJSON *n = nodes->child;
+    for (uint32_t i = 0; n && i < node; i++)
+        n = n->next;
+    snprintf(buf, size, "node '%.100s'", n && n->string ? n->string : "?");
+}
+
+static lx_status check_gltf1(const char *path, const cJSON *gltf)
+{
+    const cJSON *nodes = lx_gltf_get(gltf, "nodes");
+    if (!cJSON_IsObject(nodes))
+        return LX_OK; /* assimp refuses what is malformed; no hierarchy to walk */
+    node_graph g = {0};
+    for (const cJSON *n = nodes->child; n; n = n->next)
+        g.nodes++;
+    named_node *ids = malloc((g.nodes ? g.nodes : 1) * sizeof *ids);
+    if (!ids)
+        return lx_fail(LX_ERR_NOMEM, "%s: out of memory for %zu nodes", path, g.nodes);
+    uint32_t i = 0;
+    for (const cJSON *n = nodes->child; n; n = n->next, i++)
+        ids[i] = (named_node){n->string ? n->string : "", i};
+    qsort(ids, g.nodes, sizeof *ids, by_id);
+    lx_status st = LX_OK;
+    i = 0;
+    for (const cJSON *n = nodes->child; n && st == LX_OK; n = n->next, i++) {
+        const cJSON *children = lx_gltf_get(n, "children");
+        for (const cJSON *c = cJSON_IsArray(children) ? children->child : NULL; c; c = c->next) {
+            if (!cJSON_IsString(c))
+                continue;
+            named_node key = {c->valuestring, 0};
+            const named_node *hit = bsearch(&key, ids, g.nodes, sizeof *ids, by_id);
+            if (hit && !node_graph_add_edge(&g, i, hit->index)) {
+                st = lx_fail(LX_ERR_NOMEM, "%s: out of memory for the node hierarchy", path);
+                break;
+            }
+        }
+    }
+    if (st == LX_OK)
+        st = judge_graph(path, &g, name_gltf1, nodes);
+    free(ids);
+    node_graph_free(&g);
+    return st;
+}
+
+/* ---- a file's bytes ---------------------------------------------------------- */
+
+typedef struct mapped_file {
+    const char *bytes;
+    size_t size;
+} mapped_file;
+
+static lx_status map_file(const char *path, mapped_file *m)
+{
+    m->bytes = NULL;
+    m->size = 0;
+    int fd = open(path, O_RDONLY | O_CLOEXEC);
+    if (fd < 0)
+        return lx_fail(LX_ERR_IO, "%s: cannot open: %s", path, strerror(errno));
+    struct stat sb;
+    if (fstat(fd, &sb) != 0 || !S_ISREG(sb.st_mode)) {
+        close(fd);
+        return lx_fail(LX_ERR_IO, "%s: not a regular file", path);
+    }
+    if (sb.st_size > 0) {
+        void *p = mmap(NULL, (size_t)sb.st_size, PROT_READ, MAP_PRIVATE, fd, 0);
+        if (p == MAP_FAILED) {
+            close(fd);
+            return lx_fail(LX_ERR_IO, "%s: cannot read: %s", path, strerror(errno));
+        }
+        m->bytes = p;
+        m->size = (size_t)sb.st_size;
+    }
+    close(fd);
+    return LX_OK;
+}
+
+static void unmap_file(mapped_file *m)
+{
+    if (m->bytes)
+        munmap((void *)(uintptr_t)m->bytes, m->size);
+}
+
+/* Ids of nodes, kept in the order met, found again by a sorted copy. */
+typedef struct id_table {
+    char **ids; /* by node index */
+    size_t count, capacity;
+    named_node *sorted;
+} id_table;
+
+static bool id_table_add(id_table *t, const char *id, size_t len)
+{
+    if (t->count == t->capacity) {
+        size_t cap = t->capacity ? t->capacity * 2 : 64;
+        char **ids = realloc(t->ids, cap * sizeof *ids);
+        if (!ids)
+            return false;
+        t->ids = ids;
+        t->capacity = cap;
+    }
+    char *copy = malloc(len + 1);
+    if (!copy)
+        return false;
+    memcpy(copy, id, len);
+    copy[len] = '\0';
+    t->ids[t->count++] = copy;
+    return true;
+}
+
+static bool id_table_sort(id_table *t)
+{
+    t->sorted = malloc((t->count ? t->count : 1) * sizeof *t->sorted);
+    if (!t->sorted)
+        return false;
+    for (size_t i = 0; i < t->count; i++)
+        t->sorted[i] = (named_node){t->ids[i], (uint32_t)i};
+    qsort(t->sorted, t->count, sizeof *t->sorted, by_id);
+    return true;
+}
+
+static const named_node *id_table_find(const id_table *t, const char *id)
+{
+    named_node key = {id, 0};
+    return bsearch(&key, t->sorted, t->count, sizeof *t->sorted, by_id);
+}
+
+static void id_table_free(id_table *t)
+{
+    for (size_t i = 0; i < t->count; i++)
+        free(t->ids[i]);
+    free(t->ids);
+    free(t->sorted);
+    memset(t, 0, sizeof *t);
+}
+
+/* ---- Collada ----------------------------------------------------------------- */
+
+/* An edge of the Collada node graph by the instanced node's id, resolved
+ * once every id is known. */
+typedef struct collada_scan {
+    const char *path;
+    id_table nodes;        /* <node id=...>, in document order */
+    node_graph graph;      /* nesting edges, then the resolved instances */
+    uint32_t *instance_of; /* the node holding each <instance_node> */
+    char **instance_url;   /* and the id it names */
+    size_t instances, instance_cap;
+} collada_scan;
+
+static void name_collada(const void *user, uint32_t node, char *buf, size_t size)
+{
+    const collada_scan *s = user;
+    snprintf(buf, size, "node '%.100s'", s->nodes.ids[node]);
+}
+
+static size_t line_at(const char *bytes, const char *at)
+{
+    size_t line = 1;
+    for (const char *p = bytes; p < at; p++)
+        line += *p == '\n';
+    return line;
+}
+
+/* The value of attribute name in the tag text [p, end), or NULL. */
+static const char *xml_attribute(const char *p, const char *end, const char *name, size_t *len)
+{
+    size_t n = strlen(name);
+    while (p < end) {
+        while (p < end && (*p == ' ' || *p == '\t' || *p == '\r' || *p == '\n'))
+            p++;
+        const char *key = p;
+        while (p < end && *p != '=' && *p != ' ' && *p != '\t' && *p != '\r' && *p != '\n')
+            p++;
+        size_t key_len = (size_t)(p - key);
+        while (p < end && *p != '=' && *p != '"' && *p != '\'')
+            p++;
+        if (p >= end || *p != '=')
+            return NULL;
+        p++;
+        while (p < end && *p != '"' && *p != '\'')
+            p++;
+        if (p >= end)
+            return NULL;
+        char quote = *p++;
+        const char *value = p;
+        while (p < end && *p != quote)
+            p++;
+        if (p >= end)
+            return NULL;
+        if (key_len == n && memcmp(key, name, n) == 0) {
+            *len = (size_t)(p - value);
+            return value;
+        }
+        p++;
+    }
+    return NULL;
+}
+
+/* The end of a construct starting at p that closes with the string close. */
+static const char *skip_past(const char *p, const char *end, const char *close)
+{
+    size_t n = strlen(close);
+    for (; p + n <= end; p++)
+        if (memcmp(p, close, n) == 0)
+            return p + n;
+    return end;
+}
+
+static bool name_is(const char *name, size_t len, const char *want)
+{
+    /* a namespace prefix (<c:node>) is ignored */
+    const char *colon = memchr(name, ':', len);
+    if (colon) {
+        len -= (size_t)(colon + 1 - name);
+        name = colon + 1;
+    }
+    return len == strlen(want) && memcmp(name, want, len) == 0;
+}
+
+static lx_status collada_scan_tags(collada_scan *s, const mapped_file *f)
+{
+    const char *p = f->bytes, *end = f->bytes + f->size;
+    uint32_t innermost[XML_DEPTH_MAX]; /* the nearest enclosing <node> */
+    size_t depth = 0;
+    while ((p = memchr(p, '<', (size_t)(end - p))) != NULL) {
+        const char *tag = p;
+        p++;
+        if (end - p >= 3 && memcmp(p, "!--", 3) == 0) {
+            p = skip_past(p + 3, end, "-->");
+            continue;
+        }
+        if (end - p >= 8 && memcmp(p, "![CDATA[", 8) == 0) {
+            p = skip_past(p + 8, end, "]]>");
+            continue;
+        }
+        if (p < end && (*p == '?' || *p == '!')) {
+            p = skip_past(p, end, ">");
+            continue;
+        }
+        /* the tag's end: the first '>' outside quotes */
+        const char *q = p;
+        char quote = 0;
+        for (; q < end; q++) {
+            if (quote) {
+                if (*q == quote)
+                    quote = 0;
+            } else if (*q == '"' || *q == '\'') {
+                quote = *q;
+            } else if (*q == '>') {
+                break;
+            }
+        }
+        if (q >= end)
+            break; /* unterminated: assimp's XML parser reports it */
+        bool closing = p < end && *p == '/';
+        bool empty = q > p && q[-1] == '/';
+        if (closing) {
+            if (depth > 0)
+                depth--;
+            p = q + 1;
+            continue;
+        }
+        const char *name = p;
+        while (p < q && *p != ' ' && *p != '\t' && *p != '\r' && *p != '\n' && *p != '/')
+            p++;
+        size_t name_len = (size_t)(p - name);
+        uint32_t parent_node = depth > 0 ? innermost[depth - 1] : UINT32_MAX;
+        uint32_t this_node = UINT32_MAX;
+        if (name_is(name, name_len, "node")) {
+            size_t len = 0;
+            const char *id = xml_attribute(p, empty ? q - 1 : q, "id", &len);
+            this_node = (uint32_t)s->nodes.count;
+            if (!id_table_add(&s->nodes, id ? id : "", id ? len : 0))
+                return lx_fail(LX_ERR_NOMEM, "%s: out of memory for the node hierarchy", s->path);
+            if (parent_node != UINT32_MAX &&
+                !node_graph_add_edge(&s->graph, parent_node, this_node))
+                return lx_fail(LX_ERR_NOMEM, "%s: out of memory for the node hierarchy", s->path);
+        } else if (name_is(name, name_len, "instance_node") && parent_node != UINT32_MAX) {
+            size_t len = 0;
+            const char *url = xml_attribute(p, empty ? q - 1 : q, "url", &len);
+            if (url && len > 0 && url[0] == '#') {
+                if (s->instances == s->instance_cap) {
+                    size_t cap = s->instance_cap ? s->instance_cap * 2 : 64;
+                    uint32_t *of = realloc(s->instance_of, cap * sizeof *of);
+                    if (of)
+                        s->instance_of = of;
+                    char **urls = of ? realloc(s->instance_url, cap * sizeof *urls) : NULL;
+                    if (!urls)
+                        return lx_fail(LX_ERR_NOMEM, "%s: out of memory for the node hierarchy",
+                                       s->path);
+                    s->instance_url = urls;
+                    s->instance_cap = cap;
+                }
+                char *copy = malloc(len);
+                if (!copy)
+                    return lx_fail(LX_ERR_NOMEM, "%s: out of memory for the node hierarchy",
+                                   s->path);
+                memcpy(copy, url + 1, len - 1);
+                copy[len - 1] = '\0';
+                s->instance_of[s->instances] = parent_node;
+                s->instance_url[s->instances++] = copy;
+            }
+        }
+        p = q + 1;
+        if (empty)
+            continue;
+        if (depth == XML_DEPTH_MAX)
+            return lx_fail(LX_ERR_FORMAT, "%s: line %zu: XML elements nested deeper than %d",
+                           s->path, line_at(f->bytes, tag), XML_DEPTH_MAX);
+        innermost[depth] = this_node != UINT32_MAX ? this_node : parent_node;
+        depth++;
+    }
+    return LX_OK;
+}
+
+static lx_status check_collada(const char *path)
+{
+    mapped_file f;
+    lx_status st = map_file(path, &f);
+    if (st != LX_OK)
+        return st;
+    collada_scan s = {.path = path};
+    st = collada_scan_tags(&s, &f);
+    unmap_file(&f);
+    if (st == LX_OK && !id_table_sort(&s.nodes))
+        st = lx_fail(LX_ERR_NOMEM, "%s: out of memory for the node hierarchy", path);
+    /* instances of ids the file lacks: assimp warns and skips them */
+    for (size_t i = 0; st == LX_OK && i < s.instances; i++) {
+        const named_node *hit = id_table_find(&s.nodes, s.instance_url[i]);
+        if (hit && !node_graph_add_edge(&s.graph, s.instance_of[i], hit->index))
+            st = lx_fail(LX_ERR_NOMEM, "%s: out of memory for the node hierarchy", path);
+    }
+    s.graph.nodes = s.nodes.count;
+    if (st == LX_OK)
+        st = judge_graph(path, &s.graph, name_collada, &s);
+    for (size_t i = 0; i < s.instances; i++)
+        free(s.instance_url[i]);
+    free(s.instance_url);
+    free(s.instance_of);
+    id_table_free(&s.nodes);
+    node_graph_free(&s.graph);
+    return st;
+}
+
+/* ---- FBX ---------------------------------------------------------------------- */
+
+/* FBX links objects by 64-bit ids: "OO" connections (child, parent)
+ * between objects, 0 the scene's root. assimp's converter walks from the
+ * root to the Model objects connected under it, recursively. */
+typedef struct fbx_scan {
+    const char *path;
+    int64_t *models; /* Model object ids, sorted once read */
+    size_t model_count, model_cap;
+    int64_t *link; /* child, parent pairs of "OO" connections */
+    size_t link_count, link_cap;
+} fbx_scan;
+
+static bool push_id(int64_t **list, size_t *count, size_t *cap, int64_t id)
+{
+    if (*count == *cap) {
+        size_t c = *cap ? *cap * 2 : 64;
+        int64_t *l = realloc(*list, c * sizeof *l);
+        if (!l)
+            return false;
+        *list = l;
+        *cap = c;
+    }
+    (*list)[(*count)++] = id;
+    return true;
+}
+
+static int by_int64(const void *a, const void *b)
+{
+    int64_t x = *(const int64_t *)a, y = *(const int64_t *)b;
+    return (x > y) - (x < y);
+}
+
+static void name_fbx(const void *user, uint32_t node, char *buf, size_t size)
+{
+    const fbx_scan *s = user;
+    if (node == 0)
+        snprintf(buf, size, "the root");
+    else
+        snprintf(buf, size, "Model %lld", (long long)s->models[node - 1]);
+}
+
+/* The graph of the Model objects (node 0 the root, model k node k+1). */
+static lx_status judge_fbx(fbx_scan *s)
+{
+    qsort(s->models, s->model_count, sizeof *s->models, by_int64);
+    node_graph g = {.nodes = s->model_count + 1};
+    lx_status st = LX_OK;
+    for (size_t i = 0; i + 1 < s->link_count && st == LX_OK; i += 2) {
+        int64_t child = s->link[i], parent = s->link[i + 1];
+        const int64_t *c = bsearch(&child, s->models, s->model_count, sizeof child, by_int64);
+        const int64_t *p =
+            parent == 0 ? NULL
+                        : bsearch(&parent, s->models, s->model_count, sizeof parent, by_int64);
+        if (!c || (parent != 0 && !p))
+            continue; /* not a link between nodes */
+        uint32_t from = p ? (uint32_t)(p - s->models) + 1 : 0;
+        if (!node_graph_add_edge(&g, from, (uint32_t)(c - s->models) + 1))
+            st = lx_fail(LX_ERR_NOMEM, "%s: out of memory for the node hierarchy", s->path);
+    }
+    if (st == LX_OK)
+        st = judge_graph(s->path, &g, name_fbx, s);
+    node_graph_free(&g);
+    return st;
+}
+
+static uint64_t read_le(const unsigned char *p, int bytes)
+{
+    uint64_t v = 0;
+    for (int i = bytes - 1; i >= 0; i--)
+        v = (v << 8) | p[i];
+    return v;
+}
+
+/* The first n properties of a binary record that are 64-bit ids ('L') or
+ * strings ('S'), in order; others are skipped. Returns how many were
+ * read. */
+static int fbx_binary_properties(const unsigned char *p, const unsigned char *end, int n,
+                                 int64_t *ids, const char **strings, size_t *string_len)
+{
+    int got = 0;
+    for (int k = 0; k < n && p < end; k++) {
+        char type = (char)*p++;
+        size_t skip = 0;
+        switch (type) {
+        case 'Y':
+            skip = 2;
+            break;
+        case 'C':
+            skip = 1;
+            break;
+        case 'I':
+        case 'F':
+            skip = 4;
+            break;
+        case 'D':
+            skip = 8;
+            break;
+        case 'L':
+            if (end - p < 8)
+                return got;
+            ids[k] = (int64_t)read_le(p, 8);
+            skip = 8;
+            got = k + 1;
+            break;
+        case 'S':
+        case 'R':
+            if (end - p < 4)
+                return got;
+            skip = 4 + (size_t)read_le(p, 4);
+            if (type == 'S' && skip <= (size_t)(end - p)) {
+                strings[k] = (const char *)p + 4;
+                string_len[k] = skip - 4;
+                got = k + 1;
+            }
+            break;
+        case 'f':
+        case 'd':
+        case 'l':
+        case 'i':
+        case 'b':
+            if (end - p < 12)
+                return got;
+            skip = 12 + (size_t)read_le(p + 8, 4);
+            break;
+        default:
+            return got;
+        }
+        if (skip > (size_t)(end - p))
+            return got;
+        p += skip;
+    }
+    return got;
+}
+
+static lx_status check_fbx_binary(fbx_scan *s, const mapped_file *f)
+{
+    const unsigned char *base = (const unsigned char *)f->bytes;
+    uint32_t version = (uint32_t)read_le(base + 23, 4);
+    int wide = version >= 7500 ? 8 : 4; /* offsets and counts */
+    size_t header = (size_t)wide * 3 + 1;
+    size_t ends[FBX_NEST_MAX + 1];
+    int top_block = 0; /* 1 Objects, 2 Connections: the top-level record we are in */
+    size_t depth = 0, pos = 27;
+    for (;;) {
+        size_t limit = depth ? ends[depth - 1] : f->size;
+        if (pos + header > limit) {
+            if (depth == 0)
+                break; /* the footer */
+            pos = limit;
+            depth--;
+            continue;
+        }
+        const unsigned char *r = base + pos;
+        uint64_t end_offset = read_le(r, wide), props = read_le(r + wide, wide);
+        uint64_t props_len = read_le(r + 2 * wide, wide);
+        size_t name_len = r[3 * wide];
+        if (end_offset == 0) { /* the record list's terminator */
+            if (depth == 0)
+                break;
+            pos = limit;
+            depth--;
+            continue;
+        }
+        if (end_offset <= pos || end_offset > limit || props_len > end_offset - pos ||
+            header + name_len > end_offset - pos - props_len)
+            return lx_fail(LX_ERR_FORMAT, "%s: FBX record at byte %zu runs past its parent",
+                           s->path, pos);
+        const char *name = (const char *)r + header;
+        const unsigned char *prop = r + header + name_len;
+        if (depth == 0)
+            top_block = name_is(name, name_len, "Objects")       ? 1
+                        : name_is(name, name_len, "Connections") ? 2
+                                                                 : 0;
+        if (depth == 1 && props > 0) {
+            int64_t ids[3] = {0};
+            const char *str[3] = {0};
+            size_t str_len[3] = {0};
+            const unsigned char *prop_end = prop + props_len;
+            if (top_block == 1 && name_is(name, name_len, "Model") &&
+                fbx_binary_properties(prop, prop_end, 1, ids, str, str_len) >= 1 &&
+                !push_id(&s->models, &s->model_count, &s->model_cap, ids[0]))
+                return lx_fail(LX_ERR_NOMEM, "%s: out of memory for the node hierarchy", s->path);
+            if (top_block == 2 && name_is(name, name_len, "C") &&
+                fbx_binary_properties(prop, prop_end, 3, ids, str, str_len) == 3 && str[0] &&
+                str_len[0] == 2 && memcmp(str[0], "OO", 2) == 0 &&
+                (!push_id(&s->link, &s->link_count, &s->link_cap, ids[1]) ||
+                 !push_id(&s->link, &s->link_count, &s->link_cap, ids[2])))
+                return lx_fail(LX_ERR_NOMEM, "%s: out of memory for the node hierarchy", s->path);
+        }
+        size_t nested = pos + header + name_len + (size_t)props_len;
+        if (nested < end_offset) {
+            if (depth == FBX_NEST_MAX)
+                return lx_fail(LX_ERR_FORMAT, "%s: FBX records nested deeper than %d (byte %zu)",
+                               s->path, FBX_NEST_MAX, pos);
+            ends[depth++] = (size_t)end_offset;
+            pos = nested;
+        } else {
+            pos = (size_t)end_offset;
+        }
+    }
+    return judge_fbx(s);
+}
+
+/* ASCII FBX: "Key: value, value {" lines, ';' comments, quoted strings. */
+static lx_status check_fbx_ascii(fbx_scan *s, const mapped_file *f)
+{
+    const char *p = f->bytes, *end = f->bytes + f->size;
+    size_t depth = 0;
+    int top_block = 0;
+    char key[32] = ""; /* the last key read */
+    int values = 0;    /* values read since it */
+    const char *first_value = NULL;
+    int64_t link[3] = {0};
+    bool oo = false;
+    char pending_top[32] = ""; /* the key of the block a '{' opens */
+    while (p < end) {
+        char c = *p;
+        if (c == ' ' || c == '\t' || c == '\r' || c == '\n' || c == ',') {
+            p++;
+            continue;
+        }
+        if (c == ';') {
+            const char *nl = memchr(p, '\n', (size_t)(end - p));
+            p = nl ? nl + 1 : end;
+            continue;
+        }
+        if (c == '{') {
+            if (depth == 0)
+                top_block = strcmp(pending_top, "Objects") == 0       ? 1
+                            : strcmp(pending_top, "Connections") == 0 ? 2
+                                                                      : 0;
+            if (++depth > FBX_NEST_MAX)
+                return lx_fail(LX_ERR_FORMAT, "%s: line %zu: FBX blocks nested deeper than %d",
+                               s->path, line_at(f->bytes, p), FBX_NEST_MAX);
+            key[0] = '\0';
+            p++;
+            continue;
+        }
+        if (c == '}') {
+            if (depth > 0)
+                depth--;
+            key[0] = '\0';
+            p++;
+            continue;
+        }
+        const char *tok = p;
+        bool quoted = c == '"';
+        if (quoted) {
+            const char *close = memchr(p + 1, '"', (size_t)(end - p - 1));
+            p = close ? close + 1 : end;
+        } else {
+            while (p < end && !strchr(" \t\r\n,{};:\"", *p))
+                p++;
+            if (p == tok)
+                p++; /* a stray ':' or the like */
+        }
+        size_t len = (size_t)(p - tok);
+        if (!quoted && p < end && *p == ':') { /* a key */
+            p++;
+            snprintf(key, sizeof key, "%.*s", (int)(len < 31 ? len : 31), tok);
+            if (depth == 0)
+                snprintf(pending_top, sizeof pending_top, "%s", key);
+            values = 0;
+            first_value = NULL;
+            oo = false;
+            continue;
+        }
+        if (depth != 1 || !key[0])
+            continue;
+        values++;
+        if (values == 1)
+            first_value = tok;
+        if (top_block == 1 && values == 1 && strcmp(key, "Model") == 0 && !quoted) {
+            if (!push_id(&s->models, &s->model_count, &s->model_cap, strtoll(tok, NULL, 10)))
+                return lx_fail(LX_ERR_NOMEM, "%s: out of memory for the node hierarchy", s->path);
+        } else if (top_block == 2 && strcmp(key, "C") == 0) {
+            if (values == 1)
+                oo = quoted && len == 4 && memcmp(first_value, "\"OO\"", 4) == 0;
+            else if (values <= 3 && !quoted)
+                link[values - 1] = strtoll(tok, NULL, 10);
+            if (values == 3 && oo &&
+                (!push_id(&s->link, &s->link_count, &s->link_cap, link[1]) ||
+                 !push_id(&s->link, &s->link_count, &s->link_cap, link[2])))
+                return lx_fail(LX_ERR_NOMEM, "%s: out of memory for the node hierarchy", s->path);
+        }
+    }
+    return judge_fbx(s);
+}
+
+static lx_status check_fbx(const char *path)
+{
+    mapped_file f;
+    lx_status st = map_file(path, &f);
+    if (st != LX_OK)
+        return st;
+    fbx_scan s = {.path = path};
+    static const char magic[] = "Kaydara FBX Binary  ";
+    if (f.size >= 27 && memcmp(f.bytes, magic, sizeof magic - 1) == 0)
+        st = check_fbx_binary(&s, &f);
+    else
+        st = check_fbx_ascii(&s, &f);
+    unmap_file(&f);
+    free(s.models);
+    free(s.link);
+    return st;
+}
+
+/* ---- by format --------------------------------------------------------------- */
+
+static bool ends_with(const char *path, const char *ext)
+{
+    size_t n = strlen(path), e = strlen(ext);
+    return n >= e && strcasecmp(path + n - e, ext) == 0;
+}
+
+lx_status import_check_hierarchy(const char *path, const cJSON *gltf)
+{
+    if (gltf)
+        return lx_gltf_is_v2(gltf) ? check_gltf2(path, gltf) : check_gltf1(path, gltf);
+    if (ends_with(path, ".dae"))
+        return check_collada(path);
+    if (ends_with(path, ".fbx"))
+        return check_fbx(path);
+    return LX_OK;
+}
