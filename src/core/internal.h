@@ -102,11 +102,11 @@ lx_status lx_read_file(const char *path, size_t max_size, char **out, size_t *ou
 
 /* The folder part of a path (malloc'd; "." when none). */
 char *lx_path_dirname(const char *path);
-/* True when path (the file named relative to folder, as written in the
- * naming file) resolves to folder or a file below it, symbolic links
- * followed; a path that does not exist is judged by relative's text
- * (absolute, or ".." above its start: outside). path_policy.c */
-bool lx_path_within(const char *folder, const char *path, const char *relative);
+/* False when path resolves (symbolic links followed; with backslashes
+ * as slashes when it does not as written) to an existing file outside
+ * folder and below it; a path naming nothing is not judged (its reader
+ * reports it missing). path_policy.c */
+bool lx_path_within(const char *folder, const char *path);
 /* LX_OK when allow_any or path lies within folder; else LX_ERR_INVALID
  * with "file: what 'named' lies outside folder ...". */
 lx_status lx_path_confine(const char *file, const char *what, const char *named, const char *folder,

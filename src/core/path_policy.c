@@ -5,7 +5,8 @@
  * /etc/passwd or ~/.ssh/id_rsa into a .glb. By default a named file must
  * lie in the naming file's folder or below it, judged on the resolved
  * path (symbolic links followed, so a link inside the folder to a file
- * outside is refused too); a caller that trusts its inputs lifts the rule
+ * outside is refused too; a name that resolves to nothing cannot be read
+ * and is left to its reader to report missing); a caller that trusts its inputs lifts the rule
  * (lx_scene_load_desc.allow_any_path and friends). */
 #define _GNU_SOURCE /* realpath */
 #include "internal.h"
@@ -15,35 +16,10 @@
 #include <stdlib.h>
 #include <string.h>
 
-/* A path that does not exist (yet) judged by its text: absolute, or
- * climbing above its start with "..". Backslashes separate too: readers
- * retry a Windows path ("..\\x.png") with slashes. */
-static bool climbs_out(const char *relative)
+bool lx_path_within(const char *folder, const char *path)
 {
-    if (relative[0] == '/' || relative[0] == '\\')
-        return true;
-    long depth = 0;
-    const char *p = relative;
-    while (*p) {
-        size_t n = strcspn(p, "/\\");
-        if (n == 2 && p[0] == '.' && p[1] == '.')
-            depth--;
-        else if (n > 0 && !(n == 1 && p[0] == '.'))
-            depth++;
-        if (depth < 0)
-            return true;
-        p += n;
-        while (*p == '/' || *p == '\\')
-            p++;
-    }
-    return false;
-}
-
-bool lx_path_within(const char *folder, const char *path, const char *relative)
-{
-    char *root = realpath(folder, NULL);
     char *real = realpath(path, NULL);
-    if (!real && strchr(path, '\\')) { /* the form a reader retries */
+    if (!real && strchr(path, '\\')) { /* the form readers retry: "..\\x.png" */
         char *slashed = lx_strdup(path);
         for (char *q = slashed; q && *q; q++)
             if (*q == '\\')
@@ -51,14 +27,14 @@ bool lx_path_within(const char *folder, const char *path, const char *relative)
         real = slashed ? realpath(slashed, NULL) : NULL;
         free(slashed);
     }
-    bool inside;
-    if (root && real) {
+    if (!real)
+        return true; /* nothing there to read: its reader reports it missing */
+    char *root = realpath(folder, NULL);
+    bool inside = false;
+    if (root) {
         size_t n = strlen(root);
         inside = strncmp(real, root, n) == 0 &&
                  (real[n] == '/' || real[n] == '\0' || (n == 1 && root[0] == '/'));
-    } else {
-        /* nothing there to resolve: its reader reports it missing */
-        inside = !climbs_out(relative ? relative : path);
     }
     free(root);
     free(real);
@@ -68,7 +44,7 @@ bool lx_path_within(const char *folder, const char *path, const char *relative)
 lx_status lx_path_confine(const char *file, const char *what, const char *named, const char *folder,
                           const char *path, bool allow_any)
 {
-    if (allow_any || lx_path_within(folder, path, named))
+    if (allow_any || lx_path_within(folder, path))
         return LX_OK;
     return lx_fail(LX_ERR_INVALID,
                    "%s: %s '%.200s' is outside the folder '%s': refused (--allow-any-path "

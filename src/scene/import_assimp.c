@@ -584,6 +584,15 @@ static void load_texture(import_ctx *c, const struct aiString *tex_path, bool ra
         full = lx_path_join(c->folder, p);
         if (!full)
             return;
+        /* a texture outside the scene's folder is not read: a missing
+         * texture's fate (a glTF image there failed the load up front,
+         * lx_gltf_check_files, since writers would copy it) */
+        if (lx_path_confine(c->path, "texture", p, c->folder, full, c->desc->allow_any_path) !=
+            LX_OK) {
+            lx_log(LX_LOG_WARN, "%s; material '%s' goes without it", lx_last_error(), material);
+            free(full);
+            return;
+        }
         struct stat sb;
         if (stat(full, &sb) != 0 && strchr(full, '\\')) {
             /* written on Windows: textures\\wood.png */
@@ -940,31 +949,6 @@ static lx_status material_refs(const import_ctx *c, unsigned i, const char *labe
                    "to the file's primitives uses it, and the file's materials it may be (by "
                    "name) differ in KHR_texture_transform or texCoord",
                    c->path, label);
-}
-
-/* Every texture file a material names lies in the scene's folder or
- * below it (lx_path_confine), checked before any is read. */
-static lx_status check_texture_paths(const import_ctx *c)
-{
-    static const enum aiTextureType types[] = {aiTextureType_NORMALS, aiTextureType_BASE_COLOR,
-                                               aiTextureType_DIFFUSE, aiTextureType_EMISSIVE};
-    for (unsigned i = 0; i < c->ai->mNumMaterials; i++)
-        for (size_t t = 0; t < sizeof types / sizeof types[0]; t++) {
-            struct aiString tex;
-            if (aiGetMaterialTexture(c->ai->mMaterials[i], types[t], 0, &tex, NULL, NULL, NULL,
-                                     NULL, NULL, NULL) != aiReturn_SUCCESS ||
-                tex.data[0] == '*')
-                continue;
-            char *full = lx_path_join(c->folder, tex.data);
-            if (!full)
-                return lx_fail(LX_ERR_NOMEM, "%s: out of memory", c->path);
-            lx_status st = lx_path_confine(c->path, "texture", tex.data, c->folder, full,
-                                           c->desc->allow_any_path);
-            free(full);
-            if (st != LX_OK)
-                return st;
-        }
-    return LX_OK;
 }
 
 static lx_status import_materials(import_ctx *c)
@@ -1447,8 +1431,6 @@ static lx_status import_scene(const char *path, const import_source *src,
         lx_scene_destroy(c.scene);
         return LX_OK;
     }
-    if (st == LX_OK)
-        st = check_texture_paths(&c);
     if (st == LX_OK)
         st = import_materials(&c);
     for (unsigned i = 0; st == LX_OK && i < ai->mNumMeshes; i++)

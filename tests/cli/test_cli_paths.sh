@@ -73,10 +73,17 @@ printf 'newmtl a\nKd 1 1 1\n' >"$OUTSIDE/lib.mtl"
 obj mtl_out.obj ../outside/lib.mtl
 run "$LUXEL" info "$S/mtl_out.obj"
 refused "OBJ mtllib outside" "../outside/lib.mtl" "$WORK/out/none"
+# a texture outside is not read: the material goes without it, as without
+# a missing texture (a file there that is no image would have been named
+# as unreadable had it been read)
+printf 'SECRET_WORD\n' >"$OUTSIDE/wood.png"
 printf 'newmtl a\nKd 1 1 1\nmap_Kd ../outside/wood.png\n' >"$S/tex.mtl"
 obj tex_out.obj tex.mtl
 run "$LUXEL" bake "$S/tex_out.obj" --ambient 1 --resolution 16 -o "$WORK/out/tex"
-refused "OBJ texture outside" "../outside/wood.png" "$WORK/out/tex"
+expect_rc 0 "OBJ texture outside: baked without it"
+expect_stderr_has "OBJ texture outside: one warning naming it" \
+    "^luxel: warning: .*tex_out.obj: texture '../outside/wood.png' is outside the folder"
+check "OBJ texture outside: not read" bash -c "! grep -q -e SECRET_WORD -e 'not loaded' '$ERR'"
 # an assimp error inside the material library: its text is not quoted
 printf 'newmtl a\nKd 1 1 1\nmap_Kd -bm SECRET_WORD y z\n' >"$S/bad.mtl"
 obj bad_mtl.obj bad.mtl
