@@ -83,7 +83,8 @@ static const char *bake_usage =
     "                          aces or clamp\n"
     "  --clean                 remove the files an earlier bake left in DIR that\n"
     "                          this one does not write (only those its manifest\n"
-    "                          lists)\n"
+    "                          lists), and the staging folders (.luxel-XXXXXX)\n"
+    "                          of runs that were killed or crashed\n"
     "  --padding N             texels of dilation around charts, 0 for none\n"
     "                          (default %d); charts luxel packs own as many\n"
     "  --unwrap MODE           auto (default): make lightmap UVs for the nodes\n"
@@ -286,33 +287,24 @@ static int parse_args(int argc, char **argv, bake_args *a)
     return 0;
 }
 
-/* A file name from a node name: path separators and control characters
- * become '_', unique among the names given so far. */
-static void file_stem(const char *name, char **taken, uint32_t taken_count, char *out, size_t size)
+/* A file stem from a node name: path separators and control characters
+ * become '_', and no leading dot (hidden files, and luxel's own staging
+ * folders, start with one). */
+static void sanitized_stem(const char *name, char *out, size_t size)
 {
-    char base[200];
     size_t n = 0;
-    for (const char *s = name; *s && n + 1 < sizeof base; s++) {
+    for (const char *s = name; *s && n + 1 < size; s++) {
         unsigned char ch = (unsigned char)*s;
-        base[n++] = (ch < 32 || ch == '/' || ch == '\\' || ch == ':' || ch == '*' || ch == '?' ||
-                     ch == '"' || ch == '<' || ch == '>' || ch == '|')
-                        ? '_'
-                        : (char)ch;
+        out[n++] = (ch < 32 || ch == '/' || ch == '\\' || ch == ':' || ch == '*' || ch == '?' ||
+                    ch == '"' || ch == '<' || ch == '>' || ch == '|')
+                       ? '_'
+                       : (char)ch;
     }
-    base[n] = '\0';
-    if (n == 0 || base[0] == '.')
-        base[0] = '_';
+    out[n] = '\0';
+    if (n == 0 || out[0] == '.')
+        out[0] = '_';
     if (n == 0)
-        base[1] = '\0';
-    snprintf(out, size, "%s", base);
-    for (int k = 2;; k++) {
-        bool clash = false;
-        for (uint32_t i = 0; i < taken_count && !clash; i++)
-            clash = strcasecmp(taken[i], out) == 0;
-        if (!clash)
-            return;
-        snprintf(out, size, "%s_%d", base, k);
-    }
+        out[1] = '\0';
 }
 
 /* The preview shows luminance: radiance as is, irradiance as the radiance of
@@ -460,36 +452,185 @@ static void sh_encode(lx_image sh[4], bool normalized)
     }
 }
 
-/* The earlier bake's files in the output folder that this one does not
- * write (cli_stale_find), from the stems of this bake's outputs. */
-static bool find_stale(const bake_args *a, char **stems, uint32_t maps, const char *uvs_name,
-                       cli_stale *out)
+/* ---- output names, planned before the bake -------------------------- */
+
+/* The files of one lightmap: the map, its preview, its AO map and its
+ * directional maps. */
+#define STEM_FILES (3 + DIR_FILES)
+
+/* The files a lightmap with this stem is written as; returns how many. */
+static int stem_files(const bake_args *a, const char *stem, char out[STEM_FILES][300])
 {
-    uint32_t n = 0;
-    char **names = calloc(8 * (size_t)maps + 2, sizeof *names);
-    bool ok = names != NULL;
-    if (ok && uvs_name[0]) /* the scene with luxel's UVs, written again */
-        ok = (names[n++] = cli_strdup(uvs_name)) != NULL;
-    for (uint32_t m = 0; ok && m < maps; m++) {
-        char name[300];
-        snprintf(name, sizeof name, "%s.%s", stems[m], lx_image_format_extension(a->format));
-        ok = (names[n++] = cli_strdup(name)) != NULL;
-        snprintf(name, sizeof name, "%s.png", stems[m]);
-        ok = ok && (names[n++] = cli_strdup(name)) != NULL;
-        snprintf(name, sizeof name, "%s_ao.png", stems[m]);
-        ok = ok && (!a->ao || (names[n++] = cli_strdup(name)) != NULL);
-        char dn[DIR_FILES][300];
-        int k = directional_names(a, stems[m], dn);
-        for (int j = 0; j < k; j++)
-            ok = ok && (names[n++] = cli_strdup(dn[j])) != NULL;
+    int n = 0;
+    snprintf(out[n++], 300, "%s.%s", stem, lx_image_format_extension(a->format));
+    if (a->format != LX_IMAGE_PNG)
+        snprintf(out[n++], 300, "%s.png", stem);
+    if (a->ao)
+        snprintf(out[n++], 300, "%s_ao.png", stem);
+    char dn[DIR_FILES][300];
+    int k = directional_names(a, stem, dn);
+    for (int j = 0; j < k; j++)
+        memcpy(out[n++], dn[j], 300);
+    return n;
+}
+
+/* Every file name the bake writes, each once. Compared without case:
+ * on macOS and Windows file systems X.png and x.png are one file. A hash
+ * set, so that thousands of nodes plan in linear time. */
+typedef struct output_names {
+    char **names;    /* in the order planned */
+    uint32_t count;
+    uint32_t *slots; /* index + 1 into names, 0 = empty; a power of two */
+    uint32_t slot_count;
+} output_names;
+
+static uint32_t name_hash(const char *s)
+{
+    uint32_t h = 2166136261u; /* FNV-1a over the lower-cased bytes */
+    for (; *s; s++) {
+        unsigned char c = (unsigned char)*s;
+        h = (h ^ (uint32_t)(c >= 'A' && c <= 'Z' ? c + 32 : c)) * 16777619u;
     }
-    if (!ok)
+    return h;
+}
+
+static bool name_taken(const output_names *on, const char *name)
+{
+    for (uint32_t i = name_hash(name) & (on->slot_count - 1); on->slots[i];
+         i = (i + 1) & (on->slot_count - 1))
+        if (strcasecmp(on->names[on->slots[i] - 1], name) == 0)
+            return true;
+    return false;
+}
+
+/* Adds a name not taken yet; false when out of memory. The set is made
+ * for `capacity` names (output_names_init) and holds at most that many. */
+static bool name_add(output_names *on, const char *name)
+{
+    char *copy = cli_strdup(name);
+    if (!copy)
+        return false;
+    uint32_t i = name_hash(name) & (on->slot_count - 1);
+    while (on->slots[i])
+        i = (i + 1) & (on->slot_count - 1);
+    on->names[on->count] = copy;
+    on->slots[i] = ++on->count;
+    return true;
+}
+
+static bool output_names_init(output_names *on, uint32_t capacity)
+{
+    memset(on, 0, sizeof *on);
+    on->slot_count = 16;
+    while (on->slot_count < 2 * (uint64_t)capacity && on->slot_count < (1u << 31))
+        on->slot_count *= 2;
+    if (on->slot_count < 2 * (uint64_t)capacity)
+        return false;
+    on->names = calloc(capacity ? capacity : 1, sizeof *on->names);
+    on->slots = calloc(on->slot_count, sizeof *on->slots);
+    return on->names && on->slots;
+}
+
+static void output_names_free(output_names *on)
+{
+    for (uint32_t i = 0; on->names && i < on->count; i++)
+        free(on->names[i]);
+    free(on->names);
+    free(on->slots);
+    memset(on, 0, sizeof *on);
+}
+
+/* The names luxel gives its own outputs, which no lightmap may take
+ * (view.png whether or not --render is given, so that a node's files do
+ * not change names with it). */
+static const char *const own_outputs[] = {"manifest.json", "view.png"};
+
+/* Plans every file of the bake before it: stems[m] for lightmap m (an
+ * atlas page is lightmap-<k>, a node's own lightmap is named after the
+ * node) and every name into *on, luxel's own outputs and uvs_name (the
+ * scene with UVs) first. A lightmap any of whose files would take a name
+ * already planned gets the first free stem <stem>_2, _3, ... (in node
+ * order, so the same scene always gets the same names); one warning
+ * lists those. false when out of memory (error printed). */
+static bool plan_outputs(const bake_args *a, const lx_scene *scene, const lx_baker *baker,
+                         bool atlas, const char *uvs_name, uint32_t maps, char **stems,
+                         output_names *on)
+{
+    uint64_t capacity = (uint64_t)maps * STEM_FILES + 3;
+    if (capacity > UINT32_MAX / 4 || !output_names_init(on, (uint32_t)capacity)) {
         cli_error("out of memory");
-    else
-        ok = cli_stale_find(a->output, a->scene, (const char *const *)names, n, out);
-    for (uint32_t i = 0; i < n; i++)
-        free(names[i]);
-    free(names);
+        return false;
+    }
+    bool ok = true;
+    for (size_t i = 0; i < sizeof own_outputs / sizeof *own_outputs && ok; i++)
+        ok = name_add(on, own_outputs[i]);
+    if (ok && uvs_name[0])
+        ok = name_add(on, uvs_name);
+    char renamed[400] = "";
+    uint32_t renamed_count = 0, unlisted = 0;
+    for (uint32_t m = 0; m < maps && ok; m++) {
+        const lx_lightmap_info *info = lx_baker_lightmap_info(baker, m);
+        bool of_node = !atlas && info->node != UINT32_MAX;
+        const char *base = of_node ? scene->nodes[info->node].name : info->name;
+        char clean[200], stem[256], files[STEM_FILES][300];
+        sanitized_stem(base, clean, sizeof clean);
+        snprintf(stem, sizeof stem, "%s", clean);
+        for (uint32_t k = 2;; k++) {
+            int n = stem_files(a, stem, files);
+            bool clash = false;
+            for (int j = 0; j < n && !clash; j++)
+                clash = name_taken(on, files[j]);
+            if (!clash) {
+                for (int j = 0; j < n && ok; j++)
+                    ok = name_add(on, files[j]);
+                break;
+            }
+            snprintf(stem, sizeof stem, "%s_%u", clean, k);
+        }
+        ok = ok && (stems[m] = cli_strdup(stem)) != NULL;
+        if (ok && strcmp(stem, clean) != 0) {
+            renamed_count++;
+            size_t len = strlen(renamed);
+            if (unlisted == 0 && len + strlen(base) + strlen(stem) + 40 < sizeof renamed)
+                snprintf(renamed + len, sizeof renamed - len, "%s'%s' as %s.*", len ? ", " : "",
+                         base, stem);
+            else
+                unlisted++;
+        }
+    }
+    if (!ok) {
+        cli_error("out of memory");
+        return false;
+    }
+    if (renamed_count) {
+        size_t len = strlen(renamed);
+        if (unlisted)
+            snprintf(renamed + len, sizeof renamed - len, " and %u more", unlisted);
+        lx_log(LX_LOG_WARN,
+               "%s: %u %s would share file names with other outputs or with luxel's own "
+               "(manifest.json, view.png, the %s of each lightmap): %s; manifest.json names "
+               "each node's files",
+               a->scene, renamed_count, cli_plural(renamed_count, "lightmap", "lightmaps"),
+               "_ao, _sh0.._sh3 and _dir maps", renamed);
+    }
+    return true;
+}
+
+/* The earlier bake's files in the output folder that this one does not
+ * write (cli_stale_find), among the names planned. */
+static bool find_stale(const bake_args *a, const output_names *on, cli_stale *out)
+{
+    const char **written = calloc(on->count ? on->count : 1, sizeof *written);
+    if (!written) {
+        cli_error("out of memory");
+        return false;
+    }
+    uint32_t n = 0;
+    for (uint32_t i = 0; i < on->count; i++)
+        if (a->render || strcmp(on->names[i], "view.png") != 0)
+            written[n++] = on->names[i];
+    bool ok = cli_stale_find(a->output, a->scene, written, n, out);
+    free(written);
     return ok;
 }
 
@@ -507,6 +648,8 @@ int cmd_bake(int argc, char **argv)
     uint32_t maps = 0;
     cli_stage stage = {0};
     cli_stale stale = {0};
+    output_names names = {0};
+    char uvs_name[300] = "";
     cli_progress progress;
     lx_scene_sky sky;
     lx_unwrap *unwrap = NULL;
@@ -515,7 +658,7 @@ int cmd_bake(int argc, char **argv)
 
     /* the output folder is checked (and made) before any long work: the
      * import, the sky, the texel maps */
-    if (!cli_stage_begin(&stage, a.output))
+    if (!cli_stage_begin_set(&stage, a.output, a.clean))
         goto done;
 
     /* the applied lightmaps (RGB float), AO maps (grey float) and
@@ -544,43 +687,17 @@ int cmd_bake(int argc, char **argv)
         cli_error("out of memory");
         goto done;
     }
-    for (uint32_t m = 0; m < maps; m++) {
-        char stem[256], name[300];
-        /* atlas pages are lightmap-<k>; a lightmap of one node is named
-         * after it */
-        const lx_lightmap_info *info = lx_baker_lightmap_info(baker, m);
-        const char *base = !atlas && info->node != UINT32_MAX ? scene->nodes[info->node].name
-                                                               : info->name;
-        file_stem(base, stems, m, stem, sizeof stem);
-        if (!(stems[m] = cli_strdup(stem))) {
-            cli_error("out of memory");
-            goto done;
-        }
-        snprintf(name, sizeof name, "%s.%s", stem, lx_image_format_extension(a.format));
-        if (!cli_stage_check(&stage, name))
-            goto done;
-        snprintf(name, sizeof name, "%s.png", stem);
-        if (a.format != LX_IMAGE_PNG && !cli_stage_check(&stage, name))
-            goto done;
-        snprintf(name, sizeof name, "%s_ao.png", stem);
-        if (a.ao && !cli_stage_check(&stage, name))
-            goto done;
-        char dn[DIR_FILES][300];
-        int k = directional_names(&a, stem, dn);
-        for (int j = 0; j < k; j++)
-            if (!cli_stage_check(&stage, dn[j]))
-                goto done;
-    }
-    if (!cli_stage_check(&stage, "manifest.json"))
-        goto done;
     /* the scene with luxel's UVs: DIR/<scene's name>.glb */
-    char uvs_name[300] = "";
-    if (unwrap && unwrap->mesh_count &&
-        (!cli_scene_glb_name(a.scene, uvs_name, sizeof uvs_name) ||
-         !cli_stage_check(&stage, uvs_name)))
+    if (unwrap && unwrap->mesh_count && !cli_scene_glb_name(a.scene, uvs_name, sizeof uvs_name))
         goto done;
+    if (!plan_outputs(&a, scene, baker, atlas, uvs_name, maps, stems, &names))
+        goto done;
+    for (uint32_t i = 0; i < names.count; i++)
+        if ((a.render || strcmp(names.names[i], "view.png") != 0) &&
+            !cli_stage_check(&stage, names.names[i]))
+            goto done;
     /* an earlier bake's files that this one will not replace */
-    if (!find_stale(&a, stems, maps, uvs_name, &stale))
+    if (!find_stale(&a, &names, &stale))
         goto done;
     cli_stale_warn(&stale, a.output, a.clean);
 
@@ -804,6 +921,8 @@ int cmd_bake(int argc, char **argv)
         for (uint32_t i = 0; i < stale.count; i++)
             cJSON_AddItemToArray(earlier, cJSON_CreateString(stale.names[i]));
     }
+    if (a.render)
+        cJSON_AddStringToObject(manifest, "render", "view.png");
     if (!failed) {
         char *text = cJSON_Print(manifest);
         failed = !text || !cli_stage_text(&stage, "manifest.json", text);
@@ -813,6 +932,14 @@ int cmd_bake(int argc, char **argv)
     }
     cli_progress_clear(&progress);
     cJSON_Delete(manifest);
+    /* --render: the view of the staged lightmaps, staged with them, so that
+     * view.png and the manifest are published together or not at all */
+    if (!failed && a.render) {
+        char *view = cli_stage_path(&stage, "view.png");
+        failed = !view || cli_render_bake(stage.dir, view, scene, a.desc.threads, a.quiet) !=
+                              EXIT_OK;
+        free(view);
+    }
     if (!failed && !cli_stage_publish(&stage))
         failed = true;
     if (failed)
@@ -829,8 +956,6 @@ int cmd_bake(int argc, char **argv)
         cli_phase_part(what, t_previews);
     }
     cli_phase("write and publish");
-    if (a.render && cli_render_bake(a.output, scene, a.desc.threads, a.quiet) != EXIT_OK)
-        goto done;
     if (!a.quiet) {
         uint64_t texels = 0;
         for (uint32_t m = 0; m < maps; m++)
@@ -842,12 +967,15 @@ int cmd_bake(int argc, char **argv)
             (unsigned long long)texels, cli_plural(texels, "texel", "texels"), scene->light_count,
             cli_plural(scene->light_count, "light", "lights"), cli_num_digits(cli_elapsed(), 3),
             cli_num_digits(ev, 3), a.has_exposure ? "" : " (auto)", lx_tonemap_name(a.tonemap));
+        if (a.render)
+            printf("%s/view.png\n", a.output);
         printf("%s/manifest.json\n", a.output);
     }
     status = EXIT_OK;
 done:
     cli_stage_clear(&stage);
     cli_stale_free(&stale);
+    output_names_free(&names);
     if (images)
         for (uint32_t m = 0; m < maps; m++)
             lx_image_free(&images[m]);

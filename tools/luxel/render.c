@@ -738,7 +738,8 @@ done:
     return status;
 }
 
-int cli_render_bake(const char *dir, const lx_scene *scene, int threads, bool quiet)
+int cli_render_bake(const char *dir, const char *out, const lx_scene *scene, int threads,
+                    bool quiet)
 {
     render_args a;
     memset(&a, 0, sizeof a);
@@ -750,11 +751,6 @@ int cli_render_bake(const char *dir, const lx_scene *scene, int threads, bool qu
     a.lightmaps = dir;
     a.quiet = quiet;
     a.no_summary = true;
-    char *out = cli_path_join(dir, "view.png");
-    if (!out) {
-        cli_error("out of memory");
-        return EXIT_FAILED;
-    }
     a.output = out;
     lx_lightmaps lm;
     int status = EXIT_FAILED;
@@ -762,9 +758,6 @@ int cli_render_bake(const char *dir, const lx_scene *scene, int threads, bool qu
         cli_error("%s", lx_last_error());
     else
         status = render_and_write(&a, &lm, scene);
-    if (status == EXIT_OK && !quiet)
-        printf("%s\n", out);
     lx_lightmaps_free(&lm);
-    free(out);
     return status;
 }
