@@ -936,9 +936,13 @@ int cmd_bake(int argc, char **argv)
      * view.png and the manifest are published together or not at all */
     if (!failed && a.render) {
         char *view = cli_stage_path(&stage, "view.png");
-        failed = !view || cli_render_bake(stage.dir, view, scene, a.desc.threads, a.quiet) !=
-                              EXIT_OK;
+        char *shown = cli_path_join(a.output, "view.png");
+        failed = !view || !shown ||
+                 cli_render_bake(stage.dir, view, shown, scene, a.desc.threads, a.quiet) != EXIT_OK;
+        if (view && !shown)
+            cli_error("out of memory");
         free(view);
+        free(shown);
     }
     if (!failed && !cli_stage_publish(&stage))
         failed = true;

@@ -17,10 +17,10 @@ int cmd_ies(int argc, char **argv);
 int cmd_ibl(int argc, char **argv);
 int cmd_render(int argc, char **argv);
 /* bake --render: the image `out` (a PNG) of DIR's lightmaps on scene from
- * the default camera. DIR is the bake's staging folder: the view is
- * published with the lightmaps. */
-int cli_render_bake(const char *dir, const char *out, const lx_scene *scene, int threads,
-                    bool quiet);
+ * the default camera, named `shown` in warnings. DIR is the bake's staging
+ * folder: the view is published with the lightmaps. */
+int cli_render_bake(const char *dir, const char *out, const char *shown, const lx_scene *scene,
+                    int threads, bool quiet);
 int cmd_unwrap(int argc, char **argv);
 int cmd_tangents(int argc, char **argv);
 int cmd_horizonmap(int argc, char **argv);

@@ -78,6 +78,8 @@ typedef struct render_args {
     bool has_camera, has_view, has_fov, has_exposure, bake_exposure, quiet;
     const char *gltf_camera; /* --gltf-camera, or NULL */
     bool no_summary; /* bake --render: the bake prints its own */
+    const char *shown; /* the output as messages name it, when not `output`
+                          (bake --render writes into its staging folder) */
     lx_view view;
     double fov_degrees;
     double exposure_ev100;
@@ -644,15 +646,17 @@ static int render_and_write(render_args *a, const lx_lightmaps *lm, const lx_sce
         size_t seen, lit_pixels;
         bool ok = meter_view(&img, coverage, &metered, &seen, &lit_pixels);
         if (seen == 0)
-            lx_log(LX_LOG_WARN, "%s: the camera sees none of the scene", a->output);
+            lx_log(LX_LOG_WARN, "%s: the camera sees none of the scene",
+                   a->shown ? a->shown : a->output);
         else if (lit_pixels == 0)
-            lx_log(LX_LOG_WARN, "%s: all the camera sees of the scene is black", a->output);
+            lx_log(LX_LOG_WARN, "%s: all the camera sees of the scene is black",
+                   a->shown ? a->shown : a->output);
         if (meter && ok) {
             ev = metered;
             ev_from = " (metered)";
         } else if (meter && seen) {
             lx_log(LX_LOG_WARN, "%s: nothing lit to meter: exposed as the bake's previews",
-                   a->output);
+                   a->shown ? a->shown : a->output);
         }
     }
     /* without a sky, a neutral grey behind the scene at half the key: it
@@ -738,8 +742,8 @@ done:
     return status;
 }
 
-int cli_render_bake(const char *dir, const char *out, const lx_scene *scene, int threads,
-                    bool quiet)
+int cli_render_bake(const char *dir, const char *out, const char *shown, const lx_scene *scene,
+                    int threads, bool quiet)
 {
     render_args a;
     memset(&a, 0, sizeof a);
@@ -752,6 +756,7 @@ int cli_render_bake(const char *dir, const char *out, const lx_scene *scene, int
     a.quiet = quiet;
     a.no_summary = true;
     a.output = out;
+    a.shown = shown;
     lx_lightmaps lm;
     int status = EXIT_FAILED;
     if (lx_lightmaps_load(dir, NULL, &lm) != LX_OK)

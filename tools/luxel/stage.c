@@ -396,6 +396,14 @@ char *cli_stage_path(cli_stage *st, const char *name)
     }
     if (!cli_stage_check(st, name))
         return NULL;
+    /* two outputs of one name: the second would overwrite the first, and
+     * publishing would fail on it after all the work (commands plan their
+     * names so that this never happens) */
+    for (uint32_t i = 0; i < st->count; i++)
+        if (strcmp(st->names[i], name) == 0) {
+            cli_error("%s/%s: two outputs of this run have this name", st->output, name);
+            return NULL;
+        }
     /* named before it exists, so cli_stage_clear removes whatever the
      * writer leaves behind */
     if (st->count == st->capacity) {
