@@ -2,7 +2,7 @@
  * manifest. Everything is computed before the first file is written; if a
  * write fails or the run is interrupted, this run's files are removed. */
 #define _POSIX_C_SOURCE 200809L
-#include "bake_setup.h"
+#include "bake_names.h"
 #include "cli.h"
 
 #include <cjson/cJSON.h>
@@ -287,26 +287,6 @@ static int parse_args(int argc, char **argv, bake_args *a)
     return 0;
 }
 
-/* A file stem from a node name: path separators and control characters
- * become '_', and no leading dot (hidden files, and luxel's own staging
- * folders, start with one). */
-static void sanitized_stem(const char *name, char *out, size_t size)
-{
-    size_t n = 0;
-    for (const char *s = name; *s && n + 1 < size; s++) {
-        unsigned char ch = (unsigned char)*s;
-        out[n++] = (ch < 32 || ch == '/' || ch == '\\' || ch == ':' || ch == '*' || ch == '?' ||
-                    ch == '"' || ch == '<' || ch == '>' || ch == '|')
-                       ? '_'
-                       : (char)ch;
-    }
-    out[n] = '\0';
-    if (n == 0 || out[0] == '.')
-        out[0] = '_';
-    if (n == 0)
-        out[1] = '\0';
-}
-
 /* The preview shows luminance: radiance as is, irradiance as the radiance of
  * a white Lambertian surface (E / pi). */
 static float preview_scale(const bake_args *a)
@@ -402,26 +382,10 @@ static bool half_fits(const bake_args *a, const lx_image *images, uint32_t maps,
 
 /* ---- directional lightmaps (docs/directional.md) ---------------------- */
 
-#define DIR_FILES 4
 /* sh: L1 in the files as the irradiance it adds along each axis, or
  * normalized by L0 for 8-bit files */
 #define SH_E0 0.886227f /* pi Y00 = sqrt(pi) / 2 */
 #define SH_E1 1.023327f /* 2 pi / 3 Y1 = sqrt(pi / 3) */
-
-/* The directional files of a lightmap: sh0..sh3 (sh) or dir (dominant);
- * returns how many. */
-static int directional_names(const bake_args *a, const char *stem, char out[DIR_FILES][300])
-{
-    if (a->desc.directional == LX_DIRECTIONAL_DOMINANT) {
-        snprintf(out[0], 300, "%s_dir.png", stem);
-        return 1;
-    }
-    if (a->desc.directional != LX_DIRECTIONAL_SH)
-        return 0;
-    for (int c = 0; c < 4; c++)
-        snprintf(out[c], 300, "%s_sh%d.%s", stem, c, lx_image_format_extension(a->format));
-    return 4;
-}
 
 /* Whether the files hold L1 normalized by L0 in [0, 1] (8-bit and RGBE
  * files, which keep no negative values) rather than as irradiance. */
@@ -450,188 +414,6 @@ static void sh_encode(lx_image sh[4], bool normalized)
         }
         sh[0].data[i] = l0 > 0.0f ? l0 * SH_E0 : 0.0f;
     }
-}
-
-/* ---- output names, planned before the bake -------------------------- */
-
-/* The files of one lightmap: the map, its preview, its AO map and its
- * directional maps. */
-#define STEM_FILES (3 + DIR_FILES)
-
-/* The files a lightmap with this stem is written as; returns how many. */
-static int stem_files(const bake_args *a, const char *stem, char out[STEM_FILES][300])
-{
-    int n = 0;
-    snprintf(out[n++], 300, "%s.%s", stem, lx_image_format_extension(a->format));
-    if (a->format != LX_IMAGE_PNG)
-        snprintf(out[n++], 300, "%s.png", stem);
-    if (a->ao)
-        snprintf(out[n++], 300, "%s_ao.png", stem);
-    char dn[DIR_FILES][300];
-    int k = directional_names(a, stem, dn);
-    for (int j = 0; j < k; j++)
-        memcpy(out[n++], dn[j], 300);
-    return n;
-}
-
-/* Every file name the bake writes, each once. Compared without case:
- * on macOS and Windows file systems X.png and x.png are one file. A hash
- * set, so that thousands of nodes plan in linear time. */
-typedef struct output_names {
-    char **names;    /* in the order planned */
-    uint32_t count;
-    uint32_t *slots; /* index + 1 into names, 0 = empty; a power of two */
-    uint32_t slot_count;
-} output_names;
-
-static uint32_t name_hash(const char *s)
-{
-    uint32_t h = 2166136261u; /* FNV-1a over the lower-cased bytes */
-    for (; *s; s++) {
-        unsigned char c = (unsigned char)*s;
-        h = (h ^ (uint32_t)(c >= 'A' && c <= 'Z' ? c + 32 : c)) * 16777619u;
-    }
-    return h;
-}
-
-static bool name_taken(const output_names *on, const char *name)
-{
-    for (uint32_t i = name_hash(name) & (on->slot_count - 1); on->slots[i];
-         i = (i + 1) & (on->slot_count - 1))
-        if (strcasecmp(on->names[on->slots[i] - 1], name) == 0)
-            return true;
-    return false;
-}
-
-/* Adds a name not taken yet; false when out of memory. The set is made
- * for `capacity` names (output_names_init) and holds at most that many. */
-static bool name_add(output_names *on, const char *name)
-{
-    char *copy = cli_strdup(name);
-    if (!copy)
-        return false;
-    uint32_t i = name_hash(name) & (on->slot_count - 1);
-    while (on->slots[i])
-        i = (i + 1) & (on->slot_count - 1);
-    on->names[on->count] = copy;
-    on->slots[i] = ++on->count;
-    return true;
-}
-
-static bool output_names_init(output_names *on, uint32_t capacity)
-{
-    memset(on, 0, sizeof *on);
-    on->slot_count = 16;
-    while (on->slot_count < 2 * (uint64_t)capacity && on->slot_count < (1u << 31))
-        on->slot_count *= 2;
-    if (on->slot_count < 2 * (uint64_t)capacity)
-        return false;
-    on->names = calloc(capacity ? capacity : 1, sizeof *on->names);
-    on->slots = calloc(on->slot_count, sizeof *on->slots);
-    return on->names && on->slots;
-}
-
-static void output_names_free(output_names *on)
-{
-    for (uint32_t i = 0; on->names && i < on->count; i++)
-        free(on->names[i]);
-    free(on->names);
-    free(on->slots);
-    memset(on, 0, sizeof *on);
-}
-
-/* The names luxel gives its own outputs, which no lightmap may take
- * (view.png whether or not --render is given, so that a node's files do
- * not change names with it). */
-static const char *const own_outputs[] = {"manifest.json", "view.png"};
-
-/* Plans every file of the bake before it: stems[m] for lightmap m (an
- * atlas page is lightmap-<k>, a node's own lightmap is named after the
- * node) and every name into *on, luxel's own outputs and uvs_name (the
- * scene with UVs) first. A lightmap any of whose files would take a name
- * already planned gets the first free stem <stem>_2, _3, ... (in node
- * order, so the same scene always gets the same names); one warning
- * lists those. false when out of memory (error printed). */
-static bool plan_outputs(const bake_args *a, const lx_scene *scene, const lx_baker *baker,
-                         bool atlas, const char *uvs_name, uint32_t maps, char **stems,
-                         output_names *on)
-{
-    uint64_t capacity = (uint64_t)maps * STEM_FILES + 3;
-    if (capacity > UINT32_MAX / 4 || !output_names_init(on, (uint32_t)capacity)) {
-        cli_error("out of memory");
-        return false;
-    }
-    bool ok = true;
-    for (size_t i = 0; i < sizeof own_outputs / sizeof *own_outputs && ok; i++)
-        ok = name_add(on, own_outputs[i]);
-    if (ok && uvs_name[0])
-        ok = name_add(on, uvs_name);
-    char renamed[400] = "";
-    uint32_t renamed_count = 0, unlisted = 0;
-    for (uint32_t m = 0; m < maps && ok; m++) {
-        const lx_lightmap_info *info = lx_baker_lightmap_info(baker, m);
-        bool of_node = !atlas && info->node != UINT32_MAX;
-        const char *base = of_node ? scene->nodes[info->node].name : info->name;
-        char clean[200], stem[256], files[STEM_FILES][300];
-        sanitized_stem(base, clean, sizeof clean);
-        snprintf(stem, sizeof stem, "%s", clean);
-        for (uint32_t k = 2;; k++) {
-            int n = stem_files(a, stem, files);
-            bool clash = false;
-            for (int j = 0; j < n && !clash; j++)
-                clash = name_taken(on, files[j]);
-            if (!clash) {
-                for (int j = 0; j < n && ok; j++)
-                    ok = name_add(on, files[j]);
-                break;
-            }
-            snprintf(stem, sizeof stem, "%s_%u", clean, k);
-        }
-        ok = ok && (stems[m] = cli_strdup(stem)) != NULL;
-        if (ok && strcmp(stem, clean) != 0) {
-            renamed_count++;
-            size_t len = strlen(renamed);
-            if (unlisted == 0 && len + strlen(base) + strlen(stem) + 40 < sizeof renamed)
-                snprintf(renamed + len, sizeof renamed - len, "%s'%s' as %s.*", len ? ", " : "",
-                         base, stem);
-            else
-                unlisted++;
-        }
-    }
-    if (!ok) {
-        cli_error("out of memory");
-        return false;
-    }
-    if (renamed_count) {
-        size_t len = strlen(renamed);
-        if (unlisted)
-            snprintf(renamed + len, sizeof renamed - len, " and %u more", unlisted);
-        lx_log(LX_LOG_WARN,
-               "%s: %u %s would share file names with other outputs or with luxel's own "
-               "(manifest.json, view.png, the %s of each lightmap): %s; manifest.json names "
-               "each node's files",
-               a->scene, renamed_count, cli_plural(renamed_count, "lightmap", "lightmaps"),
-               "_ao, _sh0.._sh3 and _dir maps", renamed);
-    }
-    return true;
-}
-
-/* The earlier bake's files in the output folder that this one does not
- * write (cli_stale_find), among the names planned. */
-static bool find_stale(const bake_args *a, const output_names *on, cli_stale *out)
-{
-    const char **written = calloc(on->count ? on->count : 1, sizeof *written);
-    if (!written) {
-        cli_error("out of memory");
-        return false;
-    }
-    uint32_t n = 0;
-    for (uint32_t i = 0; i < on->count; i++)
-        if (a->render || strcmp(on->names[i], "view.png") != 0)
-            written[n++] = on->names[i];
-    bool ok = cli_stale_find(a->output, a->scene, written, n, out);
-    free(written);
-    return ok;
 }
 
 int cmd_bake(int argc, char **argv)
@@ -690,14 +472,14 @@ int cmd_bake(int argc, char **argv)
     /* the scene with luxel's UVs: DIR/<scene's name>.glb */
     if (unwrap && unwrap->mesh_count && !cli_scene_glb_name(a.scene, uvs_name, sizeof uvs_name))
         goto done;
-    if (!plan_outputs(&a, scene, baker, atlas, uvs_name, maps, stems, &names))
+    if (!bake_plan_outputs(&a, scene, baker, atlas, uvs_name, maps, stems, &names))
         goto done;
     for (uint32_t i = 0; i < names.count; i++)
         if ((a.render || strcmp(names.names[i], "view.png") != 0) &&
             !cli_stage_check(&stage, names.names[i]))
             goto done;
     /* an earlier bake's files that this one will not replace */
-    if (!find_stale(&a, &names, &stale))
+    if (!bake_find_stale(&a, &names, &stale))
         goto done;
     cli_stale_warn(&stale, a.output, a.clean);
 
@@ -885,7 +667,7 @@ int cmd_bake(int argc, char **argv)
             failed = !cli_stage_image(&stage, ao_file, &ao_images[m], &ad);
         }
         char dn[DIR_FILES][300];
-        int dk = directional_names(&a, stems[m], dn);
+        int dk = bake_directional_names(&a, stems[m], dn);
         lx_image *di = &dir_images[(size_t)m * DIR_FILES];
         for (int j = 0; j < dk && !failed; j++) {
             /* sh0 is written as the lightmap is (its units, exposure and
@@ -979,7 +761,7 @@ int cmd_bake(int argc, char **argv)
 done:
     cli_stage_clear(&stage);
     cli_stale_free(&stale);
-    output_names_free(&names);
+    bake_output_names_free(&names);
     if (images)
         for (uint32_t m = 0; m < maps; m++)
             lx_image_free(&images[m]);

@@ -140,8 +140,10 @@ static bool lock_output(cli_stage *st)
         return false;
     }
     /* a file system without flock (some network mounts): no guard */
-    lx_log(LX_LOG_INFO, "%s: cannot lock the output folder (%s): a second run into it would not "
-           "be noticed", st->output, strerror(err));
+    lx_log(LX_LOG_INFO,
+           "%s: cannot lock the output folder (%s): a second run into it would not "
+           "be noticed",
+           st->output, strerror(err));
     return true;
 }
 
@@ -314,17 +316,17 @@ static void handle_leftovers(const cli_stage *st, bool clean, bool clean_option)
     end_list(found, sizeof found, found_unlisted);
     bool one = found_count == 1;
     if (clean) {
-        lx_log(LX_LOG_INFO, "%s: removing %s left by luxel %s that did not finish: %s",
-               st->output, one ? "a staging folder" : "staging folders", one ? "a run" : "runs",
-               found);
+        lx_log(LX_LOG_INFO, "%s: removing %s left by luxel %s that did not finish: %s", st->output,
+               one ? "a staging folder" : "staging folders", one ? "a run" : "runs", found);
         if (failed[0]) {
             end_list(failed, sizeof failed, failed_unlisted);
-            lx_log(LX_LOG_WARN, "%s: could not remove all of %s: it holds what luxel does not "
-                   "write there", st->output, failed);
+            lx_log(LX_LOG_WARN,
+                   "%s: could not remove all of %s: it holds what luxel does not "
+                   "write there",
+                   st->output, failed);
         }
     } else {
-        lx_log(LX_LOG_WARN,
-               "%s: %s left by %s that did not finish (killed or crashed): %s; %s",
+        lx_log(LX_LOG_WARN, "%s: %s left by %s that did not finish (killed or crashed): %s; %s",
                st->output, one ? "a staging folder" : "staging folders",
                one ? "a luxel run" : "luxel runs", found,
                clean_option ? (one ? "--clean removes it" : "--clean removes them")
@@ -333,8 +335,7 @@ static void handle_leftovers(const cli_stage *st, bool clean, bool clean_option)
 }
 
 /* cli_stage_begin and cli_stage_begin_set. */
-static bool stage_begin(cli_stage *st, const char *output, bool lock, bool clean,
-                        bool clean_option)
+static bool stage_begin(cli_stage *st, const char *output, bool lock, bool clean, bool clean_option)
 {
     memset(st, 0, sizeof *st);
     st->output = cli_strdup(output);
