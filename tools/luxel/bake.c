@@ -2,7 +2,7 @@
  * manifest. Everything is computed before the first file is written; if a
  * write fails or the run is interrupted, this run's files are removed. */
 #define _POSIX_C_SOURCE 200809L
-#include "bake_setup.h"
+#include "bake_names.h"
 #include "cli.h"
 
 #include <cjson/cJSON.h>
@@ -83,7 +83,8 @@ static const char *bake_usage =
     "                          aces or clamp\n"
     "  --clean                 remove the files an earlier bake left in DIR that\n"
     "                          this one does not write (only those its manifest\n"
-    "                          lists)\n"
+    "                          lists), and the staging folders (.luxel-XXXXXX)\n"
+    "                          of runs that were killed or crashed\n"
     "  --padding N             texels of dilation around charts, 0 for none\n"
     "                          (default %d); charts luxel packs own as many\n"
     "  --unwrap MODE           auto (default): make lightmap UVs for the nodes\n"
@@ -288,35 +289,6 @@ static int parse_args(int argc, char **argv, bake_args *a)
     return 0;
 }
 
-/* A file name from a node name: path separators and control characters
- * become '_', unique among the names given so far. */
-static void file_stem(const char *name, char **taken, uint32_t taken_count, char *out, size_t size)
-{
-    char base[200];
-    size_t n = 0;
-    for (const char *s = name; *s && n + 1 < sizeof base; s++) {
-        unsigned char ch = (unsigned char)*s;
-        base[n++] = (ch < 32 || ch == '/' || ch == '\\' || ch == ':' || ch == '*' || ch == '?' ||
-                     ch == '"' || ch == '<' || ch == '>' || ch == '|')
-                        ? '_'
-                        : (char)ch;
-    }
-    base[n] = '\0';
-    if (n == 0 || base[0] == '.')
-        base[0] = '_';
-    if (n == 0)
-        base[1] = '\0';
-    snprintf(out, size, "%s", base);
-    for (int k = 2;; k++) {
-        bool clash = false;
-        for (uint32_t i = 0; i < taken_count && !clash; i++)
-            clash = strcasecmp(taken[i], out) == 0;
-        if (!clash)
-            return;
-        snprintf(out, size, "%s_%d", base, k);
-    }
-}
-
 /* The preview shows luminance: radiance as is, irradiance as the radiance of
  * a white Lambertian surface (E / pi). */
 static float preview_scale(const bake_args *a)
@@ -412,26 +384,10 @@ static bool half_fits(const bake_args *a, const lx_image *images, uint32_t maps,
 
 /* ---- directional lightmaps (docs/directional.md) ---------------------- */
 
-#define DIR_FILES 4
 /* sh: L1 in the files as the irradiance it adds along each axis, or
  * normalized by L0 for 8-bit files */
 #define SH_E0 0.886227f /* pi Y00 = sqrt(pi) / 2 */
 #define SH_E1 1.023327f /* 2 pi / 3 Y1 = sqrt(pi / 3) */
-
-/* The directional files of a lightmap: sh0..sh3 (sh) or dir (dominant);
- * returns how many. */
-static int directional_names(const bake_args *a, const char *stem, char out[DIR_FILES][300])
-{
-    if (a->desc.directional == LX_DIRECTIONAL_DOMINANT) {
-        snprintf(out[0], 300, "%s_dir.png", stem);
-        return 1;
-    }
-    if (a->desc.directional != LX_DIRECTIONAL_SH)
-        return 0;
-    for (int c = 0; c < 4; c++)
-        snprintf(out[c], 300, "%s_sh%d.%s", stem, c, lx_image_format_extension(a->format));
-    return 4;
-}
 
 /* Whether the files hold L1 normalized by L0 in [0, 1] (8-bit and RGBE
  * files, which keep no negative values) rather than as irradiance. */
@@ -462,39 +418,6 @@ static void sh_encode(lx_image sh[4], bool normalized)
     }
 }
 
-/* The earlier bake's files in the output folder that this one does not
- * write (cli_stale_find), from the stems of this bake's outputs. */
-static bool find_stale(const bake_args *a, char **stems, uint32_t maps, const char *uvs_name,
-                       cli_stale *out)
-{
-    uint32_t n = 0;
-    char **names = calloc(8 * (size_t)maps + 2, sizeof *names);
-    bool ok = names != NULL;
-    if (ok && uvs_name[0]) /* the scene with luxel's UVs, written again */
-        ok = (names[n++] = cli_strdup(uvs_name)) != NULL;
-    for (uint32_t m = 0; ok && m < maps; m++) {
-        char name[300];
-        snprintf(name, sizeof name, "%s.%s", stems[m], lx_image_format_extension(a->format));
-        ok = (names[n++] = cli_strdup(name)) != NULL;
-        snprintf(name, sizeof name, "%s.png", stems[m]);
-        ok = ok && (names[n++] = cli_strdup(name)) != NULL;
-        snprintf(name, sizeof name, "%s_ao.png", stems[m]);
-        ok = ok && (!a->ao || (names[n++] = cli_strdup(name)) != NULL);
-        char dn[DIR_FILES][300];
-        int k = directional_names(a, stems[m], dn);
-        for (int j = 0; j < k; j++)
-            ok = ok && (names[n++] = cli_strdup(dn[j])) != NULL;
-    }
-    if (!ok)
-        cli_error("out of memory");
-    else
-        ok = cli_stale_find(a->output, a->scene, (const char *const *)names, n, out);
-    for (uint32_t i = 0; i < n; i++)
-        free(names[i]);
-    free(names);
-    return ok;
-}
-
 int cmd_bake(int argc, char **argv)
 {
     bake_args a;
@@ -509,6 +432,8 @@ int cmd_bake(int argc, char **argv)
     uint32_t maps = 0;
     cli_stage stage = {0};
     cli_stale stale = {0};
+    output_names names = {0};
+    char uvs_name[300] = "";
     cli_progress progress;
     lx_scene_sky sky;
     lx_unwrap *unwrap = NULL;
@@ -517,7 +442,7 @@ int cmd_bake(int argc, char **argv)
 
     /* the output folder is checked (and made) before any long work: the
      * import, the sky, the texel maps */
-    if (!cli_stage_begin(&stage, a.output))
+    if (!cli_stage_begin_set(&stage, a.output, a.clean))
         goto done;
 
     /* the applied lightmaps (RGB float), AO maps (grey float) and
@@ -546,43 +471,17 @@ int cmd_bake(int argc, char **argv)
         cli_error("out of memory");
         goto done;
     }
-    for (uint32_t m = 0; m < maps; m++) {
-        char stem[256], name[300];
-        /* atlas pages are lightmap-<k>; a lightmap of one node is named
-         * after it */
-        const lx_lightmap_info *info = lx_baker_lightmap_info(baker, m);
-        const char *base = !atlas && info->node != UINT32_MAX ? scene->nodes[info->node].name
-                                                               : info->name;
-        file_stem(base, stems, m, stem, sizeof stem);
-        if (!(stems[m] = cli_strdup(stem))) {
-            cli_error("out of memory");
-            goto done;
-        }
-        snprintf(name, sizeof name, "%s.%s", stem, lx_image_format_extension(a.format));
-        if (!cli_stage_check(&stage, name))
-            goto done;
-        snprintf(name, sizeof name, "%s.png", stem);
-        if (a.format != LX_IMAGE_PNG && !cli_stage_check(&stage, name))
-            goto done;
-        snprintf(name, sizeof name, "%s_ao.png", stem);
-        if (a.ao && !cli_stage_check(&stage, name))
-            goto done;
-        char dn[DIR_FILES][300];
-        int k = directional_names(&a, stem, dn);
-        for (int j = 0; j < k; j++)
-            if (!cli_stage_check(&stage, dn[j]))
-                goto done;
-    }
-    if (!cli_stage_check(&stage, "manifest.json"))
-        goto done;
     /* the scene with luxel's UVs: DIR/<scene's name>.glb */
-    char uvs_name[300] = "";
-    if (unwrap && unwrap->mesh_count &&
-        (!cli_scene_glb_name(a.scene, uvs_name, sizeof uvs_name) ||
-         !cli_stage_check(&stage, uvs_name)))
+    if (unwrap && unwrap->mesh_count && !cli_scene_glb_name(a.scene, uvs_name, sizeof uvs_name))
         goto done;
+    if (!bake_plan_outputs(&a, scene, baker, atlas, uvs_name, maps, stems, &names))
+        goto done;
+    for (uint32_t i = 0; i < names.count; i++)
+        if ((a.render || strcmp(names.names[i], "view.png") != 0) &&
+            !cli_stage_check(&stage, names.names[i]))
+            goto done;
     /* an earlier bake's files that this one will not replace */
-    if (!find_stale(&a, stems, maps, uvs_name, &stale))
+    if (!bake_find_stale(&a, &names, &stale))
         goto done;
     cli_stale_warn(&stale, a.output, a.clean);
 
@@ -770,7 +669,7 @@ int cmd_bake(int argc, char **argv)
             failed = !cli_stage_image(&stage, ao_file, &ao_images[m], &ad);
         }
         char dn[DIR_FILES][300];
-        int dk = directional_names(&a, stems[m], dn);
+        int dk = bake_directional_names(&a, stems[m], dn);
         lx_image *di = &dir_images[(size_t)m * DIR_FILES];
         for (int j = 0; j < dk && !failed; j++) {
             /* sh0 is written as the lightmap is (its units, exposure and
@@ -806,6 +705,8 @@ int cmd_bake(int argc, char **argv)
         for (uint32_t i = 0; i < stale.count; i++)
             cJSON_AddItemToArray(earlier, cJSON_CreateString(stale.names[i]));
     }
+    if (a.render)
+        cJSON_AddStringToObject(manifest, "render", "view.png");
     if (!failed) {
         char *text = cJSON_Print(manifest);
         failed = !text || !cli_stage_text(&stage, "manifest.json", text);
@@ -815,6 +716,18 @@ int cmd_bake(int argc, char **argv)
     }
     cli_progress_clear(&progress);
     cJSON_Delete(manifest);
+    /* --render: the view of the staged lightmaps, staged with them, so that
+     * view.png and the manifest are published together or not at all */
+    if (!failed && a.render) {
+        char *view = cli_stage_path(&stage, "view.png");
+        char *shown = cli_path_join(a.output, "view.png");
+        failed = !view || !shown ||
+                 cli_render_bake(stage.dir, view, shown, scene, a.desc.threads, a.quiet) != EXIT_OK;
+        if (view && !shown)
+            cli_error("out of memory");
+        free(view);
+        free(shown);
+    }
     if (!failed && !cli_stage_publish(&stage))
         failed = true;
     if (failed)
@@ -831,8 +744,6 @@ int cmd_bake(int argc, char **argv)
         cli_phase_part(what, t_previews);
     }
     cli_phase("write and publish");
-    if (a.render && cli_render_bake(a.output, scene, a.desc.threads, a.quiet) != EXIT_OK)
-        goto done;
     if (!a.quiet) {
         uint64_t texels = 0;
         for (uint32_t m = 0; m < maps; m++)
@@ -844,12 +755,15 @@ int cmd_bake(int argc, char **argv)
             (unsigned long long)texels, cli_plural(texels, "texel", "texels"), scene->light_count,
             cli_plural(scene->light_count, "light", "lights"), cli_num_digits(cli_elapsed(), 3),
             cli_num_digits(ev, 3), a.has_exposure ? "" : " (auto)", lx_tonemap_name(a.tonemap));
+        if (a.render)
+            printf("%s/view.png\n", a.output);
         printf("%s/manifest.json\n", a.output);
     }
     status = EXIT_OK;
 done:
     cli_stage_clear(&stage);
     cli_stale_free(&stale);
+    bake_output_names_free(&names);
     if (images)
         for (uint32_t m = 0; m < maps; m++)
             lx_image_free(&images[m]);

@@ -16,8 +16,11 @@ int cmd_info(int argc, char **argv);
 int cmd_ies(int argc, char **argv);
 int cmd_ibl(int argc, char **argv);
 int cmd_render(int argc, char **argv);
-/* bake --render: DIR/view.png of DIR's lightmaps on scene (default camera). */
-int cli_render_bake(const char *dir, const lx_scene *scene, int threads, bool quiet);
+/* bake --render: the image `out` (a PNG) of DIR's lightmaps on scene from
+ * the default camera, named `shown` in warnings. DIR is the bake's staging
+ * folder: the view is published with the lightmaps. */
+int cli_render_bake(const char *dir, const char *out, const char *shown, const lx_scene *scene,
+                    int threads, bool quiet);
 int cmd_unwrap(int argc, char **argv);
 int cmd_tangents(int argc, char **argv);
 int cmd_horizonmap(int argc, char **argv);
@@ -253,12 +256,25 @@ typedef struct cli_stage {
     char **made; /* folders this run created, deepest first */
     uint32_t made_count;
     bool published; /* the outputs are in place: nothing is undone */
+    int dir_fd;     /* dir, open while dir_locked: its flock marks it in use */
+    bool dir_locked;
+    int output_fd; /* OUTPUT, open while output_locked (cli_stage_begin_set) */
+    bool output_locked;
 } cli_stage;
 
 /* Creates dir and its parents. */
 bool cli_make_dirs(const char *dir);
-/* Creates the output folder (and parents) and the staging folder in it. */
+/* Creates the output folder (and parents) and the staging folder in it,
+ * locked (flock) for as long as the run lives. Staging folders in OUTPUT
+ * that no run holds (left by a run that was killed or crashed) are
+ * reported in one warning. For outputs that stand alone (one file). */
 bool cli_stage_begin(cli_stage *st, const char *output);
+/* The same for files that belong together (bake's lightmaps and manifest,
+ * ibl's cube maps): the output folder itself is locked too until
+ * cli_stage_clear, and a second such run into it fails at once ("another
+ * luxel run is writing OUTPUT"). clean (--clean) removes the leftover
+ * staging folders instead of warning about them. */
+bool cli_stage_begin_set(cli_stage *st, const char *output, bool clean);
 /* Checks that OUTPUT/name can be replaced: nothing but a regular file (or
  * nothing) is in the way. For checking every name before the long work. */
 bool cli_stage_check(const cli_stage *st, const char *name);
@@ -291,8 +307,9 @@ cJSON *cli_json_parse(const char *name, const char *text, size_t size, char *err
 char *cli_read_text(const char *path, size_t *size);
 
 /* Files of an earlier bake in the output folder that this bake does not
- * write: the names its DIR/manifest.json lists (pages' files and previews,
- * scene_with_uvs) that are not among `outputs` and are still regular
+ * write: the names its DIR/manifest.json lists (pages' files, previews,
+ * AO and directional maps, scene_with_uvs, render) that are not among
+ * `outputs` and are still regular
  * files. other_scene: the earlier bake's scene when it is another. */
 typedef struct cli_stale {
     char **names;

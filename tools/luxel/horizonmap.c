@@ -174,7 +174,8 @@ int cmd_horizonmap(int argc, char **argv)
     if (cli_horizon_load(&o, &hf) != EXIT_OK)
         return EXIT_FAILED;
     cli_stage st;
-    if (!cli_stage_begin(&st, o.output)) {
+    /* the three files are read together: one run at a time into a folder */
+    if (!cli_stage_begin_set(&st, o.output, false)) {
         lx_image_free(&hf);
         return EXIT_FAILED;
     }

@@ -65,6 +65,8 @@ static const char *ibl_usage =
     "                           cube maps seamlessly); by default edge texels are\n"
     "                           averaged across faces (the seed's seam fix)\n"
     "  --intensity X            multiply the environment by X (default %g)\n"
+    "  --clean                  remove the staging folders (.luxel-XXXXXX) that\n"
+    "                           runs killed or crashed left in DIR\n"
     "  --threads N              worker threads (default: all cores)\n"
     "  -v, --verbose            the time of each phase, and notes\n"
     "  -q, --quiet              no progress bar, no list of files\n"
@@ -87,7 +89,8 @@ enum {
     OPT_NO_SEAM_FIX,
     OPT_INTENSITY,
     OPT_EXPOSURE,
-    OPT_TONEMAP
+    OPT_TONEMAP,
+    OPT_CLEAN
 };
 
 /* The output layouts by their option names. */
@@ -143,6 +146,7 @@ typedef struct ibl_args {
     bool has_exposure;
     double exposure_ev100;
     lx_tonemap tonemap;
+    bool clean; /* --clean: remove staging folders killed runs left */
 } ibl_args;
 
 static bool parse_exponents(const char *s, ibl_args *a)
@@ -188,6 +192,7 @@ static int parse_args(int argc, char **argv, ibl_args *a)
         {"threads", required_argument, NULL, CLI_OPT_THREADS},
         {"exposure", required_argument, NULL, OPT_EXPOSURE},
         {"tonemap", required_argument, NULL, OPT_TONEMAP},
+        {"clean", no_argument, NULL, OPT_CLEAN},
         {"quiet", no_argument, NULL, 'q'},
         {"verbose", no_argument, NULL, 'v'},
         {"help", no_argument, NULL, 'h'},
@@ -314,6 +319,9 @@ static int parse_args(int argc, char **argv, ibl_args *a)
                 return cli_usage_error("ibl", "--tonemap must be filmic, aces or clamp, not '%s'",
                                        optarg);
             tonemap_given = true;
+            break;
+        case OPT_CLEAN:
+            a->clean = true;
             break;
         case 'h':
             print_usage();
@@ -619,7 +627,7 @@ int cmd_ibl(int argc, char **argv)
      * every output name in it: the specular chain's when its length is
      * known (the environment's size or the options tell it), else its
      * level 0, and the rest once the environment is loaded */
-    if (!cli_stage_begin(&w.stage, a.output))
+    if (!cli_stage_begin_set(&w.stage, a.output, a.clean))
         goto done;
     int levels_known = a.mips;
     if (!levels_known && (known || a.specular_size))

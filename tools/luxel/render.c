@@ -79,6 +79,8 @@ typedef struct render_args {
     bool has_camera, has_view, has_fov, has_exposure, bake_exposure, quiet;
     const char *gltf_camera; /* --gltf-camera, or NULL */
     bool no_summary; /* bake --render: the bake prints its own */
+    const char *shown; /* the output as messages name it, when not `output`
+                          (bake --render writes into its staging folder) */
     lx_view view;
     double fov_degrees;
     double exposure_ev100;
@@ -646,15 +648,17 @@ static int render_and_write(render_args *a, const lx_lightmaps *lm, const lx_sce
         size_t seen, lit_pixels;
         bool ok = meter_view(&img, coverage, &metered, &seen, &lit_pixels);
         if (seen == 0)
-            lx_log(LX_LOG_WARN, "%s: the camera sees none of the scene", a->output);
+            lx_log(LX_LOG_WARN, "%s: the camera sees none of the scene",
+                   a->shown ? a->shown : a->output);
         else if (lit_pixels == 0)
-            lx_log(LX_LOG_WARN, "%s: all the camera sees of the scene is black", a->output);
+            lx_log(LX_LOG_WARN, "%s: all the camera sees of the scene is black",
+                   a->shown ? a->shown : a->output);
         if (meter && ok) {
             ev = metered;
             ev_from = " (metered)";
         } else if (meter && seen) {
             lx_log(LX_LOG_WARN, "%s: nothing lit to meter: exposed as the bake's previews",
-                   a->output);
+                   a->shown ? a->shown : a->output);
         }
     }
     /* without a sky, a neutral grey behind the scene at half the key: it
@@ -742,7 +746,8 @@ done:
     return status;
 }
 
-int cli_render_bake(const char *dir, const lx_scene *scene, int threads, bool quiet)
+int cli_render_bake(const char *dir, const char *out, const char *shown, const lx_scene *scene,
+                    int threads, bool quiet)
 {
     render_args a;
     memset(&a, 0, sizeof a);
@@ -754,12 +759,8 @@ int cli_render_bake(const char *dir, const lx_scene *scene, int threads, bool qu
     a.lightmaps = dir;
     a.quiet = quiet;
     a.no_summary = true;
-    char *out = cli_path_join(dir, "view.png");
-    if (!out) {
-        cli_error("out of memory");
-        return EXIT_FAILED;
-    }
     a.output = out;
+    a.shown = shown;
     lx_lightmaps lm;
     int status = EXIT_FAILED;
     lx_lightmaps_load_desc lmd = {.allow_any_path = cli_allow_any_path()};
@@ -767,9 +768,6 @@ int cli_render_bake(const char *dir, const lx_scene *scene, int threads, bool qu
         cli_error("%s", lx_last_error());
     else
         status = render_and_write(&a, &lm, scene);
-    if (status == EXIT_OK && !quiet)
-        printf("%s\n", out);
     lx_lightmaps_free(&lm);
-    free(out);
     return status;
 }

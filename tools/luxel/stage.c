@@ -2,20 +2,37 @@
  * every file goes to DIR/.luxel-<random> first and is moved into DIR only
  * when all of them are written, so a failure or an interrupt leaves DIR as
  * it was. Publishing keeps what it replaces until the last rename is done
- * and restores it if one fails. */
+ * and restores it if one fails.
+ * Locks (flock, released by the kernel when a run dies): every run holds
+ * its staging folder's, so a staging folder whose lock can be taken was
+ * left by a run that was killed or crashed; a command whose files belong
+ * together (bake, ibl) holds the output folder's too, so two such runs
+ * never mix their files in one folder. */
 #define _POSIX_C_SOURCE 200809L
+#define _DEFAULT_SOURCE /* flock */
 #include "cli.h"
 
+#include <dirent.h>
 #include <errno.h>
+#include <fcntl.h>
 #include <stdio.h>
 #include <stdlib.h>
 #include <string.h>
+#include <sys/file.h>
 #include <sys/stat.h>
 #include <unistd.h>
 
 /* The folder inside the staging folder that holds the replaced outputs
  * while publishing (staged names never start with a dot). */
 #define PREVIOUS ".previous"
+
+/* A staging folder is STAGE_PREFIX and mkdtemp's six characters. */
+#define STAGE_PREFIX ".luxel-"
+#define STAGE_NAME_LENGTH (sizeof STAGE_PREFIX - 1 + 6)
+
+/* How often a staging folder is made again when another run's --clean
+ * took it for a leftover between its creation and its lock. */
+#define STAGE_ATTEMPTS 8
 
 bool cli_make_dirs(const char *dir)
 {
@@ -90,10 +107,235 @@ static void stage_free(cli_stage *st)
     free(st->names);
     free(st->dir);
     free(st->output);
+    /* closing a folder's descriptor releases its lock: the staging folder
+     * is gone by now, the output folder's lock goes last */
+    if (st->dir_locked)
+        close(st->dir_fd);
+    if (st->output_locked)
+        close(st->output_fd);
     memset(st, 0, sizeof *st);
 }
 
-bool cli_stage_begin(cli_stage *st, const char *output)
+/* Takes the output folder's lock: an exclusive flock on the folder itself
+ * (a lock file would stay behind), held until cli_stage_clear. Fails at
+ * once when another run holds it: waiting would hide a mistake (two
+ * bakes into one folder) behind a run that seems to hang. */
+static bool lock_output(cli_stage *st)
+{
+    int fd = open(st->output, O_RDONLY | O_DIRECTORY | O_CLOEXEC);
+    if (fd < 0) {
+        cli_error("%s: cannot open the output folder: %s", st->output, strerror(errno));
+        return false;
+    }
+    if (flock(fd, LOCK_EX | LOCK_NB) == 0) {
+        st->output_fd = fd;
+        st->output_locked = true;
+        return true;
+    }
+    int err = errno;
+    close(fd);
+    if (err == EWOULDBLOCK) {
+        cli_error("another luxel run is writing %s: wait for it to end, or give another -o",
+                  st->output);
+        return false;
+    }
+    /* a file system without flock (some network mounts): no guard */
+    lx_log(LX_LOG_INFO,
+           "%s: cannot lock the output folder (%s): a second run into it would not "
+           "be noticed",
+           st->output, strerror(err));
+    return true;
+}
+
+/* Makes the staging folder and takes its lock, which tells other runs it
+ * is in use. Another run's --clean may take a just-made folder for a
+ * leftover before its lock is taken, and remove it: then it is made
+ * again. */
+static bool make_staging(cli_stage *st)
+{
+    /* mkdtemp replaces the template's last six characters, which must be
+     * 'X'; they are written in below so the name reads as .luxel-<random> */
+    st->dir = cli_path_join(st->output, STAGE_PREFIX "123456");
+    if (!st->dir) {
+        cli_error("out of memory");
+        return false;
+    }
+    for (int attempt = 0; attempt < STAGE_ATTEMPTS; attempt++) {
+        memset(st->dir + strlen(st->dir) - 6, 'X', 6);
+        if (!mkdtemp(st->dir)) {
+            cli_error("%s: cannot write into the output folder: %s", st->output, strerror(errno));
+            return false;
+        }
+        int fd = open(st->dir, O_RDONLY | O_DIRECTORY | O_NOFOLLOW | O_CLOEXEC);
+        if (fd < 0)
+            continue; /* removed already */
+        if (flock(fd, LOCK_EX | LOCK_NB) != 0) {
+            int err = errno;
+            close(fd);
+            if (err == EWOULDBLOCK)
+                continue; /* being removed: that run's --clean rmdirs it */
+            return true;  /* no flock here: the folder is used unlocked */
+        }
+        /* still the folder at that name, not one removed under the lock */
+        struct stat held, named;
+        if (fstat(fd, &held) == 0 && lstat(st->dir, &named) == 0 && held.st_dev == named.st_dev &&
+            held.st_ino == named.st_ino) {
+            st->dir_fd = fd;
+            st->dir_locked = true;
+            return true;
+        }
+        close(fd);
+    }
+    cli_error("%s: cannot make a staging folder: it was removed %d times while being made",
+              st->output, STAGE_ATTEMPTS);
+    return false;
+}
+
+/* The names of folder fd's entries (without . and ..), malloc'd; *count
+ * of them. NULL with *count 0 when there are none or the folder cannot
+ * be read. */
+static char **folder_entries(int fd, uint32_t *count)
+{
+    *count = 0;
+    int copy = dup(fd);
+    DIR *d = copy >= 0 ? fdopendir(copy) : NULL;
+    if (!d) {
+        if (copy >= 0)
+            close(copy);
+        return NULL;
+    }
+    rewinddir(d);
+    char **names = NULL;
+    uint32_t n = 0;
+    struct dirent *e;
+    while ((e = readdir(d))) {
+        if (strcmp(e->d_name, ".") == 0 || strcmp(e->d_name, "..") == 0)
+            continue;
+        char **grown = realloc(names, sizeof *names * (n + 1));
+        char *name = grown ? cli_strdup(e->d_name) : NULL;
+        if (grown)
+            names = grown;
+        if (!name)
+            break;
+        names[n++] = name;
+    }
+    closedir(d);
+    *count = n;
+    return names;
+}
+
+static void free_entries(char **names, uint32_t count)
+{
+    for (uint32_t i = 0; i < count; i++)
+        free(names[i]);
+    free(names);
+}
+
+/* Empties a leftover staging folder (fd, its lock held) of what a run
+ * leaves there: files, and PREVIOUS with the files publishing set aside.
+ * Anything else (a folder luxel does not make) stays: false then. */
+static bool empty_leftover(int fd, bool top)
+{
+    uint32_t n;
+    char **names = folder_entries(fd, &n);
+    bool ok = true;
+    for (uint32_t i = 0; i < n; i++) {
+        struct stat sb;
+        if (fstatat(fd, names[i], &sb, AT_SYMLINK_NOFOLLOW) != 0)
+            continue;
+        if (!S_ISDIR(sb.st_mode)) {
+            ok = unlinkat(fd, names[i], 0) == 0 && ok;
+        } else if (top && strcmp(names[i], PREVIOUS) == 0) {
+            int sub = openat(fd, names[i], O_RDONLY | O_DIRECTORY | O_NOFOLLOW | O_CLOEXEC);
+            ok = sub >= 0 && empty_leftover(sub, false) && ok;
+            if (sub >= 0)
+                close(sub);
+            ok = unlinkat(fd, names[i], AT_REMOVEDIR) == 0 && ok;
+        } else {
+            ok = false;
+        }
+    }
+    free_entries(names, n);
+    return ok;
+}
+
+/* Appends ", name" (the first without the comma) to list while it fits,
+ * else counts it in *unlisted. */
+static void list_name(char *list, size_t size, const char *name, uint32_t *unlisted)
+{
+    size_t len = strlen(list);
+    if (*unlisted == 0 && len + strlen(name) + 24 < size)
+        snprintf(list + len, size - len, "%s%s", len ? ", " : "", name);
+    else
+        (*unlisted)++;
+}
+
+static void end_list(char *list, size_t size, uint32_t unlisted)
+{
+    size_t len = strlen(list);
+    if (unlisted)
+        snprintf(list + len, size - len, " and %u more", unlisted);
+}
+
+/* Staging folders in the output folder whose lock can be taken: runs that
+ * were killed or crashed left them. One warning names them; with clean
+ * they are removed instead (an INFO line). Never an error: they hold no
+ * output of this run. */
+static void handle_leftovers(const cli_stage *st, bool clean, bool clean_option)
+{
+    int out = open(st->output, O_RDONLY | O_DIRECTORY | O_CLOEXEC);
+    if (out < 0)
+        return;
+    uint32_t n;
+    char **names = folder_entries(out, &n);
+    char found[400] = "", failed[400] = "";
+    uint32_t found_count = 0, found_unlisted = 0, failed_unlisted = 0;
+    for (uint32_t i = 0; i < n; i++) {
+        if (strlen(names[i]) != STAGE_NAME_LENGTH ||
+            strncmp(names[i], STAGE_PREFIX, sizeof STAGE_PREFIX - 1) != 0)
+            continue;
+        /* a folder, not a link to one: O_NOFOLLOW */
+        int fd = openat(out, names[i], O_RDONLY | O_DIRECTORY | O_NOFOLLOW | O_CLOEXEC);
+        if (fd < 0)
+            continue;
+        /* held: a running run's; not lockable at all: cannot tell */
+        if (flock(fd, LOCK_EX | LOCK_NB) != 0) {
+            close(fd);
+            continue;
+        }
+        found_count++;
+        list_name(found, sizeof found, names[i], &found_unlisted);
+        if (clean && !(empty_leftover(fd, true) && unlinkat(out, names[i], AT_REMOVEDIR) == 0))
+            list_name(failed, sizeof failed, names[i], &failed_unlisted);
+        close(fd); /* after the rmdir: a new run cannot take it meanwhile */
+    }
+    free_entries(names, n);
+    close(out);
+    if (!found_count)
+        return;
+    end_list(found, sizeof found, found_unlisted);
+    bool one = found_count == 1;
+    if (clean) {
+        lx_log(LX_LOG_INFO, "%s: removing %s left by luxel %s that did not finish: %s", st->output,
+               one ? "a staging folder" : "staging folders", one ? "a run" : "runs", found);
+        if (failed[0]) {
+            end_list(failed, sizeof failed, failed_unlisted);
+            lx_log(LX_LOG_WARN,
+                   "%s: could not remove all of %s: it holds what luxel does not "
+                   "write there",
+                   st->output, failed);
+        }
+    } else {
+        lx_log(LX_LOG_WARN, "%s: %s left by %s that did not finish (killed or crashed): %s; %s",
+               st->output, one ? "a staging folder" : "staging folders",
+               one ? "a luxel run" : "luxel runs", found,
+               clean_option ? (one ? "--clean removes it" : "--clean removes them")
+                            : (one ? "remove it by hand" : "remove them by hand"));
+    }
+}
+
+/* cli_stage_begin and cli_stage_begin_set. */
+static bool stage_begin(cli_stage *st, const char *output, bool lock, bool clean, bool clean_option)
 {
     memset(st, 0, sizeof *st);
     st->output = cli_strdup(output);
@@ -111,24 +353,25 @@ bool cli_stage_begin(cli_stage *st, const char *output)
         stage_free(st);
         return false;
     }
-    /* mkdtemp replaces the template's last six characters, which must be
-     * 'X'; they are written in below so the name reads as .luxel-<random> */
-    st->dir = cli_path_join(output, ".luxel-123456");
-    if (st->dir)
-        memset(st->dir + strlen(st->dir) - 6, 'X', 6);
-    if (!st->dir || !mkdtemp(st->dir)) {
-        int err = errno;
+    if ((lock && !lock_output(st)) || !make_staging(st)) {
         if (st->dir)
-            cli_error("%s: cannot write into the output folder: %s", output, strerror(err));
-        else
-            cli_error("out of memory");
-        free(st->dir);
-        st->dir = NULL;
+            rmdir(st->dir); /* made, or a template that never was: either way */
         remove_made(st);
         stage_free(st);
         return false;
     }
+    handle_leftovers(st, clean, clean_option);
     return true;
+}
+
+bool cli_stage_begin(cli_stage *st, const char *output)
+{
+    return stage_begin(st, output, false, false, false);
+}
+
+bool cli_stage_begin_set(cli_stage *st, const char *output, bool clean)
+{
+    return stage_begin(st, output, true, clean, true);
 }
 
 bool cli_stage_check(const cli_stage *st, const char *name)
@@ -154,6 +397,14 @@ char *cli_stage_path(cli_stage *st, const char *name)
     }
     if (!cli_stage_check(st, name))
         return NULL;
+    /* two outputs of one name: the second would overwrite the first, and
+     * publishing would fail on it after all the work (commands plan their
+     * names so that this never happens) */
+    for (uint32_t i = 0; i < st->count; i++)
+        if (strcmp(st->names[i], name) == 0) {
+            cli_error("%s/%s: two outputs of this run have this name", st->output, name);
+            return NULL;
+        }
     /* named before it exists, so cli_stage_clear removes whatever the
      * writer leaves behind */
     if (st->count == st->capacity) {

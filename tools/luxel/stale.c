@@ -210,9 +210,17 @@ bool cli_stale_find(const char *dir, const char *scene, const char *const *outpu
         const cJSON *e;
         cJSON_ArrayForEach(e, arr)
         {
-            const char *keys[2] = {"file", "preview"};
-            for (int k = 0; k < 2; k++) {
+            /* a page's files: the map, its preview, AO and directional maps */
+            const char *keys[4] = {"file", "preview", "ao", "dir"};
+            for (int k = 0; k < 4; k++) {
                 const cJSON *f = cJSON_GetObjectItemCaseSensitive(e, keys[k]);
+                if (cJSON_IsString(f) && plain_name(f->valuestring) &&
+                    !listed(f->valuestring, outputs, output_count))
+                    ok = ok && add(out, f->valuestring);
+            }
+            const cJSON *f;
+            cJSON_ArrayForEach(f, cJSON_GetObjectItemCaseSensitive(e, "sh"))
+            {
                 if (cJSON_IsString(f) && plain_name(f->valuestring) &&
                     !listed(f->valuestring, outputs, output_count))
                     ok = ok && add(out, f->valuestring);
@@ -226,10 +234,14 @@ bool cli_stale_find(const char *dir, const char *scene, const char *const *outpu
             !listed(e->valuestring, outputs, output_count))
             ok = ok && add(out, e->valuestring);
     }
-    const cJSON *uvs = cJSON_GetObjectItemCaseSensitive(root, "scene_with_uvs");
-    if (cJSON_IsString(uvs) && plain_name(uvs->valuestring) &&
-        !listed(uvs->valuestring, outputs, output_count))
-        ok = ok && add(out, uvs->valuestring);
+    /* the scene with UVs, and the render of --render */
+    const char *top[2] = {"scene_with_uvs", "render"};
+    for (int k = 0; k < 2; k++) {
+        const cJSON *f = cJSON_GetObjectItemCaseSensitive(root, top[k]);
+        if (cJSON_IsString(f) && plain_name(f->valuestring) &&
+            !listed(f->valuestring, outputs, output_count))
+            ok = ok && add(out, f->valuestring);
+    }
     cJSON_Delete(root);
     if (!ok) {
         cli_error("out of memory");
