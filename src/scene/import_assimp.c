@@ -166,6 +166,8 @@ typedef struct import_source {
     const char *path;    /* the scene file, for messages */
     const char *folder;  /* other files must lie in it or below ... */
     bool allow_any_path; /* ... unless this is set (lx_path_confine) */
+    bool text_others;    /* other files may be text assimp quotes (an OBJ's
+                            mtllib; a glTF's are binary buffers) */
 } import_source;
 
 typedef struct io_file {
@@ -286,7 +288,7 @@ static struct aiFile *io_open(struct aiFileIO *io, const char *path, const char 
             return NULL;
         }
         struct stat sb;
-        state->read_others = true;
+        state->read_others = src->text_others;
         h->fp = open_slashed(path);
         if (!h->fp || fstat(fileno(h->fp), &sb) != 0 || !S_ISREG(sb.st_mode)) {
             if (h->fp)
@@ -1623,7 +1625,8 @@ lx_status lx_scene_load(const char *path, const lx_scene_load_desc *in, lx_scene
                          .size = glb_size,
                          .path = path,
                          .folder = folder,
-                         .allow_any_path = desc->allow_any_path};
+                         .allow_any_path = desc->allow_any_path,
+                         .text_others = gltf == NULL};
     import_job job = {.path = path,
                       .src = &src,
                       .desc = desc,

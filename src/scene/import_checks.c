@@ -76,28 +76,36 @@ static lx_status judge_graph(const char *path, const node_graph *g, node_namer n
 
 /* ---- glTF ------------------------------------------------------------------ */
 
+static void name_gltf2(const void *user, uint32_t node, char *buf, size_t size)
+{
+    lx_gltf_label(buf, size, "node", node, cJSON_GetArrayItem(user, (int)node));
+}
+
+/* "children" by index; entries that name no node are the readers' to
+ * report. (One parent each is glTF's rule, checked with the transforms
+ * where lights and cameras are placed; a subtree listed twice is counted
+ * twice here, as assimp copies it.) */
 static lx_status check_gltf2(const char *path, const cJSON *gltf)
 {
-    lx_gltf_graph g = {0};
-    lx_status st = lx_gltf_graph_build(path, gltf, &g); /* one parent each, no cycles */
-    uint32_t *depth = NULL;
-    if (st == LX_OK && g.count > 0 && !(depth = malloc(g.count * sizeof *depth)))
-        st = lx_fail(LX_ERR_NOMEM, "%s: out of memory for %zu nodes", path, g.count);
-    for (size_t i = 0; st == LX_OK && i < g.reached; i++) {
-        size_t k = g.order[i]; /* parents first */
-        depth[k] = g.parent[k] < 0 ? 1 : depth[g.parent[k]] + 1;
-        if (depth[k] > NODE_DEPTH_MAX) {
-            size_t top = k;
-            while (g.parent[top] >= 0)
-                top = (size_t)g.parent[top];
-            char who[128];
-            lx_gltf_label(who, sizeof who, "node", top, g.nodes[top]);
-            st = lx_fail(LX_ERR_FORMAT, "%s: node hierarchy deeper than %d levels (below %s)", path,
-                         NODE_DEPTH_MAX, who);
+    const cJSON *nodes = lx_gltf_get(gltf, "nodes");
+    if (!cJSON_IsArray(nodes))
+        return LX_OK;
+    node_graph g = {.nodes = (size_t)cJSON_GetArraySize(nodes)};
+    lx_status st = LX_OK;
+    uint32_t i = 0;
+    for (const cJSON *n = nodes->child; n && st == LX_OK; n = n->next, i++) {
+        const cJSON *children = lx_gltf_get(n, "children");
+        for (const cJSON *c = cJSON_IsArray(children) ? children->child : NULL; c; c = c->next) {
+            size_t k;
+            if (lx_gltf_index(c, g.nodes, &k) && !node_graph_add_edge(&g, i, (uint32_t)k)) {
+                st = lx_fail(LX_ERR_NOMEM, "%s: out of memory for the node hierarchy", path);
+                break;
+            }
         }
     }
-    free(depth);
-    lx_gltf_graph_free(&g);
+    if (st == LX_OK)
+        st = judge_graph(path, &g, name_gltf2, nodes);
+    node_graph_free(&g);
     return st;
 }
 
