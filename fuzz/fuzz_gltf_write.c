@@ -25,7 +25,7 @@ int LLVMFuzzerTestOneInput(const uint8_t *data, size_t size)
     fwrite(data + 1, 1, size - 1, fp);
     fclose(fp);
     lx_scene *scene = NULL;
-    lx_scene_load_desc desc = {.skip_degenerate = (data[0] & 4) != 0};
+    lx_scene_load_desc desc = {.strict = (data[0] & 4) != 0};
     if (lx_scene_load(path, &desc, &scene) == LX_OK) {
         uint32_t n = 0;
         for (uint32_t i = 0; i < scene->node_count; i++)
