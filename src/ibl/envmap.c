@@ -381,6 +381,8 @@ lx_status lx_env_from_image(const lx_image *img, const char *name, const lx_env_
 
 lx_status lx_env_constant(lx_vec3 radiance, int size, lx_cubemap *out)
 {
+    if (!out)
+        return lx_fail_null(__func__, "out");
     memset(out, 0, sizeof *out);
     if (!lx_vec3_finite(radiance) || radiance.x < 0.0f || radiance.y < 0.0f || radiance.z < 0.0f)
         return lx_fail(LX_ERR_INVALID,
