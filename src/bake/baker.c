@@ -318,8 +318,12 @@ lx_status lx_baker_create(const lx_scene *scene, const lx_bake_desc *in, lx_bake
     if (st != LX_OK)
         return st;
     for (uint32_t l = 0; l < scene->light_count; l++)
-        if ((st = lx_light_validate(&scene->lights[l])) != LX_OK)
+        if ((st = lx_light_validate(&scene->lights[l])) != LX_OK) {
+            /* lights added through the API are checked here too: name the scene */
+            if (scene->path)
+                lx_error_prefix(scene->path);
             return st;
+        }
     if (!lx_vec3_finite(scene->ambient) || scene->ambient.x < 0 || scene->ambient.y < 0 ||
         scene->ambient.z < 0)
         return lx_fail(LX_ERR_INVALID, "%s: ambient must be finite and >= 0", scene->path);
