@@ -489,6 +489,8 @@ lx_status lx_baker_set_light(lx_baker *b, uint32_t light, const lx_light *value)
 {
     if (!b)
         return lx_fail_null(__func__, "baker");
+    if (!value)
+        return lx_fail_null(__func__, "value");
     if (light >= b->light_count)
         return lx_fail(LX_ERR_INVALID, "light %u out of range (count %u)", light, b->light_count);
     lx_status st = lx_light_validate(value);
@@ -504,6 +506,8 @@ lx_status lx_baker_set_node_transform(lx_baker *b, uint32_t node, const lx_mat4 
 {
     if (!b)
         return lx_fail_null(__func__, "baker");
+    if (!world)
+        return lx_fail_null(__func__, "world");
     if (node >= b->node_count)
         return lx_fail(LX_ERR_INVALID, "node %u out of range (count %u)", node, b->node_count);
     /* the object space a move needs, before anything changes */

@@ -362,6 +362,8 @@ lx_status lx_env_load(const char *path, const lx_env_load_desc *desc, lx_cubemap
 lx_status lx_env_from_image(const lx_image *img, const char *name, const lx_env_load_desc *desc,
                             lx_cubemap *out)
 {
+    if (!img)
+        return lx_fail_null(__func__, "img");
     if (out)
         memset(out, 0, sizeof *out);
     name = name ? name : "environment";

@@ -273,6 +273,8 @@ float lx_ev100_from_luminance(double average_luminance)
 
 lx_status lx_ev100_from_camera(float aperture, float shutter_seconds, float iso, float *ev100)
 {
+    if (!ev100)
+        return lx_fail_null(__func__, "ev100");
     if (!(aperture > 0.0f && isfinite(aperture)) ||
         !(shutter_seconds > 0.0f && isfinite(shutter_seconds)) || !(iso > 0.0f && isfinite(iso)))
         return lx_fail(LX_ERR_INVALID,

@@ -121,6 +121,8 @@ lx_status lx_camera_auto(const lx_scene *scene, const lx_lightmaps *lm, const lx
 {
     if (!scene)
         return lx_fail_null(__func__, "scene");
+    if (!out)
+        return lx_fail_null(__func__, "out");
     lx_camera_auto_info local;
     if (!info)
         info = &local;

@@ -362,6 +362,8 @@ lx_status lx_lightmaps_load(const char *dir, const lx_lightmaps_load_desc *desc,
 {
     if (!out)
         return lx_fail_null(__func__, "out");
+    if (!dir)
+        return lx_fail_null(__func__, "dir");
     memset(out, 0, sizeof *out);
     lx_lightmaps_load_desc d = lx_lightmaps_load_desc_defaults(desc);
     if (!dir || !dir[0])

@@ -385,6 +385,8 @@ lx_status lx_render_view(const lx_scene *scene, const lx_lightmaps *lm, const lx
         return lx_fail_null(__func__, "lm");
     if (!out)
         return lx_fail_null(__func__, "out");
+    if (!scene)
+        return lx_fail_null(__func__, "scene");
     return lx_render_view_quiet(scene, lm, tracer, desc, out, false);
 }
 

@@ -246,6 +246,8 @@ lx_status lx_tracer_set_node_transform(lx_tracer *tr, uint32_t node, const lx_ma
 {
     if (!tr)
         return lx_fail_null(__func__, "tracer");
+    if (!world)
+        return lx_fail_null(__func__, "world");
     if (node >= tr->node_count)
         return lx_fail(LX_ERR_INVALID, "node %u out of range (count %u)", node, tr->node_count);
     if (!lx_mat4_finite(world) || !(fabsf(lx_mat4_det3(world)) > 1e-20f))
