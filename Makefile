@@ -5,8 +5,9 @@ BUILD_FUZZ ?= build-fuzz
 JOBS       ?= $(shell nproc)
 CMAKE_FLAGS ?=
 FUZZ_SECONDS ?= 60
+FUZZ_SMOKE_SECONDS ?= 5
 
-.PHONY: all deps configure demo check check-asan bench fuzz clean
+.PHONY: all deps configure demo check check-asan bench fuzz fuzz-smoke clean
 
 all: configure
 	cmake --build $(BUILD) -j $(JOBS)
@@ -60,7 +61,7 @@ bench: all
 
 fuzz: all
 	@test -f $(BUILD_FUZZ)/CMakeCache.txt || CC=clang cmake -S . -B $(BUILD_FUZZ) -DCMAKE_BUILD_TYPE=Debug -DLX_FUZZ=ON
-	cmake --build $(BUILD_FUZZ) -j $(JOBS)
+	cmake --build $(BUILD_FUZZ) -j $(JOBS) --target fuzzers
 	@# seed the scene fuzzer with the example scenes (first byte picks .glb)
 	$(BUILD)/bin/gen_scenes $(BUILD_FUZZ)/seeds
 	@mkdir -p $(BUILD_FUZZ)/corpus/fuzz_scene
@@ -72,6 +73,12 @@ fuzz: all
 		seeds=; test -d fuzz/corpus/$${name#fuzz_} && seeds=fuzz/corpus/$${name#fuzz_}; \
 		dict=; test -f fuzz/$${name#fuzz_}.dict && dict=-dict=fuzz/$${name#fuzz_}.dict; \
 		echo "== $$f"; $$f -max_total_time=$(FUZZ_SECONDS) $$dict $$corpus $$seeds || exit 1; done
+
+# What CI runs after make check (.ci/run): every harness built and run a few
+# seconds on its seeds, so a harness that no longer builds or crashes at
+# once fails the run.
+fuzz-smoke:
+	$(MAKE) fuzz FUZZ_SECONDS=$(FUZZ_SMOKE_SECONDS)
 
 clean:
 	rm -rf $(BUILD) $(BUILD_ASAN) $(BUILD_FUZZ)

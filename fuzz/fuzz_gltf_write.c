@@ -25,7 +25,7 @@ int LLVMFuzzerTestOneInput(const uint8_t *data, size_t size)
     fwrite(data + 1, 1, size - 1, fp);
     fclose(fp);
     lx_scene *scene = NULL;
-    lx_scene_load_desc desc = {.skip_degenerate = (data[0] & 4) != 0};
+    lx_scene_load_desc desc = {.strict = (data[0] & 4) != 0};
     if (lx_scene_load(path, &desc, &scene) == LX_OK) {
         uint32_t n = 0;
         for (uint32_t i = 0; i < scene->node_count; i++)
@@ -41,8 +41,12 @@ int LLVMFuzzerTestOneInput(const uint8_t *data, size_t size)
                 uv[k] = calloc(m->vertex_count + 1, sizeof(lx_vec2));
                 for (uint32_t v = 0; src[k] && v < m->vertex_count; v++)
                     src[k][v] = v;
-                uvs[k] = (lx_scene_uvs){i, scene->nodes[i].meshes[j], m->vertex_count, src[k],
-                                        uv[k], m->indices};
+                uvs[k] = (lx_scene_uvs){.node = i,
+                                        .mesh = scene->nodes[i].meshes[j],
+                                        .vertex_count = m->vertex_count,
+                                        .vertex_source = src[k],
+                                        .uv = uv[k],
+                                        .indices = m->indices};
             }
         lx_glb_write_desc d = {.uvs = uvs, .uv_count = k};
         lx_scene_write_glb(scene, out, &d);

@@ -7,6 +7,10 @@
  * ERRORS  Every function that can fail returns lx_status and sets a message
  *   readable with lx_last_error() (thread-local) naming the file, the place
  *   in it and the problem: "scene.glb: accessor 7: index 912 out of range".
+ *   A NULL pointer where a function needs one is LX_ERR_INVALID
+ *   ("lx_scene_load: out is NULL"), never a crash; pointers that may be
+ *   NULL say so (tests/usage/null_optional.txt lists them all), and
+ *   *_free / *_destroy accept NULL.
  * MEMORY  lx_image_alloc/lx_image_load allocate; lx_image_free releases.
  * THREADING  Every function here is thread-safe. The log callback is
  *   process-wide: lx_set_log_callback may be called while other threads

@@ -180,8 +180,21 @@ void lx_rect_light_corners(const lx_light *light, lx_vec3 corners[4]);
  * pointing down -Y. */
 lx_light lx_light_defaults(lx_light_type type);
 
-/* Checks every field (finite, in range, unit direction); fails with
- * LX_ERR_INVALID and "light 'name': <problem>". */
+/* The largest values a light may hold (lx_light_validate). No real scene
+ * comes near them (the sun gives 1.2e5 lx and its disc 1.6e9 nt, a
+ * searchlight 1e9 cd; the Earth is 1.3e7 m across), and they keep every
+ * float of a bake finite: intensity x colour at the 1 cm floor of the
+ * inverse square law is at most 1e12 x 1e2 / 1e-4 = 1e18 lx, the largest
+ * value a lightmap may hold, and squared distances and sizes (1e14 m^2)
+ * are far from float's 3.4e38 while metres keep 1 m steps. */
+#define LX_LIGHT_MAX_INTENSITY 1e12f /* of its native unit: cd, lx, nt (cd/m, linear tube);
+                                        also each ambient component, lx */
+#define LX_LIGHT_MAX_COLOR 1e2f      /* each linear RGB component */
+#define LX_LIGHT_MAX_DISTANCE 1e7f   /* metres: position components, range, radius,
+                                        length, width, height */
+
+/* Checks every field (finite, in range, unit direction, within the
+ * limits above); fails with LX_ERR_INVALID and "light 'name': <problem>". */
 lx_status lx_light_validate(const lx_light *light);
 
 /* Converts value in unit to the light's native unit (cd or lx) given its

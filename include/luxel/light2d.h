@@ -132,7 +132,8 @@ lx_status lx_light2d_set_lights(lx_light2d *ctx, const lx_light2d_light *lights,
  * LX_LIGHT2D_MAX_LIGHT]. out (may be NULL) gets width*height*3 floats,
  * albedo x (ambient + sum of lights), albedo from `albedo` (the casters'
  * size, RGB or RGBA, linear; NULL = white). light_map (may be NULL) gets
- * width*height*3 floats of ambient + sum of lights. */
+ * width*height*3 floats of ambient + sum of lights. At least one of out
+ * and light_map must be given (LX_ERR_INVALID otherwise). */
 lx_status lx_light2d_render(lx_light2d *ctx, lx_vec3 ambient, const lx_image *albedo, float *out,
                             float *light_map);
 

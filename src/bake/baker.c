@@ -308,14 +308,22 @@ static lx_status check_coverage(const lx_baker *b, const lx_scene *scene, const 
 
 lx_status lx_baker_create(const lx_scene *scene, const lx_bake_desc *in, lx_baker **out)
 {
+    if (!scene)
+        return lx_fail_null(__func__, "scene");
+    if (!out)
+        return lx_fail_null(__func__, "out");
     *out = NULL;
     lx_bake_desc desc = lx_bake_desc_defaults(in);
     lx_status st = validate_desc(&desc);
     if (st != LX_OK)
         return st;
     for (uint32_t l = 0; l < scene->light_count; l++)
-        if ((st = lx_light_validate(&scene->lights[l])) != LX_OK)
+        if ((st = lx_light_validate(&scene->lights[l])) != LX_OK) {
+            /* lights added through the API are checked here too: name the scene */
+            if (scene->path)
+                lx_error_prefix(scene->path);
             return st;
+        }
     if (!lx_vec3_finite(scene->ambient) || scene->ambient.x < 0 || scene->ambient.y < 0 ||
         scene->ambient.z < 0)
         return lx_fail(LX_ERR_INVALID, "%s: ambient must be finite and >= 0", scene->path);
@@ -479,6 +487,10 @@ const lx_light *lx_baker_light(const lx_baker *b, uint32_t light)
 
 lx_status lx_baker_set_light(lx_baker *b, uint32_t light, const lx_light *value)
 {
+    if (!b)
+        return lx_fail_null(__func__, "baker");
+    if (!value)
+        return lx_fail_null(__func__, "value");
     if (light >= b->light_count)
         return lx_fail(LX_ERR_INVALID, "light %u out of range (count %u)", light, b->light_count);
     lx_status st = lx_light_validate(value);
@@ -492,6 +504,10 @@ lx_status lx_baker_set_light(lx_baker *b, uint32_t light, const lx_light *value)
 
 lx_status lx_baker_set_node_transform(lx_baker *b, uint32_t node, const lx_mat4 *world)
 {
+    if (!b)
+        return lx_fail_null(__func__, "baker");
+    if (!world)
+        return lx_fail_null(__func__, "world");
     if (node >= b->node_count)
         return lx_fail(LX_ERR_INVALID, "node %u out of range (count %u)", node, b->node_count);
     /* the object space a move needs, before anything changes */
@@ -563,6 +579,8 @@ static lx_status bake_direct(lx_baker *b, const uint32_t *idx, uint32_t n, float
 
 lx_status lx_baker_bake(lx_baker *b)
 {
+    if (!b)
+        return lx_fail_null(__func__, "baker");
     uint32_t *idx = malloc(sizeof(uint32_t) * (b->light_count + 1));
     if (!idx)
         return lx_fail(LX_ERR_NOMEM, "out of memory");
@@ -616,6 +634,8 @@ lx_status lx_baker_bake(lx_baker *b)
 
 lx_status lx_baker_update(lx_baker *b)
 {
+    if (!b)
+        return lx_fail_null(__func__, "baker");
     uint32_t idx_buf[64] = {0};
     uint32_t *idx = b->light_count <= 64 ? idx_buf : malloc(sizeof(uint32_t) * b->light_count);
     if (!idx)
@@ -662,6 +682,8 @@ lx_status lx_baker_update(lx_baker *b)
 
 lx_status lx_baker_apply(const lx_baker *b, uint32_t map_index, lx_image *out)
 {
+    if (!b)
+        return lx_fail_null(__func__, "baker");
     if (map_index >= b->map_count)
         return lx_fail(LX_ERR_INVALID, "lightmap %u out of range (count %u)", map_index,
                        b->map_count);
@@ -736,6 +758,10 @@ lx_status lx_baker_apply(const lx_baker *b, uint32_t map_index, lx_image *out)
 
 lx_status lx_baker_apply_alloc(const lx_baker *b, uint32_t map, lx_image *out)
 {
+    if (!b)
+        return lx_fail_null(__func__, "baker");
+    if (!out)
+        return lx_fail_null(__func__, "out");
     memset(out, 0, sizeof *out);
     if (map >= b->map_count)
         return lx_fail(LX_ERR_INVALID, "lightmap %u out of range (count %u)", map, b->map_count);
@@ -751,6 +777,8 @@ lx_status lx_baker_apply_alloc(const lx_baker *b, uint32_t map, lx_image *out)
 lx_status lx_baker_apply_rgba8(const lx_baker *b, uint32_t map, float exposure, bool srgb,
                                uint8_t *out)
 {
+    if (!b)
+        return lx_fail_null(__func__, "baker");
     lx_image img;
     lx_status st = lx_baker_apply_alloc(b, map, &img);
     if (st != LX_OK)

@@ -658,6 +658,8 @@ done:
 lx_status lx_denoise(const lx_denoise_guides *guides, const float *in, float *out,
                      const lx_denoise_desc *desc)
 {
+    if (!in)
+        return lx_fail_null(__func__, "in");
     return run(LX_DENOISE_ALL, guides, NULL, in, out, desc, false);
 }
 
@@ -665,5 +667,7 @@ lx_status lx_denoise_combine(lx_denoise_mode mode, const lx_denoise_guides *guid
                              const float *direct, const float *indirect, float *out,
                              const lx_denoise_desc *desc)
 {
+    if (!indirect)
+        return lx_fail_null(__func__, "indirect");
     return run(mode, guides, direct, indirect, out, desc, true);
 }

@@ -73,6 +73,10 @@ static lx_status pad(const lx_baker *b, const lx_lightmap *map, lx_image *img)
 
 lx_status lx_baker_sh(const lx_baker *b, uint32_t map_index, lx_image out[4])
 {
+    if (!b)
+        return lx_fail_null(__func__, "baker");
+    if (!out)
+        return lx_fail_null(__func__, "out");
     memset(out, 0, sizeof(lx_image) * 4);
     lx_status st = check(b, map_index, "its spherical harmonics");
     if (st != LX_OK)
@@ -104,6 +108,10 @@ lx_status lx_baker_sh(const lx_baker *b, uint32_t map_index, lx_image out[4])
 
 lx_status lx_baker_dominant(const lx_baker *b, uint32_t map_index, lx_image *out)
 {
+    if (!b)
+        return lx_fail_null(__func__, "baker");
+    if (!out)
+        return lx_fail_null(__func__, "out");
     memset(out, 0, sizeof *out);
     lx_status st = check(b, map_index, "its dominant direction");
     if (st != LX_OK)

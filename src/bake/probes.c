@@ -44,6 +44,8 @@ lx_probe_desc lx_probe_desc_defaults(const lx_probe_desc *desc)
 
 lx_status lx_probe_grid(lx_vec3 lo, lx_vec3 hi, int nx, int ny, int nz, lx_vec3 *out)
 {
+    if (!out)
+        return lx_fail_null(__func__, "out");
     if (nx < 1 || ny < 1 || nz < 1 || nx > LX_MAX_PROBE_GRID || ny > LX_MAX_PROBE_GRID ||
         nz > LX_MAX_PROBE_GRID)
         return lx_fail(LX_ERR_INVALID, "probe grid %dx%dx%d: each count must be 1..%d", nx, ny, nz,

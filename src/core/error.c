@@ -75,6 +75,11 @@ lx_status lx_fail(lx_status status, const char *fmt, ...)
     return status;
 }
 
+lx_status lx_fail_null(const char *function, const char *param)
+{
+    return lx_fail(LX_ERR_INVALID, "%s: %s is NULL", function, param);
+}
+
 void lx_error_prefix(const char *prefix)
 {
     char old[LX_ERROR_MAX];

@@ -39,6 +39,8 @@ static void advise_huge_pages(void *data, size_t bytes)
 
 lx_status lx_image_alloc(lx_image *img, int width, int height, int channels)
 {
+    if (!img)
+        return lx_fail_null(__func__, "img");
     memset(img, 0, sizeof *img);
     if (width < 1 || height < 1 || channels < 1 || channels > 4)
         return lx_fail(LX_ERR_INVALID,
@@ -276,6 +278,8 @@ lx_image_load_desc lx_image_load_desc_defaults(const lx_image_load_desc *desc)
 lx_status lx_image_load_memory(const void *bytes, size_t size, const char *name,
                                const lx_image_load_desc *desc, lx_image *out)
 {
+    if (!bytes)
+        return lx_fail_null(__func__, "bytes");
     if (!out)
         return lx_fail(LX_ERR_INVALID, "lx_image_load_memory: out is NULL");
     memset(out, 0, sizeof *out);

@@ -23,6 +23,10 @@
 /* Sets this thread's error message (printf format) and returns status. */
 lx_status lx_fail(lx_status status, const char *fmt, ...) LX_PRINTF(2, 3);
 
+/* LX_ERR_INVALID with "function: param is NULL" for a required pointer
+ * the caller left NULL (public entry points call it first of all). */
+lx_status lx_fail_null(const char *function, const char *param);
+
 /* Prefixes this thread's current error message with "prefix: ". */
 void lx_error_prefix(const char *prefix);
 

@@ -75,6 +75,8 @@ int lx_cube_mip_count(int size)
 
 lx_status lx_cubemap_alloc(lx_cubemap *c, int size)
 {
+    if (!c)
+        return lx_fail_null(__func__, "c");
     memset(c, 0, sizeof *c);
     if (size < 1 || size > LX_MAX_CUBE_SIZE)
         return lx_fail(LX_ERR_INVALID, "cube map size %d is outside 1..%d", size, LX_MAX_CUBE_SIZE);

@@ -256,6 +256,8 @@ static lx_status start(const lx_ibl_desc *in, lx_ibl_run *run)
 lx_status lx_cubemap_from_equirect(const lx_image *eq, int size, const lx_ibl_desc *in,
                                    lx_cubemap *out)
 {
+    if (!out)
+        return lx_fail_null(__func__, "out");
     memset(out, 0, sizeof *out);
     lx_ibl_run run;
     if (!image_ok(eq))
@@ -343,6 +345,8 @@ lx_status lx_ibl_cube_to_equirect(const lx_cubemap *c, int width, const lx_ibl_r
 lx_status lx_cubemap_to_equirect(const lx_cubemap *c, int width, const lx_ibl_desc *in,
                                  lx_image *out)
 {
+    if (!out)
+        return lx_fail_null(__func__, "out");
     memset(out, 0, sizeof *out);
     lx_ibl_run run;
     if (!c || !c->data || c->size < 1)
@@ -426,6 +430,8 @@ lx_status lx_ibl_cube_from_cross(const lx_image *cross, const lx_ibl_run *run, l
 
 lx_status lx_cubemap_from_cross(const lx_image *cross, const lx_ibl_desc *in, lx_cubemap *out)
 {
+    if (!out)
+        return lx_fail_null(__func__, "out");
     memset(out, 0, sizeof *out);
     lx_ibl_run run;
     if (!image_ok(cross))
@@ -460,6 +466,8 @@ lx_status lx_ibl_cube_to_cross(const lx_cubemap *c, bool vertical, const lx_ibl_
 lx_status lx_cubemap_to_cross(const lx_cubemap *c, bool vertical, const lx_ibl_desc *in,
                               lx_image *out)
 {
+    if (!out)
+        return lx_fail_null(__func__, "out");
     memset(out, 0, sizeof *out);
     lx_ibl_run run;
     if (!c || !c->data || c->size < 1 || c->size > LX_MAX_CUBE_SIZE)

@@ -247,13 +247,15 @@ lx_status lx_env_write(const char *folder, const char *stem, const lx_cubemap *l
                        const lx_env_write_desc *desc)
 {
     lx_env_write_desc d = lx_env_write_desc_defaults(desc);
+    if (!stem) /* a NULL stem is named first, as check_desc names it */
+        return check_desc(stem, count, &d);
+    if (!levels)
+        return lx_fail(LX_ERR_INVALID, "%s: no levels (NULL)", stem);
     if (!folder || !folder[0])
         return lx_fail(LX_ERR_INVALID, "environment output: no folder given");
     lx_status st = check_desc(stem, count, &d);
     if (st != LX_OK)
         return st;
-    if (!levels)
-        return lx_fail(LX_ERR_INVALID, "%s: no levels (NULL)", stem);
     int sizes[LX_MAX_CUBE_MIPS] = {0};
     for (int l = 0; l < count; l++) {
         char what[240];

@@ -362,6 +362,8 @@ lx_status lx_env_load(const char *path, const lx_env_load_desc *desc, lx_cubemap
 lx_status lx_env_from_image(const lx_image *img, const char *name, const lx_env_load_desc *desc,
                             lx_cubemap *out)
 {
+    if (!img)
+        return lx_fail_null(__func__, "img");
     if (out)
         memset(out, 0, sizeof *out);
     name = name ? name : "environment";
@@ -381,6 +383,8 @@ lx_status lx_env_from_image(const lx_image *img, const char *name, const lx_env_
 
 lx_status lx_env_constant(lx_vec3 radiance, int size, lx_cubemap *out)
 {
+    if (!out)
+        return lx_fail_null(__func__, "out");
     memset(out, 0, sizeof *out);
     if (!lx_vec3_finite(radiance) || radiance.x < 0.0f || radiance.y < 0.0f || radiance.z < 0.0f)
         return lx_fail(LX_ERR_INVALID,

@@ -9,6 +9,10 @@
 
 lx_status lx_temperature_to_xy(float kelvin, float *x, float *y)
 {
+    if (!x)
+        return lx_fail_null(__func__, "x");
+    if (!y)
+        return lx_fail_null(__func__, "y");
     if (!(kelvin >= LX_MIN_TEMPERATURE && kelvin <= LX_MAX_TEMPERATURE))
         return lx_fail(LX_ERR_INVALID, "colour temperature %g K is outside %g..%g K",
                        (double)kelvin, (double)LX_MIN_TEMPERATURE, (double)LX_MAX_TEMPERATURE);
@@ -25,6 +29,8 @@ lx_status lx_temperature_to_xy(float kelvin, float *x, float *y)
 
 lx_status lx_temperature_to_rgb(float kelvin, lx_vec3 *rgb)
 {
+    if (!rgb)
+        return lx_fail_null(__func__, "rgb");
     float xf, yf;
     lx_status st = lx_temperature_to_xy(kelvin, &xf, &yf);
     if (st != LX_OK)

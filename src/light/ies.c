@@ -415,6 +415,8 @@ static lx_status parse(lx_ies_profile *p, ies_reader *r)
 
 lx_status lx_ies_parse(const char *text, size_t size, const char *name, lx_ies_profile **out)
 {
+    if (!text)
+        return lx_fail_null(__func__, "text");
     if (!out)
         return lx_fail(LX_ERR_INVALID, "lx_ies_parse: out is NULL");
     *out = NULL;

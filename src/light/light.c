@@ -9,6 +9,7 @@
  * across lights). */
 #include "luxel/light.h"
 #include "core/internal.h"
+#include "light_internal.h"
 
 #include <math.h>
 #include <stdio.h>
@@ -239,6 +240,70 @@ static lx_status check_non_negative(const lx_light *light, const char *field, fl
     return LX_OK;
 }
 
+/* A value (already known finite) within [-limit, limit]. */
+static lx_status check_limit(const lx_light *light, const char *field, float v, float limit,
+                             const char *unit)
+{
+    char msg[200];
+    if (fabsf(v) > limit) {
+        snprintf(msg, sizeof msg, "%s %g %s is beyond %g %s (the largest luxel accepts)", field, v,
+                 unit, limit, unit);
+        return invalid(light, msg);
+    }
+    return LX_OK;
+}
+
+static lx_status check_vec_limit(const lx_light *light, const char *field, lx_vec3 v, float limit,
+                                 const char *unit)
+{
+    char msg[200];
+    if (fabsf(v.x) > limit || fabsf(v.y) > limit || fabsf(v.z) > limit) {
+        snprintf(msg, sizeof msg, "%s [%g, %g, %g] has a component beyond %g%s%s (the largest luxel accepts)",
+                 field, v.x, v.y, v.z, limit, unit[0] ? " " : "", unit);
+        return invalid(light, msg);
+    }
+    return LX_OK;
+}
+
+lx_status light_check_sizes(const lx_light *light)
+{
+    lx_status st;
+    const char *names[4] = {"radius", "length", "width", "height"};
+    const float sizes[4] = {light->radius, light->length, light->width, light->height};
+    for (int k = 0; k < 4; k++)
+        if (isfinite(sizes[k]) &&
+            (st = check_limit(light, names[k], sizes[k], LX_LIGHT_MAX_DISTANCE, "m")) != LX_OK)
+            return st;
+    return LX_OK;
+}
+
+/* The unit intensity is held in for this light (for messages). */
+static const char *native_unit(const lx_light *light)
+{
+    if (light->type == LX_LIGHT_DIRECTIONAL)
+        return "lx";
+    if (light->type == LX_LIGHT_TUBE && !(light->radius > 0.0f))
+        return "cd/m";
+    return lx_light_is_area(light) ? "nt" : "cd";
+}
+
+/* Values finite but absurd (LX_LIGHT_MAX_*, light.h says why): refused
+ * here, before a bake turns them into infinities. */
+static lx_status check_limits(const lx_light *light)
+{
+    lx_status st;
+    if ((st = check_vec_limit(light, "position", light->position, LX_LIGHT_MAX_DISTANCE, "m")) !=
+            LX_OK ||
+        (st = check_limit(light, "intensity", light->intensity, LX_LIGHT_MAX_INTENSITY,
+                          native_unit(light))) != LX_OK ||
+        (st = check_vec_limit(light, "color", light->color, LX_LIGHT_MAX_COLOR, "")) != LX_OK ||
+        (st = check_vec_limit(light, "ambient", light->ambient, LX_LIGHT_MAX_INTENSITY, "lx")) !=
+            LX_OK ||
+        (st = check_limit(light, "range", light->range, LX_LIGHT_MAX_DISTANCE, "m")) != LX_OK)
+        return st;
+    return light_check_sizes(light);
+}
+
 /* The area-light fields: sizes, the rect's up vector, soft shadows. */
 static lx_status validate_area(const lx_light *light)
 {
@@ -352,6 +417,8 @@ lx_status lx_light_validate(const lx_light *light)
         if (!(light->profile_scale >= 0.0f) || !isfinite(light->profile_scale))
             return invalid(light, "profile_scale must be finite and >= 0");
     }
+    if ((st = check_limits(light)) != LX_OK)
+        return st;
     return validate_area(light);
 }
 

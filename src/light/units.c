@@ -7,6 +7,7 @@
  * names. */
 #include "luxel/light.h"
 #include "core/internal.h"
+#include "light_internal.h"
 
 #include <math.h>
 #include <stdio.h>
@@ -126,8 +127,10 @@ lx_status lx_light_intensity_to_native(const lx_light *light, float value, lx_li
         *native = value;
         return LX_OK;
     }
-    if (lx_light_is_area(light))
-        return area_to_native(light, who, value, unit, native);
+    if (lx_light_is_area(light)) {
+        lx_status st = light_check_sizes(light);
+        return st != LX_OK ? st : area_to_native(light, who, value, unit, native);
+    }
     if (light->type != LX_LIGHT_POINT && light->type != LX_LIGHT_SPOT)
         return lx_fail(LX_ERR_INVALID, "%s: type %d is not a light type", who, (int)light->type);
     if (unit == LX_UNIT_NIT)
@@ -270,6 +273,8 @@ float lx_ev100_from_luminance(double average_luminance)
 
 lx_status lx_ev100_from_camera(float aperture, float shutter_seconds, float iso, float *ev100)
 {
+    if (!ev100)
+        return lx_fail_null(__func__, "ev100");
     if (!(aperture > 0.0f && isfinite(aperture)) ||
         !(shutter_seconds > 0.0f && isfinite(shutter_seconds)) || !(iso > 0.0f && isfinite(iso)))
         return lx_fail(LX_ERR_INVALID,

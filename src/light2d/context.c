@@ -28,6 +28,8 @@ lx_light2d_light lx_light2d_light_defaults(lx_light2d_type type)
 
 lx_status lx_light2d_light_validate(const lx_light2d_light *l)
 {
+    if (!l)
+        return lx_fail_null(__func__, "light");
     if (l->type != LX_LIGHT2D_POINT && l->type != LX_LIGHT2D_SPOT)
         return lx_fail(LX_ERR_INVALID, "type %d is neither point nor spot", (int)l->type);
     if (l->falloff < LX_FALLOFF2D_SMOOTH || l->falloff > LX_FALLOFF2D_NONE)
@@ -199,6 +201,8 @@ lx_status l2_build_edges(lx_light2d *ctx)
 lx_status lx_light2d_create(const lx_image *casters, const lx_light2d_desc *desc,
                             lx_light2d **out)
 {
+    if (!out)
+        return lx_fail_null(__func__, "out");
     *out = NULL;
     lx_light2d_desc d = lx_light2d_desc_defaults(desc);
     if (!casters || !casters->data || casters->width <= 0 || casters->height <= 0)
@@ -275,6 +279,8 @@ void lx_light2d_destroy(lx_light2d *ctx)
 
 lx_status lx_light2d_set_normals(lx_light2d *ctx, const lx_image *normals, bool green_down)
 {
+    if (!ctx)
+        return lx_fail_null(__func__, "ctx");
     if (!normals) {
         free(ctx->normals);
         ctx->normals = NULL;
@@ -334,6 +340,8 @@ static void light_box(const lx_light2d *ctx, const lx_light2d_light *l, int *x0,
 lx_status lx_light2d_update_casters(lx_light2d *ctx, const lx_image *casters, int x, int y,
                                     int w, int h)
 {
+    if (!ctx)
+        return lx_fail_null(__func__, "ctx");
     if (!casters || casters->width != ctx->width || casters->height != ctx->height)
         return lx_fail(LX_ERR_INVALID, "casters: the update is not %dx%d", ctx->width,
                        ctx->height);
@@ -397,6 +405,8 @@ static void prepare(const lx_light2d *ctx, l2_prep *p)
 
 lx_status lx_light2d_set_lights(lx_light2d *ctx, const lx_light2d_light *lights, int count)
 {
+    if (!ctx)
+        return lx_fail_null(__func__, "ctx");
     if (count < 0 || (count > 0 && !lights))
         return lx_fail(LX_ERR_INVALID, "light2d: %d lights and no array", count);
     for (int i = 0; i < count; i++) {

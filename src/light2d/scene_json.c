@@ -222,6 +222,8 @@ static void position_of(const char *text, size_t at, size_t *line, size_t *col)
 lx_status lx_light2d_scene_parse(const char *name, const char *text, size_t size,
                                  lx_light2d_scene *out)
 {
+    if (!out)
+        return lx_fail_null(__func__, "out");
     memset(out, 0, sizeof *out);
     jctx c = {.file = name ? name : "lights"};
     if (!text)
@@ -314,6 +316,10 @@ done:
 
 lx_status lx_light2d_scene_load(const char *path, lx_light2d_scene *out)
 {
+    if (!path)
+        return lx_fail_null(__func__, "path");
+    if (!out)
+        return lx_fail_null(__func__, "out");
     memset(out, 0, sizeof *out);
     char *text = NULL;
     size_t size = 0;

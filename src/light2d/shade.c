@@ -346,6 +346,11 @@ static void shade_band(const lx_light2d *ctx, const l2_prep *p, int y0, int y1, 
 lx_status lx_light2d_render(lx_light2d *ctx, lx_vec3 ambient, const lx_image *albedo, float *out,
                             float *light_map)
 {
+    if (!ctx)
+        return lx_fail_null(__func__, "ctx");
+    /* a frame with nowhere to go is a caller's mistake, not a no-op */
+    if (!out && !light_map)
+        return lx_fail(LX_ERR_INVALID, "%s: out and light_map are both NULL", __func__);
     int w = ctx->width, hgt = ctx->height;
     if (albedo) {
         if (albedo->width != w || albedo->height != hgt)

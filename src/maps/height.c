@@ -45,6 +45,8 @@ bool lx_wrap_parse(const char *name, lx_wrap *out)
 
 lx_status lx_height_load(const char *path, lx_image *out)
 {
+    if (!out)
+        return lx_fail_null(__func__, "out");
     memset(out, 0, sizeof *out);
     lx_image img;
     lx_image_load_desc d = {.raw_8bit = true};

@@ -50,6 +50,8 @@ static lx_vec3 face_dir(int face, float x, float y)
 
 lx_status lx_horizon_weight_cube(int size, lx_image *out)
 {
+    if (!out)
+        return lx_fail_null(__func__, "out");
     memset(out, 0, sizeof *out);
     if (size < 1 || size > 4096)
         return lx_fail(LX_ERR_INVALID, "horizon weight cube: size %d is not from 1 to 4096", size);

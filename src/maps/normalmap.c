@@ -281,6 +281,8 @@ lx_status lx_normal_encode(const lx_image *normals, lx_image *out)
 
 lx_status lx_normal_decode(const lx_image *encoded, const char *name, lx_image *out)
 {
+    if (!encoded)
+        return lx_fail_null(__func__, "encoded");
     if (!out)
         return lx_fail(LX_ERR_INVALID, "lx_normal_decode: out must not be NULL");
     memset(out, 0, sizeof *out);

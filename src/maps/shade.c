@@ -201,6 +201,8 @@ static bool finite3(const float *v)
 
 lx_status lx_shade(const lx_shade_desc *desc, lx_image *out)
 {
+    if (!desc)
+        return lx_fail_null(__func__, "desc");
     if (!out)
         return lx_fail(LX_ERR_INVALID, "shade: out must not be NULL");
     memset(out, 0, sizeof *out);

@@ -10,6 +10,10 @@
 
 lx_status lx_compute_tangents(const lx_mesh *mesh, int uv_set, lx_vec4 *out)
 {
+    if (!mesh)
+        return lx_fail_null(__func__, "mesh");
+    if (!out)
+        return lx_fail_null(__func__, "out");
     if (uv_set < 0 || uv_set >= LX_MAX_UV_SETS || !mesh->uv[uv_set])
         return lx_fail(LX_ERR_INVALID, "mesh '%s': no TEXCOORD_%d for tangents",
                        mesh->name ? mesh->name : "?", uv_set);

@@ -38,6 +38,8 @@ static lx_vec3 up_hint(lx_vec3 fwd, lx_vec3 up)
 
 lx_status lx_camera_check(const lx_camera *cam)
 {
+    if (!cam)
+        return lx_fail_null(__func__, "cam");
     if (!lx_vec3_finite(cam->eye) || !lx_vec3_finite(cam->target) || !lx_vec3_finite(cam->up) ||
         !isfinite(cam->fov) || !isfinite(cam->ortho_height))
         return lx_fail(LX_ERR_INVALID, "camera: eye, target, up and fov must be finite");

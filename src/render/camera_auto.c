@@ -119,6 +119,10 @@ static float score(const view_probe *v, bool use_light, double lit, float *of_hi
 lx_status lx_camera_auto(const lx_scene *scene, const lx_lightmaps *lm, const lx_tracer *tracer,
                          float fov, float aspect, lx_camera *out, lx_camera_auto_info *info)
 {
+    if (!scene)
+        return lx_fail_null(__func__, "scene");
+    if (!out)
+        return lx_fail_null(__func__, "out");
     lx_camera_auto_info local;
     if (!info)
         info = &local;

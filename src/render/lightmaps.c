@@ -380,6 +380,10 @@ static lx_status load_directional(const char *manifest, const lx_lightmaps *lm, 
 
 lx_status lx_lightmaps_load(const char *dir, const lx_lightmaps_load_desc *desc, lx_lightmaps *out)
 {
+    if (!out)
+        return lx_fail_null(__func__, "out");
+    if (!dir)
+        return lx_fail_null(__func__, "dir");
     memset(out, 0, sizeof *out);
     lx_lightmaps_load_desc d = lx_lightmaps_load_desc_defaults(desc);
     if (!dir || !dir[0])
@@ -513,5 +517,9 @@ lx_status lx_lightmaps_bind(const lx_lightmaps *lm, const lx_scene *scene, uint3
 
 lx_status lx_lightmaps_check(const lx_lightmaps *lm, const lx_scene *scene)
 {
+    if (!lm)
+        return lx_fail_null(__func__, "lm");
+    if (!scene)
+        return lx_fail_null(__func__, "scene");
     return lx_lightmaps_bind(lm, scene, NULL);
 }

@@ -381,6 +381,12 @@ static lx_status check_desc(const lx_render_desc *d)
 lx_status lx_render_view(const lx_scene *scene, const lx_lightmaps *lm, const lx_tracer *tracer,
                          const lx_render_desc *desc, lx_image *out)
 {
+    if (!lm)
+        return lx_fail_null(__func__, "lm");
+    if (!out)
+        return lx_fail_null(__func__, "out");
+    if (!scene)
+        return lx_fail_null(__func__, "scene");
     return lx_render_view_quiet(scene, lm, tracer, desc, out, false);
 }
 

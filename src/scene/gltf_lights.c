@@ -326,6 +326,8 @@ lx_status lx_gltf_lights_from_json(lx_scene *scene, const char *file, const cJSO
 lx_status lx_gltf_lights_load_memory(lx_scene *scene, const void *bytes, size_t size,
                                      const char *name)
 {
+    if (!bytes)
+        return lx_fail_null(__func__, "bytes");
     const char *file = name && name[0] ? name : "glTF";
     if (!scene)
         return failf(file, LX_ERR_INVALID, "no scene to add the lights to");

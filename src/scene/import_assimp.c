@@ -1532,6 +1532,10 @@ lx_scene_load_desc lx_scene_load_desc_defaults(const lx_scene_load_desc *desc)
 
 lx_status lx_scene_load(const char *path, const lx_scene_load_desc *in, lx_scene **out)
 {
+    if (!path)
+        return lx_fail_null(__func__, "path");
+    if (!out)
+        return lx_fail_null(__func__, "out");
     *out = NULL;
     lx_scene_load_desc defaults = lx_scene_load_desc_defaults(in);
     const lx_scene_load_desc *desc = &defaults;

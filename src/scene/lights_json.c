@@ -716,6 +716,8 @@ static lx_status apply_root(lx_scene *scene, const cJSON *root, const char *file
 lx_status lx_lights_json_apply_text(lx_scene *scene, const char *text, size_t size,
                                     const char *name)
 {
+    if (!text)
+        return lx_fail_null(__func__, "text");
     const char *file = name && name[0] ? name : "lights.json";
     if (!scene)
         return lx_fail(LX_ERR_INVALID, "%s: no scene to apply the lights to", file);
@@ -732,6 +734,8 @@ lx_status lx_lights_json_apply_text(lx_scene *scene, const char *text, size_t si
 
 lx_status lx_lights_json_apply(lx_scene *scene, const char *path)
 {
+    if (!scene)
+        return lx_fail_null(__func__, "scene");
     if (!path)
         return lx_fail(LX_ERR_INVALID, "lights JSON: no path");
     char *text;

@@ -42,6 +42,8 @@ static lx_status grow(void **array, uint32_t *capacity, uint32_t count, size_t e
 
 lx_status lx_scene_create(const char *name, lx_scene **out)
 {
+    if (!out)
+        return lx_fail_null(__func__, "out");
     *out = NULL;
     scene_store *store = calloc(1, sizeof *store);
     if (!store || !(store->scene.path = lx_strdup(name ? name : "scene"))) {
@@ -207,6 +209,10 @@ static lx_status validate_mesh(const lx_scene *s, const lx_mesh *m, const char *
 
 lx_status lx_scene_add_mesh(lx_scene *s, const lx_mesh *src, uint32_t *index)
 {
+    if (!s)
+        return lx_fail_null(__func__, "scene");
+    if (!src)
+        return lx_fail_null(__func__, "mesh");
     char fallback[32];
     snprintf(fallback, sizeof fallback, "mesh%u", s->mesh_count);
     const char *name = src->name && src->name[0] ? src->name : fallback;
@@ -249,6 +255,10 @@ lx_status lx_scene_add_mesh(lx_scene *s, const lx_mesh *src, uint32_t *index)
 
 lx_status lx_scene_add_material(lx_scene *s, const lx_material *src, uint32_t *index)
 {
+    if (!s)
+        return lx_fail_null(__func__, "scene");
+    if (!src)
+        return lx_fail_null(__func__, "material");
     lx_status st = grow((void **)&s->materials, &store_of(s)->material_capacity, s->material_count,
                         sizeof(lx_material), "materials");
     if (st != LX_OK)
@@ -288,6 +298,13 @@ lx_status lx_scene_add_material(lx_scene *s, const lx_material *src, uint32_t *i
 lx_status lx_scene_add_node(lx_scene *s, const char *name, const lx_mat4 *world,
                             const uint32_t *meshes, uint32_t mesh_count, uint32_t *index)
 {
+    if (!s)
+        return lx_fail_null(__func__, "scene");
+    if (!world)
+        return lx_fail_null(__func__, "world");
+    if (mesh_count > 0 && !meshes)
+        return lx_fail(LX_ERR_INVALID, "%s: meshes is NULL with mesh_count %u", __func__,
+                       mesh_count);
     if (!name || !name[0])
         return lx_fail(LX_ERR_INVALID, "%s: a node needs a name", s->path);
     for (uint32_t i = 0; i < s->node_count; i++)
@@ -326,6 +343,8 @@ lx_status lx_scene_add_node(lx_scene *s, const char *name, const lx_mat4 *world,
 
 lx_status lx_scene_add_light(lx_scene *s, const lx_light *light)
 {
+    if (!s)
+        return lx_fail_null(__func__, "scene");
     lx_status st = lx_light_validate(light);
     if (st != LX_OK) {
         lx_error_prefix(s->path);
@@ -347,6 +366,10 @@ lx_status lx_scene_add_light(lx_scene *s, const lx_light *light)
 
 lx_status lx_scene_add_camera(lx_scene *s, const lx_scene_camera *camera)
 {
+    if (!s)
+        return lx_fail_null(__func__, "scene");
+    if (!camera)
+        return lx_fail_null(__func__, "camera");
     const lx_scene_camera *c = camera;
     const char *who = c->name && c->name[0] ? c->name : "(unnamed)";
     if (!lx_vec3_finite(c->eye) || !lx_vec3_finite(c->forward) || !lx_vec3_finite(c->up) ||
@@ -390,6 +413,8 @@ lx_status lx_scene_add_camera(lx_scene *s, const lx_scene_camera *camera)
 
 lx_status lx_scene_adopt_profile(lx_scene *s, lx_ies_profile *profile)
 {
+    if (!s)
+        return lx_fail_null(__func__, "scene");
     lx_status st = grow((void **)&s->profiles, &store_of(s)->profile_capacity, s->profile_count,
                         sizeof(lx_ies_profile *), "photometric profiles");
     if (st != LX_OK)

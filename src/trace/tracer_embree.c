@@ -121,6 +121,10 @@ static bool on_build_progress(void *ptr, double n)
 
 lx_status lx_tracer_create(const lx_scene *scene, const lx_tracer_desc *in, lx_tracer **out)
 {
+    if (!scene)
+        return lx_fail_null(__func__, "scene");
+    if (!out)
+        return lx_fail_null(__func__, "out");
     *out = NULL;
     embree_error[0] = '\0';
     lx_tracer_desc desc = lx_tracer_desc_defaults(in);
@@ -240,6 +244,10 @@ void lx_tracer_destroy(lx_tracer *tr)
 
 lx_status lx_tracer_set_node_transform(lx_tracer *tr, uint32_t node, const lx_mat4 *world)
 {
+    if (!tr)
+        return lx_fail_null(__func__, "tracer");
+    if (!world)
+        return lx_fail_null(__func__, "world");
     if (node >= tr->node_count)
         return lx_fail(LX_ERR_INVALID, "node %u out of range (count %u)", node, tr->node_count);
     if (!lx_mat4_finite(world) || !(fabsf(lx_mat4_det3(world)) > 1e-20f))
@@ -257,6 +265,8 @@ lx_status lx_tracer_set_node_transform(lx_tracer *tr, uint32_t node, const lx_ma
 
 lx_status lx_tracer_commit(lx_tracer *tr)
 {
+    if (!tr)
+        return lx_fail_null(__func__, "tracer");
     rtcCommitScene(tr->scene);
     return embree_status("tracer");
 }

@@ -13,6 +13,12 @@ static bool same_uv(lx_vec2 a, lx_vec2 b)
 
 lx_status lx_uv_seams(const lx_mesh *mesh, int uv_set, lx_uv_seam **out, uint32_t *count)
 {
+    if (!mesh)
+        return lx_fail_null(__func__, "mesh");
+    if (!out)
+        return lx_fail_null(__func__, "out");
+    if (!count)
+        return lx_fail_null(__func__, "count");
     *out = NULL;
     *count = 0;
     if (uv_set < 0 || uv_set >= LX_MAX_UV_SETS || !mesh->uv[uv_set])

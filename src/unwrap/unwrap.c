@@ -622,6 +622,10 @@ static lx_status emit_mesh(const lx_scene *scene, const plan *p, uint32_t node, 
 
 lx_status lx_unwrap_scene(const lx_scene *scene, const lx_unwrap_desc *desc, lx_unwrap **out)
 {
+    if (!scene)
+        return lx_fail_null(__func__, "scene");
+    if (!out)
+        return lx_fail_null(__func__, "out");
     *out = NULL;
     lx_unwrap_desc d = lx_unwrap_desc_defaults(desc);
     lx_status st = check_desc(scene, &d);
@@ -793,6 +797,10 @@ fail:
 
 lx_status lx_unwrap_apply(lx_scene *scene, const lx_unwrap *u)
 {
+    if (!scene)
+        return lx_fail_null(__func__, "scene");
+    if (!u)
+        return lx_fail_null(__func__, "unwrap");
     if (u->node_count != scene->node_count)
         return lx_fail(LX_ERR_INVALID, "%s: the unwrap places %u nodes, the scene has %u",
                        scene->path, u->node_count, scene->node_count);

@@ -506,6 +506,10 @@ static lx_status health_of(const hmesh *meshes, uint32_t mesh_count, int uv_set,
 lx_status lx_uv_health_mesh(const lx_mesh *mesh, int uv_set, const lx_uv_health_desc *desc,
                             lx_uv_health *out)
 {
+    if (!mesh)
+        return lx_fail_null(__func__, "mesh");
+    if (!out)
+        return lx_fail_null(__func__, "out");
     hmesh m = {mesh, NULL};
     return health_of(&m, 1, uv_set, desc, false, out);
 }
@@ -513,6 +517,10 @@ lx_status lx_uv_health_mesh(const lx_mesh *mesh, int uv_set, const lx_uv_health_
 lx_status lx_uv_health_node(const lx_scene *scene, uint32_t node, int uv_set,
                             const lx_uv_health_desc *desc, lx_uv_health *out)
 {
+    if (!scene)
+        return lx_fail_null(__func__, "scene");
+    if (!out)
+        return lx_fail_null(__func__, "out");
     memset(out, 0, sizeof *out);
     if (node >= scene->node_count)
         return lx_fail(LX_ERR_INVALID, "%s: node %u out of range (count %u)", scene->path, node,

@@ -98,9 +98,45 @@ static void dilate_rejects_bad_channel_counts(void **state)
     assert_true(data[8] == 0.0f);
 }
 
+/* Light values beyond luxel's limits (LX_LIGHT_MAX_*, light.h) fail up
+ * front naming the scene and the light: added through the API
+ * (lx_scene_add_light) or written into the scene's array afterwards
+ * (lx_baker_create checks again); the limits themselves are accepted. */
+static void absurd_lights_fail_up_front(void **state)
+{
+    (void)state;
+    lx_scene *scene = plane_scene(1.0f, 0.0f);
+    lx_light lamp = lx_light_defaults(LX_LIGHT_POINT);
+    strcpy(lamp.name, "lamp");
+    lamp.position = lx_v3(0, 1, 0);
+    lamp.intensity = LX_LIGHT_MAX_INTENSITY;
+    lamp.range = LX_LIGHT_MAX_DISTANCE;
+    assert_int_equal(lx_light_validate(&lamp), LX_OK);
+    lamp.intensity = nextafterf(LX_LIGHT_MAX_INTENSITY, INFINITY);
+    assert_int_equal(lx_light_validate(&lamp), LX_ERR_INVALID);
+    lamp.intensity = 1e38f;
+    assert_int_equal(lx_scene_add_light(scene, &lamp), LX_ERR_INVALID);
+    assert_non_null(strstr(lx_last_error(), "'lamp'"));
+    assert_non_null(strstr(lx_last_error(), "intensity"));
+
+    scene->lights[0].intensity = 1e38f; /* the sun, past the check of add_light */
+    lx_baker *baker = NULL;
+    lx_bake_desc desc = {.resolution = 8};
+    assert_int_equal(lx_baker_create(scene, &desc, &baker), LX_ERR_INVALID);
+    assert_null(baker);
+    assert_non_null(strstr(lx_last_error(), "limits: "));
+    assert_non_null(strstr(lx_last_error(), "intensity 1e+38 lx"));
+    scene->lights[0].intensity = 1000.0f;
+    scene->lights[0].color = lx_v3(1, 1, nextafterf(LX_LIGHT_MAX_COLOR, INFINITY));
+    assert_int_equal(lx_baker_create(scene, &desc, &baker), LX_ERR_INVALID);
+    assert_non_null(strstr(lx_last_error(), "color"));
+    lx_scene_destroy(scene);
+}
+
 int main(void)
 {
     const struct CMUnitTest tests[] = {
+        cmocka_unit_test(absurd_lights_fail_up_front),
         cmocka_unit_test(huge_scale_keeps_normals),
         cmocka_unit_test(far_uvs_cover_nothing),
         cmocka_unit_test(density_beyond_int_caps),

@@ -191,6 +191,26 @@ expect_files() {
 # The magic bytes of a file, as lowercase hex without spaces.
 magic() { head -c "$2" "$1" | od -An -tx1 | tr -d ' \n'; }
 
+# as_user_setup DIR: for tests that need luxel run by an unprivileged user
+# (root reads and writes anything). The build and WORK may live where that
+# user cannot go (a checkout in root's 0700 home), so the real binary (not
+# the --bounces wrapper, which points back into the build) is copied into
+# DIR, a fresh folder made traversable, with the shared libluxel it links
+# to when there is one, and DIR/as_user runs it as nobody (65534). Returns
+# 1 when that user cannot run it (no setpriv, no permission to switch).
+as_user_setup() {
+    local dir=$1 lib
+    chmod 755 "$dir" || return 1
+    cp "$LUXEL_REAL" "$dir/luxel" || return 1
+    # a libluxel.so found through the build's RPATH would be out of reach
+    for lib in $(ldd "$LUXEL_REAL" 2>/dev/null | awk '/libluxel/ { print $3 }'); do
+        cp "$lib" "$dir/" || return 1
+    done
+    printf '#!/bin/sh\nLD_LIBRARY_PATH=%s exec setpriv --reuid=65534 --regid=65534 --clear-groups %s "$@"\n' \
+        "$dir" "$dir/luxel" >"$dir/as_user" && chmod 755 "$dir/as_user" || return 1
+    "$dir/as_user" --version >/dev/null 2>&1
+}
+
 # Little-endian float32 bytes as printf escapes, for the handful of exactly
 # representable values the hand-written glTF buffers use (IEEE 754 binary32).
 f32() {
