@@ -24,12 +24,10 @@
 
 int LLVMFuzzerTestOneInput(const uint8_t *data, size_t size);
 
-/* Deepest hierarchy the harness generates (free nodes plus chain). assimp
- * recurses once per level before luxel's own depth check runs, so until
- * the up-front check on the file (issue 27) lands, deeper inputs would
- * crash assimp rather than luxel's code; raise this past the importer's
- * limit (to ~30000) once that check is in. */
-#define FUZZ_MAX_DEPTH 200
+/* Deepest hierarchy the harness generates (free nodes plus chain): far
+ * past the 256 levels lx_scene_load accepts, so the up-front check
+ * (scene/import_checks.c) is what stops deep inputs before assimp. */
+#define FUZZ_MAX_DEPTH 30000
 
 #define FREE_NODES_MAX 32
 
