@@ -76,39 +76,6 @@ static lx_status judge_graph(const char *path, const node_graph *g, node_namer n
 
 /* ---- glTF ------------------------------------------------------------------ */
 
-static void name_gltf2(const void *user, uint32_t node, char *buf, size_t size)
-{
-    lx_gltf_label(buf, size, "node", node, cJSON_GetArrayItem(user, (int)node));
-}
-
-/* "children" by index; entries that name no node are the readers' to
- * report. (One parent each is glTF's rule, checked with the transforms
- * where lights and cameras are placed; a subtree listed twice is counted
- * twice here, as assimp copies it.) */
-static lx_status check_gltf2(const char *path, const cJSON *gltf)
-{
-    const cJSON *nodes = lx_gltf_get(gltf, "nodes");
-    if (!cJSON_IsArray(nodes))
-        return LX_OK;
-    node_graph g = {.nodes = (size_t)cJSON_GetArraySize(nodes)};
-    lx_status st = LX_OK;
-    uint32_t i = 0;
-    for (const cJSON *n = nodes->child; n && st == LX_OK; n = n->next, i++) {
-        const cJSON *children = lx_gltf_get(n, "children");
-        for (const cJSON *c = cJSON_IsArray(children) ? children->child : NULL; c; c = c->next) {
-            size_t k;
-            if (lx_gltf_index(c, g.nodes, &k) && !node_graph_add_edge(&g, i, (uint32_t)k)) {
-                st = lx_fail(LX_ERR_NOMEM, "%s: out of memory for the node hierarchy", path);
-                break;
-            }
-        }
-    }
-    if (st == LX_OK)
-        st = judge_graph(path, &g, name_gltf2, nodes);
-    node_graph_free(&g);
-    return st;
-}
-
 /* glTF 1.0 names its nodes by id: "nodes": {"id": {"children": ["id"]}}. */
 typedef struct named_node {
     const char *id;
@@ -120,47 +87,83 @@ static int by_id(const void *a, const void *b)
     return strcmp(((const named_node *)a)->id, ((const named_node *)b)->id);
 }
 
-static void name_gltf1(const void *user, uint32_t node, char *buf, size_t size)
+/* The glTF nodes ("nodes": an array in 2.0, an object by id in 1.0) and
+ * how a "children" entry names one. */
+typedef struct gltf_nodes {
+    const cJSON *nodes;
+    size_t count;
+    const named_node *ids; /* 1.0: sorted by id; NULL for 2.0 */
+} gltf_nodes;
+
+/* The node a "children" entry names, or false: entries that name no node
+ * are the readers' to report. */
+static bool gltf_child(const gltf_nodes *n, const cJSON *entry, uint32_t *out)
 {
-    const cJSON *nodes = user;
-    const cJSON *n = nodes->child;
-    for (uint32_t i = 0; n && i < node; i++)
-        n = n->next;
-    snprintf(buf, size, "node '%.100s'", n && n->string ? n->string : "?");
+    size_t k;
+    if (!n->ids) {
+        if (!lx_gltf_index(entry, n->count, &k))
+            return false;
+        *out = (uint32_t)k;
+        return true;
+    }
+    if (!cJSON_IsString(entry))
+        return false;
+    named_node key = {entry->valuestring, 0};
+    const named_node *hit = bsearch(&key, n->ids, n->count, sizeof *n->ids, by_id);
+    if (hit)
+        *out = hit->index;
+    return hit != NULL;
 }
 
-static lx_status check_gltf1(const char *path, const cJSON *gltf)
+static void name_gltf(const void *user, uint32_t node, char *buf, size_t size)
 {
-    const cJSON *nodes = lx_gltf_get(gltf, "nodes");
-    if (!cJSON_IsObject(nodes))
-        return LX_OK; /* assimp refuses what is malformed; no hierarchy to walk */
-    node_graph g = {0};
-    for (const cJSON *n = nodes->child; n; n = n->next)
-        g.nodes++;
-    named_node *ids = malloc((g.nodes ? g.nodes : 1) * sizeof *ids);
-    if (!ids)
-        return lx_fail(LX_ERR_NOMEM, "%s: out of memory for %zu nodes", path, g.nodes);
-    uint32_t i = 0;
-    for (const cJSON *n = nodes->child; n; n = n->next, i++)
-        ids[i] = (named_node){n->string ? n->string : "", i};
-    qsort(ids, g.nodes, sizeof *ids, by_id);
+    const gltf_nodes *n = user;
+    const cJSON *it = n->nodes->child;
+    for (uint32_t i = 0; it && i < node; i++)
+        it = it->next;
+    if (n->ids)
+        snprintf(buf, size, "node '%.100s'", it && it->string ? it->string : "?");
+    else
+        lx_gltf_label(buf, size, "node", node, it);
+}
+
+/* "children", glTF 2.0 by index and 1.0 by id. (One parent each is
+ * glTF's rule, checked with the transforms where lights and cameras are
+ * placed; a subtree listed twice is counted twice here, as assimp copies
+ * it.) */
+static lx_status check_gltf(const char *path, const cJSON *gltf)
+{
+    gltf_nodes n = {.nodes = lx_gltf_get(gltf, "nodes")};
+    bool v2 = lx_gltf_is_v2(gltf);
+    if (v2 ? !cJSON_IsArray(n.nodes) : !cJSON_IsObject(n.nodes))
+        return LX_OK; /* no hierarchy to walk; the readers report what is malformed */
+    for (const cJSON *it = n.nodes->child; it; it = it->next)
+        n.count++;
+    named_node *ids = NULL;
+    if (!v2) {
+        if (!(ids = malloc((n.count ? n.count : 1) * sizeof *ids)))
+            return lx_fail(LX_ERR_NOMEM, "%s: out of memory for %zu nodes", path, n.count);
+        uint32_t i = 0;
+        for (const cJSON *it = n.nodes->child; it; it = it->next, i++)
+            ids[i] = (named_node){it->string ? it->string : "", i};
+        qsort(ids, n.count, sizeof *ids, by_id);
+        n.ids = ids;
+    }
+    node_graph g = {.nodes = n.count};
     lx_status st = LX_OK;
-    i = 0;
-    for (const cJSON *n = nodes->child; n && st == LX_OK; n = n->next, i++) {
-        const cJSON *children = lx_gltf_get(n, "children");
+    uint32_t i = 0;
+    for (const cJSON *it = n.nodes->child; it && st == LX_OK; it = it->next, i++) {
+        const cJSON *children = lx_gltf_get(it, "children");
         for (const cJSON *c = cJSON_IsArray(children) ? children->child : NULL; c; c = c->next) {
-            if (!cJSON_IsString(c))
-                continue;
-            named_node key = {c->valuestring, 0};
-            const named_node *hit = bsearch(&key, ids, g.nodes, sizeof *ids, by_id);
-            if (hit && !node_graph_add_edge(&g, i, hit->index)) {
+            uint32_t k;
+            if (gltf_child(&n, c, &k) && !node_graph_add_edge(&g, i, k)) {
                 st = lx_fail(LX_ERR_NOMEM, "%s: out of memory for the node hierarchy", path);
                 break;
             }
         }
     }
     if (st == LX_OK)
-        st = judge_graph(path, &g, name_gltf1, nodes);
+        st = judge_graph(path, &g, name_gltf, &n);
     free(ids);
     node_graph_free(&g);
     return st;
@@ -783,7 +786,7 @@ static bool ends_with(const char *path, const char *ext)
 lx_status import_check_hierarchy(const char *path, const cJSON *gltf)
 {
     if (gltf)
-        return lx_gltf_is_v2(gltf) ? check_gltf2(path, gltf) : check_gltf1(path, gltf);
+        return check_gltf(path, gltf);
     if (ends_with(path, ".dae"))
         return check_collada(path);
     if (ends_with(path, ".fbx"))
