@@ -1,0 +1,111 @@
+# cases: gltf_sparse
+# End-to-end tests of inputs that ask for more memory than they are worth
+# (issue 27, "memory taken before it is checked"): a few bytes of file
+# that would make luxel or a decoder it calls allocate gigabytes must fail
+# up front, before the allocation, with one line naming the file and the
+# size asked, exit 1 and no output, and the run's peak memory stays small.
+# The cases run under an address-space limit (ulimit -v), which the
+# library counts as the memory it may use, so they fail the same on any
+# machine; a build that cannot run under such a limit (a sanitizer's)
+# reports them skipped, as test_cli_limits.sh does.
+#
+# usage: bash test_cli_input_memory.sh LUXEL GEN_SCENES WORKDIR CASE
+set -u
+. "$(dirname "${BASH_SOURCE[0]}")/common.sh" "$@"
+
+IN=$WORK/in
+mkdir -p "$IN"
+LIMIT_KIB=2097152 # 2 GiB of address space
+PEAK_KIB=0
+
+# limited CMD ARGS...: runs the command under the address-space limit,
+# with its peak resident memory in PEAK_KIB (from /usr/bin/time when the
+# machine has it, else 0 and the RSS checks are skipped).
+limited() {
+    local peak=$WORK/.peak
+    rm -f "$peak"
+    if [ -x /usr/bin/time ]; then
+        run /usr/bin/time -f %M -o "$peak" bash -c 'ulimit -v "$0" && exec "$@"' "$LIMIT_KIB" "$@"
+        PEAK_KIB=$(tail -n 1 "$peak" 2>/dev/null)
+    else
+        run bash -c 'ulimit -v "$0" && exec "$@"' "$LIMIT_KIB" "$@"
+        PEAK_KIB=0
+    fi
+}
+
+# expect_peak_below DESCRIPTION MIB: the last limited run's peak RSS.
+expect_peak_below() {
+    if [ ! -x /usr/bin/time ]; then
+        skip "$1: no /usr/bin/time to measure the peak memory"
+    elif [ "${PEAK_KIB:-0}" -lt $(($2 * 1024)) ] 2>/dev/null; then
+        pass "$1: peak memory $((PEAK_KIB / 1024)) MiB, below $2 MiB"
+    else
+        fail "$1: peak memory ${PEAK_KIB:-?} KiB, want below $2 MiB"
+    fi
+}
+
+if ! bash -c 'ulimit -v "$0" && exec "$@"' "$LIMIT_KIB" "$LUXEL" --version >/dev/null 2>&1; then
+    skip "luxel cannot run with a 2 GiB address-space limit (sanitizer build?)"
+    finish
+fi
+
+case $CASE_NAME in
+gltf_sparse)
+    # One triangle's worth of sparse values on an accessor of 30M VEC3
+    # floats without a bufferView: 360 MB of zeros assimp would fill, and
+    # about 2 GB it takes doing so (measured), from ~1 KB of JSON.
+    {
+        printf '\x00\x00\x00\x00\x01\x00\x00\x00\x02\x00\x00\x00' # indices 0 1 2
+        for v in 0 0 0 1 0 0 0 1 0; do f32 "$v"; done
+    } >"$IN/sparse.bin"
+    sparse_gltf() { # sparse_gltf COUNT SPARSE_COUNT
+        cat <<JSON
+{
+  "asset": {"version": "2.0", "generator": "luxel tests/cli"},
+  "scene": 0, "scenes": [{"nodes": [0]}],
+  "nodes": [{"name": "zeros", "mesh": 0}],
+  "meshes": [{"primitives": [{"attributes": {"POSITION": 0}, "mode": 4}]}],
+  "accessors": [
+    {"componentType": 5126, "count": $1, "type": "VEC3", "min": [0, 0, 0], "max": [1, 1, 0],
+     "sparse": {"count": $2, "indices": {"bufferView": 0, "componentType": 5125},
+                "values": {"bufferView": 1}}}],
+  "bufferViews": [
+    {"buffer": 0, "byteOffset": 0, "byteLength": 12},
+    {"buffer": 0, "byteOffset": 12, "byteLength": 36}],
+  "buffers": [{"uri": "sparse.bin", "byteLength": 48}]
+}
+JSON
+    }
+    sparse_gltf 30000000 3 >"$IN/sparse.gltf"
+    for cmd in bake unwrap; do
+        out=$WORK/out_$cmd
+        [ $cmd = unwrap ] && out=$out.glb
+        limited "$LUXEL" $cmd "$IN/sparse.gltf" -q -o "$out"
+        expect_rc 1 "$cmd: 30M elements without a bufferView"
+        expect_error "$cmd: 30M elements without a bufferView" "sparse.gltf" "accessor 0" \
+            "30000000 elements" "GiB of memory"
+        expect_no_output "$cmd: 30M elements without a bufferView" "$out"
+        expect_peak_below "$cmd: 30M elements without a bufferView" 256
+    done
+    # a sparse block larger than its accessor is malformed, whatever the memory
+    sparse_gltf 2 3 >"$IN/over.gltf"
+    run "$LUXEL" bake "$IN/over.gltf" -q -o "$WORK/out_over"
+    expect_rc 1 "sparse count 3 on an accessor of 2"
+    expect_error "sparse count 3 on an accessor of 2" "over.gltf" "accessor 0" \
+        "sparse count 3 is more than the accessor's count 2"
+    expect_no_output "sparse count 3 on an accessor of 2" "$WORK/out_over"
+    # its indices must lie in their bufferView: 3 uint32 do not fit in 12 bytes at offset 4
+    sparse_gltf 30 3 | sed 's/"componentType": 5125}/"componentType": 5125, "byteOffset": 4}/' \
+        >"$IN/short.gltf"
+    run "$LUXEL" bake "$IN/short.gltf" -q -o "$WORK/out_short"
+    expect_rc 1 "sparse indices past their bufferView"
+    expect_error "sparse indices past their bufferView" "short.gltf" "accessor 0" \
+        "sparse indices: 4 bytes past the end of bufferView 0"
+    expect_no_output "sparse indices past their bufferView" "$WORK/out_short"
+    ;;
+*)
+    fail "unknown case '$CASE_NAME'"
+    ;;
+esac
+
+finish
