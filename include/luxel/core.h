@@ -123,13 +123,21 @@ typedef struct lx_image_load_desc {
     bool keep_nonfinite; /* keep NaN and infinite values (the caller checks
                             them, e.g. to count them); default: fail on the
                             first one */
+    uint64_t max_pixels; /* refuse an image of more pixels (width * height)
+                            than this, from its header, before decoding;
+                            0 = no cap but the memory */
 } lx_image_load_desc;
 
 /* A copy of desc (or of zeros when NULL) with every default filled in. */
 lx_image_load_desc lx_image_load_desc_defaults(const lx_image_load_desc *desc);
 
 /* Loads PNG/JPEG/TGA/HDR (stb_image), PFM and EXR. desc may be NULL.
- * On failure *out is zeroed. */
+ * On failure *out is zeroed. The size in the file's header is checked
+ * before anything is decoded: against desc->max_pixels
+ * (LX_ERR_UNSUPPORTED) and against the memory the process may use for
+ * the decoder's buffer, the image and its channel conversion together
+ * (LX_ERR_NOMEM); either message names the file, its width x height and
+ * (for memory) the bytes asked. */
 lx_status lx_image_load(const char *path, const lx_image_load_desc *desc, lx_image *out);
 /* Same from memory; name is used in messages. */
 lx_status lx_image_load_memory(const void *bytes, size_t size, const char *name,

@@ -1,4 +1,4 @@
-# cases: gltf_sparse
+# cases: gltf_sparse texture ibl_image light2d_image
 # End-to-end tests of inputs that ask for more memory than they are worth
 # (issue 27, "memory taken before it is checked"): a few bytes of file
 # that would make luxel or a decoder it calls allocate gigabytes must fail
@@ -48,6 +48,24 @@ if ! bash -c 'ulimit -v "$0" && exec "$@"' "$LIMIT_KIB" "$LUXEL" --version >/dev
     skip "luxel cannot run with a 2 GiB address-space limit (sanitizer build?)"
     finish
 fi
+
+# big_png FILE WIDTH HEIGHT: an 8-bit RGB PNG whose header claims
+# WIDTH x HEIGHT, with an empty (valid) zlib stream for its data: what the
+# size check reads is the header, before anything is decoded. (Neither stb
+# nor luxel reads the chunks' CRCs, left zero here.)
+be32() { printf "\\x%02x\\x%02x\\x%02x\\x%02x" $(($1 >> 24 & 255)) $(($1 >> 16 & 255)) \
+    $(($1 >> 8 & 255)) $(($1 & 255)); }
+big_png() {
+    {
+        printf '\x89PNG\r\n\x1a\n'
+        printf '\x00\x00\x00\x0dIHDR'
+        printf "$(be32 "$2")$(be32 "$3")"
+        printf '\x08\x02\x00\x00\x00\x00\x00\x00\x00'           # 8 bits, RGB; CRC
+        printf '\x00\x00\x00\x0bIDAT\x78\x01\x01\x00\x00\xff\xff\x00\x00\x00\x01'
+        printf '\x00\x00\x00\x00'                                 # CRC
+        printf '\x00\x00\x00\x00IEND\x00\x00\x00\x00'
+    } >"$1"
+}
 
 case $CASE_NAME in
 gltf_sparse)
@@ -102,6 +120,45 @@ JSON
     expect_error "sparse indices past their bufferView" "short.gltf" "accessor 0" \
         "sparse indices: 4 bytes past the end of bufferView 0"
     expect_no_output "sparse indices past their bufferView" "$WORK/out_short"
+    ;;
+texture)
+    # A base-colour texture of 16000^2 (the issue's 746 KB PNG took 7.8 GB
+    # for a 32^2 bake): refused from its header, beyond the
+    # 8192 x 8192 pixels a scene load decodes, with a warning naming its
+    # size; the bake goes on with the material's factor.
+    big_png "$IN/huge.png" 16000 16000
+    write_gltf "$IN/plane.gltf" plane floor "0 0 0  1 0 0  1 0 1" "0 0  1 0  1 1" || exit 1
+    sed -i 's/"mode": 4}/"mode": 4, "material": 0}/
+        s/"buffers":/"materials": [{"pbrMetallicRoughness": {"baseColorTexture": {"index": 0}}}],\
+  "textures": [{"source": 0}], "images": [{"uri": "huge.png"}],\
+  "buffers":/' "$IN/plane.gltf"
+    limited "$LUXEL" bake "$IN/plane.gltf" --resolution 32 --ambient 1,1,1 -o "$WORK/out_tex"
+    expect_rc 0 "bake with a 16000^2 base-colour texture"
+    expect_stderr_has "the warning names the texture and its size" \
+        "huge\.png: image 16000x16000 \(256000000 pixels\) is larger than the 67108864 pixels allowed"
+    expect_peak_below "bake with a 16000^2 base-colour texture" 256
+    ;;
+ibl_image)
+    # an environment of 16000 x 8000 RGB: 1.4 GiB of floats, and the
+    # decoder's buffer beside it, beyond 2 GiB: refused from the header
+    big_png "$IN/sky.png" 16000 8000
+    limited "$LUXEL" ibl "$IN/sky.png" -q -o "$WORK/out_ibl"
+    expect_rc 1 "ibl of a 16000x8000 PNG"
+    expect_error "ibl of a 16000x8000 PNG" "sky.png" "image 16000x8000 (3 channels) needs" \
+        "GiB of memory"
+    expect_no_output "ibl of a 16000x8000 PNG" "$WORK/out_ibl"
+    expect_peak_below "ibl of a 16000x8000 PNG" 256
+    ;;
+light2d_image)
+    big_png "$IN/casters.png" 16000 16000
+    printf '{"lights": [{"position": [8, 8], "radius": 10}]}\n' >"$IN/lights.json"
+    limited "$LUXEL" light2d --casters "$IN/casters.png" --mask --lights "$IN/lights.json" -q \
+        -o "$WORK/out_l2.png"
+    expect_rc 1 "light2d casters of 16000x16000"
+    expect_error "light2d casters of 16000x16000" "casters.png" \
+        "image 16000x16000 (3 channels) needs" "GiB of memory"
+    expect_no_output "light2d casters of 16000x16000" "$WORK/out_l2.png"
+    expect_peak_below "light2d casters of 16000x16000" 256
     ;;
 *)
     fail "unknown case '$CASE_NAME'"
