@@ -1,4 +1,4 @@
-# cases: gltf_sparse texture ibl_image light2d_image
+# cases: gltf_sparse texture ibl_image light2d_image light2d_lights
 # End-to-end tests of inputs that ask for more memory than they are worth
 # (issue 27, "memory taken before it is checked"): a few bytes of file
 # that would make luxel or a decoder it calls allocate gigabytes must fail
@@ -159,6 +159,41 @@ light2d_image)
         "image 16000x16000 (3 channels) needs" "GiB of memory"
     expect_no_output "light2d casters of 16000x16000" "$WORK/out_l2.png"
     expect_peak_below "light2d casters of 16000x16000" 256
+    ;;
+light2d_lights)
+    # 5000 static shadowed lights of radius 1000 over 400 x 400 pixels: each
+    # caches its lit box (400^2 x 3 floats, 1.8 MiB) and keeps a polar
+    # shadow map; 190 KB of JSON asked for 9.3 GB before the check.
+    # The casters: a grey PFM (--mask) of zeros, no caster at all.
+    { printf 'Pf\n400 400\n-1.0\n'; head -c $((400 * 400 * 4)) /dev/zero; } >"$IN/casters.pfm"
+    {
+        printf '{"lights": ['
+        for ((i = 0; i < 5000; i++)); do
+            [ $i -gt 0 ] && printf ','
+            printf '{"position": [%d, %d], "radius": 1000}\n' $((i % 400)) $((i / 400))
+        done
+        printf ']}\n'
+    } >"$IN/many.json"
+    limited "$LUXEL" light2d --casters "$IN/casters.pfm" --mask --lights "$IN/many.json" -q \
+        -o "$WORK/out_many.png"
+    expect_rc 1 "light2d with 5000 lights"
+    expect_error "light2d with 5000 lights" "many.json" \
+        "the caches and shadow maps of 5000 lights needs" "GiB of memory"
+    expect_no_output "light2d with 5000 lights" "$WORK/out_many.png"
+    expect_peak_below "light2d with 5000 lights" 256
+    # the same lights, 50 of them, fit
+    {
+        printf '{"lights": ['
+        for ((i = 0; i < 50; i++)); do
+            [ $i -gt 0 ] && printf ','
+            printf '{"position": [%d, 200], "radius": 1000}\n' $((i * 8))
+        done
+        printf ']}\n'
+    } >"$IN/fifty.json"
+    limited "$LUXEL" light2d --casters "$IN/casters.pfm" --mask --lights "$IN/fifty.json" -q \
+        -o "$WORK/out_fifty.png"
+    expect_rc 0 "light2d with 50 lights"
+    check "light2d with 50 lights: the image is written" test -s "$WORK/out_fifty.png"
     ;;
 *)
     fail "unknown case '$CASE_NAME'"
