@@ -1,4 +1,4 @@
-# cases: gltf_sparse texture ibl_image light2d_image light2d_lights
+# cases: gltf_sparse texture ibl_image light2d_image light2d_lights probes_count probes_write
 # End-to-end tests of inputs that ask for more memory than they are worth
 # (issue 27, "memory taken before it is checked"): a few bytes of file
 # that would make luxel or a decoder it calls allocate gigabytes must fail
@@ -194,6 +194,38 @@ light2d_lights)
         -o "$WORK/out_fifty.png"
     expect_rc 0 "light2d with 50 lights"
     check "light2d with 50 lights: the image is written" test -s "$WORK/out_fifty.png"
+    ;;
+probes_count)
+    # 2^24 probes (the most --grid allows) hold 2 GiB of points and
+    # results: refused before the bake
+    "$GEN" "$WORK/scenes" >/dev/null || { echo "gen_scenes failed"; exit 1; }
+    limited "$LUXEL" probes "$WORK/scenes/room.glb" --grid 1024,1024,16 -q -o "$WORK/grid.json"
+    expect_rc 1 "probes --grid 1024,1024,16"
+    expect_error "probes --grid 1024,1024,16" "room.glb" "the buffers of 16777216 light probes needs" \
+        "GiB of memory"
+    expect_no_output "probes --grid 1024,1024,16" "$WORK/grid.json"
+    expect_peak_below "probes --grid 1024,1024,16" 256
+    ;;
+probes_write)
+    # 200k probes at the points of a 3.7 MB file: the file is written as
+    # it is made (a JSON tree of them took 804 MB and 11 s)
+    "$GEN" "$WORK/scenes" >/dev/null || { echo "gen_scenes failed"; exit 1; }
+    awk 'BEGIN {
+        printf "{\"points\": ["
+        for (i = 0; i < 200000; i++) {
+            if (i) printf ","
+            printf "[%g, 1.5, %g]", (i % 100) * 0.03 - 1.5, int(i / 100) % 100 * 0.03 - 1.5
+        }
+        printf "]}\n"
+    }' >"$IN/points.json"
+    limited "$LUXEL" probes "$WORK/scenes/room.glb" --points "$IN/points.json" --resolution 16 \
+        --bounces 1 --gi-samples 4 --samples 16 -q -o "$WORK/many.json"
+    expect_rc 0 "probes at 200000 points"
+    check "probes at 200000 points: every probe is in the file" \
+        test "$(grep -c '"position":' "$WORK/many.json")" -eq 200000
+    check "probes at 200000 points: the file ends its JSON" \
+        cmp -s <(tail -c 4 "$WORK/many.json") <(printf '}]\n}')
+    expect_peak_below "probes at 200000 points" 300
     ;;
 *)
     fail "unknown case '$CASE_NAME'"
