@@ -1,4 +1,4 @@
-# cases: gltf_sparse texture ibl_image light2d_image light2d_lights probes_count probes_write
+# cases: gltf_sparse texture ibl_image light2d_image light2d_lights probes_count probes_write bake_plan
 # End-to-end tests of inputs that ask for more memory than they are worth
 # (issue 27, "memory taken before it is checked"): a few bytes of file
 # that would make luxel or a decoder it calls allocate gigabytes must fail
@@ -226,6 +226,31 @@ probes_write)
     check "probes at 200000 points: the file ends its JSON" \
         cmp -s <(tail -c 4 "$WORK/many.json") <(printf '}]\n}')
     expect_peak_below "probes at 200000 points" 300
+    ;;
+bake_plan)
+    # Under ulimit -v the bake's plan counts what the run will reserve
+    # (Embree's device, the threads' stacks and arenas) as well as its
+    # buffers: a run given what a failing run said it needs (plus a little
+    # for the rounding) bakes to the end, it does not pass the plan and
+    # fail later (in a tile's rebuild or the denoiser, as it did).
+    "$GEN" "$WORK/scenes" >/dev/null || { echo "gen_scenes failed"; exit 1; }
+    PLAN=(bake "$WORK/scenes/room.glb" --resolution 128 --denoise all --threads 1 -q)
+    LIMIT_KIB=$((150 * 1024))
+    limited "$LUXEL" "${PLAN[@]}" -o "$WORK/out_small"
+    expect_rc 1 "bake under 150 MiB of address space"
+    expect_error "bake under 150 MiB of address space" "room.glb" "MiB of memory, the address-space limit"
+    expect_no_output "bake under 150 MiB of address space" "$WORK/out_small"
+    line=$(grep '^luxel: error:' "$ERR")
+    need=$(printf '%s\n' "$line" | sed -n 's/.* needs \([0-9.]*\) MiB of memory.*/\1/p')
+    used=$(printf '%s\n' "$line" | sed -n 's/.*, \([0-9.]*\) MiB of it in use.*/\1/p')
+    if [ -z "$need" ] || [ -z "$used" ]; then
+        fail "the error states the memory needed and in use in MiB" "$line"
+        finish
+    fi
+    LIMIT_KIB=$(awk -v n="$need" -v u="$used" 'BEGIN { printf "%d", (n + u + 2) * 1024 }')
+    limited "$LUXEL" "${PLAN[@]}" -o "$WORK/out_fits"
+    expect_rc 0 "bake under the $LIMIT_KIB KiB the plan asked for"
+    check "the bake under the plan's limit wrote its lightmaps" test -s "$WORK/out_fits/room.exr"
     ;;
 *)
     fail "unknown case '$CASE_NAME'"
