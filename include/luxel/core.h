@@ -58,6 +58,13 @@ typedef enum lx_status {
  * Borrowed: valid until the next luxel call on this thread. */
 const char *lx_last_error(void);
 
+/* For callers that size their own buffers by input (a probe count, a
+ * points file): LX_OK when bytes fit in the memory the process may use
+ * now (the machine's, its control group's limit, RLIMIT_AS and
+ * RLIMIT_DATA less what it holds), else LX_ERR_NOMEM with the message
+ * "<what> needs N GiB of memory, <what bounds it>". Allocates nothing. */
+lx_status lx_memory_check(uint64_t bytes, const char *what);
+
 /* Short name of a status ("LX_ERR_IO"). Static storage. */
 const char *lx_status_name(lx_status status);
 
@@ -127,13 +134,21 @@ typedef struct lx_image_load_desc {
     bool keep_nonfinite; /* keep NaN and infinite values (the caller checks
                             them, e.g. to count them); default: fail on the
                             first one */
+    uint64_t max_pixels; /* refuse an image of more pixels (width * height)
+                            than this, from its header, before decoding;
+                            0 = no cap but the memory */
 } lx_image_load_desc;
 
 /* A copy of desc (or of zeros when NULL) with every default filled in. */
 lx_image_load_desc lx_image_load_desc_defaults(const lx_image_load_desc *desc);
 
 /* Loads PNG/JPEG/TGA/HDR (stb_image), PFM and EXR. desc may be NULL.
- * On failure *out is zeroed. */
+ * On failure *out is zeroed. The size in the file's header is checked
+ * before anything is decoded: against desc->max_pixels
+ * (LX_ERR_UNSUPPORTED) and against the memory the process may use for
+ * the decoder's buffer, the image and its channel conversion together
+ * (LX_ERR_NOMEM); either message names the file, its width x height and
+ * (for memory) the bytes asked. */
 lx_status lx_image_load(const char *path, const lx_image_load_desc *desc, lx_image *out);
 /* Same from memory; name is used in messages. */
 lx_status lx_image_load_memory(const void *bytes, size_t size, const char *name,

@@ -204,6 +204,12 @@ typedef struct lx_scene {
                             lx_scene_load from its desc */
 } lx_scene;
 
+/* The largest texture a scene load decodes, in pixels (8192 x 8192, the
+ * largest most engines and GPUs take): a larger one is refused from its
+ * header, before decoding, with a warning naming its size, and its
+ * material goes without the map, as for any texture that does not load. */
+#define LX_SCENE_TEXTURE_MAX_PIXELS ((uint64_t)8192 * 8192)
+
 typedef struct lx_scene_load_desc {
     bool strict;        /* fail (LX_ERR_FORMAT) on zero-area triangles instead
                            of dropping them with one warning */

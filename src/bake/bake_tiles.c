@@ -14,6 +14,7 @@
 #include "core/internal.h"
 
 #include <omp.h>
+#include <sys/resource.h>
 #include <stdio.h>
 #include <stdlib.h>
 #include <string.h>
@@ -202,6 +203,31 @@ uint64_t lx_bake_scene_bytes(const lx_scene *scene, bool copy)
 
 /* ---- tiles ------------------------------------------------------------------ */
 
+/* Address space the run reserves beyond its buffers, made after this plan
+ * and touched little or not at all, so that only an address-space limit
+ * (RLIMIT_AS, ulimit -v) counts it: Embree's device maps 128 MiB when it
+ * is made (rtcNewDevice; seen with strace -k), and each worker thread
+ * beyond the first, of OpenMP's pool and of Embree's, takes a stack
+ * (RLIMIT_STACK, glibc's default) and a glibc malloc arena (64 MiB
+ * reserved on 64-bit systems); and 16 MiB of slack for the heap's own
+ * overhead and the small allocations no table lists (a bake planned to
+ * the byte ran out 4 MiB short). Without it a bake under ulimit -v passed
+ * the plan and failed later, in a tile's rebuild or the denoiser. */
+#define EMBREE_DEVICE_RESERVE ((uint64_t)128 << 20)
+#define MALLOC_ARENA_RESERVE ((uint64_t)64 << 20)
+#define HEAP_SLACK ((uint64_t)16 << 20)
+
+static uint64_t reserved_address_space(int threads)
+{
+    struct rlimit stack;
+    uint64_t stack_bytes = (uint64_t)8 << 20;
+    if (getrlimit(RLIMIT_STACK, &stack) == 0 && stack.rlim_cur != RLIM_INFINITY)
+        stack_bytes = (uint64_t)stack.rlim_cur;
+    uint64_t extra_threads = threads > 1 ? 2 * (uint64_t)(threads - 1) : 0;
+    return EMBREE_DEVICE_RESERVE + HEAP_SLACK +
+           extra_threads * (stack_bytes + MALLOC_ARENA_RESERVE);
+}
+
 /* Decides whether the lightmaps fit the memory limit together or are
  * baked in tiles (b->tiled), and fails with one line when even the part
  * that stays for the whole bake and the largest lightmap's working set do
@@ -216,6 +242,11 @@ lx_status lx_bake_plan_memory(lx_baker *b, const lx_scene *scene, const lx_tile_
     b->memory_limit = limit;
     uint64_t together = lx_bake_scene_bytes(scene, false);
     uint64_t resident = lx_bake_scene_bytes(scene, true), largest = 0;
+    if (!asked && ml.bound == LX_MEMORY_ADDRESS_SPACE) {
+        uint64_t reserved = reserved_address_space(lx_thread_count(b->desc.threads));
+        together += reserved;
+        resident += reserved;
+    }
     uint32_t largest_at = 0;
     for (uint32_t i = 0; i < count; i++) {
         lx_bake_texel_bytes tb = lx_bake_texel_bytes_of(&b->desc, c[i].horizon, needs);

@@ -6,6 +6,9 @@
 #include "luxel/math.h"
 
 #include <ctype.h>
+#include <inttypes.h>
+#include <limits.h>
+#include <stdio.h>
 #include <math.h>
 #include <stdint.h>
 #include <stdlib.h>
@@ -209,6 +212,35 @@ static const char *format_title(lx_image_format f)
 
 /* ---- loading ----------------------------------------------------------------- */
 
+lx_status lx_img_check_size(const lx_img_budget *budget, const char *name, int64_t w, int64_t h,
+                            int stored_channels, uint64_t decoder_bytes)
+{
+    if (w < 1 || h < 1 || w > INT_MAX || h > INT_MAX)
+        return lx_fail(LX_ERR_FORMAT, "%s: invalid image size %lldx%lld", name, (long long)w,
+                       (long long)h);
+    uint64_t pixels = (uint64_t)w * (uint64_t)h; /* < 2^62 */
+    if (budget->max_pixels && pixels > budget->max_pixels)
+        return lx_fail(LX_ERR_UNSUPPORTED,
+                       "%s: image %lldx%lld (%" PRIu64 " pixels) is larger than the %" PRIu64
+                       " pixels allowed",
+                       name, (long long)w, (long long)h, pixels, budget->max_pixels);
+    /* the reader's buffers and the stored image live together, then the
+     * stored image and its conversion; each term < 2^62 * 16 would
+     * overflow, so the sum is taken in double and clamped */
+    int want = budget->want_channels;
+    double stored = (double)pixels * stored_channels * sizeof(float);
+    double converted = want && want != stored_channels ? (double)pixels * want * sizeof(float) : 0;
+    double after = converted > (double)decoder_bytes ? converted : (double)decoder_bytes;
+    double total = stored + after;
+    char what[96];
+    snprintf(what, sizeof what, "image %lldx%lld (%d channels)", (long long)w, (long long)h,
+             stored_channels);
+    lx_status s = lx_check_memory(total >= 1.8e19 ? UINT64_MAX : (uint64_t)total, what);
+    if (s != LX_OK)
+        lx_error_prefix(name);
+    return s;
+}
+
 static lx_status check_finite(const lx_image *img, const char *name)
 {
     size_t n = (size_t)img->width * (size_t)img->height * (size_t)img->channels;
@@ -308,16 +340,17 @@ lx_status lx_image_load_memory(const void *bytes, size_t size, const char *name,
         format = LX_IMAGE_TGA;
     }
 
+    lx_img_budget budget = {.max_pixels = d.max_pixels, .want_channels = d.channels};
     lx_status s;
     switch (format) {
     case LX_IMAGE_EXR:
-        s = lx_img_load_exr(data, size, name, out);
+        s = lx_img_load_exr(data, size, name, &budget, out);
         break;
     case LX_IMAGE_PFM:
-        s = lx_img_load_pfm(data, size, name, out);
+        s = lx_img_load_pfm(data, size, name, &budget, out);
         break;
     default:
-        s = lx_img_load_stb(data, size, name, format == LX_IMAGE_TGA, d.raw_8bit, out);
+        s = lx_img_load_stb(data, size, name, format == LX_IMAGE_TGA, d.raw_8bit, &budget, out);
         break;
     }
     if (s == LX_OK && !d.keep_nonfinite)

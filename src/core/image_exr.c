@@ -127,6 +127,7 @@ typedef struct exr_reader {
     channel_map map;
     lx_image *img;
     const char *name;
+    const lx_img_budget *budget;
     float *planes; /* one chunk, channel after channel */
     size_t planes_size;
 } exr_reader;
@@ -282,6 +283,10 @@ static lx_status read_part(exr_reader *r)
     lx_status s = choose_channels(list, r->name, &r->map);
     if (s != LX_OK)
         return s;
+    /* the decoder's buffers hold one chunk at a time: small beside the image */
+    s = lx_img_check_size(r->budget, r->name, w, h, r->map.channels, 0);
+    if (s != LX_OK)
+        return s;
     s = lx_image_alloc(r->img, (int)w, (int)h, r->map.channels);
     if (s != LX_OK) {
         lx_error_prefix(r->name);
@@ -290,7 +295,8 @@ static lx_status read_part(exr_reader *r)
     return storage == EXR_STORAGE_TILED ? read_tiles(r) : read_scanlines(r, &dw);
 }
 
-lx_status lx_img_load_exr(const unsigned char *data, size_t size, const char *name, lx_image *out)
+lx_status lx_img_load_exr(const unsigned char *data, size_t size, const char *name,
+                          const lx_img_budget *budget, lx_image *out)
 {
     memset(out, 0, sizeof *out);
     exr_memory mem = {data, size};
@@ -303,7 +309,8 @@ lx_status lx_img_load_exr(const unsigned char *data, size_t size, const char *na
     init.flags = EXR_CONTEXT_FLAG_DISABLE_CHUNK_RECONSTRUCTION;
     exr_detail[0] = '\0';
 
-    exr_reader r = {.dec = EXR_DECODE_PIPELINE_INITIALIZER, .img = out, .name = name};
+    exr_reader r = {
+        .dec = EXR_DECODE_PIPELINE_INITIALIZER, .img = out, .name = name, .budget = budget};
     exr_result_t rv = exr_start_read(&r.ctx, name, &init);
     if (rv != EXR_ERR_SUCCESS) {
         exr_finish(&r.ctx);

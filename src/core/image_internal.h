@@ -44,16 +44,34 @@ LX_IMG_HIDDEN bool lx_img_progress_add(lx_img_progress *p, uint64_t units);
 /* Whether the callback has asked to stop. */
 LX_IMG_HIDDEN bool lx_img_progress_stopped(lx_img_progress *p);
 
+/* What a load may take: the caller's pixel cap (0: none) and the
+ * channels the image is converted to afterwards (0: as stored). */
+typedef struct lx_img_budget {
+    uint64_t max_pixels;
+    int want_channels;
+} lx_img_budget;
+
+/* Checked by every reader once it has the header's size and before it
+ * decodes: width * height against the cap, then the memory of the whole
+ * load (decoder_bytes, the reader's own buffers, beside the float image of
+ * stored_channels, then the converted image beside that) against what
+ * the process may use. The message names the file, its size and the
+ * bytes asked. */
+LX_IMG_HIDDEN lx_status lx_img_check_size(const lx_img_budget *budget, const char *name, int64_t w,
+                                          int64_t h, int stored_channels, uint64_t decoder_bytes);
+
 /* Readers. name is used in messages only; data holds size bytes; is_tga
- * says the stb reader got a TGA (which has no signature). Each fills
- * *out with the values as stored (no channel conversion, no NaN check) and
- * leaves it zeroed on failure. */
+ * says the stb reader got a TGA (which has no signature). Each checks the
+ * header's size with lx_img_check_size before decoding, fills *out with
+ * the values as stored (no channel conversion, no NaN check) and leaves it
+ * zeroed on failure. */
 LX_IMG_HIDDEN lx_status lx_img_load_stb(const unsigned char *data, size_t size, const char *name,
-                                        bool is_tga, bool raw_8bit, lx_image *out);
+                                        bool is_tga, bool raw_8bit, const lx_img_budget *budget,
+                                        lx_image *out);
 LX_IMG_HIDDEN lx_status lx_img_load_pfm(const unsigned char *data, size_t size, const char *name,
-                                        lx_image *out);
+                                        const lx_img_budget *budget, lx_image *out);
 LX_IMG_HIDDEN lx_status lx_img_load_exr(const unsigned char *data, size_t size, const char *name,
-                                        lx_image *out);
+                                        const lx_img_budget *budget, lx_image *out);
 
 /* Writers to an open temporary file. The caller has checked img (1..4
  * channels, finite values, exposed values in the format's range) and

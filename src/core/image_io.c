@@ -357,7 +357,7 @@ static bool is_alpha(int c, int channels)
 }
 
 lx_status lx_img_load_stb(const unsigned char *data, size_t size, const char *name, bool is_tga,
-                          bool raw_8bit, lx_image *out)
+                          bool raw_8bit, const lx_img_budget *budget, lx_image *out)
 {
     memset(out, 0, sizeof *out);
     if (size > INT_MAX)
@@ -365,38 +365,37 @@ lx_status lx_img_load_stb(const unsigned char *data, size_t size, const char *na
                        name, size);
     int len = (int)size;
     lx_status s = LX_OK;
+    bool png = size >= 8 && memcmp(data, "\x89PNG\r\n\x1a\n", 8) == 0;
     if (size >= 3 && data[0] == 0xff && data[1] == 0xd8 && data[2] == 0xff)
         s = check_jpeg(data, size, name);
-    else if (size >= 8 && memcmp(data, "\x89PNG\r\n\x1a\n", 8) == 0) {
+    else if (png)
         s = check_png_header(data, size, name);
-        if (s == LX_OK)
-            s = check_png_data(data, size, name);
-    }
     else if (is_tga)
         s = check_tga_size(data, size, name);
     if (s != LX_OK)
         return s;
 
-    /* Size up front, so a header claiming a huge image fails with luxel's
-     * message before stb allocates. 4 channels is the most stb returns. */
-    int w, h, comp;
-    if (!stbi_info_from_memory(data, len, &w, &h, &comp))
-        return stb_failure(name);
-    size_t bytes;
-    if (w < 1 || h < 1 || !lx_size_mul((size_t)w, (size_t)h, 4 * sizeof(float), &bytes))
-        return lx_fail(LX_ERR_FORMAT, "%s: invalid image size %dx%d", name, w, h);
-    char what[64];
-    snprintf(what, sizeof what, "image %dx%d", w, h);
-    s = lx_check_memory(bytes, what);
-    if (s != LX_OK) {
-        lx_error_prefix(name);
-        return s;
-    }
-
     /* stbi_loadf would also accept 8-bit files and apply its own gamma and
      * scale; luxel decodes those itself, so loadf is only for real HDR. */
     bool hdr = stbi_is_hdr_from_memory(data, len) != 0;
     bool wide = !hdr && stbi_is_16_bit_from_memory(data, len) != 0;
+
+    /* Size up front, from the header, so a file claiming a huge image
+     * fails with luxel's message before stb allocates. stb holds its
+     * decoded samples and, while decoding, about as much again (a PNG's
+     * inflated rows, a JPEG's component planes). */
+    int w, h, comp;
+    if (!stbi_info_from_memory(data, len, &w, &h, &comp))
+        return stb_failure(name);
+    double sample = hdr ? sizeof(float) : wide ? 2 : 1;
+    double decoder = 2.0 * (double)w * (double)h * (comp > 0 ? comp : 4) * sample;
+    s = lx_img_check_size(budget, name, w, h, comp > 0 ? comp : 4,
+                          decoder >= 1.8e19 ? UINT64_MAX : (uint64_t)decoder);
+    if (s != LX_OK)
+        return s;
+    /* inflating a PNG's whole stream: once its size is known to fit */
+    if (png && (s = check_png_data(data, size, name)) != LX_OK)
+        return s;
     if (hdr) {
         s = check_hdr_data(data, size, w, h, name);
         if (s != LX_OK)

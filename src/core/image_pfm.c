@@ -93,7 +93,8 @@ static float float_from_bytes(const unsigned char *b, bool little)
     return f;
 }
 
-lx_status lx_img_load_pfm(const unsigned char *data, size_t size, const char *name, lx_image *out)
+lx_status lx_img_load_pfm(const unsigned char *data, size_t size, const char *name,
+                          const lx_img_budget *budget, lx_image *out)
 {
     memset(out, 0, sizeof *out);
     if (size < 2 || data[0] != 'P' || (data[1] != 'F' && data[1] != 'f'))
@@ -142,6 +143,10 @@ lx_status lx_img_load_pfm(const unsigned char *data, size_t size, const char *na
                        name, need, have);
     if (have > need)
         lx_log(LX_LOG_WARN, "%s: %zu bytes after the pixels ignored", name, have - need);
+    /* the pixels are read from the file's bytes: no buffer of the reader's */
+    s = lx_img_check_size(budget, name, width, height, channels, 0);
+    if (s != LX_OK)
+        return s;
 
     s = lx_image_alloc(out, width, height, channels);
     if (s != LX_OK) {

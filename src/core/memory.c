@@ -273,6 +273,11 @@ void lx_memory_limit_describe(const lx_memory_limit *m, char *buf, size_t size)
     }
 }
 
+lx_status lx_memory_check(uint64_t bytes, const char *what)
+{
+    return lx_check_memory(bytes, what ? what : "the request");
+}
+
 lx_status lx_check_memory(uint64_t bytes, const char *what)
 {
     lx_memory_limit m;

@@ -418,6 +418,25 @@ lx_status lx_light2d_set_lights(lx_light2d *ctx, const lx_light2d_light *lights,
             return st;
         }
     }
+    /* What the lights will hold, counted before any of it is taken: a
+     * static light caches its lit box (3 floats a pixel), a shadowed one
+     * keeps its polar map. (The lights already held and unchanged are
+     * counted too: an upper bound.) */
+    uint64_t bytes = (uint64_t)count * sizeof(l2_prep);
+    for (int i = 0; i < count; i++) {
+        l2_prep probe = {.l = lights[i]};
+        prepare(ctx, &probe);
+        if (!probe.l.dynamic && probe.x1 > probe.x0 && probe.y1 > probe.y0)
+            bytes += (uint64_t)(probe.x1 - probe.x0) * (uint64_t)(probe.y1 - probe.y0) * 3 *
+                     sizeof(float);
+        if (probe.l.shadow && probe.x1 > probe.x0 && probe.y1 > probe.y0)
+            bytes += l2_polar_bytes(ctx, &probe.l);
+    }
+    char what[96];
+    snprintf(what, sizeof what, "light2d: the caches and shadow maps of %d lights", count);
+    lx_status enough = lx_check_memory(bytes, what);
+    if (enough != LX_OK)
+        return enough;
     if (count > ctx->prep_capacity) {
         l2_prep *p = realloc(ctx->preps, (size_t)count * sizeof *p);
         if (!p)

@@ -185,6 +185,9 @@ lx_status l2_build_edges(lx_light2d *ctx);
 /* Rays for a light of this radius (or the context's fixed resolution). */
 int l2_ray_count(const lx_light2d *ctx, float radius);
 
+/* The bytes l2_polar_build reserves for the light's polar map. */
+uint64_t l2_polar_bytes(const lx_light2d *ctx, const lx_light2d_light *l);
+
 /* Fills p->polar for the light (allocating as needed). */
 lx_status l2_polar_build(const lx_light2d *ctx, l2_prep *p);
 void l2_polar_free(l2_polar *pm);

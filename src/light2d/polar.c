@@ -322,6 +322,22 @@ L2_CLONES static void open_gaps(l2_polar *pm, int32_t *fw)
     }
 }
 
+/* As reserve() below takes them: per ray the occluders, exits, lit
+ * flags, their quantized copy (4 floats), three occluder coordinates,
+ * an angle and 2 L2_HZ horizons; the min/max tables of `levels` levels
+ * and the gaps of `depth_levels`. */
+uint64_t l2_polar_bytes(const lx_light2d *ctx, const lx_light2d_light *l)
+{
+    uint64_t n = (uint64_t)l2_ray_count(ctx, l->radius);
+    uint64_t levels = 0;
+    while (((uint64_t)1 << levels) <= n)
+        levels++;
+    uint64_t depth_levels =
+        l->softness > 0.0f ? (uint64_t)l2_depth_level(l->radius + 2.0f, 1 << 10) + 1 : 0;
+    uint64_t floats = n * (4 + 3 + 1 + 2 * L2_HZ) + 1 + n * levels * 2 + n * depth_levels;
+    return floats * sizeof(float);
+}
+
 lx_status l2_polar_build(const lx_light2d *ctx, l2_prep *p)
 {
     const lx_light2d_light *l = &p->l;

@@ -560,7 +560,8 @@ static void load_texture(import_ctx *c, const struct aiString *tex_path, bool ra
         *out_path = p[0] == '*' ? lx_strdup(p) : lx_path_join(c->folder, p);
         return;
     }
-    lx_image_load_desc ld = {.raw_8bit = raw, .channels = raw ? 3 : 4};
+    lx_image_load_desc ld = {
+        .raw_8bit = raw, .channels = raw ? 3 : 4, .max_pixels = LX_SCENE_TEXTURE_MAX_PIXELS};
     lx_status st;
     char *full = NULL;
     if (p[0] == '*') {
