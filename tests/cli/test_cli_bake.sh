@@ -358,23 +358,33 @@ run "$LUXEL" bake "$ROOM" --resolution 32 --format pfm -q -o "$WORK/soft2" --thr
     --lights "$WORK/soft.json"
 check "soft bake: the same bytes with 1 thread" cmp -s "$WORK/soft/room.pfm" "$WORK/soft2/room.pfm"
 
-# Sky light: gen_scenes' sky through a lights JSON in another
-# folder (the path is relative to the JSON), with sky shadows; the manifest
-# records it; 1 and 2 threads give the same bytes; --sky on the command line
-# wins over the file's.
-mkdir -p "$WORK/skycfg"
+# Sky light: gen_scenes' sky through a lights JSON in another folder (the
+# path is relative to the JSON, in its folder or below), with sky shadows;
+# the manifest records it; 1 and 2 threads give the same bytes; --sky on
+# the command line wins over the file's. A sky outside the JSON's folder
+# is read with --allow-any-path only.
+mkdir -p "$WORK/skycfg/hdri"
+cp "$WORK/scenes/sky.pfm" "$WORK/skycfg/hdri/sky.pfm"
 cat >"$WORK/skycfg/day.json" <<'JSON'
-{"sky": {"environment": "../scenes/sky.pfm", "shadows": true, "samples": 16},
+{"sky": {"environment": "hdri/sky.pfm", "shadows": true, "samples": 16},
  "lights": [{"name": "sun", "intensity": 0}]}
 JSON
+sed 's#hdri/sky.pfm#../scenes/sky.pfm#' "$WORK/skycfg/day.json" >"$WORK/skycfg/outside.json"
+run "$LUXEL" bake "$RETRO" --texel-density 4 --format pfm -q -o "$WORK/sky0" --lights "$WORK/skycfg/outside.json"
+expect_rc 1 "a sky outside the lights JSON's folder"
+expect_error "a sky outside the lights JSON's folder" "outside.json" "../scenes/sky.pfm" "--allow-any-path"
+run "$LUXEL" bake "$RETRO" --texel-density 4 --format pfm -q -o "$WORK/sky0" --lights "$WORK/skycfg/outside.json" \
+    --allow-any-path
+expect_rc 0 "a sky outside the lights JSON's folder with --allow-any-path"
 run "$LUXEL" bake "$RETRO" --texel-density 4 --format pfm -q -o "$WORK/sky1" --lights "$WORK/skycfg/day.json"
 expect_rc 0 "bake with a sky from the lights JSON"
-check "sky bake: manifest names the environment" grep -q '"environment":.*scenes/sky.pfm' "$WORK/sky1/manifest.json"
+check "sky bake: manifest names the environment" grep -q '"environment":.*skycfg/hdri/sky.pfm' "$WORK/sky1/manifest.json"
+check "sky bake: the same bytes as the sky outside" cmp -s "$WORK/sky0/ground.pfm" "$WORK/sky1/ground.pfm"
 sky_block=$(grep -A4 '"sky"' "$WORK/sky1/manifest.json")
 check "sky bake: manifest says shadows" grep -q '"shadows":.*true' <<<"$sky_block"
 check "sky bake: manifest says 16 samples" grep -q '"samples":.*16' <<<"$sky_block"
 run "$LUXEL" info "$RETRO" --lights "$WORK/skycfg/day.json"
-expect_stdout_has "info: the sky" '^sky: .*scenes/sky.pfm x 1, shadows \(16 samples\)$'
+expect_stdout_has "info: the sky" '^sky: .*hdri/sky.pfm x 1, shadows \(16 samples\)$'
 run "$LUXEL" bake "$RETRO" --texel-density 4 --format pfm -q -o "$WORK/sky2" --threads 1 \
     --lights "$WORK/skycfg/day.json"
 check "sky bake: the same bytes with 1 thread" cmp -s "$WORK/sky1/ground.pfm" "$WORK/sky2/ground.pfm"
