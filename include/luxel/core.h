@@ -62,7 +62,8 @@ const char *lx_last_error(void);
  * points file): LX_OK when bytes fit in the memory the process may use
  * now (the machine's, its control group's limit, RLIMIT_AS and
  * RLIMIT_DATA less what it holds), else LX_ERR_NOMEM with the message
- * "<what> needs N GiB of memory, <what bounds it>". Allocates nothing. */
+ * "<what> needs N GiB of memory, <what bounds it>" (what NULL: "the
+ * request"). Allocates nothing. */
 lx_status lx_memory_check(uint64_t bytes, const char *what);
 
 /* Short name of a status ("LX_ERR_IO"). Static storage. */
