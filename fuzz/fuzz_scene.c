@@ -2,7 +2,10 @@
  * .obj, .dae, .fbx, .ply or .stl file (chosen by the first byte) loaded
  * through lx_scene_load, which runs assimp plus luxel's own validation,
  * its glTF rewrite (meshopt, quantization), KHR_lights_punctual and camera
- * readers (fuzz/corpus/scene/cameras.gltf seeds the cameras). */
+ * readers (fuzz/corpus/scene/cameras.gltf seeds the cameras), and the
+ * hierarchy checks made before assimp (collada_instances.txt and
+ * fbx_ascii_chain.txt: their first byte, 'B' and 'C', picks .dae and
+ * .fbx). */
 #define _POSIX_C_SOURCE 200809L
 #include "luxel/scene.h"
 
