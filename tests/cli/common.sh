@@ -233,6 +233,34 @@ f32() {
     esac
 }
 
+# snapshot DIR: every entry with its checksum, hidden ones included.
+snapshot() { (cd "$1" && find . -mindepth 1 | LC_ALL=C sort | while read -r f; do
+    if [ -f "$f" ]; then echo "$f $(cksum <"$f")"; else echo "$f"; fi
+done); }
+
+# expect_same LABEL BEFORE DIR: DIR's snapshot is BEFORE.
+expect_same() {
+    local after
+    after=$(snapshot "$3")
+    if [ "$2" = "$after" ]; then
+        pass "$1: the folder is exactly as before"
+    else
+        fail "$1: the folder changed" "$(diff <(echo "$2") <(echo "$after") | head -5)"
+    fi
+}
+
+# wait_for_pause PID ERRFILE: waits (up to 60 s) until a run started with
+# LUXEL_TEST_PAUSE says in ERRFILE that it paused; false when it ended first.
+wait_for_pause() {
+    local i
+    for ((i = 0; i < 6000; i++)); do
+        grep -qs '^luxel: test: paused at ' "$2" && return 0
+        kill -0 "$1" 2>/dev/null || return 1
+        sleep 0.01
+    done
+    return 1
+}
+
 # write_gltf FILE.gltf MESH NODE "x y z  x y z ..." "u v  u v ...": a glTF
 # 2.0 file with one node NODE carrying mesh MESH, one non-indexed triangle
 # list (POSITION and TEXCOORD_0 float32), its buffer in FILE.bin. The

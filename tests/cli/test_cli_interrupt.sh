@@ -16,18 +16,6 @@ RETRO=$WORK/scenes/retro.glb
 SKY=$WORK/scenes/sky.pfm
 BAKE=(bake "$RETRO" --resolution 64 --threads 2)
 
-# wait_for_pause PID: waits (up to 60 s) until the run says it paused;
-# false when it ended first.
-wait_for_pause() {
-    local i
-    for ((i = 0; i < 6000; i++)); do
-        grep -qs '^luxel: test: paused at ' "$ERR" && return 0
-        kill -0 "$1" 2>/dev/null || return 1
-        sleep 0.01
-    done
-    return 1
-}
-
 # interrupt LABEL PHASE SIGNAL OUTDIR ARGS...: runs luxel ARGS... -o OUTDIR
 # paused at PHASE, sends SIGNAL, and checks how the run ended.
 interrupt() {
@@ -36,7 +24,7 @@ interrupt() {
     : >"$ERR" # empty before the run starts: a stale "paused" line would send the signal too early
     LUXEL_TEST_PAUSE=$phase "$LUXEL" "$@" -o "$out" >"$OUT" 2>"$ERR" </dev/null &
     local pid=$!
-    if ! wait_for_pause "$pid"; then
+    if ! wait_for_pause "$pid" "$ERR"; then
         wait "$pid"
         fail "$label: the run never paused at '$phase' (exit $?)"
         show_stderr

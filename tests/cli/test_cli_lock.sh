@@ -21,36 +21,16 @@ BAKE=(bake "$ROOM" --resolution 16)
 ROOM_FILES=(room.exr room.png tall_box.exr tall_box.png short_box.exr short_box.png
     manifest.json)
 
-# snapshot DIR: every entry with its checksum, hidden ones included.
-snapshot() { (cd "$1" && find . -mindepth 1 | LC_ALL=C sort | while read -r f; do
-    if [ -f "$f" ]; then echo "$f $(cksum <"$f")"; else echo "$f"; fi
-done); }
-
-expect_same() { # expect_same LABEL BEFORE DIR
-    local after
-    after=$(snapshot "$3")
-    if [ "$2" = "$after" ]; then
-        pass "$1: the folder is exactly as before"
-    else
-        fail "$1: the folder changed" "$(diff <(echo "$2") <(echo "$after") | head -5)"
-    fi
-}
-
 # start_paused PHASE ERRFILE ARGS...: runs luxel ARGS... in the background,
 # stopped at PHASE; PAUSED_PID is its process id. False when it never
 # paused.
 start_paused() {
-    local phase=$1 err=$2 i
+    local phase=$1 err=$2
     shift 2
     : >"$err"
     LUXEL_TEST_PAUSE=$phase "$LUXEL" "$@" >/dev/null 2>"$err" </dev/null &
     PAUSED_PID=$!
-    for ((i = 0; i < 6000; i++)); do
-        grep -qs '^luxel: test: paused at ' "$err" && return 0
-        kill -0 "$PAUSED_PID" 2>/dev/null || return 1
-        sleep 0.01
-    done
-    return 1
+    wait_for_pause "$PAUSED_PID" "$err"
 }
 
 # staging_folders DIR: the names of the staging folders in DIR.

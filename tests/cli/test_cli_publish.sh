@@ -21,22 +21,6 @@ set -u
 RETRO=$WORK/scenes/retro.glb
 SKY=$WORK/scenes/sky.pfm
 
-# snapshot DIR: every entry with its checksum, hidden ones included.
-snapshot() { (cd "$1" && find . -mindepth 1 | LC_ALL=C sort | while read -r f; do
-    if [ -f "$f" ]; then echo "$f $(cksum <"$f")"; else echo "$f"; fi
-done); }
-
-# expect_same LABEL BEFORE DIR: DIR's snapshot is BEFORE.
-expect_same() {
-    local after
-    after=$(snapshot "$3")
-    if [ "$2" = "$after" ]; then
-        pass "$1: the folder is exactly as before (old files restored)"
-    else
-        fail "$1: the folder changed" "$(diff <(echo "$2") <(echo "$after") | head -5)"
-    fi
-}
-
 # ---- a rename failing half-way: the replaced files come back ----------------------
 
 run "$LUXEL" bake "$RETRO" --resolution 32 -q -o "$WORK/out"
