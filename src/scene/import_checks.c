@@ -512,6 +512,8 @@ static void name_fbx(const void *user, uint32_t node, char *buf, size_t size)
 /* The graph of the Model objects (node 0 the root, model k node k+1). */
 static lx_status judge_fbx(fbx_scan *s)
 {
+    if (s->model_count == 0)
+        return LX_OK; /* no nodes (and no array to sort) */
     qsort(s->models, s->model_count, sizeof *s->models, by_int64);
     node_graph g = {.nodes = s->model_count + 1};
     lx_status st = LX_OK;
