@@ -135,7 +135,8 @@ bool lx_lfs_pointer(const void *bytes, size_t size);
 bool lx_lfs_pointer_file(const char *path);
 /* Fails naming the first buffer or image file (uri) that lies outside the
  * file's folder (unless allow_any_path; lx_path_confine) or is a Git LFS
- * pointer. */
+ * pointer, and the first base64 data: URI that is not base64 or, for a
+ * buffer, holds fewer bytes than its byteLength. */
 lx_status lx_gltf_check_files(const char *path, const cJSON *root, bool allow_any_path);
 /* When the file uses EXT_meshopt_compression or quantized vertex
  * attributes (KHR_mesh_quantization), decodes them: root is changed in

@@ -24,6 +24,8 @@
 #include <sys/wait.h>
 #include <unistd.h>
 
+#include "core/internal.h" /* lx_read_file */
+
 #include "helpers.h"
 #include "luxel/scene.h"
 
@@ -550,6 +552,34 @@ static void test_room_like_gltf(void **state)
     lx_scene_destroy(s);
 }
 
+/* A data: URI that is not base64, or holds fewer bytes than the buffer's
+ * byteLength, fails naming the buffer before assimp reads it (its reader
+ * leaked what it had allocated when it threw on such a URI: fuzz_scene). */
+static void test_bad_data_uri(void **state)
+{
+    (void)state;
+    const char *dir = lx_test_dir("test_import_bad_data_uri");
+    char path[1024];
+    path_in(path, sizeof path, dir, "room.gltf");
+    gltf_builder g;
+    build_room_like(&g);
+    gb_write_gltf(&g, path);
+    char *text = NULL;
+    size_t size = 0;
+    assert_int_equal(lx_read_file(path, 1 << 24, &text, &size), LX_OK);
+    char *b64 = strstr(text, ";base64,") + 8;
+    char saved = b64[4];
+    b64[4] = '\xff'; /* a byte no base64 alphabet has */
+    write_text(path, text);
+    load_fails(path, NULL, LX_ERR_FORMAT, "buffer 0", "not base64");
+    b64[4] = saved;
+    char *end = strchr(b64, '"');
+    memmove(end - 8, end, strlen(end) + 1); /* 6 bytes fewer than byteLength */
+    write_text(path, text);
+    load_fails(path, NULL, LX_ERR_FORMAT, "buffer 0", "byteLength");
+    free(text);
+}
+
 /* The same scene with the buffer in an external .bin file. */
 static void test_room_like_external_bin(void **state)
 {
@@ -922,6 +952,7 @@ int main(void)
         cmocka_unit_test(test_node_transforms),
         cmocka_unit_test(test_room_like_gltf),
         cmocka_unit_test(test_room_like_external_bin),
+        cmocka_unit_test(test_bad_data_uri),
         cmocka_unit_test(test_room_like_glb_and_truncated),
         cmocka_unit_test(test_lights_only_gltf),
         cmocka_unit_test(test_missing_file),
