@@ -708,9 +708,13 @@ static lx_status check_fbx_ascii(fbx_scan *s, const mapped_file *f)
             p++;
             continue;
         }
+        /* an unbalanced brace or an unclosed string: assimp's parser
+         * throws on them and leaks what it has built (fuzz_scene) */
         if (c == '}') {
-            if (depth > 0)
-                depth--;
+            if (depth == 0)
+                return lx_fail(LX_ERR_FORMAT, "%s: line %zu: '}' closes no FBX block", s->path,
+                               line_at(f->bytes, p));
+            depth--;
             key[0] = '\0';
             p++;
             continue;
@@ -719,7 +723,10 @@ static lx_status check_fbx_ascii(fbx_scan *s, const mapped_file *f)
         bool quoted = c == '"';
         if (quoted) {
             const char *close = memchr(p + 1, '"', (size_t)(end - p - 1));
-            p = close ? close + 1 : end;
+            if (!close)
+                return lx_fail(LX_ERR_FORMAT, "%s: line %zu: an FBX string is not closed",
+                               s->path, line_at(f->bytes, p));
+            p = close + 1;
         } else {
             while (p < end && !strchr(" \t\r\n,{};:\"", *p))
                 p++;
@@ -756,6 +763,9 @@ static lx_status check_fbx_ascii(fbx_scan *s, const mapped_file *f)
                 return lx_fail(LX_ERR_NOMEM, "%s: out of memory for the node hierarchy", s->path);
         }
     }
+    if (depth > 0)
+        return lx_fail(LX_ERR_FORMAT, "%s: %zu FBX block%s not closed at the end of the file",
+                       s->path, depth, depth == 1 ? "" : "s");
     return judge_fbx(s);
 }
 
