@@ -72,7 +72,7 @@ fuzz: all
 		name=$$(basename $$f); corpus=$(BUILD_FUZZ)/corpus/$$name; mkdir -p $$corpus; \
 		seeds=; test -d fuzz/corpus/$${name#fuzz_} && seeds=fuzz/corpus/$${name#fuzz_}; \
 		dict=; test -f fuzz/$${name#fuzz_}.dict && dict=-dict=fuzz/$${name#fuzz_}.dict; \
-		echo "== $$f"; LSAN_OPTIONS=suppressions=$(CURDIR)/fuzz/lsan.supp $$f -max_total_time=$(FUZZ_SECONDS) $$dict $$corpus $$seeds || exit 1; done
+		echo "== $$f"; ASAN_OPTIONS=fast_unwind_on_malloc=0 LSAN_OPTIONS=suppressions=$(CURDIR)/fuzz/lsan.supp $$f -max_total_time=$(FUZZ_SECONDS) $$dict $$corpus $$seeds || exit 1; done
 
 # What CI runs after make check (.ci/run): every harness built and run a few
 # seconds on its seeds, so a harness that no longer builds or crashes at
