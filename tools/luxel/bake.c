@@ -83,7 +83,7 @@ static const char *bake_usage =
     "                          aces or clamp\n"
     "  --clean                 remove the files an earlier bake left in DIR that\n"
     "                          this one does not write (only those its manifest\n"
-    "                          lists), and the staging folders (.luxel-XXXXXX)\n"
+    "                          lists), and the staging folders (.luxel-*)\n"
     "                          of runs that were killed or crashed\n"
     "  --padding N             texels of dilation around charts, 0 for none\n"
     "                          (default %d); charts luxel packs own as many\n"

@@ -65,7 +65,7 @@ static const char *ibl_usage =
     "                           cube maps seamlessly); by default edge texels are\n"
     "                           averaged across faces (the seed's seam fix)\n"
     "  --intensity X            multiply the environment by X (default %g)\n"
-    "  --clean                  remove the staging folders (.luxel-XXXXXX) that\n"
+    "  --clean                  remove the staging folders (.luxel-*) that\n"
     "                           runs killed or crashed left in DIR\n"
     "  --threads N              worker threads (default: all cores)\n"
     "  -v, --verbose            the time of each phase, and notes\n"
