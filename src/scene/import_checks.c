@@ -342,8 +342,173 @@ static bool name_is(const char *name, size_t len, const char *want)
     return len == strlen(want) && memcmp(name, want, len) == 0;
 }
 
+/* ---- Collada data that assimp sizes its arrays by ------------------------- */
+
+/* assimp's Collada reader reserves arrays by the file's own counts (an
+ * array's count, a primitive's count times its vertices and inputs, the
+ * sum of a <vcount>) before reading the numbers they count, and reads the
+ * integers of a <p> until the text ends, never advancing past a character
+ * it cannot read: "<p>0 1) 2</p>" grew an index array until 3 GB failed.
+ * So each count is held to what the text it counts could hold (a number
+ * and a separator, two bytes at least) and integer lists to the
+ * characters assimp's reader steps over. */
+typedef struct collada_primitive {
+    bool open;              /* inside <triangles>, <polylist>, ... */
+    uint64_t count;         /* its count attribute */
+    uint64_t vertices;      /* indices per primitive assimp expects (0: none) */
+    uint64_t inputs;        /* the largest <input> offset + 1 */
+    uint64_t vcount_sum;    /* a <polylist>'s vertices, from its <vcount> */
+} collada_primitive;
+
+/* The decimal value of attribute name, UINT64_MAX past 2^63 or negative;
+ * 0 when absent. */
+static uint64_t xml_count(const char *p, const char *end, const char *name)
+{
+    size_t len = 0;
+    const char *v = xml_attribute(p, end, name, &len);
+    if (!v)
+        return 0;
+    while (len > 0 && (*v == ' ' || *v == '\t' || *v == '\r' || *v == '\n'))
+        v++, len--;
+    if (len > 0 && *v == '-') {
+        for (size_t i = 1; i < len; i++)
+            if (v[i] != '0')
+                return UINT64_MAX;
+        return 0;
+    }
+    if (len > 0 && *v == '+')
+        v++, len--;
+    uint64_t value = 0;
+    for (size_t i = 0; i < len && v[i] >= '0' && v[i] <= '9'; i++) {
+        if (value > (UINT64_MAX / 2) / 10)
+            return UINT64_MAX;
+        value = value * 10 + (uint64_t)(v[i] - '0');
+    }
+    return value;
+}
+
+/* The largest number of items text of len bytes can hold. */
+static uint64_t items_in(size_t len)
+{
+    return (uint64_t)len / 2 + 1;
+}
+
+/* The text of an integer list from p up to its closing tag: only what
+ * assimp's reader steps over (digits, signs, spaces and line ends). Returns
+ * the bad character's position, or NULL; *len is the text's length and
+ * *sum the sum of its numbers (saturating). */
+static const char *integer_list(const char *p, const char *end, size_t *len, uint64_t *sum)
+{
+    const char *start = p;
+    *sum = 0;
+    uint64_t value = 0;
+    for (; p < end && *p != '<'; p++) {
+        char c = *p;
+        if (c >= '0' && c <= '9') {
+            value = value > UINT64_MAX / 20 ? UINT64_MAX / 2 : value * 10 + (uint64_t)(c - '0');
+            continue;
+        }
+        if (c != ' ' && c != '\t' && c != '\r' && c != '\n' && c != '\f' && c != '+' &&
+            c != '-')
+            return p;
+        *sum = *sum + value < *sum ? UINT64_MAX : *sum + value;
+        value = 0;
+    }
+    *sum = *sum + value < *sum ? UINT64_MAX : *sum + value;
+    *len = (size_t)(p - start);
+    /* the list ends at its own closing tag, not in a comment or CDATA */
+    if (p < end && (end - p < 2 || p[1] != '/'))
+        return p;
+    return NULL;
+}
+
+static bool is_primitive(const char *name, size_t len, uint64_t *vertices)
+{
+    static const struct {
+        const char *name;
+        uint64_t vertices;
+    } kinds[] = {{"triangles", 3}, {"lines", 2},     {"polylist", 0},  {"polygons", 0},
+                 {"tristrips", 0}, {"trifans", 0},   {"linestrips", 0}};
+    for (size_t i = 0; i < sizeof kinds / sizeof *kinds; i++)
+        if (name_is(name, len, kinds[i].name)) {
+            *vertices = kinds[i].vertices;
+            return true;
+        }
+    return false;
+}
+
+static bool name_ends_with(const char *name, size_t len, const char *tail)
+{
+    size_t n = strlen(tail);
+    return len >= n && memcmp(name + len - n, tail, n) == 0;
+}
+
+/* The checks above for the element opened by the tag [name, tag_end),
+ * its text starting at text (NULL for an empty element). */
+static lx_status collada_check_data(const collada_scan *s, const mapped_file *f,
+                                    collada_primitive *prim, const char *tag, const char *name,
+                                    size_t name_len, const char *attrs, const char *tag_end,
+                                    const char *text)
+{
+    const char *end = f->bytes + f->size;
+    uint64_t count = xml_count(attrs, tag_end, "count");
+    uint64_t vertices = 0;
+    if (count > (uint64_t)f->size)
+        return lx_fail(LX_ERR_FORMAT, "%s: line %zu: <%.*s> count %s beyond what the file holds",
+                       s->path, line_at(f->bytes, tag), (int)name_len, name,
+                       count == UINT64_MAX ? "negative or huge" : "of more items");
+    if (name_ends_with(name, name_len, "_array")) {
+        const char *close = text ? memchr(text, '<', (size_t)(end - text)) : NULL;
+        size_t len = text ? (size_t)((close ? close : end) - text) : 0;
+        if (count > items_in(len))
+            return lx_fail(LX_ERR_FORMAT,
+                           "%s: line %zu: <%.*s> count %llu beyond the %zu bytes of its text",
+                           s->path, line_at(f->bytes, tag), (int)name_len, name,
+                           (unsigned long long)count, len);
+    } else if (is_primitive(name, name_len, &vertices)) {
+        *prim = (collada_primitive){.open = true, .count = count, .vertices = vertices,
+                                    .inputs = 1};
+    } else if (prim->open && name_is(name, name_len, "input")) {
+        uint64_t offset = xml_count(attrs, tag_end, "offset");
+        if (offset >= 4096)
+            return lx_fail(LX_ERR_FORMAT, "%s: line %zu: <input> offset %s", s->path,
+                           line_at(f->bytes, tag),
+                           offset == UINT64_MAX ? "negative or huge" : "beyond 4095");
+        if (offset + 1 > prim->inputs)
+            prim->inputs = offset + 1;
+    } else if (name_is(name, name_len, "p") || name_is(name, name_len, "h") ||
+               name_is(name, name_len, "v") || name_is(name, name_len, "vcount")) {
+        size_t len = 0;
+        uint64_t sum = 0;
+        const char *bad = text ? integer_list(text, end, &len, &sum) : NULL;
+        if (bad)
+            return lx_fail(LX_ERR_FORMAT, "%s: line %zu: <%.*s> holds something other than "
+                                          "integers",
+                           s->path, line_at(f->bytes, bad), (int)name_len, name);
+        if (name_is(name, name_len, "vcount")) {
+            /* each vertex it counts is an index (or a weight) in the file */
+            if (sum > (uint64_t)f->size)
+                return lx_fail(LX_ERR_FORMAT,
+                               "%s: line %zu: <vcount> counts more vertices than the file holds",
+                               s->path, line_at(f->bytes, tag));
+            if (prim->open)
+                prim->vcount_sum = sum;
+        } else if (name_is(name, name_len, "p") && prim->open) {
+            uint64_t expected = prim->vertices ? prim->count * prim->vertices : prim->vcount_sum;
+            if (expected > items_in(len) / prim->inputs)
+                return lx_fail(LX_ERR_FORMAT,
+                               "%s: line %zu: %llu primitive vertices of %llu inputs each "
+                               "beyond the %zu bytes of the <p> holding them",
+                               s->path, line_at(f->bytes, tag), (unsigned long long)expected,
+                               (unsigned long long)prim->inputs, len);
+        }
+    }
+    return LX_OK;
+}
+
 static lx_status collada_scan_tags(collada_scan *s, const mapped_file *f)
 {
+    collada_primitive prim = {0};
     const char *p = f->bytes, *end = f->bytes + f->size;
     uint32_t innermost[XML_DEPTH_MAX]; /* the nearest enclosing <node> */
     size_t depth = 0;
@@ -380,6 +545,15 @@ static lx_status collada_scan_tags(collada_scan *s, const mapped_file *f)
         bool closing = p < end && *p == '/';
         bool empty = q > p && q[-1] == '/';
         if (closing) {
+            const char *close_name = p + 1;
+            size_t close_len = 0;
+            while (close_name + close_len < q && close_name[close_len] != ' ' &&
+                   close_name[close_len] != '\t' && close_name[close_len] != '\r' &&
+                   close_name[close_len] != '\n')
+                close_len++;
+            uint64_t vertices;
+            if (is_primitive(close_name, close_len, &vertices))
+                prim.open = false;
             if (depth > 0)
                 depth--;
             p = q + 1;
@@ -426,6 +600,10 @@ static lx_status collada_scan_tags(collada_scan *s, const mapped_file *f)
                 s->instance_url[s->instances++] = copy;
             }
         }
+        lx_status st = collada_check_data(s, f, &prim, tag, name, name_len, p,
+                                          empty ? q - 1 : q, empty ? NULL : q + 1);
+        if (st != LX_OK)
+            return st;
         p = q + 1;
         if (empty)
             continue;

@@ -154,19 +154,33 @@ static void test_gltf1_depth(void **state)
 
 /* ---- Collada ------------------------------------------------------------------ */
 
+static const char COLLADA_POSITIONS[] = "<float_array id=\"pa\" count=\"9\">0 0 0 1 0 0 0 0 1"
+                                        "</float_array>";
+static const char COLLADA_TRIANGLE[] =
+    "<triangles count=\"1\"><input semantic=\"VERTEX\" source=\"#v\" offset=\"0\"/>"
+    "<p>0 1 2</p></triangles>";
+
+/* A Collada file's head with one mesh "tri" of the given positions array
+ * and primitives. */
+static void collada_head_with(text *t, const char *positions, const char *primitives)
+{
+    putf(t,
+         "<?xml version=\"1.0\"?>\n<COLLADA xmlns=\"http://www.collada.org/2005/11/"
+         "COLLADASchema\" version=\"1.4.1\">\n<asset><unit meter=\"1\"/><up_axis>Y_UP"
+         "</up_axis></asset>\n"
+         "<library_geometries><geometry id=\"tri\"><mesh>"
+         "<source id=\"p\">%s"
+         "<technique_common><accessor source=\"#pa\" count=\"3\" stride=\"3\">"
+         "<param name=\"X\" type=\"float\"/><param name=\"Y\" type=\"float\"/>"
+         "<param name=\"Z\" type=\"float\"/></accessor></technique_common></source>"
+         "<vertices id=\"v\"><input semantic=\"POSITION\" source=\"#p\"/></vertices>"
+         "%s</mesh></geometry></library_geometries>\n",
+         positions, primitives);
+}
+
 static void collada_head(text *t)
 {
-    putf(t, "<?xml version=\"1.0\"?>\n<COLLADA xmlns=\"http://www.collada.org/2005/11/"
-            "COLLADASchema\" version=\"1.4.1\">\n<asset><unit meter=\"1\"/><up_axis>Y_UP"
-            "</up_axis></asset>\n"
-            "<library_geometries><geometry id=\"tri\"><mesh>"
-            "<source id=\"p\"><float_array id=\"pa\" count=\"9\">0 0 0 1 0 0 0 0 1</float_array>"
-            "<technique_common><accessor source=\"#pa\" count=\"3\" stride=\"3\">"
-            "<param name=\"X\" type=\"float\"/><param name=\"Y\" type=\"float\"/>"
-            "<param name=\"Z\" type=\"float\"/></accessor></technique_common></source>"
-            "<vertices id=\"v\"><input semantic=\"POSITION\" source=\"#p\"/></vertices>"
-            "<triangles count=\"1\"><input semantic=\"VERTEX\" source=\"#v\" offset=\"0\"/>"
-            "<p>0 1 2</p></triangles></mesh></geometry></library_geometries>\n");
+    collada_head_with(t, COLLADA_POSITIONS, COLLADA_TRIANGLE);
 }
 
 static void collada_tail(text *t)
@@ -245,6 +259,79 @@ static void test_collada_instances(void **state)
     save(&t, path);
     loads(path);
     free(t.s);
+}
+
+/* The counts assimp sizes arrays by, and the integer lists it reads until
+ * their text ends, against the text that holds them: each case a few
+ * hundred bytes that asked assimp for gigabytes (or grew without end). */
+static void write_collada_mesh(const char *path, const char *positions, const char *primitives)
+{
+    text t = {0};
+    collada_head_with(&t, positions, primitives);
+    putf(&t, "<library_visual_scenes><visual_scene id=\"s\"><node id=\"n\">"
+             "<instance_geometry url=\"#tri\"/></node>");
+    collada_tail(&t);
+    save(&t, path);
+    free(t.s);
+}
+
+static void test_collada_data(void **state)
+{
+    (void)state;
+    const char *path = file_in("test_import_hierarchy_dae_data", "mesh.dae");
+    static const struct {
+        const char *positions, *primitives, *says;
+    } bad[] = {
+        /* the fuzzer's case: a character assimp's index reader never passes */
+        {COLLADA_POSITIONS,
+         "<triangles count=\"1\"><input semantic=\"VERTEX\" source=\"#v\" offset=\"0\"/>"
+         "<p>0 1) 2</p></triangles>",
+         "<p> holds something other than integers"},
+        {COLLADA_POSITIONS,
+         "<triangles count=\"1\"><input semantic=\"VERTEX\" source=\"#v\" offset=\"0\"/>"
+         "<p>0 1<![CDATA[x]]> 2</p></triangles>",
+         "<p> holds something other than integers"},
+        {"<float_array id=\"pa\" count=\"400000000\">0 0 0 1 0 0 0 0 1</float_array>",
+         COLLADA_TRIANGLE, "count of more items beyond what the file holds"},
+        {"<float_array id=\"pa\" count=\"90\">0 0 0 1 0 0 0 0 1</float_array>",
+         COLLADA_TRIANGLE, "count 90 beyond the 17 bytes of its text"},
+        {"<float_array id=\"pa\" count=\"-1\">0 0 0 1 0 0 0 0 1</float_array>",
+         COLLADA_TRIANGLE, "count negative or huge"},
+        {COLLADA_POSITIONS,
+         "<triangles count=\"300\"><input semantic=\"VERTEX\" source=\"#v\" offset=\"0\"/>"
+         "<p>0 1 2</p></triangles>",
+         "900 primitive vertices of 1 inputs each beyond the 5 bytes"},
+        {COLLADA_POSITIONS,
+         "<triangles count=\"1\"><input semantic=\"VERTEX\" source=\"#v\" offset=\"0\"/>"
+         "<input semantic=\"NORMAL\" source=\"#p\" offset=\"4000\"/>"
+         "<p>0 1 2</p></triangles>",
+         "primitive vertices of 4001 inputs each"},
+        {COLLADA_POSITIONS,
+         "<triangles count=\"1\"><input semantic=\"VERTEX\" source=\"#v\" offset=\"9999\"/>"
+         "<p>0 1 2</p></triangles>",
+         "<input> offset beyond 4095"},
+        {COLLADA_POSITIONS,
+         "<polylist count=\"1\"><input semantic=\"VERTEX\" source=\"#v\" offset=\"0\"/>"
+         "<vcount>300</vcount><p>0 1 2</p></polylist>",
+         "300 primitive vertices"},
+        {COLLADA_POSITIONS,
+         "<polylist count=\"1\"><input semantic=\"VERTEX\" source=\"#v\" offset=\"0\"/>"
+         "<vcount>4000000000</vcount><p>0 1 2</p></polylist>",
+         "<vcount> counts more vertices than the file holds"},
+    };
+    for (size_t i = 0; i < sizeof bad / sizeof *bad; i++) {
+        write_collada_mesh(path, bad[i].positions, bad[i].primitives);
+        refused(path, bad[i].says);
+    }
+    /* the same meshes written as exporters write them load */
+    write_collada_mesh(path, COLLADA_POSITIONS, COLLADA_TRIANGLE);
+    loads(path);
+    write_collada_mesh(path,
+                       "<float_array id=\"pa\" count=\"9\">\n  0 0 0\n  1 0 0\n  0 0 1\n"
+                       "</float_array>",
+                       "<polylist count=\"1\"><input semantic=\"VERTEX\" source=\"#v\" "
+                       "offset=\"0\"/><vcount>3 </vcount><p>\n0 1 2\n</p></polylist>");
+    loads(path);
 }
 
 /* ---- FBX ------------------------------------------------------------------------ */
@@ -412,6 +499,7 @@ int main(void)
     const struct CMUnitTest tests[] = {
         cmocka_unit_test(test_gltf_depth),    cmocka_unit_test(test_gltf1_depth),
         cmocka_unit_test(test_collada_depth), cmocka_unit_test(test_collada_instances),
+        cmocka_unit_test(test_collada_data),
         cmocka_unit_test(test_fbx_ascii),     cmocka_unit_test(test_fbx_binary),
     };
     return cmocka_run_group_tests(tests, NULL, NULL);
