@@ -86,8 +86,10 @@ int lx_thread_count(int requested);
 /* A file written under a temporary name in the target folder
  * (<path>.tmp.<random>, created with O_EXCL and mode 0666 less the umask)
  * and renamed over the target by lx_out_commit; lx_out_abort removes it.
- * Nothing process-wide is touched: no signal masks, no umask calls, no
- * registry. */
+ * The writer holds an flock on it throughout, so lx_out_open can tell a
+ * temporary file of the same target left by a killed run (nobody holds
+ * it): it removes such files with one warning each. Nothing process-wide
+ * is touched: no signal masks, no umask calls, no registry. */
 typedef struct lx_out_file {
     void *fp; /* FILE* */
     char *tmp_path;

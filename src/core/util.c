@@ -1,8 +1,9 @@
 /* Sizes, thread counts, atomic output files, counter-based
  * hashing, whole-file reads and path helpers (declared in internal.h). */
-#define _POSIX_C_SOURCE 200809L
+#define _DEFAULT_SOURCE /* flock, DT_REG */
 #include "internal.h"
 
+#include <dirent.h>
 #include <errno.h>
 #include <fcntl.h>
 #include <omp.h>
@@ -10,6 +11,7 @@
 #include <stdio.h>
 #include <stdlib.h>
 #include <string.h>
+#include <sys/file.h>
 #include <sys/stat.h>
 #include <time.h>
 #include <unistd.h>
@@ -49,6 +51,55 @@ static void temp_suffix(char out[7])
     out[6] = '\0';
 }
 
+/* True for the name of a temporary file of lx_out_open for base:
+ * "<base>.tmp." and six of temp_suffix's characters. */
+static bool is_temp_of(const char *name, const char *base)
+{
+    size_t n = strlen(base);
+    if (strncmp(name, base, n) != 0 || strncmp(name + n, ".tmp.", 5) != 0)
+        return false;
+    const char *suffix = name + n + 5;
+    if (strlen(suffix) != 6)
+        return false;
+    for (int i = 0; i < 6; i++)
+        if (!((suffix[i] >= 'a' && suffix[i] <= 'z') || (suffix[i] >= '0' && suffix[i] <= '9')))
+            return false;
+    return true;
+}
+
+/* A writer holds an exclusive flock on its temporary file until it is
+ * renamed or removed. A temporary file of the same target that nobody
+ * holds was left by a run that was killed (or crashed) before it could
+ * remove it: it is reported and removed, as nothing else could finish it. */
+static void remove_leftovers(const char *path, const char *mine)
+{
+    char *folder = lx_path_dirname(path);
+    const char *base = strrchr(path, '/') ? strrchr(path, '/') + 1 : path;
+    DIR *dir = folder ? opendir(folder) : NULL;
+    if (!dir) {
+        free(folder);
+        return;
+    }
+    const char *mine_base = strrchr(mine, '/') ? strrchr(mine, '/') + 1 : mine;
+    struct dirent *e;
+    while ((e = readdir(dir)) != NULL) {
+        if (!is_temp_of(e->d_name, base) || strcmp(e->d_name, mine_base) == 0)
+            continue;
+        int fd = openat(dirfd(dir), e->d_name, O_RDONLY | O_NOFOLLOW | O_CLOEXEC | O_NONBLOCK);
+        if (fd < 0)
+            continue;
+        struct stat st;
+        if (fstat(fd, &st) == 0 && S_ISREG(st.st_mode) && flock(fd, LOCK_EX | LOCK_NB) == 0 &&
+            unlinkat(dirfd(dir), e->d_name, 0) == 0)
+            lx_log(LX_LOG_WARN, "%s/%s: removed, a partial file of %s left by a run that was "
+                                "stopped",
+                   folder, e->d_name, base);
+        close(fd);
+    }
+    closedir(dir);
+    free(folder);
+}
+
 lx_status lx_out_open(lx_out_file *f, const char *path)
 {
     memset(f, 0, sizeof *f);
@@ -71,7 +122,18 @@ lx_status lx_out_open(lx_out_file *f, const char *path)
         err = errno;
         if (fd < 0 && err != EEXIST)
             break;
+        /* held until the file is renamed or removed; a leftover sweep of
+         * another writer may have taken this file between open and flock,
+         * so a file no longer linked is given up for a new one */
+        struct stat st;
+        if (fd >= 0 && (flock(fd, LOCK_EX) != 0 || fstat(fd, &st) != 0 || st.st_nlink == 0)) {
+            close(fd);
+            fd = -1;
+            err = EEXIST;
+        }
     }
+    if (fd >= 0)
+        remove_leftovers(path, f->tmp_path);
     if (fd < 0) {
         free(f->path);
         free(f->tmp_path);
@@ -92,18 +154,20 @@ lx_status lx_out_commit(lx_out_file *f)
 {
     FILE *fp = f->fp;
     f->fp = NULL;
-    /* on disk before the rename, so a crash never leaves an empty target */
+    /* on disk before the rename, so a crash never leaves an empty target;
+     * renamed while still open (and locked), so no leftover sweep takes it */
     int failed = fflush(fp) != 0 || ferror(fp) || fsync(fileno(fp)) != 0;
     int err = errno;
-    if (fclose(fp) != 0 && !failed) {
-        failed = 1;
-        err = errno;
-    }
     const char *what = "write failed";
     if (!failed && rename(f->tmp_path, f->path) != 0) {
         failed = 1;
         err = errno;
         what = "cannot rename temporary file";
+    }
+    if (fclose(fp) != 0 && !failed) {
+        failed = 1;
+        err = errno;
+        unlink(f->path); /* renamed, but not all of it written */
     }
     if (failed) {
         char *path = f->path;
@@ -121,10 +185,10 @@ lx_status lx_out_commit(lx_out_file *f)
 
 void lx_out_abort(lx_out_file *f)
 {
-    if (f->fp)
-        fclose(f->fp);
     if (f->tmp_path)
         unlink(f->tmp_path);
+    if (f->fp)
+        fclose(f->fp);
     free(f->tmp_path);
     free(f->path);
     memset(f, 0, sizeof *f);

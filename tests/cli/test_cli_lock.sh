@@ -161,4 +161,31 @@ check "$label: the subfolder the user put there stays" \
 expect_stderr_has "$label: a warning says what could not be removed" \
     "could not remove all of .luxel-Zz99yy"
 
+# ---- a single file's partial copy: out.glb.tmp.XXXXXX ----------------------------
+
+# unwrap, tangents and the library's writers write <name>.tmp.XXXXXX beside
+# the target under an flock and rename it over the target; a run killed
+# mid-write leaves it. The next write of that target reports and removes
+# the ones nobody holds; one a live writer holds (its flock), and names
+# that are not its own, stay.
+mkdir -p "$WORK/single"
+echo partial >"$WORK/single/out.glb.tmp.abc123"
+echo live >"$WORK/single/out.glb.tmp.zz9999"
+echo "the user's" >"$WORK/single/out.glb.tmp.NotOurs"
+echo "the user's" >"$WORK/single/other.glb.tmp.abc123"
+exec {live_fd}<"$WORK/single/out.glb.tmp.zz9999"
+flock -n "$live_fd" || { echo "flock(1) cannot lock a file here"; exit 1; }
+for cmd in unwrap tangents; do
+    label="$cmd into a folder with a partial out.glb of a stopped run"
+    run "$LUXEL" "$cmd" "$ROOM" -o "$WORK/single/out.glb"
+    expect_rc 0 "$label"
+    expect_files "$label: the partial file gone, the others kept" "$WORK/single" out.glb \
+        out.glb.tmp.zz9999 out.glb.tmp.NotOurs other.glb.tmp.abc123
+    echo partial >"$WORK/single/out.glb.tmp.abc123"
+done
+check "the partial file was named in one warning" test "$(grep -cxF \
+    "luxel: warning: $WORK/single/out.glb.tmp.abc123: removed, a partial file of out.glb left by a run that was stopped" \
+    "$ERR")" -eq 1
+exec {live_fd}<&-
+
 finish
