@@ -47,4 +47,44 @@ for scene in deep.gltf deep.dae; do
 done
 check "no staging folder left" test -z "$(find "$WORK" -name '.luxel-*' -print -quit)"
 
+# ---- an import assimp cannot be stopped in: a signal still ends the run ----------
+
+# 100,000 vertices at one point (an accessor without a bufferView, one
+# sparse value): assimp's normal generation compares every pair, half a
+# minute or more. SIGTERM a second in ends each command at once (the import
+# left running, the process ended by the signal): status 143, one line, no
+# output, no staging folder. Before, the signal waited for the import.
+sparse_one='AAAAAAAAgD8AAAAAAAAAAA==' # index 0, then the position (1, 0, 0)
+printf '%s' '{"asset":{"version":"2.0"},"scene":0,"scenes":[{"nodes":[0]}],"nodes":[{"mesh":0}],' \
+    '"meshes":[{"primitives":[{"attributes":{"POSITION":0}}]}],' \
+    '"buffers":[{"byteLength":16,"uri":"data:application/octet-stream;base64,'"$sparse_one"'"}],' \
+    '"bufferViews":[{"buffer":0,"byteLength":4},{"buffer":0,"byteOffset":4,"byteLength":12}],' \
+    '"accessors":[{"componentType":5126,"count":100000,"type":"VEC3","min":[0,0,0],"max":[1,0,0],' \
+    '"sparse":{"count":1,"indices":{"bufferView":0,"componentType":5125},"values":{"bufferView":1}}}]}' \
+    >"$IN/one_point.gltf"
+for cmd in bake info unwrap; do
+    out=$WORK/out/$cmd-one_point
+    case $cmd in
+    bake) args=(bake "$IN/one_point.gltf" --ambient 1 -o "$out") ;;
+    info) args=(info "$IN/one_point.gltf") ;;
+    unwrap) args=(unwrap "$IN/one_point.gltf" -o "$out.glb") ;;
+    esac
+    "$LUXEL" "${args[@]}" >"$OUT" 2>"$ERR" </dev/null &
+    pid=$!
+    sleep 1
+    kill -TERM "$pid"
+    start=$(date +%s%N)
+    wait "$pid"
+    RC=$?
+    ms=$((($(date +%s%N) - start) / 1000000))
+    label="$cmd of one_point.gltf, SIGTERM during the import"
+    expect_rc 143 "$label"
+    check "$label: ends within 2 s of the signal ($ms ms)" test "$ms" -lt 2000
+    expect_error "$label" "interrupted"
+    expect_no_output "$label" "$out"
+    check "$label: no file beside the output" test ! -e "$out.glb"
+done
+check "no staging folder left after the interrupts" \
+    test -z "$(find "$WORK" -name '.luxel-*' -print -quit)"
+
 finish

@@ -471,10 +471,8 @@ int cli_bake_prepare(bake_args *a, cli_progress *progress, lx_scene **scene_out,
     *baker = NULL;
     *atlas = false;
     lx_scene_load_desc ld = {.strict = a->desc.strict, .allow_any_path = cli_allow_any_path()};
-    if (lx_scene_load(a->scene, &ld, &scene) != LX_OK) {
-        cli_error("%s", lx_last_error());
+    if (!cli_scene_load(a->scene, &ld, &scene))
         goto done;
-    }
     *scene_out = scene;
     cli_phase("import");
     if (a->lights && lx_lights_json_apply(scene, a->lights) != LX_OK) {

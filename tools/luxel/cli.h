@@ -191,6 +191,14 @@ bool cli_interrupted(void);
 int cli_interrupt_signal(void);
 /* Prints the one error line of an interrupted run. */
 void cli_report_interrupt(bool removed_outputs);
+/* lx_scene_load, interruptible: the import runs on a thread of its own
+ * while this one waits for it or for a signal. assimp's import has no way
+ * to stop, and some files keep it busy for minutes (its normal generation
+ * is quadratic in vertices at one position), so on a signal the import is
+ * left running and the command winds down as interrupted (the process
+ * ends on the signal, the import with it). False, with the error printed
+ * (or the interrupt reported), when no scene was loaded. */
+bool cli_scene_load(const char *path, const lx_scene_load_desc *desc, lx_scene **out);
 
 /* Test hooks, read from the environment (never set outside tests):
  * LUXEL_TEST_PAUSE=PHASE stops the run the first time it reaches PHASE (a

@@ -165,10 +165,8 @@ int cmd_info(int argc, char **argv)
      * triangles are dropped with a warning (--strict: refused) */
     lx_scene_load_desc ld = {
         .skip_textures = true, .strict = strict, .allow_any_path = cli_allow_any_path()};
-    if (lx_scene_load(path, &ld, &s) != LX_OK) {
-        cli_error("%s", lx_last_error());
+    if (!cli_scene_load(path, &ld, &s))
         return EXIT_FAILED;
-    }
     if (lights && lx_lights_json_apply(s, lights) != LX_OK) {
         cli_error("%s", lx_last_error());
         lx_scene_destroy(s);

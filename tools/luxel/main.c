@@ -299,6 +299,62 @@ void cli_report_interrupt(bool removed_outputs)
     cli_error("interrupted; %s", removed_outputs ? "outputs removed" : "nothing written");
 }
 
+/* One scene load on a thread of its own (cli_scene_load). An abandoned
+ * job is never freed: the process is about to end on the signal. */
+typedef struct scene_load_job {
+    const char *path;
+    lx_scene_load_desc desc;
+    lx_scene *scene;
+    char error[1024];
+    _Atomic bool done;
+} scene_load_job;
+
+static void *scene_load_run(void *arg)
+{
+    scene_load_job *job = arg;
+    if (lx_scene_load(job->path, &job->desc, &job->scene) != LX_OK)
+        snprintf(job->error, sizeof job->error, "%s", lx_last_error());
+    atomic_store(&job->done, true);
+    return NULL;
+}
+
+bool cli_scene_load(const char *path, const lx_scene_load_desc *desc, lx_scene **out)
+{
+    *out = NULL;
+    scene_load_job *job = calloc(1, sizeof *job);
+    if (!job) {
+        cli_error("%s: out of memory", path);
+        return false;
+    }
+    job->path = path;
+    job->desc = *desc;
+    pthread_t thread;
+    int err = pthread_create(&thread, NULL, scene_load_run, job);
+    if (err != 0) {
+        free(job);
+        cli_error("%s: cannot start the import thread: %s", path, strerror(err));
+        return false;
+    }
+    while (!atomic_load(&job->done)) {
+        int sig = take_signal(0.05);
+        if (sig) {
+            int none = 0;
+            atomic_compare_exchange_strong(&interrupt_signal, &none, sig);
+            pthread_detach(thread);
+            cli_report_interrupt(false);
+            return false;
+        }
+    }
+    pthread_join(thread, NULL);
+    bool loaded = job->scene != NULL;
+    if (loaded)
+        *out = job->scene;
+    else
+        cli_error("%s", job->error);
+    free(job);
+    return loaded;
+}
+
 /* Ends an interrupted run the way the signal would have: default action,
  * unblocked, raised. Returns only if the signal does not end the process. */
 static int end_interrupted(int sig)

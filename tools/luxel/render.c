@@ -729,10 +729,8 @@ int cmd_render(int argc, char **argv)
     lx_scene *scene = NULL;
     int status = EXIT_FAILED;
     lx_scene_load_desc ld = {.allow_any_path = cli_allow_any_path()};
-    if (lx_scene_load(path, &ld, &scene) != LX_OK) {
-        cli_error("%s", lx_last_error());
+    if (!cli_scene_load(path, &ld, &scene))
         goto done;
-    }
     cli_phase("import");
     if (!with_uvs && any_generated(&lm)) {
         if (unwrap_again(&lm, scene, a.scene, a.desc.threads, a.quiet) != EXIT_OK)

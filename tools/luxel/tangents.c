@@ -190,10 +190,8 @@ int cmd_tangents(int argc, char **argv)
     lx_scene_uvs *entries = NULL;
     int status = EXIT_FAILED;
     lx_scene_load_desc ld = {.allow_any_path = cli_allow_any_path()};
-    if (lx_scene_load(a.scene, &ld, &scene) != LX_OK) {
-        cli_error("%s", lx_last_error());
+    if (!cli_scene_load(a.scene, &ld, &scene))
         goto done;
-    }
     outs = calloc(scene->mesh_count + 1, sizeof *outs);
     entries = calloc(scene->mesh_count + 1, sizeof *entries);
     if (!outs || !entries) {

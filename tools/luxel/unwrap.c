@@ -226,10 +226,8 @@ int cmd_unwrap(int argc, char **argv)
     lx_unwrap *u = NULL;
     int status = EXIT_FAILED;
     lx_scene_load_desc ld = {.strict = a.strict, .allow_any_path = cli_allow_any_path()};
-    if (lx_scene_load(a.scene, &ld, &scene) != LX_OK) {
-        cli_error("%s", lx_last_error());
+    if (!cli_scene_load(a.scene, &ld, &scene))
         goto done;
-    }
     cli_phase("import");
     if (scene->node_count == 0) {
         cli_error("%s: the scene has no meshes to unwrap", a.scene);
