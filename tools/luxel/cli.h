@@ -191,13 +191,13 @@ bool cli_interrupted(void);
 int cli_interrupt_signal(void);
 /* Prints the one error line of an interrupted run. */
 void cli_report_interrupt(bool removed_outputs);
-/* lx_scene_load, interruptible: the import runs on a thread of its own
- * while this one waits for it or for a signal. assimp's import has no way
- * to stop, and some files keep it busy for minutes (its normal generation
- * is quadratic in vertices at one position), so on a signal the import is
- * left running and the command winds down as interrupted (the process
- * ends on the signal, the import with it). False, with the error printed
- * (or the interrupt reported), when no scene was loaded. */
+/* lx_scene_load, interruptible. assimp's import has no way to stop, and
+ * some files keep it busy for minutes (its normal generation is quadratic
+ * in vertices at one position), so a watcher thread (it allocates nothing:
+ * no malloc arena of its own) takes signals while the scene loads; on one
+ * it reports the interrupt, clears the active stage (cli_stage_clear_active)
+ * and ends the process on the signal. False, with the error printed, when
+ * the load fails. */
 bool cli_scene_load(const char *path, const lx_scene_load_desc *desc, lx_scene **out);
 
 /* Test hooks, read from the environment (never set outside tests):
@@ -299,6 +299,9 @@ bool cli_stage_publish(cli_stage *st);
 /* Removes whatever is still staged, the staging folder, and, unless the
  * outputs were published, the folders the run created. */
 void cli_stage_clear(cli_stage *st);
+/* cli_stage_clear of the stage begun last and not yet cleared, if any:
+ * for a run ending on a signal while its thread is busy elsewhere. */
+void cli_stage_clear_active(void);
 
 /* ---- JSON and stale outputs (stale.c) -------------------------------------
  * cJSON reports only where it stopped: true when that place is a '}' or

@@ -299,62 +299,6 @@ void cli_report_interrupt(bool removed_outputs)
     cli_error("interrupted; %s", removed_outputs ? "outputs removed" : "nothing written");
 }
 
-/* One scene load on a thread of its own (cli_scene_load). An abandoned
- * job is never freed: the process is about to end on the signal. */
-typedef struct scene_load_job {
-    const char *path;
-    lx_scene_load_desc desc;
-    lx_scene *scene;
-    char error[1024];
-    _Atomic bool done;
-} scene_load_job;
-
-static void *scene_load_run(void *arg)
-{
-    scene_load_job *job = arg;
-    if (lx_scene_load(job->path, &job->desc, &job->scene) != LX_OK)
-        snprintf(job->error, sizeof job->error, "%s", lx_last_error());
-    atomic_store(&job->done, true);
-    return NULL;
-}
-
-bool cli_scene_load(const char *path, const lx_scene_load_desc *desc, lx_scene **out)
-{
-    *out = NULL;
-    scene_load_job *job = calloc(1, sizeof *job);
-    if (!job) {
-        cli_error("%s: out of memory", path);
-        return false;
-    }
-    job->path = path;
-    job->desc = *desc;
-    pthread_t thread;
-    int err = pthread_create(&thread, NULL, scene_load_run, job);
-    if (err != 0) {
-        free(job);
-        cli_error("%s: cannot start the import thread: %s", path, strerror(err));
-        return false;
-    }
-    while (!atomic_load(&job->done)) {
-        int sig = take_signal(0.05);
-        if (sig) {
-            int none = 0;
-            atomic_compare_exchange_strong(&interrupt_signal, &none, sig);
-            pthread_detach(thread);
-            cli_report_interrupt(false);
-            return false;
-        }
-    }
-    pthread_join(thread, NULL);
-    bool loaded = job->scene != NULL;
-    if (loaded)
-        *out = job->scene;
-    else
-        cli_error("%s", job->error);
-    free(job);
-    return loaded;
-}
-
 /* Ends an interrupted run the way the signal would have: default action,
  * unblocked, raised. Returns only if the signal does not end the process. */
 static int end_interrupted(int sig)
@@ -367,6 +311,48 @@ static int end_interrupted(int sig)
     raise(sig);
     pthread_sigmask(SIG_UNBLOCK, &set, NULL);
     return 128 + sig;
+}
+
+/* cli_scene_load's watcher: takes the interrupting signals while the scene
+ * loads, and on one ends the run as the signal would. */
+static _Atomic bool scene_loading;
+
+static void *watch_scene_load(void *arg)
+{
+    (void)arg;
+    while (atomic_load(&scene_loading)) {
+        int sig = take_signal(0.02);
+        if (!sig)
+            continue;
+        atomic_store(&interrupt_signal, sig);
+        cli_stage_clear_active();
+        cli_report_interrupt(false);
+        end_interrupted(sig);
+        _exit(128 + sig); /* a signal whose default action is not to end */
+    }
+    return NULL;
+}
+
+bool cli_scene_load(const char *path, const lx_scene_load_desc *desc, lx_scene **out)
+{
+    *out = NULL;
+    pthread_attr_t attr;
+    pthread_t watcher;
+    bool watching = false;
+    atomic_store(&scene_loading, true);
+    if (pthread_attr_init(&attr) == 0) {
+        pthread_attr_setstacksize(&attr, 256 * 1024);
+        watching = pthread_create(&watcher, &attr, watch_scene_load, NULL) == 0;
+        pthread_attr_destroy(&attr);
+    }
+    /* without a watcher the load is not interruptible, as before */
+    lx_status st = lx_scene_load(path, desc, out);
+    atomic_store(&scene_loading, false);
+    if (watching)
+        pthread_join(watcher, NULL);
+    if (st != LX_OK)
+        cli_error("%s", lx_last_error());
+    return st == LX_OK;
 }
 
 void cli_test_pause(const char *phase)

@@ -334,6 +334,9 @@ static void handle_leftovers(const cli_stage *st, bool clean, bool clean_option)
     }
 }
 
+/* The stage begun last and not yet cleared (cli_stage_clear_active). */
+static cli_stage *active_stage;
+
 /* cli_stage_begin and cli_stage_begin_set. */
 static bool stage_begin(cli_stage *st, const char *output, bool lock, bool clean, bool clean_option)
 {
@@ -361,7 +364,14 @@ static bool stage_begin(cli_stage *st, const char *output, bool lock, bool clean
         return false;
     }
     handle_leftovers(st, clean, clean_option);
+    active_stage = st;
     return true;
+}
+
+void cli_stage_clear_active(void)
+{
+    if (active_stage)
+        cli_stage_clear(active_stage);
 }
 
 bool cli_stage_begin(cli_stage *st, const char *output)
@@ -579,6 +589,8 @@ bool cli_stage_publish(cli_stage *st)
 
 void cli_stage_clear(cli_stage *st)
 {
+    if (st == active_stage)
+        active_stage = NULL;
     if (st->dir) {
         for (uint32_t i = 0; i < st->count; i++) {
             char *path = cli_path_join(st->dir, st->names[i]);
