@@ -72,15 +72,18 @@ typedef enum lx_quantity {
 
 /* Which UV set holds a node's lightmap UVs. */
 typedef enum lx_uv_choice {
-    LX_UV_SET_AUTO = 0, /* TEXCOORD_1 when every mesh with UVs has it, else TEXCOORD_0 */
+    LX_UV_SET_AUTO = 0, /* luxel's own lightmap set, else TEXCOORD_1, else TEXCOORD_0
+                           (lx_bake_uv_set) */
     LX_UV_SET_0,        /* TEXCOORD_0 */
     LX_UV_SET_1         /* TEXCOORD_1 */
 } lx_uv_choice;
 
-/* The lightmap UV set (0 or 1) of scene node `node` under `choice`: the
- * set named, or for LX_UV_SET_AUTO TEXCOORD_1 when every mesh of the node
- * that has UVs has it, else TEXCOORD_0. Whether the meshes have it is
- * the caller's to check. */
+/* The lightmap UV set of scene node `node` under `choice`: the set named,
+ * or for LX_UV_SET_AUTO the set luxel writes lightmap UVs to
+ * (lx_scene_lightmap_set) when that is above TEXCOORD_1 - a set no material
+ * reads, so one luxel wrote - and every mesh of the node that has UVs has
+ * it; else TEXCOORD_1 when every such mesh has it; else TEXCOORD_0.
+ * Whether the meshes have it is the caller's to check. */
 int lx_bake_uv_set(const lx_scene *scene, uint32_t node, lx_uv_choice choice);
 
 /* lx_lightmap_info.uv_set of an atlas page whose nodes use different sets. */
@@ -231,7 +234,7 @@ typedef struct lx_lightmap_info {
                          several nodes */
     const char *name; /* node name, or "lightmap-<k>" for atlas page k */
     int width, height;
-    int uv_set;              /* 1 = TEXCOORD_1, 0 = TEXCOORD_0, LX_UV_SET_MIXED */
+    int uv_set;              /* n = TEXCOORD_n, or LX_UV_SET_MIXED */
     uint32_t used_texels;    /* texels covered by triangles */
     uint32_t overlap_texels; /* texels claimed by two triangles' interiors */
 } lx_lightmap_info;

@@ -137,7 +137,7 @@ typedef struct lx_lightmap_node {
     char *name;            /* scene node name */
     uint32_t mesh_count;   /* meshes the manifest lists for it */
     uint32_t page;         /* index into pages */
-    int uv_set;            /* 0 = TEXCOORD_0, 1 = TEXCOORD_1 */
+    int uv_set;            /* n = TEXCOORD_n, below LX_MAX_UV_SETS */
     bool generated;        /* luxel made the UVs ("uvs": "generated") */
     float scale_offset[4]; /* node UV -> page UV */
 } lx_lightmap_node;

@@ -50,7 +50,9 @@
 extern "C" {
 #endif
 
-#define LX_MAX_UV_SETS 2
+/* UV sets a mesh keeps: TEXCOORD_0 to TEXCOORD_7, as assimp reads them
+ * (three.js reads four: uv to uv3). */
+#define LX_MAX_UV_SETS 8
 
 typedef struct lx_mesh {
     char *name;
@@ -121,6 +123,11 @@ typedef struct lx_material {
     int emissive_uv_set;                /* texCoord (or KHR_texture_transform's) */
     char *emissive_map_path;            /* where it came from, or NULL */
     lx_uv_transform emissive_transform; /* KHR_texture_transform of the map */
+    /* Bit k set: some texture of the material reads TEXCOORD_k - any
+     * texture the file gives it (occlusion, metallic-roughness, extensions'
+     * textures), not only those luxel samples. A lightmap set luxel writes
+     * never takes such a set (lx_scene_lightmap_set). */
+    uint32_t uv_sets_read;
     /* The lights JSON's "materials" entry (docs/lights-json.md): a height
      * texture the baker self-shadows (horizon) and occludes (ao) the
      * material's texels with, read at uv[normal_uv_set] under
@@ -349,10 +356,10 @@ lx_glb_write_desc lx_glb_write_desc_defaults(const lx_glb_write_desc *desc);
  * extensions, extras) except that each primitive with new UVs gets every
  * vertex attribute and morph target rebuilt per new vertex, new indices
  * (mode TRIANGLES, triangles in the file's order) and the UVs as
- * TEXCOORD_1 - or, when TEXCOORD_1 exists and the primitive's material
- * reads a texture through it, as the next free TEXCOORD_n. A primitive
- * without TEXCOORD_0 gets the UVs as TEXCOORD_0 too (sets are numbered
- * from 0). A mesh that several nodes place with new UVs is copied for
+ * TEXCOORD_n, n = lx_scene_lightmap_set of the node (replacing a set of
+ * that name, which no material of the node reads). A primitive lacking a
+ * set below n gets the UVs there too (sets are numbered from 0 without
+ * gaps). A mesh that several nodes place with new UVs is copied for
  * every node after the first. An entry's attributes are added to its
  * primitive, replacing those of the same name (a TANGENT is left out, with
  * a warning through lx_log, where the file's primitive has no NORMAL).
@@ -370,6 +377,14 @@ lx_glb_write_desc lx_glb_write_desc_defaults(const lx_glb_write_desc *desc);
  * glTF (Draco, meshopt) or a mesh luxel could not match to the file's
  * primitives, LX_ERR_IO / LX_ERR_FORMAT naming the file and the part. */
 lx_status lx_scene_write_glb(const lx_scene *scene, const char *path, const lx_glb_write_desc *desc);
+
+/* The UV set that holds the lightmap UVs luxel makes for node n (written
+ * by lx_scene_write_glb, named by the bake's manifest, read back by
+ * lx_bake_uv_set and luxel render): TEXCOORD_1, or when a material of one
+ * of the node's meshes reads a texture through it (lx_material.uv_sets_read)
+ * the lowest set above it that none reads. -1 when every set below
+ * LX_MAX_UV_SETS is read. */
+int lx_scene_lightmap_set(const lx_scene *scene, uint32_t node);
 
 #ifdef __cplusplus
 }

@@ -217,7 +217,7 @@ typedef struct lx_uv_health {
                                      texels", "outside [0,1] (u 1..2, v 0..1)" */
 } lx_uv_health;
 
-/* UV set uv_set (0 or 1) of one mesh, in its own space, on a bitmap of
+/* UV set uv_set (below LX_MAX_UV_SETS) of one mesh, in its own space, on a bitmap of
  * desc->resolution. desc may be NULL. LX_ERR_INVALID for a bad set or
  * options, LX_ERR_NOMEM, LX_ERR_CANCELLED. Deterministic for any thread
  * count; the time follows the covered texels (plus, per texel, the pairs

@@ -254,8 +254,9 @@ static lx_status build_pages(lx_baker *b, const lx_scene *scene, const lx_bake_d
                 continue;
             lx_page_node *pn = &k->page.nodes[k->page.node_count++];
             pn->node = n;
-            /* generated UVs are TEXCOORD_1 once applied, in page coordinates */
-            pn->uv_set = un->mode == LX_UNWRAP_KEEP ? un->uv_set : 1;
+            /* generated UVs are in the node's lightmap set once applied,
+             * in page coordinates */
+            pn->uv_set = un->mode == LX_UNWRAP_KEEP ? un->uv_set : lx_scene_lightmap_set(scene, n);
             memcpy(pn->scale_offset, un->scale_offset, sizeof pn->scale_offset);
         }
         k->page.width = atlas->pages[p].width;

@@ -378,10 +378,19 @@ static int size_from_density(const lx_scene *scene, const lx_node *node, const s
     return size < 4 ? 4 : size;
 }
 
+/* The index of the mesh's UV set a slot reads. */
+static int slot_uv_set(const slot *s)
+{
+    for (int k = 0; k < LX_MAX_UV_SETS; k++)
+        if (s->uv == s->mesh->uv[k])
+            return k;
+    return 0;
+}
+
 static lx_status check_uv_triangles(const lx_scene *scene, const slot *s, const lx_node *node,
                                     const lx_bake_desc *desc, uint8_t *skip)
 {
-    int uv_set = s->uv == s->mesh->uv[1] ? 1 : 0;
+    int uv_set = slot_uv_set(s);
     uint32_t degenerate = 0, outside = 0;
     const lx_mesh *m = s->mesh;
     for (uint32_t t = 0; t < m->triangle_count; t++) {
@@ -449,19 +458,30 @@ static void place_texel(lx_lightmap *map, uint32_t n, const lx_mat4 *world, cons
     }
 }
 
-/* The lightmap UV set of a node: TEXCOORD_1 when every mesh with UVs has
- * it, else TEXCOORD_0. */
+/* True when every mesh of the node with UVs has set `set`. */
+static bool node_has_set(const lx_scene *scene, const lx_node *node, int set)
+{
+    for (uint32_t k = 0; k < node->mesh_count; k++) {
+        const lx_mesh *m = &scene->meshes[node->meshes[k]];
+        if (m->uv[0] && !m->uv[set])
+            return false;
+    }
+    return true;
+}
+
+/* The lightmap UV set of a node: the set luxel writes lightmap UVs to when
+ * it is above TEXCOORD_1 (a set no material reads: luxel's own, from an
+ * earlier unwrap) and every mesh with UVs has it, else TEXCOORD_1 when
+ * every one has that, else TEXCOORD_0. */
 int lx_bake_uv_set(const lx_scene *scene, uint32_t node_index, lx_uv_choice choice)
 {
     if (choice == LX_UV_SET_0 || choice == LX_UV_SET_1)
         return choice == LX_UV_SET_1 ? 1 : 0;
     const lx_node *node = &scene->nodes[node_index];
-    for (uint32_t k = 0; k < node->mesh_count; k++) {
-        const lx_mesh *m = &scene->meshes[node->meshes[k]];
-        if ((m->uv[0] || m->uv[1]) && !m->uv[1])
-            return 0;
-    }
-    return 1;
+    int own = lx_scene_lightmap_set(scene, node_index);
+    if (own > 1 && node_has_set(scene, node, own))
+        return own;
+    return node_has_set(scene, node, 1) ? 1 : 0;
 }
 
 /* Appends the node's meshes that have UV set `uv_set` (a negative one:
@@ -514,7 +534,7 @@ static lx_status build_stitch(const slot *slots, uint32_t slot_count, lx_lightma
         return lx_fail(LX_ERR_NOMEM, "%s: out of memory", what);
     for (uint32_t s = 0; s < slot_count; s++) {
         meshes[s].mesh = slots[s].mesh;
-        meshes[s].uv_set = slots[s].uv == slots[s].mesh->uv[1] ? 1 : 0;
+        meshes[s].uv_set = slot_uv_set(&slots[s]);
         memcpy(meshes[s].scale_offset, slots[s].scale_offset, sizeof meshes[s].scale_offset);
     }
     lx_status st = lx_seam_stitch_build(meshes, slot_count, map->info.width, map->info.height,

@@ -188,14 +188,17 @@ static lx_status parse_nodes(const char *file, const cJSON *root, lx_lightmaps *
                                file, i, ln->name);
             ln->scale_offset[k] = (float)v->valuedouble;
         }
-        if (cJSON_IsString(set) && strcmp(set->valuestring, "TEXCOORD_0") == 0)
-            ln->uv_set = 0;
-        else if (cJSON_IsString(set) && strcmp(set->valuestring, "TEXCOORD_1") == 0)
-            ln->uv_set = 1;
-        else
+        int set_index = -1;
+        char tail;
+        if (!cJSON_IsString(set) ||
+            sscanf(set->valuestring, "TEXCOORD_%d%c", &set_index, &tail) != 1 ||
+            set_index < 0 || set_index >= LX_MAX_UV_SETS ||
+            strncmp(set->valuestring, "TEXCOORD_", 9) != 0 ||
+            !(set->valuestring[9] >= '0' && set->valuestring[9] <= '9'))
             return lx_fail(LX_ERR_FORMAT,
-                           "%s: nodes[%d] ('%s'): \"uv_set\" must be TEXCOORD_0 or TEXCOORD_1",
-                           file, i, ln->name);
+                           "%s: nodes[%d] ('%s'): \"uv_set\" must be TEXCOORD_0 to TEXCOORD_%d",
+                           file, i, ln->name, LX_MAX_UV_SETS - 1);
+        ln->uv_set = set_index;
         if (uvs && !(cJSON_IsString(uvs) && (strcmp(uvs->valuestring, "own") == 0 ||
                                              strcmp(uvs->valuestring, "generated") == 0)))
             return lx_fail(LX_ERR_FORMAT, "%s: nodes[%d] ('%s'): \"uvs\" must be own or generated",

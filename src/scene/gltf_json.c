@@ -260,6 +260,19 @@ bool lx_gltf_index(const cJSON *item, size_t count, size_t *out)
     return true;
 }
 
+uint32_t lx_gltf_texcoords_read(const cJSON *j)
+{
+    uint32_t sets = 0;
+    for (const cJSON *c = j ? j->child : NULL; c; c = c->next) {
+        if (c->string && strcmp(c->string, "texCoord") == 0 && cJSON_IsNumber(c) &&
+            c->valuedouble >= 0 && c->valuedouble < 32 && c->valuedouble == (int)c->valuedouble)
+            sets |= 1u << (int)c->valuedouble;
+        if (cJSON_IsObject(c) || cJSON_IsArray(c))
+            sets |= lx_gltf_texcoords_read(c);
+    }
+    return sets;
+}
+
 void lx_gltf_label(char *buf, size_t size, const char *what, size_t index, const cJSON *obj)
 {
     const char *name = lx_gltf_get_string(obj, "name");

@@ -39,6 +39,10 @@ bool lx_gltf_number(const cJSON *item, float *out);
 bool lx_gltf_numbers(const cJSON *item, float *out, int n);
 /* An integer index in [0, count). */
 bool lx_gltf_index(const cJSON *item, size_t count, size_t *out);
+/* The UV sets the textures of a material object read, bit k for
+ * TEXCOORD_k (k < 32): every "texCoord" in it, core textures', extensions'
+ * and KHR_texture_transform's alike. */
+uint32_t lx_gltf_texcoords_read(const cJSON *material);
 /* "node 3 ('Lamp')" for messages. */
 void lx_gltf_label(char *buf, size_t size, const char *what, size_t index, const cJSON *obj);
 

@@ -41,20 +41,6 @@ typedef struct wctx {
     const char *out;
 } wctx;
 
-/* True when the material JSON reads a texture through TEXCOORD_1 anywhere
- * (core textures, extensions' textureInfos, KHR_texture_transform). */
-static bool uses_set(const cJSON *j, int set)
-{
-    for (const cJSON *c = j ? j->child : NULL; c; c = c->next) {
-        if (c->string && strcmp(c->string, "texCoord") == 0 && cJSON_IsNumber(c) &&
-            c->valuedouble == set)
-            return true;
-        if ((cJSON_IsObject(c) || cJSON_IsArray(c)) && uses_set(c, set))
-            return true;
-    }
-    return false;
-}
-
 static bool close_to(lx_vec3 a, lx_vec3 b)
 {
     float s = 1.0f + fmaxf(fabsf(a.x), fmaxf(fabsf(a.y), fabsf(a.z)));
@@ -368,24 +354,19 @@ static lx_status rebuild_primitive(wctx *c, cJSON *prim, const job *jb, const ch
             }
             new_index[k] = found;
         }
-    /* the lightmap set: TEXCOORD_1 unless the material reads a texture
-     * through it, then the next free set */
-    const cJSON *mat = NULL;
-    size_t mi;
-    const cJSON *mats = lx_gltf_get(c->f->root, "materials");
-    if (lx_gltf_index(lx_gltf_get(prim, "material"), (size_t)cJSON_GetArraySize(mats), &mi))
-        mat = cJSON_GetArrayItem(mats, (int)mi);
-    char set[32] = "TEXCOORD_1";
-    if (!e->uv)
-        set[0] = '\0'; /* no lightmap set */
-    else if (lx_gltf_get(attrs, "TEXCOORD_1") && uses_set(mat, 1)) {
-        int n = 2;
-        for (;; n++) {
-            snprintf(set, sizeof set, "TEXCOORD_%d", n);
-            if (!lx_gltf_get(attrs, set))
-                break;
-        }
+    /* the lightmap set: the node's, one for all its primitives (the set
+     * the manifest names) */
+    char set[32] = "";
+    int lightmap_set = e->uv ? lx_scene_lightmap_set(c->scene, e->node) : 0;
+    if (lightmap_set < 0) {
+        st = lx_fail(LX_ERR_UNSUPPORTED,
+                     "%s: %s: its materials read textures through every UV set from 1 to %d: "
+                     "no set is left for the lightmap",
+                     c->f->path, where, LX_MAX_UV_SETS - 1);
+        goto done;
     }
+    if (e->uv)
+        snprintf(set, sizeof set, "TEXCOORD_%d", lightmap_set);
     bool has_normal = lx_gltf_get(attrs, "NORMAL") != NULL;
     st = remap_attributes(c, attrs, src_of, nv, set[0] ? set : NULL, e, where);
     cJSON *targets = cJSON_GetObjectItemCaseSensitive(prim, "targets");
@@ -399,9 +380,14 @@ static lx_status rebuild_primitive(wctx *c, cJSON *prim, const job *jb, const ch
         view = lx_glb_add_view(c->f->root, &c->bin, uv, sizeof(lx_vec2) * nv, 0,
                                LX_GL_ARRAY_BUFFER);
         acc = lx_glb_add_accessor(c->f->root, view, LX_GL_FLOAT, nv, "VEC2", false, NULL, NULL);
-        /* TEXCOORD_0 before the set: readers (assimp) want sets in order */
-        if (!lx_gltf_get(attrs, "TEXCOORD_0"))
-            cJSON_AddNumberToObject(attrs, "TEXCOORD_0", acc);
+        /* sets are numbered from 0 without gaps (glTF, and readers such as
+         * assimp): the lightmap UVs fill any missing set below theirs */
+        for (int k = 0; k < lightmap_set; k++) {
+            char below[32];
+            snprintf(below, sizeof below, "TEXCOORD_%d", k);
+            if (!lx_gltf_get(attrs, below))
+                cJSON_AddNumberToObject(attrs, below, acc);
+        }
         cJSON_AddNumberToObject(attrs, set, acc);
     }
     st = add_attributes(c, attrs, e, key_of, nv, has_normal, where);

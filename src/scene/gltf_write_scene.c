@@ -118,7 +118,7 @@ static bool replaced(const lx_scene_uvs *e, const char *name)
     return false;
 }
 
-static cJSON *primitive(bctx *c, const lx_mesh *m, const lx_scene_uvs *e)
+static cJSON *primitive(bctx *c, const lx_mesh *m, const lx_scene_uvs *e, int lightmap_set)
 {
     size_t nv = e ? e->vertex_count : m->vertex_count;
     const uint32_t *src = e ? e->vertex_source : NULL;
@@ -137,28 +137,43 @@ static cJSON *primitive(bctx *c, const lx_mesh *m, const lx_scene_uvs *e)
     if (m->tangents && !replaced(e, "TANGENT"))
         cJSON_AddNumberToObject(a, "TANGENT",
                                 float_attribute(c, &m->tangents[0].x, 4, src, nv, false));
-    int uv0 = m->uv[0] && !replaced(e, "TEXCOORD_0")
-                  ? float_attribute(c, &m->uv[0][0].x, 2, src, nv, false)
-                  : -1;
-    int uv1 = e && e->uv         ? float_attribute(c, &e->uv[0].x, 2, NULL, nv, false)
-              : replaced(e, "TEXCOORD_1") ? -1
-              : m->uv[1]         ? float_attribute(c, &m->uv[1][0].x, 2, src, nv, false)
-                                 : -1;
+    /* every UV set the mesh has, the entry's lightmap UVs as set
+     * lightmap_set and its TEXCOORD_n attributes over the mesh's */
+    int uv[LX_MAX_UV_SETS];
+    int top = -1;
+    for (int k = 0; k < LX_MAX_UV_SETS; k++) {
+        char name[16];
+        snprintf(name, sizeof name, "TEXCOORD_%d", k);
+        uv[k] = -1;
+        if (e && e->uv && k == lightmap_set)
+            uv[k] = float_attribute(c, &e->uv[0].x, 2, NULL, nv, false);
+        else if (!replaced(e, name) && m->uv[k])
+            uv[k] = float_attribute(c, &m->uv[k][0].x, 2, src, nv, false);
+        if (uv[k] >= 0)
+            top = k;
+    }
     for (uint32_t k = 0; e && k < e->attribute_count; k++) {
         const lx_vertex_attribute *at = &e->attributes[k];
-        if (strcmp(at->name, "TEXCOORD_0") == 0)
-            uv0 = float_attribute(c, at->data, at->components, NULL, nv, false);
-        else if (strcmp(at->name, "TEXCOORD_1") == 0)
-            uv1 = float_attribute(c, at->data, at->components, NULL, nv, false);
-        else
+        int set = -1;
+        if (sscanf(at->name, "TEXCOORD_%d", &set) == 1 && set >= 0 && set < LX_MAX_UV_SETS &&
+            !(e->uv && set == lightmap_set)) {
+            uv[set] = float_attribute(c, at->data, at->components, NULL, nv, false);
+            top = set > top ? set : top;
+        } else if (set < 0) {
             cJSON_AddNumberToObject(a, at->name,
                                     float_attribute(c, at->data, at->components, NULL, nv, false));
+        }
     }
-    /* sets are numbered from 0: the lightmap set stands in for a missing 0 */
-    if (uv0 >= 0 || uv1 >= 0)
-        cJSON_AddNumberToObject(a, "TEXCOORD_0", uv0 >= 0 ? uv0 : uv1);
-    if (uv1 >= 0)
-        cJSON_AddNumberToObject(a, "TEXCOORD_1", uv1);
+    /* sets are numbered from 0 without gaps: the lightmap set (else the
+     * first set there is) stands in for a missing one */
+    int stand_in = e && e->uv && lightmap_set >= 0 ? uv[lightmap_set] : -1;
+    for (int k = 0; stand_in < 0 && k <= top; k++)
+        stand_in = uv[k];
+    for (int k = 0; k <= top; k++) {
+        char name[16];
+        snprintf(name, sizeof name, "TEXCOORD_%d", k);
+        cJSON_AddNumberToObject(a, name, uv[k] >= 0 ? uv[k] : stand_in);
+    }
     size_t ni = 3 * (size_t)m->triangle_count;
     bool small = nv < 65535;
     uint8_t *ib = malloc((small ? 2 : 4) * (ni ? ni : 1));
@@ -266,6 +281,21 @@ static bool identity(const lx_mat4 *m)
 
 static lx_status write_built(const lx_scene *s, const char *path, const lx_glb_write_desc *d)
 {
+    /* a node given lightmap UVs needs a set for them */
+    for (uint32_t k = 0; k < d->uv_count; k++)
+        for (uint32_t n = 0; d->uvs[k].uv && n < s->node_count; n++) {
+            const lx_node *node = &s->nodes[n];
+            bool placed = d->uvs[k].node == n;
+            for (uint32_t q = 0; !placed && d->uvs[k].node == LX_SCENE_EVERY_NODE &&
+                                 q < node->mesh_count;
+                 q++)
+                placed = node->meshes[q] == d->uvs[k].mesh;
+            if (placed && lx_scene_lightmap_set(s, n) < 0)
+                return lx_fail(LX_ERR_UNSUPPORTED,
+                               "%s: node '%s': its materials read textures through every UV "
+                               "set from 1 to %d: no set is left for the lightmap",
+                               path, node->name, LX_MAX_UV_SETS - 1);
+        }
     bctx c = {.root = cJSON_CreateObject(), .out = path};
     if (!c.root)
         return lx_fail(LX_ERR_NOMEM, "%s: out of memory", path);
@@ -289,10 +319,12 @@ static lx_status write_built(const lx_scene *s, const char *path, const lx_glb_w
         /* a node with new UVs: its entries (the meshes it placed when
          * unwrapped), else its meshes as they are */
         bool has = false;
+        int set = lx_scene_lightmap_set(s, n);
         for (uint32_t k = 0; k < d->uv_count; k++)
             if (d->uvs[k].node == n) {
                 has = true;
-                cJSON_AddItemToArray(prims, primitive(&c, &s->meshes[d->uvs[k].mesh], &d->uvs[k]));
+                cJSON_AddItemToArray(prims,
+                                     primitive(&c, &s->meshes[d->uvs[k].mesh], &d->uvs[k], set));
             }
         for (uint32_t k = 0; !has && k < node->mesh_count; k++) {
             /* an entry for the mesh wherever it is placed, else as it is */
@@ -300,7 +332,7 @@ static lx_status write_built(const lx_scene *s, const char *path, const lx_glb_w
             for (uint32_t q = 0; q < d->uv_count && !every; q++)
                 if (d->uvs[q].node == LX_SCENE_EVERY_NODE && d->uvs[q].mesh == node->meshes[k])
                     every = &d->uvs[q];
-            cJSON_AddItemToArray(prims, primitive(&c, &s->meshes[node->meshes[k]], every));
+            cJSON_AddItemToArray(prims, primitive(&c, &s->meshes[node->meshes[k]], every, set));
         }
         cJSON_AddItemToArray(meshes, mesh);
         cJSON *j = cJSON_CreateObject();

@@ -893,6 +893,29 @@ static bool ref_equal(const lx_gltf_texture_ref *a, const lx_gltf_texture_ref *b
  * references for those textures, they are its; when none of them has a
  * KHR_texture_transform, assimp's texCoord is the file's. Otherwise its
  * transform cannot be told and the load fails rather than guess. */
+/* The UV sets material i's textures read (lx_material.uv_sets_read):
+ * assimp's for every texture it knows, the file's own for a glTF
+ * material (extensions' textures, which assimp drops). */
+static uint32_t texcoords_read(const import_ctx *c, const struct aiMaterial *am, unsigned i)
+{
+    uint32_t sets = 0;
+    for (int type = aiTextureType_NONE + 1; type <= aiTextureType_UNKNOWN; type++) {
+        unsigned count = aiGetMaterialTextureCount(am, (enum aiTextureType)type);
+        for (unsigned k = 0; k < count && k < 64; k++) {
+            struct aiString path;
+            unsigned uv = 0;
+            if (aiGetMaterialTexture(am, (enum aiTextureType)type, k, &path, NULL, &uv, NULL,
+                                     NULL, NULL, NULL) == aiReturn_SUCCESS &&
+                uv < 32)
+                sets |= 1u << uv;
+        }
+    }
+    if (c->map && c->map->material_of[i] >= 0 &&
+        (size_t)c->map->material_of[i] < c->map->material_count)
+        sets |= lx_gltf_texcoords_read(c->map->materials[c->map->material_of[i]]);
+    return sets;
+}
+
 static lx_status material_refs(const import_ctx *c, unsigned i, const char *label, bool has_base,
                                bool has_normal, lx_gltf_texture_ref *base,
                                lx_gltf_texture_ref *normal)
@@ -990,6 +1013,7 @@ static lx_status import_materials(import_ctx *c)
             if (est != LX_OK)
                 return est;
         }
+        m.uv_sets_read = texcoords_read(c, am, i);
         struct aiString tex;
         bool has_normal = aiGetMaterialTexture(am, aiTextureType_NORMALS, 0, &tex, NULL, NULL, NULL,
                                                NULL, NULL, NULL) == aiReturn_SUCCESS;
@@ -1061,7 +1085,7 @@ static lx_status import_materials(import_ctx *c)
             if (m.emissive_uv_set >= LX_MAX_UV_SETS) {
                 lx_log(LX_LOG_WARN,
                        "%s: material '%s': emissive texture on UV set %u is not supported "
-                       "(0 and 1 are); ignored",
+                       "(0 to 7 are); ignored",
                        c->path, name_buf, uv);
                 lx_image_free(&m.emissive_map);
                 m.emissive_uv_set = 0;
@@ -1070,7 +1094,7 @@ static lx_status import_materials(import_ctx *c)
         }
         if (m.normal_uv_set >= LX_MAX_UV_SETS || m.base_color_uv_set >= LX_MAX_UV_SETS) {
             lx_log(LX_LOG_WARN,
-                   "%s: material '%s': textures on UV sets above 1 are not "
+                   "%s: material '%s': textures on UV sets above 7 are not "
                    "supported; ignored",
                    c->path, name_buf);
             if (m.normal_uv_set >= LX_MAX_UV_SETS) {

@@ -289,10 +289,32 @@ lx_status lx_scene_add_material(lx_scene *s, const lx_material *src, uint32_t *i
     }
     if (m.normal_scale == 0.0f)
         m.normal_scale = 1.0f;
+    /* the sets of the maps luxel samples are read too */
+    const int sets[3] = {src->normal_uv_set, src->base_color_uv_set, src->emissive_uv_set};
+    for (int i = 0; i < 3; i++)
+        if (maps[i]->width > 0 && sets[i] >= 0 && sets[i] < 32)
+            m.uv_sets_read |= 1u << sets[i];
     if (index)
         *index = s->material_count;
     s->materials[s->material_count++] = m;
     return LX_OK;
+}
+
+int lx_scene_lightmap_set(const lx_scene *s, uint32_t n)
+{
+    if (!s || n >= s->node_count)
+        return -1;
+    uint32_t read = 0;
+    const lx_node *node = &s->nodes[n];
+    for (uint32_t k = 0; k < node->mesh_count; k++) {
+        uint32_t mat = s->meshes[node->meshes[k]].material;
+        if (mat < s->material_count)
+            read |= s->materials[mat].uv_sets_read;
+    }
+    for (int set = 1; set < LX_MAX_UV_SETS; set++)
+        if (!(read & (1u << set)))
+            return set;
+    return -1;
 }
 
 lx_status lx_scene_add_node(lx_scene *s, const char *name, const lx_mat4 *world,

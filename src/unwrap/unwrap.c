@@ -298,11 +298,15 @@ static int kept_uv_set(const lx_scene *scene, uint32_t n, const lx_unwrap_desc *
 {
     if (d->keep_uv_sets)
         return d->keep_uv_sets[n];
+    /* lx_bake_uv_set's choice: luxel's own set above 1, else 1, else 0 */
     const lx_node *node = &scene->nodes[n];
-    bool all1 = node->mesh_count > 0;
-    for (uint32_t k = 0; k < node->mesh_count; k++)
+    int own = lx_scene_lightmap_set(scene, n);
+    bool all_own = node->mesh_count > 0 && own > 1, all1 = node->mesh_count > 0;
+    for (uint32_t k = 0; k < node->mesh_count; k++) {
+        all_own = all_own && scene->meshes[node->meshes[k]].uv[own];
         all1 = all1 && scene->meshes[node->meshes[k]].uv[1];
-    return all1 ? 1 : 0;
+    }
+    return all_own ? own : all1 ? 1 : 0;
 }
 
 /* ---- the whole ----------------------------------------------------------- */
@@ -821,7 +825,16 @@ lx_status lx_unwrap_apply(lx_scene *scene, const lx_unwrap *u)
             st = lx_fail(LX_ERR_INVALID, "%s: the unwrap was made for another scene", scene->path);
             break;
         }
-        /* the node's own copy: split vertices, TEXCOORD_1 the page's */
+        /* the node's own copy: split vertices, the page's UVs in the
+         * node's lightmap set, its other sets kept */
+        int set = lx_scene_lightmap_set(scene, um->node);
+        if (set < 0) {
+            st = lx_fail(LX_ERR_UNSUPPORTED,
+                         "%s: node '%s': its materials read textures through every UV set from "
+                         "1 to %d: no set is left for the lightmap",
+                         scene->path, scene->nodes[um->node].name, LX_MAX_UV_SETS - 1);
+            break;
+        }
         lx_mesh m = {.name = src->name,
                      .vertex_count = um->vertex_count,
                      .triangle_count = src->triangle_count,
@@ -831,10 +844,12 @@ lx_status lx_unwrap_apply(lx_scene *scene, const lx_unwrap *u)
         m.positions = malloc(sizeof(lx_vec3) * nv);
         m.normals = src->normals ? malloc(sizeof(lx_vec3) * nv) : NULL;
         m.tangents = src->tangents ? malloc(sizeof(lx_vec4) * nv) : NULL;
-        m.uv[0] = src->uv[0] ? malloc(sizeof(lx_vec2) * nv) : NULL;
-        m.uv[1] = um->uv;
-        bool ok = m.positions && (!src->normals || m.normals) && (!src->tangents || m.tangents) &&
-                  (!src->uv[0] || m.uv[0]);
+        bool ok = m.positions && (!src->normals || m.normals) && (!src->tangents || m.tangents);
+        for (int q = 0; q < LX_MAX_UV_SETS; q++) {
+            m.uv[q] = q != set && src->uv[q] ? malloc(sizeof(lx_vec2) * nv) : NULL;
+            ok = ok && (q == set || !src->uv[q] || m.uv[q]);
+        }
+        m.uv[set] = um->uv;
         for (uint32_t v = 0; ok && v < um->vertex_count; v++) {
             uint32_t from = um->vertex_source[v];
             if (from >= src->vertex_count) {
@@ -846,8 +861,9 @@ lx_status lx_unwrap_apply(lx_scene *scene, const lx_unwrap *u)
                 m.normals[v] = src->normals[from];
             if (m.tangents)
                 m.tangents[v] = src->tangents[from];
-            if (m.uv[0])
-                m.uv[0][v] = src->uv[0][from];
+            for (int q = 0; q < LX_MAX_UV_SETS; q++)
+                if (q != set && m.uv[q])
+                    m.uv[q][v] = src->uv[q][from];
         }
         uint32_t index = 0;
         if (!ok)
@@ -857,7 +873,9 @@ lx_status lx_unwrap_apply(lx_scene *scene, const lx_unwrap *u)
         free(m.positions);
         free(m.normals);
         free(m.tangents);
-        free(m.uv[0]);
+        for (int q = 0; q < LX_MAX_UV_SETS; q++)
+            if (q != set)
+                free(m.uv[q]);
         if (st == LX_OK)
             scene->nodes[um->node].meshes[slot_of[um->node]++] = index;
     }

@@ -455,8 +455,10 @@ static void test_obj_scene_round_trip(void **state)
     lx_scene_destroy(s);
 }
 
-/* A primitive with TEXCOORD_1 that its material reads keeps it: the
- * lightmap goes to TEXCOORD_2. Without a reader, TEXCOORD_1 is replaced. */
+/* A node whose material reads TEXCOORD_1 (an occlusion map) keeps that
+ * set: the node's lightmap goes to TEXCOORD_2, one set for all its
+ * primitives (the manifest names one per node), and every primitive keeps
+ * its own TEXCOORD_1. Read back, TEXCOORD_2 is where a later bake looks. */
 static void test_material_uv1_kept(void **state)
 {
     (void)state;
@@ -492,16 +494,37 @@ static void test_material_uv1_kept(void **state)
     cJSON *a0 = cJSON_GetObjectItem(cJSON_GetArrayItem(prims, 0), "attributes");
     cJSON *a1 = cJSON_GetObjectItem(cJSON_GetArrayItem(prims, 1), "attributes");
     assert_non_null(cJSON_GetObjectItem(a0, "TEXCOORD_2"));
-    assert_null(cJSON_GetObjectItem(a1, "TEXCOORD_2"));
+    assert_non_null(cJSON_GetObjectItem(a1, "TEXCOORD_2"));
+    assert_int_equal(lx_scene_lightmap_set(s, 0), 2);
     /* the image is embedded: no uri left */
     cJSON *img = cJSON_GetArrayItem(cJSON_GetObjectItem(j, "images"), 0);
     assert_null(cJSON_GetObjectItem(img, "uri"));
     assert_string_equal(cJSON_GetObjectItem(img, "mimeType")->valuestring, "image/png");
     cJSON_Delete(j);
-    /* primitive 1's TEXCOORD_1 is the unwrapper's */
+    /* read back: both primitives keep their TEXCOORD_1 (every value one
+     * of the input's, not page UVs), the lightmap set is 2 and a bake
+     * takes it */
     lx_scene *r;
     assert_int_equal(lx_scene_load(out, NULL, &r), LX_OK);
     assert_int_equal(r->node_count, 1);
+    assert_int_equal(lx_scene_lightmap_set(r, 0), 2);
+    assert_int_equal(lx_bake_uv_set(r, 0, LX_UV_SET_AUTO), 2);
+    for (uint32_t k = 0; k < r->nodes[0].mesh_count; k++) {
+        const lx_mesh *m = &r->meshes[r->nodes[0].meshes[k]];
+        assert_non_null(m->uv[1]);
+        assert_non_null(m->uv[2]);
+        const lx_mesh *in_mesh = &s->meshes[k];
+        bool page_uvs_differ = false;
+        for (uint32_t v = 0; v < m->vertex_count; v++) {
+            bool found = false;
+            for (uint32_t w = 0; w < in_mesh->vertex_count && !found; w++)
+                found = in_mesh->uv[1][w].x == m->uv[1][v].x &&
+                        in_mesh->uv[1][w].y == m->uv[1][v].y;
+            assert_true(found);
+            page_uvs_differ |= m->uv[2][v].x != m->uv[1][v].x;
+        }
+        assert_true(page_uvs_differ);
+    }
     lx_unwrap_destroy(u);
     lx_scene_destroy(r);
     lx_scene_destroy(s);

@@ -249,7 +249,7 @@ static void missing_set(void **state)
     assert_false(h.usable);
     assert_int_equal(h.problem, LX_UV_MISSING);
     assert_string_equal(h.reason, "no TEXCOORD_0");
-    assert_int_equal(lx_uv_health_mesh(&m, 2, NULL, &h), LX_ERR_INVALID);
+    assert_int_equal(lx_uv_health_mesh(&m, LX_MAX_UV_SETS, NULL, &h), LX_ERR_INVALID);
     lx_uv_health_desc bad = {.threads = -1};
     assert_int_equal(lx_uv_health_mesh(&m, 1, &bad, &h), LX_ERR_INVALID);
     free_grid(&m);

@@ -92,7 +92,8 @@ static const char *bake_usage =
     "                          zero-area triangles or overlap on more than 1%%\n"
     "                          of their texels (see luxel info); always; or never\n"
     "  --uv-set S              the lightmap UV set: 0, 1 or auto (default: 1 when\n"
-    "                          every mesh of a node has TEXCOORD_1, else 0)\n"
+    "                          every mesh of a node has TEXCOORD_1, else 0; a\n"
+    "                          set above 1 luxel wrote its UVs to comes first)\n"
     "  --atlas, --no-atlas     share pages between nodes, or a lightmap per node\n"
     "                          (default: pages whenever luxel makes UVs)\n"
     "  --atlas-size N          largest atlas page side (default %d)\n"
@@ -341,10 +342,13 @@ static cJSON *node_entries(const lx_scene *scene, const lx_baker *baker, const l
         for (int k = 0; k < 4; k++)
             cJSON_AddItemToArray(sov, cJSON_CreateNumber(so[k]));
         bool generated = unwrap && unwrap->nodes[n].mode == LX_UNWRAP_GENERATE;
-        int set = generated ? 1
+        /* the set the lightmap UVs are in, as in the scene_with_uvs file */
+        int set = generated ? lx_scene_lightmap_set(scene, n)
                   : unwrap  ? unwrap->nodes[n].uv_set
                             : lx_bake_uv_set(scene, n, a->desc.uv_set);
-        cJSON_AddStringToObject(e, "uv_set", set == 1 ? "TEXCOORD_1" : "TEXCOORD_0");
+        char set_name[16];
+        snprintf(set_name, sizeof set_name, "TEXCOORD_%d", set);
+        cJSON_AddStringToObject(e, "uv_set", set_name);
         cJSON_AddStringToObject(e, "uvs", generated ? "generated" : "own");
         cJSON_AddItemToArray(list, e);
     }

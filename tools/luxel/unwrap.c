@@ -1,5 +1,6 @@
 /* luxel unwrap: lightmap UVs for every node of a scene, written with the
- * scene as a .glb (TEXCOORD_1), and a one-line summary. */
+ * scene as a .glb (in each node's lightmap set, lx_scene_lightmap_set),
+ * and a one-line summary. */
 #define _POSIX_C_SOURCE 200809L
 #include "cli.h"
 
@@ -15,9 +16,11 @@ static const char *unwrap_usage =
     "\n"
     "Makes lightmap UVs for every node that carries a mesh of SCENE (glTF 2.0\n"
     ".gltf/.glb or OBJ), packs them into atlas pages and writes the scene as a\n"
-    "glTF binary with the UVs, in page coordinates, in TEXCOORD_1. A glTF\n"
-    "scene keeps everything else as it was; a mesh several nodes share is\n"
-    "copied per node (each instance has its own region of a page).\n"
+    "glTF binary with the UVs, in page coordinates, in TEXCOORD_1 (or, when a\n"
+    "material of the node reads a texture through TEXCOORD_1, the lowest set\n"
+    "above it that none reads). A glTF scene keeps everything else as it was;\n"
+    "a mesh several nodes share is copied per node (each instance has its own\n"
+    "region of a page).\n"
     "\n"
     "options:\n"
     "  -o, --output FILE      the .glb to write (required)\n"
