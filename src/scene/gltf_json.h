@@ -132,7 +132,9 @@ void lx_gltf_primitives_free(lx_gltf_primitives *p);
 /* ---- what assimp cannot read (gltf_rewrite.c) ---------------------------- */
 
 /* Fails with LX_ERR_UNSUPPORTED naming the first extension in
- * extensionsRequired that luxel does not read. */
+ * extensionsRequired that luxel does not read; one that only adds an image
+ * format (KHR_texture_basisu, EXT_texture_webp, EXT_texture_avif) is a
+ * warning: the file loads without those textures. */
 lx_status lx_gltf_check_required(const char *file, const cJSON *root);
 /* Whether bytes (or the start of the file at path) are a Git LFS pointer. */
 bool lx_lfs_pointer(const void *bytes, size_t size);

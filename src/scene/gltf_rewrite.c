@@ -31,6 +31,11 @@ static const char *const supported[] = {
     "KHR_lights_punctual",    "KHR_materials_emissive_strength",
 };
 
+/* Extensions that only add image formats: a file requiring one loads, its
+ * textures in that format left out. */
+static const char *const texture_formats[] = {"KHR_texture_basisu", "EXT_texture_webp",
+                                              "EXT_texture_avif"};
+
 lx_status lx_gltf_check_required(const char *file, const cJSON *root)
 {
     const cJSON *req = lx_gltf_get(root, "extensionsRequired");
@@ -44,6 +49,17 @@ lx_status lx_gltf_check_required(const char *file, const cJSON *root)
         bool known = false;
         for (size_t i = 0; i < sizeof supported / sizeof supported[0] && !known; i++)
             known = strcmp(e->valuestring, supported[i]) == 0;
+        bool texture_only = false;
+        for (size_t i = 0; i < sizeof texture_formats / sizeof texture_formats[0]; i++)
+            texture_only |= strcmp(e->valuestring, texture_formats[i]) == 0;
+        if (texture_only) {
+            /* only textures need it: the geometry and lights are there */
+            lx_log(LX_LOG_WARN,
+                   "%s: requires %s, an image format luxel does not decode: textures only in "
+                   "it are left out (their materials' factors are used)",
+                   file, e->valuestring);
+            continue;
+        }
         if (!known)
             return failf(file, LX_ERR_UNSUPPORTED, "requires extension %.80s, which luxel does not read",
                          e->valuestring);

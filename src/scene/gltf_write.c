@@ -433,7 +433,10 @@ done:
     return st;
 }
 
-/* Every image with a uri moves into the binary chunk. */
+/* Every image with a uri moves into the binary chunk. One that cannot be
+ * read or is no image format glTF carries keeps its uri, with a warning:
+ * the import went without it (a warning too), and the scene's other
+ * outputs need not fail for it. */
 static lx_status embed_images(wctx *c)
 {
     cJSON *images = cJSON_GetObjectItemCaseSensitive(c->f->root, "images");
@@ -448,16 +451,23 @@ static lx_status embed_images(wctx *c)
         size_t size;
         char *mime = NULL;
         lx_status st = lx_gltf_uri_read(c->f, uri, what, &bytes, &size, &mime);
-        if (st != LX_OK)
+        if (st == LX_ERR_NOMEM)
             return st;
+        if (st != LX_OK) {
+            lx_log(LX_LOG_WARN, "%s; the .glb written refers to it by its uri", lx_last_error());
+            continue;
+        }
         const char *given = lx_gltf_get_string(im, "mimeType");
         const char *sniffed = lx_image_mime_sniff(bytes, size);
         const char *type = given ? given : sniffed ? sniffed : mime;
         if (!type) {
             free(bytes);
             free(mime);
-            return lx_fail(LX_ERR_FORMAT, "%s: %s ('%s'): not a PNG, JPEG, WebP or KTX2 image",
-                           c->f->path, what, uri);
+            lx_log(LX_LOG_WARN,
+                   "%s: %s ('%s'): not a PNG, JPEG, WebP or KTX2 image; the .glb written "
+                   "refers to it by its uri",
+                   c->f->path, what, uri);
+            continue;
         }
         char type_copy[64];
         snprintf(type_copy, sizeof type_copy, "%s", type);

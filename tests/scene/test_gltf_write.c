@@ -532,6 +532,54 @@ static void test_material_uv1_kept(void **state)
     prim_free(&b);
 }
 
+static int image_warnings;
+static void count_image_warnings(void *user, lx_log_level level, const char *msg)
+{
+    (void)user;
+    if (level == LX_LOG_WARN && strstr(msg, "image 0") && strstr(msg, "gone.png"))
+        image_warnings++;
+}
+
+/* A texture file that is not there: the import goes without it and the
+ * write does too (before, the write failed - after a whole bake), the
+ * image keeping its uri, each with a warning naming it. */
+static void test_missing_image(void **state)
+{
+    (void)state;
+    const char *dir = lx_test_dir("gltfw_missing_image");
+    char in[512], out[512];
+    snprintf(in, sizeof in, "%s/in.gltf", dir);
+    snprintf(out, sizeof out, "%s/out.glb", dir);
+    prim_data a = box_data(lx_v3(0, 0, 0), lx_v3(1, 1, 1));
+    lx_test_gltf *g = lx_test_gltf_new();
+    int tex = lx_test_gltf_texture(g, "gone.png");
+    char json[256];
+    snprintf(json, sizeof json,
+             "{\"name\":\"m\",\"pbrMetallicRoughness\":{\"baseColorTexture\":{\"index\":%d}}}",
+             tex);
+    lx_test_gltf_material(g, json);
+    lx_test_primitive p = prim_of(&a, 0);
+    lx_test_gltf_mesh(g, "m", &p, 1);
+    lx_test_gltf_node(g, "n", 0, "");
+    lx_test_gltf_write(g, in);
+    lx_test_gltf_free(g);
+    image_warnings = 0;
+    lx_set_log_callback(count_image_warnings, NULL);
+    lx_scene *s;
+    lx_unwrap *u;
+    unwrap_and_write(in, out, &s, &u);
+    lx_set_log_callback(NULL, NULL);
+    assert_int_equal(image_warnings, 1); /* the write's; the import names the material */
+    cJSON *j = glb_json(out);
+    cJSON *img = cJSON_GetArrayItem(cJSON_GetObjectItem(j, "images"), 0);
+    assert_string_equal(cJSON_GetObjectItem(img, "uri")->valuestring, "gone.png");
+    assert_null(cJSON_GetObjectItem(img, "bufferView"));
+    cJSON_Delete(j);
+    lx_unwrap_destroy(u);
+    lx_scene_destroy(s);
+    prim_free(&a);
+}
+
 static void test_validator_accepts_outputs(void **state)
 {
     (void)state;
@@ -706,6 +754,7 @@ int main(void)
         cmocka_unit_test(test_instances_get_meshes_of_their_own),
         cmocka_unit_test(test_obj_scene_round_trip),
         cmocka_unit_test(test_material_uv1_kept),
+        cmocka_unit_test(test_missing_image),
         cmocka_unit_test(test_validator_accepts_outputs),
         cmocka_unit_test(test_strips_and_fans),
         cmocka_unit_test(test_bad_inputs),

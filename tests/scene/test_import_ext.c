@@ -566,6 +566,16 @@ static void write_quad(const char *path, const char *required, const char *mater
     lx_test_gltf_free(g);
 }
 
+/* Warnings naming an extension, counted by count_warnings. */
+static int warnings_naming;
+static const char *warning_needle;
+static void count_warnings(void *user, lx_log_level level, const char *msg)
+{
+    (void)user;
+    if (level == LX_LOG_WARN && strstr(msg, warning_needle))
+        warnings_naming++;
+}
+
 static void test_required_extensions(void **state)
 {
     (void)state;
@@ -583,6 +593,26 @@ static void test_required_extensions(void **state)
         lx_scene *s = NULL;
         if (lx_scene_load(path, NULL, &s) != LX_OK)
             fail_msg("%s: %s", fine[i], lx_last_error());
+        lx_scene_destroy(s);
+    }
+    /* extensions that only add an image format: the file loads, one
+     * warning names the extension, the material keeps its factor */
+    const char *images[] = {"KHR_texture_basisu", "EXT_texture_webp", "EXT_texture_avif"};
+    for (int i = 0; i < 3; i++) {
+        path_in(path, sizeof path, dir, "image_format.gltf");
+        write_quad(path, images[i],
+                   "{\"name\":\"red\",\"pbrMetallicRoughness\":{\"baseColorFactor\":[1,0,0,1]}}");
+        warnings_naming = 0;
+        warning_needle = images[i];
+        lx_set_log_callback(count_warnings, NULL);
+        lx_scene *s = NULL;
+        lx_status st = lx_scene_load(path, NULL, &s);
+        lx_set_log_callback(NULL, NULL);
+        if (st != LX_OK)
+            fail_msg("%s: %s", images[i], lx_last_error());
+        assert_int_equal(warnings_naming, 1);
+        const lx_material *red = &s->materials[s->meshes[0].material];
+        assert_true(red->base_color.x == 1.0f && red->base_color.y == 0.0f);
         lx_scene_destroy(s);
     }
 }
