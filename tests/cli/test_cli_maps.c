@@ -185,6 +185,24 @@ static void codes_and_formats(void **state)
     assert_int_equal((int)lrint(p[2] * 255), (int)floor((1 / l + 1) / 2 * 255 + 0.5));
     lx_image_free(&n);
 
+    /* --invert reads the steps as a depth map: heights negated, so the
+     * slope's x and y flip and z stays (closed form at column 20, row 15:
+     * normalize(+3, 0, 1)); in float, every texel mirrors the plain map */
+    const char *inv[] = {"normalmap", path("steps.png"), "-o", path("inv.exr"), "--invert",
+                         "-q", NULL};
+    const char *plain[] = {"normalmap", path("steps.png"), "-o", path("plain.exr"), "-q", NULL};
+    assert_int_equal(run(inv), 0);
+    assert_int_equal(run(plain), 0);
+    lx_image ni = load_raw("inv.exr"), np = load_raw("plain.exr");
+    assert_float_equal(ni.data[(15 * SW + 20) * 3], (3 / l + 1) / 2, 1e-6);
+    for (int i = 0; i < SW * SH; i++) {
+        assert_float_equal(2 * ni.data[3 * i] - 1, -(2 * np.data[3 * i] - 1), 1e-6);
+        assert_float_equal(2 * ni.data[3 * i + 1] - 1, -(2 * np.data[3 * i + 1] - 1), 1e-6);
+        assert_float_equal(ni.data[3 * i + 2], np.data[3 * i + 2], 1e-6);
+    }
+    lx_image_free(&ni);
+    lx_image_free(&np);
+
     /* green down: y negated (row 8 tilts toward +y up, so down it is < 0.5) */
     const char *up[] = {"normalmap", path("steps.png"), "-o", path("up.exr"), "-q", NULL};
     const char *down[] = {"normalmap", path("steps.png"), "-o",   path("down.pfm"),

@@ -27,6 +27,7 @@ static const char *normalmap_usage =
     "options:\n"
     "  -o, --output OUT     the normal map (.png, .exr or .pfm)\n"
     "  --strength S         texels of height per unit value (default %g)\n"
+    "  --invert             HEIGHT is a depth map: larger values lie deeper\n"
     "  --filter F           slopes: central (default; the seed's differences),\n"
     "                       sobel or scharr (smoothed across; same slope on a ramp)\n"
     "  --wrap W             texels beyond the edges: repeat (default; tiles),\n"
@@ -42,7 +43,7 @@ static const char *normalmap_usage =
     "  -q, --quiet          no progress bar or summary\n"
     "  -h, --help           show this help\n";
 
-enum { OPT_BLEND = MAPS_OPT_OWN, OPT_METHOD };
+enum { OPT_BLEND = MAPS_OPT_OWN, OPT_METHOD, OPT_INVERT };
 
 typedef struct normalmap_args {
     const char *inputs[2];
@@ -50,7 +51,8 @@ typedef struct normalmap_args {
     maps_output out;
     lx_normalmap_desc desc;
     bool blend, quiet;
-    const char *height_option; /* --strength, --filter or --wrap given */
+    bool invert;               /* HEIGHT is a depth map: higher values lie deeper */
+    const char *height_option; /* --strength, --filter, --wrap or --invert given */
     bool method_given;
     lx_normal_blend_method method;
 } normalmap_args;
@@ -66,6 +68,7 @@ static int parse_args(int argc, char **argv, normalmap_args *a)
                                             {"format", required_argument, NULL, MAPS_OPT_FORMAT},
                                             {"blend", no_argument, NULL, OPT_BLEND},
                                             {"method", required_argument, NULL, OPT_METHOD},
+                                            {"invert", no_argument, NULL, OPT_INVERT},
                                             {"threads", required_argument, NULL, CLI_OPT_THREADS},
                                             {"quiet", no_argument, NULL, 'q'},
                                             {"verbose", no_argument, NULL, 'v'},
@@ -80,6 +83,9 @@ static int parse_args(int argc, char **argv, normalmap_args *a)
         switch (c) {
         case OPT_BLEND:
             a->blend = true;
+            break;
+        case OPT_INVERT:
+            a->invert = true;
             break;
         case OPT_METHOD:
             if (!lx_normal_blend_parse(optarg, &a->method))
@@ -106,7 +112,7 @@ static int parse_args(int argc, char **argv, normalmap_args *a)
     a->desc.green_down = m.green_down;
     a->desc.threads = m.threads;
     a->quiet = m.quiet;
-    a->height_option = m.height_option;
+    a->height_option = m.height_option ? m.height_option : a->invert ? "--invert" : NULL;
     int want = a->blend ? 2 : 1;
     a->input_count = argc - optind;
     if (a->input_count < want)
@@ -141,6 +147,9 @@ static bool from_height(normalmap_args *a, lx_image *encoded)
         return false;
     }
     cli_phase("load");
+    /* a depth map: the heights are its values negated */
+    for (size_t i = 0; a->invert && i < (size_t)height.width * (size_t)height.height; i++)
+        height.data[i * (size_t)height.channels] = -height.data[i * (size_t)height.channels];
     cli_progress progress;
     cli_progress_init(&progress, "normalmap", a->quiet);
     a->desc.progress = cli_progress_update;
