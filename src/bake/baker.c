@@ -110,6 +110,39 @@ static void candidates_free(lx_tile_candidate *c, uint32_t count)
     free(c);
 }
 
+/* One warning for every node whose lightmap the automatic choice sent to
+ * TEXCOORD_0 because a mesh of it has no TEXCOORD_1 (fallback[n] set):
+ * the first named with its mesh, the rest counted. */
+static void warn_texcoord0(const lx_scene *scene, const uint8_t *fallback)
+{
+    uint32_t count = 0, first = UINT32_MAX;
+    for (uint32_t n = 0; n < scene->node_count; n++)
+        if (fallback[n]) {
+            count++;
+            first = first == UINT32_MAX ? n : first;
+        }
+    if (count == 0)
+        return;
+    const lx_node *node = &scene->nodes[first];
+    const char *without = "?";
+    uint32_t unused = 0; /* meshes whose TEXCOORD_1 goes unused */
+    for (uint32_t k = 0; k < node->mesh_count; k++) {
+        const lx_mesh *m = &scene->meshes[node->meshes[k]];
+        if (m->uv[0] && !m->uv[1] && strcmp(without, "?") == 0)
+            without = m->name;
+        unused += m->uv[1] != NULL;
+    }
+    char others[160] = "";
+    if (unused > 0)
+        snprintf(others, sizeof others, " (the TEXCOORD_1 of its %u other %s goes unused)", unused,
+                 unused == 1 ? "mesh" : "meshes");
+    char more[96] = "";
+    if (count > 1)
+        snprintf(more, sizeof more, "; so do %u more nodes with such a mesh", count - 1);
+    lx_log(LX_LOG_WARN, "%s: node '%s': mesh '%s' has no TEXCOORD_1; its lightmap uses TEXCOORD_0%s%s",
+           scene->path, node->name, without, others, more);
+}
+
 /* Builds the candidates' texel maps (a tiled baker lets each go once
  * built, keeping what stays resident), marking the nodes that cover a
  * texel in hit. */
@@ -126,6 +159,9 @@ static lx_status build_maps(lx_baker *b, const lx_scene *scene, const lx_bake_de
     }
     /* a tiled baker builds from its copy, as it will build again */
     const lx_scene *from_scene = b->tiled ? b->tile_scene : scene;
+    uint8_t *fallback = calloc(scene->node_count + 1, 1);
+    if (st == LX_OK && !fallback)
+        st = lx_fail(LX_ERR_NOMEM, "out of memory creating a baker");
     for (uint32_t i = 0; i < count && st == LX_OK; i++) {
         lx_lightmap *map = &b->maps[b->map_count];
         float from = maps_from(b), span = TEXEL_MAPS_SHARE - from;
@@ -149,6 +185,11 @@ static lx_status build_maps(lx_baker *b, const lx_scene *scene, const lx_bake_de
         for (uint32_t k = 0; k < c[i].page.node_count; k++) {
             const lx_page_node *pn = &c[i].page.nodes[k];
             b->node_map[pn->node] = b->map_count;
+            if (pn->uv_set < 0 && lx_bake_uv_set(scene, pn->node, LX_UV_SET_AUTO) == 0)
+                for (uint32_t q = 0; q < scene->nodes[pn->node].mesh_count; q++) {
+                    const lx_mesh *m = &scene->meshes[scene->nodes[pn->node].meshes[q]];
+                    fallback[pn->node] |= m->uv[0] && !m->uv[1];
+                }
             if (b->node_uv_set)
                 b->node_uv_set[pn->node] = (int8_t)(
                     pn->uv_set >= 0 ? pn->uv_set
@@ -167,6 +208,9 @@ static lx_status build_maps(lx_baker *b, const lx_scene *scene, const lx_bake_de
         if (desc->progress && !desc->progress(desc->progress_user, share.to))
             st = lx_fail(LX_ERR_CANCELLED, "bake cancelled");
     }
+    if (st == LX_OK)
+        warn_texcoord0(scene, fallback);
+    free(fallback);
     if (st == LX_OK)
         st = lx_bake_plan_tiles(b, scene, needs);
     b->loaded_tile = b->tiled ? UINT32_MAX : 0;

@@ -491,8 +491,9 @@ static uint32_t collect_slots(const lx_scene *scene, uint32_t node_index, const 
                               int *uv_set, slot *slots, uint32_t *first, bool warn)
 {
     const lx_node *node = &scene->nodes[node_index];
-    bool chosen = *uv_set < 0;
-    if (chosen)
+    /* the automatic choice's TEXCOORD_0 fallback is warned about once per
+     * bake, for every node (lx_bake_warn_texcoord0) */
+    if (*uv_set < 0)
         *uv_set = lx_bake_uv_set(scene, node_index, LX_UV_SET_AUTO);
     uint32_t n = 0;
     for (uint32_t k = 0; k < node->mesh_count; k++) {
@@ -506,18 +507,6 @@ static uint32_t collect_slots(const lx_scene *scene, uint32_t node_index, const 
                        scene->path, node->name, m->name);
             continue;
         }
-        if (chosen && *uv_set == 0 && warn && !m->uv[1])
-            lx_log(LX_LOG_WARN,
-                   "%s: node '%s': mesh '%s' has no TEXCOORD_1; its lightmap "
-                   "uses TEXCOORD_0",
-                   scene->path, node->name, m->name);
-        else if (chosen && *uv_set == 0 && warn)
-            /* a node has one lightmap UV set: one mesh without TEXCOORD_1
-             * sends all of them to TEXCOORD_0 */
-            lx_log(LX_LOG_WARN,
-                   "%s: node '%s': mesh '%s': its TEXCOORD_1 is not used: another mesh of "
-                   "the node has none, so the node's lightmap uses TEXCOORD_0",
-                   scene->path, node->name, m->name);
         slot *sl = &slots[n++];
         *sl = (slot){m, node->meshes[k], node_index, *first, uv, {so[0], so[1], so[2], so[3]}};
         *first += m->triangle_count;

@@ -440,20 +440,23 @@ static void uvless_occluder_same_node(void **state)
 
 /* ---- the lightmap UV set of a node -------------------------------------------- */
 
-static int warn_no_uv1, warn_unused_uv1;
+static int warn_no_uv1, warn_unused_uv1, warn_more_nodes, warnings;
 static void count_uv_warnings(void *user, lx_log_level level, const char *msg)
 {
     (void)user;
     if (level != LX_LOG_WARN)
         return;
+    warnings++;
     warn_no_uv1 += strstr(msg, "'half' has no TEXCOORD_1; its lightmap uses TEXCOORD_0") != NULL;
-    warn_unused_uv1 += strstr(msg, "'full': its TEXCOORD_1 is not used") != NULL;
+    warn_unused_uv1 += strstr(msg, "the TEXCOORD_1 of its 1 other mesh goes unused") != NULL;
+    warn_more_nodes += strstr(msg, "so do 14 more nodes with such a mesh") != NULL;
 }
 
 /* A node whose meshes do not all have TEXCOORD_1 bakes every mesh on
- * TEXCOORD_0 (one lightmap UV space per node), warning once per mesh with
- * what happens to it. Texel counts are closed forms: "full" covers the
- * left half of TEXCOORD_0 (16 of 32 columns), "half" the right half. */
+ * TEXCOORD_0 (one lightmap UV space per node), with one warning saying
+ * what happens to its meshes; 15 such nodes give one warning, not 15.
+ * Texel counts are closed forms: "full" covers the left half of
+ * TEXCOORD_0 (16 of 32 columns), "half" the right half. */
 static void texcoord0_for_the_whole_node(void **state)
 {
     (void)state;
@@ -488,6 +491,30 @@ static void texcoord0_for_the_whole_node(void **state)
     assert_int_equal(info->overlap_texels, 0);
     assert_int_equal(warn_no_uv1, 1);
     assert_int_equal(warn_unused_uv1, 1);
+    lx_baker_destroy(baker);
+    lx_scene_destroy(scene);
+
+    scene = lx_test_new_scene("uv-sets-many");
+    assert_int_equal(lx_scene_add_material(scene, &white, NULL), LX_OK);
+    for (int n = 0; n < 15; n++) {
+        lx_mesh m = lx_test_plane(n == 0 ? "half" : "plane", 1.0f, 0.0f, 2.0f * (float)n, 0.0f, 1);
+        free(m.uv[1]);
+        m.uv[1] = NULL;
+        uint32_t index;
+        assert_int_equal(lx_scene_add_mesh(scene, &m, &index), LX_OK);
+        lx_test_mesh_free(&m);
+        char name[16];
+        snprintf(name, sizeof name, "n%d", n);
+        assert_int_equal(lx_scene_add_node(scene, name, &id, &index, 1, NULL), LX_OK);
+    }
+    warn_no_uv1 = warn_more_nodes = warnings = 0;
+    lx_set_log_callback(count_uv_warnings, NULL);
+    st = lx_baker_create(scene, &desc, &baker);
+    lx_set_log_callback(NULL, NULL);
+    assert_int_equal(st, LX_OK);
+    assert_int_equal(warnings, 1);
+    assert_int_equal(warn_no_uv1, 1);
+    assert_int_equal(warn_more_nodes, 1);
     lx_baker_destroy(baker);
     lx_scene_destroy(scene);
 }
