@@ -11,6 +11,7 @@
 #include <stdio.h>
 #include <stdlib.h>
 #include <string.h>
+#include <strings.h>
 
 static const char *light2d_usage =
     "usage: luxel light2d --casters C.png --lights L.json -o OUT [options]\n"
@@ -25,7 +26,8 @@ static const char *light2d_usage =
     "                      a grey mask, casters where it is >= the threshold)\n"
     "  --lights FILE       the lights JSON (required)\n"
     "  -o, --output FILE   the lit image: .png (sRGB), .exr, .pfm or .hdr (linear)\n"
-    "  --albedo FILE       the colours lit (default white), the casters' size\n"
+    "  --albedo FILE       the colours lit (default white), the casters' size;\n"
+    "                      its alpha, when it has one, is the output's (PNG, EXR)\n"
     "  --normals FILE      tangent-space normal map, the casters' size\n"
     "  --green up|down     the normal map's green axis (default up)\n"
     "  --mask              casters from the first channel, not alpha\n"
@@ -176,6 +178,22 @@ static bool same_size(const char *casters, const lx_image *c, const char *path,
     return false;
 }
 
+/* out (RGB) becomes RGBA with the alpha of albedo (RGBA, same size). */
+static bool with_alpha(lx_image *out, const lx_image *albedo)
+{
+    lx_image rgba;
+    if (lx_image_alloc(&rgba, out->width, out->height, 4) != LX_OK)
+        return false;
+    size_t n = (size_t)out->width * (size_t)out->height;
+    for (size_t i = 0; i < n; i++) {
+        memcpy(&rgba.data[4 * i], &out->data[3 * i], 3 * sizeof(float));
+        rgba.data[4 * i + 3] = albedo->data[4 * i + 3];
+    }
+    lx_image_free(out);
+    *out = rgba;
+    return true;
+}
+
 /* Stages one image in the folder of `path` and publishes it. */
 typedef struct l2_out {
     cli_stage st;
@@ -284,6 +302,19 @@ static int run(const l2_args *a)
         }
     }
     double seconds = cli_now() - t0;
+    /* the albedo's alpha carries over: transparent pixels stay transparent
+     * (PNG and EXR hold it; PFM and HDR cannot, and say so) */
+    if (a->albedo && albedo.channels == 4) {
+        const char *dot = strrchr(a->output, '.');
+        bool holds_alpha = dot && (strcasecmp(dot, ".png") == 0 || strcasecmp(dot, ".exr") == 0);
+        if (!holds_alpha) {
+            lx_log(LX_LOG_WARN, "%s: %s holds no alpha: the albedo's (%s) is left out", a->output,
+                   dot ? dot + 1 : "the format", a->albedo);
+        } else if (!with_alpha(&out, &albedo)) {
+            cli_error("%s: out of memory", a->output);
+            goto done;
+        }
+    }
     lx_image_write_desc wd = {.threads = a->threads};
     if (!cli_stage_image(&o1.st, o1.name, &out, &wd) ||
         (a->light_map && !cli_stage_image(&o2.st, o2.name, &lm, &wd)))
