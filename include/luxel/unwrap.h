@@ -175,7 +175,9 @@ typedef enum lx_uv_problem {
     LX_UV_MISSING,   /* a mesh lacks the set */
     LX_UV_OUTSIDE,   /* a triangle reaches outside [0,1] (texels there are lost) */
     LX_UV_ZERO_AREA, /* triangles of zero UV area (the baker refuses them) */
-    LX_UV_OVERLAP    /* more than max_overlap of the covered texels overlapped */
+    LX_UV_OVERLAP,   /* more than max_overlap of the covered texels overlapped */
+    LX_UV_SPARSE     /* the triangles cover less than min_coverage of the unit square
+                        (a texture atlas's corner, not a lightmap layout) */
 } lx_uv_problem;
 
 typedef struct lx_uv_health_desc {
@@ -188,6 +190,8 @@ typedef struct lx_uv_health_desc {
     int max_resolution;  /* cap of density sizes, 0 = 4096 */
     float max_overlap;   /* overlapped share of the covered texels above which
                             the set is not usable, 0 = 0.01 */
+    float min_coverage;  /* UV area of the triangles (unit square = 1) below which
+                            the set is not usable, 0 = 1/8 */
     int threads;         /* 0 = all cores */
     lx_progress_fn progress; /* hears the texels' tiles (0 to 1), from one thread
                                 at a time; returning false stops the call with
@@ -212,7 +216,8 @@ typedef struct lx_uv_health {
     double world_area;            /* m^2: world space for a node, object space for a mesh */
     double uv_area;               /* summed UV area of the triangles (unit square = 1) */
     bool usable;                  /* problem == LX_UV_OK */
-    lx_uv_problem problem;        /* the first of missing, outside, zero area, overlap */
+    lx_uv_problem problem;        /* the first of missing, outside, zero area, overlap,
+                                     sparse */
     char reason[96];              /* "" when usable, else e.g. "overlaps on 12.5% of its
                                      texels", "outside [0,1] (u 1..2, v 0..1)" */
 } lx_uv_health;

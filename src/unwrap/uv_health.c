@@ -36,6 +36,8 @@ lx_uv_health_desc lx_uv_health_desc_defaults(const lx_uv_health_desc *desc)
         d.max_resolution = 4096;
     if (!(d.max_overlap > 0.0f))
         d.max_overlap = 0.01f;
+    if (!(d.min_coverage > 0.0f))
+        d.min_coverage = 0.125f;
     return d;
 }
 
@@ -52,6 +54,8 @@ const char *lx_uv_problem_name(lx_uv_problem problem)
         return "zero-area triangles";
     case LX_UV_OVERLAP:
         return "overlapping";
+    case LX_UV_SPARSE:
+        return "sparse";
     }
     return "unknown";
 }
@@ -344,6 +348,10 @@ static void set_reason(lx_uv_health *h, lx_uv_problem problem)
         snprintf(h->reason, sizeof h->reason, "overlaps on %.3g%% of its texels",
                  100.0 * h->overlap_share);
         break;
+    case LX_UV_SPARSE:
+        snprintf(h->reason, sizeof h->reason,
+                 "covers %.3g%% of the UV square (a texture atlas's part?)", 100.0 * h->uv_area);
+        break;
     }
 }
 
@@ -499,6 +507,7 @@ static lx_status health_of(const hmesh *meshes, uint32_t mesh_count, int uv_set,
     set_reason(out, outside                             ? LX_UV_OUTSIDE
                     : out->zero_area_triangles          ? LX_UV_ZERO_AREA
                     : out->overlap_share > d.max_overlap ? LX_UV_OVERLAP
+                    : total && out->uv_area < d.min_coverage ? LX_UV_SPARSE
                                                          : LX_UV_OK);
     return LX_OK;
 }

@@ -255,6 +255,34 @@ static void missing_set(void **state)
     free_grid(&m);
 }
 
+/* UVs in a corner of the square, as a texture atlas gives each object: a
+ * 4x4 grid squeezed into [0, 0.115]^2 covers 0.115^2 = 1.3% of the
+ * square (closed form) and is not usable; squeezed to 0.36 (13%) it is, at
+ * the default min_coverage of 1/8, and a min_coverage of 0.2 refuses it. */
+static void corner_of_the_square(void **state)
+{
+    (void)state;
+    for (int c = 0; c < 3; c++) {
+        static const float side[3] = {0.115f, 0.36f, 0.36f};
+        static const float min_coverage[3] = {0.0f, 0.0f, 0.2f};
+        lx_mesh m = grid(4, 0);
+        for (uint32_t v = 0; v < m.vertex_count; v++)
+            m.uv[1][v] = lx_v2(m.uv[1][v].x * side[c], m.uv[1][v].y * side[c]);
+        lx_uv_health_desc d = {.min_coverage = min_coverage[c]};
+        lx_uv_health h;
+        assert_int_equal(lx_uv_health_mesh(&m, 1, &d, &h), LX_OK);
+        assert_float_equal(h.uv_area, (double)side[c] * side[c], 1e-6);
+        bool usable = c == 1;
+        assert_int_equal(h.usable, usable);
+        if (!usable) {
+            assert_int_equal(h.problem, LX_UV_SPARSE);
+            if (!strstr(h.reason, "% of the UV square"))
+                fail_msg("reason '%s'", h.reason);
+        }
+        free_grid(&m);
+    }
+}
+
 /* Two nodes: the node's meshes share one lightmap, so two clean meshes on
  * the same cells overlap as a node; the density sizes the bitmap as the
  * baker does (side^2 * uv_area = density^2 * world_area). */
@@ -320,6 +348,7 @@ int main(void)
         cmocka_unit_test(clean_grid_is_usable), cmocka_unit_test(one_tile_off_is_outside),
         cmocka_unit_test(tiled_overlap_share),  cmocka_unit_test(folded_triangle),
         cmocka_unit_test(zero_area_triangle),   cmocka_unit_test(missing_set),
+        cmocka_unit_test(corner_of_the_square),
         cmocka_unit_test(node_level),           cmocka_unit_test(threads_agree),
     };
     return cmocka_run_group_tests(tests, NULL, NULL);

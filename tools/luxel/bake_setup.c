@@ -198,7 +198,7 @@ static int plan_lightmaps(bake_args *a, lx_scene *scene, lx_unwrap **out, bool *
         .threads = a->desc.threads,
         .progress = cli_progress_update,
         .progress_user = &progress};
-    uint32_t count[LX_UV_OVERLAP + 1] = {0}, generate = 0, skipped = 0;
+    uint32_t count[LX_UV_SPARSE + 1] = {0}, generate = 0, skipped = 0;
     for (uint32_t n = 0; n < nn; n++) {
         sets[n] = lx_bake_uv_set(scene, n, a->desc.uv_set);
         lx_uv_problem why = LX_UV_OK;
@@ -244,7 +244,7 @@ static int plan_lightmaps(bake_args *a, lx_scene *scene, lx_unwrap **out, bool *
     *atlas = a->atlas == 1 || (a->atlas < 0 && generate > 0);
     if (generate && a->unwrap == UNWRAP_AUTO) {
         char detail[200] = "";
-        for (int r = LX_UV_MISSING, first = 1; r <= LX_UV_OVERLAP; r++)
+        for (int r = LX_UV_MISSING, first = 1; r <= LX_UV_SPARSE; r++)
             if (count[r]) {
                 size_t len = strlen(detail);
                 snprintf(detail + len, sizeof detail - len, "%s%s %u", first ? "" : ", ",
