@@ -27,10 +27,12 @@ static const char *bake_usage =
     "\n"
     "options:\n"
     "  -o, --output DIR        output folder (default ./lightmaps)\n"
-    "  --resolution N          texels per side of every lightmap (default %d), or\n"
-    "                          of the atlas page to fill (default %d)\n"
+    "  --resolution N          texels per side of every lightmap, or of the atlas\n"
+    "                          page to fill\n"
     "  --texel-density T       texels per metre instead: each lightmap sized from\n"
-    "                          its world and UV areas, a multiple of 4\n"
+    "                          its world and UV areas, a multiple of 4 (default\n"
+    "                          without either: 2^20 texels over the scene's area,\n"
+    "                          held to 4..40 texels/m)\n"
     "  --max-resolution N      cap for --texel-density sizes (default %d)\n"
     "  --lights FILE.json      lights and settings added to or overriding the\n"
     "                          scene's (docs/lights-json.md)\n"
@@ -256,7 +258,7 @@ static int parse_args(int argc, char **argv, bake_args *a)
             /* the defaults shown are the library's */
             lx_bake_desc d = lx_bake_desc_defaults(NULL);
             lx_unwrap_desc u = lx_unwrap_desc_defaults(NULL);
-            printf(bake_usage, d.resolution, CLI_ATLAS_RESOLUTION, d.max_resolution,
+            printf(bake_usage, d.max_resolution,
                    d.quantity == LX_QUANTITY_RADIANCE ? "radiance" : "irradiance",
                    (double)d.sky.intensity, d.sky.samples, LX_MAX_BOUNCES,
                    LX_BOUNCES_RECOMMENDED, d.gi_samples, LX_MAX_SUPERSAMPLE,
@@ -750,14 +752,21 @@ int cmd_bake(int argc, char **argv)
     }
     cli_phase("write and publish");
     if (!a.quiet) {
+        /* the density the lightmaps were sized by, when the scene chose it */
+        char density_note[64] = "";
+        if (a.density_from_scene)
+            snprintf(density_note, sizeof density_note, " at %s texels/m",
+                     cli_num((double)(unwrap ? unwrap->texel_density : a.desc.texel_density)));
         uint64_t texels = 0;
         for (uint32_t m = 0; m < maps; m++)
             texels += lx_baker_lightmap_info(baker, m)->used_texels;
         fprintf(
-            stderr, "luxel: baked %u %s (%llu %s, %u %s) in %s s; preview EV100 %s%s, %s\n", maps,
+            stderr, "luxel: baked %u %s (%llu %s%s, %u %s) in %s s; preview EV100 %s%s, %s\n",
+            maps,
             atlas ? cli_plural(maps, "atlas page", "atlas pages")
                   : cli_plural(maps, "lightmap", "lightmaps"),
-            (unsigned long long)texels, cli_plural(texels, "texel", "texels"), scene->light_count,
+            (unsigned long long)texels, cli_plural(texels, "texel", "texels"), density_note,
+            scene->light_count,
             cli_plural(scene->light_count, "light", "lights"), cli_num_digits(cli_elapsed(), 3),
             cli_num_digits(ev, 3), a.has_exposure ? "" : " (auto)", lx_tonemap_name(a.tonemap));
         if (a.render)

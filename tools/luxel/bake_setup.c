@@ -63,6 +63,23 @@ static double node_area(const lx_scene *scene, uint32_t n)
     return area;
 }
 
+/* The texel density a bake gets when no option sizes its lightmaps: the
+ * density that spends CLI_DENSITY_BUDGET texels on the world area of every
+ * node with a mesh, held to CLI_DENSITY_MIN..CLI_DENSITY_MAX texels a
+ * metre (the tens of texels per metre Unity's and Bakery's defaults give
+ * rooms and levels), to two significant digits. A room of 200 m^2 gets the
+ * maximum; a level of 10,000 m^2 about 10. */
+double cli_default_density(const lx_scene *scene)
+{
+    double total = 0.0;
+    for (uint32_t n = 0; n < scene->node_count; n++)
+        total += node_area(scene, n);
+    double d = total > 0.0 ? sqrt(CLI_DENSITY_BUDGET / total) : CLI_DENSITY_MAX;
+    d = d > CLI_DENSITY_MAX ? CLI_DENSITY_MAX : d < CLI_DENSITY_MIN ? CLI_DENSITY_MIN : d;
+    double scale = pow(10.0, floor(log10(d)) - 1.0);
+    return floor(d / scale + 0.5) * scale;
+}
+
 /* Warnings for units that look wrong: a scene smaller than 5 cm or larger
  * than 10 km, a node that gets fewer than 8x8 texels at --texel-density,
  * a scene only a few texels across at the unwrapper's density. */
@@ -78,7 +95,8 @@ static void check_scale(const bake_args *a, const lx_scene *scene, const lx_unwr
     for (uint32_t n = 0; n < scene->node_count; n++) {
         double area = node_area(scene, n);
         total += area;
-        if (density > 0.0f && area > 0.0 && area * density * density < 64.0) {
+        if (density > 0.0f && !a->density_from_scene && area > 0.0 &&
+            area * density * density < 64.0) {
             small++;
             if (area < smallest) {
                 smallest = area;
@@ -529,6 +547,11 @@ int cli_bake_prepare(bake_args *a, cli_progress *progress, lx_scene **scene_out,
         goto done;
     }
     check_spots(a, scene);
+    /* nothing sizes the lightmaps: a density from the scene's area */
+    if (!a->has_resolution && !(a->desc.texel_density > 0.0f)) {
+        a->desc.texel_density = (float)cli_default_density(scene);
+        a->density_from_scene = true;
+    }
     /* lightmap UVs: the file's, or luxel's where those do not serve */
     int planned = plan_lightmaps(a, scene, unwrap, atlas);
     if (planned != EXIT_OK) {

@@ -15,6 +15,12 @@ typedef enum unwrap_choice { UNWRAP_AUTO, UNWRAP_ALWAYS, UNWRAP_NEVER } unwrap_c
  * resolution). */
 #define CLI_ATLAS_RESOLUTION 1024
 
+/* The default texel density (cli_default_density): the texels a bake
+ * spends on the scene's area, and the range the density is held to. */
+#define CLI_DENSITY_BUDGET (1024.0 * 1024.0)
+#define CLI_DENSITY_MIN 4.0
+#define CLI_DENSITY_MAX 40.0
+
 /* The largest bitmap a node's own UVs are checked on (lx_uv_health): the
  * overlapped share hardly changes with the size, the time grows with it. */
 #define CLI_HEALTH_SIZE 256
@@ -96,6 +102,8 @@ typedef struct bake_args {
     int sky_shadows;      /* 1 on, 0 off, -1 not given */
     long sky_samples;     /* 0: not given */
     bool has_resolution;
+    bool density_from_scene; /* neither --resolution nor --texel-density: the
+                                density came from the scene (cli_default_density) */
     unwrap_choice unwrap;
     int atlas;      /* 1 --atlas, 0 --no-atlas, -1 not given */
     int atlas_size; /* 0: the unwrapper's default */
@@ -132,5 +140,9 @@ int cli_bake_prepare(bake_args *a, cli_progress *progress, lx_scene **scene, lx_
                      lx_unwrap **unwrap, bool *atlas, lx_baker **baker);
 /* --strict: true (error printed) when any warning so far fails the run. */
 bool cli_bake_strict_failed(const bake_args *a);
+
+/* The texel density (texels a metre) a bake gets when neither
+ * --resolution nor --texel-density is given (bake_setup.c). */
+double cli_default_density(const lx_scene *scene);
 
 #endif
