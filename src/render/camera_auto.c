@@ -8,7 +8,8 @@
  * sides, then views from inside the bounds - raised, near one end of a
  * horizontal axis, looking along it - are scored too, and the first group
  * with a view of which at least half scores gives the one with the most
- * scoring probes: a closed room seen from
+ * scoring probes (the first in that order unless a later one scores
+ * clearly more): a closed room seen from
  * outside shows the back faces of walls that face in, or the unlit
  * outside of walls with two sides; a box open on one side is best seen
  * through that side. */
@@ -37,6 +38,10 @@
 #define VIEWS 9
 /* lit: luminance above this fraction of the brightest view's median */
 #define LIT_FRACTION 0.01
+/* a later view of a group replaces an earlier one that is right only when
+ * it scores this much more: views of a symmetric room score within noise
+ * of each other, and the camera must not flip between two bakes of it */
+#define CLEARLY_BETTER 0.05f
 
 enum { MISS = 0, FRONT, BACK, BLOCKED };
 
@@ -209,7 +214,7 @@ lx_status lx_camera_auto(const lx_scene *scene, const lx_lightmaps *lm, const lx
         float best_score = info->outside_score;
         for (int k = 1 + 4 * group; k < 5 + 4 * group; k++) {
             float s = score(&v[k], use_light, lit, &good);
-            if (good >= GOOD && s > best_score) {
+            if (good >= GOOD && s > best_score + (best ? CLEARLY_BETTER : 0.0f)) {
                 best = k;
                 best_score = s;
             }

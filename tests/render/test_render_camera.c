@@ -168,6 +168,80 @@ static void test_thick_walls(void **state)
     lx_scene_destroy(s);
 }
 
+/* The thick-walled room lit evenly but for a dark 2x2 patch on the wall
+ * at +X (face 0's chart) or at -X (face 1's): the inside views along +X and
+ * -X then score a little apart, one way or the other. The camera must not
+ * follow such noise: both bakes get the same view, the first inside view
+ * (along +X). */
+static lx_camera thick_room_with_patch(int face, lx_camera_auto_info *info)
+{
+    char dir_name[64];
+    snprintf(dir_name, sizeof dir_name, "render_camera_patch%d", face);
+    const char *dir = lx_test_dir(dir_name);
+    char path[4096];
+    lx_image page;
+    assert_int_equal(lx_image_alloc(&page, 16, 16, 3), LX_OK);
+    for (int i = 0; i < 16 * 16 * 3; i++)
+        page.data[i] = 100.0f;
+    /* face f's chart: columns (f % 3) * 16/3 .. , rows (f / 3) * 8 .. */
+    int x0 = (face % 3) * 16 / 3 + 2, y0 = (face / 3) * 8 + 3;
+    for (int y = y0; y < y0 + 2; y++)
+        for (int x = x0; x < x0 + 2; x++)
+            for (int k = 0; k < 3; k++)
+                page.data[3 * (y * 16 + x) + k] = 0.0f;
+    snprintf(path, sizeof path, "%s/inner.exr", dir);
+    assert_int_equal(lx_image_write(path, &page, NULL), LX_OK);
+    memset(page.data, 0, sizeof(float) * 16 * 16 * 3);
+    snprintf(path, sizeof path, "%s/outer.exr", dir);
+    assert_int_equal(lx_image_write(path, &page, NULL), LX_OK);
+    lx_image_free(&page);
+    snprintf(path, sizeof path, "%s/manifest.json", dir);
+    write_text(path, "{\"scene\":\"thick\",\"quantity\":\"irradiance\",\"unit\":\"lx\","
+                     "\"pages\":[{\"file\":\"inner.exr\",\"width\":16,\"height\":16},"
+                     "{\"file\":\"outer.exr\",\"width\":16,\"height\":16}],"
+                     "\"nodes\":[{\"node\":\"inner\",\"meshes\":[\"inner\"],\"page\":0,"
+                     "\"scale_offset\":[1,1,0,0],\"uv_set\":\"TEXCOORD_1\"},"
+                     "{\"node\":\"outer\",\"meshes\":[\"outer\"],\"page\":1,"
+                     "\"scale_offset\":[1,1,0,0],\"uv_set\":\"TEXCOORD_1\"}]}");
+    lx_scene *s = lx_test_new_scene("thick");
+    lx_material mat = {.name = "white", .base_color = {0.8f, 0.8f, 0.8f, 1.0f},
+                       .normal_scale = 1.0f};
+    uint32_t mi;
+    assert_int_equal(lx_scene_add_material(s, &mat, &mi), LX_OK);
+    lx_mesh in = lx_test_box("inner", lx_v3(-3, 0, -2), lx_v3(3, 3, 2), true);
+    lx_mesh out = lx_test_box("outer", lx_v3(-3.2f, -0.2f, -2.2f), lx_v3(3.2f, 3.2f, 2.2f), false);
+    in.material = out.material = mi;
+    lx_test_add(s, &in);
+    lx_test_add(s, &out);
+    lx_test_mesh_free(&in);
+    lx_test_mesh_free(&out);
+    lx_lightmaps lm;
+    if (lx_lightmaps_load(dir, NULL, &lm) != LX_OK)
+        fail_msg("%s", lx_last_error());
+    lx_tracer *tr;
+    assert_int_equal(lx_tracer_create(s, NULL, &tr), LX_OK);
+    lx_camera cam;
+    assert_int_equal(lx_camera_auto(s, &lm, tr, 0.0f, 16.0f / 9.0f, &cam, info), LX_OK);
+    lx_tracer_destroy(tr);
+    lx_lightmaps_free(&lm);
+    lx_scene_destroy(s);
+    return cam;
+}
+
+static void test_no_flip_on_noise(void **state)
+{
+    (void)state;
+    lx_camera_auto_info a, b;
+    lx_camera ca = thick_room_with_patch(0, &a), cb = thick_room_with_patch(1, &b);
+    print_message("patch at +X: %s (score %.4f); at -X: %s (score %.4f)\n", a.placement,
+                  (double)a.score, b.placement, (double)b.score);
+    assert_true(a.inside && b.inside);
+    assert_true(a.score != b.score); /* the patches do change the scores */
+    assert_string_equal(a.placement, b.placement);
+    assert_string_equal(a.placement, "inside, looking along +X");
+    assert_memory_equal(&ca, &cb, sizeof ca);
+}
+
 static const char *room_manifest =
     "{\"scene\":\"box\",\"quantity\":\"irradiance\",\"unit\":\"lx\",\"preview_ev100\":7,"
     "\"pages\":[{\"file\":\"room.exr\",\"width\":16,\"height\":16}],"
@@ -325,6 +399,7 @@ int main(void)
         cmocka_unit_test(test_closed_room_inside),
         cmocka_unit_test(test_closed_object_outside),
         cmocka_unit_test(test_thick_walls),
+        cmocka_unit_test(test_no_flip_on_noise),
         cmocka_unit_test(test_default_render_is_auto),
         cmocka_unit_test(test_gltf_camera_render),
         cmocka_unit_test(test_orthographic_render),
