@@ -26,19 +26,13 @@
 #include "gltf_writer.h"
 #include "helpers.h"
 
-#include <fcntl.h>
 #include <limits.h>
 #include <math.h>
-#include <spawn.h>
 #include <stdio.h>
 #include <stdlib.h>
 #include <string.h>
-#include <sys/wait.h>
 #include <unistd.h>
 
-extern char **environ;
-
-static char luxel[PATH_MAX];
 static char dir[PATH_MAX];
 static char out_log[PATH_MAX + 16], err_log[PATH_MAX + 16];
 static char cams_gltf[PATH_MAX + 32], plain_gltf[PATH_MAX + 32];
@@ -48,23 +42,7 @@ static char cams_maps[PATH_MAX + 32], plain_maps[PATH_MAX + 32];
  * DIR/out.log and DIR/err.log. Returns the exit status. */
 static int run(const char *const *args)
 {
-    const char *argv[40] = {luxel};
-    int n = 1;
-    for (; *args && n < 39; args++)
-        argv[n++] = *args;
-    argv[n] = NULL;
-    posix_spawn_file_actions_t fa;
-    posix_spawn_file_actions_init(&fa);
-    posix_spawn_file_actions_addopen(&fa, 1, out_log, O_WRONLY | O_CREAT | O_TRUNC, 0644);
-    posix_spawn_file_actions_addopen(&fa, 2, err_log, O_WRONLY | O_CREAT | O_TRUNC, 0644);
-    pid_t pid;
-    int rc = posix_spawn(&pid, luxel, &fa, NULL, (char *const *)argv, environ);
-    posix_spawn_file_actions_destroy(&fa);
-    if (rc != 0)
-        fail_msg("cannot run %s", luxel);
-    int status;
-    assert_int_equal(waitpid(pid, &status, 0), pid);
-    return WIFEXITED(status) ? WEXITSTATUS(status) : -1;
+    return lx_test_run_luxel(args, out_log, err_log);
 }
 
 static char *slurp(const char *path, size_t *size)
@@ -176,7 +154,6 @@ static void bake(const char *scene, const char *out)
 static int setup(void **state)
 {
     (void)state;
-    lx_test_sibling("luxel", luxel, sizeof luxel);
     snprintf(dir, sizeof dir, "%s", lx_test_dir("test_cli_cameras"));
     snprintf(out_log, sizeof out_log, "%s/out.log", dir);
     snprintf(err_log, sizeof err_log, "%s/err.log", dir);

@@ -19,42 +19,25 @@
 #include "helpers.h"
 #include "texture_oracle.h"
 
-#include <fcntl.h>
 #include <limits.h>
 #include <math.h>
-#include <spawn.h>
 #include <stdio.h>
 #include <stdlib.h>
 #include <string.h>
-#include <sys/wait.h>
 #include <unistd.h>
 
-extern char **environ;
-
-static char luxel[PATH_MAX];
 static char dir[PATH_MAX];
 
 static int run_ibl(const char *const *args)
 {
-    const char *argv[32] = {luxel, "ibl", "const:1", "-q"};
-    int n = 4;
+    const char *argv[32] = {"ibl", "const:1", "-q"};
+    int n = 3;
     for (; *args && n < 31; args++)
         argv[n++] = *args;
     argv[n] = NULL;
     char log[PATH_MAX + 16];
     snprintf(log, sizeof log, "%s/cli.log", dir);
-    posix_spawn_file_actions_t fa;
-    posix_spawn_file_actions_init(&fa);
-    posix_spawn_file_actions_addopen(&fa, 1, log, O_WRONLY | O_CREAT | O_TRUNC, 0644);
-    posix_spawn_file_actions_adddup2(&fa, 1, 2);
-    pid_t pid;
-    int rc = posix_spawn(&pid, luxel, &fa, NULL, (char *const *)argv, environ);
-    posix_spawn_file_actions_destroy(&fa);
-    if (rc != 0)
-        fail_msg("cannot run %s", luxel);
-    int status;
-    assert_int_equal(waitpid(pid, &status, 0), pid);
-    return WIFEXITED(status) ? WEXITSTATUS(status) : -1;
+    return lx_test_run_luxel(argv, log, log);
 }
 
 static lx_image load(const char *sub, const char *file, bool raw)
@@ -71,7 +54,6 @@ static lx_image load(const char *sub, const char *file, bool raw)
 static int setup(void **state)
 {
     (void)state;
-    lx_test_sibling("luxel", luxel, sizeof luxel);
     snprintf(dir, sizeof dir, "%s", lx_test_dir("test_cli_ibl_8bit"));
     return 0;
 }

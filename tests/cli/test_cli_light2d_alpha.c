@@ -17,20 +17,14 @@
 #include "gltf_writer.h"
 #include "helpers.h"
 
-#include <fcntl.h>
 #include <limits.h>
-#include <spawn.h>
 #include <stdio.h>
 #include <stdlib.h>
 #include <string.h>
-#include <sys/wait.h>
-
-extern char **environ;
 
 #define W 48
 #define H 32
 
-static char luxel[PATH_MAX];
 static char dir[PATH_MAX];
 static char log_text[8192];
 
@@ -46,30 +40,10 @@ static const char *in_dir(const char *name)
 /* Runs luxel with args (NULL-terminated); its stderr in log_text. */
 static int run_luxel(const char *const *args)
 {
-    const char *argv[32] = {luxel};
-    int n = 1;
-    for (; *args && n < 31; args++)
-        argv[n++] = *args;
-    argv[n] = NULL;
     const char *log = in_dir("cli.log");
-    posix_spawn_file_actions_t fa;
-    posix_spawn_file_actions_init(&fa);
-    posix_spawn_file_actions_addopen(&fa, 2, log, O_WRONLY | O_CREAT | O_TRUNC, 0644);
-    pid_t pid;
-    int rc = posix_spawn(&pid, luxel, &fa, NULL, (char *const *)argv, environ);
-    posix_spawn_file_actions_destroy(&fa);
-    if (rc != 0)
-        fail_msg("cannot run %s", luxel);
-    int status;
-    assert_int_equal(waitpid(pid, &status, 0), pid);
-    log_text[0] = '\0';
-    FILE *fp = fopen(log, "r");
-    if (fp) {
-        size_t got = fread(log_text, 1, sizeof log_text - 1, fp);
-        log_text[got] = '\0';
-        fclose(fp);
-    }
-    return WIFEXITED(status) ? WEXITSTATUS(status) : -1;
+    int status = lx_test_run_luxel(args, in_dir("out.log"), log);
+    lx_test_read_text(log, log_text, sizeof log_text);
+    return status;
 }
 
 static lx_image load_raw(const char *path)
@@ -84,7 +58,6 @@ static lx_image load_raw(const char *path)
 static void albedo_alpha_carries_over(void **state)
 {
     (void)state;
-    lx_test_sibling("luxel", luxel, sizeof luxel);
     snprintf(dir, sizeof dir, "%s", lx_test_dir("test_cli_light2d_alpha"));
     /* a sprite: a block caster on the left, opaque coloured ground below,
      * transparent sky above with a soft edge of partial alpha */

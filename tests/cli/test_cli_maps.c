@@ -25,52 +25,27 @@
 
 #include "helpers.h"
 
-#include <fcntl.h>
 #include <limits.h>
 #include <math.h>
-#include <spawn.h>
 #include <stdio.h>
 #include <stdlib.h>
 #include <string.h>
 #include <sys/stat.h>
-#include <sys/wait.h>
 #include <unistd.h>
 #include <zlib.h>
 
-extern char **environ;
-
-static char luxel[PATH_MAX];
 static char dir[PATH_MAX];
 static char err_text[8192];
 
 /* Runs luxel with args (NULL-terminated); stderr into err_text. */
 static int run(const char *const *args)
 {
-    const char *argv[40] = {luxel};
-    int n = 1;
-    for (; *args && n < 39; args++)
-        argv[n++] = *args;
-    argv[n] = NULL;
     char log[PATH_MAX + 16], out[PATH_MAX + 16];
     snprintf(log, sizeof log, "%s/stderr.txt", dir);
     snprintf(out, sizeof out, "%s/stdout.txt", dir);
-    posix_spawn_file_actions_t fa;
-    posix_spawn_file_actions_init(&fa);
-    posix_spawn_file_actions_addopen(&fa, 1, out, O_WRONLY | O_CREAT | O_TRUNC, 0644);
-    posix_spawn_file_actions_addopen(&fa, 2, log, O_WRONLY | O_CREAT | O_TRUNC, 0644);
-    pid_t pid;
-    int rc = posix_spawn(&pid, luxel, &fa, NULL, (char *const *)argv, environ);
-    posix_spawn_file_actions_destroy(&fa);
-    if (rc != 0)
-        fail_msg("cannot run %s", luxel);
-    int status;
-    assert_int_equal(waitpid(pid, &status, 0), pid);
-    FILE *f = fopen(log, "r");
-    size_t got = f ? fread(err_text, 1, sizeof err_text - 1, f) : 0;
-    err_text[got] = '\0';
-    if (f)
-        fclose(f);
-    return WIFEXITED(status) ? WEXITSTATUS(status) : -1;
+    int status = lx_test_run_luxel(args, out, log);
+    lx_test_read_text(log, err_text, sizeof err_text);
+    return status;
 }
 
 static const char *path(const char *name)
@@ -107,7 +82,6 @@ static lx_image load_raw(const char *name)
 static int setup(void **state)
 {
     (void)state;
-    lx_test_sibling("luxel", luxel, sizeof luxel);
     snprintf(dir, sizeof dir, "%s", lx_test_dir("test_cli_maps"));
     return 0;
 }

@@ -35,22 +35,16 @@
 #include "helpers.h"
 #include "texture_oracle.h"
 
-#include <fcntl.h>
 #include <limits.h>
 #include <math.h>
-#include <spawn.h>
 #include <stdio.h>
 #include <stdlib.h>
 #include <string.h>
-#include <sys/wait.h>
 #include <unistd.h>
-
-extern char **environ;
 
 #define RES 32
 #define EV100 7.5
 
-static char luxel[PATH_MAX];
 static char dir[PATH_MAX];
 static char scene_path[PATH_MAX];
 static char lights_path[PATH_MAX];
@@ -61,26 +55,15 @@ static lx_image reference; /* the library's bake */
 static int run_bake(const char *const *args)
 {
     /* direct light only: the library bake it is compared with has no bounces */
-    const char *argv[32] = {luxel,       "bake",         scene_path, "--lights", lights_path,
-                            "--resolution", "32",       "-q",       "--bounces", "0"};
-    int n = 10;
+    const char *argv[32] = {"bake",         scene_path, "--lights", lights_path, "--resolution",
+                            "32",           "-q",       "--bounces", "0"};
+    int n = 9;
     for (; *args && n < 31; args++)
         argv[n++] = *args;
     argv[n] = NULL;
     char log[PATH_MAX + 16];
     snprintf(log, sizeof log, "%s/cli.log", dir);
-    posix_spawn_file_actions_t fa;
-    posix_spawn_file_actions_init(&fa);
-    posix_spawn_file_actions_addopen(&fa, 1, log, O_WRONLY | O_CREAT | O_TRUNC, 0644);
-    posix_spawn_file_actions_adddup2(&fa, 1, 2);
-    pid_t pid;
-    int rc = posix_spawn(&pid, luxel, &fa, NULL, (char *const *)argv, environ);
-    posix_spawn_file_actions_destroy(&fa);
-    if (rc != 0)
-        fail_msg("cannot run %s", luxel);
-    int status;
-    assert_int_equal(waitpid(pid, &status, 0), pid);
-    return WIFEXITED(status) ? WEXITSTATUS(status) : -1;
+    return lx_test_run_luxel(argv, log, log);
 }
 
 static lx_image load(const char *sub, const char *file, bool raw)
@@ -99,7 +82,6 @@ static lx_image load(const char *sub, const char *file, bool raw)
 static int setup(void **state)
 {
     (void)state;
-    lx_test_sibling("luxel", luxel, sizeof luxel);
     snprintf(dir, sizeof dir, "%s", lx_test_dir("test_cli_readback"));
 
     /* a 4 m floor facing +Y, TEXCOORD_1 over the unit square */

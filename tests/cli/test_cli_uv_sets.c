@@ -30,17 +30,12 @@
 #include "helpers.h"
 
 #include <cjson/cJSON.h>
-#include <fcntl.h>
 #include <limits.h>
 #include <math.h>
-#include <spawn.h>
 #include <stdio.h>
 #include <stdlib.h>
 #include <string.h>
-#include <sys/wait.h>
 #include <unistd.h>
-
-extern char **environ;
 
 #define GRID 4          /* quads per side */
 #define SIDE 4.0f       /* metres */
@@ -48,39 +43,17 @@ extern char **environ;
 #define INTENSITY 900.0 /* cd */
 static const double LIGHT_X = 0.5, LIGHT_Z = -0.25;
 
-static char luxel[PATH_MAX];
 static char dir[PATH_MAX];
 
 /* Runs luxel with args (NULL-terminated); output to DIR/cli.log. */
 static int run_luxel(const char *const *args)
 {
-    const char *argv[40] = {luxel};
-    int n = 1;
-    for (; *args && n < 39; args++)
-        argv[n++] = *args;
-    argv[n] = NULL;
     char log[PATH_MAX + 16];
     snprintf(log, sizeof log, "%s/cli.log", dir);
-    posix_spawn_file_actions_t fa;
-    posix_spawn_file_actions_init(&fa);
-    posix_spawn_file_actions_addopen(&fa, 1, log, O_WRONLY | O_CREAT | O_TRUNC, 0644);
-    posix_spawn_file_actions_adddup2(&fa, 1, 2);
-    pid_t pid;
-    int rc = posix_spawn(&pid, luxel, &fa, NULL, (char *const *)argv, environ);
-    posix_spawn_file_actions_destroy(&fa);
-    if (rc != 0)
-        fail_msg("cannot run %s", luxel);
-    int status;
-    assert_int_equal(waitpid(pid, &status, 0), pid);
-    int code = WIFEXITED(status) ? WEXITSTATUS(status) : -1;
+    int code = lx_test_run_luxel(args, log, log);
     if (code != 0) {
-        char text[4096] = "";
-        FILE *fp = fopen(log, "r");
-        if (fp) {
-            size_t got = fread(text, 1, sizeof text - 1, fp);
-            text[got] = '\0';
-            fclose(fp);
-        }
+        char text[4096];
+        lx_test_read_text(log, text, sizeof text);
         print_message("luxel said:\n%s\n", text);
     }
     return code;
@@ -257,7 +230,6 @@ static void floor_set(const char *out, int want_set, const char *want_uvs, const
 static void generated_uvs_where_the_manifest_says(void **state)
 {
     (void)state;
-    lx_test_sibling("luxel", luxel, sizeof luxel);
     snprintf(dir, sizeof dir, "%s", lx_test_dir("test_cli_uv_sets"));
     char scene[PATH_MAX + 16], lights[PATH_MAX + 16], out[PATH_MAX + 16];
     snprintf(scene, sizeof scene, "%s/floor.gltf", dir);

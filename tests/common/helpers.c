@@ -11,12 +11,17 @@
 
 #include <dirent.h>
 #include <math.h>
+#include <fcntl.h>
 #include <signal.h>
+#include <spawn.h>
 #include <stdio.h>
 #include <stdlib.h>
 #include <string.h>
 #include <sys/stat.h>
+#include <sys/wait.h>
 #include <unistd.h>
+
+extern char **environ;
 
 static void mkdirs(const char *path)
 {
@@ -276,6 +281,41 @@ void lx_test_sibling(const char *name, char *out, size_t size)
     snprintf(out, size, "%s/%s", self, name);
     if (access(out, X_OK) != 0)
         fail_msg("no %s executable next to the test: %s", name, out);
+}
+
+int lx_test_run_luxel(const char *const *args, const char *out_log, const char *err_log)
+{
+    char luxel[4096];
+    lx_test_sibling("luxel", luxel, sizeof luxel);
+    const char *argv[64] = {luxel};
+    int n = 1;
+    for (; *args && n < 63; args++)
+        argv[n++] = *args;
+    argv[n] = NULL;
+    posix_spawn_file_actions_t fa;
+    posix_spawn_file_actions_init(&fa);
+    posix_spawn_file_actions_addopen(&fa, 1, out_log, O_WRONLY | O_CREAT | O_TRUNC, 0644);
+    if (strcmp(out_log, err_log) == 0)
+        posix_spawn_file_actions_adddup2(&fa, 1, 2);
+    else
+        posix_spawn_file_actions_addopen(&fa, 2, err_log, O_WRONLY | O_CREAT | O_TRUNC, 0644);
+    pid_t pid;
+    int rc = posix_spawn(&pid, luxel, &fa, NULL, (char *const *)argv, environ);
+    posix_spawn_file_actions_destroy(&fa);
+    if (rc != 0)
+        fail_msg("cannot run %s", luxel);
+    int status;
+    assert_int_equal(waitpid(pid, &status, 0), pid);
+    return WIFEXITED(status) ? WEXITSTATUS(status) : -1;
+}
+
+void lx_test_read_text(const char *path, char *buf, size_t size)
+{
+    FILE *f = fopen(path, "r");
+    size_t got = f ? fread(buf, 1, size - 1, f) : 0;
+    buf[got] = '\0';
+    if (f)
+        fclose(f);
 }
 
 static void log_to_book(void *user, lx_log_level level, const char *message)

@@ -66,6 +66,15 @@ void lx_test_watchdog(unsigned seconds);
  * gen_scenes...) into out; fails the test when it is not an executable. */
 void lx_test_sibling(const char *name, char *out, size_t size);
 
+/* Runs the `luxel` built beside the running test with args (NULL-terminated,
+ * after the program's name): stdout to out_log, stderr to err_log (the same
+ * path: both into one file). Returns its exit status, -1 when a signal
+ * ended it; fails the test when it cannot be started. */
+int lx_test_run_luxel(const char *const *args, const char *out_log, const char *err_log);
+/* The start of the text file at path into buf (NUL-terminated; "" when it
+ * cannot be read). */
+void lx_test_read_text(const char *path, char *buf, size_t size);
+
 /* The warnings the library logs while a scene loads: their count and text
  * (one a line). */
 typedef struct lx_test_logbook {

@@ -115,13 +115,12 @@ static void test_closed_object_outside(void **state)
  * a room lit from inside leaves them. Faces alone cannot tell it from a
  * plain box; the lightmaps can: with them the camera goes inside, without
  * them the iso view stays. */
-static void test_thick_walls(void **state)
+/* A room (inward box) inside a box (outward), walls 0.2 m thick: DIR's
+ * inner.exr (written by the caller) lights the room, outer.exr (black)
+ * the outside; the manifest, the scene and its lightmaps. */
+static lx_scene *thick_room(const char *dir, lx_lightmaps *lm)
 {
-    (void)state;
-    const char *dir = lx_test_dir("render_camera_thick");
     char path[4096];
-    snprintf(path, sizeof path, "%s/inner.exr", dir);
-    write_page(path, 16, 16);
     lx_image black;
     assert_int_equal(lx_image_alloc(&black, 16, 16, 3), LX_OK);
     memset(black.data, 0, sizeof(float) * 16 * 16 * 3);
@@ -148,9 +147,20 @@ static void test_thick_walls(void **state)
     lx_test_add(s, &out);
     lx_test_mesh_free(&in);
     lx_test_mesh_free(&out);
-    lx_lightmaps lm;
-    if (lx_lightmaps_load(dir, NULL, &lm) != LX_OK)
+    if (lx_lightmaps_load(dir, NULL, lm) != LX_OK)
         fail_msg("%s", lx_last_error());
+    return s;
+}
+
+static void test_thick_walls(void **state)
+{
+    (void)state;
+    const char *dir = lx_test_dir("render_camera_thick");
+    char path[4096];
+    snprintf(path, sizeof path, "%s/inner.exr", dir);
+    write_page(path, 16, 16);
+    lx_lightmaps lm;
+    lx_scene *s = thick_room(dir, &lm);
     lx_tracer *tr;
     assert_int_equal(lx_tracer_create(s, NULL, &tr), LX_OK);
     lx_camera cam;
@@ -191,33 +201,9 @@ static lx_camera thick_room_with_patch(int face, lx_camera_auto_info *info)
                 page.data[3 * (y * 16 + x) + k] = 0.0f;
     snprintf(path, sizeof path, "%s/inner.exr", dir);
     assert_int_equal(lx_image_write(path, &page, NULL), LX_OK);
-    memset(page.data, 0, sizeof(float) * 16 * 16 * 3);
-    snprintf(path, sizeof path, "%s/outer.exr", dir);
-    assert_int_equal(lx_image_write(path, &page, NULL), LX_OK);
     lx_image_free(&page);
-    snprintf(path, sizeof path, "%s/manifest.json", dir);
-    write_text(path, "{\"scene\":\"thick\",\"quantity\":\"irradiance\",\"unit\":\"lx\","
-                     "\"pages\":[{\"file\":\"inner.exr\",\"width\":16,\"height\":16},"
-                     "{\"file\":\"outer.exr\",\"width\":16,\"height\":16}],"
-                     "\"nodes\":[{\"node\":\"inner\",\"meshes\":[\"inner\"],\"page\":0,"
-                     "\"scale_offset\":[1,1,0,0],\"uv_set\":\"TEXCOORD_1\"},"
-                     "{\"node\":\"outer\",\"meshes\":[\"outer\"],\"page\":1,"
-                     "\"scale_offset\":[1,1,0,0],\"uv_set\":\"TEXCOORD_1\"}]}");
-    lx_scene *s = lx_test_new_scene("thick");
-    lx_material mat = {.name = "white", .base_color = {0.8f, 0.8f, 0.8f, 1.0f},
-                       .normal_scale = 1.0f};
-    uint32_t mi;
-    assert_int_equal(lx_scene_add_material(s, &mat, &mi), LX_OK);
-    lx_mesh in = lx_test_box("inner", lx_v3(-3, 0, -2), lx_v3(3, 3, 2), true);
-    lx_mesh out = lx_test_box("outer", lx_v3(-3.2f, -0.2f, -2.2f), lx_v3(3.2f, 3.2f, 2.2f), false);
-    in.material = out.material = mi;
-    lx_test_add(s, &in);
-    lx_test_add(s, &out);
-    lx_test_mesh_free(&in);
-    lx_test_mesh_free(&out);
     lx_lightmaps lm;
-    if (lx_lightmaps_load(dir, NULL, &lm) != LX_OK)
-        fail_msg("%s", lx_last_error());
+    lx_scene *s = thick_room(dir, &lm);
     lx_tracer *tr;
     assert_int_equal(lx_tracer_create(s, NULL, &tr), LX_OK);
     lx_camera cam;
