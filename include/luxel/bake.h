@@ -178,10 +178,11 @@ typedef struct lx_bake_desc {
     int bounces;           /* 0..LX_MAX_BOUNCES; 0 = direct light only (the
                               library's default, like padding's zero a value;
                               luxel bake uses LX_BOUNCES_RECOMMENDED) */
-    uint32_t gi_samples;   /* gather rays per texel per bounce, 1..
+    uint32_t gi_samples;   /* gather rays per texel per bounce, and the
+                              emitters' shadow rays (at most 256), 1..
                               LX_MAX_GI_SAMPLES, 0 = LX_GI_SAMPLES_DEFAULT */
     float emissive_scale;  /* multiplies the emissive materials' radiance
-                              (nits) when bounces > 0; 0 = 1 */
+                              (nits); 0 = 1 */
     lx_denoise_mode denoise; /* edge-aware denoising of the baked buffers at the
                               end of lx_baker_bake (denoise.h): OFF (the
                               library's default), INDIRECT (the bounces' part
@@ -304,9 +305,9 @@ const uint8_t *lx_baker_mask(const lx_baker *baker, uint32_t map);
  * lightmap (no UVs) reflect nothing.
  * EMITTERS  An emissive surface (emissiveFactor x emissiveTexture x
  * KHR_materials_emissive_strength x desc.emissive_scale, nits, from its
- * front face) is direct light when bounces > 0: its triangles are
+ * front face) is direct light at any bounce count: its triangles are
  * importance-sampled (luminance x area) with shadow rays,
- * min(gi_samples, 64) a texel, and their exact unshadowed irradiance
+ * min(gi_samples, 256) a texel, and their exact unshadowed irradiance
  * (Lambert's polygon formula) is the control variate while the scene has
  * at most 64 emissive triangles, so only penumbrae are noisy; the
  * gathers do not count emission again. With N bounces emitted light is

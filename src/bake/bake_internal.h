@@ -393,10 +393,11 @@ lx_status lx_seam_stitch_apply(const lx_seam_stitch *s, float *data, int channel
                                const char *what);
 uint32_t lx_seam_stitch_samples(const lx_seam_stitch *s);
 void lx_seam_stitch_free(lx_seam_stitch *s);
-/* gi.c: copies what finding a gather ray's hit needs (when desc.bounces
- * > 0); frees it; adds desc.bounces of indirect light into the baked
+/* gi.c: copies what finding a gather ray's hit needs (when the baker
+ * keeps surfaces; emitters_only: only the emissive meshes, for the
+ * emitters' direct light without bounces); frees it; adds desc.bounces of indirect light into the baked
  * buffers, within [progress_base, progress_base + progress_span]. */
-lx_status lx_gi_prepare(lx_baker *b, const lx_scene *scene);
+lx_status lx_gi_prepare(lx_baker *b, const lx_scene *scene, bool emitters_only);
 void lx_gi_free(lx_baker *b);
 lx_status lx_bake_indirect(lx_baker *b, float progress_base, float progress_span);
 /* A texel's gather frame (gi.c): the ray origin (lifted off the surface
@@ -431,8 +432,27 @@ bool lx_gi_texel_inside(const lx_baker *b, uint32_t map_index, uint32_t i);
  * flags) or already filled neighbours, ring by ring. */
 lx_status lx_gi_fill_invalid(const lx_lightmap *map, const uint8_t *valid, const uint8_t *invalid,
                              float *buf, int channels);
+/* emitter_tree.c: a light tree over emissive triangles, each given by
+ * its bounds (box, front normal, power = emission luminance x area > 0).
+ * A pick for a receiving point (normal n) and one uniform number u walks
+ * down by the children's importance; it gives the triangle, its
+ * probability and u rescaled into the picked share (false: nothing in
+ * the tree can light the point). lx_emitter_tree_probability is the
+ * probability a pick gives a triangle (every path searched; for tests). */
+typedef struct lx_emitter_bounds {
+    lx_vec3 lo, hi, normal;
+    double power;
+} lx_emitter_bounds;
+typedef struct lx_emitter_tree lx_emitter_tree;
+lx_status lx_emitter_tree_build(const lx_emitter_bounds *tri, uint32_t count,
+                                lx_emitter_tree **out);
+void lx_emitter_tree_destroy(lx_emitter_tree *tree);
+bool lx_emitter_tree_pick(const lx_emitter_tree *tree, lx_vec3 point, lx_vec3 normal, float u,
+                          uint32_t *triangle, double *probability, float *u_rest);
+double lx_emitter_tree_probability(const lx_emitter_tree *tree, lx_vec3 point, lx_vec3 normal,
+                                   uint32_t triangle);
 /* emitters.c: next-event estimation of the emissive triangles' light
- * (direct light, when desc.bounces > 0 and an emitter exists). The set of
+ * (direct light, at any bounce count, when an emitter exists). The set of
  * emissive triangles is made once (NULL when nothing emits; a tiled
  * baker builds every map again to read textured emission), then each
  * tile's texels get their light added into the baked buffers of the maps
@@ -492,6 +512,7 @@ typedef struct lx_bake_texel_bytes {
 enum {
     LX_SCENE_NEEDS_DYNAMIC = 1u << 0,          /* a dynamic light */
     LX_SCENE_NEEDS_EMISSIVE_TEXTURE = 1u << 1, /* an emissive material with a texture */
+    LX_SCENE_NEEDS_EMISSION = 1u << 2,         /* an emissive material */
 };
 uint32_t lx_bake_scene_needs(const lx_scene *scene);
 /* The bytes per pixel of a lightmap under desc: horizon when a node on it

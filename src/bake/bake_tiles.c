@@ -39,6 +39,7 @@ enum {
     WHEN_DYN_BOUNCE = 1u << 10, /* dynamic_bounce_samples > 0 */
     WHEN_PROBES = 1u << 11,     /* desc.probes */
     WHEN_EMISSIVE_TEXTURE = 1u << 12, /* an emissive material has a texture */
+    WHEN_TEXEL_EMISSION = 1u << 13, /* surfaces kept, or an emissive texture */
 };
 
 /* Where a buffer lives: the whole bake, a tile's texel maps (while the
@@ -79,8 +80,7 @@ static const texel_buffer texel_buffers[] = {
     {"bounces: validity (kept for the denoiser)", 1, PER_TEXEL, LIFE_RESIDENT, WHEN_GI},
     {"bounces: exitant radiance of the last and the next bounce", 24, PER_TEXEL, LIFE_RESIDENT,
      WHEN_GI},
-    {"emitters: textured emission", 12, PER_TEXEL, LIFE_RESIDENT,
-     WHEN_GI | WHEN_EMISSIVE_TEXTURE},
+    {"emitters: textured emission", 12, PER_TEXEL, LIFE_RESIDENT, WHEN_EMISSIVE_TEXTURE},
     {"denoising: the direct light kept", 12, PER_TEXEL, LIFE_RESIDENT, WHEN_GI | WHEN_KEEP},
     {"denoising: the direct directional data kept", 48, PER_TEXEL, LIFE_RESIDENT,
      WHEN_GI | WHEN_KEEP | WHEN_DIRECTIONAL},
@@ -99,7 +99,7 @@ static const texel_buffer texel_buffers[] = {
      LIFE_TEXEL_MAP, WHEN_ALWAYS},
     {"texel map: tile offsets", 1, PER_TEXEL, LIFE_TEXEL_MAP, WHEN_ALWAYS},
     {"texel map: albedo", 12, PER_TEXEL, LIFE_TEXEL_MAP, WHEN_ALBEDO},
-    {"texel map: emission", 12, PER_TEXEL, LIFE_TEXEL_MAP, WHEN_SURFACES},
+    {"texel map: emission", 12, PER_TEXEL, LIFE_TEXEL_MAP, WHEN_TEXEL_EMISSION},
     {"texel map: horizon record (layers, AO, frame)", (uint32_t)sizeof(lx_texel_horizon),
      PER_TEXEL, LIFE_TEXEL_MAP, WHEN_HORIZON},
     {"supersampling: each point's position, normals and coverage", 37, PER_POINT,
@@ -130,6 +130,9 @@ lx_bake_texel_bytes lx_bake_texel_bytes_of(const lx_bake_desc *d, bool horizon,
     have |= horizon ? WHEN_HORIZON : 0;
     have |= scene_needs & LX_SCENE_NEEDS_DYNAMIC ? WHEN_DYNAMIC : 0;
     have |= scene_needs & LX_SCENE_NEEDS_EMISSIVE_TEXTURE ? WHEN_EMISSIVE_TEXTURE : 0;
+    have |= (lx_bake_keeps_surfaces(d) || (scene_needs & LX_SCENE_NEEDS_EMISSIVE_TEXTURE))
+                ? WHEN_TEXEL_EMISSION
+                : 0;
     have |= (d->denoise == LX_DENOISE_ALL || (d->denoise == LX_DENOISE_INDIRECT && gi))
                 ? WHEN_DENOISE
                 : 0;
@@ -166,9 +169,9 @@ uint32_t lx_bake_scene_needs(const lx_scene *scene)
             needs |= LX_SCENE_NEEDS_DYNAMIC;
     for (uint32_t k = 0; k < scene->material_count; k++) {
         const lx_material *m = &scene->materials[k];
-        if (m->emissive_map.width > 0 &&
-            (m->emissive.x > 0.0f || m->emissive.y > 0.0f || m->emissive.z > 0.0f))
-            needs |= LX_SCENE_NEEDS_EMISSIVE_TEXTURE;
+        bool emits = m->emissive.x > 0.0f || m->emissive.y > 0.0f || m->emissive.z > 0.0f;
+        needs |= emits ? LX_SCENE_NEEDS_EMISSION : 0;
+        needs |= emits && m->emissive_map.width > 0 ? LX_SCENE_NEEDS_EMISSIVE_TEXTURE : 0;
     }
     return needs;
 }

@@ -421,7 +421,10 @@ lx_status lx_baker_create(const lx_scene *scene, const lx_bake_desc *in, lx_bake
         b->node_scale_offset[n][0] = b->node_scale_offset[n][1] = 1.0f;
         b->node_scale_offset[n][2] = b->node_scale_offset[n][3] = 0.0f;
     }
-    if (lx_bake_keeps_surfaces(&desc) && (st = lx_gi_prepare(b, scene)) != LX_OK) {
+    /* the emitters are direct light at any bounce count */
+    bool emission = (lx_bake_scene_needs(scene) & LX_SCENE_NEEDS_EMISSION) != 0;
+    if ((lx_bake_keeps_surfaces(&desc) || emission) &&
+        (st = lx_gi_prepare(b, scene, !lx_bake_keeps_surfaces(&desc))) != LX_OK) {
         lx_baker_destroy(b);
         return st;
     }
@@ -598,12 +601,12 @@ static void clear_buffers(lx_baker *b, bool realtime)
     }
 }
 
-/* The static lights, then the emitters (with bounces), into every map's
+/* The static lights, then the emitters, into every map's
  * baked buffer, tile by tile, within [from, to] of the progress. */
 static lx_status bake_direct(lx_baker *b, const uint32_t *idx, uint32_t n, float from, float to)
 {
     lx_emitter_set *emitters = NULL;
-    lx_status st = b->desc.bounces > 0 ? lx_emitter_set_create(b, &emitters) : LX_OK;
+    lx_status st = lx_emitter_set_create(b, &emitters);
     for (uint32_t t = 0; t < b->tile_count && st == LX_OK; t++) {
         float tf, tt;
         lx_bake_tile_share(b, t, from, to, &tf, &tt);

@@ -6,13 +6,15 @@
  * Arvo, "Analytic Methods for Simulated Light Transport", 1995) as a
  * control variate when the emitters are few.
  *
- * The emitters are every node's emissive triangles, picked with
- * probability emission luminance (the material's factor) x area (a CDF
- * over them); a point on the picked triangle is uniform in area. A texel
+ * The emitters are every node's emissive triangles, picked for each
+ * texel by a light tree (emitter_tree.c: with probability close to each
+ * one's share of the texel's light, from its power, distance and
+ * orientation, so a texel beside one of many small emitters samples that
+ * one); a point on the picked triangle is uniform in area. A texel
  * casts S stratified samples (the unit square in sx x sy cells, jittered
  * by (map, texel, sample), so any thread count gives the same bytes): the
- * first coordinate picks the triangle through the CDF and, rescaled within
- * the triangle's share, places the point with the second. Each sample
+ * first coordinate picks the triangle down the tree and, rescaled within
+ * the picked share, places the point with the second. Each sample
  * brings L_e(x) V cos(theta) cos(theta') / d^2 / pdf(x), V from a shadow
  * ray (lx_shadow_ray), theta at the texel's shading normal, theta' at the
  * emitter's front face (an emitter emits from its front only, as the
@@ -57,8 +59,7 @@ typedef struct emitter_tri {
 struct lx_emitter_set {
     emitter_tri *tri;
     uint32_t count;
-    double *cdf; /* cumulative pick weights; cdf[count - 1] = total */
-    double total;
+    lx_emitter_tree *tree; /* picks a triangle for a texel (emitter_tree.c) */
     bool exact;
     float **emission; /* per map: emitted radiance per pixel, or NULL (all NULL
                          when no emitter has a texture) */
@@ -92,7 +93,7 @@ static void emitter_set_free(const lx_baker *b, emitter_set *set)
         free(set->emission[m]);
     free(set->emission);
     free(set->tri);
-    free(set->cdf);
+    lx_emitter_tree_destroy(set->tree);
 }
 
 static lx_status emitter_set_build(lx_baker *b, emitter_set *set)
@@ -104,13 +105,16 @@ static lx_status emitter_set_build(lx_baker *b, emitter_set *set)
     if (n > UINT32_MAX / 2)
         return lx_fail(LX_ERR_INVALID, "%llu emissive triangles are too many",
                        (unsigned long long)n);
-    lx_status st = lx_check_memory(n * (sizeof(emitter_tri) + sizeof(double)), "the emitters");
+    /* the triangles, their bounds while building, and the tree's nodes */
+    lx_status st = lx_check_memory(n * (sizeof(emitter_tri) + sizeof(lx_emitter_bounds) + 256),
+                                   "the emitters");
     if (st != LX_OK)
         return st;
     set->tri = malloc(sizeof(emitter_tri) * (n + 1));
-    set->cdf = malloc(sizeof(double) * (n + 1));
+    lx_emitter_bounds *bounds = malloc(sizeof(lx_emitter_bounds) * (n + 1));
     set->emission = calloc(b->map_count + 1, sizeof(float *));
-    if (!set->tri || !set->cdf || !set->emission) {
+    if (!set->tri || !bounds || !set->emission) {
+        free(bounds);
         emitter_set_free(b, set);
         return lx_fail(LX_ERR_NOMEM, "out of memory for the emitters");
     }
@@ -122,6 +126,7 @@ static lx_status emitter_set_build(lx_baker *b, emitter_set *set)
     for (uint32_t m = 0; m < b->map_count && textured; m++) {
         lx_status need = lx_bake_tile_need(b, m);
         if (need != LX_OK) {
+            free(bounds);
             emitter_set_free(b, set);
             return need;
         }
@@ -130,6 +135,7 @@ static lx_status emitter_set_build(lx_baker *b, emitter_set *set)
             continue;
         size_t pixels = (size_t)map->info.width * (size_t)map->info.height;
         if (!(set->emission[m] = calloc(pixels * 3, sizeof(float)))) {
+            free(bounds);
             emitter_set_free(b, set);
             return lx_fail(LX_ERR_NOMEM, "lightmap '%s': out of memory for its emission",
                            map->name);
@@ -139,7 +145,6 @@ static lx_status emitter_set_build(lx_baker *b, emitter_set *set)
             px[0] = map->emission[i].x, px[1] = map->emission[i].y, px[2] = map->emission[i].z;
         }
     }
-    double total = 0.0;
     uint32_t count = 0;
     for (uint32_t e = 0; e < b->emitter_count; e++) {
         uint32_t node = b->emitters[e].node, mesh = b->emitters[e].mesh;
@@ -166,15 +171,23 @@ static lx_status emitter_set_build(lx_baker *b, emitter_set *set)
             tr->node = node, tr->mesh = mesh, tr->triangle = t;
             tr->textured = b->mesh_emission_textured[mesh] != 0;
             tr->le = emission_at(b, set, tr, 1.0f / 3.0f, 1.0f / 3.0f);
-            total += lum * (double)tr->area;
-            set->cdf[count] = total;
+            lx_emitter_bounds *bd = &bounds[count];
+            bd->lo = lx_v3(fminf(a.x, fminf(bb.x, c.x)), fminf(a.y, fminf(bb.y, c.y)),
+                           fminf(a.z, fminf(bb.z, c.z)));
+            bd->hi = lx_v3(fmaxf(a.x, fmaxf(bb.x, c.x)), fmaxf(a.y, fmaxf(bb.y, c.y)),
+                           fmaxf(a.z, fmaxf(bb.z, c.z)));
+            bd->normal = tr->n;
+            bd->power = lum * (double)tr->area;
             count++;
         }
     }
     set->count = count;
-    set->total = total;
     set->exact = count <= EXACT_TRIANGLES;
-    return LX_OK;
+    st = lx_emitter_tree_build(bounds, count, &set->tree);
+    free(bounds);
+    if (st != LX_OK)
+        emitter_set_free(b, set);
+    return st;
 }
 
 /* Lambert's formula: the irradiance at p (unit normal n) from a convex
@@ -254,6 +267,21 @@ static lx_ray shadow_ray(const lx_baker *b, lx_vec3 p, lx_vec3 ng, lx_vec3 x, lx
     return r;
 }
 
+/* order[0..n) a permutation of 0..n-1 (n <= NEE_SAMPLES_MAX), from the
+ * texel's seed (Fisher-Yates). */
+static void shuffle(uint8_t *order, uint32_t n, uint32_t map_index, uint32_t pixel, uint32_t key)
+{
+    for (uint32_t i = 0; i < n; i++)
+        order[i] = (uint8_t)i;
+    for (uint32_t i = n; i > 1; i--) {
+        uint32_t j = (uint32_t)(lx_random(map_index, pixel, i, key) * (float)i);
+        j = j < i ? j : i - 1;
+        uint8_t t = order[i - 1];
+        order[i - 1] = order[j];
+        order[j] = t;
+    }
+}
+
 /* The emitters' irradiance at texel i of map. */
 static lx_vec3 texel_emitters(const lx_baker *b, const emitter_set *set, uint32_t map_index,
                               const lx_lightmap *map, uint32_t i, lx_vec3 *towards)
@@ -282,6 +310,15 @@ static lx_vec3 texel_emitters(const lx_baker *b, const emitter_set *set, uint32_
     uint32_t sx, sy;
     lx_cosine_strata(want, &sx, &sy);
     uint32_t cells = sx * sy;
+    /* multi-jittered samples (Chiu, Shirley and Wang, "Multi-jittered
+     * sampling", Graphics Gems IV, 1994; Kensler's correlated form):
+     * stratified in the sx x sy cells and over all `cells` strata on each
+     * axis, so the tree's pick (the first coordinate) sees every stratum
+     * of its unit interval once. The columns' and rows' orders are
+     * shuffled per texel. */
+    uint8_t column[NEE_SAMPLES_MAX], row[NEE_SAMPLES_MAX];
+    shuffle(column, sx, map_index, pixel, NEE_KEY + 2);
+    shuffle(row, sy, map_index, pixel, NEE_KEY + 3);
     enum { BATCH = 64 };
     lx_ray rays[BATCH];
     lx_vec3 on[BATCH], off[BATCH]; /* what a visible and a blocked sample add */
@@ -291,24 +328,21 @@ static lx_vec3 texel_emitters(const lx_baker *b, const emitter_set *set, uint32_
     while (k < cells) {
         uint32_t m = 0;
         for (; m < BATCH && k < cells; k++) {
-            float u = ((float)(k % sx) + lx_random(map_index, pixel, k, NEE_KEY)) / (float)sx;
-            float v = ((float)(k / sx) + lx_random(map_index, pixel, k, NEE_KEY + 1)) / (float)sy;
-            /* the triangle: the first cdf entry above u x total */
-            double target = (double)u * set->total;
-            uint32_t lo = 0, hi = set->count - 1;
-            while (lo < hi) {
-                uint32_t mid = (lo + hi) / 2;
-                if (set->cdf[mid] > target)
-                    hi = mid;
-                else
-                    lo = mid + 1;
-            }
-            const emitter_tri *t = &set->tri[lo];
-            double before = lo ? set->cdf[lo - 1] : 0.0, share = set->cdf[lo] - before;
-            if (!in_front(b, t, p) || !(share > 0.0))
+            float u = ((float)k + lx_random(map_index, pixel, k, NEE_KEY)) / (float)cells;
+            float v = ((float)column[k % sx] +
+                       ((float)row[k / sx] + lx_random(map_index, pixel, k, NEE_KEY + 1)) /
+                           (float)sy) /
+                      (float)sx;
+            u = fminf(u, 0x1.fffffep-1f), v = fminf(v, 0x1.fffffep-1f);
+            /* the triangle, by its share of the texel's light (the tree) */
+            uint32_t pick;
+            double prob;
+            float ur;
+            if (!lx_emitter_tree_pick(set->tree, p, n, u, &pick, &prob, &ur))
                 continue;
-            float ur = (float)((target - before) / share);
-            ur = fminf(fmaxf(ur, 0.0f), 1.0f);
+            const emitter_tri *t = &set->tri[pick];
+            if (!in_front(b, t, p))
+                continue;
             float su = sqrtf(ur), bu = su * (1.0f - v), bv = su * v;
             lx_vec3 x = lx_add(t->p0, lx_add(lx_scale(t->e1, bu), lx_scale(t->e2, bv)));
             lx_vec3 d = lx_sub(x, p);
@@ -319,9 +353,8 @@ static lx_vec3 texel_emitters(const lx_baker *b, const emitter_set *set, uint32_
             float cos_r = lx_dot(n, d) / dist, cos_e = -lx_dot(t->n, d) / dist;
             if (!(cos_r > 0.0f) || !(cos_e > 0.0f))
                 continue;
-            /* G / pdf, pdf = share / total / area */
-            double g = (double)cos_r * (double)cos_e / (double)d2 * set->total / share *
-                       (double)t->area;
+            /* G / pdf, pdf = prob / area */
+            double g = (double)cos_r * (double)cos_e / (double)d2 / prob * (double)t->area;
             if (!isfinite(g))
                 continue;
             lx_vec3 le = t->textured ? emission_at(b, set, t, bu, bv) : t->le;

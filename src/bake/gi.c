@@ -32,7 +32,7 @@
 /* rings searched for a valid texel when none of the four bilinear ones is */
 #define LOOKUP_RINGS 3
 
-lx_status lx_gi_prepare(lx_baker *b, const lx_scene *scene)
+lx_status lx_gi_prepare(lx_baker *b, const lx_scene *scene, bool emitters_only)
 {
     b->mesh_count = scene->mesh_count;
     size_t m1 = scene->mesh_count + 1;
@@ -65,8 +65,9 @@ lx_status lx_gi_prepare(lx_baker *b, const lx_scene *scene)
                 memcpy(b->mesh_positions[m], mesh->positions,
                        sizeof(lx_vec3) * mesh->vertex_count);
         }
+        /* direct light only: the emitters' meshes are all it reads */
         bool any = emits;
-        for (int s = 0; s < LX_MAX_UV_SETS && ok; s++) {
+        for (int s = 0; s < LX_MAX_UV_SETS && ok && (emits || !emitters_only); s++) {
             if (!mesh->uv[s])
                 continue;
             any = true;

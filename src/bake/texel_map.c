@@ -794,11 +794,15 @@ lx_status lx_texel_map_build(const lx_scene *scene, const lx_page_spec *page,
     bool want_albedo = desc->quantity == LX_QUANTITY_RADIANCE || lx_bake_keeps_surfaces(desc);
     if (want_albedo)
         map->albedo = malloc(sizeof(lx_vec3) * (used ? used : 1));
-    /* emission per texel: for the gather, when a material here emits */
+    /* emission per texel, when a material here emits: for the gather, and
+     * for the emitters' direct light when its emission has a texture */
     bool emits = false;
-    for (uint32_t s = 0; s < slot_count && lx_bake_keeps_surfaces(desc); s++) {
-        lx_vec3 e = lx_material_emission(lx_mesh_material(scene, slots[s].mesh), desc->emissive_scale);
-        emits |= e.x > 0.0f || e.y > 0.0f || e.z > 0.0f;
+    for (uint32_t s = 0; s < slot_count; s++) {
+        const lx_material *mat = lx_mesh_material(scene, slots[s].mesh);
+        lx_vec3 e = lx_material_emission(mat, desc->emissive_scale);
+        bool textured = mat && mat->emissive_map.width > 0;
+        emits |= (e.x > 0.0f || e.y > 0.0f || e.z > 0.0f) &&
+                 (lx_bake_keeps_surfaces(desc) || textured);
     }
     if (emits)
         map->emission = malloc(sizeof(lx_vec3) * (used ? used : 1));

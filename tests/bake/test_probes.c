@@ -157,12 +157,11 @@ static void furnace_is_a_geometric_series(void **state)
         lx_baker *b = bake(scene, &d);
         lx_scene_destroy(scene);
         /* the walls' exitant radiance as a probe reads it: emission plus
-         * albedo / pi x the lightmap. With bounces the lightmap holds the
-         * emitted light as direct light reflected n times (emitters.c), so
-         * the probe sees it reflected up to n + 1 times; without bounces
-         * emitters are not baked and the probe sees the emission alone */
+         * albedo / pi x the lightmap. The lightmap holds the emitted light
+         * as direct light (emitters.c, at any bounce count) reflected n
+         * times, so the probe sees it reflected up to n + 1 times */
         double series = 0.0;
-        for (int k = 0; k <= (n > 0 ? n + 1 : 0); k++)
+        for (int k = 0; k <= n + 1; k++)
             series += pow(rho, k);
         double want = le * series;
         lx_vec3 at[2] = {lx_v3(0.0f, 0.0f, 0.0f), lx_v3(0.5f, -0.4f, 0.7f)};

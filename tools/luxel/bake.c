@@ -65,7 +65,7 @@ static const char *bake_usage =
     "                          direct light's rays and about 37 N^2 bytes a texel\n"
     "  --emissive-scale X      multiplier on emissive materials' radiance (nits),\n"
     "                          for files not authored in physical units\n"
-    "                          (default 1); emitters light through the bounces\n"
+    "                          (default 1); emitters are lights at any --bounces\n"
     "  --denoise M             indirect (default): the bounces' light filtered by\n"
     "                          an edge-aware denoiser (docs/denoise.md); all: the\n"
     "                          whole lightmap (area-light and sky noise too); off\n"

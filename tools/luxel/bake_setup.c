@@ -137,12 +137,12 @@ static void check_scale(const bake_args *a, const lx_scene *scene, const lx_unwr
 
 /* Something must emit light, or every lightmap is black: returns the
  * error's reason, or NULL when a light, the sky or an ambient does. */
-static const char *nothing_emits(const lx_scene *scene, const lx_scene_sky *sky, int bounces)
+static const char *nothing_emits(const lx_scene *scene, const lx_scene_sky *sky)
 {
     if (sky->environment)
         return NULL;
-    /* emissive materials light through the bounces */
-    for (uint32_t m = 0; m < scene->material_count && bounces > 0; m++) {
+    /* emissive materials are lights (direct light at any bounce count) */
+    for (uint32_t m = 0; m < scene->material_count; m++) {
         lx_vec3 e = scene->materials[m].emissive;
         if (e.x > 0.0f || e.y > 0.0f || e.z > 0.0f)
             return NULL;
@@ -156,13 +156,10 @@ static const char *nothing_emits(const lx_scene *scene, const lx_scene_sky *sky,
         if ((li->intensity > 0.0f && colour) || ambient)
             return NULL;
     }
-    return scene->light_count ? "every light has zero intensity or colour, and there is no sky "
-                                "or ambient"
-           : bounces > 0      ? "the scene has no lights, no sky, no ambient and "
-                                "no emissive material"
-                              : "the scene has no lights, no sky and no ambient "
-                                "(emissive materials light through --bounces "
-                                "only)";
+    return scene->light_count ? "every light has zero intensity or colour, and there is no sky, "
+                                "ambient or emissive material"
+                              : "the scene has no lights, no sky, no ambient and "
+                                "no emissive material";
 }
 
 /* A spot cone under a degree is almost surely radians typed as degrees. */
@@ -539,7 +536,7 @@ int cli_bake_prepare(bake_args *a, cli_progress *progress, lx_scene **scene_out,
         a->desc.sky = lx_sky_desc_defaults(&given);
     }
     cli_phase(sky->environment ? "lights and sky" : "lights");
-    const char *dark = nothing_emits(scene, sky, a->desc.bounces);
+    const char *dark = nothing_emits(scene, sky);
     if (dark) {
         cli_error("%s: nothing emits light: %s; give lights with --lights FILE.json, a sky with "
                   "--sky ENV or an ambient with --ambient R,G,B",
