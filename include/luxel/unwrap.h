@@ -8,7 +8,9 @@
  * atlas pages at a texel density, each chart owning `padding` rings of
  * texels so that bilinear filtering never mixes two charts.
  * lx_uv_health_mesh / _node say whether UVs a file brings can serve as
- * lightmap UVs (range, zero-area, flipped and overlapping triangles).
+ * lightmap UVs (range, zero-area, flipped and overlapping triangles);
+ * lx_uv_share_nodes judges the nodes' sets together (pieces of one UV
+ * square that several nodes share, as objects sharing a texture atlas do).
  *
  * CONVENTIONS  Texel density in texels per metre of world space: a node's
  *   scale counts, so an instance scaled 2x gets twice the texels across.
@@ -28,8 +30,8 @@
  *   UVs of zero area and are counted in stats.degenerate_triangles.
  * MEMORY  lx_unwrap_scene allocates the result; lx_unwrap_destroy frees it.
  *   The scene is only read and may be destroyed afterwards.
- * THREADING  lx_unwrap_scene, the lx_uv_health_* functions and the
- *   *_desc_defaults are thread-safe;
+ * THREADING  lx_unwrap_scene, the lx_uv_health_* functions,
+ *   lx_uv_share_nodes and the *_desc_defaults are thread-safe;
  *   each call runs OpenMP over meshes and charts, at most desc.threads
  *   threads, and gives the same result for any thread count.
  *
@@ -176,8 +178,10 @@ typedef enum lx_uv_problem {
     LX_UV_OUTSIDE,   /* a triangle reaches outside [0,1] (texels there are lost) */
     LX_UV_ZERO_AREA, /* triangles of zero UV area (the baker refuses them) */
     LX_UV_OVERLAP,   /* more than max_overlap of the covered texels overlapped */
-    LX_UV_SPARSE     /* the triangles cover less than min_coverage of the unit square
+    LX_UV_SPARSE,    /* the triangles cover less than min_coverage of the unit square
                         (a texture atlas's corner, not a lightmap layout) */
+    LX_UV_SHARED     /* a piece of a UV square other nodes share (lx_uv_share_nodes
+                        judges it across the scene; lx_uv_health_* never report it) */
 } lx_uv_problem;
 
 typedef struct lx_uv_health_desc {
@@ -234,8 +238,69 @@ lx_status lx_uv_health_mesh(const lx_mesh *mesh, int uv_set, const lx_uv_health_
  * would (desc->texel_density) or desc->resolution. */
 lx_status lx_uv_health_node(const lx_scene *scene, uint32_t node, int uv_set,
                             const lx_uv_health_desc *desc, lx_uv_health *out);
-/* "usable", "missing", "outside [0,1]", "zero-area triangles", "overlapping". */
+/* "usable", "missing", "outside [0,1]", "zero-area triangles", "overlapping",
+ * "sparse", "shared". */
 const char *lx_uv_problem_name(lx_uv_problem problem);
+
+/* ---- Shared UV squares ---------------------------------------------------------
+ * Whether a node's lightmap UV set is a piece of a UV square that other
+ * nodes share, judged across the scene. Objects sharing one texture atlas
+ * each use a part of the unit square, side by side with or on top of the
+ * other objects' parts; a lightmap of the node's own made of the whole
+ * square would be mostly empty (a game level's 61 nodes so baked used
+ * 1.3% of their pages). lx_uv_health's min_coverage sees a node whose
+ * triangles cover under 1/8 of the square; this sees the parts larger
+ * than that, and names the sharing.
+ *
+ * A node's UV box is the bounding box of its triangles' UVs in its set,
+ * over all its meshes. A node counts when every mesh has the set, it has
+ * triangles and the box lies in [0,1]^2 (a set reaching outside tiles,
+ * it is no square). The span of a set is the bounding box of the boxes
+ * of the counted nodes using that set; a node's share is its box's area
+ * over its span's, and it is a piece of a shared square when the share
+ * is at most max_share. So:
+ * - a set every node fills (Blender's Lightmap Pack, Unity's generated
+ *   lightmap UVs, xatlas and luxel's own reach every side of the square)
+ *   gives every node a share near 1: not shared;
+ * - instances (nodes placing the same meshes) have equal boxes: however
+ *   many, they never make each other's share small;
+ * - a node alone in its set, or whose set only it and its instances use,
+ *   has share 1: min_coverage judges how much of the square it uses;
+ * - objects laid side by side in one atlas, or overlapping there, have
+ *   boxes that are each a small part of the span: shared. */
+typedef struct lx_uv_share_desc {
+    float max_share; /* a node's box area over its set's span area at or below
+                        which it is a piece of a shared square, 0 = 1/2 (baked
+                        as the whole square, at least half of its lightmap
+                        would be empty), at most 1 */
+} lx_uv_share_desc;
+
+/* A copy of desc (or of zeros when NULL) with every default filled in. */
+lx_uv_share_desc lx_uv_share_desc_defaults(const lx_uv_share_desc *desc);
+
+typedef struct lx_uv_share {
+    int uv_set;                 /* the set judged (0 = TEXCOORD_0) */
+    bool counted;               /* the node's box is part of its set's span (else
+                                   nothing below is filled, shared is false) */
+    lx_vec2 min, max;           /* the node's UV box */
+    lx_vec2 span_min, span_max; /* the span: every counted box of the set together */
+    uint32_t users;             /* counted nodes using the set, this one included */
+    uint32_t boxes;             /* different boxes among them (instances share one) */
+    double share;               /* box area / span area (1 when the span has none) */
+    bool shared;                /* share <= max_share: a piece of a shared square */
+    char reason[112];           /* "" unless shared, else e.g. "is a piece of a UV square
+                                   8 nodes share (its UV box 12.5% of theirs; a texture
+                                   atlas?)" */
+} lx_uv_share;
+
+/* Judges the lightmap UV set of every node of scene together into out,
+ * which must hold scene->node_count entries (out[n] for node n).
+ * uv_sets[n] is node n's set, below LX_MAX_UV_SETS (NULL: lx_bake_uv_set's
+ * automatic choice, as lx_unwrap_desc.keep_uv_sets). desc may be NULL.
+ * Nodes without meshes are not counted. LX_ERR_INVALID for a bad set or
+ * option, LX_ERR_NOMEM. Reads each mesh's UVs once; thread-safe. */
+lx_status lx_uv_share_nodes(const lx_scene *scene, const int *uv_sets,
+                            const lx_uv_share_desc *desc, lx_uv_share *out);
 
 /* ---- UV seams -----------------------------------------------------------------
  * Edges where the surface continues but its UVs do not: two triangles

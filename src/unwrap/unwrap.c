@@ -294,11 +294,9 @@ static bool kept_areas(const lx_scene *scene, uint32_t n, int set, double *world
     return true;
 }
 
-static int kept_uv_set(const lx_scene *scene, uint32_t n, const lx_unwrap_desc *d)
+/* lx_bake_uv_set's choice: luxel's own set above 1, else 1, else 0 */
+int uw_auto_uv_set(const lx_scene *scene, uint32_t n)
 {
-    if (d->keep_uv_sets)
-        return d->keep_uv_sets[n];
-    /* lx_bake_uv_set's choice: luxel's own set above 1, else 1, else 0 */
     const lx_node *node = &scene->nodes[n];
     int own = lx_scene_lightmap_set(scene, n);
     bool all_own = node->mesh_count > 0 && own > 1, all1 = node->mesh_count > 0;
@@ -307,6 +305,11 @@ static int kept_uv_set(const lx_scene *scene, uint32_t n, const lx_unwrap_desc *
         all1 = all1 && scene->meshes[node->meshes[k]].uv[1];
     }
     return all_own ? own : all1 ? 1 : 0;
+}
+
+static int kept_uv_set(const lx_scene *scene, uint32_t n, const lx_unwrap_desc *d)
+{
+    return d->keep_uv_sets ? d->keep_uv_sets[n] : uw_auto_uv_set(scene, n);
 }
 
 /* ---- the whole ----------------------------------------------------------- */

@@ -29,6 +29,11 @@ typedef struct uw_mesh {
     uint32_t degenerate_count;
 } uw_mesh;
 
+/* The lightmap set of node n lx_bake_uv_set chooses by itself (bake.h sits
+ * above this module): luxel's own set above 1 on every mesh, else
+ * TEXCOORD_1 on every mesh, else TEXCOORD_0. */
+int uw_auto_uv_set(const lx_scene *scene, uint32_t n);
+
 /* Builds m from mesh under the 3x3 linear part `linear` (row-major) of a
  * node's transform. The mesh arrays are borrowed. */
 lx_status uw_mesh_build(const lx_mesh *mesh, const double linear[9], uw_mesh *m);

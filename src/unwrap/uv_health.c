@@ -56,6 +56,8 @@ const char *lx_uv_problem_name(lx_uv_problem problem)
         return "overlapping";
     case LX_UV_SPARSE:
         return "sparse";
+    case LX_UV_SHARED:
+        return "shared";
     }
     return "unknown";
 }
@@ -351,6 +353,9 @@ static void set_reason(lx_uv_health *h, lx_uv_problem problem)
     case LX_UV_SPARSE:
         snprintf(h->reason, sizeof h->reason,
                  "covers %.3g%% of the UV square (a texture atlas's part?)", 100.0 * h->uv_area);
+        break;
+    case LX_UV_SHARED: /* lx_uv_share_nodes's, never set here */
+        snprintf(h->reason, sizeof h->reason, "a piece of a UV square other nodes share");
         break;
     }
 }

@@ -213,9 +213,28 @@ static int plan_lightmaps(bake_args *a, lx_scene *scene, lx_unwrap **out, bool *
         .threads = a->desc.threads,
         .progress = cli_progress_update,
         .progress_user = &progress};
-    uint32_t count[LX_UV_SPARSE + 1] = {0}, generate = 0, skipped = 0;
-    for (uint32_t n = 0; n < nn; n++) {
+    uint32_t count[LX_UV_SHARED + 1] = {0}, generate = 0, skipped = 0;
+    for (uint32_t n = 0; n < nn; n++)
         sets[n] = lx_bake_uv_set(scene, n, a->desc.uv_set);
+    /* pieces of a UV square several nodes share (a texture atlas) are
+     * judged across the nodes; a node's own problems, but sparse, come
+     * before it */
+    lx_uv_share *share = NULL;
+    if (a->unwrap == UNWRAP_AUTO) {
+        share = calloc(nn ? nn : 1, sizeof *share);
+        lx_status ss = share ? lx_uv_share_nodes(scene, sets, NULL, share) : LX_ERR_NOMEM;
+        if (ss != LX_OK) {
+            if (share)
+                cli_error("%s: %s", a->scene, lx_last_error());
+            else
+                cli_error("out of memory");
+            free(share);
+            free(modes);
+            free(sets);
+            return EXIT_FAILED;
+        }
+    }
+    for (uint32_t n = 0; n < nn; n++) {
         lx_uv_problem why = LX_UV_OK;
         if (scene->nodes[n].mesh_count == 0) {
             modes[n] = LX_UNWRAP_SKIP;
@@ -227,6 +246,7 @@ static int plan_lightmaps(bake_args *a, lx_scene *scene, lx_unwrap **out, bool *
             lx_status hs = lx_uv_health_node(scene, n, sets[n], &hd, &h);
             if (hs != LX_OK) {
                 cli_progress_clear(&progress);
+                free(share);
                 free(modes);
                 free(sets);
                 if (hs == LX_ERR_CANCELLED)
@@ -236,9 +256,15 @@ static int plan_lightmaps(bake_args *a, lx_scene *scene, lx_unwrap **out, bool *
                 return EXIT_FAILED;
             }
             why = h.problem;
+            const char *reason = h.reason;
+            /* a shared piece says more than its small coverage */
+            if ((why == LX_UV_OK || why == LX_UV_SPARSE) && share[n].shared) {
+                why = LX_UV_SHARED;
+                reason = share[n].reason;
+            }
             if (why != LX_UV_OK)
                 lx_log(LX_LOG_INFO, "%s: node '%s': TEXCOORD_%d %s", a->scene, scene->nodes[n].name,
-                       sets[n], h.reason);
+                       sets[n], reason);
         } else if (!has_uv_set(scene, n, sets[n])) {
             why = LX_UV_MISSING;
         }
@@ -256,10 +282,11 @@ static int plan_lightmaps(bake_args *a, lx_scene *scene, lx_unwrap **out, bool *
         }
     }
     cli_progress_finish(&progress);
+    free(share);
     *atlas = a->atlas == 1 || (a->atlas < 0 && generate > 0);
     if (generate && a->unwrap == UNWRAP_AUTO) {
         char detail[200] = "";
-        for (int r = LX_UV_MISSING, first = 1; r <= LX_UV_SPARSE; r++)
+        for (int r = LX_UV_MISSING, first = 1; r <= LX_UV_SHARED; r++)
             if (count[r]) {
                 size_t len = strlen(detail);
                 snprintf(detail + len, sizeof detail - len, "%s%s %u", first ? "" : ", ",

@@ -6,6 +6,7 @@
 
 #include <getopt.h>
 #include <stdio.h>
+#include <stdlib.h>
 #include <string.h>
 
 static const char *info_usage =
@@ -106,6 +107,40 @@ static bool print_uv_health(const lx_scene *s, const lx_uv_health_desc *hd)
                    h.flipped_triangles, h.usable ? "usable" : "not usable: ", h.reason);
         }
     }
+    return true;
+}
+
+/* Nodes whose lightmap set (as bake --uv-set auto picks it) is a piece of
+ * a UV square other nodes share: bake --unwrap auto makes their UVs. */
+static bool print_uv_share(const lx_scene *s)
+{
+    lx_uv_share *share = calloc(s->node_count ? s->node_count : 1, sizeof *share);
+    if (!share) {
+        cli_error("out of memory");
+        return false;
+    }
+    if (lx_uv_share_nodes(s, NULL, NULL, share) != LX_OK) {
+        cli_error("%s: %s", s->path, lx_last_error());
+        free(share);
+        return false;
+    }
+    uint32_t shared = 0;
+    for (uint32_t n = 0; n < s->node_count; n++)
+        shared += share[n].shared;
+    if (shared)
+        printf("UV squares shared: %u %s of a square other nodes share (bake --unwrap auto "
+               "makes theirs):\n",
+               shared,
+               cli_plural(shared, "node's lightmap UVs are a piece",
+                          "nodes' lightmap UVs are pieces"));
+    for (uint32_t n = 0; n < s->node_count; n++) {
+        const lx_uv_share *h = &share[n];
+        if (h->shared)
+            printf("  %-24s TEXCOORD_%d  u %s..%s  v %s..%s  %s\n", s->nodes[n].name, h->uv_set,
+                   cli_num_digits(h->min.x, 4), cli_num_digits(h->max.x, 4),
+                   cli_num_digits(h->min.y, 4), cli_num_digits(h->max.y, 4), h->reason);
+    }
+    free(share);
     return true;
 }
 
@@ -214,7 +249,7 @@ int cmd_info(int argc, char **argv)
                cli_num_digits(n->world.m[13], 3), cli_num_digits(n->world.m[14], 3),
                n->mesh_count, cli_plural(n->mesh_count, "mesh", "meshes"));
     }
-    if (!print_uv_health(s, &hd)) {
+    if (!print_uv_health(s, &hd) || !print_uv_share(s)) {
         lx_scene_destroy(s);
         return EXIT_FAILED;
     }
