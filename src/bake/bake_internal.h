@@ -161,6 +161,10 @@ typedef struct lx_lightmap {
                           applied); NULL unless bounces > 0 and a material
                           of the map emits */
     lx_texel_horizon *horizon; /* per texel; NULL when no texel's material has a height */
+    /* per texel: from the facet to the smooth surface its vertex normals
+     * describe (lx_lift_shadow_ray), world space, and object space when
+     * the object arrays are kept; NULL when no mesh here is smooth-shaded */
+    lx_vec3 *lift, *object_lift;
     uint8_t *mask;   /* width * height */
     float *baked;    /* width * height * 3 */
     float *realtime; /* width * height * 3; NULL (reads as zero) until the
@@ -337,6 +341,17 @@ lx_status lx_bake_straddle(lx_baker *b, float progress_base, float progress_span
 /* Shadow ray from texel position p with geometric normal ng toward e's
  * light (direct.c). */
 lx_ray lx_shadow_ray(const lx_baker *b, lx_vec3 p, lx_vec3 ng, const lx_light_eval *e);
+/* The shadow terminator (Hanika, "Hacking the Shadow Terminator", Ray
+ * Tracing Gems II, 2021): a ray leaving a smooth-shaded facet below its
+ * plane (the shading normal lit, the facet turned away) starts from the
+ * smooth surface the vertex normals describe, the texel's lift above the
+ * facet (texel_map.c), not from inside the mesh. Lift NULL: none. */
+static inline lx_ray lx_lift_shadow_ray(lx_ray r, lx_vec3 ng, const lx_vec3 *lift, uint32_t texel)
+{
+    if (lift && lx_dot(ng, r.dir) < 0.0f)
+        r.origin = lx_add(r.origin, lift[texel]);
+    return r;
+}
 
 /* Stratified cosine-weighted directions (Malley's method), shared by the
  * sky's, the gathers' and AO's rays (sky.c): n rays as sx x sy cells
@@ -513,7 +528,11 @@ enum {
     LX_SCENE_NEEDS_DYNAMIC = 1u << 0,          /* a dynamic light */
     LX_SCENE_NEEDS_EMISSIVE_TEXTURE = 1u << 1, /* an emissive material with a texture */
     LX_SCENE_NEEDS_EMISSION = 1u << 2,         /* an emissive material */
+    LX_SCENE_NEEDS_LIFT = 1u << 3,             /* a smooth-shaded mesh (lx_mesh_is_smooth) */
 };
+/* Whether a mesh's vertex normals leave some triangle's plane (smooth
+ * shading, where the shadow terminator needs lifted rays). */
+bool lx_mesh_is_smooth(const lx_mesh *mesh);
 uint32_t lx_bake_scene_needs(const lx_scene *scene);
 /* The bytes per pixel of a lightmap under desc: horizon when a node on it
  * has a height; needs from lx_bake_scene_needs. The same buffers whether

@@ -40,6 +40,7 @@ enum {
     WHEN_PROBES = 1u << 11,     /* desc.probes */
     WHEN_EMISSIVE_TEXTURE = 1u << 12, /* an emissive material has a texture */
     WHEN_TEXEL_EMISSION = 1u << 13, /* surfaces kept, or an emissive texture */
+    WHEN_LIFT = 1u << 14,           /* a smooth-shaded mesh */
 };
 
 /* Where a buffer lives: the whole bake, a tile's texel maps (while the
@@ -98,6 +99,8 @@ static const texel_buffer texel_buffers[] = {
     {"texel map: footprint axes, until samples are moved out of walls", 24, PER_TEXEL,
      LIFE_TEXEL_MAP, WHEN_ALWAYS},
     {"texel map: tile offsets", 1, PER_TEXEL, LIFE_TEXEL_MAP, WHEN_ALWAYS},
+    {"texel map: lift to the smooth surface (shadow terminator)", 12, PER_TEXEL, LIFE_TEXEL_MAP,
+     WHEN_LIFT},
     {"texel map: albedo", 12, PER_TEXEL, LIFE_TEXEL_MAP, WHEN_ALBEDO},
     {"texel map: emission", 12, PER_TEXEL, LIFE_TEXEL_MAP, WHEN_TEXEL_EMISSION},
     {"texel map: horizon record (layers, AO, frame)", (uint32_t)sizeof(lx_texel_horizon),
@@ -130,6 +133,7 @@ lx_bake_texel_bytes lx_bake_texel_bytes_of(const lx_bake_desc *d, bool horizon,
     have |= horizon ? WHEN_HORIZON : 0;
     have |= scene_needs & LX_SCENE_NEEDS_DYNAMIC ? WHEN_DYNAMIC : 0;
     have |= scene_needs & LX_SCENE_NEEDS_EMISSIVE_TEXTURE ? WHEN_EMISSIVE_TEXTURE : 0;
+    have |= scene_needs & LX_SCENE_NEEDS_LIFT ? WHEN_LIFT : 0;
     have |= (lx_bake_keeps_surfaces(d) || (scene_needs & LX_SCENE_NEEDS_EMISSIVE_TEXTURE))
                 ? WHEN_TEXEL_EMISSION
                 : 0;
@@ -173,7 +177,30 @@ uint32_t lx_bake_scene_needs(const lx_scene *scene)
         needs |= emits ? LX_SCENE_NEEDS_EMISSION : 0;
         needs |= emits && m->emissive_map.width > 0 ? LX_SCENE_NEEDS_EMISSIVE_TEXTURE : 0;
     }
+    for (uint32_t m = 0; m < scene->mesh_count && !(needs & LX_SCENE_NEEDS_LIFT); m++)
+        needs |= lx_mesh_is_smooth(&scene->meshes[m]) ? LX_SCENE_NEEDS_LIFT : 0;
     return needs;
+}
+
+bool lx_mesh_is_smooth(const lx_mesh *mesh)
+{
+    if (!mesh->normals)
+        return false;
+    for (uint32_t t = 0; t < mesh->triangle_count; t++) {
+        const uint32_t *i = &mesh->indices[3 * (size_t)t];
+        lx_vec3 a = mesh->positions[i[0]], b = mesh->positions[i[1]], c = mesh->positions[i[2]];
+        lx_vec3 g = lx_cross(lx_sub(b, a), lx_sub(c, a));
+        float len = lx_length(g);
+        if (!(len > 0.0f))
+            continue;
+        for (int k = 0; k < 3; k++) {
+            lx_vec3 n = mesh->normals[i[k]];
+            /* more than about half a degree off the plane's normal */
+            if (fabsf(lx_dot(n, g)) < 0.99996f * lx_length(n) * len)
+                return true;
+        }
+    }
+    return false;
 }
 
 uint64_t lx_bake_scene_bytes(const lx_scene *scene, bool copy)

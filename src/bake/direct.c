@@ -76,7 +76,7 @@ static float soft_visibility(const lx_baker *b, uint32_t map_index, const lx_lig
                 continue;
             float dist = sqrtf(d2);
             lx_light_eval e = {.to_light = lx_scale(d, 1.0f / dist), .distance = dist};
-            rays[m] = lx_shadow_ray(b, p, ng, &e);
+            rays[m] = lx_lift_shadow_ray(lx_shadow_ray(b, p, ng, &e), ng, map->lift, texel);
             weight[m] = w;
             m++;
         }
@@ -133,7 +133,9 @@ static void light_tile(const lx_baker *b, uint32_t map_index, const lx_lightmap 
                 lx_sh4_add_lit_floor(&sh[k], lx_scale(e.illuminance, vis), nn, e.to_light, floor_c);
             continue;
         }
-        rays[n] = lx_shadow_ray(b, map->world_position[i], map->world_geometric_normal[i], &e);
+        lx_vec3 ng = map->world_geometric_normal[i];
+        rays[n] = lx_lift_shadow_ray(lx_shadow_ray(b, map->world_position[i], ng, &e), ng,
+                                     map->lift, i);
         pending[n] = (pending_ray){k, e.illuminance};
         if (light->shadow == LX_SHADOW_BLUR) {
             /* the article's blur = nearest occluder distance / light distance */
@@ -229,6 +231,8 @@ typedef struct tile_soa {
     float nx[TILE_TEXELS], ny[TILE_TEXELS], nz[TILE_TEXELS];
     float gx[TILE_TEXELS], gy[TILE_TEXELS], gz[TILE_TEXELS];
     float bias[TILE_TEXELS]; /* lx_shadow_ray's origin offset */
+    bool lifted;             /* the map has lifts (lx_lift_shadow_ray) ... */
+    float lfx[TILE_TEXELS], lfy[TILE_TEXELS], lfz[TILE_TEXELS]; /* ... these */
     float acc[3][TILE_TEXELS];
 } tile_soa;
 
@@ -258,7 +262,13 @@ static void tile_load(const lx_baker *b, const lx_lightmap *map, uint32_t first,
                  b->bias + 4e-6f * lx_max_abs_component(p));
         t->texel[k] = (int32_t)j;
         t->lanes[block] |= 1u << lane;
+        if (map->lift)
+            t->lfx[k] = map->lift[i].x, t->lfy[k] = map->lift[i].y, t->lfz[k] = map->lift[i].z;
     }
+    t->lifted = map->lift != NULL;
+    for (int k = 0; k < TILE_TEXELS && t->lifted; k++)
+        if (t->texel[k] < 0)
+            t->lfx[k] = t->lfy[k] = t->lfz[k] = 0.0f;
     /* empty places copy a texel so every lane computes on real numbers */
     int any = 0;
     while (t->texel[any] < 0)
@@ -380,9 +390,16 @@ shade_lanes(const fast_light *f, tile_soa *t, uint32_t base, lx_ray_packet *pk, 
     v16f bias = vload(t->bias + base);
     v16i front = gx * lx + gy * ly + gz * lz >= 0.0f;
     v16f ox = gx * bias, oy = gy * bias, oz = gz * bias;
-    vstore(pk->origin_x, vsel(front, px + ox, px - ox));
-    vstore(pk->origin_y, vsel(front, py + oy, py - oy));
-    vstore(pk->origin_z, vsel(front, pz + oz, pz - oz));
+    v16f origin_x = vsel(front, px + ox, px - ox), origin_y = vsel(front, py + oy, py - oy),
+         origin_z = vsel(front, pz + oz, pz - oz);
+    if (t->lifted) { /* lx_lift_shadow_ray: behind the facet, from the smooth surface */
+        origin_x = vsel(front, origin_x, origin_x + vload(t->lfx + base));
+        origin_y = vsel(front, origin_y, origin_y + vload(t->lfy + base));
+        origin_z = vsel(front, origin_z, origin_z + vload(t->lfz + base));
+    }
+    vstore(pk->origin_x, origin_x);
+    vstore(pk->origin_y, origin_y);
+    vstore(pk->origin_z, origin_z);
     vstore(pk->dir_x, lx);
     vstore(pk->dir_y, ly);
     vstore(pk->dir_z, lz);

@@ -368,7 +368,7 @@ static lx_vec3 texel_emitters(const lx_baker *b, const emitter_set *set, uint32_
             off[m] = lx_v3((float)(-base.x * g), (float)(-base.y * g), (float)(-base.z * g));
             /* the sample's direction weighted by what it brings when seen */
             ways[m] = lx_scale(d, (float)((double)max3(le) * g) / dist);
-            rays[m] = shadow_ray(b, p, ng, x, t->n, d);
+            rays[m] = lx_lift_shadow_ray(shadow_ray(b, p, ng, x, t->n, d), ng, map->lift, i);
             m++;
         }
         if (m == 0)

@@ -552,6 +552,33 @@ static void surface_point(const lx_scene *scene, const slot *sl, const lx_vec4 *
     *normal = nrm;
 }
 
+/* From point `position` of triangle t (barycentrics w0, w1, w2, object
+ * space) to the smooth surface its vertex normals describe: the point
+ * projected onto each vertex's tangent plane where it lies below it,
+ * blended by the barycentrics (Hanika 2021); zero on a flat facet, where
+ * it would point into the mesh, or where the shading normal faces away
+ * from the facet's (normals against the winding). */
+static lx_vec3 terminator_lift(const lx_mesh *m, uint32_t t, float w0, float w1, float w2,
+                               lx_vec3 position, lx_vec3 normal, lx_vec3 geometric)
+{
+    const uint32_t *i = &m->indices[3 * t];
+    const float w[3] = {w0, w1, w2};
+    lx_vec3 lift = lx_v3(0.0f, 0.0f, 0.0f);
+    for (int k = 0; k < 3; k++) {
+        lx_vec3 n = m->normals[i[k]];
+        float len = lx_length(n);
+        if (!(len > 0.0f))
+            continue;
+        n = lx_scale(n, 1.0f / len);
+        float below = lx_dot(lx_sub(position, m->positions[i[k]]), n);
+        if (below < 0.0f)
+            lift = lx_madd(lift, n, -w[k] * below);
+    }
+    if (!(lx_dot(lift, geometric) > 0.0f) || !(lx_dot(normal, geometric) > 0.0f))
+        return lx_v3(0.0f, 0.0f, 0.0f);
+    return lift;
+}
+
 /* The world step of one texel along x and along y on triangle t of a
  * slot (the inverse of its UV-to-texel map): zero for a triangle without
  * UV area. */
@@ -866,6 +893,17 @@ lx_status lx_texel_map_build(const lx_scene *scene, const lx_page_spec *page,
         if (!map->object_position || !map->object_normal || !map->object_geometric_normal)
             st = lx_fail(LX_ERR_NOMEM, "%s: out of memory", what);
     }
+    /* the shadow terminator's lift, where a mesh is smooth-shaded */
+    bool smooth = false;
+    for (uint32_t sl = 0; sl < slot_count && !smooth; sl++)
+        smooth = lx_mesh_is_smooth(slots[sl].mesh);
+    if (smooth && st == LX_OK) {
+        map->lift = malloc(sizeof(lx_vec3) * (used ? used : 1));
+        if (map->object_position)
+            map->object_lift = malloc(sizeof(lx_vec3) * (used ? used : 1));
+        if (!map->lift || (map->object_position && !map->object_lift))
+            st = lx_fail(LX_ERR_NOMEM, "%s: out of memory", what);
+    }
     /* texels in tile order: count each tile's, place the tiles, then fill
      * them in parallel (every texel's slot is known, so any thread count
      * writes the same arrays) */
@@ -916,6 +954,12 @@ lx_status lx_texel_map_build(const lx_scene *scene, const lx_page_spec *page,
                 if (map->emission)
                     map->emission[k] =
                         lx_material_emission_at(mat, m, i, w0, w1, w2, desc->emissive_scale);
+                if (map->lift) {
+                    lx_vec3 lift = terminator_lift(m, t, w0, w1, w2, position, nrm, geometric);
+                    map->lift[k] = lx_mat4_vector(&scene->nodes[slots[s].node].world, lift);
+                    if (map->object_lift)
+                        map->object_lift[k] = lift;
+                }
                 place_texel(map, k++, &scene->nodes[slots[s].node].world, &nms[slot_node[s]],
                             position, nrm, geometric);
                 map->mask[p] = 1;
@@ -989,6 +1033,12 @@ lx_status lx_texel_map_keep_object_space(lx_lightmap *map)
     map->object_position = p;
     map->object_normal = n;
     map->object_geometric_normal = g;
+    if (map->lift) {
+        if (!(map->object_lift = malloc(bytes)))
+            return lx_fail(LX_ERR_NOMEM, "lightmap '%s': out of memory for its object space",
+                           map->name);
+        memcpy(map->object_lift, map->lift, bytes);
+    }
     if (map->sub_count) {
         size_t sub = sizeof(lx_vec3) * map->sub_count * (size_t)map->info.used_texels;
         lx_vec3 *sp = malloc(sub ? sub : 1), *sn = malloc(sub ? sub : 1),
@@ -1023,6 +1073,8 @@ void lx_texel_map_transform(lx_lightmap *map, uint32_t node, const lx_mat4 *worl
         map->world_normal[i] = lx_normalize(lx_mat4_vector(&nm, map->object_normal[i]));
         map->world_geometric_normal[i] =
             lx_normalize(lx_mat4_vector(&nm, map->object_geometric_normal[i]));
+        if (map->lift)
+            map->lift[i] = lx_mat4_vector(world, map->object_lift[i]);
         for (uint32_t s = 0; s < map->sub_count; s++) {
             size_t at = (size_t)s * map->info.used_texels + i;
             map->sub_position[at] = lx_mat4_point(world, map->sub_object_position[at]);
@@ -1045,6 +1097,8 @@ void lx_texel_map_free(lx_lightmap *map)
     free(map->object_position);
     free(map->object_normal);
     free(map->object_geometric_normal);
+    free(map->lift);
+    free(map->object_lift);
     free(map->albedo);
     free(map->emission);
     free(map->mask);
