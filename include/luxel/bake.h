@@ -121,6 +121,9 @@ int lx_bake_uv_set(const lx_scene *scene, uint32_t node, lx_uv_choice choice);
 /* Texel supersampling (lx_bake_desc.supersample): at most this many
  * sample points a side, N x N a texel. */
 #define LX_MAX_SUPERSAMPLE 16
+/* Edge supersampling (lx_bake_desc.edge_supersample): the points a side
+ * `luxel bake` gives the texels on a hard shadow's edge unless told. */
+#define LX_EDGE_SUPERSAMPLE_RECOMMENDED 4
 
 /* What a bake's denoising filters (`luxel bake --denoise off|indirect|all`). */
 typedef enum lx_denoise_mode {
@@ -213,6 +216,20 @@ typedef struct lx_bake_desc {
                               real-time buffers keep the texel's one point. Costs N^2 times the direct pass and about
                               40 N^2 bytes a texel more (72 N^2 for a map of a
                               node away from the identity) */
+    int edge_supersample;  /* 0..LX_MAX_SUPERSAMPLE; 0 or 1 = off (the
+                              library's default); N: a texel whose hard
+                              shadows differ from a neighbour's (a shadow's
+                              edge crosses it: some point or spot light or
+                              the sun reaches one and not the other) gets
+                              its direct light again as the mean over N x N
+                              points of its footprint, as supersample does
+                              for every texel (Bakery's antialiasing): smooth
+                              shadow edges for a few texels' cost. Points
+                              the texel's centre cannot see along its
+                              surface (under a wall) are left out. Ignored
+                              with supersample > 1; luxel bake uses
+                              LX_EDGE_SUPERSAMPLE_RECOMMENDED. 4 bytes a
+                              texel while the direct light is baked */
     /* Memory and scale (see "MEMORY AND TILES" above lx_baker_tile_count). */
     uint64_t memory_limit;  /* bytes the bake may take; 0 (or more than the
                                machine has) = what the machine has: its

@@ -186,8 +186,9 @@ typedef struct lx_lightmap {
     lx_vec3 *sub_position, *sub_normal, *sub_geometric_normal;
     lx_vec3 *sub_object_position, *sub_object_normal, *sub_object_geometric_normal;
     uint8_t *sub_covered;
-    /* per texel until lx_bake_straddle has run (then NULL): the world
-     * step of one texel along x and along y, [2 i] and [2 i + 1] */
+    /* per texel until lx_bake_straddle has run (then NULL; kept for edge
+     * supersampling, until the node moves): the world step of one texel
+     * along x and along y, [2 i] and [2 i + 1] */
     lx_vec3 *texel_axes;
     /* Whether the texel map (texels, tiles, positions, normals, albedo,
      * emission, horizon, stitch) is in memory. A tiled baker
@@ -501,6 +502,13 @@ lx_vec3 lx_hit_radiance(const lx_baker *b, const lx_radiance_source *sources, bo
 static inline bool lx_bake_keeps_surfaces(const lx_bake_desc *desc)
 {
     return desc->bounces > 0 || desc->dynamic_bounce_samples > 0 || desc->probes;
+}
+
+/* The points a side edge supersampling gives a shadow edge's texels
+ * (desc.edge_supersample), 0 when it is off. */
+static inline int lx_bake_edge_supersample(const lx_bake_desc *desc)
+{
+    return desc->edge_supersample > 1 && desc->supersample <= 1 ? desc->edge_supersample : 0;
 }
 
 /* bake_denoise.c: a copy of every map's baked buffer before the bounces

@@ -41,6 +41,7 @@ enum {
     WHEN_EMISSIVE_TEXTURE = 1u << 12, /* an emissive material has a texture */
     WHEN_TEXEL_EMISSION = 1u << 13, /* surfaces kept, or an emissive texture */
     WHEN_LIFT = 1u << 14,           /* a smooth-shaded mesh */
+    WHEN_EDGE = 1u << 15,           /* edge supersampling */
 };
 
 /* Where a buffer lives: the whole bake, a tile's texel maps (while the
@@ -96,8 +97,10 @@ static const texel_buffer texel_buffers[] = {
      WHEN_ALWAYS},
     {"texel map: world position, shading and geometric normal", 36, PER_TEXEL, LIFE_TEXEL_MAP,
      WHEN_ALWAYS},
-    {"texel map: footprint axes, until samples are moved out of walls", 24, PER_TEXEL,
-     LIFE_TEXEL_MAP, WHEN_ALWAYS},
+    {"texel map: footprint axes, until samples are moved out of walls (kept for edge "
+     "supersampling)", 24, PER_TEXEL, LIFE_TEXEL_MAP, WHEN_ALWAYS},
+    {"edge supersampling: shadow records, edge flags and the page's texel index", 9, PER_TEXEL,
+     LIFE_TEXEL_MAP, WHEN_EDGE},
     {"texel map: tile offsets", 1, PER_TEXEL, LIFE_TEXEL_MAP, WHEN_ALWAYS},
     {"texel map: lift to the smooth surface (shadow terminator)", 12, PER_TEXEL, LIFE_TEXEL_MAP,
      WHEN_LIFT},
@@ -134,6 +137,7 @@ lx_bake_texel_bytes lx_bake_texel_bytes_of(const lx_bake_desc *d, bool horizon,
     have |= scene_needs & LX_SCENE_NEEDS_DYNAMIC ? WHEN_DYNAMIC : 0;
     have |= scene_needs & LX_SCENE_NEEDS_EMISSIVE_TEXTURE ? WHEN_EMISSIVE_TEXTURE : 0;
     have |= scene_needs & LX_SCENE_NEEDS_LIFT ? WHEN_LIFT : 0;
+    have |= lx_bake_edge_supersample(d) ? WHEN_EDGE : 0;
     have |= (lx_bake_keeps_surfaces(d) || (scene_needs & LX_SCENE_NEEDS_EMISSIVE_TEXTURE))
                 ? WHEN_TEXEL_EMISSION
                 : 0;

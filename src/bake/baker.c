@@ -65,6 +65,9 @@ static lx_status validate_desc(const lx_bake_desc *d)
     if (d->gi_samples < 1 || d->gi_samples > LX_MAX_GI_SAMPLES)
         return lx_fail(LX_ERR_INVALID, "gi samples %u is outside 1..%u", d->gi_samples,
                        LX_MAX_GI_SAMPLES);
+    if (d->edge_supersample < 0 || d->edge_supersample > LX_MAX_SUPERSAMPLE)
+        return lx_fail(LX_ERR_INVALID, "edge supersample %d is outside 0..%d",
+                       d->edge_supersample, LX_MAX_SUPERSAMPLE);
     if (d->supersample < 1 || d->supersample > LX_MAX_SUPERSAMPLE)
         return lx_fail(LX_ERR_INVALID, "supersample %d is outside 1..%d", d->supersample,
                        LX_MAX_SUPERSAMPLE);

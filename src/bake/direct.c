@@ -92,11 +92,24 @@ static float soft_visibility(const lx_baker *b, uint32_t map_index, const lx_lig
     return total > 0.0 ? (float)(visible / total) : 0.0f;
 }
 
+/* What a light adds to a texel's shadow record when it is blocked there
+ * (edge supersampling compares neighbours' records): a hash of the light,
+ * so two records differ when different lights reach the texels. */
+static uint32_t shadow_key(uint32_t light_index)
+{
+    uint32_t h = (light_index + 1u) * 0x9E3779B1u;
+    h ^= h >> 16;
+    h *= 0x85EBCA6Bu;
+    h ^= h >> 13;
+    return h | 1u;
+}
+
 /* sh (NULL: no directional data) gets what accum gets, with its
- * direction (lx_sh4_add_lit_floor). */
+ * direction (lx_sh4_add_lit_floor); shadows (NULL: none) each texel's
+ * shadow record (shadow_key of the hard-shadowed lights blocked there). */
 static void light_tile(const lx_baker *b, uint32_t map_index, const lx_lightmap *map,
                        uint32_t first, uint32_t count, uint32_t light_index, lx_vec3 *accum,
-                       lx_sh4 *sh)
+                       lx_sh4 *sh, uint32_t *shadows)
 {
     const lx_light *light = &b->lights[light_index];
     const float floor_c = lx_light_is_area(light) ? 0.1f : 1e-3f; /* lx_sh4_add_lit_floor */
@@ -152,6 +165,9 @@ static void light_tile(const lx_baker *b, uint32_t map_index, const lx_lightmap 
     if (n == 0)
         return;
     lx_tracer_occluded_batch(b->tracer, rays, n, true, occluded);
+    for (uint32_t j = 0; shadows && j < n; j++)
+        if (occluded[j])
+            shadows[pending[j].texel] += shadow_key(light_index);
     for (uint32_t j = 0; j < n; j++)
         if (!occluded[j]) {
             uint32_t k = pending[j].texel;
@@ -416,7 +432,8 @@ shade_lanes(const fast_light *f, tile_soa *t, uint32_t base, lx_ray_packet *pk, 
 __attribute__((target_clones("avx512f", "avx2", "default")))
 #endif
 static void
-fast_light_tile(const lx_baker *b, const fast_light *f, tile_soa *t, lx_sh4 *sh)
+fast_light_tile(const lx_baker *b, const fast_light *f, tile_soa *t, lx_sh4 *sh, uint32_t *shadows,
+                uint32_t key)
 {
     lx_ray_packet pk;
     float e[3][LX_RAY_PACKET];
@@ -441,6 +458,9 @@ fast_light_tile(const lx_baker *b, const fast_light *f, tile_soa *t, lx_sh4 *sh)
             continue;
         uint32_t blocked = f->shadowed ? lx_tracer_occluded_packet(b->tracer, &pk, active) : 0;
         uint32_t add = active & ~blocked;
+        for (uint32_t j = 0; shadows && j < LX_RAY_PACKET; j++)
+            if ((active & blocked) >> j & 1u)
+                shadows[t->texel[base + j]] += key;
         int32_t on[LX_RAY_PACKET];
         for (int j = 0; j < LX_RAY_PACKET; j++)
             on[j] = (add >> j) & 1u ? -1 : 0;
@@ -488,10 +508,12 @@ static void vec3_to_acc(const lx_vec3 *accum, tile_soa *t)
 static void shade_tile(const lx_baker *b, uint32_t seed, const lx_lightmap *map, uint32_t first,
                        uint32_t count, const uint32_t *lights, uint32_t light_count,
                        const fast_light *fast, const bool *is_fast, lx_vec3 ambient,
-                       bool to_realtime, tile_soa *t, lx_sh4 *sh)
+                       bool to_realtime, tile_soa *t, lx_sh4 *sh, uint32_t *shadows)
 {
     lx_vec3 accum[TILE_TEXELS];
     tile_load(b, map, first, count, t);
+    if (shadows)
+        memset(shadows, 0, sizeof(uint32_t) * count);
     if (sh) {
         memset(sh, 0, sizeof(lx_sh4) * TILE_TEXELS);
         for (uint32_t k = 0; k < count; k++) {
@@ -516,11 +538,11 @@ static void shade_tile(const lx_baker *b, uint32_t seed, const lx_lightmap *map,
         }
     for (uint32_t l = 0; l < light_count; l++) {
         if (is_fast[l] && !horizon) {
-            fast_light_tile(b, &fast[l], t, sh);
+            fast_light_tile(b, &fast[l], t, sh, shadows, shadow_key(lights[l]));
             continue;
         }
         acc_to_vec3(t, accum);
-        light_tile(b, seed, map, first, count, lights[l], accum, sh);
+        light_tile(b, seed, map, first, count, lights[l], accum, sh, shadows);
         vec3_to_acc(accum, t);
     }
     if (!to_realtime && b->has_sky && !horizon) {
@@ -581,7 +603,7 @@ static void shade_supersampled(const lx_baker *b, uint32_t map_index, const lx_l
         if (!any)
             continue;
         shade_tile(b, map_index ^ (s << 16), &view, first, count, lights, light_count, fast,
-                   is_fast, ambient, false, t, sh ? point_sh : NULL);
+                   is_fast, ambient, false, t, sh ? point_sh : NULL, NULL);
         for (int k = 0; k < TILE_TEXELS; k++) {
             int32_t j = t->texel[k];
             if (j < 0 || !on[j])
@@ -598,7 +620,7 @@ static void shade_supersampled(const lx_baker *b, uint32_t map_index, const lx_l
         missing |= covered[j] == 0;
     if (missing)
         shade_tile(b, map_index, map, first, count, lights, light_count, fast, is_fast, ambient,
-                   false, t, sh);
+                   false, t, sh, NULL);
     for (int k = 0; k < TILE_TEXELS; k++) {
         int32_t j = t->texel[k];
         if (j < 0 || covered[j] == 0)
@@ -608,6 +630,174 @@ static void shade_supersampled(const lx_baker *b, uint32_t map_index, const lx_l
         for (int c = 0; sh && c < LX_SH_FLOATS; c++)
             sh[j].c[c] = (float)(sh_sum[j][c] / (double)covered[j]);
     }
+}
+
+/* ---- edge supersampling ----------------------------------------------------
+ * After the direct pass each texel has a shadow record (the sum of
+ * shadow_key over the hard-shadowed lights blocked at it). A texel whose
+ * record differs from a neighbour's on the same node has a shadow edge
+ * within a texel of it; its direct light is shaded again at n x n
+ * stratified points of its footprint (its centre plus the footprint
+ * axes) and averaged. A point the centre cannot see
+ * along the surface (a wall stands between) is left out, as straddle.c
+ * leaves out supersampling points under walls. */
+
+/* Marks the texels of map whose shadow record differs from an
+ * 8-neighbour's (same node); returns how many, or -1 out of memory. */
+static int64_t mark_edges(const lx_lightmap *map, const uint32_t *records, uint8_t *edge,
+                          int threads)
+{
+    int w = map->info.width, h = map->info.height;
+    int32_t *at = malloc(sizeof(int32_t) * (size_t)w * (size_t)h);
+    if (!at)
+        return -1;
+    memset(at, 0xFF, sizeof(int32_t) * (size_t)w * (size_t)h);
+    int64_t used = map->info.used_texels, marked = 0;
+    for (int64_t i = 0; i < used; i++)
+        at[map->texels[i].pixel] = (int32_t)i;
+#pragma omp parallel for schedule(static) reduction(+ : marked) num_threads(threads)
+    for (int64_t i = 0; i < used; i++) {
+        int x = (int)(map->texels[i].pixel % (uint32_t)w), y = (int)(map->texels[i].pixel / (uint32_t)w);
+        bool differs = false;
+        for (int dy = -1; dy <= 1 && !differs; dy++)
+            for (int dx = -1; dx <= 1 && !differs; dx++) {
+                int nx = x + dx, ny = y + dy;
+                if ((dx == 0 && dy == 0) || nx < 0 || ny < 0 || nx >= w || ny >= h)
+                    continue;
+                int32_t j = at[(size_t)ny * (size_t)w + (size_t)nx];
+                differs = j >= 0 && map->texels[j].node == map->texels[i].node &&
+                          records[j] != records[i];
+            }
+        edge[i] = differs;
+        marked += differs;
+    }
+    free(at);
+    return marked;
+}
+
+/* The marked texels of one tile of map m shaded again over their
+ * footprints, into the baked buffer (and the directional data). */
+static void edge_tile(const lx_baker *b, uint32_t m, uint32_t first, uint32_t count,
+                      const uint8_t *edge, int n, const uint32_t *lights, uint32_t light_count,
+                      const fast_light *fast, const bool *is_fast, lx_vec3 ambient, bool directional)
+{
+    const lx_lightmap *map = &b->maps[m];
+    lx_texel rec[TILE_TEXELS];
+    lx_vec3 pos[TILE_TEXELS], nrm[TILE_TEXELS], geo[TILE_TEXELS], lift[TILE_TEXELS];
+    lx_texel_horizon hor[TILE_TEXELS];
+    uint32_t orig[TILE_TEXELS], marked = 0;
+    for (uint32_t i = first; i < first + count; i++) {
+        if (!edge[i])
+            continue;
+        orig[marked] = i;
+        rec[marked] = map->texels[i];
+        nrm[marked] = map->world_normal[i];
+        geo[marked] = map->world_geometric_normal[i];
+        if (map->lift)
+            lift[marked] = map->lift[i];
+        if (map->horizon)
+            hor[marked] = map->horizon[i];
+        marked++;
+    }
+    if (!marked)
+        return;
+    lx_lightmap view = *map;
+    view.texels = rec;
+    view.world_position = pos;
+    view.world_normal = nrm;
+    view.world_geometric_normal = geo;
+    view.lift = map->lift ? lift : NULL;
+    view.horizon = map->horizon ? hor : NULL;
+    view.sub_count = 0;
+    double sum[TILE_TEXELS][3], sh_sum[TILE_TEXELS][LX_SH_FLOATS];
+    uint32_t seen[TILE_TEXELS];
+    memset(sum, 0, sizeof(sum[0]) * marked);
+    memset(sh_sum, 0, sizeof(sh_sum[0]) * marked);
+    memset(seen, 0, sizeof(seen[0]) * marked);
+    lx_ray rays[TILE_TEXELS];
+    uint8_t blocked[TILE_TEXELS];
+    tile_soa t;
+    lx_sh4 point_sh[TILE_TEXELS];
+    for (int s = 0; s < n * n; s++) {
+        /* n-rooks within the n x n cells (the canonical multi-jittered
+         * pattern): every point its own column and row of n^2, so an
+         * edge along either axis of the texel is resolved n^2 ways */
+        int col = s % n, row = s / n;
+        float du = ((float)col + ((float)row + 0.5f) / (float)n) / (float)n - 0.5f;
+        float dv = ((float)row + ((float)col + 0.5f) / (float)n) / (float)n - 0.5f;
+        for (uint32_t j = 0; j < marked; j++) {
+            uint32_t i = orig[j];
+            lx_vec3 p = map->world_position[i], g = geo[j];
+            lx_vec3 step = lx_add(lx_scale(map->texel_axes[2 * (size_t)i], du),
+                                  lx_scale(map->texel_axes[2 * (size_t)i + 1], dv));
+            pos[j] = lx_add(p, step);
+            /* the centre sees the point along the surface (lifted by the
+             * shadow bias), or the point is left out */
+            float lifted = b->bias + 4e-6f * lx_max_abs_component(p), len = lx_length(step);
+            rays[j] = (lx_ray){.origin = lx_madd(p, g, lifted),
+                               .dir = len > 0.0f ? lx_scale(step, 1.0f / len) : g,
+                               .tmin = 0.0f,
+                               .tmax = len};
+        }
+        lx_tracer_occluded_batch(b->tracer, rays, marked, true, blocked);
+        for (uint32_t j = 0; j < marked; j++)
+            if (blocked[j])
+                pos[j] = map->world_position[orig[j]];
+        shade_tile(b, m ^ ((uint32_t)s << 16), &view, 0, marked, lights, light_count, fast,
+                   is_fast, ambient, false, &t, directional ? point_sh : NULL, NULL);
+        for (int k = 0; k < TILE_TEXELS; k++) {
+            int32_t j = t.texel[k];
+            if (j < 0 || blocked[j])
+                continue;
+            for (int c = 0; c < 3; c++)
+                sum[j][c] += (double)t.acc[c][k];
+            for (int c = 0; directional && c < LX_SH_FLOATS; c++)
+                sh_sum[j][c] += (double)point_sh[j].c[c];
+            seen[j]++;
+        }
+    }
+    for (uint32_t j = 0; j < marked; j++) {
+        if (!seen[j])
+            continue; /* no point seen: the centre's light stays */
+        size_t pixel = map->texels[orig[j]].pixel;
+        for (int c = 0; c < 3; c++)
+            map->baked[3 * pixel + (size_t)c] = (float)(sum[j][c] / (double)seen[j]);
+        for (int c = 0; directional && c < LX_SH_FLOATS; c++)
+            map->sh[LX_SH_FLOATS * pixel + (size_t)c] = (float)(sh_sum[j][c] / (double)seen[j]);
+    }
+}
+
+/* Edge supersampling of every map with shadow records (records[m]). */
+static lx_status edge_supersample(const lx_baker *b, uint32_t *const *records, int n,
+                                  const uint32_t *lights, uint32_t light_count,
+                                  const fast_light *fast, const bool *is_fast, lx_vec3 ambient,
+                                  bool directional)
+{
+    int threads = lx_thread_count(b->desc.threads);
+    int64_t total = 0;
+    for (uint32_t m = 0; m < b->map_count; m++) {
+        const lx_lightmap *map = &b->maps[m];
+        if (!records[m])
+            continue;
+        uint8_t *edge = malloc(map->info.used_texels ? map->info.used_texels : 1);
+        int64_t marked = edge ? mark_edges(map, records[m], edge, threads) : -1;
+        if (marked < 0) {
+            free(edge);
+            return lx_fail(LX_ERR_NOMEM, "lightmap '%s': out of memory for edge supersampling",
+                           map->name);
+        }
+        total += marked;
+        int tiles = (int)map->tile_count;
+#pragma omp parallel for schedule(dynamic, 4) num_threads(threads)
+        for (int tile = 0; tile < tiles; tile++)
+            edge_tile(b, m, map->tile_start[tile], map->tile_start[tile + 1] - map->tile_start[tile],
+                      edge, n, lights, light_count, fast, is_fast, ambient, directional);
+        free(edge);
+    }
+    if (total)
+        lx_log(LX_LOG_INFO, "%lld texels on hard shadow edges supersampled (%dx%d points)",
+               (long long)total, n, n);
+    return LX_OK;
 }
 
 lx_status lx_bake_lights(lx_baker *b, const uint32_t *lights, uint32_t light_count, lx_vec3 ambient,
@@ -643,6 +833,25 @@ lx_status lx_bake_lights(lx_baker *b, const uint32_t *lights, uint32_t light_cou
             is_fast[l] = false;
     }
     int threads = lx_thread_count(b->desc.threads);
+    /* edge supersampling: the maps in memory that keep their footprints
+     * record each texel's shadows */
+    int edge_n = to_realtime ? 0 : lx_bake_edge_supersample(&b->desc);
+    uint32_t **records = edge_n ? calloc(b->map_count + 1, sizeof(uint32_t *)) : NULL;
+    bool out_of_memory = edge_n && !records;
+    for (uint32_t m = 0; records && m < b->map_count && !out_of_memory; m++) {
+        const lx_lightmap *map = &b->maps[m];
+        if (map->loaded && map->texel_axes && map->info.used_texels)
+            out_of_memory = !(records[m] = malloc(sizeof(uint32_t) * map->info.used_texels));
+    }
+    if (out_of_memory) {
+        for (uint32_t m = 0; records && m < b->map_count; m++)
+            free(records[m]);
+        free(records);
+        free(fast);
+        free(is_fast);
+        lx_tile_walk_end(&w);
+        return lx_fail(LX_ERR_NOMEM, "out of memory for edge supersampling");
+    }
 
 #pragma omp parallel for schedule(dynamic, 4) num_threads(threads)
     for (int global = 0; global < w.tiles; global++) {
@@ -661,7 +870,7 @@ lx_status lx_bake_lights(lx_baker *b, const uint32_t *lights, uint32_t light_cou
                                    ambient, &t, sh);
             else
                 shade_tile(b, m, map, first, count, lights, light_count, fast, is_fast, ambient,
-                           to_realtime, &t, sh);
+                           to_realtime, &t, sh, records && records[m] ? records[m] + first : NULL);
             /* every texel belongs to one tile: plain stores, no clearing */
             for (int k = 0; k < TILE_TEXELS; k++) {
                 if (t.texel[k] < 0)
@@ -678,9 +887,16 @@ lx_status lx_bake_lights(lx_baker *b, const uint32_t *lights, uint32_t light_cou
         }
         lx_tile_walk_done(&w, global, count);
     }
+    st = lx_tile_walk_end(&w);
+    if (st == LX_OK && records)
+        st = edge_supersample(b, records, edge_n, lights, light_count, fast, is_fast, ambient,
+                              directional);
+    for (uint32_t m = 0; records && m < b->map_count; m++)
+        free(records[m]);
+    free(records);
     free(fast);
     free(is_fast);
-    if ((st = lx_tile_walk_end(&w)) != LX_OK)
+    if (st != LX_OK)
         return st;
     if (b->desc.progress && !b->desc.progress(b->desc.progress_user, progress_base + progress_span))
         return lx_fail(LX_ERR_CANCELLED, "bake cancelled");

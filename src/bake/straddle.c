@@ -206,7 +206,8 @@ lx_status lx_bake_straddle(lx_baker *b, float progress_base, float progress_span
         return st;
     if (moved)
         lx_log(LX_LOG_INFO, "%lld texel samples moved out of geometry", (long long)moved);
-    for (uint32_t m = 0; m < b->map_count; m++) {
+    /* edge supersampling places its points by the footprints too */
+    for (uint32_t m = 0; m < b->map_count && !lx_bake_edge_supersample(&b->desc); m++) {
         free(b->maps[m].texel_axes);
         b->maps[m].texel_axes = NULL;
     }

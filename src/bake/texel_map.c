@@ -1063,6 +1063,9 @@ lx_status lx_texel_map_keep_object_space(lx_lightmap *map)
 
 void lx_texel_map_transform(lx_lightmap *map, uint32_t node, const lx_mat4 *world)
 {
+    /* the footprints were the old transform's: edge supersampling stops */
+    free(map->texel_axes);
+    map->texel_axes = NULL;
     lx_mat4 nm;
     if (!lx_mat4_normal_matrix(world, &nm))
         nm = *world;

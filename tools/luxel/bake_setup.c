@@ -16,6 +16,7 @@ void cli_bake_args_init(bake_args *a, const char *command)
     a->desc.padding = LX_PADDING_RECOMMENDED;
     a->desc.denoise = LX_DENOISE_INDIRECT;
     a->desc.bounces = LX_BOUNCES_RECOMMENDED;
+    a->desc.edge_supersample = LX_EDGE_SUPERSAMPLE_RECOMMENDED;
     a->sky_intensity = -1.0;
     a->sky_shadows = -1;
     a->atlas = -1;
