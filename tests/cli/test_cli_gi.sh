@@ -92,10 +92,21 @@ for n in room tall_box short_box; do
     check "$n.exr: --supersample 1 is the plain bake" cmp -s "$WORK/direct/$n.exr" "$WORK/ss1/$n.exr"
 done
 
+# edge supersampling is on by default: only the texels a shadow edge crosses
+# change, and --supersample takes its place
+run "$BIN" bake "$ROOM" "${SMALL[@]}" --bounces 0 --edge-supersample 0 -o "$WORK/edge0"
+expect_rc 0 "--edge-supersample 0"
+check "--edge-supersample (default 4) changes room.exr (its shadow edges)" \
+    sh -c "! cmp -s '$WORK/direct/room.exr' '$WORK/edge0/room.exr'"
+check "manifest: the edge supersampling" grep -Eq '"edge_supersample":[[:space:]]*4' \
+    "$WORK/direct/manifest.json"
+check "manifest: no edge supersampling with --supersample 3" \
+    sh -c "! grep -q edge_supersample '$WORK/ss3/manifest.json'"
+
 # ---- bad values -------------------------------------------------------------------
 for bad in "--bounces -1" "--bounces 65" "--bounces two" "--gi-samples 0" "--gi-samples 70000" \
     "--emissive-scale 0" "--emissive-scale -2" "--emissive-scale nan" "--supersample 0" \
-    "--supersample 17" "--supersample two"; do
+    "--supersample 17" "--supersample two" "--edge-supersample -1" "--edge-supersample 17"; do
     # shellcheck disable=SC2086
     run "$BIN" bake "$ROOM" $bad -q -o "$WORK/bad"
     expect_rc 2 "$bad"
