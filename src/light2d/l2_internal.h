@@ -49,23 +49,36 @@ typedef struct l2_edge {
     uint8_t free;
 } l2_edge;
 
-/* A boundary pixel where rays leave their caster run: its bins [b0, b1]
- * (b1 may pass n: wrap) and the distance of its far corner. */
+/* A boundary pixel, kept for the pass that finds where rays leave their
+ * first caster run: the rays [b0, b1] (b1 may pass n: wrap) whose
+ * sampled line crosses it, its square relative to the light (ax, ay: the
+ * corner nearest the origin of the image, side 1) and its free sides; or,
+ * for a square no sampled line crosses (b0 > b1 on entry: the bins it
+ * touches), the distance of its far corner in df. */
 typedef struct l2_exit {
     int b0, b1;
-    float df;
+    float ax, ay, df;
+    uint8_t free;
+    bool sampled;
 } l2_exit;
 
 /* A light's polar shadow map: n rays over the pseudo-angle p in [0, 8)
  * (the point where the ray meets the unit square around the light, walked
  * counter-clockwise: p = 1 + dy/dx on the +x face, 3 - dx/dy on +y, 5 +
- * dy/dx on -x, 7 - dx/dy on -y). occ[b]: distance to the nearest caster
- * along ray b; ex[b]: where the first caster run of the ray ends. For soft
- * lights, sparse tables of the minimum and maximum of occ over 2^l rays. */
+ * dy/dx on -x, 7 - dx/dy on -y). Ray b holds the pixels whose centres'
+ * p lies in [b, b + 1) x 8/n and is sampled along the line through its
+ * middle, p = (b + 0.5) x 8/n: occ[b], the distance at which that line
+ * enters its first caster pixel; ex[b], where it leaves the caster run it
+ * entered there. For soft lights, sparse tables of the minimum and
+ * maximum of occ over 2^l rays. */
 typedef struct l2_polar {
     int n;
     float bins_per_p; /* n / 8 */
     float *occ, *ex;
+    /* the sampled lines' unit directions as 1/x and 1/y (never 0: no
+     * line lies on an axis), for ray_n = n rays */
+    float *inv_ux, *inv_uy;
+    int ray_n;
     float *occx; /* occ three times over: occx[n + b] = occ[b mod n] for b
                     in [-n, 2n), so that windows need no wrapping */
     /* soft lights: the horizons' reach (horizons in polar.c), as an

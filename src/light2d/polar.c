@@ -58,6 +58,8 @@ void l2_polar_free(l2_polar *pm)
 {
     free(pm->occ);
     free(pm->ex);
+    free(pm->inv_ux);
+    free(pm->inv_uy);
     free(pm->lit);
     free(pm->occx);
     free(pm->hz);
@@ -70,9 +72,9 @@ void l2_polar_free(l2_polar *pm)
     memset(pm, 0, sizeof *pm);
 }
 
-/* The bins [b0, b1] of a square from its corners' pseudo-angles p[4]
- * (the second half of square_bins). */
-static void corner_bins(const l2_polar *pm, const float p[4], int *b0, int *b1)
+/* The pseudo-angles [lo, hi] a square spans from its corners' p[4]; a
+ * square that straddles p = 0 gets hi (and maybe lo) past 8. */
+static void corner_span(const float p[4], float *lo_out, float *hi_out)
 {
     float lo = p[0], hi = p[0];
     for (int k = 1; k < 4; k++) {
@@ -88,6 +90,16 @@ static void corner_bins(const l2_polar *pm, const float p[4], int *b0, int *b1)
             hi = l2_max(hi, q);
         }
     }
+    *lo_out = lo;
+    *hi_out = hi;
+}
+
+/* The bins [b0, b1] of a square from its corners' pseudo-angles p[4]
+ * (the second half of square_bins). */
+static void corner_bins(const l2_polar *pm, const float p[4], int *b0, int *b1)
+{
+    float lo, hi;
+    corner_span(p, &lo, &hi);
     int n = pm->n;
     int a = (int)(lo * pm->bins_per_p), b = (int)(hi * pm->bins_per_p);
     if (a >= n) {
@@ -128,6 +140,13 @@ static lx_status reserve(l2_polar *pm, int n, int levels, int depth_levels)
         float *ex = realloc(pm->ex, (size_t)n * sizeof *ex);
         if (ex)
             pm->ex = ex;
+        float *iux = realloc(pm->inv_ux, (size_t)n * sizeof *iux);
+        if (iux)
+            pm->inv_ux = iux;
+        float *iuy = realloc(pm->inv_uy, (size_t)n * sizeof *iuy);
+        if (iuy)
+            pm->inv_uy = iuy;
+        pm->ray_n = 0;
         float *lit = realloc(pm->lit, (size_t)n * sizeof *lit);
         if (lit)
             pm->lit = lit;
@@ -144,7 +163,7 @@ static lx_status reserve(l2_polar *pm, int n, int levels, int depth_levels)
         float *hz = realloc(pm->hz, (size_t)n * 2 * L2_HZ * sizeof *hz);
         if (hz)
             pm->hz = hz;
-        if (!occ || !ex || !lit || !qocc || !occx || !th || !hz)
+        if (!occ || !ex || !iux || !iuy || !lit || !qocc || !occx || !th || !hz)
             return lx_fail(LX_ERR_NOMEM, "light2d: out of memory for a polar map of %d rays", n);
         pm->capacity = n;
     }
@@ -161,6 +180,38 @@ static lx_status reserve(l2_polar *pm, int n, int levels, int depth_levels)
         pm->table_capacity = (int)t;
     }
     return LX_OK;
+}
+
+/* The sampled lines' directions, pm->inv_ux and inv_uy: ray b's line has
+ * p = (b + 0.5) / bpp, on the face f = floor(p / 2) the direction (1, p -
+ * 1), (3 - p, 1), (-1, 5 - p) or (p - 7, -1), normalised. With n a
+ * multiple of 8 no line lies on an axis or a diagonal (p would be a whole
+ * number). They depend on n alone. */
+static void ray_dirs(l2_polar *pm)
+{
+    int n = pm->n;
+    double bpp = (double)n / 8.0;
+    for (int b = 0; b < n; b++) {
+        double p = (b + 0.5) / bpp, x, y;
+        int f = (int)floor(p * 0.5);
+        if (f <= 0) {
+            x = 1.0;
+            y = p - 1.0;
+        } else if (f == 1) {
+            x = 3.0 - p;
+            y = 1.0;
+        } else if (f == 2) {
+            x = -1.0;
+            y = 5.0 - p;
+        } else {
+            x = p - 7.0;
+            y = -1.0;
+        }
+        double len = sqrt(x * x + y * y);
+        pm->inv_ux[b] = (float)(len / x);
+        pm->inv_uy[b] = (float)(len / y);
+    }
+    pm->ray_n = n;
 }
 
 /* The ray boundaries' true angles, theta[b] for b in [0, n] (radians,
@@ -323,7 +374,8 @@ L2_CLONES static void open_gaps(l2_polar *pm, int32_t *fw)
 }
 
 /* As reserve() below takes them: per ray the occluders, exits, lit
- * flags, their quantized copy (4 floats), three occluder coordinates,
+ * flags, their quantized copy (4 floats), the sampled line's direction
+ * (2), three occluder coordinates,
  * an angle and 2 L2_HZ horizons; the min/max tables of `levels` levels
  * and the gaps of `depth_levels`. */
 uint64_t l2_polar_bytes(const lx_light2d *ctx, const lx_light2d_light *l)
@@ -334,8 +386,47 @@ uint64_t l2_polar_bytes(const lx_light2d *ctx, const lx_light2d_light *l)
         levels++;
     uint64_t depth_levels =
         l->softness > 0.0f ? (uint64_t)l2_depth_level(l->radius + 2.0f, 1 << 10) + 1 : 0;
-    uint64_t floats = n * (4 + 3 + 1 + 2 * L2_HZ) + 1 + n * levels * 2 + n * depth_levels;
+    uint64_t floats = n * (4 + 2 + 3 + 1 + 2 * L2_HZ) + 1 + n * levels * 2 + n * depth_levels;
     return floats * sizeof(float);
+}
+
+/* The rays [i0, i1] (no wrap) whose sampled lines cross the square
+ * [ax, bx] x [ay, by] (relative to the light, which lies outside it):
+ * occ[i] becomes at most the distance along line i to where it enters the
+ * square, the larger of its distances to the near x and near y sides
+ * (slabs). A loop without branches, so that it vectorizes. */
+static void enter_run(float *restrict occ, const float *restrict iux, const float *restrict iuy,
+                      int i0, int i1, float ax, float bx, float ay, float by)
+{
+    for (int i = i0; i <= i1; i++) {
+        float tx = l2_min(ax * iux[i], bx * iux[i]);
+        float ty = l2_min(ay * iuy[i], by * iuy[i]);
+        occ[i] = l2_min(occ[i], l2_max(tx, ty));
+    }
+}
+
+/* The rays [i0, i1] (no wrap) whose sampled lines cross the boundary
+ * pixel whose square starts at (ax, ay) (relative to the light, side 1):
+ * where line i leaves it, through the x side when its far x slab ends
+ * first, else the y side; when that side is free (free: L2_FREE_*) and the
+ * point lies at or beyond the ray's occluder, ex[i] becomes at most its
+ * distance. */
+static void leave_run(const float *restrict occ, float *restrict ex, const float *restrict iux,
+                      const float *restrict iuy, int i0, int i1, float ax, float ay,
+                      uint8_t free_sides)
+{
+    float bx = ax + 1.0f, by = ay + 1.0f;
+    bool right = free_sides & L2_FREE_RIGHT, left = free_sides & L2_FREE_LEFT;
+    bool down = free_sides & L2_FREE_DOWN, up = free_sides & L2_FREE_UP;
+    for (int i = i0; i <= i1; i++) {
+        float tx = l2_max(ax * iux[i], bx * iux[i]);
+        float ty = l2_max(ay * iuy[i], by * iuy[i]);
+        bool xs = tx <= ty;
+        float t = xs ? tx : ty;
+        bool open = xs ? (iux[i] > 0.0f ? right : left) : (iuy[i] > 0.0f ? down : up);
+        if (open && t >= occ[i] && t < ex[i])
+            ex[i] = t;
+    }
 }
 
 lx_status l2_polar_build(const lx_light2d *ctx, l2_prep *p)
@@ -367,8 +458,13 @@ lx_status l2_polar_build(const lx_light2d *ctx, l2_prep *p)
     int tx1 = (int)fmin(ctx->tiles_x - 1, floor((l->x + r + 1.0) / L2_TILE));
     int ty1 = (int)fmin(ctx->tiles_y - 1, floor((l->y + r + 1.0) / L2_TILE));
     bool face = !l->self_shadow;
-    /* the boundary pixels where a ray leaves its caster run, listed with
-     * their bins for the second pass (at most every pixel of the tiles) */
+    if (pm->ray_n != n)
+        ray_dirs(pm);
+    const float *iux = pm->inv_ux, *iuy = pm->inv_uy;
+    float bpp = pm->bins_per_p;
+    /* the boundary pixels, listed with their rays for the second pass
+     * (where rays leave their caster run; at most every pixel of the
+     * tiles) */
     size_t most = 0;
     if (face)
         for (int ty = ty0; ty <= ty1; ty++)
@@ -397,32 +493,78 @@ lx_status l2_polar_build(const lx_light2d *ctx, l2_prep *p)
                 if (dn2 >= r2)
                     continue;
                 bool inside = nx == 0.0f && ny == 0.0f;
-                int b0 = 0, b1 = n - 1;
-                if (!inside)
-                    square_bins(pm, ax, bx, ay, by, &b0, &b1);
-                float dn = sqrtf(dn2);
-                for (int b = b0; b <= b1; b++) {
-                    int i = b >= n ? b - n : b;
-                    if (dn < occ[i])
-                        occ[i] = dn;
+                /* the rays whose sampled line crosses the square: those
+                 * whose middle p lies in the square's span */
+                int c0 = 0, c1 = n - 1;
+                if (!inside) {
+                    float u, pc[4] = {pseudo_angle(ax, ay, &u), pseudo_angle(bx, ay, &u),
+                                      pseudo_angle(ax, by, &u), pseudo_angle(bx, by, &u)};
+                    float lo, hi;
+                    corner_span(pc, &lo, &hi);
+                    c0 = (int)ceilf(lo * bpp - 0.5f);
+                    c1 = (int)floorf(hi * bpp - 0.5f);
+                    if (c0 >= n) {
+                        c0 -= n;
+                        c1 -= n;
+                    }
+                    c1 = c1 < c0 + n - 1 ? c1 : c0 + n - 1;
                 }
-                if (face) {
+                bool sampled = c0 <= c1;
+                if (inside) {
+                    for (int i = 0; i < n; i++)
+                        occ[i] = 0.0f;
+                } else if (sampled) {
+                    /* each line's distance to where it enters the square */
+                    int e0 = c1 < n ? c1 : n - 1;
+                    enter_run(occ, iux, iuy, c0, e0, ax, bx, ay, by);
+                    if (c1 >= n)
+                        enter_run(occ, iux, iuy, 0, c1 - n, ax, bx, ay, by);
+                } else {
+                    /* a square between two sampled lines (only where rays
+                     * are farther apart than a pixel: a fixed
+                     * polar_resolution) still blocks the rays it touches,
+                     * from its nearest point, so no caster falls between
+                     * rays */
+                    square_bins(pm, ax, bx, ay, by, &c0, &c1);
+                    float dn = sqrtf(dn2);
+                    for (int b = c0; b <= c1; b++) {
+                        int i = b >= n ? b - n : b;
+                        occ[i] = l2_min(occ[i], dn);
+                    }
+                }
+                if (!face)
+                    continue;
+                l2_exit *ev = &pm->exits[exits];
+                *ev = (l2_exit){c0, c1, ax, ay, 0.0f, ed->free, sampled || inside};
+                if (!ev->sampled) {
+                    /* such a square ends the runs of all its rays at its
+                     * far corner where it has a free side away from the
+                     * light */
                     float cx = ax + 0.5f, cy = ay + 0.5f;
                     bool exit = ((ed->free & L2_FREE_RIGHT) && cx > 0.0f) ||
                                 ((ed->free & L2_FREE_LEFT) && cx < 0.0f) ||
                                 ((ed->free & L2_FREE_DOWN) && cy > 0.0f) ||
-                                ((ed->free & L2_FREE_UP) && cy < 0.0f) || inside;
-                    if (exit) {
-                        float fx = l2_max(ax * ax, bx * bx), fy = l2_max(ay * ay, by * by);
-                        pm->exits[exits++] = (l2_exit){b0, b1, sqrtf(fx + fy)};
-                    }
+                                ((ed->free & L2_FREE_UP) && cy < 0.0f);
+                    if (!exit)
+                        continue;
+                    float fx = l2_max(ax * ax, bx * bx), fy = l2_max(ay * ay, by * by);
+                    ev->df = sqrtf(fx + fy);
                 }
+                exits++;
             }
         }
-    /* where the first caster run of each ray ends: the nearest far corner
-     * of an exit pixel at or beyond the ray's occluder */
+    /* where the first caster run of each ray ends: the nearest point at or
+     * beyond the ray's occluder where its line leaves a boundary pixel
+     * through a free side */
     for (size_t x = 0; x < exits; x++) {
         const l2_exit *ev = &pm->exits[x];
+        if (ev->sampled) {
+            int e0 = ev->b1 < n ? ev->b1 : n - 1;
+            leave_run(occ, ex, iux, iuy, ev->b0, e0, ev->ax, ev->ay, ev->free);
+            if (ev->b1 >= n)
+                leave_run(occ, ex, iux, iuy, 0, ev->b1 - n, ev->ax, ev->ay, ev->free);
+            continue;
+        }
         float df = ev->df;
         for (int b = ev->b0; b <= ev->b1; b++) {
             int i = b >= n ? b - n : b;
