@@ -99,6 +99,26 @@ static double relative_rms(const float *x, const float *ref, size_t n)
     return sum > 0.0 ? sqrt(se / (double)(3 * n)) / (sum / (double)(3 * n)) : 0.0;
 }
 
+/* The share of n texels whose luminance is off ref's by more than
+ * `tolerance` of ref's (texels where ref is dark, below 1/100 of its mean,
+ * left out): the issue's blotch measure, what a viewer sees as patches. */
+static double share_off(const float *x, const float *ref, size_t n, double tolerance)
+{
+    double mean = 0.0;
+    for (size_t i = 0; i < n; i++)
+        mean += lx_luminance(ref + 3 * i);
+    mean /= n ? (double)n : 1.0;
+    size_t off = 0, judged = 0;
+    for (size_t i = 0; i < n; i++) {
+        double want = lx_luminance(ref + 3 * i), got = lx_luminance(x + 3 * i);
+        if (want < 0.01 * mean)
+            continue;
+        judged++;
+        off += fabs(got - want) > tolerance * want;
+    }
+    return judged ? (double)off / (double)judged : 0.0;
+}
+
 /* The noise section (see the top). */
 static void noise_at_equal_time(const lx_scene *scene, const char *scene_path, int res,
                                 int samples, int bounces, int threads, int reps)
@@ -132,10 +152,13 @@ static void noise_at_equal_time(const lx_scene *scene, const char *scene_path, i
            e_eq = relative_rms(eq, ref, n);
     printf("\nnoise  %s, %dx%d a node, %zu texels, %d bounces, against %d rays a texel (%.1f s)\n",
            scene_path, res, res, n, bounces, samples * 64, t_ref);
-    printf("  %-44s %9s %14s\n", "", "time", "RMS error");
-    printf("  %-44s %8.3fs %13.2f%%\n", "raw, gi-samples S", t_raw, 100.0 * e_raw);
-    printf("  %-44s %8.3fs %13.2f%%\n", "denoised (--denoise indirect), S", t_den, 100.0 * e_den);
-    printf("  raw at equal time, %-25d %8.3fs %13.2f%%\n", equal, t_eq, 100.0 * e_eq);
+    printf("  %-44s %9s %14s %14s\n", "", "time", "RMS error", "texels off 5%");
+    printf("  %-44s %8.3fs %13.2f%% %13.2f%%\n", "raw, gi-samples S", t_raw, 100.0 * e_raw,
+           100.0 * share_off(raw, ref, n, 0.05));
+    printf("  %-44s %8.3fs %13.2f%% %13.2f%%\n", "denoised (--denoise indirect), S", t_den,
+           100.0 * e_den, 100.0 * share_off(den, ref, n, 0.05));
+    printf("  raw at equal time, %-25d %8.3fs %13.2f%% %13.2f%%\n", equal, t_eq, 100.0 * e_eq,
+           100.0 * share_off(eq, ref, n, 0.05));
     printf("noise: at %d rays a texel the denoiser cuts the RMS error against a 64x reference "
            "%.1fx (%.2f%% -> %.2f%%); %.1fx against the raw bake of equal time (%d rays); "
            "a raw bake would need about %.0f rays (1/sqrt law) to match\n",

@@ -136,7 +136,20 @@ lx_status lx_bake_denoise(lx_baker *b, float **direct, float progress_base, floa
         lx_denoise_desc dd = {.threads = b->desc.threads,
                               .progress = b->desc.progress ? share_progress : NULL,
                               .progress_user = &sh};
-        if (mode == LX_DENOISE_INDIRECT) {
+        /* the bounces' own variance guides the filter's luminance weight
+         * (the guides' spatial estimate otherwise) */
+        size_t pixels = n / 3;
+        if (mode == LX_DENOISE_INDIRECT && map->gi_variance && !g.variance) {
+            float *v = malloc(sizeof(float) * (pixels ? pixels : 1));
+            if (v)
+                memcpy(v, map->gi_variance, sizeof(float) * pixels);
+            g.variance = v;
+            if (!v)
+                st = lx_fail(LX_ERR_NOMEM, "lightmap '%s': out of memory for denoising",
+                             map->name);
+        }
+        if (st != LX_OK) {
+        } else if (mode == LX_DENOISE_INDIRECT) {
             /* the bounces' part, in place of the buffer's copy of it */
             float *indirect = malloc(sizeof(float) * n);
             if (!indirect) {

@@ -173,6 +173,11 @@ typedef struct lx_lightmap {
                         spherical harmonics (directional.c); NULL unless
                         desc.directional */
     lx_seam_stitch *stitch; /* NULL: not asked, or no seams */
+    float *gi_variance; /* width * height: the variance of the bounces' estimate
+                           of each texel's luminance (the gathers' sample
+                           variance over their rays, summed over the
+                           bounces), the denoiser's guide; after a bake
+                           with bounces that denoises them, else NULL */
     uint8_t *gi_valid; /* width * height, after a bake with bounces in which
                           a texel lay inside geometry (else NULL): 0 at
                           those texels, left out of the denoiser; resident */

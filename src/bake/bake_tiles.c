@@ -80,6 +80,8 @@ static const texel_buffer texel_buffers[] = {
     {"directional: L1 SH of the baked light (12 floats)", 48, PER_TEXEL, LIFE_RESIDENT,
      WHEN_DIRECTIONAL},
     {"bounces: validity (kept for the denoiser)", 1, PER_TEXEL, LIFE_RESIDENT, WHEN_GI},
+    {"bounces: each texel's variance (the denoiser's guide)", 4, PER_TEXEL, LIFE_RESIDENT,
+     WHEN_GI | WHEN_KEEP},
     {"bounces: exitant radiance of the last and the next bounce", 24, PER_TEXEL, LIFE_RESIDENT,
      WHEN_GI},
     {"emitters: textured emission", 12, PER_TEXEL, LIFE_RESIDENT, WHEN_EMISSIVE_TEXTURE},
@@ -445,6 +447,7 @@ void lx_bake_map_unload(lx_lightmap *map)
     map->mask = NULL;
     map->baked = map->realtime = map->sh = NULL;
     map->gi_valid = NULL;
+    map->gi_variance = NULL;
     lx_texel_map_free(map);
     map->name = keep.name;
     map->info = keep.info;
@@ -453,6 +456,7 @@ void lx_bake_map_unload(lx_lightmap *map)
     map->realtime = keep.realtime;
     map->sh = keep.sh;
     map->gi_valid = keep.gi_valid;
+    map->gi_variance = keep.gi_variance;
     map->horizon_page = keep.horizon_page;
     map->loaded = false;
 }
@@ -486,6 +490,7 @@ static lx_status map_load(lx_baker *b, uint32_t m)
     free(fresh.realtime);
     free(fresh.sh);
     free(fresh.gi_valid);
+    free(fresh.gi_variance);
     fresh.name = map->name;
     fresh.info = map->info;
     fresh.mask = map->mask;
@@ -493,6 +498,7 @@ static lx_status map_load(lx_baker *b, uint32_t m)
     fresh.realtime = map->realtime;
     fresh.sh = map->sh;
     fresh.gi_valid = map->gi_valid;
+    fresh.gi_variance = map->gi_variance;
     fresh.horizon_page = map->horizon_page;
     fresh.loaded = true;
     *map = fresh;

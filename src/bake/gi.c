@@ -150,6 +150,8 @@ typedef struct gi_map {
     lx_vec3 *next;      /* tile: per texel, this bounce's irradiance */
     lx_sh4 *next_sh;    /* tile: per texel, this bounce's directional data
                            (NULL unless desc.directional) */
+    float *next_var;    /* tile: per texel, the variance of this bounce's
+                           luminance (NULL unless map->gi_variance) */
     uint8_t *invalid;   /* tile: per texel, inside geometry */
 } gi_map;
 
@@ -293,16 +295,17 @@ bool lx_gi_texel_inside(const lx_baker *b, uint32_t map_index, uint32_t i)
 
 /* One gather for one texel: pi / N x the radiance its rays bring; with
  * sh, the same rays' estimate of int L Y dw (lx_sh_ray_weight / N x L Y,
- * directional.c). */
+ * directional.c); with variance, the estimate's luminance variance (the
+ * rays' sample variance over N, stratification ignored: an upper bound). */
 static lx_vec3 texel_gather(const gi_run *run, uint32_t map_index, uint32_t i, uint32_t key,
-                            lx_sh4 *sh)
+                            lx_sh4 *sh, float *variance)
 {
     const lx_baker *b = run->b;
     const lx_lightmap *map = &b->maps[map_index];
     uint32_t sx, sy;
     lx_cosine_strata(b->desc.gi_samples, &sx, &sy);
     uint32_t cells = sx * sy;
-    double sum[3] = {0.0, 0.0, 0.0}, shs[LX_SH_FLOATS] = {0};
+    double sum[3] = {0.0, 0.0, 0.0}, shs[LX_SH_FLOATS] = {0}, lum = 0.0, lum2 = 0.0;
     lx_gather_frame f = lx_gather_frame_of(b, map_index, map, i);
     for (uint32_t k = 0; k < cells; k++) {
         lx_ray ray;
@@ -316,6 +319,10 @@ static lx_vec3 texel_gather(const gi_run *run, uint32_t map_index, uint32_t i, u
         sum[0] += l.x;
         sum[1] += l.y;
         sum[2] += l.z;
+        const float rgb[3] = {l.x, l.y, l.z};
+        double luma = lx_luminance(rgb);
+        lum += luma;
+        lum2 += luma * luma;
         if (sh) {
             lx_vec3 d = ray.dir;
             float w0;
@@ -332,6 +339,10 @@ static lx_vec3 texel_gather(const gi_run *run, uint32_t map_index, uint32_t i, u
     if (sh)
         for (int c = 0; c < LX_SH_FLOATS; c++)
             sh->c[c] = (float)(shs[c] / (double)cells);
+    if (variance) {
+        double n = (double)cells, spread = cells > 1 ? (lum2 - lum * lum / n) / (n - 1.0) : 0.0;
+        *variance = (float)(LX_PI * LX_PI * fmax(spread, 0.0) / n);
+    }
     double scale = LX_PI / (double)cells;
     return lx_v3((float)(sum[0] * scale), (float)(sum[1] * scale), (float)(sum[2] * scale));
 }
@@ -360,8 +371,11 @@ static lx_status run_pass(gi_run *run, bool validity, uint32_t key, float from, 
                 g->next[i] = lx_v3(0.0f, 0.0f, 0.0f);
                 if (g->next_sh)
                     memset(&g->next_sh[i], 0, sizeof(lx_sh4));
+                if (g->next_var)
+                    g->next_var[i] = 0.0f;
             } else {
-                g->next[i] = texel_gather(run, m, i, key, g->next_sh ? &g->next_sh[i] : NULL);
+                g->next[i] = texel_gather(run, m, i, key, g->next_sh ? &g->next_sh[i] : NULL,
+                                          g->next_var ? &g->next_var[i] : NULL);
             }
         }
         lx_tile_walk_done(&w, global, count);
@@ -452,7 +466,9 @@ static lx_status tile_begin(gi_run *run, uint32_t t, bool from_valid)
         g->next = malloc(sizeof(lx_vec3) * used);
         g->invalid = malloc(used);
         g->next_sh = map->sh ? malloc(sizeof(lx_sh4) * used) : NULL;
-        if (!g->next || !g->invalid || (map->sh && !g->next_sh)) {
+        g->next_var = map->gi_variance ? malloc(sizeof(float) * used) : NULL;
+        if (!g->next || !g->invalid || (map->sh && !g->next_sh) ||
+            (map->gi_variance && !g->next_var)) {
             st = lx_fail(LX_ERR_NOMEM, "lightmap '%s': out of memory for global illumination",
                          map->name);
             break;
@@ -471,9 +487,11 @@ static void tile_end(gi_run *run, uint32_t t)
         free(g->next);
         free(g->invalid);
         free(g->next_sh);
+        free(g->next_var);
         g->next = NULL;
         g->invalid = NULL;
         g->next_sh = NULL;
+        g->next_var = NULL;
     }
 }
 
@@ -506,6 +524,8 @@ static void add_bounce(lx_lightmap *map, const gi_map *g)
             for (int c = 0; c < LX_SH_FLOATS; c++)
                 q[c] += g->next_sh[i].c[c];
         }
+        if (g->next_var)
+            map->gi_variance[p] += g->next_var[i];
     }
 }
 
@@ -563,7 +583,12 @@ lx_status lx_bake_indirect(lx_baker *b, float progress_base, float progress_span
         g->valid = malloc(pixels);
         g->source = malloc(sizeof(float) * 3 * pixels);
         g->source_next = b->desc.bounces > 1 ? malloc(sizeof(float) * 3 * pixels) : NULL;
-        if (!g->valid || !g->source || (b->desc.bounces > 1 && !g->source_next))
+        /* the variance the denoiser is guided by, summed over the bounces */
+        free(b->maps[m].gi_variance);
+        b->maps[m].gi_variance =
+            b->desc.denoise == LX_DENOISE_INDIRECT ? calloc(pixels + 1, sizeof(float)) : NULL;
+        if (!g->valid || !g->source || (b->desc.bounces > 1 && !g->source_next) ||
+            (b->desc.denoise == LX_DENOISE_INDIRECT && !b->maps[m].gi_variance))
             st = lx_fail(LX_ERR_NOMEM, "lightmap '%s': out of memory for global illumination",
                          map->name);
         run.sources[m].valid = g->valid;
@@ -636,6 +661,7 @@ lx_status lx_bake_indirect(lx_baker *b, float progress_base, float progress_span
         free(run.maps[m].next);
         free(run.maps[m].invalid);
         free(run.maps[m].next_sh);
+        free(run.maps[m].next_var);
     }
     free(run.maps);
     free(run.sources);
