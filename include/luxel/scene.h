@@ -283,7 +283,10 @@ lx_scene_load_desc lx_scene_load_desc_defaults(const lx_scene_load_desc *desc);
  * not read (extras, extensions) are ignored.
  * glTF extensions: KHR_mesh_quantization, EXT_meshopt_compression (decoded
  * by luxel before assimp reads the file), KHR_texture_transform,
- * KHR_materials_emissive_strength and KHR_lights_punctual are read; a file
+ * KHR_materials_emissive_strength, KHR_materials_unlit and
+ * KHR_lights_punctual are read; nodes' luxel_* extras set their bake
+ * settings (lx_node.bake; a bad value fails the load naming the node and
+ * the key) and sky domes are marked (lx_scene_mark_sky_domes); a file
  * whose extensionsRequired names any other fails with LX_ERR_UNSUPPORTED
  * naming it. A scene, buffer or texture that is a Git LFS pointer is named
  * as one. Triangles of zero area in space are dropped with one warning per
@@ -343,8 +346,10 @@ uint32_t lx_scene_mark_sky_domes(lx_scene *scene);
 /* Reads a lights JSON file (docs/lights-json.md) and applies it: its
  * "ambient" sets scene->ambient, each light is added or overrides the scene
  * light of the same name (an override starts from that light and changes
- * only the keys given). All or nothing: on failure, naming the file and the
- * field, the scene is unchanged. */
+ * only the keys given), its "nodes" entries (by name or glob) change the
+ * matching nodes' bake settings (lx_node.bake; a pattern matching no node
+ * is one warning through lx_log). All or nothing: on failure, naming the
+ * file and the field, the scene is unchanged. */
 lx_status lx_lights_json_apply(lx_scene *scene, const char *path);
 /* Same from text already in memory; name is used in messages. */
 lx_status lx_lights_json_apply_text(lx_scene *scene, const char *text, size_t size,
