@@ -54,12 +54,17 @@ static bool matches(const char *pattern, const char *name)
     return strcmp(pattern, name) == 0 || fnmatch(pattern, name, 0) == 0;
 }
 
+/* Entries a section may have (each is checked against the ones before it
+ * for repeats), and entries times nodes matched: a 64 MiB file of
+ * patterns over a large level would otherwise run for hours. */
+#define MAX_ENTRIES 4096u
+#define MAX_MATCHES 100000000ull
+
 struct lx_lj_nodes {
-    lx_node_settings *entries; /* per entry of the section, in file order */
-    char **unmatched;          /* patterns that matched no node (copies) */
-    uint32_t entry_count, unmatched_count;
-    uint32_t *first, *node_entries; /* per scene node: its entries, CSR */
+    lx_node_bake *bake; /* per scene node: its settings once the file applies */
     uint32_t node_count;
+    char **unmatched; /* patterns that matched no node (copies) */
+    uint32_t unmatched_count;
     char *scene_name, *file; /* for the warning */
 };
 
@@ -70,9 +75,7 @@ void lx_lj_nodes_free(lx_lj_nodes *p)
     for (uint32_t k = 0; k < p->unmatched_count; k++)
         free(p->unmatched[k]);
     free(p->unmatched);
-    free(p->entries);
-    free(p->first);
-    free(p->node_entries);
+    free(p->bake);
     free(p->scene_name);
     free(p->file);
     free(p);
@@ -84,35 +87,39 @@ lx_status lx_lj_nodes_read(lx_jf_ctx *c, const cJSON *obj, const lx_scene *scene
     snprintf(c->where, sizeof c->where, "nodes");
     if (!cJSON_IsObject(obj))
         return lx_jf_fail(c, LX_ERR_FORMAT, "must be an object of node names or patterns");
-    uint32_t count = 0;
+    uint64_t count = 0;
     for (const cJSON *e = obj->child; e; e = e->next)
         count++;
     uint32_t nn = scene->node_count;
+    if (count > MAX_ENTRIES)
+        return lx_jf_fail(c, LX_ERR_INVALID, "%llu entries are more than the %u allowed",
+                          (unsigned long long)count, MAX_ENTRIES);
+    if (count * (nn ? nn : 1) > MAX_MATCHES)
+        return lx_jf_fail(c, LX_ERR_INVALID,
+                          "%llu entries over %u nodes are more than the %llu matches allowed",
+                          (unsigned long long)count, nn, MAX_MATCHES);
     lx_lj_nodes *p = calloc(1, sizeof *p);
     if (p) {
-        p->entries = calloc((size_t)count + 1, sizeof *p->entries);
+        p->bake = calloc((size_t)nn + 1, sizeof *p->bake);
         p->unmatched = calloc((size_t)count + 1, sizeof *p->unmatched);
-        p->first = calloc((size_t)nn + 1, sizeof *p->first);
         p->scene_name = lx_strdup(scene->path ? scene->path : "the scene");
         p->file = lx_strdup(c->file);
     }
-    if (!p || !p->entries || !p->unmatched || !p->first || !p->scene_name || !p->file) {
+    if (!p || !p->bake || !p->unmatched || !p->scene_name || !p->file) {
         lx_lj_nodes_free(p);
         return lx_jf_fail(c, LX_ERR_NOMEM, "out of memory");
     }
     p->node_count = nn;
-    p->entry_count = count;
-    uint32_t k = 0;
-    uint64_t pairs = 0;
+    for (uint32_t n = 0; n < nn; n++)
+        p->bake[n] = scene->nodes[n].bake;
+    /* entries in file order, each over the nodes it matches */
     lx_status st = LX_OK;
-    for (const cJSON *e = obj->child; e && st == LX_OK; e = e->next, k++) {
+    for (const cJSON *e = obj->child; e && st == LX_OK; e = e->next) {
         const char *pattern = e->string ? e->string : "";
         snprintf(c->where, sizeof c->where, "nodes");
-        for (const cJSON *q = obj->child; q != e; q = q->next)
-            if (strcmp(q->string, pattern) == 0) {
+        for (const cJSON *q = obj->child; q != e && st == LX_OK; q = q->next)
+            if (strcmp(q->string, pattern) == 0)
                 st = lx_jf_fail(c, LX_ERR_FORMAT, "'%.60s' appears twice", pattern);
-                break;
-            }
         if (st != LX_OK)
             break;
         if (!pattern[0]) {
@@ -120,43 +127,17 @@ lx_status lx_lj_nodes_read(lx_jf_ctx *c, const cJSON *obj, const lx_scene *scene
             break;
         }
         snprintf(c->where, sizeof c->where, "nodes ('%.60s')", pattern);
-        p->entries[k] = lx_node_settings_none();
-        if ((st = read_entry(c, e, &p->entries[k])) != LX_OK)
+        lx_node_settings settings = lx_node_settings_none();
+        if ((st = read_entry(c, e, &settings)) != LX_OK)
             break;
-        uint32_t hits = 0;
+        bool hit = false;
         for (uint32_t n = 0; n < nn; n++)
             if (matches(pattern, scene->nodes[n].name)) {
-                p->first[n]++;
-                hits++;
+                lx_node_settings_apply(&settings, &p->bake[n]);
+                hit = true;
             }
-        pairs += hits;
-        if (!hits && !(p->unmatched[p->unmatched_count++] = lx_strdup(pattern)))
+        if (!hit && !(p->unmatched[p->unmatched_count++] = lx_strdup(pattern)))
             st = lx_jf_fail(c, LX_ERR_NOMEM, "out of memory");
-    }
-    /* per node, the entries that match it, in file order */
-    if (st == LX_OK) {
-        p->node_entries = malloc(sizeof(uint32_t) * (size_t)(pairs + 1));
-        if (!p->node_entries)
-            st = lx_jf_fail(c, LX_ERR_NOMEM, "out of memory");
-    }
-    if (st == LX_OK) {
-        uint32_t run = 0;
-        for (uint32_t n = 0; n <= nn; n++) {
-            uint32_t here = n < nn ? p->first[n] : 0;
-            p->first[n] = run;
-            run += here;
-        }
-        uint32_t *fill = calloc((size_t)nn + 1, sizeof *fill);
-        if (!fill) {
-            st = lx_jf_fail(c, LX_ERR_NOMEM, "out of memory");
-        } else {
-            k = 0;
-            for (const cJSON *e = obj->child; e; e = e->next, k++)
-                for (uint32_t n = 0; n < nn; n++)
-                    if (matches(e->string, scene->nodes[n].name))
-                        p->node_entries[p->first[n] + fill[n]++] = k;
-            free(fill);
-        }
     }
     if (st != LX_OK) {
         lx_lj_nodes_free(p);
@@ -171,8 +152,7 @@ void lx_lj_nodes_apply(const lx_lj_nodes *p, lx_scene *scene)
     if (!p)
         return;
     for (uint32_t n = 0; n < p->node_count && n < scene->node_count; n++)
-        for (uint32_t i = p->first[n]; i < p->first[n + 1]; i++)
-            lx_node_settings_apply(&p->entries[p->node_entries[i]], &scene->nodes[n].bake);
+        scene->nodes[n].bake = p->bake[n];
     if (p->unmatched_count) {
         char more[64] = "";
         if (p->unmatched_count > 1)

@@ -27,6 +27,7 @@
 
 #include <limits.h>
 #include <stdio.h>
+#include <stdlib.h>
 #include <string.h>
 
 /* An axis-aligned box [lo, hi] as a glTF mesh with material mat. */
@@ -219,6 +220,19 @@ static void test_json_nodes(void **state)
         {"{\"nodes\": {\"Floor\": {\"lightmap\": false}}, \"ambient\": [1, 2]}",
          "l.json: ambient must be an array of 3 numbers, not 2", LX_ERR_FORMAT},
     };
+    /* more entries than a section may have (each is checked against the
+     * ones before it) */
+    size_t cap = 4097 * 24 + 64, len = 0;
+    char *many = malloc(cap);
+    assert_non_null(many);
+    len += (size_t)snprintf(many + len, cap - len, "{\"nodes\": {");
+    for (int k = 0; k < 4097; k++)
+        len += (size_t)snprintf(many + len, cap - len, "%s\"n%d\": {}", k ? ", " : "", k);
+    len += (size_t)snprintf(many + len, cap - len, "}}");
+    assert_int_equal(lx_lights_json_apply_text(s, many, len, "l.json"), LX_ERR_INVALID);
+    assert_string_equal(lx_last_error(),
+                        "l.json: nodes: 4097 entries are more than the 4096 allowed");
+    free(many);
     for (size_t i = 0; i < sizeof cases / sizeof cases[0]; i++) {
         st = lx_lights_json_apply_text(s, cases[i].json, strlen(cases[i].json), "l.json");
         if (st != cases[i].status || strcmp(lx_last_error(), cases[i].message) != 0)
