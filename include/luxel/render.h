@@ -140,6 +140,8 @@ typedef struct lx_lightmap_node {
     int uv_set;            /* n = TEXCOORD_n, below LX_MAX_UV_SETS */
     bool generated;        /* luxel made the UVs ("uvs": "generated") */
     float scale_offset[4]; /* node UV -> page UV */
+    float lightmap_scale;  /* the node's lightmap scale in the bake (lx_node.bake;
+                              1 when absent) */
 } lx_lightmap_node;
 
 typedef struct lx_lightmaps {
@@ -165,6 +167,10 @@ typedef struct lx_lightmaps {
     uint32_t page_count;
     lx_lightmap_node *nodes;
     uint32_t node_count;
+    char **unbaked; /* "nodes_without_lightmap": the nodes the bake gave
+                       none by their settings (lx_node.bake.no_lightmap,
+                       sky domes), by name */
+    uint32_t unbaked_count;
 } lx_lightmaps;
 
 typedef struct lx_lightmaps_load_desc {
@@ -189,10 +195,19 @@ void lx_lightmaps_free(lx_lightmaps *lm);
 
 /* LX_OK when lm fits scene: every manifest node is a scene node with as
  * many meshes, each with the UV set named; and the scene nodes the
- * manifest leaves out have no UVs in any set (they could not be baked).
- * Else LX_ERR_INVALID: "lightmaps/room/manifest.json: node 'floor' is not
- * in scene.glb: the lightmaps of another scene?". */
+ * manifest leaves out have no UVs in any set (they could not be baked),
+ * or no lightmap by their settings (bake.no_lightmap, or named in
+ * lm->unbaked). Else LX_ERR_INVALID: "lightmaps/room/manifest.json: node
+ * 'floor' is not in scene.glb: the lightmaps of another scene?". */
 lx_status lx_lightmaps_check(const lx_lightmaps *lm, const lx_scene *scene);
+
+/* Gives the scene's nodes the bake settings the bake had where lm records
+ * them (settings from a lights JSON the scene file does not carry):
+ * bake.no_lightmap for the nodes lm->unbaked names, so the default camera
+ * leaves them out as the bake did, and each lightmap node's
+ * lightmap_scale, so UVs made again pack as the bake's did. Names the
+ * scene lacks are left alone. */
+void lx_lightmaps_apply_settings(const lx_lightmaps *lm, lx_scene *scene);
 
 /* ---- the default camera ---------------------------------------------- */
 
@@ -210,9 +225,12 @@ typedef struct lx_camera_auto_info {
 } lx_camera_auto_info;
 
 /* The default camera of a scene that brings none. Starts from
- * lx_camera_frame(..., LX_VIEW_ISO, ...) of the bounds and probes it with a
+ * lx_camera_frame(..., LX_VIEW_ISO, ...) of the bounds of the nodes that
+ * get a lightmap and are not sky domes (lx_node.bake; the scene's bounds
+ * when there are none) and probes it with a
  * grid of 18 rows of rays (as many columns as the aspect asks, at most
- * 64) through tracer (made from scene): a probe scores when the first
+ * 64) through tracer (made from scene; the probes are LX_RAY_FRAMING
+ * rays, which pass through the nodes left out): a probe scores when the first
  * surface it meets, either face, is a front face that is lit - lit judged
  * with lm by a 1-sample render of the same grid (luminance above 1% of
  * the brightest probed view's median); lm NULL, or every view black:
@@ -278,7 +296,8 @@ lx_render_desc lx_render_desc_defaults(const lx_render_desc *desc);
  * before. tracer may be NULL (one is built and destroyed
  * here), else it must have been made from scene. Checks lm against the
  * scene first (lx_lightmaps_check), and lm must have its images loaded.
- * Scene nodes without a lightmap are drawn black. On failure out is
+ * Scene nodes without a lightmap are drawn black; sky domes
+ * (lx_node.bake.sky) are not drawn (camera rays pass through them). On failure out is
  * zeroed. desc may be NULL. */
 lx_status lx_render_view(const lx_scene *scene, const lx_lightmaps *lm, const lx_tracer *tracer,
                          const lx_render_desc *desc, lx_image *out);

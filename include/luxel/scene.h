@@ -144,7 +144,41 @@ typedef struct lx_material {
     bool height_green_down;   /* that normal map's y points down the image (DirectX) */
     bool height_horizon;   /* direct light times the horizon factor */
     bool height_ao;        /* ambient and sky light times the AO map */
+    /* KHR_materials_unlit: the file means it drawn as its base colour, not
+     * lit (a sky dome, a backdrop). The bake still lights it; a node whose
+     * every material is unlit and that encloses the scene is a sky dome
+     * (lx_scene_mark_sky_domes). */
+    bool unlit;
 } lx_material;
+
+/* How a bake treats a node: what Unity's Cast Shadows, Receive GI,
+ * Contribute GI and Scale In Lightmap, Bakery's per-object settings and
+ * Godot's GI mode set. Zero is the default (the node casts shadows, gets
+ * a lightmap, takes part in bounces, at the scene's texel density), so a
+ * node lx_scene_add_node adds bakes as every node did before these
+ * existed. lx_scene_load reads them from glTF node extras (luxel_*: see
+ * docs/bake.md, "Per-node bake control") and marks sky domes; the lights
+ * JSON's "nodes" section (lx_lights_json_apply) overrides both. */
+typedef struct lx_node_bake {
+    bool no_cast_shadows;  /* invisible to shadow rays: lights, sky, AO, emitters */
+    bool no_lightmap;      /* no lightmap: needs no UVs, gets no texels, no page */
+    bool no_contribute_gi; /* bounces pass through it: it reflects and emits
+                              nothing into other texels, and does not make
+                              texels that see its back faces invalid */
+    float lightmap_scale;  /* texel-density multiplier of its lightmap (or, at a
+                              fixed resolution, of its side), > 0; 0 = 1 */
+    bool sky;              /* a sky dome (lx_scene_mark_sky_domes, or marked):
+                              left out of lx_scene_bounds, the default camera,
+                              the CLI's default texel density and camera rays.
+                              The three no_* flags are what bakes it: marking
+                              sets them, and settings given later change them */
+} lx_node_bake;
+
+/* lightmap_scale with its default applied. */
+static inline float lx_node_lightmap_scale(const lx_node_bake *b)
+{
+    return b->lightmap_scale > 0.0f ? b->lightmap_scale : 1.0f;
+}
 
 typedef struct lx_node {
     char *name;       /* unique within the scene */
@@ -153,6 +187,7 @@ typedef struct lx_node {
     uint32_t mesh_count;
     int32_t source_node; /* the glTF node index, -1 when not glTF, not matched
                           * or added with lx_scene_add_node */
+    lx_node_bake bake;   /* zero (the default) from lx_scene_add_node */
 } lx_node;
 
 #define LX_MAX_SKY_SAMPLES 65536u
@@ -248,7 +283,10 @@ lx_scene_load_desc lx_scene_load_desc_defaults(const lx_scene_load_desc *desc);
  * not read (extras, extensions) are ignored.
  * glTF extensions: KHR_mesh_quantization, EXT_meshopt_compression (decoded
  * by luxel before assimp reads the file), KHR_texture_transform,
- * KHR_materials_emissive_strength and KHR_lights_punctual are read; a file
+ * KHR_materials_emissive_strength, KHR_materials_unlit and
+ * KHR_lights_punctual are read; nodes' luxel_* extras set their bake
+ * settings (lx_node.bake; a bad value fails the load naming the node and
+ * the key) and sky domes are marked (lx_scene_mark_sky_domes); a file
  * whose extensionsRequired names any other fails with LX_ERR_UNSUPPORTED
  * naming it. A scene, buffer or texture that is a Git LFS pointer is named
  * as one. Triangles of zero area in space are dropped with one warning per
@@ -290,14 +328,28 @@ lx_status lx_scene_add_camera(lx_scene *scene, const lx_scene_camera *camera);
  * cannot be trusted). */
 bool lx_triangle_degenerate(lx_vec3 a, lx_vec3 b, lx_vec3 c);
 
-/* World-space bounds of every node's meshes. false when empty. */
+/* World-space bounds of every node's meshes but sky domes (bake.sky),
+ * or of every node's when all are sky domes. false when empty. */
 bool lx_scene_bounds(const lx_scene *scene, lx_vec3 *lo, lx_vec3 *hi);
+
+/* Sky domes: a node whose every material is unlit (lx_material.unlit,
+ * KHR_materials_unlit) and whose world bounds contain the bounds of every
+ * node that is neither unlit nor already a sky, with a diagonal at least
+ * LX_SKY_DOME_RATIO times theirs. Each such node gets bake.sky and the
+ * three no_* flags (it casts no shadows, gets no lightmap and takes no part
+ * in bounces), and one warning through lx_log names it (the first, and how
+ * many more). lx_scene_load calls this after reading node extras, leaving
+ * alone a node whose extras say luxel_sky. Returns the nodes marked. */
+#define LX_SKY_DOME_RATIO 4.0f
+uint32_t lx_scene_mark_sky_domes(lx_scene *scene);
 
 /* Reads a lights JSON file (docs/lights-json.md) and applies it: its
  * "ambient" sets scene->ambient, each light is added or overrides the scene
  * light of the same name (an override starts from that light and changes
- * only the keys given). All or nothing: on failure, naming the file and the
- * field, the scene is unchanged. */
+ * only the keys given), its "nodes" entries (by name or glob) change the
+ * matching nodes' bake settings (lx_node.bake; a pattern matching no node
+ * is one warning through lx_log). All or nothing: on failure, naming the
+ * file and the field, the scene is unchanged. */
 lx_status lx_lights_json_apply(lx_scene *scene, const char *path);
 /* Same from text already in memory; name is used in messages. */
 lx_status lx_lights_json_apply_text(lx_scene *scene, const char *text, size_t size,

@@ -4,7 +4,9 @@
  *
  * CONVENTIONS  World space, metres. A ray covers origin + t*dir for t in
  *   [tmin, tmax]; dir need not be unit length (t is then in units of |dir|).
- *   Both faces of every triangle block rays.
+ *   Both faces of every triangle block rays. Which nodes a ray meets
+ *   depends on its kind (lx_ray_kind) and the nodes' bake settings, read
+ *   at lx_tracer_create.
  * ERRORS  lx_tracer_create fails with LX_ERR_NOMEM or LX_ERR_INVALID (an
  *   Embree error, named). Queries cannot fail.
  * MEMORY  The tracer copies the geometry it needs; the scene may be freed
@@ -72,6 +74,22 @@ typedef struct lx_hit {
                           dot(dir, normal) > 0 hit its back face */
 } lx_hit;
 
+/* Kinds of rays: which nodes a ray meets, by their bake settings
+ * (lx_node.bake, scene.h). The occlusion queries (lx_tracer_occluded*) and
+ * lx_tracer_nearest_distance are shadow rays; lx_tracer_closest meets
+ * every node; lx_tracer_closest_kind takes the kind. */
+typedef enum lx_ray_kind {
+    LX_RAY_ANY = 0, /* every node */
+    LX_RAY_SHADOW,  /* nodes that cast shadows (bake.no_cast_shadows false):
+                       the visibility of lights, the sky, AO and emitters */
+    LX_RAY_GATHER,  /* nodes that take part in bounces (no_contribute_gi false) */
+    LX_RAY_SURFACE, /* nodes that cast shadows or take part in bounces: what
+                       light meets (samples moved out of geometry) */
+    LX_RAY_CAMERA,  /* every node but sky domes (bake.sky): what a view shows */
+    LX_RAY_FRAMING  /* nodes that get a lightmap and are not sky domes: what
+                       the default camera frames */
+} lx_ray_kind;
+
 typedef struct lx_tracer_desc {
     int threads;             /* Embree's BVH-build threads, 0 = all cores */
     lx_progress_fn progress; /* hears the BVH build (fraction built); may be NULL;
@@ -93,7 +111,9 @@ lx_status lx_tracer_set_node_transform(lx_tracer *tracer, uint32_t node, const l
  * triangles). */
 lx_status lx_tracer_commit(lx_tracer *tracer);
 
-/* True when anything blocks the ray within [tmin, tmax]. */
+/* True when a node that casts shadows blocks the ray within [tmin, tmax]
+ * (every node does unless its bake.no_cast_shadows). The batch and packet
+ * queries below are shadow rays too. */
 bool lx_tracer_occluded(const lx_tracer *tracer, const lx_ray *ray);
 
 /* Occlusion for count rays in one call; coherent hints that neighbouring
@@ -138,11 +158,14 @@ typedef struct lx_ray_packet {
  * in any lane and any packet. */
 uint32_t lx_tracer_occluded_packet(const lx_tracer *tracer, lx_ray_packet *packet, uint32_t active);
 
-/* Nearest hit within [tmin, tmax]; false when none. */
+/* Nearest hit within [tmin, tmax] on any node; false when none. */
 bool lx_tracer_closest(const lx_tracer *tracer, const lx_ray *ray, lx_hit *hit);
+/* The same on the nodes a ray of `kind` meets. */
+bool lx_tracer_closest_kind(const lx_tracer *tracer, const lx_ray *ray, lx_ray_kind kind,
+                            lx_hit *hit);
 
-/* Nearest hit from the origin, t only; INFINITY when none. Cheaper than
- * lx_tracer_closest when only the distance matters. */
+/* Nearest hit from the origin on a node that casts shadows (the distance
+ * to the occluder blurred shadows use), t only; INFINITY when none. */
 float lx_tracer_nearest_distance(const lx_tracer *tracer, const lx_ray *ray);
 
 #ifdef __cplusplus

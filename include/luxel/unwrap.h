@@ -297,7 +297,8 @@ typedef struct lx_uv_share {
  * which must hold scene->node_count entries (out[n] for node n).
  * uv_sets[n] is node n's set, below LX_MAX_UV_SETS (NULL: lx_bake_uv_set's
  * automatic choice, as lx_unwrap_desc.keep_uv_sets). desc may be NULL.
- * Nodes without meshes are not counted. LX_ERR_INVALID for a bad set or
+ * Nodes without meshes or a lightmap (bake.no_lightmap) are not counted.
+ * LX_ERR_INVALID for a bad set or
  * option, LX_ERR_NOMEM. Reads each mesh's UVs once; thread-safe. */
 lx_status lx_uv_share_nodes(const lx_scene *scene, const int *uv_sets,
                             const lx_uv_share_desc *desc, lx_uv_share *out);

@@ -556,9 +556,12 @@ lx_status lx_bake_scene_copy(const lx_scene *s, lx_scene **out)
         if (st == LX_OK && from->normals)
             memcpy(c->meshes[k].normals, from->normals, sizeof(lx_vec3) * from->vertex_count);
     }
-    for (uint32_t k = 0; k < s->node_count && st == LX_OK; k++)
+    for (uint32_t k = 0; k < s->node_count && st == LX_OK; k++) {
         st = lx_scene_add_node(c, s->nodes[k].name, &s->nodes[k].world, s->nodes[k].meshes,
                                s->nodes[k].mesh_count, NULL);
+        if (st == LX_OK)
+            c->nodes[k].bake = s->nodes[k].bake;
+    }
     if (st != LX_OK) {
         lx_scene_destroy(c);
         char what[300];

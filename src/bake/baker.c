@@ -239,6 +239,8 @@ static lx_status build_node_maps(lx_baker *b, const lx_scene *scene, const lx_ba
     uint32_t count = 0;
     lx_status st = LX_OK;
     for (uint32_t n = 0; n < scene->node_count && st == LX_OK; n++) {
+        if (scene->nodes[n].bake.no_lightmap)
+            continue; /* baked for its shadows and bounces only */
         int w, h;
         lx_texel_map_size(scene, n, desc, &w, &h);
         lx_tile_candidate *k = &c[count++];
@@ -297,7 +299,7 @@ static lx_status build_pages(lx_baker *b, const lx_scene *scene, const lx_bake_d
         }
         for (uint32_t n = 0; n < scene->node_count; n++) {
             const lx_unwrap_node *un = &atlas->nodes[n];
-            if (un->page != p)
+            if (un->page != p || scene->nodes[n].bake.no_lightmap)
                 continue;
             lx_page_node *pn = &k->page.nodes[k->page.node_count++];
             pn->node = n;

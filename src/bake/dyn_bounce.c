@@ -142,7 +142,8 @@ static lx_status dyn_build(lx_baker *b)
                 out[k].fx = out[k].fy = 0.0f;
                 if (!lx_gather_ray(&f, k, d->sx, d->sy, DYN_KEY, &ray))
                     continue;
-                if (!lx_tracer_closest(b->tracer, &ray, &h) || !(lx_dot(ray.dir, h.normal) < 0.0f))
+                if (!lx_tracer_closest_kind(b->tracer, &ray, LX_RAY_GATHER, &h) ||
+                    !(lx_dot(ray.dir, h.normal) < 0.0f))
                     continue;
                 uint32_t mi;
                 float fx, fy;

@@ -92,7 +92,9 @@ lx_status lx_gi_prepare(lx_baker *b, const lx_scene *scene, bool emitters_only)
         for (uint32_t n = 0; n < scene->node_count; n++)
             for (uint32_t k = 0; k < scene->nodes[n].mesh_count; k++) {
                 uint32_t mi = scene->nodes[n].meshes[k];
-                if (mi >= scene->mesh_count || !b->mesh_positions[mi])
+                /* a node out of the bounces emits nothing into them */
+                if (mi >= scene->mesh_count || !b->mesh_positions[mi] ||
+                    scene->nodes[n].bake.no_contribute_gi)
                     continue;
                 if (pass)
                     b->emitters[count] = (lx_emitter_instance){n, mi};
@@ -287,7 +289,8 @@ bool lx_gi_texel_inside(const lx_baker *b, uint32_t map_index, uint32_t i)
         lx_hit h;
         if (!lx_gather_ray(&f, k, sx, sy, VALIDITY_KEY, &ray))
             continue;
-        if (lx_tracer_closest(b->tracer, &ray, &h) && lx_dot(ray.dir, h.normal) > 0.0f)
+        if (lx_tracer_closest_kind(b->tracer, &ray, LX_RAY_GATHER, &h) &&
+            lx_dot(ray.dir, h.normal) > 0.0f)
             back++;
     }
     return 2 * back > cells;
@@ -312,7 +315,8 @@ static lx_vec3 texel_gather(const gi_run *run, uint32_t map_index, uint32_t i, u
         lx_hit h;
         if (!lx_gather_ray(&f, k, sx, sy, key, &ray))
             continue;
-        if (!lx_tracer_closest(b->tracer, &ray, &h) || !(lx_dot(ray.dir, h.normal) < 0.0f))
+        if (!lx_tracer_closest_kind(b->tracer, &ray, LX_RAY_GATHER, &h) ||
+            !(lx_dot(ray.dir, h.normal) < 0.0f))
             continue; /* escaped (sky: direct light), or a back face */
         /* emission is direct light (emitters.c), not picked up here */
         lx_vec3 l = lx_hit_radiance(b, run->sources, false, &h);

@@ -216,7 +216,7 @@ static void probe_one(const probe_run *run, uint32_t index, lx_vec3 p, lx_probe 
         lx_ray ray = {.origin = p, .dir = d, .tmin = 0.0f, .tmax = INFINITY};
         lx_hit h;
         lx_vec3 l;
-        if (lx_tracer_closest(b->tracer, &ray, &h)) {
+        if (lx_tracer_closest_kind(b->tracer, &ray, LX_RAY_GATHER, &h)) {
             if (!(lx_dot(d, h.normal) < 0.0f)) {
                 back++;
                 continue;

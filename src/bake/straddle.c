@@ -46,7 +46,7 @@ static int first_hit(const lx_tracer *tr, lx_vec3 p, lx_vec3 ng, float lift, lx_
 {
     lx_ray ray = {.origin = lx_madd(p, ng, lift), .dir = d, .tmin = 0.0f, .tmax = reach};
     lx_hit hit;
-    if (!lx_tracer_closest(tr, &ray, &hit))
+    if (!lx_tracer_closest_kind(tr, &ray, LX_RAY_SURFACE, &hit))
         return 0;
     *t = hit.t;
     return lx_dot(d, hit.normal) > 0.0f ? -1 : 1;

@@ -343,7 +343,19 @@ done:
     return st;
 }
 
-/* Lightmap size for texel density: R^2 * uv_area = T^2 * world_area. */
+/* A node's side at a fixed resolution: the resolution times its
+ * lightmap scale (a multiple of 4 when scaled, 4..LX_MAX_LIGHTMAP_SIZE). */
+static int scaled_resolution(const lx_node *node, const lx_bake_desc *desc)
+{
+    float scale = lx_node_lightmap_scale(&node->bake);
+    if (scale == 1.0f)
+        return desc->resolution;
+    double r = ceil((double)desc->resolution * scale / 4.0) * 4.0;
+    return r < 4.0 ? 4 : r > LX_MAX_LIGHTMAP_SIZE ? LX_MAX_LIGHTMAP_SIZE : (int)r;
+}
+
+/* Lightmap size for texel density: R^2 * uv_area = (T s)^2 * world_area,
+ * s the node's lightmap scale. */
 static int size_from_density(const lx_scene *scene, const lx_node *node, const slot *slots,
                              uint32_t slot_count, const lx_bake_desc *desc, bool warn)
 {
@@ -363,13 +375,15 @@ static int size_from_density(const lx_scene *scene, const lx_node *node, const s
     }
     if (!(uv_area > 0))
         return 4;
-    double r = desc->texel_density * sqrt(world_area / uv_area);
+    double r =
+        desc->texel_density * lx_node_lightmap_scale(&node->bake) * sqrt(world_area / uv_area);
     /* compare in double: a huge (or infinite) size must cap, not wrap */
     if (!(r <= desc->max_resolution)) {
         if (warn)
             lx_log(LX_LOG_WARN,
                    "%s: node '%s': %.0f texels per side needed for %.3g texels/m; capped at %d",
-                   scene->path, node->name, r, desc->texel_density, desc->max_resolution);
+                   scene->path, node->name, r,
+                   desc->texel_density * lx_node_lightmap_scale(&node->bake), desc->max_resolution);
         return desc->max_resolution;
     }
     int size = (int)(ceil(r / 4.0) * 4.0);
@@ -736,7 +750,7 @@ lx_status lx_texel_map_build(const lx_scene *scene, const lx_page_spec *page,
         const lx_node *node = &scene->nodes[page->nodes[0].node];
         w = h = desc->texel_density > 0
                     ? size_from_density(scene, node, slots, slot_count, desc, true)
-                    : desc->resolution;
+                    : scaled_resolution(node, desc);
     }
     map->info.width = w;
     map->info.height = h;
@@ -1009,7 +1023,7 @@ void lx_texel_map_size(const lx_scene *scene, uint32_t node_index, const lx_bake
     if (n)
         *width = *height = desc->texel_density > 0
                                ? size_from_density(scene, node, slots, n, desc, false)
-                               : desc->resolution;
+                               : scaled_resolution(node, desc);
     free(slots);
 }
 

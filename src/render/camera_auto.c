@@ -1,5 +1,6 @@
 /* The default camera of a scene with no camera of its own: the iso framing
- * of its bounds (camera.c), checked by what it sees. A grid of probe rays
+ * of its bounds (camera.c; the nodes with a lightmap, sky domes left out),
+ * checked by what it sees. A grid of probe rays
  * through the view finds the first surface along each (both faces); with
  * the bake's lightmaps, a small render of the same view (one sample a
  * pixel on the same grid) tells which of those surfaces are lit. A probe
@@ -77,7 +78,7 @@ static lx_status probe(const lx_scene *scene, const lx_lightmaps *lm, const lx_t
             lx_ray r = {.origin = b.eye, .tmin = 0.0f, .dir = d, .tmax = INFINITY};
             lx_hit h;
             unsigned char *k = &v->kind[j * nx + i];
-            if (!lx_tracer_closest(tracer, &r, &h))
+            if (!lx_tracer_closest_kind(tracer, &r, LX_RAY_FRAMING, &h))
                 *k = MISS;
             else if (h.t < near)
                 *k = BLOCKED;
@@ -121,6 +122,33 @@ static float score(const view_probe *v, bool use_light, double lit, float *of_hi
     return (float)n / (float)count;
 }
 
+/* The bounds the default camera frames: the nodes that get a lightmap
+ * and are not sky domes (what a bake lights), else the scene's. */
+static bool framed_bounds(const lx_scene *scene, lx_vec3 *lo, lx_vec3 *hi)
+{
+    bool any = false;
+    lx_vec3 a = lx_v3(INFINITY, INFINITY, INFINITY), b = lx_v3(-INFINITY, -INFINITY, -INFINITY);
+    for (uint32_t n = 0; n < scene->node_count; n++) {
+        const lx_node *node = &scene->nodes[n];
+        if (node->bake.sky || node->bake.no_lightmap)
+            continue;
+        for (uint32_t k = 0; k < node->mesh_count; k++) {
+            const lx_mesh *m = &scene->meshes[node->meshes[k]];
+            for (uint32_t v = 0; v < m->vertex_count; v++) {
+                lx_vec3 p = lx_mat4_point(&node->world, m->positions[v]);
+                a = lx_v3(fminf(a.x, p.x), fminf(a.y, p.y), fminf(a.z, p.z));
+                b = lx_v3(fmaxf(b.x, p.x), fmaxf(b.y, p.y), fmaxf(b.z, p.z));
+                any = true;
+            }
+        }
+    }
+    if (!any)
+        return lx_scene_bounds(scene, lo, hi);
+    *lo = a;
+    *hi = b;
+    return true;
+}
+
 lx_status lx_camera_auto(const lx_scene *scene, const lx_lightmaps *lm, const lx_tracer *tracer,
                          float fov, float aspect, lx_camera *out, lx_camera_auto_info *info)
 {
@@ -133,7 +161,7 @@ lx_status lx_camera_auto(const lx_scene *scene, const lx_lightmaps *lm, const lx
         info = &local;
     memset(info, 0, sizeof *info);
     lx_vec3 lo, hi;
-    if (!lx_scene_bounds(scene, &lo, &hi))
+    if (!framed_bounds(scene, &lo, &hi))
         return lx_fail(LX_ERR_INVALID, "%s: the scene is empty: nothing to frame",
                        scene->path ? scene->path : "render");
     if (!(fov > 0.0f && fov < LX_PI))

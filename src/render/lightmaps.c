@@ -33,6 +33,9 @@ void lx_lightmaps_free(lx_lightmaps *lm)
     }
     for (uint32_t i = 0; i < lm->node_count; i++)
         free(lm->nodes[i].name);
+    for (uint32_t i = 0; i < lm->unbaked_count; i++)
+        free(lm->unbaked[i]);
+    free(lm->unbaked);
     free(lm->pages);
     free(lm->nodes);
     free(lm->dir);
@@ -136,6 +139,56 @@ static lx_status parse_pages(const char *file, const char *dir, bool any_path, c
     return LX_OK;
 }
 
+/* "nodes_without_lightmap": optional, an array of node names. */
+static lx_status parse_unbaked(const char *file, const cJSON *root, lx_lightmaps *lm)
+{
+    const cJSON *list = cJSON_GetObjectItemCaseSensitive(root, "nodes_without_lightmap");
+    if (!list)
+        return LX_OK;
+    if (!cJSON_IsArray(list))
+        return lx_fail(LX_ERR_FORMAT, "%s: \"nodes_without_lightmap\" must be an array of names",
+                       file);
+    int n = cJSON_GetArraySize(list);
+    lm->unbaked = calloc((size_t)n + 1, sizeof *lm->unbaked);
+    if (!lm->unbaked)
+        return lx_fail(LX_ERR_NOMEM, "%s: out of memory", file);
+    const cJSON *e;
+    cJSON_ArrayForEach(e, list)
+    {
+        if (!cJSON_IsString(e))
+            return lx_fail(LX_ERR_FORMAT, "%s: nodes_without_lightmap[%u] must be a node's name",
+                           file, lm->unbaked_count);
+        if (!(lm->unbaked[lm->unbaked_count] = lx_strdup(e->valuestring)))
+            return lx_fail(LX_ERR_NOMEM, "%s: out of memory", file);
+        lm->unbaked_count++;
+    }
+    return LX_OK;
+}
+
+static bool is_unbaked(const lx_lightmaps *lm, const char *name)
+{
+    for (uint32_t i = 0; i < lm->unbaked_count; i++)
+        if (strcmp(lm->unbaked[i], name) == 0)
+            return true;
+    return false;
+}
+
+void lx_lightmaps_apply_settings(const lx_lightmaps *lm, lx_scene *scene)
+{
+    if (!lm || !scene)
+        return;
+    for (uint32_t n = 0; n < scene->node_count; n++) {
+        lx_node *node = &scene->nodes[n];
+        if (!node->name)
+            continue;
+        if (is_unbaked(lm, node->name))
+            node->bake.no_lightmap = true;
+        for (uint32_t i = 0; i < lm->node_count; i++)
+            if (strcmp(lm->nodes[i].name, node->name) == 0)
+                node->bake.lightmap_scale = lm->nodes[i].lightmap_scale;
+    }
+}
+
 static lx_status parse_nodes(const char *file, const cJSON *root, lx_lightmaps *lm)
 {
     const cJSON *nodes = cJSON_GetObjectItemCaseSensitive(root, "nodes");
@@ -158,6 +211,7 @@ static lx_status parse_nodes(const char *file, const cJSON *root, lx_lightmaps *
         const cJSON *so = cJSON_GetObjectItemCaseSensitive(e, "scale_offset");
         const cJSON *set = cJSON_GetObjectItemCaseSensitive(e, "uv_set");
         const cJSON *uvs = cJSON_GetObjectItemCaseSensitive(e, "uvs");
+        const cJSON *scale = cJSON_GetObjectItemCaseSensitive(e, "lightmap_scale");
         if (!cJSON_IsString(name))
             return lx_fail(LX_ERR_FORMAT, "%s: nodes[%d]: \"node\" must be the node's name", file,
                            i);
@@ -176,6 +230,15 @@ static lx_status parse_nodes(const char *file, const cJSON *root, lx_lightmaps *
             return lx_fail(LX_ERR_FORMAT, "%s: nodes[%d] ('%s'): \"page\" must index pages (%u)",
                            file, i, ln->name, lm->page_count);
         ln->page = (uint32_t)page->valuedouble;
+        ln->lightmap_scale = 1.0f;
+        if (scale) {
+            double v = cJSON_IsNumber(scale) ? scale->valuedouble : NAN;
+            if (!(v > 0.0) || !isfinite((float)v))
+                return lx_fail(LX_ERR_FORMAT,
+                               "%s: nodes[%d] ('%s'): \"lightmap_scale\" must be a number above 0",
+                               file, i, ln->name);
+            ln->lightmap_scale = (float)v;
+        }
         if (!cJSON_IsArray(so) || cJSON_GetArraySize(so) != 4)
             return lx_fail(LX_ERR_FORMAT,
                            "%s: nodes[%d] ('%s'): \"scale_offset\" must be 4 numbers", file, i,
@@ -296,6 +359,8 @@ static lx_status parse_manifest(const char *file, const char *dir, bool any_path
     lx_status st = parse_pages(file, dir, any_path, root, lm);
     if (st == LX_OK)
         st = parse_nodes(file, root, lm);
+    if (st == LX_OK)
+        st = parse_unbaked(file, root, lm);
     return st;
 }
 
@@ -475,8 +540,10 @@ lx_status lx_lightmaps_bind(const lx_lightmaps *lm, const lx_scene *scene, uint3
         if (map)
             map[n] = e ? e->index : UINT32_MAX;
         if (!e) {
-            /* a node the bake could not map: some mesh lacks a UV set */
-            bool could_skip = node->mesh_count == 0;
+            /* a node the bake could not map (some mesh lacks a UV set),
+             * or gave no lightmap by its settings */
+            bool could_skip =
+                node->mesh_count == 0 || node->bake.no_lightmap || is_unbaked(lm, key);
             for (uint32_t k = 0; k < node->mesh_count; k++) {
                 const lx_mesh *mesh = &scene->meshes[node->meshes[k]];
                 could_skip |= !mesh->uv[0] || !mesh->uv[1];

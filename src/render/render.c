@@ -200,7 +200,7 @@ static lx_vec3 shade(const render_ctx *c, lx_ray r, bool *hit)
     const lx_scene *scene = c->scene;
     for (int pass = 0; pass < MAX_CULLED; pass++) {
         lx_hit h;
-        if (!lx_tracer_closest(c->tracer, &r, &h))
+        if (!lx_tracer_closest_kind(c->tracer, &r, LX_RAY_CAMERA, &h))
             break;
         if (h.node >= scene->node_count || h.mesh >= scene->mesh_count)
             break;
@@ -435,7 +435,8 @@ lx_status lx_render_view_quiet(const lx_scene *scene, const lx_lightmaps *lm,
     uint32_t unlit = 0;
     for (uint32_t n = 0; n < nn; n++) {
         det_sign[n] = lx_mat4_det3(&scene->nodes[n].world) < 0.0f ? -1.0f : 1.0f;
-        unlit += map[n] == UINT32_MAX && scene->nodes[n].mesh_count > 0;
+        unlit += map[n] == UINT32_MAX && scene->nodes[n].mesh_count > 0 &&
+                 !scene->nodes[n].bake.sky; /* not drawn */
     }
     if (st == LX_OK && unlit && !quiet)
         lx_log(LX_LOG_WARN, "%s: %u nodes have no lightmap and are drawn black",

@@ -12,6 +12,7 @@
 #include "core/internal.h"
 
 #include "gltf_json.h"
+#include "node_bake.h"
 #include "import_checks.h"
 #include "json_text.h"
 #include "node_graph.h"
@@ -916,6 +917,25 @@ static uint32_t texcoords_read(const import_ctx *c, const struct aiMaterial *am,
     return sets;
 }
 
+/* KHR_materials_unlit on glTF material i: the file's JSON when the
+ * material is matched to it, else assimp's shading model (its glTF 2.0
+ * reader sets aiShadingMode_Unlit for the extension). Other formats:
+ * never (assimp's "no shading" also stands for OBJ's illum 0). */
+static bool material_unlit(const import_ctx *c, const struct aiMaterial *am, unsigned i)
+{
+    if (!c->gltf)
+        return false;
+    if (c->map && c->map->material_of[i] >= 0 &&
+        (size_t)c->map->material_of[i] < c->map->material_count)
+        return lx_gltf_get(lx_gltf_get(c->map->materials[c->map->material_of[i]], "extensions"),
+                           "KHR_materials_unlit") != NULL;
+    int mode = 0;
+    unsigned max = 1;
+    return aiGetMaterialIntegerArray(am, AI_MATKEY_SHADING_MODEL, &mode, &max) ==
+               aiReturn_SUCCESS &&
+           mode == aiShadingMode_Unlit;
+}
+
 static lx_status material_refs(const import_ctx *c, unsigned i, const char *label, bool has_base,
                                bool has_normal, lx_gltf_texture_ref *base,
                                lx_gltf_texture_ref *normal)
@@ -1014,6 +1034,7 @@ static lx_status import_materials(import_ctx *c)
                 return est;
         }
         m.uv_sets_read = texcoords_read(c, am, i);
+        m.unlit = material_unlit(c, am, i);
         struct aiString tex;
         bool has_normal = aiGetMaterialTexture(am, aiTextureType_NORMALS, 0, &tex, NULL, NULL, NULL,
                                                NULL, NULL, NULL) == aiReturn_SUCCESS;
@@ -1473,6 +1494,18 @@ static lx_status import_scene(const char *path, const import_source *src,
         lx_mat4 root = lx_mat4_identity();
         uint32_t counter = 0;
         st = import_node(&c, ai->mRootNode, &root, 0, &counter);
+    }
+    /* per-node bake settings from the file, then sky domes among the
+     * nodes whose extras do not say */
+    if (st == LX_OK) {
+        bool *decided = calloc(c.scene->node_count + 1, sizeof *decided);
+        if (!decided)
+            st = lx_fail(LX_ERR_NOMEM, "%s: out of memory", path);
+        if (st == LX_OK && c.gltf)
+            st = lx_gltf_node_extras_read(c.scene, path, c.gltf, decided);
+        if (st == LX_OK)
+            lx_scene_mark_sky_domes_except(c.scene, decided);
+        free(decided);
     }
     if (st == LX_OK && gltf)
         st = lx_gltf_lights_from_json(c.scene, path, gltf);

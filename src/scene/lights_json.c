@@ -579,7 +579,7 @@ static lx_status read_light(lx_jf_ctx *c, const cJSON *obj, const name_table *na
 
 /* ---- the file ----------------------------------------------------------- */
 
-static const char *const root_keys[] = {"ambient", "lights", "sky", "materials"};
+static const char *const root_keys[] = {"ambient", "lights", "sky", "materials", "nodes"};
 static const char *const sky_keys[] = {"environment", "intensity", "shadows", "samples"};
 
 /* "sky": {"environment": path relative to the file, "intensity",
@@ -661,6 +661,13 @@ static lx_status apply_root(lx_scene *scene, const cJSON *root, const char *file
         free(sky.environment);
         return st;
     }
+    const cJSON *node_item = cJSON_GetObjectItemCaseSensitive(root, "nodes");
+    lx_lj_nodes *nodes = NULL;
+    if (node_item && (st = lx_lj_nodes_read(&c, node_item, scene, &nodes)) != LX_OK) {
+        free(sky.environment);
+        lx_lj_materials_free(mats);
+        return st;
+    }
     c.where[0] = '\0';
     lx_light *pending = malloc((count ? count : 1) * sizeof *pending);
     name_table names = {0};
@@ -669,6 +676,7 @@ static lx_status apply_root(lx_scene *scene, const cJSON *root, const char *file
         table_free(&names);
         free(sky.environment);
         lx_lj_materials_free(mats);
+        lx_lj_nodes_free(nodes);
         return lx_jf_fail(&c, LX_ERR_NOMEM, "out of memory for %zu lights", count);
     }
     for (uint32_t i = 0; i < scene->light_count; i++)
@@ -700,6 +708,7 @@ static lx_status apply_root(lx_scene *scene, const cJSON *root, const char *file
             sky.environment = NULL;
         }
         lx_lj_materials_apply(mats, scene);
+        lx_lj_nodes_apply(nodes, scene);
         for (i = 0; i < count && st == LX_OK; i++)
             if ((st = lx_scene_add_light(scene, &pending[i])) != LX_OK) {
                 char where[160];
@@ -710,6 +719,7 @@ static lx_status apply_root(lx_scene *scene, const cJSON *root, const char *file
     free(pending);
     free(sky.environment);
     lx_lj_materials_free(mats);
+    lx_lj_nodes_free(nodes);
     return st;
 }
 

@@ -447,10 +447,14 @@ lx_status lx_scene_adopt_profile(lx_scene *s, lx_ies_profile *profile)
 
 bool lx_scene_bounds(const lx_scene *s, lx_vec3 *lo, lx_vec3 *hi)
 {
-    bool any = false;
+    bool any = false, all_sky = true;
+    for (uint32_t n = 0; n < s->node_count && all_sky; n++)
+        all_sky = s->nodes[n].bake.sky;
     lx_vec3 a = lx_v3(INFINITY, INFINITY, INFINITY), b = lx_v3(-INFINITY, -INFINITY, -INFINITY);
     for (uint32_t n = 0; n < s->node_count; n++) {
         const lx_node *node = &s->nodes[n];
+        if (node->bake.sky && !all_sky)
+            continue; /* a sky dome is not what the scene spans */
         for (uint32_t k = 0; k < node->mesh_count; k++) {
             const lx_mesh *m = &s->meshes[node->meshes[k]];
             for (uint32_t v = 0; v < m->vertex_count; v++) {

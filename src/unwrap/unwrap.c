@@ -368,7 +368,8 @@ typedef struct plan {
     uint32_t *ref_job;   /* per (node, mesh slot) */
     job *jobs;
     uint32_t job_count;
-    double *node_scale; /* density multiplier of nodes too big for a page */
+    double *node_scale; /* density multiplier: the node's lightmap scale, lowered
+                           for a node too big for a page */
 } plan;
 
 static void plan_free(plan *p)
@@ -405,10 +406,10 @@ static lx_status make_plan(const lx_scene *scene, const lx_unwrap_desc *d, plan 
     uint32_t r = 0;
     for (uint32_t n = 0; n < nn; n++) {
         const lx_node *node = &scene->nodes[n];
-        p->node_scale[n] = 1.0;
+        p->node_scale[n] = lx_node_lightmap_scale(&node->bake);
         p->ref_first[n] = r;
         p->mode[n] = d->modes ? d->modes[n] : LX_UNWRAP_GENERATE;
-        if (node->mesh_count == 0)
+        if (node->mesh_count == 0 || node->bake.no_lightmap)
             p->mode[n] = LX_UNWRAP_SKIP;
         if (p->mode[n] == LX_UNWRAP_KEEP) {
             int set = kept_uv_set(scene, n, d);
@@ -504,19 +505,22 @@ static void items_free(uw_item *items, uint32_t count)
     free(items);
 }
 
-/* The surface the unwrap places for node n (all nodes: UW_NONE), m^2. */
+/* The surface the unwrap places for node n (all nodes: UW_NONE), m^2,
+ * each node's weighted by its lightmap scale squared (the texels it takes
+ * at a density of 1). */
 static double placed_area(const lx_scene *scene, const plan *p, uint32_t only)
 {
     double area = 0.0;
     for (uint32_t n = 0; n < scene->node_count; n++) {
         if (only != UW_NONE && n != only)
             continue;
+        double s2 = p->node_scale[n] * p->node_scale[n]; /* 1 exactly by default */
         if (p->mode[n] == LX_UNWRAP_KEEP)
-            area += p->kept_world[n];
+            area += p->kept_world[n] * s2;
         for (uint32_t r = p->ref_first[n]; r < p->ref_first[n + 1]; r++) {
             const job *jb = &p->jobs[p->ref_job[r]];
             for (uint32_t c = 0; c < jb->chart_count; c++)
-                area += jb->charts[c].area;
+                area += jb->charts[c].area * s2;
         }
     }
     return area;
@@ -542,7 +546,7 @@ static lx_status pack_at(const lx_scene *scene, plan *p, double density, const u
         items_free(items, count);
         if (st != LX_ERR_UNSUPPORTED || too_big == UW_NONE || attempt > 64 || !may_scale)
             return st;
-        if (p->node_scale[too_big] == 1.0)
+        if (p->node_scale[too_big] == (double)lx_node_lightmap_scale(&scene->nodes[too_big].bake))
             lx_log(LX_LOG_WARN,
                    "node '%s' does not fit in one %dx%d page at %g texels/m: its "
                    "density is lowered until it does",

@@ -113,7 +113,7 @@ lx_status lx_uv_share_nodes(const lx_scene *scene, const int *uv_sets, const lx_
         memset(o, 0, sizeof *o);
         o->uv_set = uv_sets ? uv_sets[n] : uw_auto_uv_set(scene, n);
         float box[4] = {INFINITY, INFINITY, -INFINITY, -INFINITY};
-        bool ok = node->mesh_count > 0, any = false;
+        bool ok = node->mesh_count > 0 && !node->bake.no_lightmap, any = false;
         for (uint32_t k = 0; k < node->mesh_count && ok; k++) {
             uint32_t mi = node->meshes[k];
             const lx_mesh *m = &scene->meshes[mi];

@@ -24,6 +24,12 @@ static const char *bake_usage =
     "DIR/manifest.json says where every node's lightmap is (docs/manifest.md).\n"
     "Something must emit light: lights in the file or --lights, --sky or\n"
     "--ambient; a bake without, or whose lightmaps cover no texel, fails.\n"
+    "Per node (docs/bake.md, \"Per-node bake control\"): whether it casts\n"
+    "shadows, gets a lightmap, takes part in bounces, and its lightmap scale,\n"
+    "from glTF node extras (luxel_cast_shadows, luxel_lightmap,\n"
+    "luxel_contribute_gi, luxel_lightmap_scale, luxel_sky) and the --lights\n"
+    "file's \"nodes\" (by name or glob), which overrides them. An unlit mesh\n"
+    "enclosing the scene is a sky dome: no shadows, no lightmap (a warning).\n"
     "\n"
     "options:\n"
     "  -o, --output DIR        output folder (default ./lightmaps)\n"
@@ -32,7 +38,8 @@ static const char *bake_usage =
     "  --texel-density T       texels per metre instead: each lightmap sized from\n"
     "                          its world and UV areas, a multiple of 4 (default\n"
     "                          without either: 2^20 texels over the scene's area,\n"
-    "                          held to 4..40 texels/m)\n"
+    "                          held to 4..40 texels/m; nodes without a lightmap\n"
+    "                          and sky domes not counted)\n"
     "  --max-resolution N      cap for --texel-density sizes (default %d)\n"
     "  --lights FILE.json      lights and settings added to or overriding the\n"
     "                          scene's (docs/lights-json.md)\n"
@@ -367,6 +374,9 @@ static cJSON *node_entries(const lx_scene *scene, const lx_baker *baker, const l
         snprintf(set_name, sizeof set_name, "TEXCOORD_%d", set);
         cJSON_AddStringToObject(e, "uv_set", set_name);
         cJSON_AddStringToObject(e, "uvs", generated ? "generated" : "own");
+        float scale = lx_node_lightmap_scale(&node->bake);
+        if (scale != 1.0f)
+            cJSON_AddNumberToObject(e, "lightmap_scale", scale);
         cJSON_AddItemToArray(list, e);
     }
     return list;
@@ -717,6 +727,15 @@ int cmd_bake(int argc, char **argv)
                                                                                       : NULL));
     }
     cJSON_AddItemToObject(manifest, "nodes", node_entries(scene, baker, unwrap, &a));
+    /* the nodes left without a lightmap by their settings: a renderer
+     * binding these lightmaps to the scene file expects none for them */
+    cJSON *unbaked = NULL;
+    for (uint32_t n = 0; n < scene->node_count; n++)
+        if (scene->nodes[n].bake.no_lightmap && scene->nodes[n].mesh_count) {
+            if (!unbaked)
+                unbaked = cJSON_AddArrayToObject(manifest, "nodes_without_lightmap");
+            cJSON_AddItemToArray(unbaked, cJSON_CreateString(scene->nodes[n].name));
+        }
     int with_uvs = !failed && uvs_name[0] ? cli_stage_scene_with_uvs(&stage, uvs_name, scene, unwrap)
                                           : 0;
     if (with_uvs > 0)

@@ -66,15 +66,21 @@ static double node_area(const lx_scene *scene, uint32_t n)
 
 /* The texel density a bake gets when no option sizes its lightmaps: the
  * density that spends CLI_DENSITY_BUDGET texels on the world area of every
- * node with a mesh, held to CLI_DENSITY_MIN..CLI_DENSITY_MAX texels a
+ * node with a mesh and a lightmap (not a sky dome), each node's area
+ * times its lightmap scale squared, held to CLI_DENSITY_MIN..CLI_DENSITY_MAX texels a
  * metre (the tens of texels per metre Unity's and Bakery's defaults give
  * rooms and levels), to two significant digits. A room of 200 m^2 gets the
  * maximum; a level of 10,000 m^2 about 10. */
 double cli_default_density(const lx_scene *scene)
 {
     double total = 0.0;
-    for (uint32_t n = 0; n < scene->node_count; n++)
-        total += node_area(scene, n);
+    for (uint32_t n = 0; n < scene->node_count; n++) {
+        const lx_node_bake *b = &scene->nodes[n].bake;
+        if (b->no_lightmap || b->sky)
+            continue; /* no texels: a sky dome's kilometres spend none */
+        double s = lx_node_lightmap_scale(b);
+        total += node_area(scene, n) * s * s;
+    }
     double d = total > 0.0 ? sqrt(CLI_DENSITY_BUDGET / total) : CLI_DENSITY_MAX;
     d = d > CLI_DENSITY_MAX ? CLI_DENSITY_MAX : d < CLI_DENSITY_MIN ? CLI_DENSITY_MIN : d;
     double scale = pow(10.0, floor(log10(d)) - 1.0);
@@ -94,7 +100,11 @@ static void check_scale(const bake_args *a, const lx_scene *scene, const lx_unwr
     uint32_t small = 0, which = 0;
     float density = a->desc.texel_density;
     for (uint32_t n = 0; n < scene->node_count; n++) {
-        double area = node_area(scene, n);
+        const lx_node_bake *b = &scene->nodes[n].bake;
+        if (b->no_lightmap || b->sky)
+            continue;
+        double s = lx_node_lightmap_scale(b);
+        double area = node_area(scene, n) * s * s; /* at the density: its texels */
         total += area;
         if (density > 0.0f && !a->density_from_scene && area > 0.0 &&
             area * density * density < 64.0) {
@@ -235,12 +245,14 @@ static int plan_lightmaps(bake_args *a, lx_scene *scene, lx_unwrap **out, bool *
             return EXIT_FAILED;
         }
     }
+    uint32_t lightmapped = 0;
     for (uint32_t n = 0; n < nn; n++) {
         lx_uv_problem why = LX_UV_OK;
-        if (scene->nodes[n].mesh_count == 0) {
-            modes[n] = LX_UNWRAP_SKIP;
+        if (scene->nodes[n].mesh_count == 0 || scene->nodes[n].bake.no_lightmap) {
+            modes[n] = LX_UNWRAP_SKIP; /* no lightmap: its UVs do not matter */
             continue;
         }
+        lightmapped++;
         if (a->unwrap == UNWRAP_AUTO) {
             lx_uv_health h;
             cli_progress_part(&progress, (int)n, (int)nn);
@@ -297,7 +309,7 @@ static int plan_lightmaps(bake_args *a, lx_scene *scene, lx_unwrap **out, bool *
         lx_log(LX_LOG_WARN,
                "%s: %u of %u nodes have no usable TEXCOORD lightmap UVs (%s): luxel makes "
                "theirs%s (--unwrap never keeps the file's; -v names the nodes)",
-               a->scene, generate, nn, detail,
+               a->scene, generate, lightmapped, detail,
                *atlas ? " and packs every node into atlas pages" : "");
     }
     if (skipped)
@@ -526,6 +538,16 @@ int cli_bake_prepare(bake_args *a, cli_progress *progress, lx_scene **scene_out,
         scene->ambient = a->ambient;
     if (scene->node_count == 0) {
         cli_error("%s: the scene has no meshes to bake", a->scene);
+        goto done;
+    }
+    uint32_t with_lightmap = 0;
+    for (uint32_t n = 0; n < scene->node_count; n++)
+        with_lightmap += !scene->nodes[n].bake.no_lightmap;
+    if (with_lightmap == 0) {
+        cli_error(
+            "%s: every node has its lightmap turned off (luxel_lightmap extras, \"lightmap\": "
+            "false in the lights JSON's \"nodes\", or sky domes): nothing to bake",
+            a->scene);
         goto done;
     }
     /* the sky: --sky and its options over the lights JSON's "sky" */

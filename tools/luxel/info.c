@@ -12,7 +12,9 @@
 static const char *info_usage =
     "usage: luxel info SCENE [options]\n"
     "\n"
-    "Lists the meshes (triangles, UV sets), materials, nodes, lights (type and\n"
+    "Lists the meshes (triangles, UV sets), materials, nodes (with their bake\n"
+    "settings when not the default: sky dome, no shadows, no lightmap, no\n"
+    "bounces, lightmap scale), lights (type and\n"
     "physical units), cameras, the sky and bounds of a glTF 2.0 or OBJ scene,\n"
     "and the health of every mesh's UV sets as lightmap UVs: their range, the\n"
     "share of covered texels two triangles overlap at --resolution, zero-area\n"
@@ -238,16 +240,29 @@ int cmd_info(int argc, char **argv)
         const lx_material *m = &s->materials[i];
         if (phantom_material(s, i))
             continue;
-        printf("  %-24s base colour (%.3g, %.3g, %.3g)%s%s\n", m->name, m->base_color.x,
+        printf("  %-24s base colour (%.3g, %.3g, %.3g)%s%s%s\n", m->name, m->base_color.x,
                m->base_color.y, m->base_color.z, m->base_color_map_path ? " + texture" : "",
-               m->normal_map_path ? "  normal map" : "");
+               m->normal_map_path ? "  normal map" : "", m->unlit ? "  unlit" : "");
     }
     printf("nodes: %u\n", s->node_count);
     for (uint32_t i = 0; i < s->node_count; i++) {
         const lx_node *n = &s->nodes[i];
-        printf("  %-24s at (%s, %s, %s), %u %s\n", n->name, cli_num_digits(n->world.m[12], 3),
-               cli_num_digits(n->world.m[13], 3), cli_num_digits(n->world.m[14], 3),
-               n->mesh_count, cli_plural(n->mesh_count, "mesh", "meshes"));
+        printf("  %-24s at (%s, %s, %s), %u %s", n->name, cli_num_digits(n->world.m[12], 3),
+               cli_num_digits(n->world.m[13], 3), cli_num_digits(n->world.m[14], 3), n->mesh_count,
+               cli_plural(n->mesh_count, "mesh", "meshes"));
+        /* the bake settings that are not the default */
+        const lx_node_bake *b = &n->bake;
+        if (b->sky)
+            printf("  sky dome");
+        if (b->no_cast_shadows)
+            printf("  no shadows");
+        if (b->no_lightmap)
+            printf("  no lightmap");
+        if (b->no_contribute_gi)
+            printf("  no bounces");
+        if (lx_node_lightmap_scale(b) != 1.0f)
+            printf("  lightmap scale %s", cli_num_digits(lx_node_lightmap_scale(b), 4));
+        printf("\n");
     }
     if (!print_uv_health(s, &hd) || !print_uv_share(s)) {
         lx_scene_destroy(s);

@@ -732,6 +732,8 @@ int cmd_render(int argc, char **argv)
     if (!cli_scene_load(path, &ld, &scene))
         goto done;
     cli_phase("import");
+    /* the bake's per-node settings its lights JSON gave */
+    lx_lightmaps_apply_settings(&lm, scene);
     if (!with_uvs && any_generated(&lm)) {
         if (unwrap_again(&lm, scene, a.scene, a.desc.threads, a.quiet) != EXIT_OK)
             goto done;
