@@ -137,6 +137,11 @@ static void noise_at_equal_time(const lx_scene *scene, const char *scene_path, i
     float *raw = baked_texels(scene, &d, reps, &n, &t_raw);
     d.denoise = LX_DENOISE_INDIRECT;
     float *den = baked_texels(scene, &d, reps, &n, &t_den);
+    /* adaptive gathers (--gi-adaptive), denoised */
+    double t_ada;
+    d.gi_adaptive = true;
+    float *ada = baked_texels(scene, &d, reps, &n, &t_ada);
+    d.gi_adaptive = false;
     /* the GI's time grows with its rays: the raw count that takes as long
      * as the denoised bake */
     double gi_raw = t_raw - t_direct, gi_den = t_den - t_direct;
@@ -159,6 +164,8 @@ static void noise_at_equal_time(const lx_scene *scene, const char *scene_path, i
            100.0 * e_den, 100.0 * share_off(den, ref, n, 0.05));
     printf("  raw at equal time, %-25d %8.3fs %13.2f%% %13.2f%%\n", equal, t_eq, 100.0 * e_eq,
            100.0 * share_off(eq, ref, n, 0.05));
+    printf("  %-44s %8.3fs %13.2f%% %13.2f%%\n", "adaptive (--gi-adaptive), denoised", t_ada,
+           100.0 * relative_rms(ada, ref, n), 100.0 * share_off(ada, ref, n, 0.05));
     printf("noise: at %d rays a texel the denoiser cuts the RMS error against a 64x reference "
            "%.1fx (%.2f%% -> %.2f%%); %.1fx against the raw bake of equal time (%d rays); "
            "a raw bake would need about %.0f rays (1/sqrt law) to match\n",
@@ -167,6 +174,7 @@ static void noise_at_equal_time(const lx_scene *scene, const char *scene_path, i
     free(ref);
     free(raw);
     free(den);
+    free(ada);
     free(eq);
 }
 

@@ -113,6 +113,9 @@ int lx_bake_uv_set(const lx_scene *scene, uint32_t node, lx_uv_choice choice);
 #define LX_MAX_BOUNCES 64
 #define LX_GI_SAMPLES_DEFAULT 128u
 #define LX_MAX_GI_SAMPLES 65536u
+/* Adaptive gathers (lx_bake_desc.gi_adaptive): the relative standard
+ * error a texel's bounce estimate stops at. */
+#define LX_GI_ADAPTIVE_NOISE 0.025
 /* The dynamic lights' one bounce (lx_baker_update): the gather rays per
  * texel a real-time user should start from, and the most taken. */
 #define LX_DYNAMIC_BOUNCE_SAMPLES_RECOMMENDED 16u
@@ -184,6 +187,15 @@ typedef struct lx_bake_desc {
     uint32_t gi_samples;   /* gather rays per texel per bounce, and the
                               emitters' shadow rays (at most 256), 1..
                               LX_MAX_GI_SAMPLES, 0 = LX_GI_SAMPLES_DEFAULT */
+    bool gi_adaptive;      /* gather in rounds of gi_samples / 4 stratified
+                              rays (at least 4), each texel stopping after
+                              two rounds once its estimate's standard error
+                              is within LX_GI_ADAPTIVE_NOISE of it (or of a
+                              tenth of the bounce's mean, for dark texels),
+                              else going on up to 16 rounds (4 x gi_samples
+                              rays): the rays go where the noise is. false
+                              (the default): gi_samples rays for every
+                              texel; `luxel bake --gi-adaptive` */
     float emissive_scale;  /* multiplies the emissive materials' radiance
                               (nits); 0 = 1 */
     lx_denoise_mode denoise; /* edge-aware denoising of the baked buffers at the

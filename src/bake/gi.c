@@ -162,7 +162,12 @@ typedef struct gi_run {
     gi_map *maps;
     lx_radiance_source *sources; /* each map's valid and source, for lx_hit_radiance */
     int threads;
+    double dark; /* adaptive gathers: the radiance luminance under which a
+                    texel's noise is judged against this, not its own */
 } gi_run;
+
+/* Adaptive gathers: the rounds at least and at most. */
+enum { ADAPTIVE_MIN_ROUNDS = 2, ADAPTIVE_MAX_ROUNDS = 16 };
 
 lx_gather_frame lx_gather_frame_of(const lx_baker *b, uint32_t map_index, const lx_lightmap *map,
                                    uint32_t i)
@@ -305,41 +310,57 @@ static lx_vec3 texel_gather(const gi_run *run, uint32_t map_index, uint32_t i, u
 {
     const lx_baker *b = run->b;
     const lx_lightmap *map = &b->maps[map_index];
+    /* adaptive: rounds of a quarter of the rays, each stratified over the
+     * whole hemisphere and jittered by its own key */
+    bool adaptive = b->desc.gi_adaptive;
+    uint32_t per_round = adaptive ? (b->desc.gi_samples + 3) / 4 : b->desc.gi_samples;
+    per_round = adaptive && per_round < 4 ? 4 : per_round;
     uint32_t sx, sy;
-    lx_cosine_strata(b->desc.gi_samples, &sx, &sy);
-    uint32_t cells = sx * sy;
+    lx_cosine_strata(per_round, &sx, &sy);
+    uint32_t cells = sx * sy, rounds = adaptive ? ADAPTIVE_MAX_ROUNDS : 1, total = 0;
     double sum[3] = {0.0, 0.0, 0.0}, shs[LX_SH_FLOATS] = {0}, lum = 0.0, lum2 = 0.0;
     lx_gather_frame f = lx_gather_frame_of(b, map_index, map, i);
-    for (uint32_t k = 0; k < cells; k++) {
-        lx_ray ray;
-        lx_hit h;
-        if (!lx_gather_ray(&f, k, sx, sy, key, &ray))
-            continue;
-        if (!lx_tracer_closest_kind(b->tracer, &ray, LX_RAY_GATHER, &h) ||
-            !(lx_dot(ray.dir, h.normal) < 0.0f))
-            continue; /* escaped (sky: direct light), or a back face */
-        /* emission is direct light (emitters.c), not picked up here */
-        lx_vec3 l = lx_hit_radiance(b, run->sources, false, &h);
-        sum[0] += l.x;
-        sum[1] += l.y;
-        sum[2] += l.z;
-        const float rgb[3] = {l.x, l.y, l.z};
-        double luma = lx_luminance(rgb);
-        lum += luma;
-        lum2 += luma * luma;
-        if (sh) {
-            lx_vec3 d = ray.dir;
-            float w0;
-            lx_vec3 v;
-            lx_sh_ray_weight(k, sx, d, f.n, &w0, &v);
-            double y[4] = {LX_SH_Y0 * w0, LX_SH_Y1 * v.y, LX_SH_Y1 * v.z, LX_SH_Y1 * v.x};
-            for (int c = 0; c < 4; c++) {
-                shs[3 * c] += l.x * y[c];
-                shs[3 * c + 1] += l.y * y[c];
-                shs[3 * c + 2] += l.z * y[c];
+    for (uint32_t r = 0; r < rounds; r++) {
+        if (adaptive && r >= ADAPTIVE_MIN_ROUNDS) {
+            double n = (double)total, mean = lum / n;
+            double spread = fmax((lum2 - lum * mean) / (n - 1.0), 0.0);
+            double limit = LX_GI_ADAPTIVE_NOISE * fmax(mean, run->dark);
+            if (spread / n <= limit * limit)
+                break;
+        }
+        total += cells;
+        for (uint32_t k = 0; k < cells; k++) {
+            lx_ray ray;
+            lx_hit h;
+            if (!lx_gather_ray(&f, k, sx, sy, key + (r << 16), &ray))
+                continue;
+            if (!lx_tracer_closest_kind(b->tracer, &ray, LX_RAY_GATHER, &h) ||
+                !(lx_dot(ray.dir, h.normal) < 0.0f))
+                continue; /* escaped (sky: direct light), or a back face */
+            /* emission is direct light (emitters.c), not picked up here */
+            lx_vec3 l = lx_hit_radiance(b, run->sources, false, &h);
+            sum[0] += l.x;
+            sum[1] += l.y;
+            sum[2] += l.z;
+            const float rgb[3] = {l.x, l.y, l.z};
+            double luma = lx_luminance(rgb);
+            lum += luma;
+            lum2 += luma * luma;
+            if (sh) {
+                lx_vec3 d = ray.dir;
+                float w0;
+                lx_vec3 v;
+                lx_sh_ray_weight(k, sx, d, f.n, &w0, &v);
+                double y[4] = {LX_SH_Y0 * w0, LX_SH_Y1 * v.y, LX_SH_Y1 * v.z, LX_SH_Y1 * v.x};
+                for (int c = 0; c < 4; c++) {
+                    shs[3 * c] += l.x * y[c];
+                    shs[3 * c + 1] += l.y * y[c];
+                    shs[3 * c + 2] += l.z * y[c];
+                }
             }
         }
     }
+    cells = total;
     if (sh)
         for (int c = 0; c < LX_SH_FLOATS; c++)
             sh->c[c] = (float)(shs[c] / (double)cells);
@@ -558,6 +579,24 @@ static bool tile_pass(gi_run *run, uint32_t t, bool validity, uint32_t key, floa
     return true;
 }
 
+/* The mean luminance of the valid texels' sources (the radiance the
+ * gathers read), over every map. */
+static double mean_source(const gi_run *run)
+{
+    double sum = 0.0;
+    uint64_t n = 0;
+    for (uint32_t m = 0; m < run->b->map_count; m++) {
+        const lx_lightmap *map = &run->b->maps[m];
+        size_t pixels = (size_t)map->info.width * (size_t)map->info.height;
+        for (size_t p = 0; p < pixels; p++)
+            if (run->maps[m].valid[p]) {
+                sum += lx_luminance(run->maps[m].source + 3 * p);
+                n++;
+            }
+    }
+    return n ? sum / (double)n : 0.0;
+}
+
 /* The passes run tile by tile (one tile when the maps fit the memory
  * together): the validity pass makes each map's valid mask and first
  * sources from its direct light; each bounce gathers a tile's texels
@@ -624,6 +663,7 @@ lx_status lx_bake_indirect(lx_baker *b, float progress_base, float progress_span
         float from = progress_base + span * (float)k;
         for (uint32_t m = 0; m < count; m++)
             run.sources[m].source = run.maps[m].source;
+        run.dark = b->desc.gi_adaptive ? 0.1 * mean_source(&run) : 0.0;
         for (uint32_t t = 0; t < b->tile_count && st == LX_OK; t++) {
             if (!tile_pass(&run, t, false, GI_KEY + 2u * (uint32_t)k, from, from + span, &st))
                 break;

@@ -45,13 +45,77 @@ static lx_scene *box_scene(void)
     return scene;
 }
 
-static lx_baker *bake(const lx_scene *scene, uint32_t samples, lx_denoise_mode denoise)
+static lx_baker *bake_adaptive(const lx_scene *scene, uint32_t samples, lx_denoise_mode denoise,
+                               bool adaptive)
 {
-    lx_bake_desc d = {.resolution = RES, .bounces = 1, .gi_samples = samples, .denoise = denoise};
+    lx_bake_desc d = {.resolution = RES,
+                      .bounces = 1,
+                      .gi_samples = samples,
+                      .denoise = denoise,
+                      .gi_adaptive = adaptive};
     lx_baker *b;
     assert_int_equal(lx_baker_create(scene, &d, &b), LX_OK);
     assert_int_equal(lx_baker_bake(b), LX_OK);
     return b;
+}
+
+static lx_baker *bake(const lx_scene *scene, uint32_t samples, lx_denoise_mode denoise)
+{
+    return bake_adaptive(scene, samples, denoise, false);
+}
+
+/* Mean squared luminance error of map's covered texels against ref's,
+ * and how many texels are off by more than 5%. */
+static double squared_error(const lx_lightmap *x, const lx_lightmap *ref, int *off)
+{
+    double err2 = 0.0;
+    int texels = 0;
+    *off = 0;
+    for (size_t p = 0; p < (size_t)RES * RES; p++) {
+        if (!ref->mask[p])
+            continue;
+        double got = lx_luminance(x->baked + 3 * p), want = lx_luminance(ref->baked + 3 * p);
+        err2 += (got - want) * (got - want);
+        *off += fabs(got - want) > 0.05 * want;
+        texels++;
+    }
+    return err2 / texels;
+}
+
+/* Adaptive gathers against the 64x reference: each texel stops once its
+ * estimate's standard error is within LX_GI_ADAPTIVE_NOISE of it or at
+ * 4x the base count, so on this noisy floor (most texels reach the cap)
+ * the error is well below the fixed gather's at the base count, and the
+ * same bytes come out of 1 and 2 threads. */
+static void adaptive_gathers_converge(void **state)
+{
+    (void)state;
+    lx_scene *scene = box_scene();
+    lx_baker *fixed = bake(scene, SAMPLES, LX_DENOISE_OFF);
+    lx_baker *ada = bake_adaptive(scene, SAMPLES, LX_DENOISE_OFF, true);
+    lx_baker *ref = bake(scene, 64 * SAMPLES, LX_DENOISE_OFF);
+    uint32_t map = lx_test_map_of(ref, 0);
+    int off_fixed, off_ada;
+    double e_fixed = squared_error(&fixed->maps[map], &ref->maps[map], &off_fixed);
+    double e_ada = squared_error(&ada->maps[map], &ref->maps[map], &off_ada);
+    printf("adaptive gathers (base %u rays): mean squared error %.4g against %.4g fixed, texels "
+           "off by 5%%: %d against %d\n",
+           SAMPLES, e_ada, e_fixed, off_ada, off_fixed);
+    /* measured 2.06x less squared error (4x at most: the cap), 334
+     * texels off by 5% against 372 */
+    assert_true(e_ada * 1.5 < e_fixed);
+    assert_true(off_ada < off_fixed);
+    lx_bake_desc d = {.resolution = RES, .bounces = 1, .gi_samples = SAMPLES,
+                      .gi_adaptive = true, .threads = 1};
+    lx_baker *one;
+    assert_int_equal(lx_baker_create(scene, &d, &one), LX_OK);
+    assert_int_equal(lx_baker_bake(one), LX_OK);
+    assert_memory_equal(one->maps[map].baked, ada->maps[map].baked, sizeof(float) * 3 * RES * RES);
+    lx_baker_destroy(one);
+    lx_baker_destroy(fixed);
+    lx_baker_destroy(ada);
+    lx_baker_destroy(ref);
+    lx_scene_destroy(scene);
 }
 
 static void variance_is_the_error_it_guides(void **state)
@@ -95,6 +159,7 @@ int main(void)
 {
     const struct CMUnitTest tests[] = {
         cmocka_unit_test(variance_is_the_error_it_guides),
+        cmocka_unit_test(adaptive_gathers_converge),
     };
     return cmocka_run_group_tests(tests, NULL, NULL);
 }

@@ -66,6 +66,9 @@ static const char *bake_usage =
     "  --bounces N             indirect diffuse bounces, 0..%d; 0 bakes direct\n"
     "                          light only (default %d)\n"
     "  --gi-samples N          gather rays per texel per bounce (default %u)\n"
+    "  --gi-adaptive           gather in rounds of a quarter of --gi-samples until\n"
+    "                          each texel's estimate is within 2.5%% (2 to 16\n"
+    "                          rounds): fewer blotches, 2-4x the bounces' time\n"
     "  --supersample N         direct light of each texel averaged over N x N\n"
     "                          points of its footprint, 1..%d (default 1): thin\n"
     "                          features, smooth hard-shadow edges; N^2 times the\n"
@@ -139,6 +142,7 @@ enum {
     OPT_CLEAN,
     OPT_SUPERSAMPLE,
     OPT_EDGE_SUPERSAMPLE,
+    OPT_GI_ADAPTIVE,
     OPT_NO_STITCH,
     OPT_AO,
     OPT_AO_DISTANCE,
@@ -162,6 +166,7 @@ static int parse_args(int argc, char **argv, bake_args *a)
         {"clean", no_argument, NULL, OPT_CLEAN},
         {"supersample", required_argument, NULL, OPT_SUPERSAMPLE},
         {"edge-supersample", required_argument, NULL, OPT_EDGE_SUPERSAMPLE},
+        {"gi-adaptive", no_argument, NULL, OPT_GI_ADAPTIVE},
         {"no-stitch", no_argument, NULL, OPT_NO_STITCH},
         {"ao", no_argument, NULL, OPT_AO},
         {"ao-distance", required_argument, NULL, OPT_AO_DISTANCE},
@@ -266,6 +271,9 @@ static int parse_args(int argc, char **argv, bake_args *a)
                 return cli_usage_error("bake", "--supersample must be an integer in 1..%d, not '%s'",
                                        LX_MAX_SUPERSAMPLE, optarg);
             a->desc.supersample = (int)n;
+            break;
+        case OPT_GI_ADAPTIVE:
+            a->desc.gi_adaptive = true;
             break;
         case OPT_EDGE_SUPERSAMPLE:
             if (!cli_parse_int(optarg, 0, LX_MAX_SUPERSAMPLE, &n))
@@ -622,6 +630,8 @@ int cmd_bake(int argc, char **argv)
         cJSON *gi = cJSON_AddObjectToObject(manifest, "indirect");
         cJSON_AddNumberToObject(gi, "bounces", a.desc.bounces);
         cJSON_AddNumberToObject(gi, "gi_samples", a.desc.gi_samples);
+        if (a.desc.gi_adaptive)
+            cJSON_AddBoolToObject(gi, "gi_adaptive", true);
         cJSON_AddNumberToObject(gi, "emissive_scale", a.desc.emissive_scale);
     }
     if (a.desc.texel_density > 0.0f || unwrap)
