@@ -168,6 +168,14 @@ bool lx_tracer_closest_kind(const lx_tracer *tracer, const lx_ray *ray, lx_ray_k
  * to the occluder blurred shadows use), t only; INFINITY when none. */
 float lx_tracer_nearest_distance(const lx_tracer *tracer, const lx_ray *ray);
 
+/* Whether a triangle near the sphere (centre, radius) leaves the plane
+ * n . x = d by more than tolerance: a conservative proximity test (a
+ * triangle counts when its bounding box meets the sphere's), so false
+ * means every triangle within radius of centre lies in the plane. Every
+ * node counts, whatever its bake settings. */
+bool lx_tracer_off_plane_near(const lx_tracer *tracer, lx_vec3 centre, float radius, lx_vec3 n,
+                              float d, float tolerance);
+
 #ifdef __cplusplus
 }
 #endif

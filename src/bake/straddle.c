@@ -175,6 +175,40 @@ static bool straddle_texel(const lx_baker *b, lx_lightmap *map, uint32_t i)
     return moved;
 }
 
+/* Whether any texel of a tile could straddle: false when its texels lie
+ * in one plane and every triangle within reach of their rays (a sphere
+ * around them, wide enough for the texels' and their supersampling
+ * points' rays) lies in that plane too (the tile's own surface): then no
+ * ray from them meets anything, and straddle_texel would move nothing.
+ * Most tiles of open floors and walls, at one point query each instead
+ * of eight rays a texel. */
+static bool tile_may_straddle(const lx_baker *b, const lx_lightmap *map, uint32_t first,
+                              uint32_t count)
+{
+    lx_vec3 n = map->world_geometric_normal[first], lo = map->world_position[first], hi = lo;
+    float d = lx_dot(n, map->world_position[first]), reach = 0.0f, tolerance = INFINITY;
+    for (uint32_t i = first; i < first + count; i++) {
+        lx_vec3 p = map->world_position[i];
+        float lift = b->bias + 4e-6f * lx_max_abs_component(p);
+        tolerance = fminf(tolerance, 0.5f * lift);
+        if (lx_dot(map->world_geometric_normal[i], n) < 0.99999f)
+            return true;
+        lx_vec3 ax = map->texel_axes[2 * (size_t)i], ay = map->texel_axes[2 * (size_t)i + 1];
+        float half = 0.5f * fmaxf(lx_length(lx_add(ax, ay)), lx_length(lx_sub(ax, ay)));
+        if (!isfinite(half))
+            return true;
+        reach = fmaxf(reach, 3.0f * half + 2.0f * lift);
+        lo = lx_v3(fminf(lo.x, p.x), fminf(lo.y, p.y), fminf(lo.z, p.z));
+        hi = lx_v3(fmaxf(hi.x, p.x), fmaxf(hi.y, p.y), fmaxf(hi.z, p.z));
+    }
+    for (uint32_t i = first; i < first + count; i++)
+        if (fabsf(lx_dot(n, map->world_position[i]) - d) > tolerance)
+            return true;
+    lx_vec3 centre = lx_scale(lx_add(lo, hi), 0.5f);
+    float radius = 0.5f * lx_length(lx_sub(hi, lo)) + reach;
+    return lx_tracer_off_plane_near(b->tracer, centre, radius, n, d, tolerance);
+}
+
 lx_status lx_bake_straddle(lx_baker *b, float progress_base, float progress_span, bool report)
 {
     if (b->tracer_dirty) {
@@ -198,7 +232,8 @@ lx_status lx_bake_straddle(lx_baker *b, float progress_base, float progress_span
         uint32_t m, first, count;
         lx_tile_walk_at(&w, global, &m, &first, &count);
         lx_lightmap *map = &b->maps[m];
-        for (uint32_t i = first; map->texel_axes && i < first + count; i++)
+        bool may = count && map->texel_axes && tile_may_straddle(b, map, first, count);
+        for (uint32_t i = first; may && i < first + count; i++)
             moved += straddle_texel(b, map, i);
         lx_tile_walk_done(&w, global, count);
     }

@@ -446,6 +446,60 @@ bool lx_tracer_closest_kind(const lx_tracer *tr, const lx_ray *ray, lx_ray_kind 
     return true;
 }
 
+typedef struct plane_query {
+    const lx_tracer *tr;
+    float n[3], d, tolerance;
+    float lo[3], hi[3]; /* the sphere's box */
+    bool found;
+} plane_query;
+
+/* Embree's point query calls this for each triangle whose bounds meet the
+ * query's: a triangle whose box meets the sphere's box and whose vertices
+ * leave the plane ends the search. */
+static bool off_plane_candidate(struct RTCPointQueryFunctionArguments *args)
+{
+    plane_query *q = args->userPtr;
+    if (q->found || args->geomID >= q->tr->geometry_count)
+        return false;
+    RTCGeometry g = q->tr->geometries[args->geomID];
+    const float *v = rtcGetGeometryBufferData(g, RTC_BUFFER_TYPE_VERTEX, 0);
+    const unsigned *idx = rtcGetGeometryBufferData(g, RTC_BUFFER_TYPE_INDEX, 0);
+    const unsigned *t = idx + 3 * (size_t)args->primID;
+    float lo[3] = {INFINITY, INFINITY, INFINITY}, hi[3] = {-INFINITY, -INFINITY, -INFINITY};
+    bool off = false;
+    for (int k = 0; k < 3; k++) {
+        const float *p = v + 3 * (size_t)t[k];
+        for (int a = 0; a < 3; a++) {
+            lo[a] = p[a] < lo[a] ? p[a] : lo[a];
+            hi[a] = p[a] > hi[a] ? p[a] : hi[a];
+        }
+        float h = q->n[0] * p[0] + q->n[1] * p[1] + q->n[2] * p[2] - q->d;
+        off |= !(h <= q->tolerance && h >= -q->tolerance);
+    }
+    for (int a = 0; a < 3; a++)
+        if (hi[a] < q->lo[a] || lo[a] > q->hi[a])
+            return false;
+    if (!off)
+        return false;
+    q->found = true;
+    args->query->radius = 0.0f; /* nothing more to look for */
+    return true;
+}
+
+bool lx_tracer_off_plane_near(const lx_tracer *tr, lx_vec3 centre, float radius, lx_vec3 n,
+                              float d, float tolerance)
+{
+    plane_query q = {.tr = tr, .n = {n.x, n.y, n.z}, .d = d, .tolerance = tolerance};
+    const float c[3] = {centre.x, centre.y, centre.z};
+    for (int a = 0; a < 3; a++)
+        q.lo[a] = c[a] - radius, q.hi[a] = c[a] + radius;
+    struct RTCPointQuery query = {.x = centre.x, .y = centre.y, .z = centre.z, .radius = radius};
+    struct RTCPointQueryContext context;
+    rtcInitPointQueryContext(&context);
+    rtcPointQuery(tr->scene, &query, &context, off_plane_candidate, &q);
+    return q.found;
+}
+
 float lx_tracer_nearest_distance(const lx_tracer *tr, const lx_ray *ray)
 {
     lx_hit h;
