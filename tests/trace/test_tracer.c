@@ -545,9 +545,45 @@ static void test_build_progress_and_cancel(void **state)
     lx_scene_destroy(scene);
 }
 
+/* lx_tracer_off_plane_near: a 4 m floor (8 x 8 quads, y = 0) and a cube
+ * [1, 1.5] x [0.2, 0.7] x [1, 1.5] above it. Spheres that reach only the
+ * floor find nothing off its plane; one whose box reaches the cube's
+ * does; any other plane finds the floor off it. */
+static void test_off_plane_near(void **state)
+{
+    (void)state;
+    lx_scene *scene = lx_test_new_scene("plane");
+    lx_mesh floor = lx_test_plane("floor", 4.0f, 0.0f, 0.0f, 0.0f, 8);
+    lx_test_add(scene, &floor);
+    lx_test_mesh_free(&floor);
+    lx_mesh cube = lx_test_box("cube", lx_v3(1.0f, 0.2f, 1.0f), lx_v3(1.5f, 0.7f, 1.5f), false);
+    lx_test_add(scene, &cube);
+    lx_test_mesh_free(&cube);
+    lx_tracer *tr;
+    assert_int_equal(lx_tracer_create(scene, NULL, &tr), LX_OK);
+    lx_vec3 up = lx_v3(0.0f, 1.0f, 0.0f);
+    /* the floor alone: in its plane, at every size up to the cube */
+    assert_false(lx_tracer_off_plane_near(tr, lx_v3(-1.0f, 0.0f, -1.0f), 0.5f, up, 0.0f, 1e-5f));
+    assert_false(lx_tracer_off_plane_near(tr, lx_v3(0.0f, 0.0f, 0.0f), 0.95f, up, 0.0f, 1e-5f));
+    /* the cube's box is 0.2 above the floor, from x, z = 1: the sphere at
+     * (1.2, 0, 1.2) reaches it from radius 0.2 */
+    assert_false(lx_tracer_off_plane_near(tr, lx_v3(1.2f, 0.0f, 1.2f), 0.19f, up, 0.0f, 1e-5f));
+    assert_true(lx_tracer_off_plane_near(tr, lx_v3(1.2f, 0.0f, 1.2f), 0.21f, up, 0.0f, 1e-5f));
+    /* a plane 1 cm above the floor: the floor leaves it, beyond the
+     * tolerance only */
+    assert_true(lx_tracer_off_plane_near(tr, lx_v3(-1.0f, 0.01f, -1.0f), 0.1f, up, 0.01f, 1e-3f));
+    assert_false(lx_tracer_off_plane_near(tr, lx_v3(-1.0f, 0.01f, -1.0f), 0.1f, up, 0.01f, 0.02f));
+    /* a wall's plane (x = -1) through the floor */
+    assert_true(lx_tracer_off_plane_near(tr, lx_v3(-1.0f, 0.0f, -1.0f), 0.1f,
+                                         lx_v3(1.0f, 0.0f, 0.0f), -1.0f, 1e-5f));
+    lx_tracer_destroy(tr);
+    lx_scene_destroy(scene);
+}
+
 int main(void)
 {
     const struct CMUnitTest tests[] = {
+        cmocka_unit_test(test_off_plane_near),
         cmocka_unit_test(test_build_progress_and_cancel), cmocka_unit_test(test_random_rays),
         cmocka_unit_test(test_move_node_and_commit),
         cmocka_unit_test(test_coherent_batch), /* last: a hang ends the program */
