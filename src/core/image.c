@@ -319,10 +319,11 @@ static void float_row(void *ctx, int y, float *row)
     memcpy(row, img->data + (size_t)y * n, sizeof(float) * n);
 }
 
-static lx_status reduce_floats(lx_image *img, uint64_t keep_pixels, const char *name)
+static lx_status reduce_floats(lx_image *img, uint64_t keep_pixels, const char *name,
+                               int *halvings)
 {
     int w, h;
-    lx_img_reduced_size(img->width, img->height, keep_pixels, &w, &h, NULL);
+    lx_img_reduced_size(img->width, img->height, keep_pixels, &w, &h, halvings);
     if (w == img->width && h == img->height)
         return LX_OK;
     lx_image out;
@@ -348,11 +349,11 @@ lx_image_load_desc lx_image_load_desc_defaults(const lx_image_load_desc *desc)
     return d; /* every field's zero is its default: as stored, sRGB-decoded, finite */
 }
 
-lx_status lx_image_load_memory(const void *bytes, size_t size, const char *name,
-                               const lx_image_load_desc *desc, lx_image *out)
+static lx_status load_memory(const void *bytes, size_t size, const char *name,
+                             const lx_image_load_desc *desc, lx_image *out, int *halvings)
 {
     if (!bytes)
-        return lx_fail_null(__func__, "bytes");
+        return lx_fail_null("lx_image_load_memory", "bytes");
     if (!out)
         return lx_fail(LX_ERR_INVALID, "lx_image_load_memory: out is NULL");
     memset(out, 0, sizeof *out);
@@ -381,8 +382,10 @@ lx_status lx_image_load_memory(const void *bytes, size_t size, const char *name,
         format = LX_IMAGE_TGA;
     }
 
-    lx_img_budget budget = {
-        .max_pixels = d.max_pixels, .want_channels = d.channels, .keep_pixels = d.keep_pixels};
+    lx_img_budget budget = {.max_pixels = d.max_pixels,
+                            .want_channels = d.channels,
+                            .keep_pixels = d.keep_pixels,
+                            .halvings = halvings};
     lx_status s;
     switch (format) {
     case LX_IMAGE_EXR:
@@ -398,7 +401,7 @@ lx_status lx_image_load_memory(const void *bytes, size_t size, const char *name,
     if (s == LX_OK && !d.keep_nonfinite)
         s = check_finite(out, name);
     if (s == LX_OK && (format == LX_IMAGE_EXR || format == LX_IMAGE_PFM))
-        s = reduce_floats(out, d.keep_pixels, name);
+        s = reduce_floats(out, d.keep_pixels, name, halvings);
     if (s == LX_OK)
         s = convert_channels(out, d.channels, name);
     if (s != LX_OK)
@@ -406,23 +409,41 @@ lx_status lx_image_load_memory(const void *bytes, size_t size, const char *name,
     return s;
 }
 
-lx_status lx_image_load(const char *path, const lx_image_load_desc *desc, lx_image *out)
+lx_status lx_image_load_memory(const void *bytes, size_t size, const char *name,
+                               const lx_image_load_desc *desc, lx_image *out)
 {
+    return load_memory(bytes, size, name, desc, out, NULL);
+}
+
+lx_status lx_image_load_halved(const char *path, const void *bytes, size_t size, const char *name,
+                               const lx_image_load_desc *desc, lx_image *out, int *halvings)
+{
+    if (halvings)
+        *halvings = 0;
+    if (bytes)
+        return load_memory(bytes, size, name, desc, out, halvings);
     if (out)
         memset(out, 0, sizeof *out);
     if (!path || !out)
         return lx_fail(LX_ERR_INVALID, "lx_image_load: path and out must not be NULL");
-    /* Files are read whole: every decoder here works from memory. */
     uint64_t limit = (uint64_t)1 << 36; /* 64 GiB */
     size_t max_size = limit > SIZE_MAX ? SIZE_MAX : (size_t)limit;
     char *buf;
-    size_t size;
-    lx_status s = lx_read_file(path, max_size, &buf, &size);
+    size_t got;
+    lx_status s = lx_read_file(path, max_size, &buf, &got);
     if (s != LX_OK)
         return s;
-    s = lx_image_load_memory(buf, size, path, desc, out);
+    s = load_memory(buf, got, name ? name : path, desc, out, halvings);
     free(buf);
+    if (s != LX_OK && halvings)
+        *halvings = 0;
     return s;
+}
+
+lx_status lx_image_load(const char *path, const lx_image_load_desc *desc, lx_image *out)
+{
+    /* Files are read whole: every decoder here works from memory. */
+    return lx_image_load_halved(path, NULL, 0, path, desc, out, NULL);
 }
 
 /* ---- writing ------------------------------------------------------------- */

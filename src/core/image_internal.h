@@ -51,6 +51,7 @@ typedef struct lx_img_budget {
     uint64_t max_pixels;
     int want_channels;
     uint64_t keep_pixels;
+    int *halvings; /* where the reader that reduces says how often (may be NULL) */
 } lx_img_budget;
 
 /* Checked by every reader once it has the header's size and before it

@@ -445,7 +445,7 @@ lx_status lx_img_load_stb(const unsigned char *data, size_t size, const char *na
     /* the float image at the size kept: the decoded samples are converted
      * (and averaged, when reduced) straight into it, then let go */
     int kw, kh;
-    lx_img_reduced_size(w, h, budget->keep_pixels, &kw, &kh, NULL);
+    lx_img_reduced_size(w, h, budget->keep_pixels, &kw, &kh, budget->halvings);
     s = lx_image_alloc(out, kw, kh, comp);
     if (s != LX_OK) {
         stbi_image_free(pixels);
