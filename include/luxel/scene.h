@@ -290,7 +290,14 @@ lx_scene_load_desc lx_scene_load_desc_defaults(const lx_scene_load_desc *desc);
  * material whose KHR_texture_transform cannot be told (assimp's material
  * matches none of the file's through the scene's meshes, and the file's
  * materials of its name state different transforms) fails the load with
- * LX_ERR_UNSUPPORTED naming the material rather than take a wrong one. */
+ * LX_ERR_UNSUPPORTED naming the material rather than take a wrong one.
+ * Textures are decoded after the geometry, one at a time, into the
+ * scene's materials, at the size desc's texture density leaves them
+ * (LX_TEXTURE_TEXELS_PER_TEXEL); memory while one loads: its file, its
+ * decoded 8-bit (16-bit, float for HDR) samples and its float image as
+ * kept. A texture that cannot be read or is larger than
+ * LX_SCENE_TEXTURE_MAX_PIXELS is a warning and its material goes
+ * without it. */
 lx_status lx_scene_load(const char *path, const lx_scene_load_desc *desc, lx_scene **out);
 
 /* An empty scene named name (used in messages). */
