@@ -138,6 +138,14 @@ typedef struct lx_image_load_desc {
     uint64_t max_pixels; /* refuse an image of more pixels (width * height)
                             than this, from its header, before decoding;
                             0 = no cap but the memory */
+    uint64_t keep_pixels; /* reduce on load: halve both sides (rounding up)
+                             while the half still holds this many pixels,
+                             each pixel the area average of the file's
+                             pixels under it, taken of the values loaded
+                             (linear light after the sRGB decoding, raw
+                             values with raw_8bit, alpha as stored); an
+                             image of fewer than 4 x keep_pixels pixels
+                             stays as stored; 0 = as stored */
 } lx_image_load_desc;
 
 /* A copy of desc (or of zeros when NULL) with every default filled in. */
@@ -149,7 +157,11 @@ lx_image_load_desc lx_image_load_desc_defaults(const lx_image_load_desc *desc);
  * (LX_ERR_UNSUPPORTED) and against the memory the process may use for
  * the decoder's buffer, the image and its channel conversion together
  * (LX_ERR_NOMEM); either message names the file, its width x height and
- * (for memory) the bytes asked. */
+ * (for memory) the bytes asked. With desc->keep_pixels, PNG, JPEG, TGA
+ * and HDR files are reduced as their decoded samples are converted, so
+ * no float image of the file's size is ever made (memory: the decoder's
+ * samples and the reduced image); EXR and PFM are decoded whole, then
+ * reduced. */
 lx_status lx_image_load(const char *path, const lx_image_load_desc *desc, lx_image *out);
 /* Same from memory; name is used in messages. */
 lx_status lx_image_load_memory(const void *bytes, size_t size, const char *name,

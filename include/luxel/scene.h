@@ -149,6 +149,11 @@ typedef struct lx_material {
      * every material is unlit and that encloses the scene is a sky dome
      * (lx_scene_mark_sky_domes). */
     bool unlit;
+    /* Times each map was halved on load (lx_scene_load_desc's texture
+     * density), 0 = as its file holds it. Heights integrated from the
+     * normal map search a radius of that many fewer texels (the same
+     * distance on the surface). */
+    int base_color_map_halvings, normal_map_halvings, emissive_map_halvings;
 } lx_material;
 
 /* How a bake treats a node: what Unity's Cast Shadows, Receive GI,
@@ -252,6 +257,24 @@ typedef struct lx_scene {
  * material goes without the map, as for any texture that does not load. */
 #define LX_SCENE_TEXTURE_MAX_PIXELS ((uint64_t)8192 * 8192)
 
+/* Textures at the resolution a bake reads them (lx_scene_load_desc's
+ * texture_density): each texture is halved on load (lx_image_load_desc's
+ * keep_pixels, an area average) while every node reading it keeps at
+ * least LX_TEXTURE_TEXELS_PER_TEXEL texture texels across each of its
+ * lightmap texels - over the node's triangles that read it, texture
+ * pixels x UV area (under the texture's transform; repeats count) >=
+ * LX_TEXTURE_TEXELS_PER_TEXEL^2 x density^2 x world area - and while it
+ * keeps LX_TEXTURE_MIN_PIXELS pixels (256 x 256): a texture of at most
+ * 512 x 512 pixels is decoded as it always was. A texture whose readers'
+ * UVs have no area is kept whole; one no node reads keeps the minimum. */
+#define LX_TEXTURE_TEXELS_PER_TEXEL 2
+#define LX_TEXTURE_MIN_PIXELS ((uint64_t)256 * 256)
+
+/* The lightmap texel density (texels per metre) a bake will give node of
+ * scene, whose geometry and nodes are loaded; 0 when its textures are
+ * read at no particular density (it then keeps its textures whole). */
+typedef float (*lx_texture_density_fn)(void *user, const lx_scene *scene, uint32_t node);
+
 typedef struct lx_scene_load_desc {
     bool strict;        /* fail (LX_ERR_FORMAT) on zero-area triangles instead
                            of dropping them with one warning */
@@ -261,6 +284,15 @@ typedef struct lx_scene_load_desc {
                             material libraries) wherever they are; by
                             default only files in the scene file's folder
                             or below it are read, others fail the load */
+    float texture_density; /* > 0: the lightmap texels per metre the scene
+                              will be baked at; textures are decoded no
+                              finer than that needs (LX_TEXTURE_TEXELS_PER_TEXEL);
+                              0 = every texture as its file holds it */
+    lx_texture_density_fn texture_density_fn; /* or the density of each node,
+                              called once per node after the geometry is
+                              loaded and before any texture is decoded;
+                              overrides texture_density; may be NULL */
+    void *texture_density_user; /* passed to texture_density_fn */
 } lx_scene_load_desc;
 
 /* A copy of desc (or of zeros when NULL) with every default filled in. */
@@ -296,7 +328,14 @@ lx_scene_load_desc lx_scene_load_desc_defaults(const lx_scene_load_desc *desc);
  * material whose KHR_texture_transform cannot be told (assimp's material
  * matches none of the file's through the scene's meshes, and the file's
  * materials of its name state different transforms) fails the load with
- * LX_ERR_UNSUPPORTED naming the material rather than take a wrong one. */
+ * LX_ERR_UNSUPPORTED naming the material rather than take a wrong one.
+ * Textures are decoded after the geometry, one at a time, into the
+ * scene's materials, at the size desc's texture density leaves them
+ * (LX_TEXTURE_TEXELS_PER_TEXEL); memory while one loads: its file, its
+ * decoded 8-bit (16-bit, float for HDR) samples and its float image as
+ * kept. A texture that cannot be read or is larger than
+ * LX_SCENE_TEXTURE_MAX_PIXELS is a warning and its material goes
+ * without it. */
 lx_status lx_scene_load(const char *path, const lx_scene_load_desc *desc, lx_scene **out);
 
 /* An empty scene named name (used in messages). */

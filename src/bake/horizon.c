@@ -45,7 +45,8 @@ static bool material_progress(void *user, float f)
 /* The heights of mat integrated from its normal map (the named file, or
  * its own normal texture), in texels times *strength_out's factor. */
 static lx_status heights_from_normals(const lx_material *mat, const lx_bake_desc *desc,
-                                      horizon_progress *hp, lx_image *height, float *scale)
+                                      horizon_progress *hp, lx_image *height, float *scale,
+                                      int *radius)
 {
     lx_image normals;
     lx_status st;
@@ -63,6 +64,15 @@ static lx_status heights_from_normals(const lx_material *mat, const lx_bake_desc
         const char *name = mat->normal_map_path ? mat->normal_map_path : "normal texture";
         st = lx_normal_decode(&mat->normal_map, name, &normals);
         *scale *= mat->normal_scale > 0.0f ? mat->normal_scale : 1.0f;
+        /* a map halved on load (lx_scene_load_desc's texture density):
+         * its heights keep their slopes (in texels of the map as kept),
+         * and the horizon is searched over the same distance on the
+         * surface, so over fewer of its texels */
+        if (mat->normal_map_halvings > 0) {
+            lx_horizon_desc given = lx_horizon_desc_defaults(NULL);
+            int h = mat->normal_map_halvings < 30 ? mat->normal_map_halvings : 30;
+            *radius = given.radius >> h > 2 ? given.radius >> h : 2;
+        }
     }
     if (st != LX_OK)
         return st;
@@ -102,14 +112,16 @@ lx_status lx_bake_horizon_load(const lx_scene *scene, const lx_bake_desc *desc,
         horizon_progress hp = {desc, from, mid};
         lx_image height;
         float strength = mat->height_strength;
+        int radius = 0; /* the default */
         if (mat->height_from_normals)
-            st = heights_from_normals(mat, desc, &hp, &height, &strength);
+            st = heights_from_normals(mat, desc, &hp, &height, &strength, &radius);
         else
             st = lx_height_load(mat->height_map_path, &height);
         if (st == LX_OK) {
             hp.from = mid;
             hp.to = to;
             lx_horizon_desc d = {.strength = strength,
+                                 .radius = radius,
                                  .wrap = LX_WRAP_REPEAT,
                                  .threads = desc->threads,
                                  .progress = desc->progress ? material_progress : NULL,

@@ -213,7 +213,7 @@ static const char *format_title(lx_image_format f)
 /* ---- loading ----------------------------------------------------------------- */
 
 lx_status lx_img_check_size(const lx_img_budget *budget, const char *name, int64_t w, int64_t h,
-                            int stored_channels, uint64_t decoder_bytes)
+                            int stored_channels, uint64_t decoder_bytes, bool floats_first)
 {
     if (w < 1 || h < 1 || w > INT_MAX || h > INT_MAX)
         return lx_fail(LX_ERR_FORMAT, "%s: invalid image size %lldx%lld", name, (long long)w,
@@ -228,9 +228,15 @@ lx_status lx_img_check_size(const lx_img_budget *budget, const char *name, int64
      * stored image and its conversion; each term < 2^62 * 16 would
      * overflow, so the sum is taken in double and clamped */
     int want = budget->want_channels;
-    double stored = (double)pixels * stored_channels * sizeof(float);
-    double converted = want && want != stored_channels ? (double)pixels * want * sizeof(float) : 0;
-    double after = converted > (double)decoder_bytes ? converted : (double)decoder_bytes;
+    int kw, kh;
+    lx_img_reduced_size((int)w, (int)h, budget->keep_pixels, &kw, &kh, NULL);
+    double kept = (double)kw * (double)kh;
+    double stored = kept * stored_channels * sizeof(float);
+    double converted = want && want != stored_channels ? kept * want * sizeof(float) : 0;
+    double decoder = (double)decoder_bytes;
+    if (floats_first && kept < (double)pixels) /* the file's size in floats, then reduced */
+        decoder += (double)pixels * stored_channels * sizeof(float);
+    double after = converted > decoder ? converted : decoder;
     double total = stored + after;
     char what[96];
     snprintf(what, sizeof what, "image %lldx%lld (%d channels)", (long long)w, (long long)h,
@@ -299,6 +305,42 @@ static lx_status convert_channels(lx_image *img, int want, const char *name)
     return LX_OK;
 }
 
+/* EXR and PFM decode to floats at the file's size: reduced afterwards
+ * (the stb formats are reduced by their reader, before any float image
+ * of the file's size exists). */
+typedef struct float_rows {
+    const lx_image *img;
+} float_rows;
+
+static void float_row(void *ctx, int y, float *row)
+{
+    const lx_image *img = ((const float_rows *)ctx)->img;
+    size_t n = (size_t)img->width * (size_t)img->channels;
+    memcpy(row, img->data + (size_t)y * n, sizeof(float) * n);
+}
+
+static lx_status reduce_floats(lx_image *img, uint64_t keep_pixels, const char *name,
+                               int *halvings)
+{
+    int w, h;
+    lx_img_reduced_size(img->width, img->height, keep_pixels, &w, &h, halvings);
+    if (w == img->width && h == img->height)
+        return LX_OK;
+    lx_image out;
+    lx_status s = lx_image_alloc(&out, w, h, img->channels);
+    float_rows rows = {img};
+    if (s == LX_OK)
+        s = lx_img_reduce(img->width, img->height, img->channels, float_row, &rows, &out);
+    if (s != LX_OK) {
+        lx_image_free(&out);
+        lx_error_prefix(name);
+        return s;
+    }
+    lx_image_free(img);
+    *img = out;
+    return LX_OK;
+}
+
 lx_image_load_desc lx_image_load_desc_defaults(const lx_image_load_desc *desc)
 {
     lx_image_load_desc d = {0};
@@ -307,11 +349,11 @@ lx_image_load_desc lx_image_load_desc_defaults(const lx_image_load_desc *desc)
     return d; /* every field's zero is its default: as stored, sRGB-decoded, finite */
 }
 
-lx_status lx_image_load_memory(const void *bytes, size_t size, const char *name,
-                               const lx_image_load_desc *desc, lx_image *out)
+static lx_status load_memory(const void *bytes, size_t size, const char *name,
+                             const lx_image_load_desc *desc, lx_image *out, int *halvings)
 {
     if (!bytes)
-        return lx_fail_null(__func__, "bytes");
+        return lx_fail_null("lx_image_load_memory", "bytes");
     if (!out)
         return lx_fail(LX_ERR_INVALID, "lx_image_load_memory: out is NULL");
     memset(out, 0, sizeof *out);
@@ -340,7 +382,10 @@ lx_status lx_image_load_memory(const void *bytes, size_t size, const char *name,
         format = LX_IMAGE_TGA;
     }
 
-    lx_img_budget budget = {.max_pixels = d.max_pixels, .want_channels = d.channels};
+    lx_img_budget budget = {.max_pixels = d.max_pixels,
+                            .want_channels = d.channels,
+                            .keep_pixels = d.keep_pixels,
+                            .halvings = halvings};
     lx_status s;
     switch (format) {
     case LX_IMAGE_EXR:
@@ -355,6 +400,8 @@ lx_status lx_image_load_memory(const void *bytes, size_t size, const char *name,
     }
     if (s == LX_OK && !d.keep_nonfinite)
         s = check_finite(out, name);
+    if (s == LX_OK && (format == LX_IMAGE_EXR || format == LX_IMAGE_PFM))
+        s = reduce_floats(out, d.keep_pixels, name, halvings);
     if (s == LX_OK)
         s = convert_channels(out, d.channels, name);
     if (s != LX_OK)
@@ -362,23 +409,41 @@ lx_status lx_image_load_memory(const void *bytes, size_t size, const char *name,
     return s;
 }
 
-lx_status lx_image_load(const char *path, const lx_image_load_desc *desc, lx_image *out)
+lx_status lx_image_load_memory(const void *bytes, size_t size, const char *name,
+                               const lx_image_load_desc *desc, lx_image *out)
 {
+    return load_memory(bytes, size, name, desc, out, NULL);
+}
+
+lx_status lx_image_load_halved(const char *path, const void *bytes, size_t size, const char *name,
+                               const lx_image_load_desc *desc, lx_image *out, int *halvings)
+{
+    if (halvings)
+        *halvings = 0;
+    if (bytes)
+        return load_memory(bytes, size, name, desc, out, halvings);
     if (out)
         memset(out, 0, sizeof *out);
     if (!path || !out)
         return lx_fail(LX_ERR_INVALID, "lx_image_load: path and out must not be NULL");
-    /* Files are read whole: every decoder here works from memory. */
     uint64_t limit = (uint64_t)1 << 36; /* 64 GiB */
     size_t max_size = limit > SIZE_MAX ? SIZE_MAX : (size_t)limit;
     char *buf;
-    size_t size;
-    lx_status s = lx_read_file(path, max_size, &buf, &size);
+    size_t got;
+    lx_status s = lx_read_file(path, max_size, &buf, &got);
     if (s != LX_OK)
         return s;
-    s = lx_image_load_memory(buf, size, path, desc, out);
+    s = load_memory(buf, got, name ? name : path, desc, out, halvings);
     free(buf);
+    if (s != LX_OK && halvings)
+        *halvings = 0;
     return s;
+}
+
+lx_status lx_image_load(const char *path, const lx_image_load_desc *desc, lx_image *out)
+{
+    /* Files are read whole: every decoder here works from memory. */
+    return lx_image_load_halved(path, NULL, 0, path, desc, out, NULL);
 }
 
 /* ---- writing ------------------------------------------------------------- */

@@ -284,7 +284,7 @@ static lx_status read_part(exr_reader *r)
     if (s != LX_OK)
         return s;
     /* the decoder's buffers hold one chunk at a time: small beside the image */
-    s = lx_img_check_size(r->budget, r->name, w, h, r->map.channels, 0);
+    s = lx_img_check_size(r->budget, r->name, w, h, r->map.channels, 0, true);
     if (s != LX_OK)
         return s;
     s = lx_image_alloc(r->img, (int)w, (int)h, r->map.channels);

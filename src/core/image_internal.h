@@ -44,21 +44,42 @@ LX_IMG_HIDDEN bool lx_img_progress_add(lx_img_progress *p, uint64_t units);
 /* Whether the callback has asked to stop. */
 LX_IMG_HIDDEN bool lx_img_progress_stopped(lx_img_progress *p);
 
-/* What a load may take: the caller's pixel cap (0: none) and the
- * channels the image is converted to afterwards (0: as stored). */
+/* What a load may take: the caller's pixel cap (0: none), the channels
+ * the image is converted to afterwards (0: as stored) and the pixels a
+ * reduction keeps (lx_image_load_desc.keep_pixels, 0: as stored). */
 typedef struct lx_img_budget {
     uint64_t max_pixels;
     int want_channels;
+    uint64_t keep_pixels;
+    int *halvings; /* where the reader that reduces says how often (may be NULL) */
 } lx_img_budget;
 
 /* Checked by every reader once it has the header's size and before it
  * decodes: width * height against the cap, then the memory of the whole
  * load (decoder_bytes, the reader's own buffers, beside the float image of
- * stored_channels, then the converted image beside that) against what
- * the process may use. The message names the file, its size and the
- * bytes asked. */
+ * stored_channels at the size budget->keep_pixels leaves, then the
+ * converted image beside that) against what the process may use; a
+ * reader that makes the float image at the file's size before reducing
+ * it says so with floats_first. The message names the file, its size and
+ * the bytes asked. */
 LX_IMG_HIDDEN lx_status lx_img_check_size(const lx_img_budget *budget, const char *name, int64_t w,
-                                          int64_t h, int stored_channels, uint64_t decoder_bytes);
+                                          int64_t h, int stored_channels, uint64_t decoder_bytes,
+                                          bool floats_first);
+
+/* The size an image of width x height is reduced to for keep_pixels
+ * (image_reduce.c): halved (sides rounded up) while the half still holds
+ * keep_pixels pixels; keep_pixels 0 leaves it as it is. *halvings (may be
+ * NULL) gets the number of halvings. */
+LX_IMG_HIDDEN void lx_img_reduced_size(int width, int height, uint64_t keep_pixels, int *out_w,
+                                       int *out_h, int *halvings);
+/* Source row y (0..height-1) of `channels` floats a pixel into row (width
+ * x channels floats): the values the load returns. */
+typedef void (*lx_img_row_fn)(void *ctx, int y, float *row);
+/* Fills out (allocated at its reduced size, `channels` channels) with the
+ * area average of the width x height source read through row, a row at
+ * a time. */
+LX_IMG_HIDDEN lx_status lx_img_reduce(int width, int height, int channels, lx_img_row_fn row,
+                                      void *ctx, lx_image *out);
 
 /* Readers. name is used in messages only; data holds size bytes; is_tga
  * says the stb reader got a TGA (which has no signature). Each checks the

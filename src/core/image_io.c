@@ -356,6 +356,37 @@ static bool is_alpha(int c, int channels)
     return (channels == 2 || channels == 4) && c == channels - 1;
 }
 
+/* stb's decoded samples a row at a time as the floats a load returns:
+ * HDR as they are, 16-bit and 8-bit samples mapped to [0,1] and
+ * sRGB-decoded but for alpha and raw data. */
+typedef struct stb_rows {
+    const void *pixels;
+    int width, channels;
+    bool hdr, wide;
+    bool linear[4]; /* channel c taken without the sRGB decoding */
+    float to_linear[256], to_unit[256];
+} stb_rows;
+
+static void stb_row(void *ctx, int y, float *row)
+{
+    const stb_rows *r = ctx;
+    int c = r->channels;
+    size_t n = (size_t)r->width * (size_t)c, at = (size_t)y * n;
+    if (r->hdr) {
+        memcpy(row, (const float *)r->pixels + at, n * sizeof(float));
+    } else if (r->wide) {
+        const stbi_us *p = (const stbi_us *)r->pixels + at;
+        for (size_t i = 0; i < n; i++) {
+            float v = (float)p[i] / 65535.0f;
+            row[i] = r->linear[i % (size_t)c] ? v : lx_srgb_to_linear(v);
+        }
+    } else {
+        const stbi_uc *p = (const stbi_uc *)r->pixels + at;
+        for (size_t i = 0; i < n; i++)
+            row[i] = r->linear[i % (size_t)c] ? r->to_unit[p[i]] : r->to_linear[p[i]];
+    }
+}
+
 lx_status lx_img_load_stb(const unsigned char *data, size_t size, const char *name, bool is_tga,
                           bool raw_8bit, const lx_img_budget *budget, lx_image *out)
 {
@@ -390,7 +421,7 @@ lx_status lx_img_load_stb(const unsigned char *data, size_t size, const char *na
     double sample = hdr ? sizeof(float) : wide ? 2 : 1;
     double decoder = 2.0 * (double)w * (double)h * (comp > 0 ? comp : 4) * sample;
     s = lx_img_check_size(budget, name, w, h, comp > 0 ? comp : 4,
-                          decoder >= 1.8e19 ? UINT64_MAX : (uint64_t)decoder);
+                          decoder >= 1.8e19 ? UINT64_MAX : (uint64_t)decoder, false);
     if (s != LX_OK)
         return s;
     /* inflating a PNG's whole stream: once its size is known to fit */
@@ -411,36 +442,35 @@ lx_status lx_img_load_stb(const unsigned char *data, size_t size, const char *na
     if (!pixels)
         return stb_failure(name);
 
-    s = lx_image_alloc(out, w, h, comp);
+    /* the float image at the size kept: the decoded samples are converted
+     * (and averaged, when reduced) straight into it, then let go */
+    int kw, kh;
+    lx_img_reduced_size(w, h, budget->keep_pixels, &kw, &kh, budget->halvings);
+    s = lx_image_alloc(out, kw, kh, comp);
     if (s != LX_OK) {
         stbi_image_free(pixels);
         lx_error_prefix(name);
         return s;
     }
-    size_t n = (size_t)w * (size_t)h * (size_t)comp;
-    if (hdr) {
-        memcpy(out->data, pixels, n * sizeof(float));
-    } else if (wide) {
-        const stbi_us *p = pixels;
-        for (size_t i = 0; i < n; i++) {
-            float v = (float)p[i] / 65535.0f;
-            bool linear = raw_8bit || is_alpha((int)(i % (size_t)comp), comp);
-            out->data[i] = linear ? v : lx_srgb_to_linear(v);
-        }
+    stb_rows rows = {.pixels = pixels, .width = w, .channels = comp, .hdr = hdr, .wide = wide};
+    for (int k = 0; k < 256; k++) {
+        rows.to_unit[k] = (float)k / 255.0f;
+        rows.to_linear[k] = raw_8bit ? rows.to_unit[k] : lx_srgb_to_linear(rows.to_unit[k]);
+    }
+    for (int c = 0; c < comp; c++)
+        rows.linear[c] = raw_8bit || is_alpha(c, comp);
+    if (kw == w && kh == h) {
+        for (int y = 0; y < h; y++)
+            stb_row(&rows, y, out->data + (size_t)y * (size_t)w * (size_t)comp);
     } else {
-        float to_linear[256], to_unit[256];
-        for (int k = 0; k < 256; k++) {
-            to_unit[k] = (float)k / 255.0f;
-            to_linear[k] = raw_8bit ? to_unit[k] : lx_srgb_to_linear(to_unit[k]);
-        }
-        const stbi_uc *p = pixels;
-        for (size_t i = 0; i < n; i++) {
-            bool alpha = is_alpha((int)(i % (size_t)comp), comp);
-            out->data[i] = alpha ? to_unit[p[i]] : to_linear[p[i]];
+        s = lx_img_reduce(w, h, comp, stb_row, &rows, out);
+        if (s != LX_OK) {
+            lx_image_free(out);
+            lx_error_prefix(name);
         }
     }
     stbi_image_free(pixels);
-    return LX_OK;
+    return s;
 }
 
 /* ---- writing ------------------------------------------------------------- */

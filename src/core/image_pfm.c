@@ -144,7 +144,7 @@ lx_status lx_img_load_pfm(const unsigned char *data, size_t size, const char *na
     if (have > need)
         lx_log(LX_LOG_WARN, "%s: %zu bytes after the pixels ignored", name, have - need);
     /* the pixels are read from the file's bytes: no buffer of the reader's */
-    s = lx_img_check_size(budget, name, width, height, channels, 0);
+    s = lx_img_check_size(budget, name, width, height, channels, 0, true);
     if (s != LX_OK)
         return s;
 

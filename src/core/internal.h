@@ -106,6 +106,13 @@ void lx_out_abort(lx_out_file *f);
  * the NUL). Fails with LX_ERR_IO naming the path. max_size bounds the read. */
 lx_status lx_read_file(const char *path, size_t max_size, char **out, size_t *out_size);
 
+/* lx_image_load / lx_image_load_memory that also tell how many times
+ * desc->keep_pixels halved the image (*halvings, may be NULL; 0 on
+ * failure): the scene's textures record it (image.c). path is read when
+ * bytes is NULL. */
+lx_status lx_image_load_halved(const char *path, const void *bytes, size_t size, const char *name,
+                               const lx_image_load_desc *desc, lx_image *out, int *halvings);
+
 /* The folder part of a path (malloc'd; "." when none). */
 char *lx_path_dirname(const char *path);
 /* False when path resolves (symbolic links followed; with backslashes

@@ -14,6 +14,7 @@
 #include "gltf_json.h"
 #include "node_bake.h"
 #include "import_checks.h"
+#include "texture_size.h"
 #include "json_text.h"
 #include "node_graph.h"
 
@@ -59,7 +60,20 @@ typedef struct import_ctx {
     uint32_t dropped, dropped_meshes; /* zero-area triangles left out, and their meshes */
     char first_dropped[LX_NAME_MAX];  /* the first mesh with one ... */
     unsigned first_dropped_face;      /* ... and its face */
+    /* textures named by materials, decoded once the geometry is known */
+    struct texture_request *textures;
+    size_t texture_count, texture_capacity;
 } import_ctx;
+
+/* A material's texture to decode: map slot (texture_size.h) of scene
+ * material `material`, named as assimp names it ("*N" embedded). */
+typedef struct texture_request {
+    uint32_t material;
+    int slot;
+    bool raw;
+    const char *what; /* "normal", "base colour", "emissive" */
+    char *name;
+} texture_request;
 
 /* ---- running assimp ------------------------------------------------------ */
 
@@ -549,20 +563,67 @@ static bool has_extension(const char *path, const char *ext)
     return n >= e && strcasecmp(path + n - e, ext) == 0;
 }
 
-/* Loads a texture named by a material: "*N" is embedded in the file, other
- * paths are relative to the scene's folder. Failures are warnings: the
- * material then goes without the map. With skip_textures only the name is
- * kept. */
-static void load_texture(import_ctx *c, const struct aiString *tex_path, bool raw, const char *what,
-                         const char *material, lx_image *out, char **out_path)
+/* A texture named by a material, for map slot of the material being
+ * imported (the scene's next): with skip_textures only its name is kept,
+ * else it is decoded with the others once the geometry is known
+ * (decode_textures), at the size the desc's density needs. */
+static lx_status request_texture(import_ctx *c, const struct aiString *tex_path, bool raw,
+                                 const char *what, int slot, char **out_path)
 {
     const char *p = tex_path->data;
     if (c->desc->skip_textures) {
         *out_path = p[0] == '*' ? lx_strdup(p) : lx_path_join(c->folder, p);
-        return;
+        return LX_OK;
     }
-    lx_image_load_desc ld = {
-        .raw_8bit = raw, .channels = raw ? 3 : 4, .max_pixels = LX_SCENE_TEXTURE_MAX_PIXELS};
+    if (c->texture_count == c->texture_capacity) {
+        size_t cap = c->texture_capacity ? 2 * c->texture_capacity : 8;
+        texture_request *t = realloc(c->textures, cap * sizeof *t);
+        if (!t)
+            return lx_fail(LX_ERR_NOMEM, "%s: out of memory", c->path);
+        c->textures = t;
+        c->texture_capacity = cap;
+    }
+    char *name = lx_strdup(p);
+    if (!name)
+        return lx_fail(LX_ERR_NOMEM, "%s: out of memory", c->path);
+    c->textures[c->texture_count++] =
+        (texture_request){c->scene->material_count, slot, raw, what, name};
+    return LX_OK;
+}
+
+/* The material being imported goes without map slot after all. */
+static void drop_texture(import_ctx *c, int slot)
+{
+    for (size_t i = 0; i < c->texture_count; i++) {
+        texture_request *t = &c->textures[i];
+        if (t->material == c->scene->material_count && t->slot == slot && t->name) {
+            free(t->name);
+            t->name = NULL;
+        }
+    }
+}
+
+static void free_textures(import_ctx *c)
+{
+    for (size_t i = 0; i < c->texture_count; i++)
+        free(c->textures[i].name);
+    free(c->textures);
+    c->textures = NULL;
+    c->texture_count = c->texture_capacity = 0;
+}
+
+/* Decodes a texture named by a material: "*N" is embedded in the file,
+ * other paths are relative to the scene's folder; keep_pixels as
+ * lx_image_load_desc's. Failures are warnings: the material then goes
+ * without the map. */
+static void load_texture(import_ctx *c, const char *p, bool raw, const char *what,
+                         const char *material, uint64_t keep_pixels, lx_image *out,
+                         char **out_path, int *halvings)
+{
+    lx_image_load_desc ld = {.raw_8bit = raw,
+                             .channels = raw ? 3 : 4,
+                             .max_pixels = LX_SCENE_TEXTURE_MAX_PIXELS,
+                             .keep_pixels = keep_pixels};
     lx_status st;
     char *full = NULL;
     if (p[0] == '*') {
@@ -583,7 +644,7 @@ static void load_texture(import_ctx *c, const struct aiString *tex_path, bool ra
         }
         char name[LX_NAME_MAX];
         snprintf(name, sizeof name, "%s: embedded texture %ld", c->path, idx);
-        st = lx_image_load_memory(t->pcData, t->mWidth, name, &ld, out);
+        st = lx_image_load_halved(NULL, t->pcData, t->mWidth, name, &ld, out, halvings);
     } else {
         full = lx_path_join(c->folder, p);
         if (!full)
@@ -612,7 +673,7 @@ static void load_texture(import_ctx *c, const struct aiString *tex_path, bool ra
             free(full);
             return;
         }
-        st = lx_image_load(full, &ld, out);
+        st = lx_image_load_halved(full, NULL, 0, full, &ld, out, halvings);
     }
     if (st != LX_OK) {
         lx_log(LX_LOG_WARN, "%s: material '%s': %s texture not loaded (%s); ignored", c->path,
@@ -622,6 +683,48 @@ static void load_texture(import_ctx *c, const struct aiString *tex_path, bool ra
         return;
     }
     *out_path = full ? full : lx_strdup(p);
+}
+
+/* Decodes the textures the materials named, straight into the scene's
+ * materials, now that its nodes and meshes say how finely each is read
+ * (lx_texture_keep_pixels), one at a time: a texture is decoded and
+ * reduced before the next one's file is read. */
+static lx_status decode_textures(import_ctx *c)
+{
+    if (!c->texture_count)
+        return LX_OK;
+    lx_scene *s = c->scene;
+    uint64_t *keep = calloc((size_t)s->material_count * LX_TEXTURE_SLOTS + 1, sizeof *keep);
+    if (!keep)
+        return lx_fail(LX_ERR_NOMEM, "%s: out of memory", c->path);
+    lx_status st = lx_texture_keep_pixels(s, c->desc, keep);
+    for (size_t i = 0; i < c->texture_count && st == LX_OK; i++) {
+        const texture_request *t = &c->textures[i];
+        if (!t->name || t->material >= s->material_count)
+            continue;
+        lx_material *m = &s->materials[t->material];
+        lx_image *img = t->slot == LX_TEXTURE_NORMAL       ? &m->normal_map
+                        : t->slot == LX_TEXTURE_BASE_COLOR ? &m->base_color_map
+                                                           : &m->emissive_map;
+        char **path = t->slot == LX_TEXTURE_NORMAL       ? &m->normal_map_path
+                      : t->slot == LX_TEXTURE_BASE_COLOR ? &m->base_color_map_path
+                                                         : &m->emissive_map_path;
+        int *halvings = t->slot == LX_TEXTURE_NORMAL       ? &m->normal_map_halvings
+                        : t->slot == LX_TEXTURE_BASE_COLOR ? &m->base_color_map_halvings
+                                                           : &m->emissive_map_halvings;
+        int set = t->slot == LX_TEXTURE_NORMAL       ? m->normal_uv_set
+                  : t->slot == LX_TEXTURE_BASE_COLOR ? m->base_color_uv_set
+                                                     : m->emissive_uv_set;
+        load_texture(c, t->name, t->raw, t->what, m->name,
+                     keep[(size_t)t->material * LX_TEXTURE_SLOTS + (size_t)t->slot], img, path,
+                     halvings);
+        /* the sets of the maps luxel samples are read too (as
+         * lx_scene_add_material counts them) */
+        if (img->width > 0 && set >= 0 && set < 32)
+            m->uv_sets_read |= 1u << set;
+    }
+    free(keep);
+    return st;
 }
 
 /* ---- assimp's glTF 2.0 meshes and materials in the file ----------------- */
@@ -1049,7 +1152,9 @@ static lx_status import_materials(import_ctx *c)
         unsigned uv = 0;
         if (aiGetMaterialTexture(am, aiTextureType_NORMALS, 0, &tex, NULL, &uv, NULL, NULL, NULL,
                                  NULL) == aiReturn_SUCCESS) {
-            load_texture(c, &tex, true, "normal", name_buf, &m.normal_map, &m.normal_map_path);
+            st = request_texture(c, &tex, true, "normal", LX_TEXTURE_NORMAL, &m.normal_map_path);
+            if (st != LX_OK)
+                return st;
             if (ref_normal.present) {
                 uv = ref_normal.tex_coord;
                 m.normal_transform = ref_normal.transform;
@@ -1068,8 +1173,12 @@ static lx_status import_materials(import_ctx *c)
                                  NULL) == aiReturn_SUCCESS ||
             aiGetMaterialTexture(am, aiTextureType_DIFFUSE, 0, &tex, NULL, &uv, NULL, NULL, NULL,
                                  NULL) == aiReturn_SUCCESS) {
-            load_texture(c, &tex, false, "base colour", name_buf, &m.base_color_map,
-                         &m.base_color_map_path);
+            st = request_texture(c, &tex, false, "base colour", LX_TEXTURE_BASE_COLOR,
+                                 &m.base_color_map_path);
+            if (st != LX_OK) {
+                free(m.normal_map_path);
+                return st;
+            }
             if (ref_base.present) {
                 uv = ref_base.tex_coord;
                 m.base_color_transform = ref_base.transform;
@@ -1081,26 +1190,23 @@ static lx_status import_materials(import_ctx *c)
         uv = 0;
         if (aiGetMaterialTexture(am, aiTextureType_EMISSIVE, 0, &tex, NULL, &uv, NULL, NULL, NULL,
                                  NULL) == aiReturn_SUCCESS) {
-            load_texture(c, &tex, false, "emissive", name_buf, &m.emissive_map,
-                         &m.emissive_map_path);
-            if (c->gltf && c->map && c->map->material_of[i] >= 0 &&
+            st = request_texture(c, &tex, false, "emissive", LX_TEXTURE_EMISSIVE,
+                                 &m.emissive_map_path);
+            if (st == LX_OK && c->gltf && c->map && c->map->material_of[i] >= 0 &&
                 (size_t)c->map->material_of[i] < c->map->material_count) {
                 size_t j = (size_t)c->map->material_of[i];
                 lx_gltf_texture_ref ref;
                 st = lx_gltf_material_emissive_texture(c->path, c->map->materials[j], j, &ref);
-                if (st != LX_OK) {
-                    lx_image_free(&m.normal_map);
-                    lx_image_free(&m.base_color_map);
-                    lx_image_free(&m.emissive_map);
-                    free(m.normal_map_path);
-                    free(m.base_color_map_path);
-                    free(m.emissive_map_path);
-                    return st;
-                }
-                if (ref.present) {
+                if (st == LX_OK && ref.present) {
                     uv = ref.tex_coord;
                     m.emissive_transform = ref.transform;
                 }
+            }
+            if (st != LX_OK) {
+                free(m.normal_map_path);
+                free(m.base_color_map_path);
+                free(m.emissive_map_path);
+                return st;
             }
             m.emissive_uv_set = uv < LX_MAX_UV_SETS ? (int)uv : LX_MAX_UV_SETS;
             if (m.emissive_uv_set >= LX_MAX_UV_SETS) {
@@ -1108,7 +1214,7 @@ static lx_status import_materials(import_ctx *c)
                        "%s: material '%s': emissive texture on UV set %u is not supported "
                        "(0 to 7 are); ignored",
                        c->path, name_buf, uv);
-                lx_image_free(&m.emissive_map);
+                drop_texture(c, LX_TEXTURE_EMISSIVE);
                 m.emissive_uv_set = 0;
                 m.emissive_transform = (lx_uv_transform){0};
             }
@@ -1119,12 +1225,12 @@ static lx_status import_materials(import_ctx *c)
                    "supported; ignored",
                    c->path, name_buf);
             if (m.normal_uv_set >= LX_MAX_UV_SETS) {
-                lx_image_free(&m.normal_map);
+                drop_texture(c, LX_TEXTURE_NORMAL);
                 m.normal_uv_set = 0;
                 m.normal_transform = (lx_uv_transform){0};
             }
             if (m.base_color_uv_set >= LX_MAX_UV_SETS) {
-                lx_image_free(&m.base_color_map);
+                drop_texture(c, LX_TEXTURE_BASE_COLOR);
                 m.base_color_uv_set = 0;
                 m.base_color_transform = (lx_uv_transform){0};
             }
@@ -1132,9 +1238,6 @@ static lx_status import_materials(import_ctx *c)
         if (m.normal_scale == 0.0f)
             m.normal_scale = 1.0f;
         st = lx_scene_add_material(c->scene, &m, NULL);
-        lx_image_free(&m.normal_map);
-        lx_image_free(&m.base_color_map);
-        lx_image_free(&m.emissive_map);
         free(m.normal_map_path);
         free(m.base_color_map_path);
         free(m.emissive_map_path);
@@ -1474,6 +1577,7 @@ static lx_status import_scene(const char *path, const import_source *src,
     if (st == LX_OK && *need_log) {
         assimp_release(&im);
         gltf_map_free(&map);
+        free_textures(&c);
         free(c.mesh_map);
         free(c.folder);
         lx_scene_destroy(c.scene);
@@ -1507,6 +1611,8 @@ static lx_status import_scene(const char *path, const import_source *src,
             lx_scene_mark_sky_domes_except(c.scene, decided);
         free(decided);
     }
+    if (st == LX_OK)
+        st = decode_textures(&c);
     if (st == LX_OK && gltf)
         st = lx_gltf_lights_from_json(c.scene, path, gltf);
     if (st == LX_OK && gltf)
@@ -1518,6 +1624,7 @@ static lx_status import_scene(const char *path, const import_source *src,
                path, ai->mNumLights);
     assimp_release(&im);
     gltf_map_free(&map);
+    free_textures(&c);
     free(c.mesh_map);
     free(c.folder);
     if (st != LX_OK) {

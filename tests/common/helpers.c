@@ -1,5 +1,6 @@
 /* Helpers shared by luxel's tests. */
 #define _POSIX_C_SOURCE 200809L
+#define _DEFAULT_SOURCE /* wait4 */
 #include "helpers.h"
 #include "core/internal.h"
 
@@ -17,6 +18,7 @@
 #include <stdio.h>
 #include <stdlib.h>
 #include <string.h>
+#include <sys/resource.h>
 #include <sys/stat.h>
 #include <sys/wait.h>
 #include <unistd.h>
@@ -285,6 +287,12 @@ void lx_test_sibling(const char *name, char *out, size_t size)
 
 int lx_test_run_luxel(const char *const *args, const char *out_log, const char *err_log)
 {
+    return lx_test_run_luxel_rss(args, out_log, err_log, NULL);
+}
+
+int lx_test_run_luxel_rss(const char *const *args, const char *out_log, const char *err_log,
+                          long *max_rss_kb)
+{
     char luxel[4096];
     lx_test_sibling("luxel", luxel, sizeof luxel);
     const char *argv[64] = {luxel};
@@ -305,7 +313,10 @@ int lx_test_run_luxel(const char *const *args, const char *out_log, const char *
     if (rc != 0)
         fail_msg("cannot run %s", luxel);
     int status;
-    assert_int_equal(waitpid(pid, &status, 0), pid);
+    struct rusage ru;
+    assert_int_equal(wait4(pid, &status, 0, &ru), pid);
+    if (max_rss_kb)
+        *max_rss_kb = ru.ru_maxrss; /* kilobytes on Linux */
     return WIFEXITED(status) ? WEXITSTATUS(status) : -1;
 }
 

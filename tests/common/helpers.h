@@ -71,6 +71,10 @@ void lx_test_sibling(const char *name, char *out, size_t size);
  * path: both into one file). Returns its exit status, -1 when a signal
  * ended it; fails the test when it cannot be started. */
 int lx_test_run_luxel(const char *const *args, const char *out_log, const char *err_log);
+/* lx_test_run_luxel that also gives the run's peak resident memory in KiB
+ * (wait4's ru_maxrss of that child alone; max_rss_kb may be NULL). */
+int lx_test_run_luxel_rss(const char *const *args, const char *out_log, const char *err_log,
+                          long *max_rss_kb);
 /* The start of the text file at path into buf (NUL-terminated; "" when it
  * cannot be read). */
 void lx_test_read_text(const char *path, char *buf, size_t size);

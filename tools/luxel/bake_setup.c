@@ -514,6 +514,38 @@ int cli_bake_check_args(const bake_args *a)
     return 0;
 }
 
+/* The lightmap density a node's textures will be read at
+ * (lx_scene_load_desc's texture_density_fn, called while the scene loads,
+ * its geometry known and no texture decoded): --texel-density, or the
+ * density the scene gets by default, or under --resolution N at most N
+ * texels across the node's world area (its lightmap, or the atlas page it
+ * shares, holds N x N texels). */
+typedef struct texture_density_ctx {
+    const bake_args *a;
+    double scene_density; /* cli_default_density, once computed */
+} texture_density_ctx;
+
+static float texture_density(void *user, const lx_scene *scene, uint32_t node)
+{
+    texture_density_ctx *t = user;
+    /* the node's own settings from its glTF extras (the lights JSON's come
+     * after the load): no lightmap reads its textures at no density worth
+     * keeping (the smallest size), a lightmap scale multiplies it */
+    const lx_node_bake *nb = &scene->nodes[node].bake;
+    if (nb->no_lightmap)
+        return 1e-6f;
+    float scale = lx_node_lightmap_scale(nb);
+    if (t->a->desc.texel_density > 0.0f)
+        return t->a->desc.texel_density * scale;
+    if (t->a->has_resolution) {
+        double area = node_area(scene, node);
+        return area > 0.0 ? (float)(t->a->desc.resolution / sqrt(area)) * scale : 0.0f;
+    }
+    if (!(t->scene_density > 0.0))
+        t->scene_density = cli_default_density(scene);
+    return (float)t->scene_density * scale;
+}
+
 int cli_bake_prepare(bake_args *a, cli_progress *progress, lx_scene **scene_out, lx_scene_sky *sky,
                      lx_unwrap **unwrap, bool *atlas, lx_baker **baker)
 {
@@ -525,7 +557,12 @@ int cli_bake_prepare(bake_args *a, cli_progress *progress, lx_scene **scene_out,
     *unwrap = NULL;
     *baker = NULL;
     *atlas = false;
-    lx_scene_load_desc ld = {.strict = a->desc.strict, .allow_any_path = cli_allow_any_path()};
+    /* textures decoded no finer than the lightmaps read them */
+    texture_density_ctx density = {a, 0.0};
+    lx_scene_load_desc ld = {.strict = a->desc.strict,
+                             .allow_any_path = cli_allow_any_path(),
+                             .texture_density_fn = texture_density,
+                             .texture_density_user = &density};
     if (!cli_scene_load(a->scene, &ld, &scene))
         goto done;
     *scene_out = scene;
