@@ -22,6 +22,10 @@ static inline lx_node_settings lx_node_settings_none(void)
     return (lx_node_settings){-1, -1, -1, -1, 0.0f};
 }
 
+/* World bounds of one node's vertices grown into [*lo, *hi]; false (and
+ * the bounds unchanged) when it has none (scene.c). */
+bool lx_node_grow_bounds(const lx_scene *s, const lx_node *node, lx_vec3 *lo, lx_vec3 *hi);
+
 /* The most a lightmap_scale may be (and 1 / it the least). */
 #define LX_NODE_MAX_LIGHTMAP_SCALE 1024.0f
 

@@ -2,6 +2,7 @@
  * validation and programmatic construction. */
 #include "luxel/scene.h"
 #include "core/internal.h"
+#include "node_bake.h"
 
 #include <math.h>
 #include <stddef.h>
@@ -455,14 +456,24 @@ bool lx_scene_bounds(const lx_scene *s, lx_vec3 *lo, lx_vec3 *hi)
         const lx_node *node = &s->nodes[n];
         if (node->bake.sky && !all_sky)
             continue; /* a sky dome is not what the scene spans */
-        for (uint32_t k = 0; k < node->mesh_count; k++) {
-            const lx_mesh *m = &s->meshes[node->meshes[k]];
-            for (uint32_t v = 0; v < m->vertex_count; v++) {
-                lx_vec3 p = lx_mat4_point(&node->world, m->positions[v]);
-                a = lx_v3(fminf(a.x, p.x), fminf(a.y, p.y), fminf(a.z, p.z));
-                b = lx_v3(fmaxf(b.x, p.x), fmaxf(b.y, p.y), fmaxf(b.z, p.z));
-                any = true;
-            }
+        any |= lx_node_grow_bounds(s, node, &a, &b);
+    }
+    *lo = a;
+    *hi = b;
+    return any;
+}
+
+bool lx_node_grow_bounds(const lx_scene *s, const lx_node *node, lx_vec3 *lo, lx_vec3 *hi)
+{
+    bool any = false;
+    lx_vec3 a = *lo, b = *hi;
+    for (uint32_t k = 0; k < node->mesh_count; k++) {
+        const lx_mesh *m = &s->meshes[node->meshes[k]];
+        for (uint32_t v = 0; v < m->vertex_count; v++) {
+            lx_vec3 p = lx_mat4_point(&node->world, m->positions[v]);
+            a = lx_v3(fminf(a.x, p.x), fminf(a.y, p.y), fminf(a.z, p.z));
+            b = lx_v3(fmaxf(b.x, p.x), fmaxf(b.y, p.y), fmaxf(b.z, p.z));
+            any = true;
         }
     }
     *lo = a;

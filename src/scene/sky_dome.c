@@ -45,20 +45,9 @@ static bool node_unlit(const lx_scene *s, const lx_node *node)
 /* World bounds of one node; false when it has no vertices. */
 static bool node_bounds(const lx_scene *s, const lx_node *node, lx_vec3 *lo, lx_vec3 *hi)
 {
-    bool any = false;
-    lx_vec3 a = lx_v3(INFINITY, INFINITY, INFINITY), b = lx_v3(-INFINITY, -INFINITY, -INFINITY);
-    for (uint32_t k = 0; k < node->mesh_count; k++) {
-        const lx_mesh *m = &s->meshes[node->meshes[k]];
-        for (uint32_t v = 0; v < m->vertex_count; v++) {
-            lx_vec3 p = lx_mat4_point(&node->world, m->positions[v]);
-            a = lx_v3(fminf(a.x, p.x), fminf(a.y, p.y), fminf(a.z, p.z));
-            b = lx_v3(fmaxf(b.x, p.x), fmaxf(b.y, p.y), fmaxf(b.z, p.z));
-            any = true;
-        }
-    }
-    *lo = a;
-    *hi = b;
-    return any;
+    *lo = lx_v3(INFINITY, INFINITY, INFINITY);
+    *hi = lx_v3(-INFINITY, -INFINITY, -INFINITY);
+    return lx_node_grow_bounds(s, node, lo, hi);
 }
 
 uint32_t lx_scene_mark_sky_domes_except(lx_scene *s, const bool *decided)

@@ -47,6 +47,18 @@ typedef struct rect {
     double x0, x1, z0, z1, y;
 } rect;
 
+/* A horizontal plane turned to face down (-Y): normals and winding. */
+static void face_down(lx_mesh *m)
+{
+    for (uint32_t v = 0; v < m->vertex_count; v++)
+        m->normals[v] = lx_v3(0.0f, -1.0f, 0.0f);
+    for (uint32_t t = 0; t < 3 * m->triangle_count; t += 3) {
+        uint32_t k = m->indices[t + 1];
+        m->indices[t + 1] = m->indices[t + 2];
+        m->indices[t + 2] = k;
+    }
+}
+
 /* A floor (4 x 4 m, black), an emitter rect r facing down (two triangles,
  * black, luminance le) and, when plate->x1 > plate->x0, a black square
  * plate between them. */
@@ -65,13 +77,8 @@ static lx_scene *emitter_scene(rect r, float le, rect plate, int sub)
         /* [0, 1]^2 onto the rect */
         e.positions[v].x = (float)(r.x0 + (r.x1 - r.x0) * e.positions[v].x);
         e.positions[v].z = (float)(r.z0 + (r.z1 - r.z0) * e.positions[v].z);
-        e.normals[v] = lx_v3(0.0f, -1.0f, 0.0f);
     }
-    for (uint32_t t = 0; t < 3 * e.triangle_count; t += 3) { /* face down */
-        uint32_t k = e.indices[t + 1];
-        e.indices[t + 1] = e.indices[t + 2];
-        e.indices[t + 2] = k;
-    }
+    face_down(&e);
     e.material = glow;
     lx_test_add(scene, &e);
     lx_test_mesh_free(&e);
@@ -418,13 +425,7 @@ static lx_scene *string_scene(float le)
         snprintf(name, sizeof name, "bulb%d", k);
         lx_mesh e = lx_test_plane(name, (float)BULB_SIZE, (float)BULB_HEIGHT, (float)bulb_x(k),
                                   0.0f, 1);
-        for (uint32_t v = 0; v < e.vertex_count; v++)
-            e.normals[v] = lx_v3(0.0f, -1.0f, 0.0f);
-        for (uint32_t t = 0; t < 3 * e.triangle_count; t += 3) { /* face down */
-            uint32_t i = e.indices[t + 1];
-            e.indices[t + 1] = e.indices[t + 2];
-            e.indices[t + 2] = i;
-        }
+        face_down(&e);
         e.material = glow;
         lx_test_add(scene, &e);
         lx_test_mesh_free(&e);
