@@ -403,15 +403,21 @@ static cli_result bench_cli(void)
            si_.triangles, si_.ground_triangles, si_.spheres, g_cli_res, g_cli_res, LIGHTS,
            g_threads);
     printf("  the CLI, timed as a child process from fork to exit: %s bake scene.glb --lights "
-           "lights.json -o out --resolution %d --threads %d -q --bounces 0  (direct light; "
+           "lights.json -o out --resolution %d --threads %d -q --bounces 0 --unwrap never "
+           "--edge-supersample 0  (direct light; "
            "writes an EXR, a PNG preview and the manifest)\n",
            luxel, g_cli_res, g_threads);
 
     char res_s[16], thr_s[16];
     snprintf(res_s, sizeof res_s, "%d", g_cli_res);
     snprintf(thr_s, sizeof thr_s, "%d", g_threads);
-    char *argv[] = {luxel,     "bake",       glb,   "--lights",  json,  "-o", out, "--resolution",
-                    res_s,     "--threads",  thr_s, "-q",        "--bounces", "0", NULL};
+    /* --unwrap never: the spheres, without UVs, stay occluders (auto would
+     * give them lightmaps and pack an atlas); --edge-supersample 0: the
+     * same rays as this process's bake (edge supersampling adds its own) */
+    char *argv[] = {luxel,       "bake",      glb,     "--lights", json,  "-o",
+                    out,         "--resolution", res_s, "--threads", thr_s, "-q",
+                    "--bounces", "0",         "--unwrap", "never", "--edge-supersample", "0",
+                    NULL};
 
     lx_bench_phases best = {INFINITY, INFINITY, INFINITY, INFINITY,
                             INFINITY, INFINITY, INFINITY, INFINITY};
