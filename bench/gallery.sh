@@ -15,6 +15,8 @@
 #   lights.json (and sky.pfm, gen_scenes' clear day) where the scene has none
 #   bake.log   luxel bake SCENE -o OUT/NAME --render [--lights lights.json]
 #   view.png, the lightmaps and their PNG previews, manifest.json
+#   view_close.png: luxel render from a camera closer in, for the scenes whose
+#              default view shows little (an interior seen from outside)
 # and a line in OUT/summary.txt: exit status, seconds, peak memory, texels,
 # texel density, warnings. A lights JSON (bench/gallery/NAME.json) is given
 # only to scenes that carry no lights of their own.
@@ -40,16 +42,17 @@ time_limit=${LUXEL_GALLERY_TIMEOUT:-1800}
 mirror=${LUXEL_GALLERY_MIRROR:-}
 base_url=https://raw.githubusercontent.com
 
-# name|scene file|repository|commit|folder in the repository|licence|author
+# name|scene file|repository|commit|folder in the repository|licence|author|
+# a close-up camera (eye,target for luxel render --camera; empty: none)
 scenes=(
-    "cornell|CornellBox.glb|bevyengine/bevy|4805ca792c3e94eef07afd6fa9a2712f388c9a67|assets/models/CornellBox|MIT OR Apache-2.0|Bevy contributors (Blender export; lit by its emissive ceiling alone)"
-    "mixed_lighting|MixedLightingExample.gltf|bevyengine/bevy|4805ca792c3e94eef07afd6fa9a2712f388c9a67|assets/models/MixedLightingExample|MIT OR Apache-2.0; SheenChair CC-BY-4.0|Bevy contributors; SheenChair (c) 2021 Wayfair LLC (glTF sample models)"
-    "circuit_board|DepthOfFieldExample.glb|bevyengine/bevy|4805ca792c3e94eef07afd6fa9a2712f388c9a67|assets/models/DepthOfFieldExample|MIT OR Apache-2.0|Bevy contributors (sun, emissive lava spheres)"
-    "fog_room|VolumetricFogExample.glb|bevyengine/bevy|4805ca792c3e94eef07afd6fa9a2712f388c9a67|assets/models/VolumetricFogExample|MIT OR Apache-2.0|Bevy contributors (sun through openings)"
-    "zdm2|zdm2.glb|godotengine/godot-demo-projects|cae8dc567a56d3e7936f171bcb85f0ccb9634ad0|3d/global_illumination|CC-BY-4.0|Cube 2: Sauerbraten map zdm2, converted by Hugo Locurcio (Calinou)"
-    "living_room|living_room.glb|godotengine/godot-demo-projects|cae8dc567a56d3e7936f171bcb85f0ccb9634ad0|3d/physical_light_camera_units|MIT|Godot Engine contributors"
-    "truck_town|town_model.gltf|godotengine/godot-demo-projects|cae8dc567a56d3e7936f171bcb85f0ccb9634ad0|3d/truck_town/town/model|MIT|Godot Engine contributors (Godot glTF export, EXT_texture_webp)"
-    "japanese_garden|scene.glb|gkjohnson/3d-demo-data|a79b5400ba8ed5bdeffebc10ce5adeecda7c3ebc|models/japanese-bridge-garden|CC-BY-4.0|\"Japanese Bridge Garden\" by kristenlee (Sketchfab), gltfpack -cc by Garrett Johnson"
+    "cornell|CornellBox.glb|bevyengine/bevy|4805ca792c3e94eef07afd6fa9a2712f388c9a67|assets/models/CornellBox|MIT OR Apache-2.0|Bevy contributors (Blender export; lit by its emissive ceiling alone)|-278,274,1050,-278,274,-280"
+    "mixed_lighting|MixedLightingExample.gltf|bevyengine/bevy|4805ca792c3e94eef07afd6fa9a2712f388c9a67|assets/models/MixedLightingExample|MIT OR Apache-2.0; SheenChair CC-BY-4.0|Bevy contributors; SheenChair (c) 2021 Wayfair LLC (glTF sample models)|"
+    "circuit_board|DepthOfFieldExample.glb|bevyengine/bevy|4805ca792c3e94eef07afd6fa9a2712f388c9a67|assets/models/DepthOfFieldExample|MIT OR Apache-2.0|Bevy contributors (sun, emissive lava spheres)|"
+    "fog_room|VolumetricFogExample.glb|bevyengine/bevy|4805ca792c3e94eef07afd6fa9a2712f388c9a67|assets/models/VolumetricFogExample|MIT OR Apache-2.0|Bevy contributors (sun through openings)|2.6,1.5,-6,-1.5,2,5"
+    "zdm2|zdm2.glb|godotengine/godot-demo-projects|cae8dc567a56d3e7936f171bcb85f0ccb9634ad0|3d/global_illumination|CC-BY-4.0|Cube 2: Sauerbraten map zdm2, converted by Hugo Locurcio (Calinou)|8,10,20,-10,-4,2"
+    "living_room|living_room.glb|godotengine/godot-demo-projects|cae8dc567a56d3e7936f171bcb85f0ccb9634ad0|3d/physical_light_camera_units|MIT|Godot Engine contributors|3.5,2.8,-1.7,-2.5,1.4,2"
+    "truck_town|town_model.gltf|godotengine/godot-demo-projects|cae8dc567a56d3e7936f171bcb85f0ccb9634ad0|3d/truck_town/town/model|MIT|Godot Engine contributors (Godot glTF export, EXT_texture_webp)|60,45,70,-5,0,-20"
+    "japanese_garden|scene.glb|gkjohnson/3d-demo-data|a79b5400ba8ed5bdeffebc10ce5adeecda7c3ebc|models/japanese-bridge-garden|CC-BY-4.0|\"Japanese Bridge Garden\" by kristenlee (Sketchfab), gltfpack -cc by Garrett Johnson|"
 )
 
 # name|path under the scene's folder|sha256
@@ -92,7 +95,7 @@ scene_field() {
     for line in "${scenes[@]}"; do
         IFS='|' read -r -a f <<<"$line"
         if [[ ${f[0]} == "$1" ]]; then
-            printf '%s\n' "${f[$2]}"
+            printf '%s\n' "${f[$2]:-}"
             return 0
         fi
     done
@@ -216,6 +219,12 @@ bake_scene() {
     peak=-
     if [[ -f $dir/time.txt ]] && grep -q '^peak_kb' "$dir/time.txt"; then
         peak=$(awk '/^peak_kb/ { printf "%d", $2 / 1024 }' "$dir/time.txt")
+    fi
+    local camera
+    camera=$(scene_field "$name" 7)
+    if [[ $status == 0 && -n $camera ]]; then
+        "$luxel" render "$scene" --lightmaps "$dir" --camera "$camera" -o "$dir/view_close.png" \
+            "${thread_args[@]}" -q >>"$log" 2>&1 || echo "   luxel render --camera $camera failed" >&2
     fi
     texels=$(sed -n 's/.*luxel: baked .*(\([0-9]*\) texels\{0,1\}.*/\1/p' "$log" | tail -1)
     density=$(sed -n 's/.* at \([0-9.]*\) texels\/m.*/\1/p' "$log" | tail -1)
