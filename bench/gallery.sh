@@ -230,7 +230,7 @@ bake_scene() {
     density=$(sed -n 's/.* at \([0-9.]*\) texels\/m.*/\1/p' "$log" | tail -1)
     warnings=$(grep -c '^luxel: warning:' "$log" || true)
     printf '%-16s %6s %8s %8s %10s %8s %9s  %s\n' "$name" "$status" "$secs" "$peak" \
-        "${texels:--}" "${density:-given}" "$warnings" \
+        "${texels:--}" "${density:-$([[ -n $texels ]] && echo given || echo -)}" "$warnings" \
         "$([[ -f $dir/view.png ]] && echo "$name/view.png" || echo "no view")" >>"$summary"
     tail -n 3 "$log" | sed 's/^/   /'
 }
