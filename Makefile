@@ -7,7 +7,7 @@ CMAKE_FLAGS ?=
 FUZZ_SECONDS ?= 60
 FUZZ_SMOKE_SECONDS ?= 5
 
-.PHONY: all deps configure demo check check-asan bench fuzz fuzz-smoke clean
+.PHONY: all deps configure demo check check-asan bench gallery fuzz fuzz-smoke clean
 
 all: configure
 	cmake --build $(BUILD) -j $(JOBS)
@@ -58,6 +58,15 @@ bench: all
 	$(BUILD)/bin/bench_light2d
 	$(BUILD)/bin/bench_gi
 	$(BUILD)/bin/bench_denoise
+
+# Public game-like glTF scenes (bench/gallery.sh lists them and their
+# licences), downloaded at run time into $(BUILD)/gallery/cache/ and checked
+# by sha256, each baked with luxel's default options and rendered:
+# $(BUILD)/gallery/<scene>/view.png and $(BUILD)/gallery/summary.txt. Not
+# part of make check. Offline: LUXEL_GALLERY_MIRROR=DIR (docs/gallery.md).
+gallery: configure
+	cmake --build $(BUILD) -j $(JOBS) --target luxel gen_scenes
+	bash bench/gallery.sh --build $(BUILD)
 
 fuzz: all
 	@test -f $(BUILD_FUZZ)/CMakeCache.txt || CC=clang cmake -S . -B $(BUILD_FUZZ) -DCMAKE_BUILD_TYPE=Debug -DLX_FUZZ=ON
