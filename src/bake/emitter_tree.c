@@ -233,6 +233,28 @@ static double importance(const tree_node *node, const double *p, const double *n
     return node->power * cos(theta_e) * cos(theta_r) / d2;
 }
 
+/* The shares of a node's two children for p, n (false when neither can
+ * light it). One function for the pick and the probability, kept out of
+ * line: the compiler then evaluates both the same way, so a pick's
+ * probability is the exact product lx_emitter_tree_probability gives. */
+#if defined(__GNUC__)
+__attribute__((noinline))
+#endif
+static bool child_shares(const lx_emitter_tree *tree, const tree_node *node, const double *p,
+                         const double *n, double *pa, double *pb)
+{
+    double ia = importance(&tree->nodes[node->child], p, n);
+    double ib = importance(&tree->nodes[node->child + 1], p, n);
+    double sum = ia + ib;
+    if (!(sum > 0.0) || !isfinite(sum))
+        return false;
+    /* each as its importance over the sum (not 1 - the other: that
+     * cancels when one side is tiny) */
+    *pa = ia / sum;
+    *pb = ib / sum;
+    return true;
+}
+
 bool lx_emitter_tree_pick(const lx_emitter_tree *tree, lx_vec3 point, lx_vec3 normal, float u,
                           uint32_t *triangle, double *probability, float *u_rest)
 {
@@ -243,17 +265,16 @@ bool lx_emitter_tree_pick(const lx_emitter_tree *tree, lx_vec3 point, lx_vec3 no
         return false;
     while (node->triangle == UINT32_MAX) {
         const tree_node *a = &tree->nodes[node->child], *b = a + 1;
-        double ia = importance(a, p, n), ib = importance(b, p, n);
-        if (!(ia + ib > 0.0) || !isfinite(ia + ib))
+        double pa, pb;
+        if (!child_shares(tree, node, p, n, &pa, &pb))
             return false;
-        double pa = ia / (ia + ib);
         if (x < pa) {
             x = x / pa;
             prob *= pa;
             node = a;
         } else {
             x = (x - pa) / (1.0 - pa);
-            prob *= 1.0 - pa;
+            prob *= pb;
             node = b;
         }
         x = fmin(fmax(x, 0.0), 0x1.fffffep-1);
@@ -282,12 +303,11 @@ double lx_emitter_tree_probability(const lx_emitter_tree *tree, lx_vec3 point, l
                 return pr;
             continue;
         }
-        double ia = importance(&tree->nodes[node->child], p, n);
-        double ib = importance(&tree->nodes[node->child + 1], p, n);
-        if (!(ia + ib > 0.0) || top + 2 > 64)
+        double pa, pb;
+        if (!child_shares(tree, node, p, n, &pa, &pb) || top + 2 > 64)
             continue;
-        stack[top] = node->child, prob[top++] = pr * ia / (ia + ib);
-        stack[top] = node->child + 1, prob[top++] = pr * ib / (ia + ib);
+        stack[top] = node->child, prob[top++] = pr * pa;
+        stack[top] = node->child + 1, prob[top++] = pr * pb;
     }
     return 0.0;
 }
