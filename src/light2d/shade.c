@@ -54,7 +54,7 @@ static void classify(const float *restrict occ, const float *restrict ex,
         bool active = (fa[i] > 0.0f) & (d > 0.0f) & pen;
         bool dark = active & !reach & closed;
         fa[i] = dark ? 0.0f : fa[i];
-        code[i] = (uint8_t)(active & !dark ? (reach ? 1 : 2) : 0);
+        code[i] = (uint8_t)((active & !dark) ? (reach ? 1 : 2) : 0);
         dea[i] = de;
         ka[i] = k;
     }

@@ -59,18 +59,27 @@ static void face_down(lx_mesh *m)
     }
 }
 
+/* A scene holding the black 4 x 4 m floor; black and glow (luminance le,
+ * black) are its materials. */
+static lx_scene *floor_scene(const char *name, float le, uint32_t *black, uint32_t *glow)
+{
+    lx_scene *scene = lx_test_new_scene(name);
+    *black = lx_test_grey_material(scene, "black", 0.0f, 0.0f);
+    *glow = lx_test_grey_material(scene, "glow", 0.0f, le);
+    lx_mesh floor = lx_test_plane("floor", 4.0f, 0.0f, 0.0f, 0.0f, 4);
+    floor.material = *black;
+    lx_test_add(scene, &floor);
+    lx_test_mesh_free(&floor);
+    return scene;
+}
+
 /* A floor (4 x 4 m, black), an emitter rect r facing down (two triangles,
  * black, luminance le) and, when plate->x1 > plate->x0, a black square
  * plate between them. */
 static lx_scene *emitter_scene(rect r, float le, rect plate, int sub)
 {
-    lx_scene *scene = lx_test_new_scene("emitter");
-    uint32_t black = lx_test_grey_material(scene, "black", 0.0f, 0.0f);
-    uint32_t glow = lx_test_grey_material(scene, "glow", 0.0f, le);
-    lx_mesh floor = lx_test_plane("floor", 4.0f, 0.0f, 0.0f, 0.0f, 4);
-    floor.material = black;
-    lx_test_add(scene, &floor);
-    lx_test_mesh_free(&floor);
+    uint32_t black, glow;
+    lx_scene *scene = floor_scene("emitter", le, &black, &glow);
     lx_mesh e = lx_test_plane("emitter", 1.0f, (float)r.y, 0.5f, 0.5f, sub);
     assert_int_equal(e.triangle_count, 2 * sub * sub);
     for (uint32_t v = 0; v < e.vertex_count; v++) {
@@ -413,13 +422,9 @@ static double bulb_x(int k)
  * down, each its own node, along x at z = 0. */
 static lx_scene *string_scene(float le)
 {
-    lx_scene *scene = lx_test_new_scene("string");
-    uint32_t black = lx_test_grey_material(scene, "black", 0.0f, 0.0f);
-    uint32_t glow = lx_test_grey_material(scene, "glow", 0.0f, le);
-    lx_mesh floor = lx_test_plane("floor", 4.0f, 0.0f, 0.0f, 0.0f, 4);
-    floor.material = black;
-    lx_test_add(scene, &floor);
-    lx_test_mesh_free(&floor);
+    uint32_t black, glow;
+    lx_scene *scene = floor_scene("string", le, &black, &glow);
+    (void)black;
     for (int k = 0; k < BULBS; k++) {
         char name[32];
         snprintf(name, sizeof name, "bulb%d", k);
