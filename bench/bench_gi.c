@@ -2,30 +2,40 @@
  * on the room demo scene (examples/gen_scenes.c) at --res texels a node,
  * against its baseline measured in the same run: as many incoherent rays
  * as the gathers cast (a validity pass of min(samples, 64) rays and
- * `bounces` passes of --samples rays a texel, cosine-weighted about each
+ * `bounces` passes of --samples rays a texel, half from the second bounce
+ * on (lx_gi_bounce_samples), cosine-weighted about each
  * texel's normal), straight through Embree's rtcIntersect1 on one flat BVH
  * built here, over the same 8x8 tiles, OpenMP schedule and threads, with
  * no lookups. The GI time is the bake with bounces less the same bake
  * without; the ratio says what finding the hit's lightmap texels and
  * summing costs on top of the rays. Best and median of --reps runs each.
  *
- * Then the noise, at --noise-res texels a node: the bake at
- * --noise-samples S gather rays a texel raw (--denoise off) and denoised
- * (indirect, the CLI's default), and a raw bake at the sample count that
- * takes as long as the denoised one (equal time), each against a
- * reference of 64 S rays a texel: RMS error over every covered texel and
- * channel, relative to the reference's mean; times are the best of --reps. The reference's own noise
- * (about 1/8 of the raw S bake's) is in every figure.
+ * Then the noise, at --noise-density texels a metre (or --noise-res a
+ * node): bakes at --noise-samples S gather rays a texel, cosine-weighted
+ * and guided (the default), raw (--denoise off) and denoised (indirect,
+ * the CLI's default), adaptive, and a raw cosine bake at the sample count
+ * that takes as long as the default (equal time), each against a
+ * reference of --ref-samples (64 S) cosine-weighted rays a texel: RMS
+ * error over every seen texel and channel, relative to the reference's
+ * mean, and the share of texels off by more than 5% (texels inside
+ * geometry, the floor under a box, left out: nobody sees them); times are
+ * the best of --reps. The reference's own noise (about 1/8 of the raw
+ * cosine bake's) is in every figure.
  *
  * Usage: bench_gi [--threads N] [--reps N] [--res N] [--samples N]
  *                 [--bounces N] [--scene FILE.glb] [--noise-res N]
- *                 [--noise-samples S] [--skip-noise] */
+ *                 [--noise-density D] [--noise-samples S] [--ref-samples R]
+ *                 [--skip-noise]
+ * (--noise-density: texels per metre, default 20, 0 for --noise-res;
+ * --ref-samples: the reference's rays, default 64 S) */
 #define _POSIX_C_SOURCE 200809L
 #define _DEFAULT_SOURCE
 #include "helpers.h"
 #include "core/internal.h"
+#include "bake/bake_internal.h"
 #include "scenes.h"
 #include "bench_cli.h"
+#include "luxel/denoise.h"
 
 #include <embree3/rtcore.h>
 #include <math.h>
@@ -46,7 +56,10 @@ static double bake_time(lx_baker *b)
 }
 
 /* Every covered texel's RGB of every lightmap of a bake with desc, in
- * map order; *seconds the best time of `reps` bakes. */
+ * map order, and a fourth float: 1 where the texel is seen, 0 where it
+ * sits inside geometry (its gathers mostly hit back faces: the floor
+ * under a box; nobody sees it, and its light is its neighbours');
+ * *seconds the best time of `reps` bakes. */
 static float *baked_texels(const lx_scene *scene, const lx_bake_desc *desc, int reps,
                            size_t *count, double *seconds)
 {
@@ -65,11 +78,14 @@ static float *baked_texels(const lx_scene *scene, const lx_bake_desc *desc, int 
         lx_image img;
         if (lx_baker_apply_alloc(b, m, &img) != LX_OK)
             lx_bench_die("apply");
+        lx_denoise_guides guides;
+        if (lx_baker_denoise_guides(b, m, &guides) != LX_OK)
+            lx_bench_die("guides");
         const uint8_t *mask = lx_baker_mask(b, m);
         size_t pixels = (size_t)img.width * (size_t)img.height;
         if (n + pixels > cap) {
             cap = (n + pixels) * 2;
-            out = realloc(out, sizeof(float) * 3 * cap);
+            out = realloc(out, sizeof(float) * 4 * cap);
             if (!out)
                 lx_bench_die("memory");
         }
@@ -77,41 +93,55 @@ static float *baked_texels(const lx_scene *scene, const lx_bake_desc *desc, int 
             if (!mask[i])
                 continue;
             for (size_t c = 0; c < 3; c++)
-                out[3 * n + c] = img.data[i * (size_t)img.channels + c];
+                out[4 * n + c] = img.data[i * (size_t)img.channels + c];
+            out[4 * n + 3] = guides.valid[i] ? 1.0f : 0.0f;
             n++;
         }
         lx_image_free(&img);
+        lx_denoise_guides_free(&guides);
     }
     lx_baker_destroy(b);
     *count = n;
     return out;
 }
 
-/* RMS of (x - ref) over n texels' channels, relative to ref's mean. */
+/* RMS of (x - ref) over the n texels' channels that ref says are seen,
+ * relative to ref's mean. */
 static double relative_rms(const float *x, const float *ref, size_t n)
 {
     double se = 0.0, sum = 0.0;
-    for (size_t i = 0; i < 3 * n; i++) {
-        double e = (double)x[i] - (double)ref[i];
-        se += e * e;
-        sum += ref[i];
+    size_t k = 0;
+    for (size_t i = 0; i < n; i++) {
+        if (ref[4 * i + 3] == 0.0f)
+            continue;
+        for (size_t c = 0; c < 3; c++) {
+            double e = (double)x[4 * i + c] - (double)ref[4 * i + c];
+            se += e * e;
+            sum += ref[4 * i + c];
+            k++;
+        }
     }
-    return sum > 0.0 ? sqrt(se / (double)(3 * n)) / (sum / (double)(3 * n)) : 0.0;
+    return sum > 0.0 ? sqrt(se / (double)k) / (sum / (double)k) : 0.0;
 }
 
-/* The share of n texels whose luminance is off ref's by more than
- * `tolerance` of ref's (texels where ref is dark, below 1/100 of its mean,
- * left out): the issue's blotch measure, what a viewer sees as patches. */
+/* The share of the n texels ref says are seen whose luminance is off
+ * ref's by more than `tolerance` of ref's (texels where ref is dark, below
+ * 1/100 of its mean, left out): the issue's blotch measure, what a viewer
+ * sees as patches. */
 static double share_off(const float *x, const float *ref, size_t n, double tolerance)
 {
     double mean = 0.0;
+    size_t seen = 0;
     for (size_t i = 0; i < n; i++)
-        mean += lx_luminance(ref + 3 * i);
-    mean /= n ? (double)n : 1.0;
+        if (ref[4 * i + 3] != 0.0f) {
+            mean += lx_luminance(ref + 4 * i);
+            seen++;
+        }
+    mean /= seen ? (double)seen : 1.0;
     size_t off = 0, judged = 0;
     for (size_t i = 0; i < n; i++) {
-        double want = lx_luminance(ref + 3 * i), got = lx_luminance(x + 3 * i);
-        if (want < 0.01 * mean)
+        double want = lx_luminance(ref + 4 * i), got = lx_luminance(x + 4 * i);
+        if (ref[4 * i + 3] == 0.0f || want < 0.01 * mean)
             continue;
         judged++;
         off += fabs(got - want) > tolerance * want;
@@ -119,61 +149,85 @@ static double share_off(const float *x, const float *ref, size_t n, double toler
     return judged ? (double)off / (double)judged : 0.0;
 }
 
+/* One row of the noise table: time, RMS error and the share of texels
+ * off by more than 5%, against ref. */
+static void noise_row(const char *what, double seconds, const float *x, const float *ref, size_t n)
+{
+    printf("  %-44s %8.3fs %13.2f%% %13.2f%%\n", what, seconds, 100.0 * relative_rms(x, ref, n),
+           100.0 * share_off(x, ref, n, 0.05));
+}
+
 /* The noise section (see the top). */
 static void noise_at_equal_time(const lx_scene *scene, const char *scene_path, int res,
-                                int samples, int bounces, int threads, int reps)
+                                float density, int samples, int ref_samples, int bounces,
+                                int threads, int reps)
 {
     lx_bake_desc d = lx_bake_desc_defaults(NULL);
     d.resolution = res;
+    d.texel_density = density;
     d.threads = threads;
     size_t n_ref, n;
-    double t_direct, t_ref, t_raw, t_den, t_eq;
+    double t_direct, t_ref, t_raw, t_den, t_eq, t_graw, t_gden, t_ada;
     float *direct = baked_texels(scene, &d, reps, &n, &t_direct);
     free(direct);
     d.bounces = bounces;
-    d.gi_samples = (uint32_t)samples * 64u;
+    d.gi_sampling = LX_GI_SAMPLING_COSINE;
+    d.gi_samples = (uint32_t)ref_samples;
     float *ref = baked_texels(scene, &d, 1, &n_ref, &t_ref);
     d.gi_samples = (uint32_t)samples;
     float *raw = baked_texels(scene, &d, reps, &n, &t_raw);
     d.denoise = LX_DENOISE_INDIRECT;
     float *den = baked_texels(scene, &d, reps, &n, &t_den);
-    /* adaptive gathers (--gi-adaptive), denoised */
-    double t_ada;
+    /* guided gathers (the default), raw and denoised; adaptive on top */
+    d.gi_sampling = LX_GI_SAMPLING_GUIDED;
+    d.denoise = LX_DENOISE_OFF;
+    float *graw = baked_texels(scene, &d, reps, &n, &t_graw);
+    d.denoise = LX_DENOISE_INDIRECT;
+    float *gden = baked_texels(scene, &d, reps, &n, &t_gden);
     d.gi_adaptive = true;
     float *ada = baked_texels(scene, &d, reps, &n, &t_ada);
     d.gi_adaptive = false;
-    /* the GI's time grows with its rays: the raw count that takes as long
-     * as the denoised bake */
-    double gi_raw = t_raw - t_direct, gi_den = t_den - t_direct;
+    /* the GI's time grows with its rays: the raw cosine count that takes
+     * as long as the default (guided, denoised) bake */
+    double gi_raw = t_raw - t_direct, gi_den = t_gden - t_direct;
     int equal = (int)lround((double)samples * gi_den / (gi_raw > 1e-6 ? gi_raw : 1e-6));
     if (equal < samples)
         equal = samples;
     d.denoise = LX_DENOISE_OFF;
+    d.gi_sampling = LX_GI_SAMPLING_COSINE;
     d.gi_samples = (uint32_t)equal;
     float *eq = baked_texels(scene, &d, reps, &n, &t_eq);
     if (n != n_ref)
         lx_bench_die("texel counts differ");
-    double e_raw = relative_rms(raw, ref, n), e_den = relative_rms(den, ref, n),
+    double e_raw = relative_rms(raw, ref, n), e_gden = relative_rms(gden, ref, n),
            e_eq = relative_rms(eq, ref, n);
-    printf("\nnoise  %s, %dx%d a node, %zu texels, %d bounces, against %d rays a texel (%.1f s)\n",
-           scene_path, res, res, n, bounces, samples * 64, t_ref);
+    char size[64];
+    if (density > 0.0f)
+        snprintf(size, sizeof size, "%g texels/m", (double)density);
+    else
+        snprintf(size, sizeof size, "%dx%d a node", res, res);
+    printf("\nnoise  %s, %s, %zu texels, %d bounces, against %d cosine rays a texel (%.1f s)\n",
+           scene_path, size, n, bounces, ref_samples, t_ref);
     printf("  %-44s %9s %14s %14s\n", "", "time", "RMS error", "texels off 5%");
-    printf("  %-44s %8.3fs %13.2f%% %13.2f%%\n", "raw, gi-samples S", t_raw, 100.0 * e_raw,
-           100.0 * share_off(raw, ref, n, 0.05));
-    printf("  %-44s %8.3fs %13.2f%% %13.2f%%\n", "denoised (--denoise indirect), S", t_den,
-           100.0 * e_den, 100.0 * share_off(den, ref, n, 0.05));
-    printf("  raw at equal time, %-25d %8.3fs %13.2f%% %13.2f%%\n", equal, t_eq, 100.0 * e_eq,
-           100.0 * share_off(eq, ref, n, 0.05));
-    printf("  %-44s %8.3fs %13.2f%% %13.2f%%\n", "adaptive (--gi-adaptive), denoised", t_ada,
-           100.0 * relative_rms(ada, ref, n), 100.0 * share_off(ada, ref, n, 0.05));
-    printf("noise: at %d rays a texel the denoiser cuts the RMS error against a 64x reference "
-           "%.1fx (%.2f%% -> %.2f%%); %.1fx against the raw bake of equal time (%d rays); "
-           "a raw bake would need about %.0f rays (1/sqrt law) to match\n",
-           samples, e_raw / e_den, 100.0 * e_raw, 100.0 * e_den, e_eq / e_den, equal,
-           (double)samples * (e_raw / e_den) * (e_raw / e_den));
+    noise_row("cosine, raw, gi-samples S", t_raw, raw, ref, n);
+    noise_row("cosine, denoised (--denoise indirect), S", t_den, den, ref, n);
+    noise_row("guided, raw, S", t_graw, graw, ref, n);
+    noise_row("guided, denoised, S (the default)", t_gden, gden, ref, n);
+    noise_row("guided, adaptive (--gi-adaptive), denoised", t_ada, ada, ref, n);
+    char eqs[64];
+    snprintf(eqs, sizeof eqs, "cosine, raw at equal time, %d", equal);
+    noise_row(eqs, t_eq, eq, ref, n);
+    printf("noise: at %d rays a texel the default (guided, denoised) cuts the RMS error against "
+           "the reference %.1fx (%.2f%% -> %.2f%%) from raw cosine gathers; %.1fx against the "
+           "raw bake of equal time (%d rays); a raw bake would need about %.0f rays (1/sqrt "
+           "law) to match\n",
+           samples, e_raw / e_gden, 100.0 * e_raw, 100.0 * e_gden, e_eq / e_gden, equal,
+           (double)samples * (e_raw / e_gden) * (e_raw / e_gden));
     free(ref);
     free(raw);
     free(den);
+    free(graw);
+    free(gden);
     free(ada);
     free(eq);
 }
@@ -225,7 +279,12 @@ static double raw_gathers(RTCScene flat, const texel *tx, const uint32_t *tile_s
 int main(int argc, char **argv)
 {
     int threads = 0, reps = 3, res = 256, samples = 256, bounces = 2;
-    int noise_res = 128, noise_samples = 16;
+    /* the noise at the CLI's defaults: 128 rays a texel (guided), against
+     * 64 times the rays, at 20 texels a metre (a quarter of the CLI's
+     * texels, so the reference takes a minute) */
+    int noise_res = 128, noise_samples = 128;
+    float noise_density = 20.0f;
+    int ref_samples = 0;
     bool skip_noise = false;
     const char *scene_path = NULL;
     for (int i = 1; i < argc; i++) {
@@ -243,6 +302,10 @@ int main(int argc, char **argv)
             scene_path = argv[++i];
         else if (!strcmp(argv[i], "--noise-res") && i + 1 < argc)
             noise_res = atoi(argv[++i]);
+        else if (!strcmp(argv[i], "--ref-samples") && i + 1 < argc)
+            ref_samples = atoi(argv[++i]);
+        else if (!strcmp(argv[i], "--noise-density") && i + 1 < argc)
+            noise_density = (float)atof(argv[++i]);
         else if (!strcmp(argv[i], "--noise-samples") && i + 1 < argc)
             noise_samples = atoi(argv[++i]);
         else if (!strcmp(argv[i], "--skip-noise"))
@@ -250,16 +313,20 @@ int main(int argc, char **argv)
         else {
             fprintf(stderr,
                     "usage: %s [--threads N] [--reps N] [--res N] [--samples N] [--bounces N] "
-                    "[--scene FILE.glb] [--noise-res N] [--noise-samples S] [--skip-noise]\n",
+                    "[--scene FILE.glb] [--noise-res N] [--noise-density D] [--noise-samples S] "
+                    "[--ref-samples R] [--skip-noise]\n",
                     argv[0]);
             return 2;
         }
     }
     if (reps < 1 || reps > 100 || res < 4 || res > 4096 || samples < 1 || samples > 4096 ||
-        bounces < 1 || bounces > 16 || noise_res < 4 || noise_res > 4096 || noise_samples < 1 ||
+        bounces < 1 || bounces > 16 || noise_res < 4 || noise_res > 4096 ||
+        !(noise_density >= 0.0f && noise_density <= 1000.0f) || ref_samples < 0 ||
+        ref_samples > 65536 || noise_samples < 1 ||
         noise_samples > 1024) {
         fprintf(stderr, "bench_gi: --reps 1..100, --res 4..4096, --samples 1..4096, --bounces "
-                        "1..16, --noise-res 4..4096, --noise-samples 1..1024\n");
+                        "1..16, --noise-res 4..4096, --noise-density 0..1000, --noise-samples "
+                        "1..1024, --ref-samples 0..65536\n");
         return 2;
     }
     threads = lx_thread_count(threads);
@@ -308,7 +375,7 @@ int main(int argc, char **argv)
     uint32_t counts[17];
     counts[0] = samples < 64 ? (uint32_t)samples : 64u;
     for (int k = 1; k <= bounces; k++)
-        counts[k] = (uint32_t)samples;
+        counts[k] = lx_gi_bounce_samples((uint32_t)samples, k);
     lx_vec3 lo, hi;
     lx_scene_bounds(scene, &lo, &hi);
     float bias = 1e-5f * lx_length(lx_sub(hi, lo));
@@ -343,7 +410,9 @@ int main(int argc, char **argv)
            "%.2fx)\n",
            tg[0] / tr[0], tg[reps / 2] / tr[reps / 2]);
     if (!skip_noise)
-        noise_at_equal_time(scene, scene_path, noise_res, noise_samples, bounces, threads, reps);
+        noise_at_equal_time(scene, scene_path, noise_res, noise_density, noise_samples,
+                            ref_samples ? ref_samples : 64 * noise_samples, bounces, threads,
+                            reps);
     free(tg);
     free(tr);
     free(tx);

@@ -114,7 +114,7 @@ int lx_bake_uv_set(const lx_scene *scene, uint32_t node, lx_uv_choice choice);
 #define LX_GI_SAMPLES_DEFAULT 128u
 #define LX_MAX_GI_SAMPLES 65536u
 /* Adaptive gathers (lx_bake_desc.gi_adaptive): the relative standard
- * error a texel's bounce estimate stops at. */
+ * error a tile's rounds aim at. */
 #define LX_GI_ADAPTIVE_NOISE 0.025
 /* The dynamic lights' one bounce (lx_baker_update): the gather rays per
  * texel a real-time user should start from, and the most taken. */
@@ -153,6 +153,21 @@ typedef struct lx_sky_desc {
 /* A copy of desc (or of zeros when NULL) with every default filled in. */
 lx_sky_desc lx_sky_desc_defaults(const lx_sky_desc *desc);
 
+/* How the bounces' gather rays are drawn (lx_bake_desc.gi_sampling). */
+typedef enum lx_gi_sampling {
+    LX_GI_SAMPLING_GUIDED = 0, /* the default: a quarter of each texel's rays
+                                  cosine-weighted, teaching its 8 x 8 texel
+                                  tile where the light comes from; the rest
+                                  half cosine-weighted, half toward that
+                                  light, weighed by multiple importance
+                                  sampling: unbiased, and no longer exact
+                                  under constant light. A bounce of fewer
+                                  than 64 rays a texel is not guided (too
+                                  few to learn from); directional data come
+                                  from the cosine-weighted rays alone */
+    LX_GI_SAMPLING_COSINE      /* every ray cosine-weighted, stratified */
+} lx_gi_sampling;
+
 typedef struct lx_bake_desc {
     int resolution;      /* texels per side for every lightmap, 0 = 256 */
     float texel_density; /* texels per metre; > 0 sizes each lightmap from its
@@ -184,18 +199,27 @@ typedef struct lx_bake_desc {
     int bounces;           /* 0..LX_MAX_BOUNCES; 0 = direct light only (the
                               library's default, like padding's zero a value;
                               luxel bake uses LX_BOUNCES_RECOMMENDED) */
-    uint32_t gi_samples;   /* gather rays per texel per bounce, and the
-                              emitters' shadow rays (at most 256), 1..
+    uint32_t gi_samples;   /* gather rays per texel of the first bounce (half,
+                              at least 16, of the later ones: they carry
+                              albedo times less light and read the smoother
+                              light of the one before), and the emitters'
+                              shadow rays (at most 256), 1..
                               LX_MAX_GI_SAMPLES, 0 = LX_GI_SAMPLES_DEFAULT */
-    bool gi_adaptive;      /* gather in rounds of gi_samples / 4 stratified
-                              rays (at least 4), each texel stopping after
-                              two rounds once its estimate's standard error
-                              is within LX_GI_ADAPTIVE_NOISE of it (or of a
-                              tenth of the bounce's mean, for dark texels),
-                              else going on up to 16 rounds (4 x gi_samples
-                              rays): the rays go where the noise is. false
-                              (the default): gi_samples rays for every
-                              texel; `luxel bake --gi-adaptive` */
+    lx_gi_sampling gi_sampling; /* GUIDED (the default) or COSINE;
+                              `luxel bake --gi-sampling` */
+    bool gi_adaptive;      /* gather in rounds of gi_samples / 4 rays (at
+                              least 4): after the first, each 8 x 8 texel
+                              tile takes as many rounds (2 to 16, up to
+                              4 x gi_samples rays) as its texels' mean
+                              relative variance a ray asks for a standard
+                              error of LX_GI_ADAPTIVE_NOISE (of a texel's
+                              light, or of a tenth of the bounce's mean for
+                              dark texels): the rays go where the noise is.
+                              One count a tile, not a texel: a texel judged
+                              by its own rays stops early when they missed
+                              the bright part, and leaves a dark blotch.
+                              false (the default): gi_samples rays for
+                              every texel; `luxel bake --gi-adaptive` */
     float emissive_scale;  /* multiplies the emissive materials' radiance
                               (nits); 0 = 1 */
     lx_denoise_mode denoise; /* edge-aware denoising of the baked buffers at the

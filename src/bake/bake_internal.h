@@ -435,6 +435,31 @@ lx_gather_frame lx_gather_frame_of(const lx_baker *b, uint32_t map_index, const 
  * points below the geometric surface (it counts as dark). */
 bool lx_gather_ray(const lx_gather_frame *f, uint32_t k, uint32_t sx, uint32_t sy, uint32_t key,
                    lx_ray *ray);
+/* The gather rays a texel of bounce `bounce` (1 = the first) casts when
+ * the bake asks for `samples`. */
+uint32_t lx_gi_bounce_samples(uint32_t samples, int bounce);
+/* Guided gathers (gi_guide.c): a histogram over the sphere of directions
+ * (LX_GUIDE_SIDE^2 cells of the octahedral map) of where a tile's light
+ * came from, and its alias table. */
+#define LX_GUIDE_SIDE 32
+#define LX_GUIDE_BINS (LX_GUIDE_SIDE * LX_GUIDE_SIDE)
+typedef struct lx_gi_guide {
+    float cell[LX_GUIDE_BINS];
+    float prob[LX_GUIDE_BINS];  /* each cell's probability */
+    float keep[LX_GUIDE_BINS];  /* the alias table: a cell drawn is kept */
+    uint16_t alias[LX_GUIDE_BINS]; /* with probability keep, else its alias */
+    bool ready; /* built and not empty */
+} lx_gi_guide;
+void lx_gi_guide_clear(lx_gi_guide *g);
+/* value (a ray's luminance over its pdf) into dir's cell */
+void lx_gi_guide_add(lx_gi_guide *g, lx_vec3 dir, float value);
+/* Smooths the cells and makes the alias table; false (and not ready) when
+ * empty. */
+bool lx_gi_guide_build(lx_gi_guide *g);
+/* A direction drawn from the guide with uniform numbers u (the cell), u1,
+ * u2 (within it); its solid-angle pdf is lx_gi_guide_pdf. */
+lx_vec3 lx_gi_guide_sample(const lx_gi_guide *g, float u, float u1, float u2);
+float lx_gi_guide_pdf(const lx_gi_guide *g, lx_vec3 dir);
 /* Where a point (barycentrics u, v of a triangle of mesh under node) lands
  * in its lightmap: the map and continuous texel coordinates (texel centres
  * at integers, clamped to [-1, w] x [-1, h]); false when the surface has

@@ -31,6 +31,10 @@
 #define VALIDITY_RAYS 64u
 /* rings searched for a valid texel when none of the four bilinear ones is */
 #define LOOKUP_RINGS 3
+/* lx_random dimensions of the guided rays, apart from the cosine ones' */
+#define GUIDE_KEY 0x4000u
+/* the fewest gi_samples (a bounce's) that are guided */
+#define GUIDE_MIN_SAMPLES 64u
 
 lx_status lx_gi_prepare(lx_baker *b, const lx_scene *scene, bool emitters_only)
 {
@@ -162,6 +166,7 @@ typedef struct gi_run {
     gi_map *maps;
     lx_radiance_source *sources; /* each map's valid and source, for lx_hit_radiance */
     int threads;
+    uint32_t samples; /* this bounce's gather rays a texel */
     double dark; /* adaptive gathers: the radiance luminance under which a
                     texel's noise is judged against this, not its own */
 } gi_run;
@@ -301,75 +306,218 @@ bool lx_gi_texel_inside(const lx_baker *b, uint32_t map_index, uint32_t i)
     return 2 * back > cells;
 }
 
-/* One gather for one texel: pi / N x the radiance its rays bring; with
- * sh, the same rays' estimate of int L Y dw (lx_sh_ray_weight / N x L Y,
- * directional.c); with variance, the estimate's luminance variance (the
- * rays' sample variance over N, stratification ignored: an upper bound). */
-static lx_vec3 texel_gather(const gi_run *run, uint32_t map_index, uint32_t i, uint32_t key,
-                            lx_sh4 *sh, float *variance)
+uint32_t lx_gi_bounce_samples(uint32_t samples, int bounce)
 {
-    const lx_baker *b = run->b;
-    const lx_lightmap *map = &b->maps[map_index];
-    /* adaptive: rounds of a quarter of the rays, each stratified over the
-     * whole hemisphere and jittered by its own key */
-    bool adaptive = b->desc.gi_adaptive;
-    uint32_t per_round = adaptive ? (b->desc.gi_samples + 3) / 4 : b->desc.gi_samples;
-    per_round = adaptive && per_round < 4 ? 4 : per_round;
+    /* the second and later bounces bring albedo times less light than the
+     * one before and read its smoother light: half the rays (at least 16)
+     * keep their share of the noise small for a quarter less time (two
+     * bounces) */
+    if (bounce < 2 || samples <= 16)
+        return samples;
+    return samples / 2 > 16 ? samples / 2 : 16;
+}
+
+/* A texel's gather so far: its rays' values y (radiance over the pdf,
+ * over pi: the bounce's irradiance is pi x their mean), summed, with
+ * their luminance's sums for the noise and, with SH, the SH estimate. */
+typedef struct gather_acc {
+    double sum[3], lum, lum2, shs[LX_SH_FLOATS];
+    uint32_t rays, sh_rays; /* all of them; the cosine-weighted ones */
+} gather_acc;
+
+static void acc_add(gather_acc *a, lx_vec3 y)
+{
+    a->sum[0] += y.x;
+    a->sum[1] += y.y;
+    a->sum[2] += y.z;
+    const float rgb[3] = {y.x, y.y, y.z};
+    double luma = lx_luminance(rgb);
+    a->lum += luma;
+    a->lum2 += luma * luma;
+}
+
+/* The exitant radiance a gather ray brings: false when it escapes (the
+ * sky is direct light) or hits a back face. Emission is direct light
+ * (emitters.c), not picked up here. */
+static bool ray_radiance(const gi_run *run, lx_ray *ray, lx_vec3 *l)
+{
+    lx_hit h;
+    if (!lx_tracer_closest_kind(run->b->tracer, ray, LX_RAY_GATHER, &h) ||
+        !(lx_dot(ray->dir, h.normal) < 0.0f))
+        return false;
+    *l = lx_hit_radiance(run->b, run->sources, false, &h);
+    return true;
+}
+
+/* One round of a texel's gather: `want` stratified cosine-weighted rays
+ * (rounded up to the strata); with guide, as many again drawn from it,
+ * every ray then weighed by the balance heuristic of the two pdfs. With
+ * learn, each ray's luminance goes into it; with sh, the cosine-weighted
+ * rays' SH estimate. */
+static void gather_round(const gi_run *run, const lx_gather_frame *f, uint32_t want,
+                         const lx_gi_guide *guide, uint32_t key, gather_acc *acc,
+                         lx_gi_guide *learn, bool sh)
+{
     uint32_t sx, sy;
-    lx_cosine_strata(per_round, &sx, &sy);
-    uint32_t cells = sx * sy, rounds = adaptive ? ADAPTIVE_MAX_ROUNDS : 1, total = 0;
-    double sum[3] = {0.0, 0.0, 0.0}, shs[LX_SH_FLOATS] = {0}, lum = 0.0, lum2 = 0.0;
-    lx_gather_frame f = lx_gather_frame_of(b, map_index, map, i);
-    for (uint32_t r = 0; r < rounds; r++) {
-        if (adaptive && r >= ADAPTIVE_MIN_ROUNDS) {
-            double n = (double)total, mean = lum / n;
-            double spread = fmax((lum2 - lum * mean) / (n - 1.0), 0.0);
-            double limit = LX_GI_ADAPTIVE_NOISE * fmax(mean, run->dark);
-            if (spread / n <= limit * limit)
-                break;
-        }
-        total += cells;
-        for (uint32_t k = 0; k < cells; k++) {
-            lx_ray ray;
-            lx_hit h;
-            if (!lx_gather_ray(&f, k, sx, sy, key + (r << 16), &ray))
+    lx_cosine_strata(want, &sx, &sy);
+    uint32_t cells = sx * sy;
+    for (uint32_t k = 0; k < 2 * cells; k++) {
+        lx_ray ray;
+        lx_vec3 l;
+        if (k < cells) {
+            if (!lx_gather_ray(f, k, sx, sy, key, &ray))
                 continue;
-            if (!lx_tracer_closest_kind(b->tracer, &ray, LX_RAY_GATHER, &h) ||
-                !(lx_dot(ray.dir, h.normal) < 0.0f))
-                continue; /* escaped (sky: direct light), or a back face */
-            /* emission is direct light (emitters.c), not picked up here */
-            lx_vec3 l = lx_hit_radiance(b, run->sources, false, &h);
-            sum[0] += l.x;
-            sum[1] += l.y;
-            sum[2] += l.z;
-            const float rgb[3] = {l.x, l.y, l.z};
-            double luma = lx_luminance(rgb);
-            lum += luma;
-            lum2 += luma * luma;
-            if (sh) {
-                lx_vec3 d = ray.dir;
-                float w0;
-                lx_vec3 v;
-                lx_sh_ray_weight(k, sx, d, f.n, &w0, &v);
-                double y[4] = {LX_SH_Y0 * w0, LX_SH_Y1 * v.y, LX_SH_Y1 * v.z, LX_SH_Y1 * v.x};
-                for (int c = 0; c < 4; c++) {
-                    shs[3 * c] += l.x * y[c];
-                    shs[3 * c + 1] += l.y * y[c];
-                    shs[3 * c + 2] += l.z * y[c];
-                }
+        } else {
+            if (!guide)
+                break;
+            uint32_t j = k - cells;
+            float u = ((float)j + lx_random(f->map, f->pixel, j, key + GUIDE_KEY)) / (float)cells;
+            ray.dir = lx_gi_guide_sample(guide, fminf(u, 0x1.fffffep-1f),
+                                         lx_random(f->map, f->pixel, j, key + GUIDE_KEY + 1),
+                                         lx_random(f->map, f->pixel, j, key + GUIDE_KEY + 2));
+            if (!(lx_dot(ray.dir, f->ng) > 0.0f) || !(lx_dot(ray.dir, f->n) > 0.0f))
+                continue;
+            ray.origin = f->origin;
+            ray.tmin = 0.0f;
+            ray.tmax = INFINITY;
+        }
+        if (!ray_radiance(run, &ray, &l))
+            continue;
+        if (sh && k < cells) {
+            /* the SH estimate from the cosine-weighted rays alone, with
+             * their stratum weights (directional.c) */
+            float w0;
+            lx_vec3 v;
+            lx_sh_ray_weight(k, sx, ray.dir, f->n, &w0, &v);
+            double y[4] = {LX_SH_Y0 * w0, LX_SH_Y1 * v.y, LX_SH_Y1 * v.z, LX_SH_Y1 * v.x};
+            for (int c = 0; c < 4; c++) {
+                acc->shs[3 * c] += l.x * y[c];
+                acc->shs[3 * c + 1] += l.y * y[c];
+                acc->shs[3 * c + 2] += l.z * y[c];
             }
         }
+        if (guide) {
+            /* L cos / (pi x the mixture's pdf), the mixture (cos / pi + pdf_guide) / 2 */
+            float c = lx_dot(ray.dir, f->n);
+            float w = 2.0f * c / (c + LX_PI * lx_gi_guide_pdf(guide, ray.dir));
+            l = lx_scale(l, w > 0.0f && isfinite(w) ? w : 0.0f);
+        }
+        acc_add(acc, l);
+        if (learn) {
+            const float rgb[3] = {l.x, l.y, l.z};
+            lx_gi_guide_add(learn, ray.dir, lx_luminance(rgb));
+        }
     }
-    cells = total;
+    acc->rays += guide ? 2 * cells : cells;
+    acc->sh_rays += cells;
+}
+
+/* Adaptive gathers: the rounds of `per_round` rays a tile's texels take
+ * in all, from their first round: as many as the tile's mean relative
+ * variance a ray asks for the standard error to reach
+ * LX_GI_ADAPTIVE_NOISE (of a texel's mean, or of run->dark where darker),
+ * within [ADAPTIVE_MIN_ROUNDS, ADAPTIVE_MAX_ROUNDS]. One count for the
+ * tile: a texel judged by its own rays would stop early exactly when they
+ * missed the bright part (a low estimate with a low spread), and leave
+ * dark blotches. */
+static uint32_t tile_rounds(const gi_run *run, const gather_acc *acc, const uint8_t *invalid,
+                            uint32_t count, uint32_t per_round)
+{
+    double cv2 = 0.0;
+    uint32_t judged = 0;
+    for (uint32_t j = 0; j < count; j++) {
+        if (invalid[j] || acc[j].rays < 2)
+            continue;
+        double n = (double)acc[j].rays, mean = acc[j].lum / n;
+        double spread = fmax((acc[j].lum2 - acc[j].lum * mean) / (n - 1.0), 0.0);
+        double ref = fmax(mean, run->dark);
+        if (ref > 0.0) {
+            cv2 += spread / (ref * ref);
+            judged++;
+        }
+    }
+    double need =
+        judged ? cv2 / (double)judged / (LX_GI_ADAPTIVE_NOISE * LX_GI_ADAPTIVE_NOISE) : 0.0;
+    double rounds = ceil(need / (double)per_round);
+    return rounds <= ADAPTIVE_MIN_ROUNDS   ? ADAPTIVE_MIN_ROUNDS
+           : rounds >= ADAPTIVE_MAX_ROUNDS ? ADAPTIVE_MAX_ROUNDS
+                                           : (uint32_t)rounds;
+}
+
+/* A texel's result from its gather: pi / N x the sum into next; the SH
+ * estimate; the estimate's luminance variance (the rays' sample variance
+ * over N, stratification ignored: an upper bound). */
+static void gather_finish(const gather_acc *a, lx_vec3 *next, lx_sh4 *sh, float *variance)
+{
+    double n = a->rays ? (double)a->rays : 1.0;
     if (sh)
         for (int c = 0; c < LX_SH_FLOATS; c++)
-            sh->c[c] = (float)(shs[c] / (double)cells);
+            sh->c[c] = (float)(a->shs[c] / (a->sh_rays ? (double)a->sh_rays : 1.0));
     if (variance) {
-        double n = (double)cells, spread = cells > 1 ? (lum2 - lum * lum / n) / (n - 1.0) : 0.0;
+        double spread = a->rays > 1 ? (a->lum2 - a->lum * a->lum / n) / (n - 1.0) : 0.0;
         *variance = (float)(LX_PI * LX_PI * fmax(spread, 0.0) / n);
     }
-    double scale = LX_PI / (double)cells;
-    return lx_v3((float)(sum[0] * scale), (float)(sum[1] * scale), (float)(sum[2] * scale));
+    double scale = LX_PI / n;
+    *next = lx_v3((float)(a->sum[0] * scale), (float)(a->sum[1] * scale),
+                  (float)(a->sum[2] * scale));
+}
+
+/* The gathers of texels [first, first + count) of map m (one tile, at most
+ * LX_TILE^2 texels) into g->next. Plain: gi_samples cosine-weighted rays
+ * each. Guided (lx_bake_desc.gi_sampling): a first round of
+ * a quarter of the rays for every texel teaches the tile's guide, the rest
+ * come half from it. Adaptive: rounds of a quarter go on per texel until
+ * its noise is low (the guided rounds after the first). */
+static void tile_gather(const gi_run *run, gi_map *g, uint32_t m, uint32_t first, uint32_t count,
+                        uint32_t key)
+{
+    const lx_baker *b = run->b;
+    const lx_lightmap *map = &b->maps[m];
+    bool sh = g->next_sh != NULL, adaptive = b->desc.gi_adaptive;
+    /* a guide learns from a quarter of the rays: at least 16 a texel, a
+     * ray a cell over the tile; fewer leave it too spiky to help */
+    uint32_t n = run->samples, quarter = (n + 3) / 4 < 4 ? 4 : (n + 3) / 4;
+    bool guided = b->desc.gi_sampling == LX_GI_SAMPLING_GUIDED && n >= GUIDE_MIN_SAMPLES;
+    uint32_t round0 = adaptive || guided ? quarter : n;
+    gather_acc acc[LX_TILE * LX_TILE];
+    lx_gi_guide guide;
+    if (count > LX_TILE * LX_TILE)
+        count = LX_TILE * LX_TILE; /* tiles are LX_TILE x LX_TILE texels */
+    memset(acc, 0, sizeof(gather_acc) * count);
+    lx_gi_guide_clear(&guide);
+    for (uint32_t j = 0; j < count; j++) {
+        if (g->invalid[first + j])
+            continue;
+        lx_gather_frame f = lx_gather_frame_of(b, m, map, first + j);
+        gather_round(run, &f, round0, NULL, key, &acc[j], guided ? &guide : NULL, sh);
+    }
+    const lx_gi_guide *use = guided && lx_gi_guide_build(&guide) ? &guide : NULL;
+    uint32_t rounds = adaptive ? tile_rounds(run, acc, g->invalid + first, count, quarter) : 1;
+    for (uint32_t j = 0; j < count; j++) {
+        uint32_t i = first + j;
+        if (g->invalid[i]) {
+            g->next[i] = lx_v3(0.0f, 0.0f, 0.0f);
+            if (g->next_sh)
+                memset(&g->next_sh[i], 0, sizeof(lx_sh4));
+            if (g->next_var)
+                g->next_var[i] = 0.0f;
+            continue;
+        }
+        lx_gather_frame f = lx_gather_frame_of(b, m, map, i);
+        /* a guided round casts twice its cosine-weighted rays */
+        uint32_t per_round = use ? (quarter + 1) / 2 : quarter;
+        if (adaptive) {
+            for (uint32_t r = 1; r < rounds; r++)
+                gather_round(run, &f, per_round, use, key + (r << 16), &acc[j], NULL, sh);
+        } else if (guided) {
+            uint32_t rest = n > acc[j].rays ? n - acc[j].rays : 0;
+            if (rest)
+                gather_round(run, &f, use ? (rest + 1) / 2 : rest, use, key + (1u << 16),
+                             &acc[j], NULL, sh);
+        }
+        gather_finish(&acc[j], &g->next[i], g->next_sh ? &g->next_sh[i] : NULL,
+                      g->next_var ? &g->next_var[i] : NULL);
+    }
 }
 
 /* One pass over every tile of every map in memory: the validity pass
@@ -389,20 +537,11 @@ static lx_status run_pass(gi_run *run, bool validity, uint32_t key, float from, 
         uint32_t m, first, count;
         lx_tile_walk_at(&w, global, &m, &first, &count);
         gi_map *g = &run->maps[m];
-        for (uint32_t i = first; i < first + count; i++) {
-            if (validity) {
+        if (validity)
+            for (uint32_t i = first; i < first + count; i++)
                 g->invalid[i] = lx_gi_texel_inside(b, m, i);
-            } else if (g->invalid[i]) {
-                g->next[i] = lx_v3(0.0f, 0.0f, 0.0f);
-                if (g->next_sh)
-                    memset(&g->next_sh[i], 0, sizeof(lx_sh4));
-                if (g->next_var)
-                    g->next_var[i] = 0.0f;
-            } else {
-                g->next[i] = texel_gather(run, m, i, key, g->next_sh ? &g->next_sh[i] : NULL,
-                                          g->next_var ? &g->next_var[i] : NULL);
-            }
-        }
+        else
+            tile_gather(run, g, m, first, count, key);
         lx_tile_walk_done(&w, global, count);
     }
     return lx_tile_walk_end(&w);
@@ -664,6 +803,7 @@ lx_status lx_bake_indirect(lx_baker *b, float progress_base, float progress_span
         for (uint32_t m = 0; m < count; m++)
             run.sources[m].source = run.maps[m].source;
         run.dark = b->desc.gi_adaptive ? 0.1 * mean_source(&run) : 0.0;
+        run.samples = lx_gi_bounce_samples(b->desc.gi_samples, k);
         for (uint32_t t = 0; t < b->tile_count && st == LX_OK; t++) {
             if (!tile_pass(&run, t, false, GI_KEY + 2u * (uint32_t)k, from, from + span, &st))
                 break;

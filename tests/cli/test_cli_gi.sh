@@ -1,5 +1,5 @@
 # End-to-end tests of `luxel bake`'s indirect light (--bounces,
-# --gi-samples, --emissive-scale, --supersample), run on the real binary with its own
+# --gi-samples, --gi-sampling, --emissive-scale, --supersample), run on the real binary with its own
 # defaults (LUXEL_REAL): the default bake has two bounces and says so in
 # the manifest; --bounces 0 ignores the other GI settings, byte for byte;
 # 1 and 2 threads give the same bytes; an emissive material alone lights a
@@ -24,6 +24,15 @@ check "manifest: two bounces by default" \
     grep -Eq '"bounces":[[:space:]]*2' "$WORK/default/manifest.json"
 check "manifest: the gather's rays" grep -Eq '"gi_samples":[[:space:]]*9' \
     "$WORK/default/manifest.json"
+check "manifest: guided gathers by default" grep -Eq '"gi_sampling":[[:space:]]*"guided"' \
+    "$WORK/default/manifest.json"
+run "$BIN" bake "$ROOM" --resolution 24 --gi-samples 9 -q --gi-sampling cosine -o "$WORK/cosine"
+expect_rc 0 "--gi-sampling cosine"
+check "manifest: --gi-sampling cosine" grep -Eq '"gi_sampling":[[:space:]]*"cosine"' \
+    "$WORK/cosine/manifest.json"
+# 9 rays a texel are too few to learn from: not guided, the same bytes
+check "room.exr: 9 rays a texel are cosine-weighted either way" \
+    cmp -s "$WORK/default/room.exr" "$WORK/cosine/room.exr"
 run "$BIN" bake "$ROOM" "${SMALL[@]}" --bounces 0 -o "$WORK/direct"
 expect_rc 0 "--bounces 0"
 check "manifest: no indirect entry without bounces" \
@@ -106,7 +115,8 @@ check "manifest: no edge supersampling with --supersample 3" \
 # ---- bad values -------------------------------------------------------------------
 for bad in "--bounces -1" "--bounces 65" "--bounces two" "--gi-samples 0" "--gi-samples 70000" \
     "--emissive-scale 0" "--emissive-scale -2" "--emissive-scale nan" "--supersample 0" \
-    "--supersample 17" "--supersample two" "--edge-supersample -1" "--edge-supersample 17"; do
+    "--supersample 17" "--supersample two" "--edge-supersample -1" "--edge-supersample 17" \
+    "--gi-sampling uniform" "--gi-sampling"; do
     # shellcheck disable=SC2086
     run "$BIN" bake "$ROOM" $bad -q -o "$WORK/bad"
     expect_rc 2 "$bad"

@@ -66,6 +66,9 @@ static const char *bake_usage =
     "  --bounces N             indirect diffuse bounces, 0..%d; 0 bakes direct\n"
     "                          light only (default %d)\n"
     "  --gi-samples N          gather rays per texel per bounce (default %u)\n"
+    "  --gi-sampling MODE      guided (default: a quarter of the rays learn where\n"
+    "                          each 8x8 texel tile's light comes from, half the\n"
+    "                          rest go there) or cosine (all cosine-weighted)\n"
     "  --gi-adaptive           gather in rounds of a quarter of --gi-samples until\n"
     "                          each texel's estimate is within 2.5%% (2 to 16\n"
     "                          rounds): fewer blotches, 2-4x the bounces' time\n"
@@ -143,6 +146,7 @@ enum {
     OPT_SUPERSAMPLE,
     OPT_EDGE_SUPERSAMPLE,
     OPT_GI_ADAPTIVE,
+    OPT_GI_SAMPLING,
     OPT_NO_STITCH,
     OPT_AO,
     OPT_AO_DISTANCE,
@@ -167,6 +171,7 @@ static int parse_args(int argc, char **argv, bake_args *a)
         {"supersample", required_argument, NULL, OPT_SUPERSAMPLE},
         {"edge-supersample", required_argument, NULL, OPT_EDGE_SUPERSAMPLE},
         {"gi-adaptive", no_argument, NULL, OPT_GI_ADAPTIVE},
+        {"gi-sampling", required_argument, NULL, OPT_GI_SAMPLING},
         {"no-stitch", no_argument, NULL, OPT_NO_STITCH},
         {"ao", no_argument, NULL, OPT_AO},
         {"ao-distance", required_argument, NULL, OPT_AO_DISTANCE},
@@ -274,6 +279,15 @@ static int parse_args(int argc, char **argv, bake_args *a)
             break;
         case OPT_GI_ADAPTIVE:
             a->desc.gi_adaptive = true;
+            break;
+        case OPT_GI_SAMPLING:
+            if (!strcmp(optarg, "guided"))
+                a->desc.gi_sampling = LX_GI_SAMPLING_GUIDED;
+            else if (!strcmp(optarg, "cosine"))
+                a->desc.gi_sampling = LX_GI_SAMPLING_COSINE;
+            else
+                return cli_usage_error("bake", "--gi-sampling must be guided or cosine, not '%s'",
+                                       optarg);
             break;
         case OPT_EDGE_SUPERSAMPLE:
             if (!cli_parse_int(optarg, 0, LX_MAX_SUPERSAMPLE, &n))
@@ -632,6 +646,8 @@ int cmd_bake(int argc, char **argv)
         cJSON_AddNumberToObject(gi, "gi_samples", a.desc.gi_samples);
         if (a.desc.gi_adaptive)
             cJSON_AddBoolToObject(gi, "gi_adaptive", true);
+        cJSON_AddStringToObject(gi, "gi_sampling",
+                                a.desc.gi_sampling == LX_GI_SAMPLING_COSINE ? "cosine" : "guided");
         cJSON_AddNumberToObject(gi, "emissive_scale", a.desc.emissive_scale);
     }
     if (a.desc.texel_density > 0.0f || unwrap)
