@@ -177,6 +177,10 @@ typedef struct lx_node_bake {
                               the CLI's default texel density and camera rays.
                               The three no_* flags are what bakes it: marking
                               sets them, and settings given later change them */
+    bool backdrop;         /* a ground or terrain running far past the rest
+                              (lx_scene_mark_backdrops): baked as any node, at
+                              the lowered lightmap_scale marking gave it; left
+                              out of the default camera's framing */
 } lx_node_bake;
 
 /* lightmap_scale with its default applied. */
@@ -381,6 +385,28 @@ bool lx_scene_bounds(const lx_scene *scene, lx_vec3 *lo, lx_vec3 *hi);
  * alone a node whose extras say luxel_sky. Returns the nodes marked. */
 #define LX_SKY_DOME_RATIO 4.0f
 uint32_t lx_scene_mark_sky_domes(lx_scene *scene);
+
+/* Marks a backdrop: the lightmapped node (not a sky, with a lightmap)
+ * holding more than half of the lightmapped world area (each node's area
+ * times its lightmap_scale squared) and at least LX_BACKDROP_MIN_AREA m^2
+ * (what luxel bake's default budget of 2^20 texels covers at 10 texels a
+ * metre; below, a room's floor under one crate, the density is the most
+ * it gives anyway), whose bounds' largest extent is at
+ * least LX_BACKDROP_RATIO times that of the other lightmapped nodes
+ * together, and whose lightmap_scale is not set: it gets bake.backdrop
+ * and the lightmap_scale that leaves it LX_BACKDROP_SHARE of the texels
+ * at any density (at least 1 / 1024), and one warning through lx_log
+ * names it. lx_scene_load calls this after the sky domes, leaving alone a
+ * node whose extras set its lightmap scale. Returns the nodes marked (0
+ * or 1). */
+#define LX_BACKDROP_RATIO 8.0f
+#define LX_BACKDROP_MIN_AREA 10000.0
+#define LX_BACKDROP_SHARE 0.1
+uint32_t lx_scene_mark_backdrops(lx_scene *scene);
+
+/* The world-space surface area of node n's triangles, in square metres;
+ * 0 for a node out of range. */
+double lx_node_world_area(const lx_scene *scene, uint32_t node);
 
 /* Reads a lights JSON file (docs/lights-json.md) and applies it: its
  * "ambient" sets scene->ambient, each light is added or overrides the scene

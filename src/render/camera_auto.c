@@ -1,5 +1,6 @@
 /* The default camera of a scene with no camera of its own: the iso framing
- * of its bounds (camera.c; the nodes with a lightmap, sky domes left out),
+ * of its bounds (camera.c; the nodes with a lightmap, sky domes and a
+ * backdrop left out),
  * checked by what it sees. A grid of probe rays
  * through the view finds the first surface along each (both faces); with
  * the bake's lightmaps, a small render of the same view (one sample a
@@ -123,14 +124,15 @@ static float score(const view_probe *v, bool use_light, double lit, float *of_hi
 }
 
 /* The bounds the default camera frames: the nodes that get a lightmap
- * and are not sky domes (what a bake lights), else the scene's. */
+ * and are neither sky domes nor a backdrop (what a bake lights, without
+ * the plain around it), else the scene's. */
 static bool framed_bounds(const lx_scene *scene, lx_vec3 *lo, lx_vec3 *hi)
 {
     bool any = false;
     lx_vec3 a = lx_v3(INFINITY, INFINITY, INFINITY), b = lx_v3(-INFINITY, -INFINITY, -INFINITY);
     for (uint32_t n = 0; n < scene->node_count; n++) {
         const lx_node *node = &scene->nodes[n];
-        if (node->bake.sky || node->bake.no_lightmap)
+        if (node->bake.sky || node->bake.no_lightmap || node->bake.backdrop)
             continue;
         for (uint32_t k = 0; k < node->mesh_count; k++) {
             const lx_mesh *m = &scene->meshes[node->meshes[k]];

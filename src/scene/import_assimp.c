@@ -1599,8 +1599,8 @@ static lx_status import_scene(const char *path, const import_source *src,
         uint32_t counter = 0;
         st = import_node(&c, ai->mRootNode, &root, 0, &counter);
     }
-    /* per-node bake settings from the file, then sky domes among the
-     * nodes whose extras do not say */
+    /* per-node bake settings from the file, then sky domes and a backdrop
+     * among the nodes whose extras do not say */
     if (st == LX_OK) {
         bool *decided = calloc(c.scene->node_count + 1, sizeof *decided);
         if (!decided)
@@ -1609,6 +1609,8 @@ static lx_status import_scene(const char *path, const import_source *src,
             st = lx_gltf_node_extras_read(c.scene, path, c.gltf, decided);
         if (st == LX_OK)
             lx_scene_mark_sky_domes_except(c.scene, decided);
+        if (st == LX_OK)
+            lx_scene_mark_backdrops_except(c.scene, decided);
         free(decided);
     }
     if (st == LX_OK)

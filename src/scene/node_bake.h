@@ -45,5 +45,7 @@ lx_status lx_gltf_node_extras_read(lx_scene *scene, const char *file, const cJSO
 /* lx_scene_mark_sky_domes leaving out the nodes whose decided[n] is true
  * (decided may be NULL). */
 uint32_t lx_scene_mark_sky_domes_except(lx_scene *scene, const bool *decided);
+/* lx_scene_mark_backdrops, the same way. */
+uint32_t lx_scene_mark_backdrops_except(lx_scene *scene, const bool *decided);
 
 #endif

@@ -224,6 +224,7 @@ f32() {
     0.125) printf '\x00\x00\x00\x3e' ;;
     0.75) printf '\x00\x00\x40\x3f' ;;
     0.875) printf '\x00\x00\x60\x3f' ;;
+    556) printf '\x00\x00\x0b\x44' ;;
     nan) printf '\x00\x00\xc0\x7f' ;;
     inf) printf '\x00\x00\x80\x7f' ;;
     *)

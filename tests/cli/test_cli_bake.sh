@@ -425,6 +425,17 @@ check "atlas: the manifest records the scene's density, 40 texels/m" \
 run "$LUXEL" bake "$ROOM" --ambient 0.5 --bounces 0 -o "$WORK/density"
 expect_stderr_has "the summary line states the scene's density" \
     "^luxel: baked 3 lightmaps \\([0-9]+ texels at 40 texels/m,"
+# a 556 m floor (a Cornell box in millimetres read as metres): the budget
+# holds, 309,136 m^2 at sqrt(2^20 / 309136) = 1.84, 1.8 texels/m (no floor
+# at 4 to ask for 2224^2 texels), with a warning about the units
+write_gltf "$WORK/huge.gltf" floor floor \
+    "0 0 0  0 0 556  556 0 0   556 0 0  0 0 556  556 0 556" "0 0  0 1  1 0   1 0  0 1  1 1"
+run "$LUXEL" bake "$WORK/huge.gltf" --ambient 1 --bounces 0 -o "$WORK/huge"
+expect_rc 0 "a 556 m floor with the default density"
+expect_stderr_has "the 556 m floor: the budget's density, 1.8 texels/m" \
+    "^luxel: baked 1 lightmap \\(1[0-9]{6} texels at 1\\.8 texels/m,"
+expect_stderr_has "the 556 m floor: a warning about its units" \
+    "309136 m\\^2 of lightmapped surface: the default budget of 1048576 texels gives it 1\\.8 texels/m .*are its units metres"
 # the same bytes for any thread count
 run "$LUXEL" bake "$ROOM" --unwrap always -q --threads 1 -o "$WORK/atlas1"
 check "atlas: the same page with 1 thread" cmp -s "$WORK/atlas/lightmap-0.exr" \

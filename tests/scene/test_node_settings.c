@@ -13,7 +13,13 @@
  * - sky domes: an unlit mesh enclosing the rest at least LX_SKY_DOME_RATIO
  *   times its diagonal is marked (one warning naming it) and left out of
  *   lx_scene_bounds; a lit one, an unlit one that does not enclose, or one
- *   whose extras say luxel_sky false is not.
+ *   whose extras say luxel_sky false is not;
+ * - backdrops: a node with more than half the lightmapped area spanning at
+ *   least LX_BACKDROP_RATIO times the rest is marked (one warning), its
+ *   lightmap scale lowered to leave it LX_BACKDROP_SHARE of the texels
+ *   (the closed form s^2 A / (s^2 A + A_rest)), and the default camera
+ *   frames the rest exactly as lx_camera_frame frames its bounds; a ground
+ *   under the ratio, or whose extras set its scale, is not.
  * Scenes are generated glTF files (tests/common/gltf_writer.c). */
 #include <setjmp.h>
 #include <stdarg.h>
@@ -341,8 +347,12 @@ static void test_sky_dome(void **state)
     for (int k = 0; k < 3; k++) {
         write_domed(path, not_dome[k].size, not_dome[k].unlit, not_dome[k].extras);
         s = lx_test_load_logged(path, NULL, &book);
-        assert_int_equal(book.warnings, 0);
-        assert_true(bake_default(&node_named(s, "SkyDome")->bake));
+        const lx_node_bake *d = &node_named(s, "SkyDome")->bake;
+        assert_false(d->sky || d->no_cast_shadows || d->no_lightmap || d->no_contribute_gi);
+        /* the lit 2 km box is baked, as a backdrop (test_backdrop): its
+         * one warning says so */
+        assert_int_equal(book.warnings, d->backdrop ? 1 : 0);
+        assert_true(d->backdrop == (not_dome[k].size > 1000.0f && k == 0));
         lx_scene_destroy(s);
     }
     /* 40 m: 4.9 room diagonals, a dome */
@@ -352,12 +362,77 @@ static void test_sky_dome(void **state)
     lx_scene_destroy(s);
 }
 
+/* A ground of side `ground` m (0.1 m thick) under a 50 x 10 x 50 m town;
+ * the ground's extras as given. */
+static void write_town(const char *path, float ground, const char *ground_extras)
+{
+    lx_test_gltf *g = lx_test_gltf_new();
+    int mat = lx_test_gltf_material(g, "{\"name\":\"grass\"}");
+    float h = 0.5f * ground;
+    char members[200] = "";
+    if (ground_extras)
+        snprintf(members, sizeof members, "\"extras\":%s", ground_extras);
+    lx_test_gltf_node(g, "Ground",
+                      box_mesh(g, "ground", lx_v3(-h, -0.1f, -h), lx_v3(h, 0, h), false, mat),
+                      members);
+    lx_test_gltf_node(g, "Town",
+                      box_mesh(g, "town", lx_v3(-25, 0, -25), lx_v3(25, 10, 25), false, mat), "");
+    lx_test_gltf_write(g, path);
+    lx_test_gltf_free(g);
+}
+
+static void test_backdrop(void **state)
+{
+    (void)state;
+    const char *dir = lx_test_dir("test_node_settings_backdrop");
+    char path[PATH_MAX];
+    snprintf(path, sizeof path, "%s/town.gltf", dir);
+    write_town(path, 2000.0f, NULL);
+    lx_test_logbook book;
+    lx_scene *s = lx_test_load_logged(path, NULL, &book);
+    const lx_node *ground = node_named(s, "Ground"), *town = node_named(s, "Town");
+    assert_true(ground->bake.backdrop);
+    assert_false(ground->bake.sky || ground->bake.no_lightmap || ground->bake.no_cast_shadows);
+    assert_true(bake_default(&town->bake) && !town->bake.backdrop);
+    assert_int_equal(book.warnings, 1);
+    assert_non_null(strstr(book.text, "node 'Ground' spans 2e+03 m around the rest's 50 m"));
+    /* areas in closed form: the ground 2 x 2000^2 + 4 x 2000 x 0.1, the
+     * town 2 x 50^2 + 4 x 50 x 10 */
+    double a_ground = 2.0 * 2000.0 * 2000.0 + 4.0 * 2000.0 * 0.1, a_town = 2.0 * 2500.0 + 2000.0;
+    lx_test_assert_rel(lx_node_world_area(s, (uint32_t)(ground - s->nodes)), a_ground, 1e-5);
+    double sc = ground->bake.lightmap_scale;
+    double share = sc * sc * a_ground / (sc * sc * a_ground + a_town);
+    printf("backdrop: lightmap scale %.4g, its share of the texels %.4g\n", sc, share);
+    lx_test_assert_rel(share, LX_BACKDROP_SHARE, 1e-4);
+    /* the default camera frames the town as lx_camera_frame frames its box */
+    lx_camera cam, want = lx_camera_frame(lx_v3(-25, 0, -25), lx_v3(25, 10, 25), LX_VIEW_ISO,
+                                          LX_DEG2RAD(LX_RENDER_DEFAULT_FOV_DEGREES), 16.0f / 9.0f);
+    assert_int_equal(lx_camera_auto(s, NULL, NULL, 0.0f, 16.0f / 9.0f, &cam, NULL), LX_OK);
+    lx_test_assert_vec3(cam.eye, want.eye.x, want.eye.y, want.eye.z);
+    lx_test_assert_vec3(cam.target, want.target.x, want.target.y, want.target.z);
+    lx_scene_destroy(s);
+
+    /* not a backdrop: a 300 m ground (6 times the town), or one whose
+     * extras set its scale */
+    const char *extras[2] = {NULL, "{\"luxel_lightmap_scale\":0.5}"};
+    const float sides[2] = {300.0f, 2000.0f};
+    for (int k = 0; k < 2; k++) {
+        write_town(path, sides[k], extras[k]);
+        s = lx_test_load_logged(path, NULL, &book);
+        assert_false(node_named(s, "Ground")->bake.backdrop);
+        assert_int_equal(book.warnings, 0);
+        assert_true(node_named(s, "Ground")->bake.lightmap_scale == (k ? 0.5f : 0.0f));
+        lx_scene_destroy(s);
+    }
+}
+
 int main(void)
 {
     const struct CMUnitTest tests[] = {
         cmocka_unit_test(test_defaults_are_zero),      cmocka_unit_test(test_extras),
         cmocka_unit_test(test_extras_errors),          cmocka_unit_test(test_json_nodes),
         cmocka_unit_test(test_json_unmatched_warning), cmocka_unit_test(test_sky_dome),
+        cmocka_unit_test(test_backdrop),
     };
     return cmocka_run_group_tests(tests, NULL, NULL);
 }

@@ -46,31 +46,16 @@ static bool has_uv_set(const lx_scene *scene, uint32_t n, int set)
     return true;
 }
 
-/* World-space surface area of node n. */
-static double node_area(const lx_scene *scene, uint32_t n)
-{
-    const lx_node *node = &scene->nodes[n];
-    double area = 0.0;
-    for (uint32_t k = 0; k < node->mesh_count; k++) {
-        const lx_mesh *m = &scene->meshes[node->meshes[k]];
-        for (uint32_t t = 0; t < m->triangle_count; t++) {
-            const uint32_t *i = &m->indices[3 * t];
-            lx_vec3 p = lx_mat4_point(&node->world, m->positions[i[0]]);
-            lx_vec3 q = lx_mat4_point(&node->world, m->positions[i[1]]);
-            lx_vec3 r = lx_mat4_point(&node->world, m->positions[i[2]]);
-            area += 0.5 * lx_length(lx_cross(lx_sub(q, p), lx_sub(r, p)));
-        }
-    }
-    return area;
-}
-
 /* The texel density a bake gets when no option sizes its lightmaps: the
  * density that spends CLI_DENSITY_BUDGET texels on the world area of every
  * node with a mesh and a lightmap (not a sky dome), each node's area
- * times its lightmap scale squared, held to CLI_DENSITY_MIN..CLI_DENSITY_MAX texels a
- * metre (the tens of texels per metre Unity's and Bakery's defaults give
- * rooms and levels), to two significant digits. A room of 200 m^2 gets the
- * maximum; a level of 10,000 m^2 about 10. */
+ * times its lightmap scale squared (a backdrop's lowered one included),
+ * at most CLI_DENSITY_MAX texels a metre (the tens of texels per metre
+ * Unity's and Bakery's defaults give rooms and levels), to two
+ * significant digits. A room of 200 m^2 gets the maximum; a level of
+ * 10,000 m^2 about 10. The budget holds below CLI_DENSITY_MIN too (a
+ * floor would let a scene in the wrong units ask for gigabytes):
+ * check_scale warns there. */
 double cli_default_density(const lx_scene *scene)
 {
     double total = 0.0;
@@ -79,10 +64,10 @@ double cli_default_density(const lx_scene *scene)
         if (b->no_lightmap || b->sky)
             continue; /* no texels: a sky dome's kilometres spend none */
         double s = lx_node_lightmap_scale(b);
-        total += node_area(scene, n) * s * s;
+        total += lx_node_world_area(scene, n) * s * s;
     }
     double d = total > 0.0 ? sqrt(CLI_DENSITY_BUDGET / total) : CLI_DENSITY_MAX;
-    d = d > CLI_DENSITY_MAX ? CLI_DENSITY_MAX : d < CLI_DENSITY_MIN ? CLI_DENSITY_MIN : d;
+    d = d > CLI_DENSITY_MAX ? CLI_DENSITY_MAX : d;
     double scale = pow(10.0, floor(log10(d)) - 1.0);
     return floor(d / scale + 0.5) * scale;
 }
@@ -104,7 +89,7 @@ static void check_scale(const bake_args *a, const lx_scene *scene, const lx_unwr
         if (b->no_lightmap || b->sky)
             continue;
         double s = lx_node_lightmap_scale(b);
-        double area = node_area(scene, n) * s * s; /* at the density: its texels */
+        double area = lx_node_world_area(scene, n) * s * s; /* at the density: its texels */
         total += area;
         if (density > 0.0f && !a->density_from_scene && area > 0.0 &&
             area * density * density < 64.0) {
@@ -116,6 +101,14 @@ static void check_scale(const bake_args *a, const lx_scene *scene, const lx_unwr
         }
     }
     bool warned = false;
+    if (a->density_from_scene && density < CLI_DENSITY_MIN) {
+        lx_log(LX_LOG_WARN,
+               "%s: %.0f m^2 of lightmapped surface: the default budget of %.0f texels gives "
+               "it %g texels/m (a texel every %.2g m); are its units metres? (--texel-density "
+               "sets the density, a node's lightmap scale its share)",
+               a->scene, total, CLI_DENSITY_BUDGET, (double)density, 1.0 / (double)density);
+        warned = true;
+    }
     if (size < 0.05 || size > 1e4) {
         lx_log(LX_LOG_WARN,
                "%s: the scene spans %.3g x %.3g x %.3g m, bounds (%.4g, %.4g, %.4g) .. (%.4g, "
@@ -538,7 +531,7 @@ static float texture_density(void *user, const lx_scene *scene, uint32_t node)
     if (t->a->desc.texel_density > 0.0f)
         return t->a->desc.texel_density * scale;
     if (t->a->has_resolution) {
-        double area = node_area(scene, node);
+        double area = lx_node_world_area(scene, node);
         return area > 0.0 ? (float)(t->a->desc.resolution / sqrt(area)) * scale : 0.0f;
     }
     if (!(t->scene_density > 0.0))

@@ -16,7 +16,8 @@ typedef enum unwrap_choice { UNWRAP_AUTO, UNWRAP_ALWAYS, UNWRAP_NEVER } unwrap_c
 #define CLI_ATLAS_RESOLUTION 1024
 
 /* The default texel density (cli_default_density): the texels a bake
- * spends on the scene's area, and the range the density is held to. */
+ * spends on the scene's area, the density under which it warns, and the
+ * most it gives. */
 #define CLI_DENSITY_BUDGET (1024.0 * 1024.0)
 #define CLI_DENSITY_MIN 4.0
 #define CLI_DENSITY_MAX 40.0
