@@ -264,8 +264,10 @@ typedef struct lx_bake_desc {
                               the texel's centre cannot see along its
                               surface (under a wall) are left out. Ignored
                               with supersample > 1; luxel bake uses
-                              LX_EDGE_SUPERSAMPLE_RECOMMENDED. 4 bytes a
-                              texel while the direct light is baked */
+                              LX_EDGE_SUPERSAMPLE_RECOMMENDED. Only the
+                              lights whose shadows differ around the texel
+                              are shaded again. 20 bytes a texel while the
+                              direct light is baked */
     /* Memory and scale (see "MEMORY AND TILES" above lx_baker_tile_count). */
     uint64_t memory_limit;  /* bytes the bake may take; 0 (or more than the
                                machine has) = what the machine has: its

@@ -339,6 +339,14 @@ void lx_texel_map_transform(lx_lightmap *map, uint32_t node, const lx_mat4 *worl
  * texel_axes. Reports within [progress_base, + progress_span] when
  * report (LX_ERR_CANCELLED when told to stop). */
 lx_status lx_bake_straddle(lx_baker *b, float progress_base, float progress_span, bool report);
+/* Whether any texel of tile [first, first + count) of map (with its
+ * texel_axes) could straddle: false when its texels lie in one plane and
+ * every triangle within reach of their rays (a sphere around them, wide
+ * enough for the texels' and their footprint points' rays) lies in that
+ * plane too (the tile's own surface): then no ray along the surface from
+ * a texel to a point of its footprint meets anything. */
+bool lx_bake_tile_may_straddle(const lx_baker *b, const lx_lightmap *map, uint32_t first,
+                               uint32_t count);
 
 /* Adds the given lights (indices into baker->lights) into target
  * (width*height*3 floats per map), plus `ambient` at every texel

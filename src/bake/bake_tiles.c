@@ -101,7 +101,7 @@ static const texel_buffer texel_buffers[] = {
      WHEN_ALWAYS},
     {"texel map: footprint axes, until samples are moved out of walls (kept for edge "
      "supersampling)", 24, PER_TEXEL, LIFE_TEXEL_MAP, WHEN_ALWAYS},
-    {"edge supersampling: shadow records, edge flags and the page's texel index", 9, PER_TEXEL,
+    {"edge supersampling: shadow records, edge masks and the page's texel index", 20, PER_TEXEL,
      LIFE_TEXEL_MAP, WHEN_EDGE},
     {"texel map: tile offsets", 1, PER_TEXEL, LIFE_TEXEL_MAP, WHEN_ALWAYS},
     {"texel map: lift to the smooth surface (shadow terminator)", 12, PER_TEXEL, LIFE_TEXEL_MAP,

@@ -93,23 +93,22 @@ static float soft_visibility(const lx_baker *b, uint32_t map_index, const lx_lig
 }
 
 /* What a light adds to a texel's shadow record when it is blocked there
- * (edge supersampling compares neighbours' records): a hash of the light,
- * so two records differ when different lights reach the texels. */
-static uint32_t shadow_key(uint32_t light_index)
+ * (edge supersampling compares neighbours' records): the bit of its place
+ * in the pass's light list, modulo 64. With up to 64 lights a record says
+ * exactly which hard-shadowed lights are blocked; beyond, lights 64 apart
+ * share a bit (re-shaded together, and an edge of two of them that cancel
+ * goes unseen). */
+static uint64_t shadow_bit(uint32_t place)
 {
-    uint32_t h = (light_index + 1u) * 0x9E3779B1u;
-    h ^= h >> 16;
-    h *= 0x85EBCA6Bu;
-    h ^= h >> 13;
-    return h | 1u;
+    return (uint64_t)1 << (place & 63u);
 }
 
 /* sh (NULL: no directional data) gets what accum gets, with its
  * direction (lx_sh4_add_lit_floor); shadows (NULL: none) each texel's
- * shadow record (shadow_key of the hard-shadowed lights blocked there). */
+ * shadow record (shadow_bit of the hard-shadowed lights blocked there). */
 static void light_tile(const lx_baker *b, uint32_t map_index, const lx_lightmap *map,
                        uint32_t first, uint32_t count, uint32_t light_index, lx_vec3 *accum,
-                       lx_sh4 *sh, uint32_t *shadows)
+                       lx_sh4 *sh, uint64_t *shadows, uint64_t bit)
 {
     const lx_light *light = &b->lights[light_index];
     const float floor_c = lx_light_is_area(light) ? 0.1f : 1e-3f; /* lx_sh4_add_lit_floor */
@@ -167,7 +166,7 @@ static void light_tile(const lx_baker *b, uint32_t map_index, const lx_lightmap 
     lx_tracer_occluded_batch(b->tracer, rays, n, true, occluded);
     for (uint32_t j = 0; shadows && j < n; j++)
         if (occluded[j])
-            shadows[pending[j].texel] += shadow_key(light_index);
+            shadows[pending[j].texel] |= bit;
     for (uint32_t j = 0; j < n; j++)
         if (!occluded[j]) {
             uint32_t k = pending[j].texel;
@@ -432,8 +431,8 @@ shade_lanes(const fast_light *f, tile_soa *t, uint32_t base, lx_ray_packet *pk, 
 __attribute__((target_clones("avx512f", "avx2", "default")))
 #endif
 static void
-fast_light_tile(const lx_baker *b, const fast_light *f, tile_soa *t, lx_sh4 *sh, uint32_t *shadows,
-                uint32_t key)
+fast_light_tile(const lx_baker *b, const fast_light *f, tile_soa *t, lx_sh4 *sh, uint64_t *shadows,
+                uint64_t key)
 {
     lx_ray_packet pk;
     float e[3][LX_RAY_PACKET];
@@ -460,7 +459,7 @@ fast_light_tile(const lx_baker *b, const fast_light *f, tile_soa *t, lx_sh4 *sh,
         uint32_t add = active & ~blocked;
         for (uint32_t j = 0; shadows && j < LX_RAY_PACKET; j++)
             if ((active & blocked) >> j & 1u)
-                shadows[t->texel[base + j]] += key;
+                shadows[t->texel[base + j]] |= key;
         int32_t on[LX_RAY_PACKET];
         for (int j = 0; j < LX_RAY_PACKET; j++)
             on[j] = (add >> j) & 1u ? -1 : 0;
@@ -508,12 +507,12 @@ static void vec3_to_acc(const lx_vec3 *accum, tile_soa *t)
 static void shade_tile(const lx_baker *b, uint32_t seed, const lx_lightmap *map, uint32_t first,
                        uint32_t count, const uint32_t *lights, uint32_t light_count,
                        const fast_light *fast, const bool *is_fast, lx_vec3 ambient,
-                       bool to_realtime, tile_soa *t, lx_sh4 *sh, uint32_t *shadows)
+                       bool to_realtime, tile_soa *t, lx_sh4 *sh, uint64_t *shadows)
 {
     lx_vec3 accum[TILE_TEXELS];
     tile_load(b, map, first, count, t);
     if (shadows)
-        memset(shadows, 0, sizeof(uint32_t) * count);
+        memset(shadows, 0, sizeof(uint64_t) * count);
     if (sh) {
         memset(sh, 0, sizeof(lx_sh4) * TILE_TEXELS);
         for (uint32_t k = 0; k < count; k++) {
@@ -538,11 +537,11 @@ static void shade_tile(const lx_baker *b, uint32_t seed, const lx_lightmap *map,
         }
     for (uint32_t l = 0; l < light_count; l++) {
         if (is_fast[l] && !horizon) {
-            fast_light_tile(b, &fast[l], t, sh, shadows, shadow_key(lights[l]));
+            fast_light_tile(b, &fast[l], t, sh, shadows, shadow_bit(l));
             continue;
         }
         acc_to_vec3(t, accum);
-        light_tile(b, seed, map, first, count, lights[l], accum, sh, shadows);
+        light_tile(b, seed, map, first, count, lights[l], accum, sh, shadows, shadow_bit(l));
         vec3_to_acc(accum, t);
     }
     if (!to_realtime && b->has_sky && !horizon) {
@@ -633,18 +632,21 @@ static void shade_supersampled(const lx_baker *b, uint32_t map_index, const lx_l
 }
 
 /* ---- edge supersampling ----------------------------------------------------
- * After the direct pass each texel has a shadow record (the sum of
- * shadow_key over the hard-shadowed lights blocked at it). A texel whose
- * record differs from a neighbour's on the same node has a shadow edge
- * within a texel of it; its direct light is shaded again at n x n
- * stratified points of its footprint (its centre plus the footprint
- * axes) and averaged. A point the centre cannot see
- * along the surface (a wall stands between) is left out, as straddle.c
- * leaves out supersampling points under walls. */
+ * After the direct pass each texel has a shadow record (shadow_bit of the
+ * hard-shadowed lights blocked at it). A texel whose record differs from
+ * a neighbour's on the same node has a shadow edge within a texel of it:
+ * each light whose bit differs is shaded again at n x n stratified
+ * points of its footprint (its centre plus the footprint axes), and its
+ * mean replaces its light at the centre; the other lights keep theirs
+ * (a texel under 16 lights on one light's edge shades that light n^2
+ * times, not all 16). A point the centre cannot see along the surface (a wall stands
+ * between) is left out, as straddle.c leaves out supersampling points
+ * under walls. */
 
-/* Marks the texels of map whose shadow record differs from an
- * 8-neighbour's (same node); returns how many, or -1 out of memory. */
-static int64_t mark_edges(const lx_lightmap *map, const uint32_t *records, uint8_t *edge,
+/* Each texel of map: the bits in which its shadow record differs from an
+ * 8-neighbour's (same node), 0 off edges; returns how many are on edges,
+ * or -1 out of memory. */
+static int64_t mark_edges(const lx_lightmap *map, const uint64_t *records, uint64_t *edge,
                           int threads)
 {
     int w = map->info.width, h = map->info.height;
@@ -658,48 +660,103 @@ static int64_t mark_edges(const lx_lightmap *map, const uint32_t *records, uint8
 #pragma omp parallel for schedule(static) reduction(+ : marked) num_threads(threads)
     for (int64_t i = 0; i < used; i++) {
         int x = (int)(map->texels[i].pixel % (uint32_t)w), y = (int)(map->texels[i].pixel / (uint32_t)w);
-        bool differs = false;
-        for (int dy = -1; dy <= 1 && !differs; dy++)
-            for (int dx = -1; dx <= 1 && !differs; dx++) {
+        uint64_t differs = 0;
+        for (int dy = -1; dy <= 1; dy++)
+            for (int dx = -1; dx <= 1; dx++) {
                 int nx = x + dx, ny = y + dy;
                 if ((dx == 0 && dy == 0) || nx < 0 || ny < 0 || nx >= w || ny >= h)
                     continue;
                 int32_t j = at[(size_t)ny * (size_t)w + (size_t)nx];
-                differs = j >= 0 && map->texels[j].node == map->texels[i].node &&
-                          records[j] != records[i];
+                if (j >= 0 && map->texels[j].node == map->texels[i].node)
+                    differs |= records[j] ^ records[i];
             }
         edge[i] = differs;
-        marked += differs;
+        marked += differs != 0;
+
     }
     free(at);
     return marked;
 }
 
-/* The marked texels of one tile of map m shaded again over their
- * footprints, into the baked buffer (and the directional data). */
-static void edge_tile(const lx_baker *b, uint32_t m, uint32_t first, uint32_t count,
-                      const uint8_t *edge, int n, const uint32_t *lights, uint32_t light_count,
-                      const fast_light *fast, const bool *is_fast, lx_vec3 ambient, bool directional)
+/* One edge tile's marked texels: their records and frames (a view of
+ * the map's arrays for shade_tile), and per footprint point where it
+ * lies and whether the centre sees it. */
+typedef struct edge_set {
+    uint32_t marked, points;
+    uint32_t orig[TILE_TEXELS];
+    uint64_t mask[TILE_TEXELS];
+    lx_vec3 *at;      /* points x marked: the point's position */
+    uint8_t *hidden;  /* points x marked: a wall stands between it and the centre */
+    uint32_t seen[TILE_TEXELS];
+} edge_set;
+
+/* The footprint points of the set's texels (n-rooks within the n x n
+ * cells, the canonical multi-jittered pattern: every point its own column
+ * and row of n^2, so an edge along either axis of the texel is resolved
+ * n^2 ways), and which the centre sees along the surface (lifted by the
+ * shadow bias; no rays when nothing but the surface itself is near the
+ * tile: no wall stands on it there). */
+static void edge_points(const lx_baker *b, const lx_lightmap *map, int n, bool near_walls,
+                        edge_set *e)
+{
+    lx_ray rays[TILE_TEXELS];
+    for (int s = 0; s < n * n; s++) {
+        int col = s % n, row = s / n;
+        float du = ((float)col + ((float)row + 0.5f) / (float)n) / (float)n - 0.5f;
+        float dv = ((float)row + ((float)col + 0.5f) / (float)n) / (float)n - 0.5f;
+        lx_vec3 *at = e->at + (size_t)s * e->marked;
+        for (uint32_t j = 0; j < e->marked; j++) {
+            uint32_t i = e->orig[j];
+            lx_vec3 p = map->world_position[i], g = map->world_geometric_normal[i];
+            lx_vec3 step = lx_add(lx_scale(map->texel_axes[2 * (size_t)i], du),
+                                  lx_scale(map->texel_axes[2 * (size_t)i + 1], dv));
+            at[j] = lx_add(p, step);
+            if (!near_walls)
+                continue;
+            float lifted = b->bias + 4e-6f * lx_max_abs_component(p), len = lx_length(step);
+            rays[j] = (lx_ray){.origin = lx_madd(p, g, lifted),
+                               .dir = len > 0.0f ? lx_scale(step, 1.0f / len) : g,
+                               .tmin = 0.0f,
+                               .tmax = len};
+        }
+        uint8_t *hidden = e->hidden + (size_t)s * e->marked;
+        if (near_walls)
+            lx_tracer_occluded_batch(b->tracer, rays, e->marked, true, hidden);
+        else
+            memset(hidden, 0, e->marked);
+        for (uint32_t j = 0; j < e->marked; j++)
+            e->seen[j] += !hidden[j];
+    }
+}
+
+/* Light `place` of the pass (lights[place], fast[place]) over the set's
+ * texels whose mask has its bit: its mean over their seen points less its
+ * light at their centres, added to delta (and sh_delta). */
+static void edge_light(const lx_baker *b, uint32_t m, const edge_set *e, uint32_t place,
+                       const uint32_t *lights, const fast_light *fast, const bool *is_fast,
+                       double (*delta)[3], double (*sh_delta)[LX_SH_FLOATS])
 {
     const lx_lightmap *map = &b->maps[m];
     lx_texel rec[TILE_TEXELS];
     lx_vec3 pos[TILE_TEXELS], nrm[TILE_TEXELS], geo[TILE_TEXELS], lift[TILE_TEXELS];
     lx_texel_horizon hor[TILE_TEXELS];
-    uint32_t orig[TILE_TEXELS], marked = 0;
-    for (uint32_t i = first; i < first + count; i++) {
-        if (!edge[i])
+    uint32_t which[TILE_TEXELS], k = 0;
+    for (uint32_t j = 0; j < e->marked; j++) {
+        if (!(e->mask[j] & shadow_bit(place)) || !e->seen[j])
             continue;
-        orig[marked] = i;
-        rec[marked] = map->texels[i];
-        nrm[marked] = map->world_normal[i];
-        geo[marked] = map->world_geometric_normal[i];
+        uint32_t i = e->orig[j];
+        which[k] = j;
+        rec[k] = map->texels[i];
+        pos[k] = map->world_position[i];
+        nrm[k] = map->world_normal[i];
+        geo[k] = map->world_geometric_normal[i];
         if (map->lift)
-            lift[marked] = map->lift[i];
+            lift[k] = map->lift[i];
         if (map->horizon)
-            hor[marked] = map->horizon[i];
-        marked++;
+            hor[k] = map->horizon[i];
+        k++;
     }
-    if (!marked)
+    if (!k)
         return;
     lx_lightmap view = *map;
     view.texels = rec;
@@ -709,69 +766,100 @@ static void edge_tile(const lx_baker *b, uint32_t m, uint32_t first, uint32_t co
     view.lift = map->lift ? lift : NULL;
     view.horizon = map->horizon ? hor : NULL;
     view.sub_count = 0;
-    double sum[TILE_TEXELS][3], sh_sum[TILE_TEXELS][LX_SH_FLOATS];
-    uint32_t seen[TILE_TEXELS];
-    memset(sum, 0, sizeof(sum[0]) * marked);
-    memset(sh_sum, 0, sizeof(sh_sum[0]) * marked);
-    memset(seen, 0, sizeof(seen[0]) * marked);
-    lx_ray rays[TILE_TEXELS];
-    uint8_t blocked[TILE_TEXELS];
+    /* one hard-shadowed light: no random numbers, sky or ambient */
+    lx_vec3 none = lx_v3(0.0f, 0.0f, 0.0f);
     tile_soa t;
-    lx_sh4 point_sh[TILE_TEXELS];
-    for (int s = 0; s < n * n; s++) {
-        /* n-rooks within the n x n cells (the canonical multi-jittered
-         * pattern): every point its own column and row of n^2, so an
-         * edge along either axis of the texel is resolved n^2 ways */
-        int col = s % n, row = s / n;
-        float du = ((float)col + ((float)row + 0.5f) / (float)n) / (float)n - 0.5f;
-        float dv = ((float)row + ((float)col + 0.5f) / (float)n) / (float)n - 0.5f;
-        for (uint32_t j = 0; j < marked; j++) {
-            uint32_t i = orig[j];
-            lx_vec3 p = map->world_position[i], g = geo[j];
-            lx_vec3 step = lx_add(lx_scale(map->texel_axes[2 * (size_t)i], du),
-                                  lx_scale(map->texel_axes[2 * (size_t)i + 1], dv));
-            pos[j] = lx_add(p, step);
-            /* the centre sees the point along the surface (lifted by the
-             * shadow bias), or the point is left out */
-            float lifted = b->bias + 4e-6f * lx_max_abs_component(p), len = lx_length(step);
-            rays[j] = (lx_ray){.origin = lx_madd(p, g, lifted),
-                               .dir = len > 0.0f ? lx_scale(step, 1.0f / len) : g,
-                               .tmin = 0.0f,
-                               .tmax = len};
-        }
-        lx_tracer_occluded_batch(b->tracer, rays, marked, true, blocked);
-        for (uint32_t j = 0; j < marked; j++)
-            if (blocked[j])
-                pos[j] = map->world_position[orig[j]];
-        shade_tile(b, m ^ ((uint32_t)s << 16), &view, 0, marked, lights, light_count, fast,
-                   is_fast, ambient, false, &t, directional ? point_sh : NULL, NULL);
-        for (int k = 0; k < TILE_TEXELS; k++) {
-            int32_t j = t.texel[k];
-            if (j < 0 || blocked[j])
+    lx_sh4 psh[TILE_TEXELS];
+    lx_sh4 *sh = sh_delta ? psh : NULL;
+    double sum[TILE_TEXELS][3], sh_sum[TILE_TEXELS][LX_SH_FLOATS];
+    memset(sum, 0, sizeof(sum[0]) * k);
+    memset(sh_sum, 0, sizeof(sh_sum[0]) * k);
+    for (int s = -1; s < (int)e->points; s++) {
+        /* s = -1: the centres, taken off; then each point, its mean added */
+        const uint8_t *hidden = s < 0 ? NULL : e->hidden + (size_t)s * e->marked;
+        for (uint32_t q = 0; q < k; q++)
+            pos[q] = s < 0 || hidden[which[q]]
+                         ? map->world_position[e->orig[which[q]]]
+                         : e->at[(size_t)s * e->marked + which[q]];
+        shade_tile(b, m, &view, 0, k, &lights[place], 1, &fast[place], &is_fast[place], none,
+                   true, &t, sh, NULL);
+        for (int lane = 0; lane < TILE_TEXELS; lane++) {
+            int32_t q = t.texel[lane];
+            if (q < 0 || (s >= 0 && hidden[which[q]]))
                 continue;
+            double w = s < 0 ? -(double)e->seen[which[q]] : 1.0;
             for (int c = 0; c < 3; c++)
-                sum[j][c] += (double)t.acc[c][k];
-            for (int c = 0; directional && c < LX_SH_FLOATS; c++)
-                sh_sum[j][c] += (double)point_sh[j].c[c];
-            seen[j]++;
+                sum[q][c] += w * (double)t.acc[c][lane];
+            for (int c = 0; sh && c < LX_SH_FLOATS; c++)
+                sh_sum[q][c] += w * (double)psh[q].c[c];
         }
     }
-    for (uint32_t j = 0; j < marked; j++) {
-        if (!seen[j])
-            continue; /* no point seen: the centre's light stays */
-        size_t pixel = map->texels[orig[j]].pixel;
+    for (uint32_t q = 0; q < k; q++) {
+        uint32_t j = which[q];
+        double seen = (double)e->seen[j];
         for (int c = 0; c < 3; c++)
-            map->baked[3 * pixel + (size_t)c] = (float)(sum[j][c] / (double)seen[j]);
-        for (int c = 0; directional && c < LX_SH_FLOATS; c++)
-            map->sh[LX_SH_FLOATS * pixel + (size_t)c] = (float)(sh_sum[j][c] / (double)seen[j]);
+            delta[j][c] += sum[q][c] / seen;
+        for (int c = 0; sh && c < LX_SH_FLOATS; c++)
+            sh_delta[j][c] += sh_sum[q][c] / seen;
     }
 }
 
+/* The marked texels of one tile of map m: each light whose shadow differs
+ * around a texel shaded again over its footprint, into the baked buffer
+ * (and the directional data); false out of memory. */
+static bool edge_tile(const lx_baker *b, uint32_t m, uint32_t first, uint32_t count,
+                      const uint64_t *edge, int n, const uint32_t *lights, uint32_t light_count,
+                      const fast_light *fast, const bool *is_fast, bool directional)
+{
+    const lx_lightmap *map = &b->maps[m];
+    edge_set e = {.points = (uint32_t)(n * n)};
+    uint64_t bits = 0;
+    for (uint32_t i = first; i < first + count; i++)
+        if (edge[i]) {
+            e.orig[e.marked] = i;
+            e.mask[e.marked] = edge[i];
+            e.seen[e.marked] = 0;
+            bits |= edge[i];
+            e.marked++;
+        }
+    if (!e.marked)
+        return true;
+    e.at = malloc(sizeof(lx_vec3) * e.points * e.marked);
+    e.hidden = malloc((size_t)e.points * e.marked);
+    if (!e.at || !e.hidden) {
+        free(e.at);
+        free(e.hidden);
+        return false;
+    }
+    edge_points(b, map, n, lx_bake_tile_may_straddle(b, map, first, count), &e);
+    double delta[TILE_TEXELS][3], sh_delta[TILE_TEXELS][LX_SH_FLOATS];
+    memset(delta, 0, sizeof(delta[0]) * e.marked);
+    memset(sh_delta, 0, sizeof(sh_delta[0]) * e.marked);
+    for (uint32_t l = 0; l < light_count; l++)
+        if (bits & shadow_bit(l))
+            edge_light(b, m, &e, l, lights, fast, is_fast, delta, directional ? sh_delta : NULL);
+    for (uint32_t j = 0; j < e.marked; j++) {
+        if (!e.seen[j])
+            continue; /* no point seen: the centre's light stays */
+        size_t pixel = map->texels[e.orig[j]].pixel;
+        for (int c = 0; c < 3; c++) {
+            /* at least 0: where those lights were all of the centre's light
+             * the difference leaves a rounding residue of either sign */
+            float *px = &map->baked[3 * pixel + (size_t)c];
+            *px = (float)fmax((double)*px + delta[j][c], 0.0);
+        }
+        for (int c = 0; directional && c < LX_SH_FLOATS; c++)
+            map->sh[LX_SH_FLOATS * pixel + (size_t)c] += (float)sh_delta[j][c];
+    }
+    free(e.at);
+    free(e.hidden);
+    return true;
+}
+
 /* Edge supersampling of every map with shadow records (records[m]). */
-static lx_status edge_supersample(const lx_baker *b, uint32_t *const *records, int n,
+static lx_status edge_supersample(const lx_baker *b, uint64_t *const *records, int n,
                                   const uint32_t *lights, uint32_t light_count,
-                                  const fast_light *fast, const bool *is_fast, lx_vec3 ambient,
-                                  bool directional)
+                                  const fast_light *fast, const bool *is_fast, bool directional)
 {
     int threads = lx_thread_count(b->desc.threads);
     int64_t total = 0;
@@ -779,7 +867,7 @@ static lx_status edge_supersample(const lx_baker *b, uint32_t *const *records, i
         const lx_lightmap *map = &b->maps[m];
         if (!records[m])
             continue;
-        uint8_t *edge = malloc(map->info.used_texels ? map->info.used_texels : 1);
+        uint64_t *edge = malloc(sizeof(uint64_t) * (map->info.used_texels + 1));
         int64_t marked = edge ? mark_edges(map, records[m], edge, threads) : -1;
         if (marked < 0) {
             free(edge);
@@ -787,12 +875,16 @@ static lx_status edge_supersample(const lx_baker *b, uint32_t *const *records, i
                            map->name);
         }
         total += marked;
-        int tiles = (int)map->tile_count;
-#pragma omp parallel for schedule(dynamic, 4) num_threads(threads)
+        int tiles = (int)map->tile_count, failed = 0;
+#pragma omp parallel for schedule(dynamic, 4) num_threads(threads) reduction(| : failed)
         for (int tile = 0; tile < tiles; tile++)
-            edge_tile(b, m, map->tile_start[tile], map->tile_start[tile + 1] - map->tile_start[tile],
-                      edge, n, lights, light_count, fast, is_fast, ambient, directional);
+            failed |= !edge_tile(b, m, map->tile_start[tile],
+                                 map->tile_start[tile + 1] - map->tile_start[tile], edge, n, lights,
+                                 light_count, fast, is_fast, directional);
         free(edge);
+        if (failed)
+            return lx_fail(LX_ERR_NOMEM, "lightmap '%s': out of memory for edge supersampling",
+                           map->name);
     }
     if (total)
         lx_log(LX_LOG_INFO, "%lld texels on hard shadow edges supersampled (%dx%d points)",
@@ -836,12 +928,12 @@ lx_status lx_bake_lights(lx_baker *b, const uint32_t *lights, uint32_t light_cou
     /* edge supersampling: the maps in memory that keep their footprints
      * record each texel's shadows */
     int edge_n = to_realtime ? 0 : lx_bake_edge_supersample(&b->desc);
-    uint32_t **records = edge_n ? calloc(b->map_count + 1, sizeof(uint32_t *)) : NULL;
+    uint64_t **records = edge_n ? calloc(b->map_count + 1, sizeof(uint64_t *)) : NULL;
     bool out_of_memory = edge_n && !records;
     for (uint32_t m = 0; records && m < b->map_count && !out_of_memory; m++) {
         const lx_lightmap *map = &b->maps[m];
         if (map->loaded && map->texel_axes && map->info.used_texels)
-            out_of_memory = !(records[m] = malloc(sizeof(uint32_t) * map->info.used_texels));
+            out_of_memory = !(records[m] = malloc(sizeof(uint64_t) * map->info.used_texels));
     }
     if (out_of_memory) {
         for (uint32_t m = 0; records && m < b->map_count; m++)
@@ -889,7 +981,7 @@ lx_status lx_bake_lights(lx_baker *b, const uint32_t *lights, uint32_t light_cou
     }
     st = lx_tile_walk_end(&w);
     if (st == LX_OK && records)
-        st = edge_supersample(b, records, edge_n, lights, light_count, fast, is_fast, ambient,
+        st = edge_supersample(b, records, edge_n, lights, light_count, fast, is_fast,
                               directional);
     for (uint32_t m = 0; records && m < b->map_count; m++)
         free(records[m]);

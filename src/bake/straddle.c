@@ -175,15 +175,10 @@ static bool straddle_texel(const lx_baker *b, lx_lightmap *map, uint32_t i)
     return moved;
 }
 
-/* Whether any texel of a tile could straddle: false when its texels lie
- * in one plane and every triangle within reach of their rays (a sphere
- * around them, wide enough for the texels' and their supersampling
- * points' rays) lies in that plane too (the tile's own surface): then no
- * ray from them meets anything, and straddle_texel would move nothing.
- * Most tiles of open floors and walls, at one point query each instead
- * of eight rays a texel. */
-static bool tile_may_straddle(const lx_baker *b, const lx_lightmap *map, uint32_t first,
-                              uint32_t count)
+/* Most tiles of open floors and walls, at one point query each instead
+ * of eight rays a texel (bake_internal.h). */
+bool lx_bake_tile_may_straddle(const lx_baker *b, const lx_lightmap *map, uint32_t first,
+                               uint32_t count)
 {
     lx_vec3 n = map->world_geometric_normal[first], lo = map->world_position[first], hi = lo;
     float d = lx_dot(n, map->world_position[first]), reach = 0.0f, tolerance = INFINITY;
@@ -232,7 +227,7 @@ lx_status lx_bake_straddle(lx_baker *b, float progress_base, float progress_span
         uint32_t m, first, count;
         lx_tile_walk_at(&w, global, &m, &first, &count);
         lx_lightmap *map = &b->maps[m];
-        bool may = count && map->texel_axes && tile_may_straddle(b, map, first, count);
+        bool may = count && map->texel_axes && lx_bake_tile_may_straddle(b, map, first, count);
         for (uint32_t i = first; may && i < first + count; i++)
             moved += straddle_texel(b, map, i);
         lx_tile_walk_done(&w, global, count);
