@@ -219,6 +219,8 @@ typedef struct lx_camera_auto_info {
     float outside_score; /* fraction of the iso view's probes on a lit front face */
     bool moved;          /* another view was taken */
     bool inside;         /* ... from inside the bounds (else a side's framing) */
+    bool enclosed;       /* ... because the scene is a closed room: its inside
+                            views meet walls all round */
     float score;         /* the taken view's fraction of probes on a lit front face */
     char placement[48];  /* "iso", "front", "back", "left", "right" or
                             "inside, looking along +X" (-X, +Z, -Z) */
@@ -227,7 +229,7 @@ typedef struct lx_camera_auto_info {
 /* The default camera of a scene that brings none. Starts from
  * lx_camera_frame(..., LX_VIEW_ISO, ...) of the bounds of the nodes that
  * get a lightmap and are not sky domes (lx_node.bake; the scene's bounds
- * when there are none) and probes it with a
+ * when there are none; a backdrop left out too) and probes it with a
  * grid of 18 rows of rays (as many columns as the aspect asks, at most
  * 64) through tracer (made from scene; the probes are LX_RAY_FRAMING
  * rays, which pass through the nodes left out): a probe scores when the first
@@ -245,7 +247,10 @@ typedef struct lx_camera_auto_info {
  * so; when there is none either, the iso view stays: a closed room seen from
  * outside shows the back faces of walls that face in, or the unlit
  * outside of walls with two sides; a box open on one side is seen
- * through it. Deterministic: the same scene and lightmaps give the same
+ * through it. First of all, when each of the four inside views meets the
+ * scene on at least 90% of its probes (walls all round: a closed room),
+ * the best of them in which half of what they meet scores is taken,
+ * whatever the iso view shows (info->enclosed). Deterministic: the same scene and lightmaps give the same
  * camera. tracer NULL: the iso framing unchecked. fov radians (0 = 50
  * degrees), aspect width / height (0 = 16/9). info may be NULL.
  * LX_ERR_INVALID for an empty scene; lx_render_view's errors for lm. */

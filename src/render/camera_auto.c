@@ -14,7 +14,10 @@
  * clearly more): a closed room seen from
  * outside shows the back faces of walls that face in, or the unlit
  * outside of walls with two sides; a box open on one side is best seen
- * through that side. */
+ * through that side. Before all that, a scene whose four inside views
+ * each meet something on 90% of their probes is a closed room (walls
+ * all round) and is shown from inside, by its best right inside view,
+ * however lit its outside. */
 #include "render_internal.h"
 
 #include <math.h>
@@ -36,6 +39,9 @@
 /* a view is right when at least this fraction of what it meets is lit
  * front faces */
 #define GOOD 0.5f
+/* the inside views of a closed room meet the scene on at least this
+ * fraction of their probes each */
+#define ENCLOSED 0.9f
 /* iso, four side framings, four inside views */
 #define VIEWS 9
 /* lit: luminance above this fraction of the brightest view's median */
@@ -232,7 +238,36 @@ lx_status lx_camera_auto(const lx_scene *scene, const lx_lightmaps *lm, const lx
     info->outside_unlit = hits ? (float)unlit / (float)hits : 0.0f;
     float good;
     info->outside_score = info->score = score(&v[0], use_light, lit, &good);
-    if (hits == 0 || good >= GOOD) {
+    float iso_good = good;
+    /* walls all round: every inside view meets the scene on nearly every
+     * probe (a window or a door lets a little through). A bake of a
+     * closed room is for its inside, however lit the outside of its walls
+     * (a sun on the roof): the best right inside view, if there is one */
+    bool enclosed = hits > 0;
+    for (int k = 5; k < VIEWS && enclosed; k++) {
+        int met = 0;
+        for (int p = 0; p < count; p++)
+            met += v[k].kind[p] != MISS;
+        enclosed = (float)met >= ENCLOSED * (float)count;
+    }
+    int room = 0;
+    float room_score = 0.0f;
+    for (int k = 5; k < VIEWS && enclosed; k++) {
+        float s = score(&v[k], use_light, lit, &good);
+        if (good >= GOOD && s > room_score + (room ? CLEARLY_BETTER : 0.0f)) {
+            room = k;
+            room_score = s;
+        }
+    }
+    if (room) {
+        *out = v[room].cam;
+        info->moved = info->inside = info->enclosed = true;
+        info->score = room_score;
+        snprintf(info->placement, sizeof info->placement, "%s", names[room]);
+        free(v);
+        return LX_OK;
+    }
+    if (hits == 0 || iso_good >= GOOD) {
         free(v);
         return LX_OK;
     }

@@ -547,7 +547,12 @@ static int choose_camera(render_args *a, const lx_scene *scene, const lx_lightma
         cli_error("%s: %s", a->scene, lx_last_error());
         return EXIT_FAILED;
     }
-    if (info.moved && !a->quiet) {
+    if (info.enclosed && !a->quiet) {
+        fprintf(stderr,
+                "luxel: the scene is a closed room (walls all round): the camera is placed %s "
+                "(--view iso shows it from outside)\n",
+                info.placement);
+    } else if (info.moved && !a->quiet) {
         char what[160];
         if (info.outside_unlit > 0.0f && info.outside_back > 0.0f)
             snprintf(what, sizeof what, "back faces (%s%%) and unlit surfaces (%s%%)",
