@@ -155,6 +155,11 @@ typedef struct lx_lightmap {
     lx_vec3 *object_position;
     lx_vec3 *object_normal;
     lx_vec3 *object_geometric_normal;
+    /* the interpolated vertex normal, before the normal map, on a map with
+     * normal-mapped texels (else NULL; object space as above): the bounces
+     * gather about it, so a normal map's detail at the texels' scale does
+     * not mottle the indirect light */
+    lx_vec3 *world_smooth_normal, *object_smooth_normal;
     lx_vec3 *albedo; /* per texel base colour (factor x texture); NULL unless
                         the bake is of radiance or has bounces */
     lx_vec3 *emission; /* per texel emitted radiance (nits, emissive scale
@@ -575,6 +580,7 @@ enum {
     LX_SCENE_NEEDS_EMISSIVE_TEXTURE = 1u << 1, /* an emissive material with a texture */
     LX_SCENE_NEEDS_EMISSION = 1u << 2,         /* an emissive material */
     LX_SCENE_NEEDS_LIFT = 1u << 3,             /* a smooth-shaded mesh (lx_mesh_is_smooth) */
+    LX_SCENE_NEEDS_SMOOTH_NORMAL = 1u << 4,    /* a material with a normal map */
 };
 /* Whether a mesh's vertex normals leave some triangle's plane (smooth
  * shading, where the shadow terminator needs lifted rays). */

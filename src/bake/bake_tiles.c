@@ -42,6 +42,7 @@ enum {
     WHEN_TEXEL_EMISSION = 1u << 13, /* surfaces kept, or an emissive texture */
     WHEN_LIFT = 1u << 14,           /* a smooth-shaded mesh */
     WHEN_EDGE = 1u << 15,           /* edge supersampling */
+    WHEN_NORMAL_MAP = 1u << 16,     /* a normal map, without directional data */
 };
 
 /* Where a buffer lives: the whole bake, a tile's texel maps (while the
@@ -104,6 +105,8 @@ static const texel_buffer texel_buffers[] = {
     {"edge supersampling: shadow records, edge masks and the page's texel index", 20, PER_TEXEL,
      LIFE_TEXEL_MAP, WHEN_EDGE},
     {"texel map: tile offsets", 1, PER_TEXEL, LIFE_TEXEL_MAP, WHEN_ALWAYS},
+    {"texel map: the vertex normal under a normal map (the bounces gather about it)", 12,
+     PER_TEXEL, LIFE_TEXEL_MAP, WHEN_NORMAL_MAP},
     {"texel map: lift to the smooth surface (shadow terminator)", 12, PER_TEXEL, LIFE_TEXEL_MAP,
      WHEN_LIFT},
     {"texel map: albedo", 12, PER_TEXEL, LIFE_TEXEL_MAP, WHEN_ALBEDO},
@@ -140,6 +143,9 @@ lx_bake_texel_bytes lx_bake_texel_bytes_of(const lx_bake_desc *d, bool horizon,
     have |= scene_needs & LX_SCENE_NEEDS_EMISSIVE_TEXTURE ? WHEN_EMISSIVE_TEXTURE : 0;
     have |= scene_needs & LX_SCENE_NEEDS_LIFT ? WHEN_LIFT : 0;
     have |= lx_bake_edge_supersample(d) ? WHEN_EDGE : 0;
+    have |= scene_needs & LX_SCENE_NEEDS_SMOOTH_NORMAL && d->directional == LX_DIRECTIONAL_OFF
+                ? WHEN_NORMAL_MAP
+                : 0;
     have |= (lx_bake_keeps_surfaces(d) || (scene_needs & LX_SCENE_NEEDS_EMISSIVE_TEXTURE))
                 ? WHEN_TEXEL_EMISSION
                 : 0;
@@ -182,6 +188,7 @@ uint32_t lx_bake_scene_needs(const lx_scene *scene)
         bool emits = m->emissive.x > 0.0f || m->emissive.y > 0.0f || m->emissive.z > 0.0f;
         needs |= emits ? LX_SCENE_NEEDS_EMISSION : 0;
         needs |= emits && m->emissive_map.width > 0 ? LX_SCENE_NEEDS_EMISSIVE_TEXTURE : 0;
+        needs |= m->normal_map.width > 0 ? LX_SCENE_NEEDS_SMOOTH_NORMAL : 0;
     }
     for (uint32_t m = 0; m < scene->mesh_count && !(needs & LX_SCENE_NEEDS_LIFT); m++)
         needs |= lx_mesh_is_smooth(&scene->meshes[m]) ? LX_SCENE_NEEDS_LIFT : 0;

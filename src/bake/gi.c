@@ -179,7 +179,9 @@ lx_gather_frame lx_gather_frame_of(const lx_baker *b, uint32_t map_index, const 
 {
     lx_gather_frame f;
     lx_vec3 p = map->world_position[i];
-    f.n = map->world_normal[i];
+    /* the vertex normal where a normal map bent the shading one: a
+     * texel-scale bump in the map would mottle the indirect light */
+    f.n = map->world_smooth_normal ? map->world_smooth_normal[i] : map->world_normal[i];
     f.ng = map->world_geometric_normal[i];
     f.t = lx_perpendicular(f.n);
     f.bt = lx_cross(f.n, f.t);

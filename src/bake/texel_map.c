@@ -460,15 +460,19 @@ static uint32_t slot_of(const slot *slots, uint32_t count, uint32_t id)
  * matrix), as lx_texel_map_transform computes them, and its object space
  * when the map keeps it. */
 static void place_texel(lx_lightmap *map, uint32_t n, const lx_mat4 *world, const lx_mat4 *nm,
-                        lx_vec3 position, lx_vec3 normal, lx_vec3 geometric)
+                        lx_vec3 position, lx_vec3 normal, lx_vec3 geometric, lx_vec3 smooth)
 {
     map->world_position[n] = lx_mat4_point(world, position);
     map->world_normal[n] = lx_normalize(lx_mat4_vector(nm, normal));
     map->world_geometric_normal[n] = lx_normalize(lx_mat4_vector(nm, geometric));
+    if (map->world_smooth_normal)
+        map->world_smooth_normal[n] = lx_normalize(lx_mat4_vector(nm, smooth));
     if (map->object_position) {
         map->object_position[n] = position;
         map->object_normal[n] = normal;
         map->object_geometric_normal[n] = geometric;
+        if (map->object_smooth_normal)
+            map->object_smooth_normal[n] = smooth;
     }
 }
 
@@ -551,7 +555,7 @@ static lx_status build_stitch(const slot *slots, uint32_t slot_count, lx_lightma
  * when tangents is not NULL) and geometric normal. */
 static void surface_point(const lx_scene *scene, const slot *sl, const lx_vec4 *tangents,
                           uint32_t t, float w0, float w1, float w2, lx_vec3 *position,
-                          lx_vec3 *normal, lx_vec3 *geometric)
+                          lx_vec3 *normal, lx_vec3 *geometric, lx_vec3 *smooth)
 {
     const lx_mesh *m = sl->mesh;
     const uint32_t *i = &m->indices[3 * t];
@@ -561,6 +565,8 @@ static void surface_point(const lx_scene *scene, const slot *sl, const lx_vec4 *
     lx_vec3 nrm = lx_add(lx_add(lx_scale(m->normals[i[0]], w0), lx_scale(m->normals[i[1]], w1)),
                          lx_scale(m->normals[i[2]], w2));
     nrm = lx_length(nrm) > 1e-12f ? lx_normalize(nrm) : *geometric;
+    if (smooth)
+        *smooth = nrm;
     if (tangents)
         lx_material_normal_at(lx_mesh_material(scene, m), m, tangents, i, w0, w1, w2, &nrm);
     *normal = nrm;
@@ -694,7 +700,7 @@ static lx_status build_subsamples(const lx_scene *scene, const lx_bake_desc *des
             float w1 = r.b1[q], w2 = r.b2[q];
             lx_vec3 position, normal, geometric;
             surface_point(scene, &slots[sl], tangents[sl], id - slots[sl].first_triangle,
-                          1.0f - w1 - w2, w1, w2, &position, &normal, &geometric);
+                          1.0f - w1 - w2, w1, w2, &position, &normal, &geometric, NULL);
             const lx_mat4 *world = &scene->nodes[slots[sl].node].world;
             const lx_mat4 *nm = &nms[slot_node[sl]];
             map->sub_position[at] = lx_mat4_point(world, position);
@@ -900,6 +906,16 @@ lx_status lx_texel_map_build(const lx_scene *scene, const lx_page_spec *page,
             k++;
         slot_node[s] = k;
     }
+    /* the vertex normals the bounces gather about, where normal maps apply */
+    bool mapped = false;
+    for (uint32_t s = 0; s < slot_count; s++)
+        mapped |= tangents[s] != NULL;
+    if (mapped && st == LX_OK) {
+        map->world_smooth_normal = malloc(sizeof(lx_vec3) * (used ? used : 1));
+        map->object_smooth_normal = identity ? NULL : malloc(sizeof(lx_vec3) * (used ? used : 1));
+        if (!map->world_smooth_normal || (!identity && !map->object_smooth_normal))
+            st = lx_fail(LX_ERR_NOMEM, "%s: out of memory", what);
+    }
     if (!identity && st == LX_OK) {
         map->object_position = malloc(sizeof(lx_vec3) * (used ? used : 1));
         map->object_normal = malloc(sizeof(lx_vec3) * (used ? used : 1));
@@ -957,9 +973,9 @@ lx_status lx_texel_map_build(const lx_scene *scene, const lx_page_spec *page,
                 tx_->mesh = slots[s].mesh_index;
                 tx_->triangle = t;
                 tx_->node = slots[s].node;
-                lx_vec3 position, nrm, geometric;
+                lx_vec3 position, nrm, geometric, vertex_normal;
                 surface_point(scene, &slots[s], tangents[s], t, w0, w1, w2, &position, &nrm,
-                              &geometric);
+                              &geometric, &vertex_normal);
                 texel_axes(&r, &slots[s], t, &scene->nodes[slots[s].node].world,
                            &map->texel_axes[2 * (size_t)k]);
                 const lx_material *mat = lx_mesh_material(scene, m);
@@ -975,7 +991,7 @@ lx_status lx_texel_map_build(const lx_scene *scene, const lx_page_spec *page,
                         map->object_lift[k] = lift;
                 }
                 place_texel(map, k++, &scene->nodes[slots[s].node].world, &nms[slot_node[s]],
-                            position, nrm, geometric);
+                            position, nrm, geometric, vertex_normal);
                 map->mask[p] = 1;
             }
     }
@@ -1053,6 +1069,12 @@ lx_status lx_texel_map_keep_object_space(lx_lightmap *map)
                            map->name);
         memcpy(map->object_lift, map->lift, bytes);
     }
+    if (map->world_smooth_normal) {
+        if (!(map->object_smooth_normal = malloc(bytes)))
+            return lx_fail(LX_ERR_NOMEM, "lightmap '%s': out of memory for its object space",
+                           map->name);
+        memcpy(map->object_smooth_normal, map->world_smooth_normal, bytes);
+    }
     if (map->sub_count) {
         size_t sub = sizeof(lx_vec3) * map->sub_count * (size_t)map->info.used_texels;
         lx_vec3 *sp = malloc(sub ? sub : 1), *sn = malloc(sub ? sub : 1),
@@ -1092,6 +1114,9 @@ void lx_texel_map_transform(lx_lightmap *map, uint32_t node, const lx_mat4 *worl
             lx_normalize(lx_mat4_vector(&nm, map->object_geometric_normal[i]));
         if (map->lift)
             map->lift[i] = lx_mat4_vector(world, map->object_lift[i]);
+        if (map->world_smooth_normal)
+            map->world_smooth_normal[i] =
+                lx_normalize(lx_mat4_vector(&nm, map->object_smooth_normal[i]));
         for (uint32_t s = 0; s < map->sub_count; s++) {
             size_t at = (size_t)s * map->info.used_texels + i;
             map->sub_position[at] = lx_mat4_point(world, map->sub_object_position[at]);
@@ -1114,6 +1139,8 @@ void lx_texel_map_free(lx_lightmap *map)
     free(map->object_position);
     free(map->object_normal);
     free(map->object_geometric_normal);
+    free(map->world_smooth_normal);
+    free(map->object_smooth_normal);
     free(map->lift);
     free(map->object_lift);
     free(map->albedo);
