@@ -164,6 +164,21 @@ static void guided_finds_a_bright_patch(void **state)
     lx_scene_destroy(scene);
 }
 
+/* Every lightmap of x and y holds the same bytes. */
+static void assert_same_lightmaps(const lx_baker *x, const lx_baker *y)
+{
+    assert_int_equal(lx_baker_lightmap_count(x), lx_baker_lightmap_count(y));
+    for (uint32_t m = 0; m < lx_baker_lightmap_count(x); m++) {
+        lx_image a, b;
+        assert_int_equal(lx_baker_apply_alloc(x, m, &a), LX_OK);
+        assert_int_equal(lx_baker_apply_alloc(y, m, &b), LX_OK);
+        size_t bytes = sizeof(float) * (size_t)a.width * (size_t)a.height * (size_t)a.channels;
+        assert_memory_equal(a.data, b.data, bytes);
+        lx_image_free(&a);
+        lx_image_free(&b);
+    }
+}
+
 /* Below 64 rays a texel there is too little to learn from: cosine. */
 static void few_rays_are_not_guided(void **state)
 {
@@ -173,15 +188,7 @@ static void few_rays_are_not_guided(void **state)
     lx_baker *g = bake(scene, &d);
     d.gi_sampling = LX_GI_SAMPLING_COSINE;
     lx_baker *c = bake(scene, &d);
-    for (uint32_t m = 0; m < lx_baker_lightmap_count(g); m++) {
-        lx_image a, b;
-        assert_int_equal(lx_baker_apply_alloc(g, m, &a), LX_OK);
-        assert_int_equal(lx_baker_apply_alloc(c, m, &b), LX_OK);
-        size_t bytes = sizeof(float) * (size_t)a.width * (size_t)a.height * (size_t)a.channels;
-        assert_memory_equal(a.data, b.data, bytes);
-        lx_image_free(&a);
-        lx_image_free(&b);
-    }
+    assert_same_lightmaps(g, c);
     lx_baker_destroy(g);
     lx_baker_destroy(c);
     lx_scene_destroy(scene);
@@ -195,15 +202,7 @@ static void threads_give_the_same_bytes(void **state)
     lx_baker *one = bake(scene, &d);
     d.threads = 2;
     lx_baker *two = bake(scene, &d);
-    for (uint32_t m = 0; m < lx_baker_lightmap_count(one); m++) {
-        lx_image a, b;
-        assert_int_equal(lx_baker_apply_alloc(one, m, &a), LX_OK);
-        assert_int_equal(lx_baker_apply_alloc(two, m, &b), LX_OK);
-        size_t bytes = sizeof(float) * (size_t)a.width * (size_t)a.height * (size_t)a.channels;
-        assert_memory_equal(a.data, b.data, bytes);
-        lx_image_free(&a);
-        lx_image_free(&b);
-    }
+    assert_same_lightmaps(one, two);
     lx_baker_destroy(one);
     lx_baker_destroy(two);
     lx_scene_destroy(scene);
