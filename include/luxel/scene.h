@@ -315,8 +315,10 @@ lx_scene_load_desc lx_scene_load_desc_defaults(const lx_scene_load_desc *desc);
  * not read (extras, extensions) are ignored.
  * glTF extensions: KHR_mesh_quantization, EXT_meshopt_compression (decoded
  * by luxel before assimp reads the file), KHR_texture_transform,
- * KHR_materials_emissive_strength, KHR_materials_unlit and
- * KHR_lights_punctual are read; nodes' luxel_* extras set their bake
+ * KHR_materials_emissive_strength, KHR_materials_unlit,
+ * KHR_materials_pbrSpecularGlossiness (diffuseFactor x diffuseTexture is
+ * the base colour, preferred to a pbrMetallicRoughness fallback beside
+ * it) and KHR_lights_punctual are read; nodes' luxel_* extras set their bake
  * settings (lx_node.bake; a bad value fails the load naming the node and
  * the key) and sky domes are marked (lx_scene_mark_sky_domes); a file
  * whose extensionsRequired names any other fails with LX_ERR_UNSUPPORTED

@@ -88,12 +88,16 @@ typedef struct lx_gltf_texture_ref {
     lx_uv_transform transform; /* KHR_texture_transform, enabled when given */
 } lx_gltf_texture_ref;
 
-/* The baseColorTexture and normalTexture of glTF material `index`, whose
- * JSON object is material (both zeroed when it is not an object).
- * Malformed extension fields fail naming the file, the material and the
- * field. */
+/* The base-colour texture and normalTexture of glTF material `index`,
+ * whose JSON object is material (both zeroed when it is not an object):
+ * pbrMetallicRoughness's baseColorTexture, or with spec_gloss
+ * KHR_materials_pbrSpecularGlossiness's diffuseTexture (the material's
+ * albedo then, its metallic-roughness part a fallback for readers without
+ * the extension). Malformed extension fields fail naming the file, the
+ * material and the field. */
 lx_status lx_gltf_material_textures(const char *file, const cJSON *material, size_t index,
-                                    lx_gltf_texture_ref *base_color, lx_gltf_texture_ref *normal);
+                                    bool spec_gloss, lx_gltf_texture_ref *base_color,
+                                    lx_gltf_texture_ref *normal);
 
 /* The emissiveTexture of glTF material `index` (zeroed when none). */
 lx_status lx_gltf_material_emissive_texture(const char *file, const cJSON *material, size_t index,

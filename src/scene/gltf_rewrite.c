@@ -27,8 +27,13 @@
 /* ---- extensionsRequired -------------------------------------------------- */
 
 static const char *const supported[] = {
-    "KHR_mesh_quantization", "EXT_meshopt_compression",         "KHR_texture_transform",
-    "KHR_lights_punctual",   "KHR_materials_emissive_strength", "KHR_materials_unlit",
+    "KHR_mesh_quantization",
+    "EXT_meshopt_compression",
+    "KHR_texture_transform",
+    "KHR_lights_punctual",
+    "KHR_materials_emissive_strength",
+    "KHR_materials_unlit",
+    "KHR_materials_pbrSpecularGlossiness", /* its diffuse colour: the albedo */
 };
 
 /* Extensions that only add image formats: a file requiring one loads, its
