@@ -465,10 +465,12 @@ lx_glb_write_desc lx_glb_write_desc_defaults(const lx_glb_write_desc *desc);
  * NORMAL, TANGENT, TEXCOORD_0 and the lightmap TEXCOORD_1 (and the
  * entries' attributes), materials with
  * their base colour factor and PNG/JPEG textures embedded.
+ * EXT_meshopt_compression views are written decoded, without the
+ * extension (quantized attributes stay as they are).
  * Fails (nothing written) with LX_ERR_INVALID when an entry names a node
- * or mesh the scene does not pair, LX_ERR_UNSUPPORTED for compressed
- * glTF (Draco, meshopt) or a mesh luxel could not match to the file's
- * primitives, LX_ERR_IO / LX_ERR_FORMAT naming the file and the part. */
+ * or mesh the scene does not pair, LX_ERR_UNSUPPORTED for Draco-compressed
+ * glTF or a mesh luxel could not match to the file's primitives,
+ * LX_ERR_IO / LX_ERR_FORMAT naming the file and the part. */
 lx_status lx_scene_write_glb(const lx_scene *scene, const char *path, const lx_glb_write_desc *desc);
 
 /* The UV set that holds the lightmap UVs luxel makes for node n (written

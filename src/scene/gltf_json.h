@@ -154,6 +154,10 @@ lx_status lx_gltf_check_files(const char *path, const cJSON *root, bool allow_an
  * bufferViews) and *glb receives the whole file as a GLB (malloc'd) for
  * assimp. Otherwise *glb is NULL and root unchanged. */
 lx_status lx_gltf_rewrite(const char *path, cJSON *root, uint8_t **glb, size_t *glb_size);
+/* The same for EXT_meshopt_compression alone (quantized attributes stay as
+ * they are, KHR_mesh_quantization listed as before): what a file written
+ * again with lightmap UVs starts from. */
+lx_status lx_gltf_decode_meshopt(const char *path, cJSON *root, uint8_t **glb, size_t *glb_size);
 /* Every accessor within its bufferView and every bufferView within its
  * buffer, by the JSON's numbers (gltf_ranges.c); the error names the
  * accessor or view and how many bytes it overruns. */
