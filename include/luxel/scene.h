@@ -149,6 +149,11 @@ typedef struct lx_material {
      * every material is unlit and that encloses the scene is a sky dome
      * (lx_scene_mark_sky_domes). */
     bool unlit;
+    /* glTF doubleSided (assimp's two-sided flag for other formats): both
+     * faces are the surface. A view draws both (lx_render_view); a bake
+     * holds one value a texel, of the side lx_bake_desc.double_sided
+     * chooses, and the bounces read it from either face. */
+    bool double_sided;
     /* Times each map was halved on load (lx_scene_load_desc's texture
      * density), 0 = as its file holds it. Heights integrated from the
      * normal map search a radius of that many fewer texels (the same

@@ -1056,6 +1056,21 @@ static bool material_spec_gloss(const import_ctx *c, const struct aiMaterial *am
                           aiReturn_SUCCESS;
 }
 
+/* glTF's doubleSided on material i: the file's JSON when the material is
+ * matched to it, else assimp's two-sided flag (its glTF 2.0 reader copies
+ * doubleSided there; other readers set it for their own two-sided
+ * materials). */
+static bool material_double_sided(const import_ctx *c, const struct aiMaterial *am, unsigned i)
+{
+    if (c->gltf && c->map && c->map->material_of[i] >= 0 &&
+        (size_t)c->map->material_of[i] < c->map->material_count)
+        return cJSON_IsTrue(lx_gltf_get(c->map->materials[c->map->material_of[i]], "doubleSided"));
+    int two = 0;
+    unsigned max = 1;
+    return aiGetMaterialIntegerArray(am, AI_MATKEY_TWOSIDED, &two, &max) == aiReturn_SUCCESS &&
+           two != 0;
+}
+
 static lx_status material_refs(const import_ctx *c, unsigned i, const char *label, bool has_base,
                                bool has_normal, bool spec_gloss, lx_gltf_texture_ref *base,
                                lx_gltf_texture_ref *normal)
@@ -1160,6 +1175,7 @@ static lx_status import_materials(import_ctx *c)
         }
         m.uv_sets_read = texcoords_read(c, am, i);
         m.unlit = material_unlit(c, am, i);
+        m.double_sided = material_double_sided(c, am, i);
         struct aiString tex;
         bool has_normal = aiGetMaterialTexture(am, aiTextureType_NORMALS, 0, &tex, NULL, NULL, NULL,
                                                NULL, NULL, NULL) == aiReturn_SUCCESS;
