@@ -151,8 +151,8 @@ typedef struct lx_material {
     bool unlit;
     /* glTF doubleSided (assimp's two-sided flag for other formats): both
      * faces are the surface. A view draws both (lx_render_view); a bake
-     * holds one value a texel, of the side lx_bake_desc.double_sided
-     * chooses, and the bounces read it from either face. */
+     * holds one value a texel, of the face lx_bake_desc.double_sided
+     * chooses, and neither face is the inside of a solid. */
     bool double_sided;
     /* Times each map was halved on load (lx_scene_load_desc's texture
      * density), 0 = as its file holds it. Heights integrated from the
