@@ -7,7 +7,8 @@
  *   every texel (the sun straight down on an up-facing surface); FRONT
  *   bakes the front, 0 (Unity's and Bakery's choice); the same plane
  *   single-sided bakes 0 in AUTO. The bed under the water is in shadow
- *   (0). The bytes are the same on 1 and 2 threads.
+ *   (0). The bytes are the same on 1 and 2 threads, and in tiles (each
+ *   lightmap built again under the smallest memory limit).
  * - a ground plane facing down over nothing: both faces look into the
  *   open, AUTO bakes the lit one, E cos(theta) for a sun theta from the
  *   zenith; FRONT 0.
@@ -143,15 +144,18 @@ typedef struct baked {
     uint32_t count;
 } baked;
 
-static baked bake(const lx_scene *s, lx_double_sided mode, int threads, int bounces,
-                  uint32_t gi_samples)
+static lx_bake_desc bake_desc(lx_double_sided mode, int threads, int bounces, uint32_t gi_samples)
 {
-    lx_bake_desc d = {.resolution = RES,
-                      .double_sided = mode,
-                      .threads = threads,
-                      .bounces = bounces,
-                      .gi_samples = gi_samples,
-                      .gi_sampling = LX_GI_SAMPLING_COSINE};
+    return (lx_bake_desc){.resolution = RES,
+                          .double_sided = mode,
+                          .threads = threads,
+                          .bounces = bounces,
+                          .gi_samples = gi_samples,
+                          .gi_sampling = LX_GI_SAMPLING_COSINE};
+}
+
+static baked bake_with(const lx_scene *s, lx_bake_desc d)
+{
     baked out = {0};
     if (lx_baker_create(s, &d, &out.baker) != LX_OK)
         fail_msg("lx_baker_create: %s", lx_last_error());
@@ -161,6 +165,33 @@ static baked bake(const lx_scene *s, lx_double_sided mode, int threads, int boun
     for (uint32_t m = 0; m < out.count; m++)
         assert_int_equal(lx_baker_apply_alloc(out.baker, m, &out.img[m]), LX_OK);
     return out;
+}
+
+static baked bake(const lx_scene *s, lx_double_sided mode, int threads, int bounces,
+                  uint32_t gi_samples)
+{
+    return bake_with(s, bake_desc(mode, threads, bounces, gi_samples));
+}
+
+/* The smallest memory limit lx_baker_create takes for s under d: the
+ * baker then works in tiles, building each lightmap again. */
+static uint64_t smallest_limit(const lx_scene *s, lx_bake_desc d)
+{
+    uint64_t lo = 1, hi = (uint64_t)1 << 32; /* lo fails, hi bakes */
+    while (hi - lo > 1) {
+        uint64_t mid = lo + (hi - lo) / 2;
+        d.memory_limit = mid;
+        lx_baker *b;
+        lx_status st = lx_baker_create(s, &d, &b);
+        assert_true(st == LX_OK || st == LX_ERR_NOMEM);
+        if (st == LX_OK) {
+            lx_baker_destroy(b);
+            hi = mid;
+        } else {
+            lo = mid;
+        }
+    }
+    return hi;
 }
 
 static void baked_free(baked *b)
@@ -232,6 +263,15 @@ static void pond(void **state)
         assert_memory_equal(a.img[m].data, one.img[m].data,
                             sizeof(float) * 3 * (size_t)a.img[m].width * a.img[m].height);
     baked_free(&one);
+    /* tiled: each map built again turns the same texels */
+    lx_bake_desc td = bake_desc(LX_DOUBLE_SIDED_AUTO, 2, 0, 0);
+    td.memory_limit = smallest_limit(s, td);
+    baked tiled = bake_with(s, td);
+    assert_true(lx_baker_tile_count(tiled.baker) >= 2);
+    for (uint32_t m = 0; m < a.count; m++)
+        assert_memory_equal(a.img[m].data, tiled.img[m].data,
+                            sizeof(float) * 3 * (size_t)a.img[m].width * a.img[m].height);
+    baked_free(&tiled);
     baked_free(&a);
     baked f = bake(s, LX_DOUBLE_SIDED_FRONT, 2, 0, 0);
     assert_node(&f, s, "water", 0.0, 0.0);
