@@ -168,6 +168,23 @@ typedef enum lx_gi_sampling {
     LX_GI_SAMPLING_COSINE      /* every ray cosine-weighted, stratified */
 } lx_gi_sampling;
 
+/* Which face of a double-sided material's surface (glTF doubleSided) its
+ * texels bake (lx_bake_desc.double_sided): a texel holds one value, and a
+ * view draws it on both faces. */
+typedef enum lx_double_sided {
+    LX_DOUBLE_SIDED_AUTO = 0, /* the default: the front (the winding's), unless
+                                 no viewer can be in front of it - per
+                                 triangle, when its front is closed in within
+                                 a metre (at most a tenth of 32 camera rays
+                                 reach open space) and its back is open (a
+                                 quarter or more): then the back, normals
+                                 turned over (a pond's water or a stepping
+                                 stone modelled facing down, an inside-out
+                                 mesh) */
+    LX_DOUBLE_SIDED_FRONT     /* always the front (Unity's and Bakery's
+                                 lightmappers) */
+} lx_double_sided;
+
 typedef struct lx_bake_desc {
     int resolution;      /* texels per side for every lightmap, 0 = 256 */
     float texel_density; /* texels per metre; > 0 sizes each lightmap from its
@@ -207,6 +224,12 @@ typedef struct lx_bake_desc {
                               LX_MAX_GI_SAMPLES, 0 = LX_GI_SAMPLES_DEFAULT */
     lx_gi_sampling gi_sampling; /* GUIDED (the default) or COSINE;
                               `luxel bake --gi-sampling` */
+    lx_double_sided double_sided; /* AUTO (the default) or FRONT; `luxel bake
+                              --double-sided`. Either way the bounces, the
+                              light probes and the samples moved out of
+                              geometry take both faces of a double-sided
+                              material for its surface, never for the
+                              inside of a solid */
     bool gi_adaptive;      /* gather in rounds of gi_samples / 4 rays (at
                               least 4): after the first, each 8 x 8 texel
                               tile takes as many rounds (2 to 16, up to
@@ -356,7 +379,8 @@ const uint8_t *lx_baker_mask(const lx_baker *baker, uint32_t map);
  * surface's bounce k-1 exitant radiance, base colour / pi x irradiance,
  * read bilinearly over the valid texels of its lightmap; E_k = pi / N x
  * sum. A ray that escapes brings nothing (the sky it sees is direct
- * light, already baked), a back face nothing. Surfaces without a
+ * light, already baked), a back face nothing (of a double-sided
+ * material: the face its texels do not bake). Surfaces without a
  * lightmap (no UVs) reflect nothing.
  * EMITTERS  An emissive surface (emissiveFactor x emissiveTexture x
  * KHR_materials_emissive_strength x desc.emissive_scale, nits, from its
@@ -367,7 +391,8 @@ const uint8_t *lx_baker_mask(const lx_baker *baker, uint32_t map);
  * at most 64 emissive triangles, so only penumbrae are noisy; the
  * gathers do not count emission again. With N bounces emitted light is
  * then reflected up to N times, as the lights' is (emitters.c).
- * A texel whose rays mostly hit back faces is inside geometry: it is
+ * A texel whose rays mostly hit back faces of single-sided materials is
+ * inside geometry: it is
  * invalid, takes no part in the bounces, and gets the average of its
  * valid neighbours. The result is direct + E_1 + ... + E_bounces, in the
  * same units; emission itself is not in the lightmaps (the material
@@ -548,7 +573,8 @@ lx_status lx_baker_ao(lx_baker *baker, uint32_t map, const lx_ao_desc *desc, lx_
  *     constant radiance ambient / pi.
  *   Dynamic lights are not in the probes (engines light dynamic objects
  *   with them directly).
- * VALIDITY  A probe whose rays mostly hit back faces sits inside geometry
+ * VALIDITY  A probe whose rays mostly hit back faces (of single-sided
+ * materials) sits inside geometry
  *   (the test of the bake's texel validity): valid = false, coefficients
  *   zero. */
 #define LX_PROBE_SAMPLES_DEFAULT 256u

@@ -14,15 +14,13 @@
  *   are divided by the manifest's pre_exposure. Pages are read with
  *   clamp-to-edge addressing at the UVs the manifest says: page_uv = uv *
  *   scale_offset.xy + scale_offset.zw (Unity's lightmapScaleOffset).
- *   Back faces are culled unless desc.two_sided (glTF materials are
- *   single-sided by default); the base colour is the material's factor
- *   times its texture read at its own UV set under KHR_texture_transform.
- * ERRORS  lx_lightmaps_load names the manifest and the field or page that
- *   is wrong; lx_render_view fails with LX_ERR_INVALID when the lightmaps
- *   belong to another scene (a node the scene lacks, a node count or a
- *   mesh count that differs, a UV set a mesh lacks), LX_ERR_CANCELLED when
- *   the progress callback says stop.
- * MEMORY  lx_lightmaps_load fills a caller-owned struct; lx_lightmaps_free
+ *   Back faces are culled unless desc.two_sided or the material is
+ *   double-sided (glTF materials are single-sided by default); the base colour is the material's
+ * factor times its texture read at its own UV set under KHR_texture_transform. ERRORS
+ * lx_lightmaps_load names the manifest and the field or page that is wrong; lx_render_view fails
+ * with LX_ERR_INVALID when the lightmaps belong to another scene (a node the scene lacks, a node
+ * count or a mesh count that differs, a UV set a mesh lacks), LX_ERR_CANCELLED when the progress
+ * callback says stop. MEMORY  lx_lightmaps_load fills a caller-owned struct; lx_lightmaps_free
  *   releases what it allocated. lx_render_view allocates out (free it with
  *   lx_image_free); nothing else outlives the call.
  * THREADING  Every function is thread-safe on distinct outputs.
@@ -272,7 +270,8 @@ typedef struct lx_render_desc {
                                   camera.fov */
     int samples;               /* per pixel, 1..4096, 0 = 4 */
     lx_lightmap_filter filter; /* lightmap lookups */
-    bool two_sided;            /* false: back faces are culled (rays go through) */
+    bool two_sided;            /* false: back faces of single-sided materials
+                                  are culled (rays go through) */
     lx_vec3 background;        /* radiance (nits) of rays that miss (default black;
                                   coverage lets a caller compose its own) */
     const lx_cubemap *sky;     /* when set, rays that miss see it (radiance, nits) */

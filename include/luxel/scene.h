@@ -149,6 +149,11 @@ typedef struct lx_material {
      * every material is unlit and that encloses the scene is a sky dome
      * (lx_scene_mark_sky_domes). */
     bool unlit;
+    /* glTF doubleSided (assimp's two-sided flag for other formats): both
+     * faces are the surface. A view draws both (lx_render_view); a bake
+     * holds one value a texel, of the face lx_bake_desc.double_sided
+     * chooses, and neither face is the inside of a solid. */
+    bool double_sided;
     /* Times each map was halved on load (lx_scene_load_desc's texture
      * density), 0 = as its file holds it. Heights integrated from the
      * normal map search a radius of that many fewer texels (the same
@@ -319,8 +324,10 @@ lx_scene_load_desc lx_scene_load_desc_defaults(const lx_scene_load_desc *desc);
  * not read (extras, extensions) are ignored.
  * glTF extensions: KHR_mesh_quantization, EXT_meshopt_compression (decoded
  * by luxel before assimp reads the file), KHR_texture_transform,
- * KHR_materials_emissive_strength, KHR_materials_unlit and
- * KHR_lights_punctual are read; nodes' luxel_* extras set their bake
+ * KHR_materials_emissive_strength, KHR_materials_unlit,
+ * KHR_materials_pbrSpecularGlossiness (diffuseFactor x diffuseTexture is
+ * the base colour, preferred to a pbrMetallicRoughness fallback beside
+ * it) and KHR_lights_punctual are read; nodes' luxel_* extras set their bake
  * settings (lx_node.bake; a bad value fails the load naming the node and
  * the key) and sky domes are marked (lx_scene_mark_sky_domes); a file
  * whose extensionsRequired names any other fails with LX_ERR_UNSUPPORTED
@@ -489,10 +496,12 @@ lx_glb_write_desc lx_glb_write_desc_defaults(const lx_glb_write_desc *desc);
  * NORMAL, TANGENT, TEXCOORD_0 and the lightmap TEXCOORD_1 (and the
  * entries' attributes), materials with
  * their base colour factor and PNG/JPEG textures embedded.
+ * EXT_meshopt_compression views are written decoded, without the
+ * extension (quantized attributes stay as they are).
  * Fails (nothing written) with LX_ERR_INVALID when an entry names a node
- * or mesh the scene does not pair, LX_ERR_UNSUPPORTED for compressed
- * glTF (Draco, meshopt) or a mesh luxel could not match to the file's
- * primitives, LX_ERR_IO / LX_ERR_FORMAT naming the file and the part. */
+ * or mesh the scene does not pair, LX_ERR_UNSUPPORTED for Draco-compressed
+ * glTF or a mesh luxel could not match to the file's primitives,
+ * LX_ERR_IO / LX_ERR_FORMAT naming the file and the part. */
 lx_status lx_scene_write_glb(const lx_scene *scene, const char *path, const lx_glb_write_desc *desc);
 
 /* The UV set that holds the lightmap UVs luxel makes for node n (written

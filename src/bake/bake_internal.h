@@ -215,6 +215,13 @@ typedef struct lx_tile_page {
     uint32_t node_count;
 } lx_tile_page;
 
+/* The triangles of one (node, mesh) pair of double-sided meshes, from
+ * first in lx_baker.side_flip (sides.c). */
+typedef struct lx_side_range {
+    uint32_t node, mesh;
+    size_t first;
+} lx_side_range;
+
 struct lx_baker {
     lx_bake_desc desc;
     lx_lightmap *maps;
@@ -272,7 +279,48 @@ struct lx_baker {
     lx_scene *tile_scene;     /* tiled: the copy texel maps are rebuilt from */
     lx_tile_page *pages;      /* tiled: per map, its page */
     uint64_t memory_limit;    /* the limit tiles were planned for */
+    /* double-sided materials (sides.c): per scene mesh, whether both faces
+     * are the surface; per triangle of the double-sided meshes of nodes
+     * with a lightmap, sorted by (node, mesh), whether it bakes its back */
+    uint8_t *mesh_double_sided;
+    uint32_t double_sided_mesh_count;
+    lx_side_range *side_ranges;
+    uint32_t side_range_count;
+    uint8_t *side_flip;
+    bool sides_decided; /* lx_bake_sides has run: rebuilt maps turn too */
 };
+
+/* sides.c: decides which face of each double-sided triangle its texels
+ * bake (once the maps and the tracer exist), and turns over the normals
+ * of a map's texels that bake the back (every map loaded then, and every
+ * map a tiled baker builds again). */
+lx_status lx_bake_sides(lx_baker *b, const lx_scene *scene);
+void lx_bake_sides_apply(const lx_baker *b, lx_lightmap *map);
+void lx_bake_sides_free(lx_baker *b);
+/* Whether triangle t of (node, mesh) bakes its back face. */
+bool lx_bake_side_flipped(const lx_baker *b, uint32_t node, uint32_t mesh, uint32_t t);
+
+/* Whether a ray along dir that hit h met the face a lightmap holds the
+ * light of: a front face, or of a double-sided material the face its
+ * texels bake (the back where lx_bake_sides turned them). The other face
+ * of a double-sided surface brings nothing - its light is not baked -
+ * but is no solid's inside either (lx_bake_hit_inside). False for a
+ * grazing hit. */
+static inline bool lx_bake_hit_surface(const lx_baker *b, lx_vec3 dir, const lx_hit *h)
+{
+    float c = lx_dot(dir, h->normal);
+    if (!(h->mesh < b->double_sided_mesh_count && b->mesh_double_sided[h->mesh]))
+        return c < 0.0f;
+    return lx_bake_side_flipped(b, h->node, h->mesh, h->triangle) ? c > 0.0f : c < 0.0f;
+}
+
+/* Whether it met the back face of a single-sided material: the inside of
+ * a solid. */
+static inline bool lx_bake_hit_inside(const lx_baker *b, lx_vec3 dir, const lx_hit *h)
+{
+    return lx_dot(dir, h->normal) > 0.0f &&
+           !(h->mesh < b->double_sided_mesh_count && b->mesh_double_sided[h->mesh]);
+}
 
 /* Bytes a lightmap needs per texel at most: raster scratch, mask, baked and
  * real-time RGB, and a texel record with its world- and object-space

@@ -509,6 +509,9 @@ static lx_status map_load(lx_baker *b, uint32_t m)
     fresh.horizon_page = map->horizon_page;
     fresh.loaded = true;
     *map = fresh;
+    /* the faces double-sided triangles bake, as when first built */
+    if (b->sides_decided)
+        lx_bake_sides_apply(b, map);
     return LX_OK;
 }
 

@@ -60,6 +60,8 @@ static lx_status validate_desc(const lx_bake_desc *d)
         return lx_fail(LX_ERR_INVALID, "bounces %d is outside 0..%d", d->bounces, LX_MAX_BOUNCES);
     if ((unsigned)d->directional > (unsigned)LX_DIRECTIONAL_DOMINANT)
         return lx_fail(LX_ERR_INVALID, "unknown directional mode %d", (int)d->directional);
+    if ((unsigned)d->double_sided > (unsigned)LX_DOUBLE_SIDED_FRONT)
+        return lx_fail(LX_ERR_INVALID, "unknown double-sided mode %d", (int)d->double_sided);
     if ((unsigned)d->denoise > (unsigned)LX_DENOISE_ALL)
         return lx_fail(LX_ERR_INVALID, "unknown denoise mode %d", (int)d->denoise);
     if (d->gi_samples < 1 || d->gi_samples > LX_MAX_GI_SAMPLES)
@@ -462,6 +464,11 @@ lx_status lx_baker_create(const lx_scene *scene, const lx_bake_desc *in, lx_bake
                          .progress = desc.progress ? bvh_progress : NULL,
                          .progress_user = &desc};
     st = lx_tracer_create(scene, &td, &b->tracer);
+    /* the face each double-sided triangle bakes (sides.c) */
+    if (st == LX_OK)
+        st = lx_bake_sides(b, scene);
+    for (uint32_t m = 0; m < b->map_count && st == LX_OK; m++)
+        lx_bake_sides_apply(b, &b->maps[m]);
     /* samples inside geometry move out (straddle.c) */
     if (st == LX_OK)
         st = lx_bake_straddle(b, BVH_SHARE, 1.0f - BVH_SHARE, true);
@@ -483,6 +490,7 @@ void lx_baker_destroy(lx_baker *b)
     lx_sky_free(b);
     lx_dyn_bounce_free(b);
     lx_gi_free(b);
+    lx_bake_sides_free(b);
     lx_bake_horizon_free(b->horizon_materials, b->horizon_material_count);
     lx_scene_destroy(b->tile_scene);
     for (uint32_t m = 0; b->pages && m < b->map_count; m++)

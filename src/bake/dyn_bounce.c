@@ -143,7 +143,7 @@ static lx_status dyn_build(lx_baker *b)
                 if (!lx_gather_ray(&f, k, d->sx, d->sy, DYN_KEY, &ray))
                     continue;
                 if (!lx_tracer_closest_kind(b->tracer, &ray, LX_RAY_GATHER, &h) ||
-                    !(lx_dot(ray.dir, h.normal) < 0.0f))
+                    !lx_bake_hit_surface(b, ray.dir, &h))
                     continue;
                 uint32_t mi;
                 float fx, fy;

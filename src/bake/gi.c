@@ -10,12 +10,13 @@
  * emitters are direct light, emitters.c, already in E_0), bilinearly over
  * the valid texels of its lightmap; the
  * texel's E_k = pi / N x sum (the cosine-weighted estimator of the
- * irradiance integral). Escaping rays and back faces bring nothing.
+ * irradiance integral). Escaping rays and back faces bring nothing (of a
+ * double-sided material: the face its texels do not bake, sides.c).
  * Validity (Unity's "backface tolerance"): a texel whose rays mostly hit
- * back faces sits inside geometry; it is left out of the bounces and takes
- * its valid neighbours' average at the end. Every texel's rays are seeded
- * by (map, texel, sample, bounce), and each texel is written by one tile,
- * so the bytes are the same for any thread count. */
+ * back faces of single-sided materials sits inside geometry; it is left out of the bounces and
+ * takes its valid neighbours' average at the end. Every texel's rays are seeded by (map, texel,
+ * sample, bounce), and each texel is written by one tile, so the bytes are the same for any thread
+ * count. */
 #include "bake_internal.h"
 #include "core/internal.h"
 
@@ -302,7 +303,7 @@ bool lx_gi_texel_inside(const lx_baker *b, uint32_t map_index, uint32_t i)
         if (!lx_gather_ray(&f, k, sx, sy, VALIDITY_KEY, &ray))
             continue;
         if (lx_tracer_closest_kind(b->tracer, &ray, LX_RAY_GATHER, &h) &&
-            lx_dot(ray.dir, h.normal) > 0.0f)
+            lx_bake_hit_inside(b, ray.dir, &h))
             back++;
     }
     return 2 * back > cells;
@@ -345,7 +346,7 @@ static bool ray_radiance(const gi_run *run, lx_ray *ray, lx_vec3 *l)
 {
     lx_hit h;
     if (!lx_tracer_closest_kind(run->b->tracer, ray, LX_RAY_GATHER, &h) ||
-        !(lx_dot(ray->dir, h.normal) < 0.0f))
+        !lx_bake_hit_surface(run->b, ray->dir, &h))
         return false;
     *l = lx_hit_radiance(run->b, run->sources, false, &h);
     return true;

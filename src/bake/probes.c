@@ -217,10 +217,13 @@ static void probe_one(const probe_run *run, uint32_t index, lx_vec3 p, lx_probe 
         lx_hit h;
         lx_vec3 l;
         if (lx_tracer_closest_kind(b->tracer, &ray, LX_RAY_GATHER, &h)) {
-            if (!(lx_dot(d, h.normal) < 0.0f)) {
+            if (lx_bake_hit_inside(b, d, &h)) {
                 back++;
                 continue;
             }
+            /* the face of a double-sided surface whose light is not baked */
+            if (!lx_bake_hit_surface(b, d, &h))
+                continue;
             l = lx_hit_radiance(b, run->sources, true, &h);
         } else {
             l = lx_sky_radiance(b, d);

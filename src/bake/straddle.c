@@ -20,7 +20,8 @@
  *
  * Limitation: single-sided geometry seen from behind looks like the
  * inside of a solid; a sample within half a texel of the back of a
- * single-sided wall moves through it. */
+ * single-sided wall moves through it. Both faces of a double-sided
+ * material are surface (lx_bake_hit_inside): no sample moves through one. */
 #include "bake_internal.h"
 #include "core/internal.h"
 
@@ -41,15 +42,16 @@ static bool along_surface(lx_vec3 v, lx_vec3 n, lx_vec3 *out)
 
 /* The first hit of a ray from p (lifted by lift along ng) in direction d
  * within reach: 1 front face, -1 back face (its distance in *t), 0 none. */
-static int first_hit(const lx_tracer *tr, lx_vec3 p, lx_vec3 ng, float lift, lx_vec3 d,
-                     float reach, float *t)
+static int first_hit(const lx_baker *b, lx_vec3 p, lx_vec3 ng, float lift, lx_vec3 d, float reach,
+                     float *t)
 {
     lx_ray ray = {.origin = lx_madd(p, ng, lift), .dir = d, .tmin = 0.0f, .tmax = reach};
     lx_hit hit;
-    if (!lx_tracer_closest_kind(tr, &ray, LX_RAY_SURFACE, &hit))
+    if (!lx_tracer_closest_kind(b->tracer, &ray, LX_RAY_SURFACE, &hit))
         return 0;
     *t = hit.t;
-    return lx_dot(d, hit.normal) > 0.0f ? -1 : 1;
+    /* both faces of a double-sided material are surface, no solid's inside */
+    return lx_bake_hit_inside(b, d, &hit) ? -1 : 1;
 }
 
 /* v through the inverse of m's upper 3x3 (Cramer's rule, in double);
@@ -90,7 +92,7 @@ static bool acceptable(const lx_baker *b, const lx_lightmap *map, uint32_t i, lx
         return false;
     for (uint32_t k = 0; k < nd; k++) {
         float t;
-        if (first_hit(b->tracer, to, ng, lift, dirs[k], b->scene_diagonal, &t) < 0)
+        if (first_hit(b, to, ng, lift, dirs[k], b->scene_diagonal, &t) < 0)
             return false;
     }
     return true;
@@ -127,7 +129,7 @@ static bool straddle_texel(const lx_baker *b, lx_lightmap *map, uint32_t i)
     bool near = false;
     for (uint32_t k = 0; k < nd; k++) {
         float t;
-        int h = first_hit(b->tracer, p, ng, lift, dirs[k], 2.0f * half, &t);
+        int h = first_hit(b, p, ng, lift, dirs[k], 2.0f * half, &t);
         near |= h != 0;
         if (h < 0 && t <= half) {
             uint32_t j = exits++;
@@ -166,7 +168,7 @@ static bool straddle_texel(const lx_baker *b, lx_lightmap *map, uint32_t i)
             lx_vec3 d;
             float t;
             if (along_surface(step[k], qg, &d) &&
-                first_hit(b->tracer, q, qg, qlift, d, 2.0f * half, &t) < 0) {
+                first_hit(b, q, qg, qlift, d, 2.0f * half, &t) < 0) {
                 map->sub_covered[at] = 0;
                 break;
             }

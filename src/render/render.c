@@ -209,7 +209,8 @@ static lx_vec3 shade(const render_ctx *c, lx_ray r, bool *hit)
         if (h.triangle >= m->triangle_count)
             break;
         const uint32_t *i = &m->indices[3 * (size_t)h.triangle];
-        if (!c->d->two_sided) {
+        /* glTF culls back faces unless the material is doubleSided */
+        if (!c->d->two_sided && !lx_mesh_material(scene, m)->double_sided) {
             lx_vec3 p0 = lx_mat4_point(&node->world, m->positions[i[0]]);
             lx_vec3 p1 = lx_mat4_point(&node->world, m->positions[i[1]]);
             lx_vec3 p2 = lx_mat4_point(&node->world, m->positions[i[2]]);

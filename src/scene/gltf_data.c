@@ -49,6 +49,42 @@ static uint32_t le32(const uint8_t *p)
     return (uint32_t)p[0] | (uint32_t)p[1] << 8 | (uint32_t)p[2] << 16 | (uint32_t)p[3] << 24;
 }
 
+/* f->bin: the binary chunk of f->bytes when they are a GLB (its JSON
+ * chunk checked by the read), else NULL. */
+static lx_status find_bin(lx_gltf_file *f)
+{
+    f->bin = NULL;
+    f->bin_size = 0;
+    size_t size = f->size;
+    if (size >= 12 && memcmp(f->bytes, "glTF", 4) == 0) {
+        /* a BIN chunk may follow the JSON */
+        uint64_t length = le32(f->bytes + 8);
+        uint64_t pos = 20 + (uint64_t)le32(f->bytes + 12);
+        pos = (pos + 3) & ~(uint64_t)3;
+        if (length <= size && pos + 8 <= length) {
+            uint64_t len = le32(f->bytes + pos);
+            if (le32(f->bytes + pos + 4) == 0x004E4942u) { /* "BIN\0" */
+                if (len > length - pos - 8)
+                    return lx_fail(LX_ERR_FORMAT,
+                                   "%s: truncated GLB: the binary chunk of %llu bytes runs past "
+                                   "the end",
+                                   f->path, (unsigned long long)len);
+                f->bin = f->bytes + pos + 8;
+                f->bin_size = (size_t)len;
+            }
+        }
+    }
+    return LX_OK;
+}
+
+lx_status lx_gltf_file_adopt_glb(lx_gltf_file *f, uint8_t *glb, size_t size)
+{
+    free(f->bytes);
+    f->bytes = glb;
+    f->size = size;
+    return find_bin(f);
+}
+
 lx_status lx_gltf_file_open(const char *path, lx_gltf_file *f)
 {
     memset(f, 0, sizeof *f);
@@ -63,24 +99,8 @@ lx_status lx_gltf_file_open(const char *path, lx_gltf_file *f)
     st = lx_gltf_json_read_memory(path, bytes, size, &f->root);
     if (st != LX_OK)
         return st;
-    if (size >= 12 && memcmp(bytes, "glTF", 4) == 0) {
-        /* the JSON chunk was checked by the read; a BIN chunk may follow */
-        uint64_t length = le32(f->bytes + 8);
-        uint64_t pos = 20 + (uint64_t)le32(f->bytes + 12);
-        pos = (pos + 3) & ~(uint64_t)3;
-        if (length <= size && pos + 8 <= length) {
-            uint64_t len = le32(f->bytes + pos);
-            if (le32(f->bytes + pos + 4) == 0x004E4942u) { /* "BIN\0" */
-                if (len > length - pos - 8)
-                    return lx_fail(LX_ERR_FORMAT,
-                                   "%s: truncated GLB: the binary chunk of %llu bytes runs past "
-                                   "the end",
-                                   path, (unsigned long long)len);
-                f->bin = f->bytes + pos + 8;
-                f->bin_size = (size_t)len;
-            }
-        }
-    }
+    if ((st = find_bin(f)) != LX_OK)
+        return st;
     f->folder = lx_path_dirname(path);
     if (!f->folder)
         return lx_fail(LX_ERR_NOMEM, "%s: out of memory", path);

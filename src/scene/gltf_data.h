@@ -46,6 +46,10 @@ typedef struct lx_gltf_file {
 
 /* Reads path (.gltf or .glb) and parses its JSON. */
 lx_status lx_gltf_file_open(const char *path, lx_gltf_file *f);
+/* Replaces the file's bytes by glb (malloc'd, taken over whatever
+ * happens), a GLB whose JSON is f->root as it is now: its binary chunk
+ * becomes f->bin. Before lx_gltf_file_buffers. */
+lx_status lx_gltf_file_adopt_glb(lx_gltf_file *f, uint8_t *glb, size_t size);
 /* Loads every buffer (each must hold its byteLength bytes). */
 lx_status lx_gltf_file_buffers(lx_gltf_file *f);
 void lx_gltf_file_close(lx_gltf_file *f);

@@ -88,12 +88,16 @@ typedef struct lx_gltf_texture_ref {
     lx_uv_transform transform; /* KHR_texture_transform, enabled when given */
 } lx_gltf_texture_ref;
 
-/* The baseColorTexture and normalTexture of glTF material `index`, whose
- * JSON object is material (both zeroed when it is not an object).
- * Malformed extension fields fail naming the file, the material and the
- * field. */
+/* The base-colour texture and normalTexture of glTF material `index`,
+ * whose JSON object is material (both zeroed when it is not an object):
+ * pbrMetallicRoughness's baseColorTexture, or with spec_gloss
+ * KHR_materials_pbrSpecularGlossiness's diffuseTexture (the material's
+ * albedo then, its metallic-roughness part a fallback for readers without
+ * the extension). Malformed extension fields fail naming the file, the
+ * material and the field. */
 lx_status lx_gltf_material_textures(const char *file, const cJSON *material, size_t index,
-                                    lx_gltf_texture_ref *base_color, lx_gltf_texture_ref *normal);
+                                    bool spec_gloss, lx_gltf_texture_ref *base_color,
+                                    lx_gltf_texture_ref *normal);
 
 /* The emissiveTexture of glTF material `index` (zeroed when none). */
 lx_status lx_gltf_material_emissive_texture(const char *file, const cJSON *material, size_t index,
@@ -150,6 +154,10 @@ lx_status lx_gltf_check_files(const char *path, const cJSON *root, bool allow_an
  * bufferViews) and *glb receives the whole file as a GLB (malloc'd) for
  * assimp. Otherwise *glb is NULL and root unchanged. */
 lx_status lx_gltf_rewrite(const char *path, cJSON *root, uint8_t **glb, size_t *glb_size);
+/* The same for EXT_meshopt_compression alone (quantized attributes stay as
+ * they are, KHR_mesh_quantization listed as before): what a file written
+ * again with lightmap UVs starts from. */
+lx_status lx_gltf_decode_meshopt(const char *path, cJSON *root, uint8_t **glb, size_t *glb_size);
 /* Every accessor within its bufferView and every bufferView within its
  * buffer, by the JSON's numbers (gltf_ranges.c); the error names the
  * accessor or view and how many bytes it overruns. */

@@ -27,8 +27,13 @@
 /* ---- extensionsRequired -------------------------------------------------- */
 
 static const char *const supported[] = {
-    "KHR_mesh_quantization", "EXT_meshopt_compression",         "KHR_texture_transform",
-    "KHR_lights_punctual",   "KHR_materials_emissive_strength", "KHR_materials_unlit",
+    "KHR_mesh_quantization",
+    "EXT_meshopt_compression",
+    "KHR_texture_transform",
+    "KHR_lights_punctual",
+    "KHR_materials_emissive_strength",
+    "KHR_materials_unlit",
+    "KHR_materials_pbrSpecularGlossiness", /* its diffuse colour: the albedo */
 };
 
 /* Extensions that only add image formats: a file requiring one loads, its
@@ -737,7 +742,11 @@ static void find_bin(const uint8_t *file, size_t size, const uint8_t **bin, size
     *bin_size = (size_t)len;
 }
 
-lx_status lx_gltf_rewrite(const char *path, cJSON *root, uint8_t **glb, size_t *glb_size)
+/* The rewrite; quantized: KHR_mesh_quantization's accessors converted to
+ * floats too (for assimp), else left as they are (for a file written
+ * again). */
+static lx_status rewrite_file(const char *path, cJSON *root, bool quantized_too, uint8_t **glb,
+                              size_t *glb_size)
 {
     *glb = NULL;
     *glb_size = 0;
@@ -763,7 +772,7 @@ lx_status lx_gltf_rewrite(const char *path, cJSON *root, uint8_t **glb, size_t *
     n_acc = 0;
     for (const cJSON *a = cJSON_IsArray(accessors) ? accessors->child : NULL; a; a = a->next)
         acc[n_acc++] = a;
-    size_t n_quantized = find_quantized(root, acc, n_acc, quantized);
+    size_t n_quantized = quantized_too ? find_quantized(root, acc, n_acc, quantized) : 0;
     if (!meshopt && !n_quantized) {
         free(acc);
         free(quantized);
@@ -814,13 +823,17 @@ lx_status lx_gltf_rewrite(const char *path, cJSON *root, uint8_t **glb, size_t *
             int k = 0;
             for (cJSON *e = cJSON_IsArray(list) ? list->child : NULL; e; k++) {
                 cJSON *next = e->next;
-                if (cJSON_IsString(e) && (strcmp(e->valuestring, "EXT_meshopt_compression") == 0 ||
-                                          strcmp(e->valuestring, "KHR_mesh_quantization") == 0)) {
+                if (cJSON_IsString(e) &&
+                    (strcmp(e->valuestring, "EXT_meshopt_compression") == 0 ||
+                     (quantized_too && strcmp(e->valuestring, "KHR_mesh_quantization") == 0))) {
                     cJSON_DeleteItemFromArray(list, k);
                     k--;
                 }
                 e = next;
             }
+            /* an empty list is invalid glTF (the validator's EMPTY_ENTITY) */
+            if (cJSON_IsArray(list) && !list->child)
+                cJSON_DeleteItemFromObjectCaseSensitive(root, lists[l]);
         }
         st = write_glb(&r, glb, glb_size);
     }
@@ -836,4 +849,14 @@ lx_status lx_gltf_rewrite(const char *path, cJSON *root, uint8_t **glb, size_t *
     free(acc);
     free(quantized);
     return st;
+}
+
+lx_status lx_gltf_rewrite(const char *path, cJSON *root, uint8_t **glb, size_t *glb_size)
+{
+    return rewrite_file(path, root, true, glb, glb_size);
+}
+
+lx_status lx_gltf_decode_meshopt(const char *path, cJSON *root, uint8_t **glb, size_t *glb_size)
+{
+    return rewrite_file(path, root, false, glb, glb_size);
 }

@@ -1,5 +1,7 @@
-/* The texture references of a glTF 2.0 material as the file states them:
- * texCoord and KHR_texture_transform (Khronos extension spec: offset,
+/* The texture references of a glTF 2.0 material as the file states them
+ * (baseColorTexture, or KHR_materials_pbrSpecularGlossiness's
+ * diffuseTexture: Khronos extension spec, archived): texCoord and
+ * KHR_texture_transform (Khronos extension spec: offset,
  * rotation, scale and a texCoord that overrides the textureInfo's). Read
  * from the JSON because assimp 5.2.5 keeps neither faithfully: it drops the
  * texCoord override, and its AI_MATKEY_UVTRANSFORM holds a translation
@@ -67,7 +69,7 @@ static lx_status read_ref(const char *file, const char *who, const cJSON *info,
     return LX_OK;
 }
 
-lx_status lx_gltf_material_textures(const char *file, const cJSON *m, size_t index,
+lx_status lx_gltf_material_textures(const char *file, const cJSON *m, size_t index, bool spec_gloss,
                                     lx_gltf_texture_ref *base_color, lx_gltf_texture_ref *normal)
 {
     memset(base_color, 0, sizeof *base_color);
@@ -76,10 +78,18 @@ lx_status lx_gltf_material_textures(const char *file, const cJSON *m, size_t ind
         return LX_OK;
     char who[160], where[200];
     lx_gltf_label(who, sizeof who, "material", index, m);
-    snprintf(where, sizeof where, "%s: baseColorTexture", who);
-    lx_status st = read_ref(file, where,
-                            lx_gltf_get(lx_gltf_get(m, "pbrMetallicRoughness"), "baseColorTexture"),
-                            base_color);
+    const cJSON *base;
+    if (spec_gloss) {
+        snprintf(where, sizeof where, "%s: KHR_materials_pbrSpecularGlossiness: diffuseTexture",
+                 who);
+        base = lx_gltf_get(
+            lx_gltf_get(lx_gltf_get(m, "extensions"), "KHR_materials_pbrSpecularGlossiness"),
+            "diffuseTexture");
+    } else {
+        snprintf(where, sizeof where, "%s: baseColorTexture", who);
+        base = lx_gltf_get(lx_gltf_get(m, "pbrMetallicRoughness"), "baseColorTexture");
+    }
+    lx_status st = read_ref(file, where, base, base_color);
     if (st != LX_OK)
         return st;
     snprintf(where, sizeof where, "%s: normalTexture", who);

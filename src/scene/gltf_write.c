@@ -543,14 +543,25 @@ static lx_status make_jobs(wctx *c, const lx_glb_write_desc *d, job *jobs)
 static lx_status write_from_file(wctx *c, const lx_glb_write_desc *d)
 {
     lx_gltf_file *f = c->f;
-    static const char *const compressed[] = {"KHR_draco_mesh_compression",
-                                             "EXT_meshopt_compression"};
-    for (int i = 0; i < 2; i++)
-        if (required(f->root, compressed[i]))
-            return lx_fail(LX_ERR_UNSUPPORTED,
-                           "%s: compressed geometry (%s) cannot be written again", f->path,
-                           compressed[i]);
-    lx_status st = lx_gltf_file_buffers(f);
+    if (required(f->root, "KHR_draco_mesh_compression"))
+        return lx_fail(LX_ERR_UNSUPPORTED,
+                       "%s: compressed geometry (KHR_draco_mesh_compression) cannot be written "
+                       "again",
+                       f->path);
+    /* EXT_meshopt_compression's views are decoded (the file's JSON changed
+     * in place, its indices kept) and written as plain data: the
+     * extension's own buffer references would not survive the buffers
+     * merged below, and its fallback buffer has no bytes */
+    uint8_t *glb = NULL;
+    size_t glb_size = 0;
+    lx_status st = lx_gltf_decode_meshopt(f->path, f->root, &glb, &glb_size);
+    if (st == LX_OK && glb)
+        st = lx_gltf_file_adopt_glb(f, glb, glb_size);
+    else
+        free(glb);
+    if (st != LX_OK)
+        return st;
+    st = lx_gltf_file_buffers(f);
     if (st != LX_OK)
         return st;
     bool *acc_before = NULL, *view_before = NULL;

@@ -248,6 +248,8 @@ static void material(bctx *c, const lx_material *m, cJSON *list)
     cJSON_AddItemToObject(pbr, "baseColorFactor", cJSON_CreateFloatArray(f, 4));
     /* luxel's materials are diffuse: no metal */
     cJSON_AddNumberToObject(pbr, "metallicFactor", 0);
+    if (m->double_sided)
+        cJSON_AddTrueToObject(j, "doubleSided");
     if (m->base_color_map_path) {
         int t = texture(c, m->base_color_map_path, m->name);
         if (t >= 0) {

@@ -1039,8 +1039,40 @@ static bool material_unlit(const import_ctx *c, const struct aiMaterial *am, uns
            mode == aiShadingMode_Unlit;
 }
 
+/* KHR_materials_pbrSpecularGlossiness on glTF material am: its diffuse
+ * colour is the albedo (the extension's spec; a pbrMetallicRoughness beside
+ * it is the fallback for readers without the extension, and three.js, as
+ * luxel, prefers the extension). assimp 5.2.5's glTF 2.0 reader puts
+ * diffuseFactor and diffuseTexture in the diffuse colour and texture while
+ * its base-colour keys keep pbrMetallicRoughness's, and sets the
+ * glossiness factor only for this extension (material.h: "If
+ * AI_MATKEY_GLOSSINESS_FACTOR is set, then a Specular/Glossiness is
+ * available"): that key tells, so the colour, the texture and its
+ * reference (material_refs) always come from the same place. */
+static bool material_spec_gloss(const import_ctx *c, const struct aiMaterial *am)
+{
+    ai_real gloss;
+    return c->gltf && aiGetMaterialFloatArray(am, AI_MATKEY_GLOSSINESS_FACTOR, &gloss, NULL) ==
+                          aiReturn_SUCCESS;
+}
+
+/* glTF's doubleSided on material i: the file's JSON when the material is
+ * matched to it, else assimp's two-sided flag (its glTF 2.0 reader copies
+ * doubleSided there; other readers set it for their own two-sided
+ * materials). */
+static bool material_double_sided(const import_ctx *c, const struct aiMaterial *am, unsigned i)
+{
+    if (c->gltf && c->map && c->map->material_of[i] >= 0 &&
+        (size_t)c->map->material_of[i] < c->map->material_count)
+        return cJSON_IsTrue(lx_gltf_get(c->map->materials[c->map->material_of[i]], "doubleSided"));
+    int two = 0;
+    unsigned max = 1;
+    return aiGetMaterialIntegerArray(am, AI_MATKEY_TWOSIDED, &two, &max) == aiReturn_SUCCESS &&
+           two != 0;
+}
+
 static lx_status material_refs(const import_ctx *c, unsigned i, const char *label, bool has_base,
-                               bool has_normal, lx_gltf_texture_ref *base,
+                               bool has_normal, bool spec_gloss, lx_gltf_texture_ref *base,
                                lx_gltf_texture_ref *normal)
 {
     memset(base, 0, sizeof *base);
@@ -1050,7 +1082,8 @@ static lx_status material_refs(const import_ctx *c, unsigned i, const char *labe
     const gltf_map *g = c->map;
     int64_t j = g->material_of[i];
     if (j >= 0 && (size_t)j < g->material_count)
-        return lx_gltf_material_textures(c->path, g->materials[j], (size_t)j, base, normal);
+        return lx_gltf_material_textures(c->path, g->materials[j], (size_t)j, spec_gloss, base,
+                                         normal);
     struct aiString name;
     bool named =
         aiGetMaterialString(c->ai->mMaterials[i], AI_MATKEY_NAME, &name) == aiReturn_SUCCESS &&
@@ -1067,7 +1100,8 @@ static lx_status material_refs(const import_ctx *c, unsigned i, const char *labe
                 continue;
             lx_gltf_texture_ref b, nm;
             candidates++;
-            if (lx_gltf_material_textures(c->path, g->materials[k], k, &b, &nm) != LX_OK) {
+            if (lx_gltf_material_textures(c->path, g->materials[k], k, spec_gloss, &b, &nm) !=
+                LX_OK) {
                 /* a malformed candidate cannot vouch for anything */
                 any_transform = true;
                 same = false;
@@ -1113,9 +1147,12 @@ static lx_status import_materials(import_ctx *c)
             snprintf(name_buf, sizeof name_buf, "material%u", i);
         m.name = name_buf;
         struct aiColor4D col;
+        bool spec_gloss = material_spec_gloss(c, am);
         m.base_color = lx_v4(1, 1, 1, 1);
-        if (aiGetMaterialColor(am, AI_MATKEY_BASE_COLOR, &col) == aiReturn_SUCCESS ||
-            aiGetMaterialColor(am, AI_MATKEY_COLOR_DIFFUSE, &col) == aiReturn_SUCCESS)
+        if (spec_gloss
+                ? aiGetMaterialColor(am, AI_MATKEY_COLOR_DIFFUSE, &col) == aiReturn_SUCCESS
+                : aiGetMaterialColor(am, AI_MATKEY_BASE_COLOR, &col) == aiReturn_SUCCESS ||
+                      aiGetMaterialColor(am, AI_MATKEY_COLOR_DIFFUSE, &col) == aiReturn_SUCCESS)
             m.base_color = lx_v4(col.r, col.g, col.b, col.a);
         if (!(isfinite(m.base_color.x) && isfinite(m.base_color.y) && isfinite(m.base_color.z)) ||
             m.base_color.x < 0 || m.base_color.y < 0 || m.base_color.z < 0)
@@ -1138,17 +1175,26 @@ static lx_status import_materials(import_ctx *c)
         }
         m.uv_sets_read = texcoords_read(c, am, i);
         m.unlit = material_unlit(c, am, i);
+        m.double_sided = material_double_sided(c, am, i);
         struct aiString tex;
         bool has_normal = aiGetMaterialTexture(am, aiTextureType_NORMALS, 0, &tex, NULL, NULL, NULL,
                                                NULL, NULL, NULL) == aiReturn_SUCCESS;
-        bool has_base = aiGetMaterialTexture(am, aiTextureType_BASE_COLOR, 0, &tex, NULL, NULL,
-                                             NULL, NULL, NULL, NULL) == aiReturn_SUCCESS ||
-                        aiGetMaterialTexture(am, aiTextureType_DIFFUSE, 0, &tex, NULL, NULL, NULL,
-                                             NULL, NULL, NULL) == aiReturn_SUCCESS;
+        /* a spec-gloss material's texture is its diffuse one (assimp's
+         * diffuse slot, which holds the fallback's baseColorTexture when the
+         * extension has no diffuseTexture: the file's JSON tells then) */
+        bool has_base =
+            (!spec_gloss && aiGetMaterialTexture(am, aiTextureType_BASE_COLOR, 0, &tex, NULL, NULL,
+                                                 NULL, NULL, NULL, NULL) == aiReturn_SUCCESS) ||
+            aiGetMaterialTexture(am, aiTextureType_DIFFUSE, 0, &tex, NULL, NULL, NULL, NULL, NULL,
+                                 NULL) == aiReturn_SUCCESS;
         lx_gltf_texture_ref ref_base = {0}, ref_normal = {0};
-        lx_status st = material_refs(c, i, name_buf, has_base, has_normal, &ref_base, &ref_normal);
+        lx_status st =
+            material_refs(c, i, name_buf, has_base, has_normal, spec_gloss, &ref_base, &ref_normal);
         if (st != LX_OK)
             return st;
+        if (spec_gloss && has_base && !ref_base.present && c->map && c->map->material_of[i] >= 0 &&
+            (size_t)c->map->material_of[i] < c->map->material_count)
+            has_base = false; /* the extension has no diffuseTexture */
         unsigned uv = 0;
         if (aiGetMaterialTexture(am, aiTextureType_NORMALS, 0, &tex, NULL, &uv, NULL, NULL, NULL,
                                  NULL) == aiReturn_SUCCESS) {
@@ -1169,10 +1215,11 @@ static lx_status import_materials(import_ctx *c)
                 m.normal_scale = scale;
         }
         uv = 0;
-        if (aiGetMaterialTexture(am, aiTextureType_BASE_COLOR, 0, &tex, NULL, &uv, NULL, NULL, NULL,
-                                 NULL) == aiReturn_SUCCESS ||
-            aiGetMaterialTexture(am, aiTextureType_DIFFUSE, 0, &tex, NULL, &uv, NULL, NULL, NULL,
-                                 NULL) == aiReturn_SUCCESS) {
+        if (has_base &&
+            ((!spec_gloss && aiGetMaterialTexture(am, aiTextureType_BASE_COLOR, 0, &tex, NULL, &uv,
+                                                  NULL, NULL, NULL, NULL) == aiReturn_SUCCESS) ||
+             aiGetMaterialTexture(am, aiTextureType_DIFFUSE, 0, &tex, NULL, &uv, NULL, NULL, NULL,
+                                  NULL) == aiReturn_SUCCESS)) {
             st = request_texture(c, &tex, false, "base colour", LX_TEXTURE_BASE_COLOR,
                                  &m.base_color_map_path);
             if (st != LX_OK) {

@@ -1,11 +1,14 @@
 # End-to-end tests of `luxel bake`'s indirect light (--bounces,
-# --gi-samples, --gi-sampling, --emissive-scale, --supersample), run on the real binary with its own
+# --gi-samples, --gi-sampling, --emissive-scale, --supersample,
+# --double-sided), run on the real binary with its own
 # defaults (LUXEL_REAL): the default bake has two bounces and says so in
 # the manifest; --bounces 0 ignores the other GI settings, byte for byte;
 # 1 and 2 threads give the same bytes; an emissive material alone lights a
 # scene through the bounces (and a bake without bounces refuses it as
 # dark); --emissive-scale 2 doubles every value exactly (the gather is
-# linear in the emission and a power of two scales floats exactly); bad
+# linear in the emission and a power of two scales floats exactly); a
+# scene without double-sided materials bakes the same bytes with
+# --double-sided front as with the default auto, the manifest saying which; bad
 # values are usage errors (exit 2, one error line, nothing written).
 #
 # usage: bash test_cli_gi.sh LUXEL GEN_SCENES WORKDIR
@@ -33,6 +36,14 @@ check "manifest: --gi-sampling cosine" grep -Eq '"gi_sampling":[[:space:]]*"cosi
 # 9 rays a texel are too few to learn from: not guided, the same bytes
 check "room.exr: 9 rays a texel are cosine-weighted either way" \
     cmp -s "$WORK/default/room.exr" "$WORK/cosine/room.exr"
+check "manifest: double-sided auto by default" grep -Eq '"double_sided":[[:space:]]*"auto"' \
+    "$WORK/default/manifest.json"
+run "$BIN" bake "$ROOM" "${SMALL[@]}" --double-sided front -o "$WORK/front"
+expect_rc 0 "--double-sided front"
+check "manifest: --double-sided front" grep -Eq '"double_sided":[[:space:]]*"front"' \
+    "$WORK/front/manifest.json"
+check "room.exr: no double-sided material, the same bytes either way" \
+    cmp -s "$WORK/default/room.exr" "$WORK/front/room.exr"
 run "$BIN" bake "$ROOM" "${SMALL[@]}" --bounces 0 -o "$WORK/direct"
 expect_rc 0 "--bounces 0"
 check "manifest: no indirect entry without bounces" \
@@ -116,7 +127,7 @@ check "manifest: no edge supersampling with --supersample 3" \
 for bad in "--bounces -1" "--bounces 65" "--bounces two" "--gi-samples 0" "--gi-samples 70000" \
     "--emissive-scale 0" "--emissive-scale -2" "--emissive-scale nan" "--supersample 0" \
     "--supersample 17" "--supersample two" "--edge-supersample -1" "--edge-supersample 17" \
-    "--gi-sampling uniform" "--gi-sampling"; do
+    "--gi-sampling uniform" "--gi-sampling" "--double-sided sideways" "--double-sided"; do
     # shellcheck disable=SC2086
     run "$BIN" bake "$ROOM" $bad -q -o "$WORK/bad"
     expect_rc 2 "$bad"

@@ -209,6 +209,42 @@ static void test_plane_constant(void **state)
     lx_scene_destroy(s);
 }
 
+/* Back faces are culled unless the material is double-sided (glTF
+ * doubleSided): from under the plane, a single-sided one is not there
+ * (the background, black) and a double-sided one shows its lightmap. */
+static void test_double_sided_drawn(void **state)
+{
+    (void)state;
+    const char *dir = lx_test_dir("render_double_sided");
+    const double E = 300.0, base = 0.5;
+    write_constant_page(join(dir, "floor.exr"), 8, 8, (float)E, (float)E, (float)E);
+    char text[1024];
+    snprintf(text, sizeof text, plane_manifest, 1.0);
+    write_text(join(dir, "manifest.json"), text);
+    lx_lightmaps lm;
+    assert_int_equal(lx_lightmaps_load(dir, NULL, &lm), LX_OK);
+    for (int two = 0; two < 2; two++) {
+        lx_scene *s = plane_scene(lx_v4((float)base, (float)base, (float)base, 1.0f));
+        s->materials[s->meshes[0].material].double_sided = two;
+        lx_render_desc d = lx_render_desc_defaults(NULL);
+        d.width = 64, d.height = 36;
+        d.camera = (lx_camera){.eye = {0, -2, 0},
+                               .target = {0, 0, 0},
+                               .up = {0, 0, -1},
+                               .fov = 40.0f * LX_PI / 180.0f};
+        lx_image img;
+        assert_int_equal(lx_render_view(s, &lm, NULL, &d, &img), LX_OK);
+        double want = two ? base * E / PI_D : 0.0;
+        for (int y = 6; y < 30; y++)
+            for (int x = 20; x < 44; x++)
+                for (int k = 0; k < 3; k++)
+                    assert_true(fabs(img.data[(y * 64 + x) * 3 + k] - want) <= 6e-7 * want);
+        lx_image_free(&img);
+        lx_scene_destroy(s);
+    }
+    lx_lightmaps_free(&lm);
+}
+
 /* An 8-bit page (bake --format png) holds E / pi at the preview exposure:
  * the render takes it back to lux. */
 static void test_png_page(void **state)
@@ -590,11 +626,16 @@ int main(void)
 {
     lx_test_watchdog(600);
     const struct CMUnitTest tests[] = {
-        cmocka_unit_test(test_plane_constant), cmocka_unit_test(test_png_page),
+        cmocka_unit_test(test_plane_constant),
+        cmocka_unit_test(test_png_page),
         cmocka_unit_test(test_radiance_page),
-        cmocka_unit_test(test_emissive_plane),  cmocka_unit_test(test_cube_no_seams),
-        cmocka_unit_test(test_framing),        cmocka_unit_test(test_threads_identical),
-        cmocka_unit_test(test_other_scene),    cmocka_unit_test(test_cancel),
+        cmocka_unit_test(test_emissive_plane),
+        cmocka_unit_test(test_cube_no_seams),
+        cmocka_unit_test(test_framing),
+        cmocka_unit_test(test_threads_identical),
+        cmocka_unit_test(test_other_scene),
+        cmocka_unit_test(test_cancel),
+        cmocka_unit_test(test_double_sided_drawn),
     };
     return cmocka_run_group_tests(tests, NULL, NULL);
 }

@@ -7,7 +7,11 @@
  * The Khronos glTF-Validator (npm, a test oracle installed by
  * scripts/install-test-oracles.sh) must report no error on the outputs;
  * those tests are skipped where it is not installed. Inputs are written
- * by tests/common/gltf_writer.c or as OBJ text here. */
+ * by tests/common/gltf_writer.c or as OBJ text here; the
+ * EXT_meshopt_compression input (gltfpack's layout: the primitives'
+ * attributes and indices sharing compressed views, octahedral int8
+ * normals, a fallback buffer without data) is encoded here with
+ * meshoptimizer's encoders. */
 #define _POSIX_C_SOURCE 200809L
 #include <setjmp.h>
 #include <stdarg.h>
@@ -21,6 +25,7 @@
 
 #include <cjson/cJSON.h>
 #include <math.h>
+#include <meshoptimizer.h>
 #include <stdio.h>
 #include <stdlib.h>
 #include <string.h>
@@ -607,6 +612,173 @@ static void test_validator_accepts_outputs(void **state)
     }
 }
 
+/* ---- EXT_meshopt_compression -------------------------------------------------- */
+
+/* A compressed bufferView (EXT_meshopt_compression, Khronos extension
+ * spec) of count elements of stride bytes: the encoded bytes in buffer 0,
+ * the view itself in fallback buffer 1 at *fallback. */
+static int meshopt_view(lx_test_gltf *g, const void *data, size_t count, size_t stride,
+                        bool triangles, const char *filter, size_t *fallback)
+{
+    size_t cap = triangles ? meshopt_encodeIndexBufferBound(count, 1u << 16)
+                           : meshopt_encodeVertexBufferBound(count, stride);
+    unsigned char *enc = malloc(cap);
+    assert_non_null(enc);
+    size_t n;
+    if (triangles) {
+        unsigned int *idx = malloc(sizeof(unsigned int) * count);
+        assert_non_null(idx);
+        for (size_t i = 0; i < count; i++)
+            idx[i] = ((const uint16_t *)data)[i];
+        n = meshopt_encodeIndexBuffer(enc, cap, idx, count);
+        free(idx);
+    } else {
+        n = meshopt_encodeVertexBuffer(enc, cap, data, count, stride);
+    }
+    assert_true(n > 0);
+    size_t at = lx_test_gltf_bytes(g, enc, n);
+    free(enc);
+    char json[512], member[64] = "";
+    if (!triangles)
+        snprintf(member, sizeof member, ",\"byteStride\":%zu,\"target\":34962", stride);
+    else
+        snprintf(member, sizeof member, ",\"target\":34963");
+    snprintf(json, sizeof json,
+             "{\"buffer\":1,\"byteOffset\":%zu,\"byteLength\":%zu%s,\"extensions\":{"
+             "\"EXT_meshopt_compression\":{\"buffer\":0,\"byteOffset\":%zu,\"byteLength\":%zu,"
+             "\"byteStride\":%zu,\"count\":%zu,\"mode\":\"%s\",\"filter\":\"%s\"}}}",
+             *fallback, count * stride, member, at, n, stride, count,
+             triangles ? "TRIANGLES" : "ATTRIBUTES", filter);
+    *fallback += (count * stride + 15) / 16 * 16;
+    return lx_test_gltf_view_json(g, json);
+}
+
+/* Two boxes without UVs as a gltfpack -cc file would hold them: both
+ * primitives' positions in one compressed view, their normals (int8,
+ * octahedral filter, KHR_mesh_quantization) in another, their indices
+ * (uint16) in one TRIANGLES view, the accessors at offsets into them;
+ * nodes "a" (moved) and "b". */
+static void write_meshopt(const char *path)
+{
+    prim_data p[2] = {box_data(lx_v3(0, 0, 0), lx_v3(1, 1, 1)),
+                      box_data(lx_v3(2, 0, 0), lx_v3(3, 2, 1))};
+    int nv = p[0].nv + p[1].nv, ni = p[0].ni + p[1].ni;
+    float *pos = malloc(sizeof(float) * 3 * (size_t)nv),
+          *nrm4 = malloc(sizeof(float) * 4 * (size_t)nv);
+    int8_t *oct = malloc(4 * (size_t)nv);
+    uint16_t *idx = malloc(sizeof(uint16_t) * (size_t)ni);
+    assert_true(pos && nrm4 && oct && idx);
+    for (int k = 0, v0 = 0, i0 = 0; k < 2; v0 += p[k].nv, i0 += p[k].ni, k++) {
+        memcpy(pos + 3 * v0, p[k].pos, sizeof(float) * 3 * (size_t)p[k].nv);
+        for (int v = 0; v < p[k].nv; v++) {
+            memcpy(nrm4 + 4 * (v0 + v), p[k].nrm + 3 * v, sizeof(float) * 3);
+            nrm4[4 * (v0 + v) + 3] = 0.0f;
+        }
+        for (int i = 0; i < p[k].ni; i++)
+            idx[i0 + i] = (uint16_t)p[k].idx[i]; /* each primitive's own vertices */
+    }
+    meshopt_encodeFilterOct(oct, (size_t)nv, 4, 8, nrm4);
+    lx_test_gltf *g = lx_test_gltf_new();
+    lx_test_gltf_require_extension(g, "EXT_meshopt_compression");
+    lx_test_gltf_require_extension(g, "KHR_mesh_quantization");
+    size_t fb = 0;
+    int vpos = meshopt_view(g, pos, (size_t)nv, 12, false, "NONE", &fb);
+    int vnrm = meshopt_view(g, oct, (size_t)nv, 4, false, "OCTAHEDRAL", &fb);
+    int vidx = meshopt_view(g, idx, (size_t)ni, 2, true, "NONE", &fb);
+    char json[512];
+    snprintf(
+        json, sizeof json,
+        "{\"byteLength\":%zu,\"extensions\":{\"EXT_meshopt_compression\":{\"fallback\":true}}}",
+        fb);
+    lx_test_gltf_buffer_json(g, json);
+    for (int k = 0, v0 = 0, i0 = 0; k < 2; v0 += p[k].nv, i0 += p[k].ni, k++) {
+        lx_vec3 lo = k ? lx_v3(2, 0, 0) : lx_v3(0, 0, 0), hi = k ? lx_v3(3, 2, 1) : lx_v3(1, 1, 1);
+        snprintf(json, sizeof json,
+                 "{\"bufferView\":%d,\"byteOffset\":%d,\"componentType\":5126,\"count\":%d,"
+                 "\"type\":\"VEC3\",\"min\":[%g,%g,%g],\"max\":[%g,%g,%g]}",
+                 vpos, 12 * v0, p[k].nv, lo.x, lo.y, lo.z, hi.x, hi.y, hi.z);
+        int apos = lx_test_gltf_accessor_json(g, json);
+        snprintf(json, sizeof json,
+                 "{\"bufferView\":%d,\"byteOffset\":%d,\"componentType\":5120,\"normalized\":"
+                 "true,\"count\":%d,\"type\":\"VEC3\"}",
+                 vnrm, 4 * v0, p[k].nv);
+        int anrm = lx_test_gltf_accessor_json(g, json);
+        snprintf(json, sizeof json,
+                 "{\"bufferView\":%d,\"byteOffset\":%d,\"componentType\":5123,\"count\":%d,"
+                 "\"type\":\"SCALAR\"}",
+                 vidx, 2 * i0, p[k].ni);
+        int aidx = lx_test_gltf_accessor_json(g, json);
+        snprintf(json, sizeof json,
+                 "{\"name\":\"box%d\",\"primitives\":[{\"attributes\":{\"POSITION\":%d,"
+                 "\"NORMAL\":%d},\"indices\":%d}]}",
+                 k, apos, anrm, aidx);
+        lx_test_gltf_node(g, k ? "b" : "a", lx_test_gltf_mesh_json(g, json),
+                          k ? "" : "\"translation\":[0,0.5,-2]");
+    }
+    lx_test_gltf_write_glb(g, path);
+    lx_test_gltf_free(g);
+    free(pos);
+    free(nrm4);
+    free(oct);
+    free(idx);
+    prim_free(&p[0]);
+    prim_free(&p[1]);
+}
+
+/* True when the JSON array root[key] holds the string s. */
+static bool lists(const cJSON *root, const char *key, const char *s)
+{
+    const cJSON *list = cJSON_GetObjectItemCaseSensitive(root, key);
+    for (const cJSON *e = cJSON_IsArray(list) ? list->child : NULL; e; e = e->next)
+        if (cJSON_IsString(e) && strcmp(e->valuestring, s) == 0)
+            return true;
+    return false;
+}
+
+/* A meshopt-compressed file is written with its views decoded: the
+ * unwrapper's UVs read back at every corner, the positions too, no view
+ * left compressed (the extension gone from the lists; an empty
+ * extensionsRequired would be invalid), the quantized normals kept as
+ * they were, and the glTF-Validator finds no error. */
+static void test_meshopt_round_trip(void **state)
+{
+    (void)state;
+    const char *dir = lx_test_dir("gltfw_meshopt");
+    char in[512], out[512];
+    snprintf(in, sizeof in, "%s/packed.glb", dir);
+    snprintf(out, sizeof out, "%s/out.glb", dir);
+    write_meshopt(in);
+    lx_scene *s;
+    lx_unwrap *u;
+    unwrap_and_write(in, out, &s, &u);
+    assert_int_equal(u->mesh_count, 2);
+    check_round_trip(s, u, out);
+    lx_unwrap_destroy(u);
+    lx_scene_destroy(s);
+    cJSON *j = glb_json(out);
+    assert_false(lists(j, "extensionsUsed", "EXT_meshopt_compression"));
+    assert_false(lists(j, "extensionsRequired", "EXT_meshopt_compression"));
+    assert_true(lists(j, "extensionsRequired", "KHR_mesh_quantization"));
+    const cJSON *views = cJSON_GetObjectItemCaseSensitive(j, "bufferViews");
+    for (const cJSON *v = views ? views->child : NULL; v; v = v->next)
+        assert_null(cJSON_GetObjectItemCaseSensitive(v, "extensions"));
+    assert_int_equal(cJSON_GetArraySize(cJSON_GetObjectItemCaseSensitive(j, "buffers")), 1);
+    const cJSON *meshes = cJSON_GetObjectItemCaseSensitive(j, "meshes");
+    const cJSON *accessors = cJSON_GetObjectItemCaseSensitive(j, "accessors");
+    for (const cJSON *m = meshes ? meshes->child : NULL; m; m = m->next) {
+        const cJSON *prim =
+            cJSON_GetArrayItem(cJSON_GetObjectItemCaseSensitive(m, "primitives"), 0);
+        const cJSON *attrs = cJSON_GetObjectItemCaseSensitive(prim, "attributes");
+        const cJSON *a = cJSON_GetArrayItem(
+            accessors, cJSON_GetObjectItemCaseSensitive(attrs, "NORMAL")->valueint);
+        assert_int_equal(cJSON_GetObjectItemCaseSensitive(a, "componentType")->valueint, 5120);
+        assert_true(cJSON_IsTrue(cJSON_GetObjectItemCaseSensitive(a, "normalized")));
+        assert_non_null(cJSON_GetObjectItemCaseSensitive(attrs, "TEXCOORD_1"));
+    }
+    cJSON_Delete(j);
+    validate(out);
+}
+
 /* Triangle strips and fans (glTF 2.0 spec, 3.7.2.1) come out as lists of
  * the same triangles in the same order and winding. */
 static void test_strips_and_fans(void **state)
@@ -757,6 +929,7 @@ int main(void)
         cmocka_unit_test(test_missing_image),
         cmocka_unit_test(test_validator_accepts_outputs),
         cmocka_unit_test(test_strips_and_fans),
+        cmocka_unit_test(test_meshopt_round_trip),
         cmocka_unit_test(test_bad_inputs),
     };
     return cmocka_run_group_tests(tests, NULL, NULL);

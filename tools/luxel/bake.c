@@ -80,6 +80,11 @@ static const char *bake_usage =
     "  --edge-supersample N    only the texels a hard shadow's edge crosses get\n"
     "                          N x N points of their footprint, 0..%d; 0 or 1:\n"
     "                          off (default %d; ignored with --supersample)\n"
+    "  --double-sided MODE     auto (default): a double-sided material's triangle\n"
+    "                          bakes its back face when its front is closed in\n"
+    "                          within a metre and its back open (a surface\n"
+    "                          modelled facing away from where it is seen);\n"
+    "                          front: always the front (Unity, Bakery)\n"
     "  --emissive-scale X      multiplier on emissive materials' radiance (nits),\n"
     "                          for files not authored in physical units\n"
     "                          (default 1); emitters are lights at any --bounces\n"
@@ -148,6 +153,7 @@ enum {
     OPT_EDGE_SUPERSAMPLE,
     OPT_GI_ADAPTIVE,
     OPT_GI_SAMPLING,
+    OPT_DOUBLE_SIDED,
     OPT_NO_STITCH,
     OPT_AO,
     OPT_AO_DISTANCE,
@@ -173,6 +179,7 @@ static int parse_args(int argc, char **argv, bake_args *a)
         {"edge-supersample", required_argument, NULL, OPT_EDGE_SUPERSAMPLE},
         {"gi-adaptive", no_argument, NULL, OPT_GI_ADAPTIVE},
         {"gi-sampling", required_argument, NULL, OPT_GI_SAMPLING},
+        {"double-sided", required_argument, NULL, OPT_DOUBLE_SIDED},
         {"no-stitch", no_argument, NULL, OPT_NO_STITCH},
         {"ao", no_argument, NULL, OPT_AO},
         {"ao-distance", required_argument, NULL, OPT_AO_DISTANCE},
@@ -288,6 +295,15 @@ static int parse_args(int argc, char **argv, bake_args *a)
                 a->desc.gi_sampling = LX_GI_SAMPLING_COSINE;
             else
                 return cli_usage_error("bake", "--gi-sampling must be guided or cosine, not '%s'",
+                                       optarg);
+            break;
+        case OPT_DOUBLE_SIDED:
+            if (!strcmp(optarg, "auto"))
+                a->desc.double_sided = LX_DOUBLE_SIDED_AUTO;
+            else if (!strcmp(optarg, "front"))
+                a->desc.double_sided = LX_DOUBLE_SIDED_FRONT;
+            else
+                return cli_usage_error("bake", "--double-sided must be auto or front, not '%s'",
                                        optarg);
             break;
         case OPT_EDGE_SUPERSAMPLE:
@@ -663,6 +679,8 @@ int cmd_bake(int argc, char **argv)
     else if (a.desc.edge_supersample > 1)
         cJSON_AddNumberToObject(manifest, "edge_supersample", a.desc.edge_supersample);
     cJSON_AddBoolToObject(manifest, "seams_stitched", a.desc.stitch_seams);
+    cJSON_AddStringToObject(manifest, "double_sided",
+                            a.desc.double_sided == LX_DOUBLE_SIDED_FRONT ? "front" : "auto");
     cJSON_AddStringToObject(manifest, "denoise", lx_denoise_mode_name(a.desc.denoise));
     if (a.desc.directional) {
         cJSON *dj = cJSON_AddObjectToObject(manifest, "directional");

@@ -240,9 +240,10 @@ int cmd_info(int argc, char **argv)
         const lx_material *m = &s->materials[i];
         if (phantom_material(s, i))
             continue;
-        printf("  %-24s base colour (%.3g, %.3g, %.3g)%s%s%s\n", m->name, m->base_color.x,
+        printf("  %-24s base colour (%.3g, %.3g, %.3g)%s%s%s%s\n", m->name, m->base_color.x,
                m->base_color.y, m->base_color.z, m->base_color_map_path ? " + texture" : "",
-               m->normal_map_path ? "  normal map" : "", m->unlit ? "  unlit" : "");
+               m->normal_map_path ? "  normal map" : "", m->unlit ? "  unlit" : "",
+               m->double_sided ? "  double-sided" : "");
     }
     printf("nodes: %u\n", s->node_count);
     for (uint32_t i = 0; i < s->node_count; i++) {
