@@ -157,6 +157,39 @@ static bool framed_bounds(const lx_scene *scene, lx_vec3 *lo, lx_vec3 *hi)
     return true;
 }
 
+/* Walls all round: every inside view (v[5..8]) meets the scene on nearly
+ * every probe (a window or a door lets a little through). A bake of a
+ * closed room is for its inside, however lit the outside of its walls (a
+ * sun on the roof): the best right inside view, into *out and info;
+ * false when the scene is open or no inside view is right. */
+static bool closed_room_view(const view_probe *v, int count, bool use_light, double lit,
+                             char names[][48], lx_camera *out, lx_camera_auto_info *info)
+{
+    for (int k = 5; k < VIEWS; k++) {
+        int met = 0;
+        for (int p = 0; p < count; p++)
+            met += v[k].kind[p] != MISS;
+        if ((float)met < ENCLOSED * (float)count)
+            return false;
+    }
+    int room = 0;
+    float room_score = 0.0f, good;
+    for (int k = 5; k < VIEWS; k++) {
+        float s = score(&v[k], use_light, lit, &good);
+        if (good >= GOOD && s > room_score + (room ? CLEARLY_BETTER : 0.0f)) {
+            room = k;
+            room_score = s;
+        }
+    }
+    if (!room)
+        return false;
+    *out = v[room].cam;
+    info->moved = info->inside = info->enclosed = true;
+    info->score = room_score;
+    snprintf(info->placement, sizeof info->placement, "%s", names[room]);
+    return true;
+}
+
 lx_status lx_camera_auto(const lx_scene *scene, const lx_lightmaps *lm, const lx_tracer *tracer,
                          float fov, float aspect, lx_camera *out, lx_camera_auto_info *info)
 {
@@ -239,31 +272,7 @@ lx_status lx_camera_auto(const lx_scene *scene, const lx_lightmaps *lm, const lx
     float good;
     info->outside_score = info->score = score(&v[0], use_light, lit, &good);
     float iso_good = good;
-    /* walls all round: every inside view meets the scene on nearly every
-     * probe (a window or a door lets a little through). A bake of a
-     * closed room is for its inside, however lit the outside of its walls
-     * (a sun on the roof): the best right inside view, if there is one */
-    bool enclosed = hits > 0;
-    for (int k = 5; k < VIEWS && enclosed; k++) {
-        int met = 0;
-        for (int p = 0; p < count; p++)
-            met += v[k].kind[p] != MISS;
-        enclosed = (float)met >= ENCLOSED * (float)count;
-    }
-    int room = 0;
-    float room_score = 0.0f;
-    for (int k = 5; k < VIEWS && enclosed; k++) {
-        float s = score(&v[k], use_light, lit, &good);
-        if (good >= GOOD && s > room_score + (room ? CLEARLY_BETTER : 0.0f)) {
-            room = k;
-            room_score = s;
-        }
-    }
-    if (room) {
-        *out = v[room].cam;
-        info->moved = info->inside = info->enclosed = true;
-        info->score = room_score;
-        snprintf(info->placement, sizeof info->placement, "%s", names[room]);
+    if (hits > 0 && closed_room_view(v, count, use_light, lit, names, out, info)) {
         free(v);
         return LX_OK;
     }
