@@ -386,6 +386,7 @@ static void bad_mode(void **state)
     lx_scene *s = lx_test_new_scene("bad");
     lx_mesh p = lx_test_plane("p", 1, 0, 0, 0, 1);
     lx_test_add(s, &p);
+    lx_test_mesh_free(&p);
     add_sun(s, lx_v3(0, -1, 0));
     lx_bake_desc d = {.resolution = 8, .double_sided = (lx_double_sided)7};
     lx_baker *b = NULL;
