@@ -483,6 +483,7 @@ static void tile_gather(const gi_run *run, gi_map *g, uint32_t m, uint32_t first
     bool guided = b->desc.gi_sampling == LX_GI_SAMPLING_GUIDED && n >= GUIDE_MIN_SAMPLES;
     uint32_t round0 = adaptive || guided ? quarter : n;
     gather_acc acc[LX_TILE * LX_TILE];
+    lx_gather_frame frame[LX_TILE * LX_TILE];
     lx_gi_guide guide;
     if (count > LX_TILE * LX_TILE)
         count = LX_TILE * LX_TILE; /* tiles are LX_TILE x LX_TILE texels */
@@ -491,8 +492,8 @@ static void tile_gather(const gi_run *run, gi_map *g, uint32_t m, uint32_t first
     for (uint32_t j = 0; j < count; j++) {
         if (g->invalid[first + j])
             continue;
-        lx_gather_frame f = lx_gather_frame_of(b, m, map, first + j);
-        gather_round(run, &f, round0, NULL, key, &acc[j], guided ? &guide : NULL, sh);
+        frame[j] = lx_gather_frame_of(b, m, map, first + j);
+        gather_round(run, &frame[j], round0, NULL, key, &acc[j], guided ? &guide : NULL, sh);
     }
     const lx_gi_guide *use = guided && lx_gi_guide_build(&guide) ? &guide : NULL;
     uint32_t rounds = adaptive ? tile_rounds(run, acc, g->invalid + first, count, quarter) : 1;
@@ -506,16 +507,16 @@ static void tile_gather(const gi_run *run, gi_map *g, uint32_t m, uint32_t first
                 g->next_var[i] = 0.0f;
             continue;
         }
-        lx_gather_frame f = lx_gather_frame_of(b, m, map, i);
+        const lx_gather_frame *f = &frame[j];
         /* a guided round casts twice its cosine-weighted rays */
         uint32_t per_round = use ? (quarter + 1) / 2 : quarter;
         if (adaptive) {
             for (uint32_t r = 1; r < rounds; r++)
-                gather_round(run, &f, per_round, use, key + (r << 16), &acc[j], NULL, sh);
+                gather_round(run, f, per_round, use, key + (r << 16), &acc[j], NULL, sh);
         } else if (guided) {
             uint32_t rest = n > acc[j].rays ? n - acc[j].rays : 0;
             if (rest)
-                gather_round(run, &f, use ? (rest + 1) / 2 : rest, use, key + (1u << 16),
+                gather_round(run, f, use ? (rest + 1) / 2 : rest, use, key + (1u << 16),
                              &acc[j], NULL, sh);
         }
         gather_finish(&acc[j], &g->next[i], g->next_sh ? &g->next_sh[i] : NULL,

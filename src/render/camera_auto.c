@@ -19,6 +19,7 @@
  * all round) and is shown from inside, by its best right inside view,
  * however lit its outside. */
 #include "render_internal.h"
+#include "scene/node_bake.h"
 
 #include <math.h>
 #include <stdio.h>
@@ -140,15 +141,7 @@ static bool framed_bounds(const lx_scene *scene, lx_vec3 *lo, lx_vec3 *hi)
         const lx_node *node = &scene->nodes[n];
         if (node->bake.sky || node->bake.no_lightmap || node->bake.backdrop)
             continue;
-        for (uint32_t k = 0; k < node->mesh_count; k++) {
-            const lx_mesh *m = &scene->meshes[node->meshes[k]];
-            for (uint32_t v = 0; v < m->vertex_count; v++) {
-                lx_vec3 p = lx_mat4_point(&node->world, m->positions[v]);
-                a = lx_v3(fminf(a.x, p.x), fminf(a.y, p.y), fminf(a.z, p.z));
-                b = lx_v3(fmaxf(b.x, p.x), fmaxf(b.y, p.y), fmaxf(b.z, p.z));
-                any = true;
-            }
-        }
+        any |= lx_node_grow_bounds(scene, node, &a, &b);
     }
     if (!any)
         return lx_scene_bounds(scene, lo, hi);
