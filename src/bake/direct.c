@@ -7,6 +7,7 @@
  * of threads. */
 #include "bake_internal.h"
 #include "core/internal.h"
+#include "direct_fast.h"
 
 #include <omp.h>
 #include <stdlib.h>
@@ -177,24 +178,7 @@ static void light_tile(const lx_baker *b, uint32_t map_index, const lx_lightmap 
         }
 }
 
-/* ---- the lean loop: punctual lights with hard or no shadows ---------------
- * Point, spot and directional lights without a photometric profile, the
- * bulk of a bake, skip lx_light_evaluate's general path: what does not
- * change per texel is worked out once per light, a tile's texels are
- * shaded 16 at a time in structure-of-arrays form (vectorized), and their
- * shadow rays go to the tracer as one coherent packet. Every operation is
- * lx_light_evaluate's and lx_shadow_ray's, in their order, so the results
- * are the same bits. */
-
-typedef struct fast_light {
-    bool directional, classic, spot, spot_hard, shadowed;
-    float px, py, pz; /* position; directional: the unit vector to the light */
-    float ax, ay, az; /* spot axis (the light's direction) */
-    float intensity, range, range_sq;
-    float cos_outer, spot_scale, spot_offset;
-    float cr, cg, cb; /* colour */
-    float mr, mg, mb; /* ambient */
-} fast_light;
+/* ---- the lean loop (direct_fast.h): punctual lights with hard or no shadows */
 
 /* false when the light needs the general path. */
 static bool fast_light_init(const lx_light *l, fast_light *f)
@@ -231,25 +215,6 @@ static bool fast_light_init(const lx_light *l, fast_light *f)
     f->mr = l->ambient.x, f->mg = l->ambient.y, f->mb = l->ambient.z;
     return true;
 }
-
-enum { TILE_TEXELS = LX_TILE * LX_TILE };
-
-/* A tile's texels in structure-of-arrays form, one lane per place in the
- * 8x8 tile, ordered by 4x4 block: a packet of 16 rays starts from a square
- * of texels, not two rows (10% more rays per second on bench_bake's
- * scene). Places without a texel (chart borders) are lanes that repeat
- * another lane's data and are never traced or stored. */
-typedef struct tile_soa {
-    int32_t texel[TILE_TEXELS];                  /* index from the tile's first texel, -1: none */
-    uint32_t lanes[TILE_TEXELS / LX_RAY_PACKET]; /* per packet: lanes with a texel */
-    float px[TILE_TEXELS], py[TILE_TEXELS], pz[TILE_TEXELS];
-    float nx[TILE_TEXELS], ny[TILE_TEXELS], nz[TILE_TEXELS];
-    float gx[TILE_TEXELS], gy[TILE_TEXELS], gz[TILE_TEXELS];
-    float bias[TILE_TEXELS]; /* lx_shadow_ray's origin offset */
-    bool lifted;             /* the map has lifts (lx_lift_shadow_ray) ... */
-    float lfx[TILE_TEXELS], lfy[TILE_TEXELS], lfz[TILE_TEXELS]; /* ... these */
-    float acc[3][TILE_TEXELS];
-} tile_soa;
 
 static void lane_set(tile_soa *t, int k, lx_vec3 p, lx_vec3 n, lx_vec3 g, float bias)
 {
@@ -293,194 +258,6 @@ static void tile_load(const lx_baker *b, const lx_lightmap *map, uint32_t first,
             lane_set(t, k, lx_v3(t->px[any], t->py[any], t->pz[any]),
                      lx_v3(t->nx[any], t->ny[any], t->nz[any]),
                      lx_v3(t->gx[any], t->gy[any], t->gz[any]), t->bias[any]);
-}
-
-/* 16 lanes as one value (GCC/Clang vector extensions: the compiler splits
- * them into the target's SIMD registers). Selects are bitwise, so no lane
- * computes anything a scalar evaluation would not. */
-#if defined(__GNUC__)
-/* the helpers below are static inline: no ABI is crossed */
-#pragma GCC diagnostic ignored "-Wpsabi"
-#endif
-typedef float v16f __attribute__((vector_size(64)));
-typedef int32_t v16i __attribute__((vector_size(64)));
-
-static inline __attribute__((always_inline)) v16f vload(const float *p)
-{
-    v16f v;
-    memcpy(&v, p, sizeof v);
-    return v;
-}
-
-static inline __attribute__((always_inline)) void vstore(float *p, v16f v)
-{
-    memcpy(p, &v, sizeof v);
-}
-
-static inline __attribute__((always_inline)) v16f vsplat(float x)
-{
-    return (v16f){0} + x;
-}
-
-/* m ? a : b, lane by lane (m is 0 or -1) */
-static inline __attribute__((always_inline)) v16f vsel(v16i m, v16f a, v16f b)
-{
-    return (v16f)(((v16i)a & m) | ((v16i)b & ~m));
-}
-
-/* The lanes [base, base + 16) of a tile for one fast light: ambient into
- * t->acc, the unshadowed illuminance into e, lit (lane mask) where it
- * lights, and the shadow rays into pk: lx_light_evaluate and
- * lx_shadow_ray, operation for operation. directional, classic and spot
- * are constants in each caller, so each kind of light gets its own code. */
-static inline __attribute__((always_inline)) void
-shade_lanes(const fast_light *f, tile_soa *t, uint32_t base, lx_ray_packet *pk, float e[3][16],
-            int32_t lit[16], bool directional, bool classic, bool spot)
-{
-    v16f px = vload(t->px + base), py = vload(t->py + base), pz = vload(t->pz + base);
-    v16f one = vsplat(1.0f), zero = vsplat(0.0f);
-    v16f tx, ty, tz, dist = vsplat(INFINITY), window = one, d2 = one;
-    v16i ok;
-    if (directional) {
-        tx = vsplat(f->px), ty = vsplat(f->py), tz = vsplat(f->pz);
-    } else {
-        tx = f->px - px, ty = f->py - py, tz = f->pz - pz;
-        d2 = tx * tx + ty * ty + tz * tz;
-        float d2s[16], ds[16];
-        vstore(d2s, d2);
-        for (int j = 0; j < 16; j++)
-            ds[j] = sqrtf(d2s[j]);
-        dist = vload(ds);
-        /* lx_light_range_window */
-        if (f->range > 0.0f) {
-            v16f factor = d2 / f->range_sq;
-            v16f smooth = 1.0f - factor * factor;
-            window = vsel(smooth > 0.0f, smooth * smooth, zero);
-        }
-    }
-    vstore(t->acc[0] + base, vload(t->acc[0] + base) + f->mr * window);
-    vstore(t->acc[1] + base, vload(t->acc[1] + base) + f->mg * window);
-    vstore(t->acc[2] + base, vload(t->acc[2] + base) + f->mb * window);
-    v16f lx = tx, ly = ty, lz = tz;
-    if (!directional) {
-        v16f inv = 1.0f / dist;
-        lx = tx * inv, ly = ty * inv, lz = tz * inv;
-    }
-    v16f ndotl = vload(t->nx + base) * lx + vload(t->ny + base) * ly + vload(t->nz + base) * lz;
-    ok = ndotl > 0.0f;
-    if (!directional)
-        ok &= dist > 0.0f;
-    v16f att = one;
-    if (spot) {
-        v16f c = -(f->ax * lx + f->ay * ly + f->az * lz);
-        if (f->spot_hard) {
-            att = vsel(c >= f->cos_outer, one, zero);
-        } else {
-            v16f u = c * f->spot_scale + f->spot_offset;
-            u = vsel(u < 0.0f, zero, vsel(u > 1.0f, one, u));
-            att = u * u;
-        }
-        ok &= att > 0.0f;
-    }
-    v16f en;
-    if (directional && classic) {
-        en = ndotl * ndotl * f->intensity;
-    } else if (directional) {
-        en = f->intensity * ndotl;
-    } else if (classic) {
-        ok &= dist < f->range;
-        v16f v = (1.0f - dist / f->range) * ndotl;
-        en = v * v * f->intensity * att;
-    } else {
-        v16f dc = vsel(d2 > 1e-4f, d2, vsplat(1e-4f)); /* LX_MIN_DISTANCE_SQ */
-        en = f->intensity * window * att * ndotl / dc;
-    }
-    ok &= en > 0.0f;
-    vstore(e[0], f->cr * en);
-    vstore(e[1], f->cg * en);
-    vstore(e[2], f->cb * en);
-    memcpy(lit, &ok, sizeof ok);
-    /* lx_shadow_ray: off the surface on the light's side */
-    v16f gx = vload(t->gx + base), gy = vload(t->gy + base), gz = vload(t->gz + base);
-    v16f bias = vload(t->bias + base);
-    v16i front = gx * lx + gy * ly + gz * lz >= 0.0f;
-    v16f ox = gx * bias, oy = gy * bias, oz = gz * bias;
-    v16f origin_x = vsel(front, px + ox, px - ox), origin_y = vsel(front, py + oy, py - oy),
-         origin_z = vsel(front, pz + oz, pz - oz);
-    if (t->lifted) { /* lx_lift_shadow_ray: behind the facet, from the smooth surface */
-        origin_x = vsel(front, origin_x, origin_x + vload(t->lfx + base));
-        origin_y = vsel(front, origin_y, origin_y + vload(t->lfy + base));
-        origin_z = vsel(front, origin_z, origin_z + vload(t->lfz + base));
-    }
-    vstore(pk->origin_x, origin_x);
-    vstore(pk->origin_y, origin_y);
-    vstore(pk->origin_z, origin_z);
-    vstore(pk->dir_x, lx);
-    vstore(pk->dir_y, ly);
-    vstore(pk->dir_z, lz);
-    vstore(pk->tmin, zero);
-    v16f tmax = directional ? dist : dist - 2.0f * bias;
-    vstore(pk->tmax, vsel(tmax < 0.0f, zero, tmax));
-}
-
-/* One fast light on a tile: lx_light_evaluate, lx_shadow_ray and
- * light_tile's sums, 16 lanes at a time. Built for AVX-512, AVX2 and the
- * baseline, chosen at load time: without FMA contraction (-ffp-contract=off)
- * the wider units compute the same bits. */
-#if defined(__GNUC__) && defined(__x86_64__) && !defined(__clang__)
-__attribute__((target_clones("avx512f", "avx2", "default")))
-#endif
-static void
-fast_light_tile(const lx_baker *b, const fast_light *f, tile_soa *t, lx_sh4 *sh, uint64_t *shadows,
-                uint64_t key)
-{
-    lx_ray_packet pk;
-    float e[3][LX_RAY_PACKET];
-    int32_t lit[LX_RAY_PACKET];
-    for (uint32_t base = 0; base < TILE_TEXELS; base += LX_RAY_PACKET) {
-        uint32_t lanes = t->lanes[base / LX_RAY_PACKET];
-        if (!lanes)
-            continue;
-        if (f->directional)
-            shade_lanes(f, t, base, &pk, e, lit, true, f->classic, false);
-        else if (f->classic)
-            shade_lanes(f, t, base, &pk, e, lit, false, true, f->spot);
-        else if (f->spot)
-            shade_lanes(f, t, base, &pk, e, lit, false, false, true);
-        else
-            shade_lanes(f, t, base, &pk, e, lit, false, false, false);
-        uint32_t active = 0;
-        for (uint32_t j = 0; j < LX_RAY_PACKET; j++)
-            active |= (uint32_t)(lit[j] != 0) << j;
-        active &= lanes;
-        if (!active)
-            continue;
-        uint32_t blocked = f->shadowed ? lx_tracer_occluded_packet(b->tracer, &pk, active) : 0;
-        uint32_t add = active & ~blocked;
-        for (uint32_t j = 0; shadows && j < LX_RAY_PACKET; j++)
-            if ((active & blocked) >> j & 1u)
-                shadows[t->texel[base + j]] |= key;
-        int32_t on[LX_RAY_PACKET];
-        for (int j = 0; j < LX_RAY_PACKET; j++)
-            on[j] = (add >> j) & 1u ? -1 : 0;
-        v16i m;
-        memcpy(&m, on, sizeof m);
-        for (int c = 0; c < 3; c++) {
-            v16f a = vload(t->acc[c] + base);
-            vstore(t->acc[c] + base, vsel(m, a + vload(e[c]), a));
-        }
-        if (!sh)
-            continue;
-        /* the directions: scalar, lane by lane (a directional bake only) */
-        for (uint32_t j = 0; j < LX_RAY_PACKET; j++) {
-            if (!((add >> j) & 1u))
-                continue;
-            uint32_t k = base + j;
-            lx_vec3 d = lx_v3(pk.dir_x[j], pk.dir_y[j], pk.dir_z[j]);
-            lx_vec3 n = lx_v3(t->nx[k], t->ny[k], t->nz[k]);
-            lx_sh4_add_lit(&sh[t->texel[k]], lx_v3(e[0][j], e[1][j], e[2][j]), n, d);
-        }
-    }
 }
 
 /* The sums between the lanes and texel order (the general path's). */
@@ -537,7 +314,7 @@ static void shade_tile(const lx_baker *b, uint32_t seed, const lx_lightmap *map,
         }
     for (uint32_t l = 0; l < light_count; l++) {
         if (is_fast[l] && !horizon) {
-            fast_light_tile(b, &fast[l], t, sh, shadows, shadow_bit(l));
+            lx_fast_light_tile(b->tracer, &fast[l], t, sh, shadows, shadow_bit(l));
             continue;
         }
         acc_to_vec3(t, accum);
