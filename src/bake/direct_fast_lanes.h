@@ -1,9 +1,8 @@
 /* The body of the lean light loop (direct_fast.h), compiled once per
  * instruction set: the including file names the function
  * (LX_FAST_LIGHT_TILE) and is built with that set's flags (-mavx512f,
- * -mavx2 or none). Whole files, not target_clones: GCC lowers vector
- * comparisons for the baseline before it makes clones, so each clone
- * compared lane by lane in scalar code. Everything here is static but the
+ * -mavx2 or none). Whole files, not target_clones: GCC 12's AVX-512 clone
+ * compared the lanes one by one in scalar code. Everything here is static but the
  * one function, so no code built for a wider set reaches another file.
  * Without FMA contraction (-ffp-contract=off) the wider units compute the
  * same bits. */
