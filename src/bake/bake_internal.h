@@ -109,6 +109,39 @@ typedef struct lx_texel {
     uint32_t node;     /* scene node placing the mesh (a page holds several) */
 } lx_texel;
 
+/* Texel footprints per triangle of a page: the triangles of the pair
+ * (node, mesh) of ranges[k] start at ranges[k].first; triangle t's two
+ * axes are axes[2 (first + t)] and the next. ranges sorted by (node,
+ * mesh). */
+typedef struct lx_footprint_range {
+    uint32_t node, mesh, first;
+} lx_footprint_range;
+
+typedef struct lx_texel_footprints {
+    lx_vec3 *axes;
+    lx_footprint_range *ranges;
+    uint32_t range_count;
+} lx_texel_footprints;
+
+void lx_texel_footprints_free(lx_texel_footprints *f);
+
+/* The world step of one texel along x ([0]) and along y ([1]) at texel
+ * t, from its triangle's footprint (zero for a triangle without UV
+ * area). */
+static inline const lx_vec3 *lx_texel_axes(const lx_texel_footprints *f, const lx_texel *t)
+{
+    uint32_t lo = 0, hi = f->range_count - 1;
+    while (lo < hi) { /* the last range at or before (node, mesh) */
+        uint32_t mid = (lo + hi + 1) / 2;
+        const lx_footprint_range *r = &f->ranges[mid];
+        if (r->node < t->node || (r->node == t->node && r->mesh <= t->mesh))
+            lo = mid;
+        else
+            hi = mid - 1;
+    }
+    return &f->axes[2 * ((size_t)f->ranges[lo].first + t->triangle)];
+}
+
 /* A texel of a material with a height (horizon.c): its horizon layers and
  * AO sampled at its material UV, and the world tangent frame of the
  * surface under the height. flags 0: the texel bakes as without one. */
@@ -196,10 +229,11 @@ typedef struct lx_lightmap {
     lx_vec3 *sub_position, *sub_normal, *sub_geometric_normal;
     lx_vec3 *sub_object_position, *sub_object_normal, *sub_object_geometric_normal;
     uint8_t *sub_covered;
-    /* per texel until lx_bake_straddle has run (then NULL; kept for edge
-     * supersampling, until the node moves): the world step of one texel
-     * along x and along y, [2 i] and [2 i + 1] */
-    lx_vec3 *texel_axes;
+    /* Until lx_bake_straddle has run (then NULL; kept for edge
+     * supersampling, until a node moves): the world step of one texel
+     * along x and along y on each triangle of the page (the same for all
+     * its texels), read through lx_texel_axes. */
+    lx_texel_footprints *footprints;
     /* Whether the texel map (texels, tiles, positions, normals, albedo,
      * emission, horizon, stitch) is in memory. A tiled baker
      * (bake_tiles.c) keeps only name, info, mask, baked and realtime of
@@ -389,11 +423,11 @@ void lx_texel_map_transform(lx_lightmap *map, uint32_t node, const lx_mat4 *worl
 /* straddle.c: moves every texel sample of the maps in memory that lies
  * inside geometry (a floor texel half under a wall standing on it) to the
  * visible side and leaves such supersampling points out; frees their
- * texel_axes. Reports within [progress_base, + progress_span] when
+ * footprints unless edge supersampling is to use them. Reports within [progress_base, + progress_span] when
  * report (LX_ERR_CANCELLED when told to stop). */
 lx_status lx_bake_straddle(lx_baker *b, float progress_base, float progress_span, bool report);
 /* Whether any texel of tile [first, first + count) of map (with its
- * texel_axes) could straddle: false when its texels lie in one plane and
+ * footprints) could straddle: false when its texels lie in one plane and
  * every triangle within reach of their rays (a sphere around them, wide
  * enough for the texels' and their footprint points' rays) lies in that
  * plane too (the tile's own surface): then no ray along the surface from

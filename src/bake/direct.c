@@ -485,8 +485,8 @@ static void edge_points(const lx_baker *b, const lx_lightmap *map, int n, bool n
         for (uint32_t j = 0; j < e->marked; j++) {
             uint32_t i = e->orig[j];
             lx_vec3 p = map->world_position[i], g = map->world_geometric_normal[i];
-            lx_vec3 step = lx_add(lx_scale(map->texel_axes[2 * (size_t)i], du),
-                                  lx_scale(map->texel_axes[2 * (size_t)i + 1], dv));
+            const lx_vec3 *axes = lx_texel_axes(map->footprints, &map->texels[i]);
+            lx_vec3 step = lx_add(lx_scale(axes[0], du), lx_scale(axes[1], dv));
             at[j] = lx_add(p, step);
             if (!near_walls)
                 continue;
@@ -709,7 +709,7 @@ lx_status lx_bake_lights(lx_baker *b, const uint32_t *lights, uint32_t light_cou
     bool out_of_memory = edge_n && !records;
     for (uint32_t m = 0; records && m < b->map_count && !out_of_memory; m++) {
         const lx_lightmap *map = &b->maps[m];
-        if (map->loaded && map->texel_axes && map->info.used_texels)
+        if (map->loaded && map->footprints && map->info.used_texels)
             out_of_memory = !(records[m] = malloc(sizeof(uint64_t) * map->info.used_texels));
     }
     if (out_of_memory) {

@@ -102,7 +102,8 @@ static bool acceptable(const lx_baker *b, const lx_lightmap *map, uint32_t i, lx
  * hidden supersampling points; returns whether it moved. */
 static bool straddle_texel(const lx_baker *b, lx_lightmap *map, uint32_t i)
 {
-    lx_vec3 ax = map->texel_axes[2 * (size_t)i], ay = map->texel_axes[2 * (size_t)i + 1];
+    const lx_vec3 *axes = lx_texel_axes(map->footprints, &map->texels[i]);
+    lx_vec3 ax = axes[0], ay = axes[1];
     float half = 0.5f * fmaxf(lx_length(lx_add(ax, ay)), lx_length(lx_sub(ax, ay)));
     if (!(half > 0.0f) || !isfinite(half))
         return false;
@@ -190,7 +191,8 @@ bool lx_bake_tile_may_straddle(const lx_baker *b, const lx_lightmap *map, uint32
         tolerance = fminf(tolerance, 0.5f * lift);
         if (lx_dot(map->world_geometric_normal[i], n) < 0.99999f)
             return true;
-        lx_vec3 ax = map->texel_axes[2 * (size_t)i], ay = map->texel_axes[2 * (size_t)i + 1];
+        const lx_vec3 *axes = lx_texel_axes(map->footprints, &map->texels[i]);
+        lx_vec3 ax = axes[0], ay = axes[1];
         float half = 0.5f * fmaxf(lx_length(lx_add(ax, ay)), lx_length(lx_sub(ax, ay)));
         if (!isfinite(half))
             return true;
@@ -229,7 +231,7 @@ lx_status lx_bake_straddle(lx_baker *b, float progress_base, float progress_span
         uint32_t m, first, count;
         lx_tile_walk_at(&w, global, &m, &first, &count);
         lx_lightmap *map = &b->maps[m];
-        bool may = count && map->texel_axes && lx_bake_tile_may_straddle(b, map, first, count);
+        bool may = count && map->footprints && lx_bake_tile_may_straddle(b, map, first, count);
         for (uint32_t i = first; may && i < first + count; i++)
             moved += straddle_texel(b, map, i);
         lx_tile_walk_done(&w, global, count);
@@ -240,8 +242,8 @@ lx_status lx_bake_straddle(lx_baker *b, float progress_base, float progress_span
         lx_log(LX_LOG_INFO, "%lld texel samples moved out of geometry", (long long)moved);
     /* edge supersampling places its points by the footprints too */
     for (uint32_t m = 0; m < b->map_count && !lx_bake_edge_supersample(&b->desc); m++) {
-        free(b->maps[m].texel_axes);
-        b->maps[m].texel_axes = NULL;
+        lx_texel_footprints_free(b->maps[m].footprints);
+        b->maps[m].footprints = NULL;
     }
     return LX_OK;
 }

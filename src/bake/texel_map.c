@@ -457,14 +457,16 @@ static uint32_t slot_of(const slot *slots, uint32_t count, uint32_t id)
 
 
 /* Texel n's world-space position and normals under world (nm: its normal
- * matrix), as lx_texel_map_transform computes them, and its object space
- * when the map keeps it. */
+ * matrix), as lx_texel_map_transform computes them (world_geometric: its
+ * triangle's, made once a triangle), and its object space when the map
+ * keeps it. */
 static void place_texel(lx_lightmap *map, uint32_t n, const lx_mat4 *world, const lx_mat4 *nm,
-                        lx_vec3 position, lx_vec3 normal, lx_vec3 geometric, lx_vec3 smooth)
+                        lx_vec3 position, lx_vec3 normal, lx_vec3 geometric,
+                        lx_vec3 world_geometric, lx_vec3 smooth)
 {
     map->world_position[n] = lx_mat4_point(world, position);
     map->world_normal[n] = lx_normalize(lx_mat4_vector(nm, normal));
-    map->world_geometric_normal[n] = lx_normalize(lx_mat4_vector(nm, geometric));
+    map->world_geometric_normal[n] = world_geometric;
     if (map->world_smooth_normal)
         map->world_smooth_normal[n] = lx_normalize(lx_mat4_vector(nm, smooth));
     if (map->object_position) {
@@ -553,15 +555,24 @@ static lx_status build_stitch(const slot *slots, uint32_t slot_count, lx_lightma
 /* The surface at barycentrics (w0, w1, w2) of triangle t of a slot's
  * mesh, in object space: position, shading normal (normal map applied
  * when tangents is not NULL) and geometric normal. */
-static void surface_point(const lx_scene *scene, const slot *sl, const lx_vec4 *tangents,
-                          uint32_t t, float w0, float w1, float w2, lx_vec3 *position,
-                          lx_vec3 *normal, lx_vec3 *geometric, lx_vec3 *smooth)
+/* Triangle t's unit geometric normal (object space). */
+static lx_vec3 triangle_normal(const lx_mesh *m, uint32_t t)
+{
+    const uint32_t *i = &m->indices[3 * t];
+    lx_vec3 pa = m->positions[i[0]], pb = m->positions[i[1]], pc = m->positions[i[2]];
+    return lx_normalize(lx_cross(lx_sub(pb, pa), lx_sub(pc, pa)));
+}
+
+/* surface_point with the triangle's normal given (geometric, from
+ * triangle_normal): what changes from texel to texel. */
+static void surface_at(const lx_scene *scene, const slot *sl, const lx_vec4 *tangents, uint32_t t,
+                       float w0, float w1, float w2, const lx_vec3 *geometric, lx_vec3 *position,
+                       lx_vec3 *normal, lx_vec3 *smooth)
 {
     const lx_mesh *m = sl->mesh;
     const uint32_t *i = &m->indices[3 * t];
     lx_vec3 pa = m->positions[i[0]], pb = m->positions[i[1]], pc = m->positions[i[2]];
     *position = lx_add(lx_add(lx_scale(pa, w0), lx_scale(pb, w1)), lx_scale(pc, w2));
-    *geometric = lx_normalize(lx_cross(lx_sub(pb, pa), lx_sub(pc, pa)));
     lx_vec3 nrm = lx_add(lx_add(lx_scale(m->normals[i[0]], w0), lx_scale(m->normals[i[1]], w1)),
                          lx_scale(m->normals[i[2]], w2));
     nrm = lx_length(nrm) > 1e-12f ? lx_normalize(nrm) : *geometric;
@@ -570,6 +581,14 @@ static void surface_point(const lx_scene *scene, const slot *sl, const lx_vec4 *
     if (tangents)
         lx_material_normal_at(lx_mesh_material(scene, m), m, tangents, i, w0, w1, w2, &nrm);
     *normal = nrm;
+}
+
+static void surface_point(const lx_scene *scene, const slot *sl, const lx_vec4 *tangents,
+                          uint32_t t, float w0, float w1, float w2, lx_vec3 *position,
+                          lx_vec3 *normal, lx_vec3 *geometric, lx_vec3 *smooth)
+{
+    *geometric = triangle_normal(sl->mesh, t);
+    surface_at(scene, sl, tangents, t, w0, w1, w2, geometric, position, normal, smooth);
 }
 
 /* From point `position` of triangle t (barycentrics w0, w1, w2, object
@@ -625,6 +644,54 @@ static void texel_axes(const raster_ctx *r, const slot *sl, uint32_t t, const lx
                           (float)(1.0 / det));
     axes[0] = lx_mat4_vector(world, dx);
     axes[1] = lx_mat4_vector(world, dy);
+}
+
+static int range_order(const void *a, const void *b)
+{
+    const lx_footprint_range *x = a, *y = b;
+    if (x->node != y->node)
+        return x->node < y->node ? -1 : 1;
+    return x->mesh < y->mesh ? -1 : x->mesh > y->mesh;
+}
+
+/* The texel footprint of every triangle of the page (texel_axes), one
+ * range of triangles per slot. */
+static lx_status build_footprints(const lx_scene *scene, const raster_ctx *r, const slot *slots,
+                                  uint32_t slot_count, uint32_t total_triangles, int threads,
+                                  const char *what, lx_texel_footprints **out)
+{
+    lx_texel_footprints *f = calloc(1, sizeof *f);
+    if (f) {
+        f->axes = malloc(2 * sizeof(lx_vec3) * (total_triangles ? total_triangles : 1));
+        f->ranges = malloc(sizeof(lx_footprint_range) * (slot_count ? slot_count : 1));
+    }
+    if (!f || !f->axes || !f->ranges) {
+        lx_texel_footprints_free(f);
+        return lx_fail(LX_ERR_NOMEM, "%s: out of memory for the texel footprints", what);
+    }
+    for (uint32_t s = 0; s < slot_count; s++)
+        f->ranges[s] = (lx_footprint_range){slots[s].node, slots[s].mesh_index,
+                                            slots[s].first_triangle};
+    f->range_count = slot_count;
+    qsort(f->ranges, slot_count, sizeof *f->ranges, range_order);
+    int64_t count = total_triangles;
+#pragma omp parallel for schedule(static) num_threads(threads)
+    for (int64_t id = 0; id < count; id++) {
+        uint32_t s = slot_of(slots, slot_count, (uint32_t)id);
+        texel_axes(r, &slots[s], (uint32_t)id - slots[s].first_triangle,
+                   &scene->nodes[slots[s].node].world, &f->axes[2 * id]);
+    }
+    *out = f;
+    return LX_OK;
+}
+
+void lx_texel_footprints_free(lx_texel_footprints *f)
+{
+    if (!f)
+        return;
+    free(f->axes);
+    free(f->ranges);
+    free(f);
 }
 
 /* Texel supersampling: the page rasterized again, centres only, at N
@@ -837,7 +904,6 @@ lx_status lx_texel_map_build(const lx_scene *scene, const lx_page_spec *page,
     map->world_position = malloc(sizeof(lx_vec3) * (used ? used : 1));
     map->world_normal = malloc(sizeof(lx_vec3) * (used ? used : 1));
     map->world_geometric_normal = malloc(sizeof(lx_vec3) * (used ? used : 1));
-    map->texel_axes = malloc(2 * sizeof(lx_vec3) * (used ? used : 1));
     bool want_albedo = desc->quantity == LX_QUANTITY_RADIANCE || lx_bake_keeps_surfaces(desc);
     if (want_albedo)
         map->albedo = malloc(sizeof(lx_vec3) * (used ? used : 1));
@@ -854,7 +920,7 @@ lx_status lx_texel_map_build(const lx_scene *scene, const lx_page_spec *page,
     if (emits)
         map->emission = malloc(sizeof(lx_vec3) * (used ? used : 1));
     if (!map->texels || !map->tile_start || !map->mask || !map->world_position ||
-        !map->world_normal || !map->world_geometric_normal || !map->texel_axes || (want_albedo && !map->albedo) ||
+        !map->world_normal || !map->world_geometric_normal || (want_albedo && !map->albedo) ||
         (emits && !map->emission)) {
         st = lx_fail(LX_ERR_NOMEM, "%s: out of memory", what);
         goto done;
@@ -958,12 +1024,21 @@ lx_status lx_texel_map_build(const lx_scene *scene, const lx_page_spec *page,
             continue;
         int ty = tile / tiles_x, tx = tile % tiles_x;
         uint32_t k = map->tile_start[tile];
+        /* what is the same across a triangle, made once per run of it */
+        uint32_t cached = UINT32_MAX, s = 0;
+        lx_vec3 geometric = {0}, world_geometric = {0};
         for (int y = ty * LX_TILE; y < (ty + 1) * LX_TILE && y < h; y++)
             for (int x = tx * LX_TILE; x < (tx + 1) * LX_TILE && x < w; x++) {
                 size_t p = (size_t)y * w + x;
                 if (r.owner[p] == UINT32_MAX)
                     continue;
-                uint32_t s = slot_of(slots, slot_count, r.owner[p]);
+                if (r.owner[p] != cached) {
+                    cached = r.owner[p];
+                    s = slot_of(slots, slot_count, cached);
+                    geometric = triangle_normal(slots[s].mesh, cached - slots[s].first_triangle);
+                    world_geometric =
+                        lx_normalize(lx_mat4_vector(&nms[slot_node[s]], geometric));
+                }
                 const lx_mesh *m = slots[s].mesh;
                 uint32_t t = r.owner[p] - slots[s].first_triangle;
                 const uint32_t *i = &m->indices[3 * t];
@@ -973,11 +1048,9 @@ lx_status lx_texel_map_build(const lx_scene *scene, const lx_page_spec *page,
                 tx_->mesh = slots[s].mesh_index;
                 tx_->triangle = t;
                 tx_->node = slots[s].node;
-                lx_vec3 position, nrm, geometric, vertex_normal;
-                surface_point(scene, &slots[s], tangents[s], t, w0, w1, w2, &position, &nrm,
-                              &geometric, &vertex_normal);
-                texel_axes(&r, &slots[s], t, &scene->nodes[slots[s].node].world,
-                           &map->texel_axes[2 * (size_t)k]);
+                lx_vec3 position, nrm, vertex_normal;
+                surface_at(scene, &slots[s], tangents[s], t, w0, w1, w2, &geometric, &position,
+                           &nrm, &vertex_normal);
                 const lx_material *mat = lx_mesh_material(scene, m);
                 if (map->albedo)
                     map->albedo[k] = lx_material_albedo_at(mat, m, i, w0, w1, w2);
@@ -991,11 +1064,14 @@ lx_status lx_texel_map_build(const lx_scene *scene, const lx_page_spec *page,
                         map->object_lift[k] = lift;
                 }
                 place_texel(map, k++, &scene->nodes[slots[s].node].world, &nms[slot_node[s]],
-                            position, nrm, geometric, vertex_normal);
+                            position, nrm, geometric, world_geometric, vertex_normal);
                 map->mask[p] = 1;
             }
     }
     map->info.used_texels = n;
+    if (st == LX_OK)
+        st = build_footprints(scene, &r, slots, slot_count, total_triangles, threads, what,
+                              &map->footprints);
     if (st == LX_OK && sub)
         st = build_subsamples(scene, desc, slots, slot_count, skip, total_triangles, tangents, nms,
                               slot_node, sub_progress, what, map);
@@ -1100,8 +1176,8 @@ lx_status lx_texel_map_keep_object_space(lx_lightmap *map)
 void lx_texel_map_transform(lx_lightmap *map, uint32_t node, const lx_mat4 *world)
 {
     /* the footprints were the old transform's: edge supersampling stops */
-    free(map->texel_axes);
-    map->texel_axes = NULL;
+    lx_texel_footprints_free(map->footprints);
+    map->footprints = NULL;
     lx_mat4 nm;
     if (!lx_mat4_normal_matrix(world, &nm))
         nm = *world;
@@ -1159,6 +1235,6 @@ void lx_texel_map_free(lx_lightmap *map)
     free(map->sub_object_normal);
     free(map->sub_object_geometric_normal);
     free(map->sub_covered);
-    free(map->texel_axes);
+    lx_texel_footprints_free(map->footprints);
     memset(map, 0, sizeof *map);
 }
