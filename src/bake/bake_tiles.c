@@ -100,8 +100,6 @@ static const texel_buffer texel_buffers[] = {
      WHEN_ALWAYS},
     {"texel map: world position, shading and geometric normal", 36, PER_TEXEL, LIFE_TEXEL_MAP,
      WHEN_ALWAYS},
-    {"texel map: footprint axes, until samples are moved out of walls (kept for edge "
-     "supersampling)", 24, PER_TEXEL, LIFE_TEXEL_MAP, WHEN_ALWAYS},
     {"edge supersampling: shadow records, edge masks and the page's texel index", 20, PER_TEXEL,
      LIFE_TEXEL_MAP, WHEN_EDGE},
     {"texel map: tile offsets", 1, PER_TEXEL, LIFE_TEXEL_MAP, WHEN_ALWAYS},
@@ -238,8 +236,9 @@ uint64_t lx_bake_scene_bytes(const lx_scene *scene, bool copy)
     }
     /* Embree's copy of the world vertices (16 bytes padded) and triangles
      * (12), and its BVH (about 64 bytes a triangle at high quality); the
-     * gathers' copy of UVs and indices is within the scene's size */
-    uint64_t bvh = vertices * 16 + triangles * (12 + 64);
+     * gathers' copy of UVs and indices is within the scene's size; the
+     * texel footprints of a page's triangles (24, texel_map.c) */
+    uint64_t bvh = vertices * 16 + triangles * (12 + 64 + 24);
     uint64_t own = vertex_bytes + triangles * 12 + textures;
     return bvh + own + (copy ? own : 0);
 }
