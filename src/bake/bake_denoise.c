@@ -11,6 +11,39 @@
 #include <stdlib.h>
 #include <string.h>
 
+lx_status lx_bake_sampled_begin(lx_baker *b, bool *made)
+{
+    *made = false;
+    lx_bake_sampled_end(b);
+    if (b->desc.denoise != LX_DENOISE_INDIRECT)
+        return LX_OK;
+    bool sampled = (b->has_sky && b->sky_shadows) || b->emitter_count > 0;
+    for (uint32_t l = 0; l < b->light_count && !sampled; l++)
+        sampled = !b->lights[l].dynamic && b->lights[l].shadow == LX_SHADOW_SOFT;
+    if (!sampled)
+        return LX_OK;
+    for (uint32_t m = 0; m < b->map_count; m++) {
+        lx_lightmap *map = &b->maps[m];
+        size_t n = (size_t)map->info.width * map->info.height * 3;
+        if (!(map->sampled = calloc(n ? n : 1, sizeof(float)))) {
+            lx_bake_sampled_end(b);
+            return lx_fail(LX_ERR_NOMEM, "lightmap '%s': out of memory keeping its sampled "
+                                         "direct light for denoising",
+                           map->name);
+        }
+    }
+    *made = true;
+    return LX_OK;
+}
+
+void lx_bake_sampled_end(lx_baker *b)
+{
+    for (uint32_t m = 0; m < b->map_count; m++) {
+        free(b->maps[m].sampled);
+        b->maps[m].sampled = NULL;
+    }
+}
+
 float **lx_bake_denoise_keep(const lx_baker *b, lx_status *st)
 {
     *st = LX_OK;
@@ -33,6 +66,8 @@ float **lx_bake_denoise_keep(const lx_baker *b, lx_status *st)
             return NULL;
         }
         memcpy(direct[m], map->baked, sizeof(float) * n);
+        for (size_t i = 0; map->sampled && i < n; i++) /* the exact part */
+            direct[m][i] -= map->sampled[i];
         if (!map->sh)
             continue;
         size_t k = n / 3 * LX_SH_FLOATS;
@@ -110,10 +145,33 @@ static lx_status denoise_sh(const lx_baker *b, lx_lightmap *map, const lx_denois
     return st;
 }
 
+/* The sampled direct light of map m (--denoise indirect), filtered apart
+ * and added back: baked = exact + F(sampled) (+ the bounces, already
+ * filtered), with the variance the filter estimates from the sampled
+ * part itself: the exact lights' edges never enter it. */
+static lx_status denoise_sampled(lx_lightmap *map, lx_denoise_guides *g, bool bounces_done,
+                                 const lx_denoise_desc *dd)
+{
+    size_t n = (size_t)map->info.width * map->info.height * 3;
+    /* without bounces the buffer still holds the sampled part */
+    for (size_t i = 0; !bounces_done && i < n; i++)
+        map->baked[i] -= map->sampled[i];
+    const float *variance = g->variance;
+    g->variance = NULL;
+    lx_status st = lx_denoise(g, map->sampled, map->sampled, dd);
+    g->variance = variance;
+    for (size_t i = 0; i < n; i++) /* on failure: the sampled part as it was */
+        map->baked[i] += map->sampled[i];
+    return st;
+}
+
 lx_status lx_bake_denoise(lx_baker *b, float **direct, float progress_base, float progress_span)
 {
     lx_denoise_mode mode = b->desc.denoise;
-    if (mode == LX_DENOISE_OFF || (mode == LX_DENOISE_INDIRECT && !direct))
+    bool sampled = false;
+    for (uint32_t m = 0; m < b->map_count; m++)
+        sampled |= b->maps[m].sampled != NULL;
+    if (mode == LX_DENOISE_OFF || (mode == LX_DENOISE_INDIRECT && !direct && !sampled))
         return LX_OK;
     lx_status st = LX_OK;
     /* the maps in memory (a tiled baker's tile), each its share */
@@ -150,21 +208,30 @@ lx_status lx_bake_denoise(lx_baker *b, float **direct, float progress_base, floa
         }
         if (st != LX_OK) {
         } else if (mode == LX_DENOISE_INDIRECT) {
-            /* the bounces' part, in place of the buffer's copy of it */
-            float *indirect = malloc(sizeof(float) * n);
-            if (!indirect) {
+            /* the bounces' part, in place of the buffer's copy of it
+             * (without the sampled direct part: that is filtered next) */
+            float *indirect = direct ? malloc(sizeof(float) * n) : NULL;
+            if (direct && !indirect) {
                 st = lx_fail(LX_ERR_NOMEM, "lightmap '%s': out of memory for denoising",
                              map->name);
-            } else {
+            } else if (direct) {
+                if (map->sampled)
+                    sh.span *= 0.5f; /* two runs, each half the map's share */
                 for (size_t i = 0; i < n; i++)
-                    indirect[i] = map->baked[i] - direct[m][i];
+                    indirect[i] = map->baked[i] - direct[m][i] -
+                                  (map->sampled ? map->sampled[i] : 0.0f);
                 st = lx_denoise_combine(mode, &g, direct[m], indirect, map->baked, &dd);
                 free(indirect);
+            }
+            if (st == LX_OK && map->sampled) {
+                if (direct)
+                    sh.from += sh.span;
+                st = denoise_sampled(map, &g, direct != NULL, &dd);
             }
         } else {
             st = lx_denoise(&g, map->baked, map->baked, &dd);
         }
-        if (st == LX_OK && map->sh)
+        if (st == LX_OK && map->sh && (mode != LX_DENOISE_INDIRECT || direct))
             st = denoise_sh(b, map, &g,
                             mode == LX_DENOISE_INDIRECT ? direct[b->map_count + m] : NULL);
         lx_denoise_guides_free(&g);

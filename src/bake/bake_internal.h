@@ -216,6 +216,11 @@ typedef struct lx_lightmap {
                            variance over their rays, summed over the
                            bounces), the denoiser's guide; after a bake
                            with bounces that denoises them, else NULL */
+    float *sampled; /* width * height * 3: the part of baked's direct light
+                       estimated by sampling (the shadowed sky, soft
+                       shadows, emitters), denoised apart under
+                       --denoise indirect (lx_bake_sampled_begin); made
+                       and freed by each such bake, else NULL; resident */
     uint8_t *gi_valid; /* width * height, after a bake with bounces in which
                           a texel lay inside geometry (else NULL): 0 at
                           those texels, left out of the denoiser; resident */
@@ -636,9 +641,18 @@ static inline int lx_bake_edge_supersample(const lx_bake_desc *desc)
     return desc->edge_supersample > 1 && desc->supersample <= 1 ? desc->edge_supersample : 0;
 }
 
-/* bake_denoise.c: a copy of every map's baked buffer before the bounces
- * when desc.denoise is INDIRECT with bounces (else NULL, *st LX_OK);
- * its release; the denoising of every map within the given progress. */
+/* bake_denoise.c: the maps' sampled buffers (zeroed) when desc.denoise
+ * is INDIRECT and the bake has a term estimated by sampling (the sky with
+ * shadows, a static light with soft shadows, an emitter): the direct pass
+ * fills them and the denoiser filters that part apart, with its own
+ * variance, so the exact lights stay sharp; false (nothing made) when
+ * there is none. Their release. */
+lx_status lx_bake_sampled_begin(lx_baker *b, bool *made);
+void lx_bake_sampled_end(lx_baker *b);
+/* A copy of every map's exact direct light (the baked buffer less its
+ * sampled part) when desc.denoise is INDIRECT with bounces (else NULL,
+ * *st LX_OK); its release; the denoising of every map within the given
+ * progress. */
 float **lx_bake_denoise_keep(const lx_baker *b, lx_status *st);
 void lx_bake_denoise_free(const lx_baker *b, float **direct);
 lx_status lx_bake_denoise(lx_baker *b, float **direct, float progress_base, float progress_span);

@@ -31,7 +31,7 @@ enum {
     WHEN_HORIZON = 1u << 2,     /* a material on the map has a height */
     WHEN_DYNAMIC = 1u << 3,     /* the scene has dynamic lights */
     WHEN_DENOISE = 1u << 4,     /* the bake denoises something */
-    WHEN_KEEP = 1u << 5,        /* denoise indirect with bounces: direct kept */
+    WHEN_KEEP = 1u << 5,        /* denoise indirect: parts kept apart */
     WHEN_PADDING = 1u << 6,     /* padding > 0 */
     WHEN_SURFACES = 1u << 7,    /* bounces, the dynamic bounce or probes */
     WHEN_DIRECTIONAL = 1u << 8, /* directional lightmaps */
@@ -87,6 +87,8 @@ static const texel_buffer texel_buffers[] = {
      WHEN_GI},
     {"emitters: textured emission", 12, PER_TEXEL, LIFE_RESIDENT, WHEN_EMISSIVE_TEXTURE},
     {"denoising: the direct light kept", 12, PER_TEXEL, LIFE_RESIDENT, WHEN_GI | WHEN_KEEP},
+    {"denoising: the sampled direct light (shadowed sky, soft shadows, emitters)", 12,
+     PER_TEXEL, LIFE_RESIDENT, WHEN_KEEP},
     {"denoising: the direct directional data kept", 48, PER_TEXEL, LIFE_RESIDENT,
      WHEN_GI | WHEN_KEEP | WHEN_DIRECTIONAL},
     {"dynamic bounce: valid mask and sources", 13, PER_TEXEL, LIFE_RESIDENT,
@@ -147,9 +149,8 @@ lx_bake_texel_bytes lx_bake_texel_bytes_of(const lx_bake_desc *d, bool horizon,
     have |= (lx_bake_keeps_surfaces(d) || (scene_needs & LX_SCENE_NEEDS_EMISSIVE_TEXTURE))
                 ? WHEN_TEXEL_EMISSION
                 : 0;
-    have |= (d->denoise == LX_DENOISE_ALL || (d->denoise == LX_DENOISE_INDIRECT && gi))
-                ? WHEN_DENOISE
-                : 0;
+    /* indirect without bounces still filters a sampled direct part */
+    have |= d->denoise != LX_DENOISE_OFF ? WHEN_DENOISE : 0;
     have |= d->denoise == LX_DENOISE_INDIRECT ? WHEN_KEEP : 0;
     have |= d->padding > 0 ? WHEN_PADDING : 0;
     have |= d->directional != LX_DIRECTIONAL_OFF ? WHEN_DIRECTIONAL : 0;
@@ -454,6 +455,7 @@ void lx_bake_map_unload(lx_lightmap *map)
     map->baked = map->realtime = map->sh = NULL;
     map->gi_valid = NULL;
     map->gi_variance = NULL;
+    map->sampled = NULL;
     lx_texel_map_free(map);
     map->name = keep.name;
     map->info = keep.info;
@@ -463,6 +465,7 @@ void lx_bake_map_unload(lx_lightmap *map)
     map->sh = keep.sh;
     map->gi_valid = keep.gi_valid;
     map->gi_variance = keep.gi_variance;
+    map->sampled = keep.sampled;
     map->horizon_page = keep.horizon_page;
     map->loaded = false;
 }
@@ -497,6 +500,7 @@ static lx_status map_load(lx_baker *b, uint32_t m)
     free(fresh.sh);
     free(fresh.gi_valid);
     free(fresh.gi_variance);
+    free(fresh.sampled);
     fresh.name = map->name;
     fresh.info = map->info;
     fresh.mask = map->mask;
@@ -505,6 +509,7 @@ static lx_status map_load(lx_baker *b, uint32_t m)
     fresh.sh = map->sh;
     fresh.gi_valid = map->gi_valid;
     fresh.gi_variance = map->gi_variance;
+    fresh.sampled = map->sampled;
     fresh.horizon_page = map->horizon_page;
     fresh.loaded = true;
     *map = fresh;

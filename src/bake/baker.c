@@ -669,12 +669,15 @@ lx_status lx_baker_bake(lx_baker *b)
     }
     /* progress: the direct pass, then the indirect one's gathers (a
      * validity pass and a gather a bounce, each about as long) */
+    bool sampled = false;
+    lx_status st = lx_bake_sampled_begin(b, &sampled);
     bool denoise = b->desc.denoise == LX_DENOISE_ALL ||
-                   (b->desc.denoise == LX_DENOISE_INDIRECT && b->desc.bounces > 0);
+                   (b->desc.denoise == LX_DENOISE_INDIRECT && (b->desc.bounces > 0 || sampled));
     float end = denoise ? 0.9f : 1.0f; /* the last tenth denoises */
     float direct = b->desc.bounces > 0 ? end / (float)(b->desc.bounces + 2) : end;
     float **kept = NULL;
-    lx_status st = bake_direct(b, idx, n, 0.0f, direct);
+    if (st == LX_OK)
+        st = bake_direct(b, idx, n, 0.0f, direct);
     if (st == LX_OK)
         kept = lx_bake_denoise_keep(b, &st);
     if (st == LX_OK && b->desc.bounces > 0)
@@ -687,6 +690,7 @@ lx_status lx_baker_bake(lx_baker *b)
             st = lx_bake_denoise(b, kept, tf, tt - tf);
     }
     lx_bake_denoise_free(b, kept);
+    lx_bake_sampled_end(b);
     if (st != LX_OK)
         clear_buffers(b, false);
     free(idx);

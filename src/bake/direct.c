@@ -106,10 +106,11 @@ static uint64_t shadow_bit(uint32_t place)
 
 /* sh (NULL: no directional data) gets what accum gets, with its
  * direction (lx_sh4_add_lit_floor); shadows (NULL: none) each texel's
- * shadow record (shadow_bit of the hard-shadowed lights blocked there). */
+ * shadow record (shadow_bit of the hard-shadowed lights blocked there);
+ * sampled (NULL: not kept) what accum gets from soft shadows' samples. */
 static void light_tile(const lx_baker *b, uint32_t map_index, const lx_lightmap *map,
                        uint32_t first, uint32_t count, uint32_t light_index, lx_vec3 *accum,
-                       lx_sh4 *sh, uint64_t *shadows, uint64_t bit)
+                       lx_sh4 *sh, uint64_t *shadows, uint64_t bit, lx_vec3 *sampled)
 {
     const lx_light *light = &b->lights[light_index];
     const float floor_c = lx_light_is_area(light) ? 0.1f : 1e-3f; /* lx_sh4_add_lit_floor */
@@ -142,6 +143,8 @@ static void light_tile(const lx_baker *b, uint32_t map_index, const lx_lightmap 
         if (light->shadow == LX_SHADOW_SOFT) {
             float vis = soft_visibility(b, map_index, map, i, light_index, light);
             accum[k] = lx_add(accum[k], lx_scale(e.illuminance, vis));
+            if (sampled)
+                sampled[k] = lx_add(sampled[k], lx_scale(e.illuminance, vis));
             if (sh)
                 lx_sh4_add_lit_floor(&sh[k], lx_scale(e.illuminance, vis), nn, e.to_light, floor_c);
             continue;
@@ -280,14 +283,20 @@ static void vec3_to_acc(const lx_vec3 *accum, tile_soa *t)
 /* A tile's direct light, ambient, lights and (for the baked buffers) the
  * sky, into t->acc lane by lane, and with sh (TILE_TEXELS, by texel of
  * the tile) their directions; seed keys its random numbers (the map's
- * index, or a supersampling point's). */
+ * index, or a supersampling point's). sampled (NULL: not kept; by texel
+ * of the tile) gets the part of it estimated by sampling: soft shadows
+ * and the shadowed sky. */
 static void shade_tile(const lx_baker *b, uint32_t seed, const lx_lightmap *map, uint32_t first,
                        uint32_t count, const uint32_t *lights, uint32_t light_count,
                        const fast_light *fast, const bool *is_fast, lx_vec3 ambient,
-                       bool to_realtime, tile_soa *t, lx_sh4 *sh, uint64_t *shadows)
+                       bool to_realtime, tile_soa *t, lx_sh4 *sh, uint64_t *shadows,
+                       lx_vec3 *sampled)
 {
     lx_vec3 accum[TILE_TEXELS];
     tile_load(b, map, first, count, t);
+    if (sampled)
+        for (uint32_t k = 0; k < count; k++)
+            sampled[k] = lx_v3(0.0f, 0.0f, 0.0f);
     if (shadows)
         memset(shadows, 0, sizeof(uint64_t) * count);
     if (sh) {
@@ -318,16 +327,18 @@ static void shade_tile(const lx_baker *b, uint32_t seed, const lx_lightmap *map,
             continue;
         }
         acc_to_vec3(t, accum);
-        light_tile(b, seed, map, first, count, lights[l], accum, sh, shadows, shadow_bit(l));
+        light_tile(b, seed, map, first, count, lights[l], accum, sh, shadows, shadow_bit(l),
+                   sampled);
         vec3_to_acc(accum, t);
     }
-    if (!to_realtime && b->has_sky && !horizon) {
+    bool sampled_sky = sampled && b->sky_shadows;
+    if (!to_realtime && b->has_sky && !horizon && !sampled_sky) {
         acc_to_vec3(t, accum);
         lx_sky_tile(b, seed, map, first, count, accum, sh);
         vec3_to_acc(accum, t);
     } else if (!to_realtime && b->has_sky) {
         /* the sky alone, then added as lx_sky_tile adds it (times
-         * the AO under a height) */
+         * the AO under a height), and to sampled */
         lx_vec3 sky[TILE_TEXELS];
         lx_sh4 sky_sh[TILE_TEXELS];
         for (uint32_t k = 0; k < count; k++)
@@ -337,10 +348,14 @@ static void shade_tile(const lx_baker *b, uint32_t seed, const lx_lightmap *map,
         lx_sky_tile(b, seed, map, first, count, sky, sh ? sky_sh : NULL);
         acc_to_vec3(t, accum);
         for (uint32_t k = 0; k < count; k++) {
-            const lx_texel_horizon *h = &map->horizon[first + k];
-            accum[k] = lx_add(accum[k], h->flags ? lx_scale(sky[k], h->ao) : sky[k]);
+            const lx_texel_horizon *h =
+                map->horizon && map->horizon[first + k].flags ? &map->horizon[first + k] : NULL;
+            lx_vec3 add = h ? lx_scale(sky[k], h->ao) : sky[k];
+            accum[k] = lx_add(accum[k], add);
+            if (sampled_sky)
+                sampled[k] = lx_add(sampled[k], add);
             if (sh) {
-                if (h->flags)
+                if (h)
                     lx_sh4_scale(&sky_sh[k], h->ao);
                 for (int c = 0; c < LX_SH_FLOATS; c++)
                     sh[k].c[c] += sky_sh[k].c[c];
@@ -358,13 +373,15 @@ static void shade_tile(const lx_baker *b, uint32_t seed, const lx_lightmap *map,
 static void shade_supersampled(const lx_baker *b, uint32_t map_index, const lx_lightmap *map,
                                uint32_t first, uint32_t count, const uint32_t *lights,
                                uint32_t light_count, const fast_light *fast, const bool *is_fast,
-                               lx_vec3 ambient, tile_soa *t, lx_sh4 *sh)
+                               lx_vec3 ambient, tile_soa *t, lx_sh4 *sh, lx_vec3 *sampled)
 {
-    double sum[TILE_TEXELS][3], sh_sum[TILE_TEXELS][LX_SH_FLOATS];
+    double sum[TILE_TEXELS][3], sh_sum[TILE_TEXELS][LX_SH_FLOATS], sampled_sum[TILE_TEXELS][3];
     uint32_t covered[TILE_TEXELS];
     lx_sh4 point_sh[TILE_TEXELS];
+    lx_vec3 point_sampled[TILE_TEXELS];
     memset(sum, 0, sizeof sum);
     memset(sh_sum, 0, sizeof sh_sum);
+    memset(sampled_sum, 0, sizeof sampled_sum);
     memset(covered, 0, sizeof covered);
     size_t used = map->info.used_texels;
     for (uint32_t s = 0; s < map->sub_count; s++) {
@@ -379,13 +396,19 @@ static void shade_supersampled(const lx_baker *b, uint32_t map_index, const lx_l
         if (!any)
             continue;
         shade_tile(b, map_index ^ (s << 16), &view, first, count, lights, light_count, fast,
-                   is_fast, ambient, false, t, sh ? point_sh : NULL, NULL);
+                   is_fast, ambient, false, t, sh ? point_sh : NULL, NULL,
+                   sampled ? point_sampled : NULL);
         for (int k = 0; k < TILE_TEXELS; k++) {
             int32_t j = t->texel[k];
             if (j < 0 || !on[j])
                 continue;
             for (int c = 0; c < 3; c++)
                 sum[j][c] += (double)t->acc[c][k];
+            if (sampled) {
+                sampled_sum[j][0] += (double)point_sampled[j].x;
+                sampled_sum[j][1] += (double)point_sampled[j].y;
+                sampled_sum[j][2] += (double)point_sampled[j].z;
+            }
             for (int c = 0; sh && c < LX_SH_FLOATS; c++)
                 sh_sum[j][c] += (double)point_sh[j].c[c];
             covered[j]++;
@@ -396,13 +419,17 @@ static void shade_supersampled(const lx_baker *b, uint32_t map_index, const lx_l
         missing |= covered[j] == 0;
     if (missing)
         shade_tile(b, map_index, map, first, count, lights, light_count, fast, is_fast, ambient,
-                   false, t, sh, NULL);
+                   false, t, sh, NULL, sampled);
     for (int k = 0; k < TILE_TEXELS; k++) {
         int32_t j = t->texel[k];
         if (j < 0 || covered[j] == 0)
             continue;
         for (int c = 0; c < 3; c++)
             t->acc[c][k] = (float)(sum[j][c] / (double)covered[j]);
+        if (sampled)
+            sampled[j] = lx_v3((float)(sampled_sum[j][0] / (double)covered[j]),
+                               (float)(sampled_sum[j][1] / (double)covered[j]),
+                               (float)(sampled_sum[j][2] / (double)covered[j]));
         for (int c = 0; sh && c < LX_SH_FLOATS; c++)
             sh[j].c[c] = (float)(sh_sum[j][c] / (double)covered[j]);
     }
@@ -559,7 +586,7 @@ static void edge_light(const lx_baker *b, uint32_t m, const edge_set *e, uint32_
                          ? map->world_position[e->orig[which[q]]]
                          : e->at[(size_t)s * e->marked + which[q]];
         shade_tile(b, m, &view, 0, k, &lights[place], 1, &fast[place], &is_fast[place], none,
-                   true, &t, sh, NULL);
+                   true, &t, sh, NULL, NULL);
         for (int lane = 0; lane < TILE_TEXELS; lane++) {
             int32_t q = t.texel[lane];
             if (q < 0 || (s >= 0 && hidden[which[q]]))
@@ -734,12 +761,15 @@ lx_status lx_bake_lights(lx_baker *b, const uint32_t *lights, uint32_t light_cou
             tile_soa t;
             lx_sh4 shs[TILE_TEXELS];
             lx_sh4 *sh = directional ? shs : NULL;
+            lx_vec3 sampled_buf[TILE_TEXELS];
+            lx_vec3 *sampled = !to_realtime && map->sampled ? sampled_buf : NULL;
             if (map->sub_count > 1 && !to_realtime)
                 shade_supersampled(b, m, map, first, count, lights, light_count, fast, is_fast,
-                                   ambient, &t, sh);
+                                   ambient, &t, sh, sampled);
             else
                 shade_tile(b, m, map, first, count, lights, light_count, fast, is_fast, ambient,
-                           to_realtime, &t, sh, records && records[m] ? records[m] + first : NULL);
+                           to_realtime, &t, sh, records && records[m] ? records[m] + first : NULL,
+                           sampled);
             /* every texel belongs to one tile: plain stores, no clearing */
             for (int k = 0; k < TILE_TEXELS; k++) {
                 if (t.texel[k] < 0)
@@ -748,6 +778,8 @@ lx_status lx_bake_lights(lx_baker *b, const uint32_t *lights, uint32_t light_cou
                 px[0] = t.acc[0][k];
                 px[1] = t.acc[1][k];
                 px[2] = t.acc[2][k];
+                if (sampled) /* the emitters add theirs after */
+                    memcpy(map->sampled + (px - target), &sampled[t.texel[k]], sizeof(lx_vec3));
                 if (sh)
                     memcpy(map->sh + (size_t)map->texels[first + (uint32_t)t.texel[k]].pixel *
                                          LX_SH_FLOATS,

@@ -446,6 +446,10 @@ lx_status lx_bake_emitters(lx_baker *b, const lx_emitter_set *set, float progres
             size_t pixel = map->texels[i].pixel;
             float *px = map->baked + 3 * pixel;
             px[0] += e.x, px[1] += e.y, px[2] += e.z;
+            if (map->sampled) { /* sampled light: the denoiser's (bake_denoise.c) */
+                float *ps = map->sampled + 3 * pixel;
+                ps[0] += e.x, ps[1] += e.y, ps[2] += e.z;
+            }
             if (map->sh) {
                 /* as an area light's: its irradiance from its mean direction */
                 lx_sh4 add = {{0}};

@@ -1227,6 +1227,7 @@ void lx_texel_map_free(lx_lightmap *map)
     free(map->sh);
     free(map->gi_valid);
     free(map->gi_variance);
+    free(map->sampled);
     lx_seam_stitch_free(map->stitch);
     free(map->sub_position);
     free(map->sub_normal);

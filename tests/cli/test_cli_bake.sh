@@ -380,6 +380,12 @@ run "$LUXEL" bake "$RETRO" --texel-density 4 --format pfm -q -o "$WORK/sky1" --l
 expect_rc 0 "bake with a sky from the lights JSON"
 check "sky bake: manifest names the environment" grep -q '"environment":.*skycfg/hdri/sky.pfm' "$WORK/sky1/manifest.json"
 check "sky bake: the same bytes as the sky outside" cmp -s "$WORK/sky0/ground.pfm" "$WORK/sky1/ground.pfm"
+# the lights JSON named from its own folder: the manifest still finds the
+# sky from anywhere (an absolute path), so a render elsewhere has its sky
+(cd "$WORK/skycfg" && "$LUXEL" bake "$RETRO" --texel-density 4 --format pfm -q -o "$WORK/sky1r" \
+    --lights day.json) >/dev/null 2>&1
+check "sky bake from the JSON's folder: the manifest's sky is absolute" \
+    grep -q "\"environment\":[[:space:]]*\"$WORK/skycfg/hdri/sky.pfm\"" "$WORK/sky1r/manifest.json"
 sky_block=$(grep -A4 '"sky"' "$WORK/sky1/manifest.json")
 check "sky bake: manifest says shadows" grep -q '"shadows":.*true' <<<"$sky_block"
 check "sky bake: manifest says 16 samples" grep -q '"samples":.*16' <<<"$sky_block"

@@ -1,13 +1,14 @@
 /* luxel bake: lightmaps for every node of a scene, with previews and a
  * manifest. Everything is computed before the first file is written; if a
  * write fails or the run is interrupted, this run's files are removed. */
-#define _POSIX_C_SOURCE 200809L
+#define _XOPEN_SOURCE 700 /* realpath */
 #include "bake_names.h"
 #include "cli.h"
 
 #include <cjson/cJSON.h>
 #include <getopt.h>
 #include <stdio.h>
+#include <limits.h>
 #include <stdlib.h>
 #include <string.h>
 #include <strings.h>
@@ -651,7 +652,12 @@ int cmd_bake(int argc, char **argv)
     cJSON_AddNumberToObject(manifest, "pre_exposure", a.pre_expose ? pre_exposure : 1.0);
     if (sky.environment) {
         cJSON *sk = cJSON_AddObjectToObject(manifest, "sky");
-        cJSON_AddStringToObject(sk, "environment", sky.environment);
+        /* absolute, so `luxel render` finds it from any directory (the
+         * lights JSON's path was relative to where the bake ran) */
+        char where[PATH_MAX];
+        bool file = strncmp(sky.environment, "const:", 6) != 0;
+        cJSON_AddStringToObject(sk, "environment",
+                                file && realpath(sky.environment, where) ? where : sky.environment);
         cJSON_AddNumberToObject(sk, "intensity", a.desc.sky.intensity);
         cJSON_AddBoolToObject(sk, "shadows", sky.shadows);
         if (sky.shadows)
