@@ -128,6 +128,12 @@ static inline double lx_luminance(const float rgb[3])
     return 0.2126 * (double)rgb[0] + 0.7152 * (double)rgb[1] + 0.0722 * (double)rgb[2];
 }
 
+/* lx_luminance of a vector's three components as R, G, B. */
+static inline double lx_luminance3(lx_vec3 v)
+{
+    return 0.2126 * (double)v.x + 0.7152 * (double)v.y + 0.0722 * (double)v.z;
+}
+
 /* Any unit vector perpendicular to n (n must be unit length). */
 static inline lx_vec3 lx_perpendicular(lx_vec3 n)
 {

@@ -25,7 +25,9 @@ lx_status lx_bake_sampled_begin(lx_baker *b, bool *made)
     for (uint32_t m = 0; m < b->map_count; m++) {
         lx_lightmap *map = &b->maps[m];
         size_t n = (size_t)map->info.width * map->info.height * 3;
-        if (!(map->sampled = calloc(n ? n : 1, sizeof(float)))) {
+        map->sampled = calloc(n ? n : 1, sizeof(float));
+        map->sampled_variance = calloc(n / 3 ? n / 3 : 1, sizeof(float));
+        if (!map->sampled || !map->sampled_variance) {
             lx_bake_sampled_end(b);
             return lx_fail(LX_ERR_NOMEM, "lightmap '%s': out of memory keeping its sampled "
                                          "direct light for denoising",
@@ -40,7 +42,9 @@ void lx_bake_sampled_end(lx_baker *b)
 {
     for (uint32_t m = 0; m < b->map_count; m++) {
         free(b->maps[m].sampled);
+        free(b->maps[m].sampled_variance);
         b->maps[m].sampled = NULL;
+        b->maps[m].sampled_variance = NULL;
     }
 }
 
@@ -147,8 +151,9 @@ static lx_status denoise_sh(const lx_baker *b, lx_lightmap *map, const lx_denois
 
 /* The sampled direct light of map m (--denoise indirect), filtered apart
  * and added back: baked = exact + F(sampled) (+ the bounces, already
- * filtered), with the variance the filter estimates from the sampled
- * part itself: the exact lights' edges never enter it. */
+ * filtered), guided by its samples' own variance: the exact lights'
+ * edges never enter it, and real gradients (a box's foot in the sky's
+ * shadow) are not taken for noise. */
 static lx_status denoise_sampled(lx_lightmap *map, lx_denoise_guides *g, bool bounces_done,
                                  const lx_denoise_desc *dd)
 {
@@ -157,7 +162,7 @@ static lx_status denoise_sampled(lx_lightmap *map, lx_denoise_guides *g, bool bo
     for (size_t i = 0; !bounces_done && i < n; i++)
         map->baked[i] -= map->sampled[i];
     const float *variance = g->variance;
-    g->variance = NULL;
+    g->variance = map->sampled_variance;
     lx_status st = lx_denoise(g, map->sampled, map->sampled, dd);
     g->variance = variance;
     for (size_t i = 0; i < n; i++) /* on failure: the sampled part as it was */

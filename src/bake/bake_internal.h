@@ -221,6 +221,9 @@ typedef struct lx_lightmap {
                        shadows, emitters), denoised apart under
                        --denoise indirect (lx_bake_sampled_begin); made
                        and freed by each such bake, else NULL; resident */
+    float *sampled_variance; /* width * height: the variance of sampled's
+                                luminance estimate (its samples' spread),
+                                the denoiser's guide; with sampled */
     uint8_t *gi_valid; /* width * height, after a bake with bounces in which
                           a texel lay inside geometry (else NULL): 0 at
                           those texels, left out of the denoiser; resident */
@@ -493,10 +496,11 @@ void lx_sky_peak_sh(const lx_baker *b, lx_vec3 p, uint32_t seed, uint32_t index,
  * when sky->environment is NULL (sky.c). */
 lx_status lx_sky_prepare(lx_baker *b, const lx_sky_desc *sky);
 void lx_sky_free(lx_baker *b);
-/* Adds the sky's irradiance to accum for count texels from first, and
- * its directional data to sh (NULL: none). */
+/* Adds the sky's irradiance to accum for count texels from first, its
+ * directional data to sh (NULL: none), and the variance of its
+ * luminance's estimate to variance (NULL: not asked; 0 unshadowed). */
 void lx_sky_tile(const lx_baker *b, uint32_t map_index, const lx_lightmap *map, uint32_t first,
-                 uint32_t count, lx_vec3 *accum, lx_sh4 *sh);
+                 uint32_t count, lx_vec3 *accum, lx_sh4 *sh, float *variance);
 
 /* A mesh of a page for stitch.c: its lightmap UV set and the scale and
  * offset that take it into the page. */

@@ -87,7 +87,8 @@ static const texel_buffer texel_buffers[] = {
      WHEN_GI},
     {"emitters: textured emission", 12, PER_TEXEL, LIFE_RESIDENT, WHEN_EMISSIVE_TEXTURE},
     {"denoising: the direct light kept", 12, PER_TEXEL, LIFE_RESIDENT, WHEN_GI | WHEN_KEEP},
-    {"denoising: the sampled direct light (shadowed sky, soft shadows, emitters)", 12,
+    {"denoising: the sampled direct light (shadowed sky, soft shadows, emitters) and its "
+     "variance", 16,
      PER_TEXEL, LIFE_RESIDENT, WHEN_KEEP},
     {"denoising: the direct directional data kept", 48, PER_TEXEL, LIFE_RESIDENT,
      WHEN_GI | WHEN_KEEP | WHEN_DIRECTIONAL},
@@ -456,6 +457,7 @@ void lx_bake_map_unload(lx_lightmap *map)
     map->gi_valid = NULL;
     map->gi_variance = NULL;
     map->sampled = NULL;
+    map->sampled_variance = NULL;
     lx_texel_map_free(map);
     map->name = keep.name;
     map->info = keep.info;
@@ -466,6 +468,7 @@ void lx_bake_map_unload(lx_lightmap *map)
     map->gi_valid = keep.gi_valid;
     map->gi_variance = keep.gi_variance;
     map->sampled = keep.sampled;
+    map->sampled_variance = keep.sampled_variance;
     map->horizon_page = keep.horizon_page;
     map->loaded = false;
 }
@@ -501,6 +504,7 @@ static lx_status map_load(lx_baker *b, uint32_t m)
     free(fresh.gi_valid);
     free(fresh.gi_variance);
     free(fresh.sampled);
+    free(fresh.sampled_variance);
     fresh.name = map->name;
     fresh.info = map->info;
     fresh.mask = map->mask;
@@ -510,6 +514,7 @@ static lx_status map_load(lx_baker *b, uint32_t m)
     fresh.gi_valid = map->gi_valid;
     fresh.gi_variance = map->gi_variance;
     fresh.sampled = map->sampled;
+    fresh.sampled_variance = map->sampled_variance;
     fresh.horizon_page = map->horizon_page;
     fresh.loaded = true;
     *map = fresh;

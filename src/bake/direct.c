@@ -43,7 +43,8 @@ lx_ray lx_shadow_ray(const lx_baker *b, lx_vec3 p, lx_vec3 ng, const lx_light_ev
  * contributes (cos at the texel x cos at the light / d^2): unoccluded, the
  * result is exactly the closed form. */
 static float soft_visibility(const lx_baker *b, uint32_t map_index, const lx_lightmap *map,
-                             uint32_t texel, uint32_t light_index, const lx_light *light)
+                             uint32_t texel, uint32_t light_index, const lx_light *light,
+                             float *variance)
 {
     uint32_t want = lx_light_sample_count(light);
     uint32_t sx = (uint32_t)sqrtf((float)want);
@@ -56,7 +57,7 @@ static float soft_visibility(const lx_baker *b, uint32_t map_index, const lx_lig
     lx_ray rays[BATCH];
     float weight[BATCH];
     uint8_t occluded[BATCH];
-    double total = 0.0, visible = 0.0;
+    double total = 0.0, visible = 0.0, squares = 0.0, visible_squares = 0.0;
     uint32_t k = 0, cells = sx * sy;
     while (k < cells) {
         uint32_t m = 0;
@@ -86,11 +87,23 @@ static float soft_visibility(const lx_baker *b, uint32_t map_index, const lx_lig
         lx_tracer_occluded_batch(b->tracer, rays, m, true, occluded);
         for (uint32_t j = 0; j < m; j++) {
             total += weight[j];
-            if (!occluded[j])
+            squares += (double)weight[j] * weight[j];
+            if (!occluded[j]) {
                 visible += weight[j];
+                visible_squares += (double)weight[j] * weight[j];
+            }
         }
     }
-    return total > 0.0 ? (float)(visible / total) : 0.0f;
+    if (!(total > 0.0)) {
+        *variance = 0.0f;
+        return 0.0f;
+    }
+    /* the self-normalized mean's variance, sum (w_j / W)^2 (v_j - vis)^2 */
+    double vis = visible / total;
+    double spread = visible_squares * (1.0 - vis) * (1.0 - vis) +
+                    (squares - visible_squares) * vis * vis;
+    *variance = (float)(spread / (total * total));
+    return (float)vis;
 }
 
 /* What a light adds to a texel's shadow record when it is blocked there
@@ -104,13 +117,20 @@ static uint64_t shadow_bit(uint32_t place)
     return (uint64_t)1 << (place & 63u);
 }
 
+/* The part of a texel's direct light estimated by sampling, and the
+ * variance of its luminance's estimate. */
+typedef struct sampled_light {
+    lx_vec3 e;
+    float variance;
+} sampled_light;
+
 /* sh (NULL: no directional data) gets what accum gets, with its
  * direction (lx_sh4_add_lit_floor); shadows (NULL: none) each texel's
  * shadow record (shadow_bit of the hard-shadowed lights blocked there);
  * sampled (NULL: not kept) what accum gets from soft shadows' samples. */
 static void light_tile(const lx_baker *b, uint32_t map_index, const lx_lightmap *map,
                        uint32_t first, uint32_t count, uint32_t light_index, lx_vec3 *accum,
-                       lx_sh4 *sh, uint64_t *shadows, uint64_t bit, lx_vec3 *sampled)
+                       lx_sh4 *sh, uint64_t *shadows, uint64_t bit, sampled_light *sampled)
 {
     const lx_light *light = &b->lights[light_index];
     const float floor_c = lx_light_is_area(light) ? 0.1f : 1e-3f; /* lx_sh4_add_lit_floor */
@@ -141,10 +161,14 @@ static void light_tile(const lx_baker *b, uint32_t map_index, const lx_lightmap 
             continue;
         }
         if (light->shadow == LX_SHADOW_SOFT) {
-            float vis = soft_visibility(b, map_index, map, i, light_index, light);
+            float var;
+            float vis = soft_visibility(b, map_index, map, i, light_index, light, &var);
             accum[k] = lx_add(accum[k], lx_scale(e.illuminance, vis));
-            if (sampled)
-                sampled[k] = lx_add(sampled[k], lx_scale(e.illuminance, vis));
+            if (sampled) {
+                float y = (float)lx_luminance3(e.illuminance);
+                sampled[k].e = lx_add(sampled[k].e, lx_scale(e.illuminance, vis));
+                sampled[k].variance += y * y * var;
+            }
             if (sh)
                 lx_sh4_add_lit_floor(&sh[k], lx_scale(e.illuminance, vis), nn, e.to_light, floor_c);
             continue;
@@ -290,13 +314,12 @@ static void shade_tile(const lx_baker *b, uint32_t seed, const lx_lightmap *map,
                        uint32_t count, const uint32_t *lights, uint32_t light_count,
                        const fast_light *fast, const bool *is_fast, lx_vec3 ambient,
                        bool to_realtime, tile_soa *t, lx_sh4 *sh, uint64_t *shadows,
-                       lx_vec3 *sampled)
+                       sampled_light *sampled)
 {
     lx_vec3 accum[TILE_TEXELS];
     tile_load(b, map, first, count, t);
     if (sampled)
-        for (uint32_t k = 0; k < count; k++)
-            sampled[k] = lx_v3(0.0f, 0.0f, 0.0f);
+        memset(sampled, 0, sizeof(sampled_light) * count);
     if (shadows)
         memset(shadows, 0, sizeof(uint64_t) * count);
     if (sh) {
@@ -334,26 +357,30 @@ static void shade_tile(const lx_baker *b, uint32_t seed, const lx_lightmap *map,
     bool sampled_sky = sampled && b->sky_shadows;
     if (!to_realtime && b->has_sky && !horizon && !sampled_sky) {
         acc_to_vec3(t, accum);
-        lx_sky_tile(b, seed, map, first, count, accum, sh);
+        lx_sky_tile(b, seed, map, first, count, accum, sh, NULL);
         vec3_to_acc(accum, t);
     } else if (!to_realtime && b->has_sky) {
         /* the sky alone, then added as lx_sky_tile adds it (times
          * the AO under a height), and to sampled */
         lx_vec3 sky[TILE_TEXELS];
         lx_sh4 sky_sh[TILE_TEXELS];
+        float sky_var[TILE_TEXELS];
         for (uint32_t k = 0; k < count; k++)
-            sky[k] = lx_v3(0.0f, 0.0f, 0.0f);
+            sky[k] = lx_v3(0.0f, 0.0f, 0.0f), sky_var[k] = 0.0f;
         if (sh)
             memset(sky_sh, 0, sizeof sky_sh);
-        lx_sky_tile(b, seed, map, first, count, sky, sh ? sky_sh : NULL);
+        lx_sky_tile(b, seed, map, first, count, sky, sh ? sky_sh : NULL, sky_var);
         acc_to_vec3(t, accum);
         for (uint32_t k = 0; k < count; k++) {
             const lx_texel_horizon *h =
                 map->horizon && map->horizon[first + k].flags ? &map->horizon[first + k] : NULL;
             lx_vec3 add = h ? lx_scale(sky[k], h->ao) : sky[k];
             accum[k] = lx_add(accum[k], add);
-            if (sampled_sky)
-                sampled[k] = lx_add(sampled[k], add);
+            if (sampled_sky) {
+                float ao = h ? h->ao : 1.0f;
+                sampled[k].e = lx_add(sampled[k].e, add);
+                sampled[k].variance += ao * ao * sky_var[k];
+            }
             if (sh) {
                 if (h)
                     lx_sh4_scale(&sky_sh[k], h->ao);
@@ -373,12 +400,12 @@ static void shade_tile(const lx_baker *b, uint32_t seed, const lx_lightmap *map,
 static void shade_supersampled(const lx_baker *b, uint32_t map_index, const lx_lightmap *map,
                                uint32_t first, uint32_t count, const uint32_t *lights,
                                uint32_t light_count, const fast_light *fast, const bool *is_fast,
-                               lx_vec3 ambient, tile_soa *t, lx_sh4 *sh, lx_vec3 *sampled)
+                               lx_vec3 ambient, tile_soa *t, lx_sh4 *sh, sampled_light *sampled)
 {
-    double sum[TILE_TEXELS][3], sh_sum[TILE_TEXELS][LX_SH_FLOATS], sampled_sum[TILE_TEXELS][3];
+    double sum[TILE_TEXELS][3], sh_sum[TILE_TEXELS][LX_SH_FLOATS], sampled_sum[TILE_TEXELS][4];
     uint32_t covered[TILE_TEXELS];
     lx_sh4 point_sh[TILE_TEXELS];
-    lx_vec3 point_sampled[TILE_TEXELS];
+    sampled_light point_sampled[TILE_TEXELS];
     memset(sum, 0, sizeof sum);
     memset(sh_sum, 0, sizeof sh_sum);
     memset(sampled_sum, 0, sizeof sampled_sum);
@@ -405,9 +432,10 @@ static void shade_supersampled(const lx_baker *b, uint32_t map_index, const lx_l
             for (int c = 0; c < 3; c++)
                 sum[j][c] += (double)t->acc[c][k];
             if (sampled) {
-                sampled_sum[j][0] += (double)point_sampled[j].x;
-                sampled_sum[j][1] += (double)point_sampled[j].y;
-                sampled_sum[j][2] += (double)point_sampled[j].z;
+                sampled_sum[j][0] += (double)point_sampled[j].e.x;
+                sampled_sum[j][1] += (double)point_sampled[j].e.y;
+                sampled_sum[j][2] += (double)point_sampled[j].e.z;
+                sampled_sum[j][3] += (double)point_sampled[j].variance;
             }
             for (int c = 0; sh && c < LX_SH_FLOATS; c++)
                 sh_sum[j][c] += (double)point_sh[j].c[c];
@@ -426,10 +454,12 @@ static void shade_supersampled(const lx_baker *b, uint32_t map_index, const lx_l
             continue;
         for (int c = 0; c < 3; c++)
             t->acc[c][k] = (float)(sum[j][c] / (double)covered[j]);
-        if (sampled)
-            sampled[j] = lx_v3((float)(sampled_sum[j][0] / (double)covered[j]),
-                               (float)(sampled_sum[j][1] / (double)covered[j]),
-                               (float)(sampled_sum[j][2] / (double)covered[j]));
+        if (sampled) { /* the mean of the points, their variances over covered^2 */
+            double c = (double)covered[j];
+            sampled[j].e = lx_v3((float)(sampled_sum[j][0] / c), (float)(sampled_sum[j][1] / c),
+                                 (float)(sampled_sum[j][2] / c));
+            sampled[j].variance = (float)(sampled_sum[j][3] / (c * c));
+        }
         for (int c = 0; sh && c < LX_SH_FLOATS; c++)
             sh[j].c[c] = (float)(sh_sum[j][c] / (double)covered[j]);
     }
@@ -761,8 +791,8 @@ lx_status lx_bake_lights(lx_baker *b, const uint32_t *lights, uint32_t light_cou
             tile_soa t;
             lx_sh4 shs[TILE_TEXELS];
             lx_sh4 *sh = directional ? shs : NULL;
-            lx_vec3 sampled_buf[TILE_TEXELS];
-            lx_vec3 *sampled = !to_realtime && map->sampled ? sampled_buf : NULL;
+            sampled_light sampled_buf[TILE_TEXELS];
+            sampled_light *sampled = !to_realtime && map->sampled ? sampled_buf : NULL;
             if (map->sub_count > 1 && !to_realtime)
                 shade_supersampled(b, m, map, first, count, lights, light_count, fast, is_fast,
                                    ambient, &t, sh, sampled);
@@ -778,8 +808,12 @@ lx_status lx_bake_lights(lx_baker *b, const uint32_t *lights, uint32_t light_cou
                 px[0] = t.acc[0][k];
                 px[1] = t.acc[1][k];
                 px[2] = t.acc[2][k];
-                if (sampled) /* the emitters add theirs after */
-                    memcpy(map->sampled + (px - target), &sampled[t.texel[k]], sizeof(lx_vec3));
+                if (sampled) { /* the emitters add theirs after */
+                    const sampled_light *sl = &sampled[t.texel[k]];
+                    size_t pixel = (size_t)(px - target) / 3;
+                    memcpy(map->sampled + 3 * pixel, &sl->e, sizeof(lx_vec3));
+                    map->sampled_variance[pixel] = sl->variance;
+                }
                 if (sh)
                     memcpy(map->sh + (size_t)map->texels[first + (uint32_t)t.texel[k]].pixel *
                                          LX_SH_FLOATS,

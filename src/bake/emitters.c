@@ -284,8 +284,10 @@ static void shuffle(uint8_t *order, uint32_t n, uint32_t map_index, uint32_t pix
 
 /* The emitters' irradiance at texel i of map. */
 static lx_vec3 texel_emitters(const lx_baker *b, const emitter_set *set, uint32_t map_index,
-                              const lx_lightmap *map, uint32_t i, lx_vec3 *towards)
+                              const lx_lightmap *map, uint32_t i, lx_vec3 *towards,
+                              float *variance)
 {
+    double lum_sum = 0.0, lum_squares = 0.0; /* the samples' luminance */
     lx_vec3 p = map->world_position[i], n = map->world_normal[i];
     lx_vec3 ng = map->world_geometric_normal[i];
     uint32_t pixel = map->texels[i].pixel;
@@ -377,6 +379,8 @@ static lx_vec3 texel_emitters(const lx_baker *b, const emitter_set *set, uint32_
         for (uint32_t j = 0; j < m; j++) {
             lx_vec3 c = occluded[j] ? off[j] : on[j];
             sum[0] += c.x, sum[1] += c.y, sum[2] += c.z;
+            double y = lx_luminance3(c);
+            lum_sum += y, lum_squares += y * y;
             if (!set->exact && !occluded[j])
                 dir[0] += ways[j].x, dir[1] += ways[j].y, dir[2] += ways[j].z;
         }
@@ -386,6 +390,9 @@ static lx_vec3 texel_emitters(const lx_baker *b, const emitter_set *set, uint32_
                                  (float)(dir[2] / len))
                          : n;
     double inv = 1.0 / (double)cells;
+    /* the mean of `cells` samples (skipped cells are zeros) */
+    double spread = cells > 1 ? (lum_squares - lum_sum * lum_sum * inv) / (double)(cells - 1) : 0.0;
+    *variance = spread > 0.0 ? (float)(spread * inv) : 0.0f;
     return lx_v3((float)fmax(exact[0] + sum[0] * inv, 0.0), (float)fmax(exact[1] + sum[1] * inv, 0.0),
                  (float)fmax(exact[2] + sum[2] * inv, 0.0));
 }
@@ -442,13 +449,15 @@ lx_status lx_bake_emitters(lx_baker *b, const lx_emitter_set *set, float progres
         lx_lightmap *map = &b->maps[m];
         for (uint32_t i = first; i < first + count; i++) {
             lx_vec3 towards;
-            lx_vec3 e = texel_emitters(b, set, m, map, i, &towards);
+            float variance;
+            lx_vec3 e = texel_emitters(b, set, m, map, i, &towards, &variance);
             size_t pixel = map->texels[i].pixel;
             float *px = map->baked + 3 * pixel;
             px[0] += e.x, px[1] += e.y, px[2] += e.z;
             if (map->sampled) { /* sampled light: the denoiser's (bake_denoise.c) */
                 float *ps = map->sampled + 3 * pixel;
                 ps[0] += e.x, ps[1] += e.y, ps[2] += e.z;
+                map->sampled_variance[pixel] += variance;
             }
             if (map->sh) {
                 /* as an area light's: its irradiance from its mean direction */

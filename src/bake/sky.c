@@ -251,7 +251,7 @@ lx_vec3 lx_cosine_direction(lx_vec3 t, lx_vec3 bt, lx_vec3 n, uint32_t map, uint
  * the weights of those that escape to sum; with shs, also w x (Y00 shw,
  * Y1 shv) to shs (4 x RGB). */
 static void cast(const lx_baker *b, lx_ray *rays, const lx_vec3 *w, uint32_t m, double sum[3],
-                 const float *shw, const lx_vec3 *shv, double *shs)
+                 double *squares, const float *shw, const lx_vec3 *shv, double *shs)
 {
     uint8_t occluded[64];
     lx_tracer_occluded_batch(b->tracer, rays, m, false, occluded);
@@ -260,6 +260,8 @@ static void cast(const lx_baker *b, lx_ray *rays, const lx_vec3 *w, uint32_t m, 
             sum[0] += w[j].x;
             sum[1] += w[j].y;
             sum[2] += w[j].z;
+            double lum = lx_luminance3(w[j]);
+            *squares += lum * lum;
             if (!shs)
                 continue;
             lx_vec3 v = shv[j];
@@ -273,12 +275,23 @@ static void cast(const lx_baker *b, lx_ray *rays, const lx_vec3 *w, uint32_t m, 
         }
 }
 
+/* The variance of a mean of n samples whose values (luminance) sum to
+ * sum with squares summing to squares, times scale^2 (the estimate is
+ * scale x the sum). Stratification makes the real variance smaller. */
+static double mean_variance(double sum, double squares, uint32_t n, double scale)
+{
+    if (n < 2)
+        return 0.0;
+    double spread = (squares - sum * sum / (double)n) / (double)(n - 1);
+    return spread > 0.0 ? scale * scale * (double)n * spread : 0.0;
+}
+
 /* Sky visibility of one texel (see the top of this file). Samples are
  * stratified and jittered by map, texel and sample, so any thread count
  * gives the same rays; directions below the geometric surface are blocked
- * by it. */
+ * by it. *variance: the estimate's (its luminance's). */
 static lx_vec3 sky_visible(const lx_baker *b, uint32_t map_index, const lx_lightmap *map,
-                           uint32_t texel, lx_sh4 *sh)
+                           uint32_t texel, lx_sh4 *sh, double *variance)
 {
     const lx_cubemap *lookup = &b->sky_lookup;
     int n = lookup->size;
@@ -299,7 +312,7 @@ static lx_vec3 sky_visible(const lx_baker *b, uint32_t map_index, const lx_light
     uint32_t want = b->sky_samples, sx, sy;
     lx_cosine_strata(want, &sx, &sy);
     uint32_t cells = sx * sy;
-    double sum[3] = {0.0, 0.0, 0.0};
+    double sum[3] = {0.0, 0.0, 0.0}, squares = 0.0;
     uint32_t m = 0;
     for (uint32_t k = 0; k < cells; k++) {
         lx_vec3 d = lx_cosine_direction(t, bt, nrm, map_index, pixel, k, sx, sy, key);
@@ -315,17 +328,18 @@ static lx_vec3 sky_visible(const lx_baker *b, uint32_t map_index, const lx_light
         shv[m] = lx_scale(shv[m], 1.0f / LX_PI);
         w[m++] = lx_v3(l[0], l[1], l[2]);
         if (m == BATCH) {
-            cast(b, rays, w, m, sum, shw, shv, sh ? shs_base : NULL);
+            cast(b, rays, w, m, sum, &squares, shw, shv, sh ? shs_base : NULL);
             m = 0;
         }
     }
     if (m)
-        cast(b, rays, w, m, sum, shw, shv, sh ? shs_base : NULL);
+        cast(b, rays, w, m, sum, &squares, shw, shv, sh ? shs_base : NULL);
     double scale = LX_PI / (double)cells;
     if (sh)
         for (int c = 0; c < LX_SH_FLOATS; c++)
             sh->c[c] += (float)(shs_base[c] * scale);
     result = lx_v3((float)(sum[0] * scale), (float)(sum[1] * scale), (float)(sum[2] * scale));
+    *variance = mean_variance(lx_luminance3(result) / scale, squares, cells, scale);
     if (!b->sky_peak)
         return result;
     /* the peak's rays: pdf luminance x solid angle / P, so L Y / pdf is
@@ -337,7 +351,7 @@ static lx_vec3 sky_visible(const lx_baker *b, uint32_t map_index, const lx_light
     double total = b->sky_peak_cdf[texels];
     float ox = lx_random(map_index, pixel, 0, key + 3),
           oy = lx_random(map_index, pixel, 0, key + 4);
-    sum[0] = sum[1] = sum[2] = 0.0;
+    sum[0] = sum[1] = sum[2] = squares = 0.0;
     m = 0;
     for (uint32_t k = 0; k < peaks; k++) {
         double u = ((double)k + lx_random(map_index, pixel, k, key + 2)) / (double)peaks;
@@ -361,28 +375,32 @@ static lx_vec3 sky_visible(const lx_baker *b, uint32_t map_index, const lx_light
         shv[m] = lx_scale(d, shw[m]);
         w[m++] = lx_v3(l[0] * chroma, l[1] * chroma, l[2] * chroma);
         if (m == BATCH) {
-            cast(b, rays, w, m, sum, shw, shv, sh ? shs_peak : NULL);
+            cast(b, rays, w, m, sum, &squares, shw, shv, sh ? shs_peak : NULL);
             m = 0;
         }
     }
     if (m)
-        cast(b, rays, w, m, sum, shw, shv, sh ? shs_peak : NULL);
+        cast(b, rays, w, m, sum, &squares, shw, shv, sh ? shs_peak : NULL);
     scale = total / (double)peaks;
     if (sh)
         for (int c = 0; c < LX_SH_FLOATS; c++)
             sh->c[c] += (float)(shs_peak[c] * scale);
-    return lx_add(result,
-                  lx_v3((float)(sum[0] * scale), (float)(sum[1] * scale), (float)(sum[2] * scale)));
+    lx_vec3 peak = lx_v3((float)(sum[0] * scale), (float)(sum[1] * scale), (float)(sum[2] * scale));
+    *variance += mean_variance(lx_luminance3(peak) / scale, squares, peaks, scale);
+    return lx_add(result, peak);
 }
 
 void lx_sky_tile(const lx_baker *b, uint32_t map_index, const lx_lightmap *map, uint32_t first,
-                 uint32_t count, lx_vec3 *accum, lx_sh4 *sh)
+                 uint32_t count, lx_vec3 *accum, lx_sh4 *sh, float *variance)
 {
     for (uint32_t k = 0; k < count; k++) {
         uint32_t i = first + k;
         lx_vec3 e;
         if (b->sky_shadows) {
-            e = sky_visible(b, map_index, map, i, sh ? &sh[k] : NULL);
+            double v = 0.0;
+            e = sky_visible(b, map_index, map, i, sh ? &sh[k] : NULL, &v);
+            if (variance)
+                variance[k] += (float)v;
         } else {
             /* unshadowed: nothing blocks any direction, so the texel's
              * directional data is the sky's own L0 and L1 */

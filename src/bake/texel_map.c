@@ -1228,6 +1228,7 @@ void lx_texel_map_free(lx_lightmap *map)
     free(map->gi_valid);
     free(map->gi_variance);
     free(map->sampled);
+    free(map->sampled_variance);
     lx_seam_stitch_free(map->stitch);
     free(map->sub_position);
     free(map->sub_normal);
