@@ -1,8 +1,8 @@
 #!/usr/bin/env bash
 # The demo room baked by luxel and by Blender Cycles (bench/cycles_room.py),
-# compared texel by texel, with both times. Needs Blender
-# (apt-get install blender); not part of make bench, which must run
-# without it.
+# compared texel by texel, with both times. Needs Blender and NumPy for
+# its Python (apt-get install blender python3-numpy); not part of make
+# bench, which must run without them.
 #
 #   bash bench/cycles_room.sh [BUILD] [BOUNCES] [SAMPLES] [RESOLUTION] [LUXEL_SAMPLES]
 #
@@ -19,6 +19,8 @@ here=$(cd "$(dirname "$0")" && pwd)
 work=$(mktemp -d)
 trap 'rm -rf "$work"' EXIT
 command -v blender > /dev/null || { echo "cycles_room: blender is not installed"; exit 1; }
+python3 -c 'import numpy' 2> /dev/null ||
+    { echo "cycles_room: NumPy is not installed (apt-get install python3-numpy)"; exit 1; }
 "$build/bin/gen_scenes" "$work/scenes" > /dev/null
 extra=(--bounces "$bounces" --gi-samples "$luxel_samples")
 start=$(date +%s.%N)
