@@ -144,4 +144,34 @@ for o in meshes:
     print("  %-10s %6d texels: luxel / Cycles %.4f (means %.4g / %.4g lx), RMS difference %.1f%% "
           "of the mean" % (o.name, n, ratio, sum_l / n, sum_c / n,
                            100.0 * math.sqrt(sum_sq / n) / (sum_c / n)))
+
+    # blotches: texels off by more than 5%, as they are (Cycles' own noise
+    # counts too) and after a 3x3 box filter of both (low-frequency error,
+    # what a denoiser's blotches are; Cycles' noise falls 3x)
+    def lum_c(x, y):
+        i = 4 * (y * res + x)
+        return math.pi * (0.2126 * c[i] + 0.7152 * c[i + 1] + 0.0722 * c[i + 2])
+
+    def lum_l(x, y):
+        i = 4 * (y * res + x)
+        return 0.2126 * L[i] + 0.7152 * L[i + 1] + 0.0722 * L[i + 2]
+
+    box = [(dx, dy) for dy in (-1, 0, 1) for dx in (-1, 0, 1)]
+    raw_n = raw_off = low_n = low_off = 0
+    for y in range(res):
+        for x in range(res):
+            if not covered(x, y) or lum_c(x, y) <= 0.0:
+                continue
+            raw_n += 1
+            raw_off += abs(lum_l(x, y) - lum_c(x, y)) > 0.05 * lum_c(x, y)
+            if not all(covered(x + dx, y + dy) for dx, dy in box):
+                continue
+            mc = sum(lum_c(x + dx, y + dy) for dx, dy in box)
+            ml = sum(lum_l(x + dx, y + dy) for dx, dy in box)
+            if mc <= 0.0:
+                continue
+            low_n += 1
+            low_off += abs(ml - mc) > 0.05 * mc
+    print("  %-10s texels off by more than 5%%: %.1f%% as baked, %.1f%% after a 3x3 low-pass"
+          % ("", 100.0 * raw_off / max(raw_n, 1), 100.0 * low_off / max(low_n, 1)))
 print("cycles_room: worst mean difference %.2f%%" % (100.0 * worst_ratio))

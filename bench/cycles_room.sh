@@ -19,7 +19,7 @@ here=$(cd "$(dirname "$0")" && pwd)
 work=$(mktemp -d)
 trap 'rm -rf "$work"' EXIT
 command -v blender > /dev/null || { echo "cycles_room: blender is not installed"; exit 1; }
-python3 -c 'import numpy' 2> /dev/null ||
+/usr/bin/python3 -c 'import numpy' 2> /dev/null ||
     { echo "cycles_room: NumPy is not installed (apt-get install python3-numpy)"; exit 1; }
 "$build/bin/gen_scenes" "$work/scenes" > /dev/null
 extra=(--bounces "$bounces" --gi-samples "$luxel_samples")
