@@ -354,6 +354,71 @@ static void resolution_fills_one_page(void **state)
     lx_scene_destroy(scene);
 }
 
+/* Six coplanar triangles (y = 0, facing +Y) in one planar region: an
+ * upper fan above A-M1-B, a lower fan below A-M2-B, joined by two
+ * triangles round B, and by nothing but the vertex A on the other side.
+ * M1 lies 2 cm below the line AB and M2 2 cm above it, so the fans
+ * overlap in space on a lens 2 m long, as the garden's faces do. */
+static lx_mesh pinched_fans(void)
+{
+    static const float xz[][2] = {{0, 0},     {2, 0},  {1, -0.02f}, {1, 0.02f},
+                                  {1, 1},     {1, -1}, {3, 0}};
+    enum { A, B, M1, M2, T, D, E };
+    static const uint32_t tris[][3] = {{A, T, M1}, {M1, T, B}, {A, M2, D},
+                                       {M2, B, D}, {B, T, E},  {B, E, D}};
+    lx_mesh m = {0};
+    m.name = "pinched";
+    m.vertex_count = 7;
+    m.triangle_count = 6;
+    m.positions = calloc(7, sizeof(lx_vec3));
+    m.indices = calloc(18, sizeof(uint32_t));
+    assert_non_null(m.positions);
+    assert_non_null(m.indices);
+    for (int v = 0; v < 7; v++)
+        m.positions[v] = lx_v3(xz[v][0], 0.0f, xz[v][1]);
+    memcpy(m.indices, tris, sizeof tris);
+    return m;
+}
+
+/* A chart whose faces overlap but whose border never crosses itself (it
+ * pinches at A, and the border segments meeting at a vertex are not
+ * compared) is cut: no texel is shared by two triangles, by the oracle's
+ * clipping of every texel against every pair. Before: one chart, 676 of
+ * its 30,459 texels shared by two triangles. */
+static void pinched_chart_is_cut(void **state)
+{
+    (void)state;
+    lx_mesh mesh = pinched_fans();
+    lx_scene *scene = scene_of(&mesh, 1, 0.0f);
+    free(mesh.positions);
+    free(mesh.indices);
+    lx_unwrap_desc d = desc_at(100.0f);
+    lx_unwrap *u;
+    /* planar charts, isometric to the page's float rounding: measured mean
+     * angle error 4.0e-8 rad, area 4.3e-10, efficiency 0.50 (2 charts) */
+    lx_uv_report r = check(scene, &d, (expect){2e-7, 2e-7, 0.4}, &u);
+    assert_true(r.charts >= 2);
+    assert_int_equal(u->page_count, 1);
+    uint32_t n;
+    lx_uv_triangle *tris = page_triangles(scene, u, 0, &n);
+    double(*uv)[3][2] = malloc(sizeof *uv * n);
+    assert_non_null(uv);
+    for (uint32_t t = 0; t < n; t++)
+        for (int c = 0; c < 3; c++) {
+            uv[t][c][0] = tris[t].uv[c][0] * u->pages[0].width;
+            uv[t][c][1] = tris[t].uv[c][1] * u->pages[0].height;
+        }
+    uint64_t covered;
+    uint64_t shared = lx_uv_pair_overlaps((const double(*)[3][2])uv, n, u->pages[0].width,
+                                          u->pages[0].height, 1e-3, &covered);
+    assert_int_equal(shared, 0);
+    assert_true(covered == u->pages[0].covered_texels);
+    free(uv);
+    free(tris);
+    lx_unwrap_destroy(u);
+    lx_scene_destroy(scene);
+}
+
 /* Boxes of many sizes, a node each: many small charts on one page, as a
  * garden or a game level gives (thousands of charts a few texels across). */
 static lx_scene *scattered_boxes(int count)
@@ -392,7 +457,9 @@ static void many_charts_pack_near_square(void **state)
     for (int k = 0; k < 3; k++) {
         lx_unwrap_desc d = desc_at((float)densities[k]);
         lx_unwrap *u;
-        check(scene, &d, (expect){1e-6, 1e-6, 0.08}, &u);
+        /* measured: mean angle error up to 6.9e-7 rad, area 1.8e-7 (the
+         * float page UVs of faces a texel across), efficiency 0.107 */
+        check(scene, &d, (expect){3e-6, 1e-6, 0.08}, &u);
         assert_int_equal(u->page_count, 1);
         double w = u->pages[0].width, h = u->pages[0].height;
         assert_true(fmax(w, h) <= 1.5 * fmin(w, h));
@@ -517,6 +584,7 @@ int main(void)
         cmocka_unit_test(full_pages_spill_to_new_ones),
         cmocka_unit_test(resolution_fills_one_page),
         cmocka_unit_test(pages_of_their_own),
+        cmocka_unit_test(pinched_chart_is_cut),
         cmocka_unit_test(many_charts_pack_near_square),
         cmocka_unit_test(kept_node_square_is_placed),
         cmocka_unit_test(progress_can_cancel),
