@@ -361,8 +361,7 @@ static void resolution_fills_one_page(void **state)
  * overlap in space on a lens 2 m long, as the garden's faces do. */
 static lx_mesh pinched_fans(void)
 {
-    static const float xz[][2] = {{0, 0},     {2, 0},  {1, -0.02f}, {1, 0.02f},
-                                  {1, 1},     {1, -1}, {3, 0}};
+    static const float xz[][2] = {{0, 0}, {2, 0}, {1, -0.02f}, {1, 0.02f}, {1, 1}, {1, -1}, {3, 0}};
     enum { A, B, M1, M2, T, D, E };
     static const uint32_t tris[][3] = {{A, T, M1}, {M1, T, B}, {A, M2, D},
                                        {M2, B, D}, {B, T, E},  {B, E, D}};
