@@ -8,12 +8,13 @@
  * gradients come closest to the Cauchy-Riemann equations, in the least-
  * squares sense weighted by area, with two vertices pinned. The normal
  * equations are solved by CHOLMOD's sparse Cholesky factorization
- * (SuiteSparse). The result is scaled to the chart's area
- * and checked: a triangle turned over, a border that crosses itself, two
- * triangles overlapping (chart_overlap.c) or an L2 stretch (Sander, Snyder, Gortler and Hoppe, "Texture Mapping
- * Progressive Meshes", 2001) above the limit sends the chart back to be
- * cut. Last, the chart is turned so that its bounding box is smallest
- * (rotating calipers over its convex hull) and wider than tall. */
+ * (SuiteSparse). The result is scaled to the chart's area and checked: a
+ * triangle turned over, a border that crosses itself, two triangles
+ * overlapping (chart_overlap.c) or an L2 stretch (Sander, Snyder, Gortler
+ * and Hoppe, "Texture Mapping Progressive Meshes", 2001) above the limit
+ * sends the chart back to be cut. Last, the chart is turned so that its
+ * bounding box is smallest (rotating calipers over its convex hull) and
+ * wider than tall. */
 #include "unwrap_internal.h"
 #include "core/internal.h"
 

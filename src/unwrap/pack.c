@@ -18,8 +18,8 @@
 #include <stdlib.h>
 #include <string.h>
 
-#define FILL_ESTIMATE 0.80 /* share of a page the dealing of nodes plans to use */
-#define MANY_CHARTS 1024   /* above this, holes are sought from a cursor */
+#define FILL_ESTIMATE 0.80  /* share of a page the dealing of nodes plans to use */
+#define MANY_CHARTS 1024    /* above this, holes are sought from a cursor */
 #define MAX_PAGE_ASPECT 1.5 /* a page's long side over its short side, when it can be */
 
 /* ---- rasterizing --------------------------------------------------------- */
