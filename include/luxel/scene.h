@@ -374,8 +374,10 @@ lx_status lx_scene_add_light(lx_scene *scene, const lx_light *light);
  * "camera<N>"; a name already taken fails (LX_ERR_INVALID). */
 lx_status lx_scene_add_camera(lx_scene *scene, const lx_scene_camera *camera);
 
-/* True when triangle abc has negligible area next to its edges (its normal
- * cannot be trusted). */
+/* True when triangle abc has negligible area next to its edges, or a
+ * height (twice its area over its longest edge) of at most 16 units in the
+ * last place of its largest coordinate: three points on a line, rounded
+ * to floats (its normal cannot be trusted). */
 bool lx_triangle_degenerate(lx_vec3 a, lx_vec3 b, lx_vec3 c);
 
 /* World-space bounds of every node's meshes but sky domes (bake.sky),

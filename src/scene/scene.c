@@ -158,14 +158,45 @@ static void repair_normals(lx_mesh *m)
     free(kept);
 }
 
+/* Heights up to this many units in the last place of a triangle's largest
+ * coordinate are the rounding of points on a line: zdm2's T-junction
+ * fillers (a vertex on the long edge, rounded off it) are 0.25 to 14.3
+ * ulps high, its next thinnest triangles 25.6 and more. */
+#define ROUNDING_ULPS 16.0
+
+/* Whether triangle abc's height (twice its area over its longest edge) is
+ * within ROUNDING_ULPS of its coordinates' float spacing: three points on
+ * a line stored as floats, whose area and normal are rounding noise (a
+ * float page UV cannot hold them either: zdm2's became zero-area). */
+static bool height_is_rounding(lx_vec3 a, lx_vec3 b, lx_vec3 c)
+{
+    double p[3][3] = {{a.x, a.y, a.z}, {b.x, b.y, b.z}, {c.x, c.y, c.z}};
+    double e1[3], e2[3], e3[3], big = 0.0;
+    for (int k = 0; k < 3; k++) {
+        e1[k] = p[1][k] - p[0][k];
+        e2[k] = p[2][k] - p[0][k];
+        e3[k] = p[2][k] - p[1][k];
+        big = fmax(big, fmax(fabs(p[0][k]), fmax(fabs(p[1][k]), fabs(p[2][k]))));
+    }
+    double n[3] = {e1[1] * e2[2] - e1[2] * e2[1], e1[2] * e2[0] - e1[0] * e2[2],
+                   e1[0] * e2[1] - e1[1] * e2[0]};
+    double longest = fmax(e1[0] * e1[0] + e1[1] * e1[1] + e1[2] * e1[2],
+                          fmax(e2[0] * e2[0] + e2[1] * e2[1] + e2[2] * e2[2],
+                               e3[0] * e3[0] + e3[1] * e3[1] + e3[2] * e3[2]));
+    double ulp = (double)nextafterf((float)big, INFINITY) - (float)big;
+    double cross = sqrt(n[0] * n[0] + n[1] * n[1] + n[2] * n[2]);
+    return cross <= ROUNDING_ULPS * ulp * sqrt(longest);
+}
+
 /* A triangle is degenerate in space when its area is negligible next to
- * its edges: its geometric normal cannot be trusted. */
+ * its edges, or its height is the rounding of its float coordinates: its
+ * geometric normal cannot be trusted. */
 bool lx_triangle_degenerate(lx_vec3 a, lx_vec3 b, lx_vec3 c)
 {
     lx_vec3 e1 = lx_sub(b, a), e2 = lx_sub(c, a), e3 = lx_sub(c, b);
     float cross_len = lx_length(lx_cross(e1, e2));
     float longest = fmaxf(lx_dot(e1, e1), fmaxf(lx_dot(e2, e2), lx_dot(e3, e3)));
-    return !(cross_len > 1e-6f * longest) || longest == 0.0f;
+    return !(cross_len > 1e-6f * longest) || longest == 0.0f || height_is_rounding(a, b, c);
 }
 
 static lx_status validate_mesh(const lx_scene *s, const lx_mesh *m, const char *name)

@@ -8,12 +8,13 @@
  * gradients come closest to the Cauchy-Riemann equations, in the least-
  * squares sense weighted by area, with two vertices pinned. The normal
  * equations are solved by CHOLMOD's sparse Cholesky factorization
- * (SuiteSparse). The result is scaled to the chart's area
- * and checked: a triangle turned over, a border that crosses itself or an
- * L2 stretch (Sander, Snyder, Gortler and Hoppe, "Texture Mapping
- * Progressive Meshes", 2001) above the limit sends the chart back to be
- * cut. Last, the chart is turned so that its bounding box is smallest
- * (rotating calipers over its convex hull) and wider than tall. */
+ * (SuiteSparse). The result is scaled to the chart's area and checked: a
+ * triangle turned over, a border that crosses itself, two triangles
+ * overlapping (chart_overlap.c) or an L2 stretch (Sander, Snyder, Gortler
+ * and Hoppe, "Texture Mapping Progressive Meshes", 2001) above the limit
+ * sends the chart back to be cut. Last, the chart is turned so that its
+ * bounding box is smallest (rotating calipers over its convex hull) and
+ * wider than tall. */
 #include "unwrap_internal.h"
 #include "core/internal.h"
 
@@ -488,6 +489,15 @@ static int border_crosses(const uw_mesh *m, const uw_chart *c)
     return crosses;
 }
 
+/* Does the flattened chart fold onto itself: its border crossing or
+ * touching itself, or two triangles overlapping (a border pinched at a
+ * vertex folds without crossing)? 1, 0, or -1 out of memory. */
+static int folds(const uw_mesh *m, const uw_chart *c)
+{
+    int crosses = border_crosses(m, c);
+    return crosses ? crosses : uw_chart_overlaps(c);
+}
+
 /* ---- the smallest bounding box ------------------------------------------- */
 
 static int cmp_point(const void *pa, const void *pb)
@@ -605,7 +615,7 @@ static int projection_serves(const uw_mesh *m, uw_chart *c, double max_stretch)
     double stretch = l2_stretch(m, c, &worst);
     if (!(stretch <= ORTHO_STRETCH && stretch <= max_stretch && worst <= ORTHO_WORST))
         return 0;
-    int crosses = border_crosses(m, c);
+    int crosses = folds(m, c);
     if (crosses)
         return crosses < 0 ? -1 : 0;
     c->stretch = stretch;
@@ -691,7 +701,7 @@ bool uw_flatten(const uw_mesh *m, uw_chart *c, double max_stretch, lx_status *st
         c->stretch = planar ? 1.0 : l2_stretch(m, c, NULL);
         if (!(c->stretch <= max_stretch))
             return false;
-        int crosses = border_crosses(m, c);
+        int crosses = folds(m, c);
         if (crosses < 0) {
             *status = lx_fail(LX_ERR_NOMEM, "out of memory flattening charts");
             return false;

@@ -5,7 +5,8 @@
  * used extent, else the place that grows the extent least (the square of
  * the larger side plus k times the area; xatlas's measure is k = 1).
  * Charts go largest first. The packing runs for k = 1, 4 and 1000 and
- * keeps the attempt covering the largest share of its pages. A node's charts
+ * keeps the attempt covering the largest share of its pages among those
+ * whose pages are near-square (at most 1.5 : 1), else the squarest. A node's charts
  * share one page: nodes are dealt to pages by area, and a node whose chart does not fit moves, all
  * its charts with it, to the next page. Footprints are kept as runs of texels per row, so charts
  * interlock and small ones fill the holes of rings. */
@@ -17,8 +18,9 @@
 #include <stdlib.h>
 #include <string.h>
 
-#define FILL_ESTIMATE 0.80 /* share of a page the dealing of nodes plans to use */
-#define MANY_CHARTS 1024   /* above this, holes are sought from a cursor */
+#define FILL_ESTIMATE 0.80  /* share of a page the dealing of nodes plans to use */
+#define MANY_CHARTS 1024    /* above this, holes are sought from a cursor */
+#define MAX_PAGE_ASPECT 1.5 /* a page's long side over its short side, when it can be */
 
 /* ---- rasterizing --------------------------------------------------------- */
 
@@ -693,6 +695,30 @@ static void pages_free(packer *k)
     k->page_count = 0;
 }
 
+/* The most elongated page's long side over its short side. */
+static double pages_aspect(const lx_unwrap_page *pages, uint32_t count)
+{
+    double worst = 1.0;
+    for (uint32_t p = 0; p < count; p++) {
+        double w = pages[p].width, h = pages[p].height;
+        worst = fmax(worst, fmax(w, h) / fmin(w, h));
+    }
+    return worst;
+}
+
+/* Whether an attempt (share of its pages covered, page aspect) beats the
+ * best so far: pages within MAX_PAGE_ASPECT first (users of xatlas and
+ * Blender's Lightmap Pack expect a near-square page; area-first growth
+ * laid zdm2 out as 2808 x 772 for 0.3 points of coverage), then the
+ * larger share; among elongated ones the squarer. Ties keep the earlier. */
+static bool better_attempt(double share, double aspect, double best_share, double best_aspect)
+{
+    bool square = aspect <= MAX_PAGE_ASPECT, best_square = best_aspect <= MAX_PAGE_ASPECT;
+    if (square != best_square)
+        return square;
+    return square ? share > best_share : aspect < best_aspect;
+}
+
 lx_status uw_pack(uw_item *items, uint32_t item_count, const uw_pack_desc *desc,
                   lx_unwrap_page **pages_out, uint32_t *page_count_out, uint32_t *too_big)
 {
@@ -746,14 +772,15 @@ lx_status uw_pack(uw_item *items, uint32_t item_count, const uw_pack_desc *desc,
     }
     sort_items(k.order, item_count, &k);
     /* Attempts with growth measures from square-first to area-first; the
-     * one covering the largest share of its pages wins (ties: the
-     * earlier). Each is deterministic, so the result is too. */
+     * near-square one covering the largest share of its pages wins (ties:
+     * the earlier; better_attempt). Each is deterministic, so the result
+     * is too. */
     static const double weights[] = {1.0, 4.0, 1000.0};
     const int attempts = (int)(sizeof weights / sizeof weights[0]);
     uw_item *best_items = NULL;
     lx_unwrap_page *best_pages = NULL;
     uint32_t best_count = 0;
-    double best_share = -1.0;
+    double best_share = -1.0, best_aspect = INFINITY;
     for (int a = 0; a < attempts && st == LX_OK; a++) {
         pages_free(&k);
         k.area_weight = weights[a];
@@ -779,7 +806,8 @@ lx_status uw_pack(uw_item *items, uint32_t item_count, const uw_pack_desc *desc,
             texels += (double)pages[p].width * pages[p].height;
         }
         double share = texels > 0.0 ? covered / texels : 0.0;
-        if (share > best_share) {
+        double aspect = pages_aspect(pages, count);
+        if (better_attempt(share, aspect, best_share, best_aspect)) {
             if (!best_items)
                 best_items = malloc(sizeof *best_items * (item_count ? item_count : 1));
             if (!best_items) {
@@ -792,6 +820,7 @@ lx_status uw_pack(uw_item *items, uint32_t item_count, const uw_pack_desc *desc,
             best_pages = pages;
             best_count = count;
             best_share = share;
+            best_aspect = aspect;
         } else {
             free(pages);
         }

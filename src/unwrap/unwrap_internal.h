@@ -77,6 +77,10 @@ bool uw_split_chart(const uw_mesh *m, const uw_chart *c, uw_chart *a, uw_chart *
  * (c then has no UVs), or LX_ERR_NOMEM through *status. */
 bool uw_flatten(const uw_mesh *m, uw_chart *c, double max_stretch, lx_status *status);
 
+/* Whether two triangles of flattened chart c (its uv) overlap with a
+ * positive area: 1, 0, or -1 out of memory (chart_overlap.c). */
+int uw_chart_overlaps(const uw_chart *c);
+
 /* ---- packing (pack.c) ---------------------------------------------------- */
 
 /* A thing to place: a chart's triangles in texels (or a kept node's square),
