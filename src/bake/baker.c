@@ -148,6 +148,37 @@ static void warn_texcoord0(const lx_scene *scene, const uint8_t *fallback)
            scene->path, node->name, without, others, more);
 }
 
+/* One warning for the meshes without their node's lightmap UV set
+ * (uvless[n]: the first of node n, UINT32_MAX: none): the first named,
+ * the other nodes counted (-v names every mesh, texel_map.c). */
+static void warn_no_uvs(const lx_scene *scene, const uint32_t *uvless)
+{
+    uint32_t count = 0, first = UINT32_MAX;
+    for (uint32_t n = 0; n < scene->node_count; n++)
+        if (uvless[n] != UINT32_MAX) {
+            count++;
+            first = first == UINT32_MAX ? n : first;
+        }
+    if (count == 0)
+        return;
+    char more[128] = "";
+    if (count > 1)
+        snprintf(more, sizeof more, "; so do meshes of %u more nodes (-v names them)", count - 1);
+    lx_log(LX_LOG_WARN,
+           "%s: node '%s': mesh '%s' has no UVs; it gets no lightmap texels (it still casts "
+           "shadows)%s",
+           scene->path, scene->nodes[first].name, scene->meshes[uvless[first]].name, more);
+}
+
+/* The UV set a page's node bakes with. */
+static int page_node_uv_set(const lx_scene *scene, const lx_bake_desc *desc,
+                            const lx_tile_candidate *c, const lx_page_node *pn)
+{
+    if (pn->uv_set >= 0)
+        return pn->uv_set;
+    return lx_bake_uv_set(scene, pn->node, c->page.width ? LX_UV_SET_AUTO : desc->uv_set);
+}
+
 /* Builds the candidates' texel maps (a tiled baker lets each go once
  * built, keeping what stays resident), marking the nodes that cover a
  * texel in hit. */
@@ -165,8 +196,22 @@ static lx_status build_maps(lx_baker *b, const lx_scene *scene, const lx_bake_de
     /* a tiled baker builds from its copy, as it will build again */
     const lx_scene *from_scene = b->tiled ? b->tile_scene : scene;
     uint8_t *fallback = calloc(scene->node_count + 1, 1);
-    if (st == LX_OK && !fallback)
+    uint32_t *uvless = malloc(sizeof(uint32_t) * (scene->node_count + 1));
+    if (st == LX_OK && (!fallback || !uvless))
         st = lx_fail(LX_ERR_NOMEM, "out of memory creating a baker");
+    for (uint32_t n = 0; uvless && n < scene->node_count; n++)
+        uvless[n] = UINT32_MAX;
+    for (uint32_t i = 0; i < count && st == LX_OK; i++)
+        for (uint32_t k = 0; k < c[i].page.node_count; k++) {
+            const lx_page_node *pn = &c[i].page.nodes[k];
+            /* the set lx_texel_map_build reads (collect_slots) */
+            int set = pn->uv_set >= 0 ? pn->uv_set
+                                      : lx_bake_uv_set(scene, pn->node, LX_UV_SET_AUTO);
+            const lx_node *node = &scene->nodes[pn->node];
+            for (uint32_t q = 0; q < node->mesh_count && uvless[pn->node] == UINT32_MAX; q++)
+                if (set >= 0 && set < LX_MAX_UV_SETS && !scene->meshes[node->meshes[q]].uv[set])
+                    uvless[pn->node] = node->meshes[q];
+        }
     for (uint32_t i = 0; i < count && st == LX_OK; i++) {
         lx_lightmap *map = &b->maps[b->map_count];
         float from = maps_from(b), span = TEXEL_MAPS_SHARE - from;
@@ -196,11 +241,7 @@ static lx_status build_maps(lx_baker *b, const lx_scene *scene, const lx_bake_de
                     fallback[pn->node] |= m->uv[0] && !m->uv[1];
                 }
             if (b->node_uv_set)
-                b->node_uv_set[pn->node] = (int8_t)(
-                    pn->uv_set >= 0 ? pn->uv_set
-                                    : lx_bake_uv_set(scene, pn->node,
-                                                     c[i].page.width ? LX_UV_SET_AUTO
-                                                                     : desc->uv_set));
+                b->node_uv_set[pn->node] = (int8_t)page_node_uv_set(scene, desc, &c[i], pn);
             memcpy(b->node_scale_offset[pn->node], pn->scale_offset, sizeof pn->scale_offset);
         }
         if (b->tiled) {
@@ -213,9 +254,12 @@ static lx_status build_maps(lx_baker *b, const lx_scene *scene, const lx_bake_de
         if (desc->progress && !desc->progress(desc->progress_user, share.to))
             st = lx_fail(LX_ERR_CANCELLED, "bake cancelled");
     }
-    if (st == LX_OK)
+    if (st == LX_OK) {
+        warn_no_uvs(scene, uvless);
         warn_texcoord0(scene, fallback);
+    }
     free(fallback);
+    free(uvless);
     if (st == LX_OK)
         st = lx_bake_plan_tiles(b, scene, needs);
     b->loaded_tile = b->tiled ? UINT32_MAX : 0;

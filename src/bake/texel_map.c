@@ -519,9 +519,9 @@ static uint32_t collect_slots(const lx_scene *scene, uint32_t node_index, const 
     for (uint32_t k = 0; k < node->mesh_count; k++) {
         const lx_mesh *m = &scene->meshes[node->meshes[k]];
         const lx_vec2 *uv = m->uv[*uv_set];
-        if (!uv) {
+        if (!uv) { /* one warning for them all: the baker's (warn_no_uvs) */
             if (warn)
-                lx_log(LX_LOG_WARN,
+                lx_log(LX_LOG_INFO,
                        "%s: node '%s': mesh '%s' has no UVs; it gets no lightmap "
                        "texels (it still casts shadows)",
                        scene->path, node->name, m->name);
