@@ -270,7 +270,22 @@ typedef struct collada_scan {
     uint32_t *instance_of; /* the node holding each <instance_node> */
     char **instance_url;   /* and the id it names */
     size_t instances, instance_cap;
+    id_table arrays;       /* <float_array id=...> and the other arrays */
+    uint64_t *array_count; /* their count attributes, by table index */
+    size_t array_cap;
+    struct collada_accessor *accessors;
+    size_t accessor_count, accessor_cap;
 } collada_scan;
+
+/* An <accessor>: the array it reads (its source without '#') and how
+ * many of its values: offset + count x stride. assimp reads them without
+ * looking at the array's length (a count="0" array read by a 3-value
+ * accessor crashed it on a null pointer). */
+typedef struct collada_accessor {
+    char *source;
+    uint64_t reads;
+    size_t line;
+} collada_accessor;
 
 static void name_collada(const void *user, uint32_t node, char *buf, size_t size)
 {
@@ -445,7 +460,87 @@ static bool name_ends_with(const char *name, size_t len, const char *tail)
 
 /* The checks above for the element opened by the tag [name, tag_end),
  * its text starting at text (NULL for an empty element). */
-static lx_status collada_check_data(const collada_scan *s, const mapped_file *f,
+/* Keeps an array's id and count, or an accessor's reads, for
+ * check_accessors. */
+static lx_status collada_note_array(collada_scan *s, const char *attrs, const char *tag_end,
+                                    uint64_t count)
+{
+    size_t len = 0;
+    const char *id = xml_attribute(attrs, tag_end, "id", &len);
+    if (!id)
+        return LX_OK;
+    if (s->arrays.count == s->array_cap) {
+        size_t cap = s->array_cap ? s->array_cap * 2 : 64;
+        uint64_t *counts = realloc(s->array_count, cap * sizeof *counts);
+        if (!counts)
+            return lx_fail(LX_ERR_NOMEM, "%s: out of memory for the arrays", s->path);
+        s->array_count = counts;
+        s->array_cap = cap;
+    }
+    s->array_count[s->arrays.count] = count;
+    if (!id_table_add(&s->arrays, id, len))
+        return lx_fail(LX_ERR_NOMEM, "%s: out of memory for the arrays", s->path);
+    return LX_OK;
+}
+
+static lx_status collada_note_accessor(collada_scan *s, const char *attrs, const char *tag_end,
+                                       uint64_t count, size_t line)
+{
+    size_t len = 0;
+    const char *source = xml_attribute(attrs, tag_end, "source", &len);
+    if (!source || len < 2 || source[0] != '#')
+        return LX_OK; /* assimp finds no array: it reports that */
+    uint64_t stride = xml_count(attrs, tag_end, "stride");
+    uint64_t offset = xml_count(attrs, tag_end, "offset");
+    stride = stride ? stride : 1;
+    uint64_t reads = UINT64_MAX; /* saturating: huge is too many anyway */
+    if (stride < UINT64_MAX / 2 && offset < UINT64_MAX / 2 &&
+        (count == 0 || stride <= (UINT64_MAX / 2) / count))
+        reads = offset + count * stride;
+    if (s->accessor_count == s->accessor_cap) {
+        size_t cap = s->accessor_cap ? s->accessor_cap * 2 : 64;
+        collada_accessor *a = realloc(s->accessors, cap * sizeof *a);
+        if (!a)
+            return lx_fail(LX_ERR_NOMEM, "%s: out of memory for the accessors", s->path);
+        s->accessors = a;
+        s->accessor_cap = cap;
+    }
+    char *copy = malloc(len);
+    if (!copy)
+        return lx_fail(LX_ERR_NOMEM, "%s: out of memory for the accessors", s->path);
+    memcpy(copy, source + 1, len - 1);
+    copy[len - 1] = '\0';
+    s->accessors[s->accessor_count++] = (collada_accessor){copy, reads, line};
+    return LX_OK;
+}
+
+/* Every accessor reads within the array it names (the first of an id
+ * given twice counts no more than the smallest). */
+static lx_status check_accessors(const collada_scan *s)
+{
+    for (size_t i = 0; i < s->accessor_count; i++) {
+        const collada_accessor *a = &s->accessors[i];
+        const named_node *hit = id_table_find(&s->arrays, a->source);
+        if (!hit)
+            continue; /* no such array: assimp reports it */
+        uint64_t have = UINT64_MAX;
+        for (size_t k = 0; k < s->arrays.count; k++) /* duplicates: the smallest */
+            if (strcmp(s->arrays.ids[k], a->source) == 0 && s->array_count[k] < have)
+                have = s->array_count[k];
+        if (a->reads > have) {
+            char reads[32] = "more than 2^63";
+            if (a->reads != UINT64_MAX)
+                snprintf(reads, sizeof reads, "%llu", (unsigned long long)a->reads);
+            return lx_fail(LX_ERR_FORMAT,
+                           "%s: line %zu: <accessor> reads %s values of array '%.100s', which "
+                           "holds %llu",
+                           s->path, a->line, reads, a->source, (unsigned long long)have);
+        }
+    }
+    return LX_OK;
+}
+
+static lx_status collada_check_data(collada_scan *s, const mapped_file *f,
                                     collada_primitive *prim, const char *tag, const char *name,
                                     size_t name_len, const char *attrs, const char *tag_end,
                                     const char *text)
@@ -465,6 +560,9 @@ static lx_status collada_check_data(const collada_scan *s, const mapped_file *f,
                            "%s: line %zu: <%.*s> count %llu beyond the %zu bytes of its text",
                            s->path, line_at(f->bytes, tag), (int)name_len, name,
                            (unsigned long long)count, len);
+        return collada_note_array(s, attrs, tag_end, count);
+    } else if (name_is(name, name_len, "accessor")) {
+        return collada_note_accessor(s, attrs, tag_end, count, line_at(f->bytes, tag));
     } else if (is_primitive(name, name_len, &vertices)) {
         *prim = (collada_primitive){.open = true, .count = count, .vertices = vertices,
                                     .inputs = 1};
@@ -634,8 +732,17 @@ static lx_status check_collada(const char *path)
             st = lx_fail(LX_ERR_NOMEM, "%s: out of memory for the node hierarchy", path);
     }
     s.graph.nodes = s.nodes.count;
+    if (st == LX_OK && !id_table_sort(&s.arrays))
+        st = lx_fail(LX_ERR_NOMEM, "%s: out of memory for the arrays", path);
+    if (st == LX_OK)
+        st = check_accessors(&s);
     if (st == LX_OK)
         st = judge_graph(path, &s.graph, name_collada, &s);
+    for (size_t i = 0; i < s.accessor_count; i++)
+        free(s.accessors[i].source);
+    free(s.accessors);
+    free(s.array_count);
+    id_table_free(&s.arrays);
     for (size_t i = 0; i < s.instances; i++)
         free(s.instance_url[i]);
     free(s.instance_url);

@@ -297,6 +297,12 @@ static void test_collada_data(void **state)
          COLLADA_TRIANGLE, "count 90 beyond the 17 bytes of its text"},
         {"<float_array id=\"pa\" count=\"-1\">0 0 0 1 0 0 0 0 1</float_array>",
          COLLADA_TRIANGLE, "count negative or huge"},
+        /* the fuzzer's case: an array shorter than its accessor reads
+         * (assimp read past it, a null pointer) */
+        {"<float_array id=\"pa\" count=\"0\">0 0 0 1 0 0 0 0 1</float_array>",
+         COLLADA_TRIANGLE, "<accessor> reads 9 values of array 'pa', which holds 0"},
+        {"<float_array id=\"pa\" count=\"8\">0 0 0 1 0 0 0 0 1</float_array>",
+         COLLADA_TRIANGLE, "<accessor> reads 9 values of array 'pa', which holds 8"},
         {COLLADA_POSITIONS,
          "<triangles count=\"300\"><input semantic=\"VERTEX\" source=\"#v\" offset=\"0\"/>"
          "<p>0 1 2</p></triangles>",
