@@ -20,6 +20,7 @@
 # (both bakes' noise and Cycles' averaging over each texel's area, where
 # luxel takes its centre, are in it).
 import math
+import os
 import sys
 import time
 
@@ -174,4 +175,26 @@ for o in meshes:
             low_off += abs(ml - mc) > 0.05 * mc
     print("  %-10s texels off by more than 5%%: %.1f%% as baked, %.1f%% after a 3x3 low-pass"
           % ("", 100.0 * raw_off / max(raw_n, 1), 100.0 * low_off / max(low_n, 1)))
+    # where they are: with CYCLES_ROOM_ERRORS=DIR, a PPM a node of the
+    # low-passed difference (red: luxel brighter, blue: darker; full at
+    # 10%), uncovered texels grey
+    out_dir = os.environ.get("CYCLES_ROOM_ERRORS")
+    if out_dir:
+        rows = []
+        for y in range(res - 1, -1, -1):  # Blender's rows run bottom-up
+            row = bytearray()
+            for x in range(res):
+                if not all(covered(x + dx, y + dy) for dx, dy in box):
+                    row += bytes((64, 64, 64))
+                    continue
+                mc = sum(lum_c(x + dx, y + dy) for dx, dy in box)
+                ml = sum(lum_l(x + dx, y + dy) for dx, dy in box)
+                e = (ml - mc) / mc if mc > 0.0 else 0.0
+                v = max(0, min(255, int(255 * abs(e) / 0.1)))
+                row += bytes((v, 0, 0)) if e > 0 else bytes((0, 0, v))
+            rows.append(bytes(row))
+        with open(os.path.join(out_dir, o.name + "_error.ppm"), "wb") as fh:
+            fh.write(b"P6 %d %d 255\n" % (res, res))
+            for r in rows:
+                fh.write(r)
 print("cycles_room: worst mean difference %.2f%%" % (100.0 * worst_ratio))

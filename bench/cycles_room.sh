@@ -6,6 +6,8 @@
 #
 #   bash bench/cycles_room.sh [BUILD] [BOUNCES] [SAMPLES] [RESOLUTION] [LUXEL_SAMPLES]
 #
+# CYCLES_ROOM_ERRORS=DIR also writes DIR/<node>_error.ppm, the low-passed
+# difference per texel (red: luxel brighter, blue: darker, full at 10%).
 # SAMPLES are Cycles' samples a texel; luxel casts LUXEL_SAMPLES gather
 # rays a texel a bounce (default SAMPLES) and denoises them as its CLI
 # does by default (--denoise indirect).
