@@ -460,6 +460,20 @@ static bool name_ends_with(const char *name, size_t len, const char *tail)
 
 /* The checks above for the element opened by the tag [name, tag_end),
  * its text starting at text (NULL for an empty element). */
+/* items (of *cap entries of size bytes) with room for entry `count`,
+ * its capacity doubled when full; NULL when out of memory (items is
+ * then left as it was). */
+static void *reserve_one(void *items, size_t *cap, size_t count, size_t size)
+{
+    if (count < *cap)
+        return items;
+    size_t grown = *cap ? *cap * 2 : 64;
+    void *more = realloc(items, grown * size);
+    if (more)
+        *cap = grown;
+    return more;
+}
+
 /* Keeps an array's id and count, or an accessor's reads, for
  * check_accessors. */
 static lx_status collada_note_array(collada_scan *s, const char *attrs, const char *tag_end,
@@ -469,14 +483,11 @@ static lx_status collada_note_array(collada_scan *s, const char *attrs, const ch
     const char *id = xml_attribute(attrs, tag_end, "id", &len);
     if (!id)
         return LX_OK;
-    if (s->arrays.count == s->array_cap) {
-        size_t cap = s->array_cap ? s->array_cap * 2 : 64;
-        uint64_t *counts = realloc(s->array_count, cap * sizeof *counts);
-        if (!counts)
-            return lx_fail(LX_ERR_NOMEM, "%s: out of memory for the arrays", s->path);
-        s->array_count = counts;
-        s->array_cap = cap;
-    }
+    uint64_t *counts =
+        reserve_one(s->array_count, &s->array_cap, s->arrays.count, sizeof *s->array_count);
+    if (!counts)
+        return lx_fail(LX_ERR_NOMEM, "%s: out of memory for the arrays", s->path);
+    s->array_count = counts;
     s->array_count[s->arrays.count] = count;
     if (!id_table_add(&s->arrays, id, len))
         return lx_fail(LX_ERR_NOMEM, "%s: out of memory for the arrays", s->path);
@@ -497,14 +508,11 @@ static lx_status collada_note_accessor(collada_scan *s, const char *attrs, const
     if (stride < UINT64_MAX / 2 && offset < UINT64_MAX / 2 &&
         (count == 0 || stride <= (UINT64_MAX / 2) / count))
         reads = offset + count * stride;
-    if (s->accessor_count == s->accessor_cap) {
-        size_t cap = s->accessor_cap ? s->accessor_cap * 2 : 64;
-        collada_accessor *a = realloc(s->accessors, cap * sizeof *a);
-        if (!a)
-            return lx_fail(LX_ERR_NOMEM, "%s: out of memory for the accessors", s->path);
-        s->accessors = a;
-        s->accessor_cap = cap;
-    }
+    collada_accessor *accessors =
+        reserve_one(s->accessors, &s->accessor_cap, s->accessor_count, sizeof *s->accessors);
+    if (!accessors)
+        return lx_fail(LX_ERR_NOMEM, "%s: out of memory for the accessors", s->path);
+    s->accessors = accessors;
     char *copy = malloc(len);
     if (!copy)
         return lx_fail(LX_ERR_NOMEM, "%s: out of memory for the accessors", s->path);
@@ -514,30 +522,40 @@ static lx_status collada_note_accessor(collada_scan *s, const char *attrs, const
     return LX_OK;
 }
 
-/* Every accessor reads within the array it names (the first of an id
- * given twice counts no more than the smallest). */
+/* Every accessor reads within the array it names (an id given twice
+ * counts as its smallest array). arrays must be sorted. */
 static lx_status check_accessors(const collada_scan *s)
 {
-    for (size_t i = 0; i < s->accessor_count; i++) {
+    const id_table *t = &s->arrays;
+    /* per sorted entry: the least count of its id's run */
+    uint64_t *least = malloc((t->count ? t->count : 1) * sizeof *least);
+    if (!least)
+        return lx_fail(LX_ERR_NOMEM, "%s: out of memory for the arrays", s->path);
+    for (size_t i = 0, run = 0; i < t->count; i = run) {
+        uint64_t m = UINT64_MAX;
+        for (run = i; run < t->count && strcmp(t->sorted[run].id, t->sorted[i].id) == 0; run++)
+            m = s->array_count[t->sorted[run].index] < m ? s->array_count[t->sorted[run].index] : m;
+        for (size_t k = i; k < run; k++)
+            least[k] = m;
+    }
+    lx_status st = LX_OK;
+    for (size_t i = 0; i < s->accessor_count && st == LX_OK; i++) {
         const collada_accessor *a = &s->accessors[i];
-        const named_node *hit = id_table_find(&s->arrays, a->source);
+        const named_node *hit = id_table_find(t, a->source);
         if (!hit)
             continue; /* no such array: assimp reports it */
-        uint64_t have = UINT64_MAX;
-        for (size_t k = 0; k < s->arrays.count; k++) /* duplicates: the smallest */
-            if (strcmp(s->arrays.ids[k], a->source) == 0 && s->array_count[k] < have)
-                have = s->array_count[k];
-        if (a->reads > have) {
-            char reads[32] = "more than 2^63";
-            if (a->reads != UINT64_MAX)
-                snprintf(reads, sizeof reads, "%llu", (unsigned long long)a->reads);
-            return lx_fail(LX_ERR_FORMAT,
-                           "%s: line %zu: <accessor> reads %s values of array '%.100s', which "
-                           "holds %llu",
-                           s->path, a->line, reads, a->source, (unsigned long long)have);
-        }
+        uint64_t have = least[hit - t->sorted];
+        if (a->reads <= have)
+            continue;
+        char reads[32] = "more than 2^63";
+        if (a->reads != UINT64_MAX)
+            snprintf(reads, sizeof reads, "%llu", (unsigned long long)a->reads);
+        st = lx_fail(LX_ERR_FORMAT,
+                     "%s: line %zu: <accessor> reads %s values of array '%.100s', which holds %llu",
+                     s->path, a->line, reads, a->source, (unsigned long long)have);
     }
-    return LX_OK;
+    free(least);
+    return st;
 }
 
 static lx_status collada_check_data(collada_scan *s, const mapped_file *f,

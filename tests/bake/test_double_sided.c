@@ -60,18 +60,7 @@ static void square(lx_test_gltf *g, const char *name, double side, double y, boo
     double ex[3] = {side, 0, 0}, ez[3] = {0, 0, side};
     memcpy(q.e1, down ? ex : ez, sizeof ex);
     memcpy(q.e2, down ? ez : ex, sizeof ex);
-    float pos[12], nrm[12], uv0[8], uv1[8];
-    uint32_t idx[6];
-    lx_test_quad_arrays(&q, pos, nrm, uv0, uv1, idx);
-    lx_test_primitive p = {.vertex_count = 4,
-                           .position = pos,
-                           .normal = nrm,
-                           .uv0 = uv0,
-                           .uv1 = uv1,
-                           .index_count = 6,
-                           .indices = idx,
-                           .material = mat};
-    lx_test_gltf_node(g, name, lx_test_gltf_mesh(g, name, &p, 1), "");
+    lx_test_gltf_node(g, name, lx_test_gltf_quad_mesh(g, name, &q, mat, NULL), "");
 }
 
 /* The box [-h, h] x [0, 2h] x [-h, h] as six squares facing in. */
@@ -93,39 +82,13 @@ static void room(lx_test_gltf *g, double h, int mat)
         memcpy(q.o, faces[f][0], sizeof q.o);
         memcpy(q.e1, faces[f][1], sizeof q.e1);
         memcpy(q.e2, faces[f][2], sizeof q.e2);
-        float pos[12], nrm[12], uv0[8], uv1[8];
-        uint32_t idx[6];
-        lx_test_quad_arrays(&q, pos, nrm, uv0, uv1, idx);
-        /* facing in: the normal points toward the box's centre (0, h, 0) */
-        double to_c[3] = {-pos[0], h - pos[1], -pos[2]};
-        assert_true(nrm[0] * to_c[0] + nrm[1] * to_c[1] + nrm[2] * to_c[2] > 0);
-        lx_test_primitive p = {.vertex_count = 4,
-                               .position = pos,
-                               .normal = nrm,
-                               .uv0 = uv0,
-                               .uv1 = uv1,
-                               .index_count = 6,
-                               .indices = idx,
-                               .material = mat};
-        lx_test_gltf_node(g, names[f], lx_test_gltf_mesh(g, names[f], &p, 1), "");
+        /* facing in: e1 x e2 points toward the box's centre (0, h, 0) */
+        const double *e1 = faces[f][1], *e2 = faces[f][2], *o = faces[f][0];
+        double n[3] = {e1[1] * e2[2] - e1[2] * e2[1], e1[2] * e2[0] - e1[0] * e2[2],
+                       e1[0] * e2[1] - e1[1] * e2[0]};
+        assert_true(n[0] * -o[0] + n[1] * (h - o[1]) + n[2] * -o[2] > 0);
+        lx_test_gltf_node(g, names[f], lx_test_gltf_quad_mesh(g, names[f], &q, mat, NULL), "");
     }
-}
-
-static lx_scene *load(const char *path)
-{
-    lx_scene *scene = NULL;
-    if (lx_scene_load(path, NULL, &scene) != LX_OK)
-        fail_msg("%s: %s", path, lx_last_error());
-    return scene;
-}
-
-static uint32_t node_named(const lx_scene *s, const char *name)
-{
-    for (uint32_t i = 0; i < s->node_count; i++)
-        if (strcmp(s->nodes[i].name, name) == 0)
-            return i;
-    fail_msg("no node '%s'", name);
-    return 0;
 }
 
 /* A sun of SUN lux toward unit dir, hard shadows. */
@@ -206,7 +169,7 @@ static void baked_free(baked *b)
 static void assert_node(const baked *b, const lx_scene *s, const char *name, double want,
                         double tol)
 {
-    uint32_t m = lx_test_map_of(b->baker, node_named(s, name));
+    uint32_t m = lx_test_map_of(b->baker, lx_test_node_named(s, name));
     const lx_image *img = &b->img[m];
     const uint8_t *mask = lx_baker_mask(b->baker, m);
     double worst = 0;
@@ -245,17 +208,17 @@ static void pond(void **state)
     char path[1024];
     snprintf(path, sizeof path, "%s/pond.gltf", dir);
     write_pond(path, true);
-    lx_scene *s = load(path);
+    lx_scene *s = lx_test_load(path);
     assert_true(
-        s->materials[s->meshes[s->nodes[node_named(s, "water")].meshes[0]].material].double_sided);
+        s->materials[s->meshes[s->nodes[lx_test_node_named(s, "water")].meshes[0]].material].double_sided);
     assert_false(
-        s->materials[s->meshes[s->nodes[node_named(s, "bed")].meshes[0]].material].double_sided);
+        s->materials[s->meshes[s->nodes[lx_test_node_named(s, "bed")].meshes[0]].material].double_sided);
     add_sun(s, lx_v3(0, -1, 0));
     baked a = bake(s, LX_DOUBLE_SIDED_AUTO, 2, 0, 0);
     /* measured: float rounding only */
     assert_node(&a, s, "water", SUN, 1e-5);
     /* the bed under the water: its centre texel is in shadow */
-    uint32_t bm = lx_test_map_of(a.baker, node_named(s, "bed"));
+    uint32_t bm = lx_test_map_of(a.baker, lx_test_node_named(s, "bed"));
     int c = (RES / 2) * RES + RES / 2;
     assert_true(a.img[bm].data[3 * c] == 0.0f);
     baked one = bake(s, LX_DOUBLE_SIDED_AUTO, 1, 0, 0);
@@ -280,7 +243,7 @@ static void pond(void **state)
 
     /* single-sided: its front is what it has */
     write_pond(path, false);
-    s = load(path);
+    s = lx_test_load(path);
     add_sun(s, lx_v3(0, -1, 0));
     baked one_sided = bake(s, LX_DOUBLE_SIDED_AUTO, 2, 0, 0);
     assert_node(&one_sided, s, "water", 0.0, 0.0);
@@ -298,7 +261,7 @@ static void ground_over_nothing(void **state)
     square(g, "ground", 4, 0, true, lx_test_gltf_material(g, DOUBLE_MAT));
     lx_test_gltf_write(g, path);
     lx_test_gltf_free(g);
-    lx_scene *s = load(path);
+    lx_scene *s = lx_test_load(path);
     add_sun(s, lx_v3(0.6f, -0.8f, 0.0f));
     baked a = bake(s, LX_DOUBLE_SIDED_AUTO, 2, 0, 0);
     assert_node(&a, s, "ground", SUN * 0.8, 1e-5);
@@ -319,7 +282,7 @@ static void closed_room_keeps_fronts(void **state)
     room(g, 2, lx_test_gltf_material(g, DOUBLE_MAT));
     lx_test_gltf_write(g, path);
     lx_test_gltf_free(g);
-    lx_scene *s = load(path);
+    lx_scene *s = lx_test_load(path);
     add_sun(s, lx_v3(0.6f, -0.8f, 0.0f));
     baked a = bake(s, LX_DOUBLE_SIDED_AUTO, 2, 0, 0);
     static const char *const names[6] = {"floor", "roof", "west", "east", "north", "south"};
@@ -350,10 +313,10 @@ static void bounce_reads_the_baked_face(void **state)
     square(g, "ceiling", 1, 1, true, one);
     lx_test_gltf_write(g, path);
     lx_test_gltf_free(g);
-    lx_scene *s = load(path);
+    lx_scene *s = lx_test_load(path);
     add_sun(s, lx_v3(0, -1, 0));
     baked a = bake(s, LX_DOUBLE_SIDED_AUTO, 2, 1, 1024);
-    uint32_t m = lx_test_map_of(a.baker, node_named(s, "ceiling"));
+    uint32_t m = lx_test_map_of(a.baker, lx_test_node_named(s, "ceiling"));
     /* the ceiling's texels against rho E x (the plane - the shadow), the
      * ceiling's own shadow the square below it */
     double got = 0, want = 0;

@@ -67,10 +67,7 @@ static lx_scene *load_quad(const char *dir, const char *name, const lx_test_quad
     char path[1024];
     snprintf(path, sizeof path, "%s/%s.gltf", dir, name);
     lx_test_write_quad_gltf(path, q, material, &texture_uri, 1, tangent);
-    lx_scene *scene = NULL;
-    if (lx_scene_load(path, NULL, &scene) != LX_OK)
-        fail_msg("%s: %s", path, lx_last_error());
-    return scene;
+    return lx_test_load(path);
 }
 
 /* Bakes scene's one lightmap at RES^2 without padding. */

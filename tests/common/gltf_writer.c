@@ -350,17 +350,12 @@ void lx_test_write_png(const char *path, int w, int h, int channels, const uint8
         fail_msg("cannot write %s", path);
 }
 
-void lx_test_write_quad_gltf(const char *path, const lx_test_quad *q, const char *material,
-                             const char *const *uris, int texture_count, const float *tangent)
+int lx_test_gltf_quad_mesh(lx_test_gltf *g, const char *name, const lx_test_quad *q, int mat,
+                           const float *tangent)
 {
     float pos[12], nrm[12], uv0[8], uv1[8];
     uint32_t idx[6];
     lx_test_quad_arrays(q, pos, nrm, uv0, uv1, idx);
-    lx_test_gltf *g = lx_test_gltf_new();
-    for (int i = 0; i < texture_count; i++)
-        lx_test_gltf_texture(g, uris[i]);
-    lx_test_gltf_use_extension(g, "KHR_texture_transform");
-    int mat = lx_test_gltf_material(g, material);
     lx_test_primitive p = {.vertex_count = 4,
                            .position = pos,
                            .normal = nrm,
@@ -370,7 +365,18 @@ void lx_test_write_quad_gltf(const char *path, const lx_test_quad *q, const char
                            .index_count = 6,
                            .indices = idx,
                            .material = mat};
-    lx_test_gltf_node(g, "quad", lx_test_gltf_mesh(g, "quad", &p, 1), "");
+    return lx_test_gltf_mesh(g, name, &p, 1);
+}
+
+void lx_test_write_quad_gltf(const char *path, const lx_test_quad *q, const char *material,
+                             const char *const *uris, int texture_count, const float *tangent)
+{
+    lx_test_gltf *g = lx_test_gltf_new();
+    for (int i = 0; i < texture_count; i++)
+        lx_test_gltf_texture(g, uris[i]);
+    lx_test_gltf_use_extension(g, "KHR_texture_transform");
+    int mat = lx_test_gltf_material(g, material);
+    lx_test_gltf_node(g, "quad", lx_test_gltf_quad_mesh(g, "quad", q, mat, tangent), "");
     lx_test_gltf_write(g, path);
     lx_test_gltf_free(g);
 }

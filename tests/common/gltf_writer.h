@@ -78,6 +78,12 @@ void lx_test_gltf_write(const lx_test_gltf *g, const char *path);
 void lx_test_gltf_write_glb(const lx_test_gltf *g, const char *path);
 
 struct lx_test_quad;
+/* Mesh `name` (returned) of quad q (texture_oracle.h): POSITION, NORMAL,
+ * TEXCOORD_0 and _1 from q, TANGENT when tangent (4 floats for each of
+ * the 4 corners) is not NULL, material mat. */
+int lx_test_gltf_quad_mesh(lx_test_gltf *g, const char *name, const struct lx_test_quad *q,
+                           int mat, const float *tangent);
+
 /* A .gltf of quad q (texture_oracle.h) as one node "quad" with mesh
  * "quad": POSITION, NORMAL, TEXCOORD_0 and _1 from q, TANGENT when tangent
  * (4 floats for each of the 4 corners) is not NULL, one material given as

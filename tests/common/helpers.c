@@ -351,3 +351,35 @@ lx_scene *lx_test_load_logged(const char *path, const lx_scene_load_desc *desc,
         fail_msg("lx_scene_load(%s): %s", path, lx_last_error());
     return s;
 }
+
+lx_scene *lx_test_load(const char *path)
+{
+    lx_scene *scene = NULL;
+    if (lx_scene_load(path, NULL, &scene) != LX_OK)
+        fail_msg("%s: %s", path, lx_last_error());
+    return scene;
+}
+
+lx_image lx_test_bake_applied(const lx_scene *scene, const lx_bake_desc *desc,
+                              uint32_t used_texels)
+{
+    lx_baker *baker;
+    if (lx_baker_create(scene, desc, &baker) != LX_OK)
+        fail_msg("lx_baker_create: %s", lx_last_error());
+    assert_int_equal(lx_baker_lightmap_count(baker), 1);
+    assert_int_equal(lx_baker_lightmap_info(baker, 0)->used_texels, used_texels);
+    assert_int_equal(lx_baker_bake(baker), LX_OK);
+    lx_image img;
+    assert_int_equal(lx_baker_apply_alloc(baker, 0, &img), LX_OK);
+    lx_baker_destroy(baker);
+    return img;
+}
+
+uint32_t lx_test_node_named(const lx_scene *scene, const char *name)
+{
+    for (uint32_t i = 0; i < scene->node_count; i++)
+        if (strcmp(scene->nodes[i].name, name) == 0)
+            return i;
+    fail_msg("no node named '%s'", name);
+    return 0;
+}

@@ -85,6 +85,18 @@ typedef struct lx_test_logbook {
     int warnings;
     char text[8192];
 } lx_test_logbook;
+/* The index of scene node `name`; fails the test when there is none. */
+uint32_t lx_test_node_named(const lx_scene *scene, const char *name);
+
+/* lx_scene_load(path) with the default desc; fails the test when the
+ * load fails. */
+lx_scene *lx_test_load(const char *path);
+
+/* Bakes scene (desc) and applies its one lightmap into a new image,
+ * asserting that the lightmap covers used_texels texels. */
+lx_image lx_test_bake_applied(const lx_scene *scene, const lx_bake_desc *desc,
+                              uint32_t used_texels);
+
 /* lx_scene_load(path, desc) with its warnings kept in *book (cleared
  * first); fails the test when the load fails. */
 lx_scene *lx_test_load_logged(const char *path, const lx_scene_load_desc *desc,

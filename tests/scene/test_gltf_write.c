@@ -109,15 +109,6 @@ static void unwrap_and_write(const char *in_path, const char *out_path, lx_scene
     free(uvs);
 }
 
-static uint32_t node_named(const lx_scene *s, const char *name)
-{
-    for (uint32_t i = 0; i < s->node_count; i++)
-        if (strcmp(s->nodes[i].name, name) == 0)
-            return i;
-    fail_msg("no node '%s'", name);
-    return 0;
-}
-
 static void assert_close3(lx_vec3 a, lx_vec3 b)
 {
     /* world positions go through the same float matrix products */
@@ -144,7 +135,7 @@ static uint32_t check_round_trip(const lx_scene *s, const lx_unwrap *u, const ch
     for (uint32_t k = 0; k < u->mesh_count; k++) {
         const lx_unwrap_mesh *um = &u->meshes[k];
         const lx_node *n = &s->nodes[um->node];
-        const lx_node *rn = &r->nodes[node_named(r, n->name)];
+        const lx_node *rn = &r->nodes[lx_test_node_named(r, n->name)];
         uint32_t slot = 0;
         while (slot < n->mesh_count && n->meshes[slot] != um->mesh)
             slot++;

@@ -321,11 +321,7 @@ static uint32_t vertex_at(const lx_mesh *m, float x, float y, float z)
 
 static const lx_node *node_named(const lx_scene *s, const char *name)
 {
-    for (uint32_t i = 0; i < s->node_count; i++)
-        if (strcmp(s->nodes[i].name, name) == 0)
-            return &s->nodes[i];
-    fail_msg("no node named '%s'", name);
-    return NULL;
+    return &s->nodes[lx_test_node_named(s, name)];
 }
 
 static const lx_light *light_named(const lx_scene *s, const char *name)

@@ -63,11 +63,7 @@ static void write_text(const char *path, const char *text)
 
 static const lx_node *node_named(const lx_scene *s, const char *name)
 {
-    for (uint32_t i = 0; i < s->node_count; i++)
-        if (strcmp(s->nodes[i].name, name) == 0)
-            return &s->nodes[i];
-    fail_msg("no node '%s'", name);
-    return NULL;
+    return &s->nodes[lx_test_node_named(s, name)];
 }
 
 /* ---- zero-area triangles ----------------------------------------------------- */

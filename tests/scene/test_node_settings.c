@@ -54,11 +54,7 @@ static int box_mesh(lx_test_gltf *g, const char *name, lx_vec3 lo, lx_vec3 hi, b
 
 static const lx_node *node_named(const lx_scene *s, const char *name)
 {
-    for (uint32_t n = 0; n < s->node_count; n++)
-        if (strcmp(s->nodes[n].name, name) == 0)
-            return &s->nodes[n];
-    fail_msg("no node '%s'", name);
-    return NULL;
+    return &s->nodes[lx_test_node_named(s, name)];
 }
 
 static bool bake_default(const lx_node_bake *b)

@@ -59,9 +59,6 @@ static const lx_test_quad QUAD = {
 static void write_quad_ex(const char *path, const char *material, const char *const *uris, int n,
                           bool required)
 {
-    float pos[12], nrm[12], uv0[8], uv1[8];
-    uint32_t idx[6];
-    lx_test_quad_arrays(&QUAD, pos, nrm, uv0, uv1, idx);
     lx_test_gltf *g = lx_test_gltf_new();
     for (int i = 0; i < n; i++)
         lx_test_gltf_texture(g, uris[i]);
@@ -70,15 +67,7 @@ static void write_quad_ex(const char *path, const char *material, const char *co
     else
         lx_test_gltf_use_extension(g, EXT);
     int mat = lx_test_gltf_material(g, material);
-    lx_test_primitive p = {.vertex_count = 4,
-                           .position = pos,
-                           .normal = nrm,
-                           .uv0 = uv0,
-                           .uv1 = uv1,
-                           .index_count = 6,
-                           .indices = idx,
-                           .material = mat};
-    lx_test_gltf_node(g, "quad", lx_test_gltf_mesh(g, "quad", &p, 1), "");
+    lx_test_gltf_node(g, "quad", lx_test_gltf_quad_mesh(g, "quad", &QUAD, mat, NULL), "");
     lx_test_gltf_write(g, path);
     lx_test_gltf_free(g);
 }
@@ -86,14 +75,6 @@ static void write_quad_ex(const char *path, const char *material, const char *co
 static void write_quad(const char *path, const char *material, const char *const *uris, int n)
 {
     write_quad_ex(path, material, uris, n, false);
-}
-
-static lx_scene *load(const char *path)
-{
-    lx_scene *scene = NULL;
-    if (lx_scene_load(path, NULL, &scene) != LX_OK)
-        fail_msg("%s: %s", path, lx_last_error());
-    return scene;
 }
 
 /* The quad's material (the mesh's, not assimp's default one). */
@@ -114,15 +95,7 @@ static lx_image bake_radiance(lx_scene *scene)
     sun.shadow = LX_SHADOW_NONE;
     assert_int_equal(lx_scene_add_light(scene, &sun), LX_OK);
     lx_bake_desc desc = {.resolution = RES, .quantity = LX_QUANTITY_RADIANCE, .threads = 2};
-    lx_baker *baker;
-    if (lx_baker_create(scene, &desc, &baker) != LX_OK)
-        fail_msg("lx_baker_create: %s", lx_last_error());
-    assert_int_equal(lx_baker_lightmap_info(baker, 0)->used_texels, RES * RES);
-    assert_int_equal(lx_baker_bake(baker), LX_OK);
-    lx_image img;
-    assert_int_equal(lx_baker_apply_alloc(baker, 0, &img), LX_OK);
-    lx_baker_destroy(baker);
-    return img;
+    return lx_test_bake_applied(scene, &desc, RES * RES);
 }
 
 /* Every texel of img within tol (relative) of E rho / pi for constant rho. */
@@ -148,7 +121,7 @@ static void factor_only(void **state)
                "{\"name\":\"sg\",\"extensions\":{\"" EXT "\":{\"diffuseFactor\":[0.2,0.5,0.8,1],"
                "\"specularFactor\":[0,0,0],\"glossinessFactor\":0.2}}}",
                NULL, 0);
-    lx_scene *s = load(path);
+    lx_scene *s = lx_test_load(path);
     const lx_material *m = quad_material(s);
     assert_string_equal(m->name, "sg");
     assert_true(m->base_color.x == 0.2f && m->base_color.y == 0.5f && m->base_color.z == 0.8f);
@@ -165,7 +138,7 @@ static void factor_only(void **state)
     write_quad_ex(
         path, "{\"name\":\"sg\",\"extensions\":{\"" EXT "\":{\"diffuseFactor\":[0.2,0.5,0.8,1]}}}",
         NULL, 0, true);
-    s = load(path);
+    s = lx_test_load(path);
     m = quad_material(s);
     assert_true(m->base_color.x == 0.2f && m->base_color.y == 0.5f && m->base_color.z == 0.8f);
     lx_scene_destroy(s);
@@ -201,7 +174,7 @@ static void fallback_ignored(void **state)
                "\"baseColorTexture\":{\"index\":0},\"metallicFactor\":0},"
                "\"extensions\":{\"" EXT "\":{\"diffuseFactor\":[0.2,0.5,0.8,1]}}}",
                &uri, 1);
-    lx_scene *s = load(path);
+    lx_scene *s = lx_test_load(path);
     const lx_material *m = quad_material(s);
     assert_true(m->base_color.x == 0.2f && m->base_color.y == 0.5f && m->base_color.z == 0.8f);
     assert_int_equal(m->base_color_map.width, 0);
@@ -218,7 +191,7 @@ static void fallback_ignored(void **state)
                "{\"name\":\"sg\",\"pbrMetallicRoughness\":{\"baseColorFactor\":[0.9,0.1,0.1,1]},"
                "\"extensions\":{\"" EXT "\":{\"glossinessFactor\":0.5}}}",
                NULL, 0);
-    s = load(path);
+    s = lx_test_load(path);
     m = quad_material(s);
     assert_true(m->base_color.x == 1.0f && m->base_color.y == 1.0f && m->base_color.z == 1.0f);
     lx_scene_destroy(s);
@@ -241,7 +214,7 @@ static void diffuse_texture(void **state)
                "\"extensions\":{\"" EXT "\":{\"diffuseFactor\":[0.5,1,0.25,1],"
                "\"diffuseTexture\":{\"index\":1,\"texCoord\":1}}}}",
                uris, 2);
-    lx_scene *s = load(path);
+    lx_scene *s = lx_test_load(path);
     const lx_material *m = quad_material(s);
     assert_true(m->base_color.x == 0.5f && m->base_color.y == 1.0f && m->base_color.z == 0.25f);
     assert_int_equal(m->base_color_uv_set, 1);
@@ -280,7 +253,7 @@ static void metal_rough_unchanged(void **state)
                "{\"name\":\"mr\",\"pbrMetallicRoughness\":{\"baseColorFactor\":[0.25,0.5,0.75,1],"
                "\"metallicFactor\":0}}",
                NULL, 0);
-    lx_scene *s = load(path);
+    lx_scene *s = lx_test_load(path);
     const lx_material *m = quad_material(s);
     assert_true(m->base_color.x == 0.25f && m->base_color.y == 0.5f && m->base_color.z == 0.75f);
     lx_scene_destroy(s);

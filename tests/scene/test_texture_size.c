@@ -64,9 +64,6 @@ static lx_scene *quads(const char *name, double side, double uv_side, const doub
                       .e1 = {side, 0, 0},
                       .e2 = {0, 0, -side},
                       .uv = {{{0, 0}, {uv_side, 0}, {0, uv_side}}, {{0, 0}, {1, 0}, {0, 1}}}};
-    float pos[12], nrm[12], uv0[8], uv1[8];
-    uint32_t idx[6];
-    lx_test_quad_arrays(&q, pos, nrm, uv0, uv1, idx);
     lx_test_gltf *g = lx_test_gltf_new();
     lx_test_gltf_texture(g, "color.png");
     lx_test_gltf_texture(g, "normal.png");
@@ -81,15 +78,7 @@ static lx_scene *quads(const char *name, double side, double uv_side, const doub
              "\"normalTexture\":{\"index\":1%s}}",
              ext, ext);
     int mat = lx_test_gltf_material(g, material);
-    lx_test_primitive p = {.vertex_count = 4,
-                           .position = pos,
-                           .normal = nrm,
-                           .uv0 = uv0,
-                           .uv1 = uv1,
-                           .index_count = 6,
-                           .indices = idx,
-                           .material = mat};
-    int mesh = lx_test_gltf_mesh(g, "quad", &p, 1);
+    int mesh = lx_test_gltf_quad_mesh(g, "quad", &q, mat, NULL);
     for (int n = 0; n < nodes; n++) {
         char node[32], members[200];
         snprintf(node, sizeof node, "quad%d", n);

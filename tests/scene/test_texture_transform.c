@@ -68,14 +68,6 @@ static const xform CASES[] = {
 };
 #define CASE_COUNT ((int)(sizeof CASES / sizeof CASES[0]))
 
-static lx_scene *load(const char *path)
-{
-    lx_scene *scene = NULL;
-    if (lx_scene_load(path, NULL, &scene) != LX_OK)
-        fail_msg("%s: %s", path, lx_last_error());
-    return scene;
-}
-
 /* The material JSON for a texture slot with transform x. */
 static void texture_info(char *out, size_t size, const char *slot, const xform *x,
                          const char *extra)
@@ -105,15 +97,7 @@ static lx_light sun(const double dir[3], double d[3])
 static lx_image bake(const lx_scene *scene, lx_quantity quantity)
 {
     lx_bake_desc desc = {.resolution = RES, .quantity = quantity, .threads = 2};
-    lx_baker *baker;
-    if (lx_baker_create(scene, &desc, &baker) != LX_OK)
-        fail_msg("lx_baker_create: %s", lx_last_error());
-    assert_int_equal(lx_baker_lightmap_info(baker, 0)->used_texels, RES * RES);
-    assert_int_equal(lx_baker_bake(baker), LX_OK);
-    lx_image img;
-    assert_int_equal(lx_baker_apply_alloc(baker, 0, &img), LX_OK);
-    lx_baker_destroy(baker);
-    return img;
+    return lx_test_bake_applied(scene, &desc, RES * RES);
 }
 
 /* Where texel (x, y) reads a texture under x: its UV set, transformed. */
@@ -146,7 +130,7 @@ static void import_fields(void **state)
         "\"normalTexture\":{\"index\":0,\"scale\":0.5,\"extensions\":{\"KHR_texture_"
         "transform\":{\"offset\":[0.5,0]}}}}",
         &uri, 1, NULL);
-    lx_scene *s = load(path);
+    lx_scene *s = lx_test_load(path);
     const lx_material *m = &s->materials[0];
     assert_string_equal(m->name, "m");
     assert_true(m->base_color_transform.enabled);
@@ -171,7 +155,7 @@ static void import_fields(void **state)
                             "{\"name\":\"plain\",\"pbrMetallicRoughness\":{\"baseColorTexture\":"
                             "{\"index\":0,\"texCoord\":1}}}",
                             &uri, 1, NULL);
-    s = load(path);
+    s = lx_test_load(path);
     assert_false(s->materials[0].base_color_transform.enabled);
     assert_int_equal(s->materials[0].base_color_uv_set, 1);
     lx_scene_destroy(s);
@@ -239,7 +223,7 @@ static void import_bad_fields(void **state)
                             &uri, 1, NULL);
     warned_uv_set = 0;
     lx_set_log_callback(on_log, NULL);
-    lx_scene *s = load(path);
+    lx_scene *s = lx_test_load(path);
     lx_set_log_callback(NULL, NULL);
     assert_int_equal(warned_uv_set, 1);
     assert_int_equal(s->materials[0].base_color_map.width, 0);
@@ -307,7 +291,7 @@ static void base_color_transforms(void **state)
         snprintf(mat, sizeof mat, "{\"name\":\"m\",\"pbrMetallicRoughness\":{%s}}", info);
         snprintf(path, sizeof path, "%s/case%d.gltf", dir, c);
         lx_test_write_quad_gltf(path, &QUAD, mat, &uri, 1, NULL);
-        lx_scene *scene = load(path);
+        lx_scene *scene = lx_test_load(path);
         assert_int_equal(lx_scene_add_light(scene, &s_), LX_OK);
         lx_image img = bake(scene, LX_QUANTITY_RADIANCE);
         double worst = 0;
@@ -388,7 +372,7 @@ static void normal_transforms(void **state)
         snprintf(mat, sizeof mat, "{\"name\":\"m\",%s}", info);
         snprintf(path, sizeof path, "%s/case%d.gltf", dir, c);
         lx_test_write_quad_gltf(path, &QUAD, mat, &uri, 1, NULL);
-        lx_scene *scene = load(path);
+        lx_scene *scene = lx_test_load(path);
         assert_int_equal(lx_scene_add_light(scene, &s_), LX_OK);
         lx_image img = bake(scene, LX_QUANTITY_IRRADIANCE);
         double n[3], t[3], b[3];
