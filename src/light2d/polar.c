@@ -123,6 +123,15 @@ static void square_bins(const l2_polar *pm, float ax, float bx, float ay, float 
     corner_bins(pm, p, b0, b1);
 }
 
+/* Rows of n floats in each of the sparse tables tmin and tmax: the
+ * levels, and at least the 8 open_gaps borrows tmax for as scratch (8
+ * ints a ray) before the tables are built; a small light has fewer
+ * levels (a radius-3 light overran tmax, found by fuzz_light2d_json). */
+static uint64_t table_rows(uint64_t levels)
+{
+    return levels > 8 ? levels : 8;
+}
+
 static lx_status reserve(l2_polar *pm, int n, int levels, int depth_levels)
 {
     size_t g = (size_t)n * depth_levels;
@@ -167,7 +176,7 @@ static lx_status reserve(l2_polar *pm, int n, int levels, int depth_levels)
             return lx_fail(LX_ERR_NOMEM, "light2d: out of memory for a polar map of %d rays", n);
         pm->capacity = n;
     }
-    size_t t = (size_t)n * levels;
+    size_t t = (size_t)n * (size_t)table_rows((uint64_t)levels);
     if (t > (size_t)pm->table_capacity) {
         float *a = realloc(pm->tmin, t * sizeof *a);
         if (a)
@@ -386,7 +395,8 @@ uint64_t l2_polar_bytes(const lx_light2d *ctx, const lx_light2d_light *l)
         levels++;
     uint64_t depth_levels =
         l->softness > 0.0f ? (uint64_t)l2_depth_level(l->radius + 2.0f, 1 << 10) + 1 : 0;
-    uint64_t floats = n * (4 + 2 + 3 + 1 + 2 * L2_HZ) + 1 + n * levels * 2 + n * depth_levels;
+    uint64_t floats =
+        n * (4 + 2 + 3 + 1 + 2 * L2_HZ) + 1 + n * table_rows(levels) * 2 + n * depth_levels;
     return floats * sizeof(float);
 }
 
@@ -584,7 +594,7 @@ lx_status l2_polar_build(const lx_light2d *ctx, l2_prep *p)
         for (int i = 0; i < n; i++)
             pm->qocc[i] = 1.0f / l2_max(occ[i], 0.5f);
         horizons(pm, l->softness);
-        /* scratch: the sparse table (levels x n >= 8 n floats) */
+        /* scratch: the sparse table (table_rows x n >= 8 n floats) */
         open_gaps(pm, (int32_t *)pm->tmax);
     }
     for (int rep = 0; rep < 3; rep++)

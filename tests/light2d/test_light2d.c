@@ -329,6 +329,33 @@ static void test_ring(void **state)
     lx_image_free(&img);
 }
 
+/* A soft light of radius 3 px (a few dozen rays, fewer than 8 levels of
+ * its tables: their scratch overran the table, seen under ASan) lights
+ * its disc and nothing past its radius. */
+static void test_small_soft_light(void **state)
+{
+    (void)state;
+    lx_image img;
+    assert_int_equal(lx_image_alloc(&img, 24, 24, 4), LX_OK);
+    img.data[(12 * 24 + 12) * 4 + 3] = 1.0f; /* one caster pixel beside it */
+    lx_light2d_light l = lx_light2d_light_defaults(LX_LIGHT2D_POINT);
+    l.x = 8.0f;
+    l.y = 12.0f;
+    l.radius = 3.0f;
+    l.softness = 41.0f;
+    float *lm = render_one(&img, &l, 1, NULL);
+    for (int y = 0; y < 24; y++)
+        for (int x = 0; x < 24; x++) {
+            float v = lm[3 * (y * 24 + x)];
+            assert_true(isfinite(v) && v >= 0.0f);
+            if (hypot(x + 0.5 - 8.0, y + 0.5 - 12.0) > 4.0)
+                assert_true(v == 0.0f);
+        }
+    assert_true(lm[3 * (12 * 24 + 8)] > 0.0f);
+    free(lm);
+    lx_image_free(&img);
+}
+
 static void test_mirror(void **state)
 {
     (void)state;
@@ -655,7 +682,8 @@ int main(void)
 {
     const struct CMUnitTest tests[] = {
         cmocka_unit_test(test_hard_shadows), cmocka_unit_test(test_falloffs),
-        cmocka_unit_test(test_ring),         cmocka_unit_test(test_mirror),
+        cmocka_unit_test(test_ring),         cmocka_unit_test(test_small_soft_light),
+        cmocka_unit_test(test_mirror),
         cmocka_unit_test(test_soft),         cmocka_unit_test(test_soft_against_disk),
         cmocka_unit_test(test_normals),
         cmocka_unit_test(test_threads_and_cache), cmocka_unit_test(test_json),
